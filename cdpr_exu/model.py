@@ -1,0 +1,197 @@
+"""Scene -> Exudyn system: builds the lumped-mass CDPR and returns a :class:`Model`.
+
+Coordinates: the scene speaks the paper's x-z plane; Exudyn's planar items live in
+its x-y plane. The builder maps paper (x, z) onto Exudyn (x, y) one to one, so
+Exudyn's y *is* the paper's height z, and rotations about Exudyn's z axis are the
+paper's platform rotation (positive counter-clockwise, eq. 17).
+
+Only the items of the effects the scene switches on are added (see
+:class:`~cdpr_exu.scene.Effects`); :meth:`Model.item_counts` says which are there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+
+from .cable import BendingItems, CableItems, add_bending, add_cable
+from .errors import UnreachableError
+from .kinematics import anchor_points, initial_cable_nodes, pulley_exit, straight_cable_nodes
+from .platform import PlatformItems, add_platform, attach_cable
+from .pulley import add_pulley_contact, add_pulley_ground
+from .scene import Scene
+from .winch import WinchItems, add_winch
+
+
+@dataclass
+class Model:
+    """An assembled Exudyn system of a scene, with the indices of its items.
+
+    Attributes
+    ----------
+    scene : Scene
+    system_container : exudyn.SystemContainer
+    mbs : exudyn.MainSystem
+    cables : list of CableItems
+    platform : PlatformItems
+    winches : list of WinchItems
+    bending : BendingItems or None
+    contacts : list of list of int
+        Contact objects of each cable with its pulley.
+    contact_nodes : list of ndarray of int
+        Cable-local indices of the nodes that carry a contact item.
+    initial_paid_out : ndarray, shape (m,) [m]
+        Paid-out length lambda_i(0) of the initial configuration.
+    """
+
+    scene: Scene
+    system_container: exu.SystemContainer
+    mbs: exu.MainSystem
+    cables: list[CableItems]
+    platform: PlatformItems
+    winches: list[WinchItems]
+    bending: BendingItems | None
+    contacts: list[list[int]] = field(default_factory=list)
+    contact_nodes: list[np.ndarray] = field(default_factory=list)
+    initial_paid_out: np.ndarray | None = None
+
+    def item_counts(self) -> dict[str, int]:
+        """How many Exudyn items each effect added."""
+        return {
+            "mass_points": sum(len(c.nodes) for c in self.cables),
+            "axial_spring_dampers": sum(len(c.springs) for c in self.cables),
+            "gravity_loads": sum(len(c.loads) for c in self.cables) + (self.platform.load is not None),
+            "bending_objects": int(self.bending is not None),
+            "bending_joints": 0 if self.bending is None else len(self.bending.joints),
+            "pulley_contacts": sum(len(c) for c in self.contacts),
+            "winch_constraints": 2 * len(self.winches),
+            "platform_joints": len(self.platform.joints),
+        }
+
+    def coordinate_indices(self) -> dict[str, np.ndarray]:
+        """Positions of the model's nodes in Exudyn's ODE2 coordinate vector.
+
+        Returns
+        -------
+        dict
+            ``"platform"``: shape (3,), (x, z, rotation); ``"cable_i"``: shape (n + 1, 2).
+        """
+        mbs = self.mbs
+        out = {"platform": mbs.GetNodeODE2Index(self.platform.node) + np.arange(3)}
+        for i, cable in enumerate(self.cables):
+            out[f"cable_{i}"] = np.array([mbs.GetNodeODE2Index(n) + np.arange(2) for n in cable.nodes])
+        return out
+
+
+def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
+    """Initial node positions (x, z) of a cable, winch end first, shape (n + 1, 2) [m].
+
+    Over a pulley: the paper's ideal configuration, straight from the anchor to the
+    pulley, wrapped over it and hanging to the winch, every element at its unstrained
+    length. With a point exit: straight from the pulley centre to the anchor.
+    """
+    cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
+    anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
+    if scene.cable_exit == "point":
+        return straight_cable_nodes(np.asarray(pulley.center), anchor, cable.n_elements)
+    return initial_cable_nodes(np.asarray(pulley.center), pulley.radius, pulley.side, anchor,
+                               cable.element_length, cable.n_elements)
+
+
+def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 2.0) -> np.ndarray:
+    """Cable-local indices of the nodes that can reach their pulley during the run.
+
+    A node at unstrained distance s = j l0i from the winch end lies on the pulley
+    when s is between the hanging length l0 - lambda(t) and that plus the wrapped arc.
+    This range is taken over the reference trajectory sampled at 200 times, widened
+    by ``margin_elements`` elements and 5 % of the cable for sag, stretch and the
+    difference between controllers.
+
+    Returns
+    -------
+    ndarray of int
+    """
+    cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
+    times = np.linspace(0.0, scene.solver.end_time, 200)
+    anchors = anchor_points(scene.trajectory.pose(times), np.asarray(scene.platform.anchors))[:, cable_index]
+    hang, arc_end = [], []
+    for anchor in anchors:
+        exit_ = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchor)
+        hanging = cable.unstrained_length - exit_.cable_length
+        hang.append(hanging)
+        arc_end.append(hanging + pulley.radius * exit_.wrap_angle)
+    margin = margin_elements * cable.element_length + 0.05 * cable.unstrained_length
+    s = np.arange(cable.n_elements + 1) * cable.element_length
+    reach = (s >= min(hang) - margin) & (s <= max(arc_end) + margin)
+    reach[0] = False  # the winch node's motion is prescribed
+    return np.flatnonzero(reach)
+
+
+def check_trajectory_reachable(scene: Scene) -> None:
+    """Refuse a reference the cables cannot follow before any simulation.
+
+    Raises UnreachableError when an anchor of the reference enters a pulley, or when
+    the ideal length exceeds the cable (nothing would be left between winch and pulley).
+    """
+    if scene.cable_exit == "point":
+        return
+    times = np.linspace(0.0, scene.solver.end_time, 400)
+    poses = scene.trajectory.pose(times)
+    anchors = anchor_points(poses, np.asarray(scene.platform.anchors))
+    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
+        for t, anchor in zip(times, anchors[:, i]):
+            exit_ = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchor)
+            if exit_.cable_length > cable.unstrained_length - cable.element_length:
+                raise UnreachableError(
+                    f"the reference pose {np.round(scene.trajectory.pose(t), 4).tolist()} at t = {t:.3f} s "
+                    f"needs {exit_.cable_length:.4f} m of cable {i} between pulley and anchor, but "
+                    f"cables[{i}].unstrained_length is {cable.unstrained_length} m (one element, "
+                    f"{cable.element_length:.4f} m, must stay on the winch side)"
+                )
+
+
+def build_model(scene: Scene) -> Model:
+    """Build and assemble the Exudyn system of ``scene``.
+
+    Raises
+    ------
+    UnreachableError
+        If the reference trajectory leaves the reachable workspace.
+    """
+    check_trajectory_reachable(scene)
+    system_container = exu.SystemContainer()
+    mbs = system_container.AddSystem()
+    ground_node = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
+    ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node, coordinate=0))
+
+    effects = scene.effects
+    platform = add_platform(mbs, scene.platform, effects, scene.gravity)
+    use_contact = effects.pulley_contact and scene.cable_exit == "pulley"
+    cables, winches, contacts, contact_nodes, paid_out = [], [], [], [], []
+    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
+        nodes_xz = initial_nodes(scene, i)
+        items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
+        attach_cable(mbs, platform, i, items.markers[-1])
+        winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1])))
+        if use_contact:
+            candidates = contact_candidates(scene, i)
+            pulley_marker = add_pulley_ground(mbs, pulley)
+            contacts.append(add_pulley_contact(mbs, pulley, pulley_marker,
+                                               [items.markers[j] for j in candidates], nodes_xz[candidates]))
+            contact_nodes.append(candidates)
+        else:
+            contacts.append([])
+            contact_nodes.append(np.zeros(0, dtype=int))
+        if scene.cable_exit == "point":
+            paid_out.append(float(np.linalg.norm(nodes_xz[-1] - nodes_xz[0])))
+        else:
+            paid_out.append(pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side,
+                                        nodes_xz[-1]).cable_length)
+        cables.append(items)
+    bending = add_bending(mbs, list(scene.cables), cables, effects)
+    mbs.Assemble()
+    return Model(scene, system_container, mbs, cables, platform, winches, bending,
+                 contacts, contact_nodes, np.asarray(paid_out))

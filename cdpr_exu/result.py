@@ -1,0 +1,185 @@
+"""The result of a run: time series in the paper's x-z plane, and their files.
+
+A :class:`Result` is plain NumPy data (no Exudyn): the platform pose, every cable
+node's position, every element's tension, the winch lengths and the reference, at
+the output times. It saves to ``result.npz`` + ``pose.csv`` + ``summary.json`` and
+loads back from the ``.npz``.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import platform as _platform
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class Result:
+    """Time series of one run. Units SI; positions (x, z) in the paper's plane.
+
+    Attributes
+    ----------
+    scene_name : str
+    controller : str
+    time : ndarray, shape (N,) [s]
+    platform_pose : ndarray, shape (N, 3) [m, m, rad]
+        (x, z, rotation), rotation positive counter-clockwise.
+    platform_velocity : ndarray, shape (N, 3) [m/s, m/s, rad/s]
+    reference_pose : ndarray, shape (N, 3)
+    nodes : list of ndarray, each shape (N, n_i + 1, 2) [m]
+        Node positions of cable i, winch end first.
+    tensions : list of ndarray, each shape (N, n_i) [N]
+        Axial force of each element (tension positive).
+    paid_out : ndarray, shape (N, m) [m]
+        Commanded paid-out length of each winch.
+    pulley_penetration : ndarray, shape (N, m) [m]
+        Deepest node penetration into each cable's pulley (0 if none).
+    wall_time : float [s]
+    steps : int
+        Time steps completed.
+    newton_iterations : int
+    status : str
+        "completed" or "failed: <cause>".
+    failure_time : float or None [s]
+    metadata : dict
+    """
+
+    scene_name: str
+    controller: str
+    time: np.ndarray
+    platform_pose: np.ndarray
+    platform_velocity: np.ndarray
+    reference_pose: np.ndarray
+    nodes: list[np.ndarray]
+    tensions: list[np.ndarray]
+    paid_out: np.ndarray
+    pulley_penetration: np.ndarray
+    wall_time: float = 0.0
+    steps: int = 0
+    newton_iterations: int = 0
+    status: str = "completed"
+    failure_time: float | None = None
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    # ----------------------------------------------------------------- derived
+    @property
+    def error(self) -> np.ndarray:
+        """Pose error actual - reference, shape (N, 3) [m, m, rad]."""
+        return self.platform_pose - self.reference_pose
+
+    @property
+    def simulated_time(self) -> float:
+        return float(self.time[-1]) if len(self.time) else 0.0
+
+    def summary(self, after: float = 0.0) -> dict[str, Any]:
+        """Scalar figures of the run (errors measured from time ``after`` on) [SI, degrees]."""
+        mask = self.time >= after
+        err = self.error[mask]
+        position_error = np.linalg.norm(err[:, :2], axis=1) if len(err) else np.zeros(0)
+        taut = [t[mask] for t in self.tensions]
+        def _max(a):
+            return float(np.max(a)) if np.size(a) else float("nan")
+        def _min(a):
+            return float(np.min(a)) if np.size(a) else float("nan")
+        return {
+            "scene": self.scene_name,
+            "controller": self.controller,
+            "status": self.status,
+            "errors_measured_after_s": after,
+            "max_abs_error_x_m": _max(np.abs(err[:, 0])) if len(err) else float("nan"),
+            "max_abs_error_z_m": _max(np.abs(err[:, 1])) if len(err) else float("nan"),
+            "min_error_z_m": _min(err[:, 1]) if len(err) else float("nan"),
+            "max_error_z_m": _max(err[:, 1]) if len(err) else float("nan"),
+            "max_position_error_m": _max(position_error),
+            "rms_position_error_m": float(np.sqrt(np.mean(position_error**2))) if len(err) else float("nan"),
+            "max_abs_rotation_deg": _max(np.degrees(np.abs(self.platform_pose[mask, 2]))),
+            "min_element_tension_N": _min(np.concatenate([t.ravel() for t in taut])) if taut else float("nan"),
+            "max_element_tension_N": _max(np.concatenate([t.ravel() for t in taut])) if taut else float("nan"),
+            "max_pulley_penetration_m": _max(self.pulley_penetration),
+            "wall_time_s": self.wall_time,
+            "simulated_time_s": self.simulated_time,
+            "real_time_factor": self.simulated_time / self.wall_time if self.wall_time > 0 else float("nan"),
+            "steps": int(self.steps),
+            "newton_iterations": int(self.newton_iterations),
+            "failure_time_s": self.failure_time,
+        }
+
+    # ----------------------------------------------------------------- files
+    def save(self, folder: str | Path, summary_after: float = 0.0) -> dict[str, Path]:
+        """Write ``result.npz``, ``pose.csv`` and ``summary.json`` into ``folder``.
+
+        Returns the paths written, by kind.
+        """
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        arrays = {
+            "time": self.time, "platform_pose": self.platform_pose,
+            "platform_velocity": self.platform_velocity, "reference_pose": self.reference_pose,
+            "paid_out": self.paid_out, "pulley_penetration": self.pulley_penetration,
+        }
+        for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
+            arrays[f"nodes_{i}"] = nodes
+            arrays[f"tensions_{i}"] = tensions
+        info = {
+            "scene_name": self.scene_name, "controller": self.controller, "wall_time": self.wall_time,
+            "steps": self.steps, "newton_iterations": self.newton_iterations, "status": self.status,
+            "failure_time": self.failure_time, "metadata": self.metadata,
+        }
+        np.savez_compressed(folder / "result.npz", info=json.dumps(info, default=str), **arrays)
+        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
+        table = np.column_stack([self.time, self.platform_pose, self.reference_pose])
+        np.savetxt(folder / "pose.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+        summary = {**self.summary(after=summary_after), **provenance()}
+        summary.update({k: v for k, v in self.metadata.items() if k not in summary})
+        (folder / "summary.json").write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
+        return {"npz": folder / "result.npz", "csv": folder / "pose.csv", "summary": folder / "summary.json"}
+
+    @classmethod
+    def load(cls, path: str | Path) -> "Result":
+        """Read a ``result.npz`` written by :meth:`save` (a folder is accepted too)."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / "result.npz"
+        with np.load(path, allow_pickle=False) as data:
+            info = json.loads(str(data["info"]))
+            m = sum(1 for k in data.files if k.startswith("nodes_"))
+            return cls(
+                scene_name=info["scene_name"], controller=info["controller"], time=data["time"],
+                platform_pose=data["platform_pose"], platform_velocity=data["platform_velocity"],
+                reference_pose=data["reference_pose"],
+                nodes=[data[f"nodes_{i}"] for i in range(m)],
+                tensions=[data[f"tensions_{i}"] for i in range(m)],
+                paid_out=data["paid_out"], pulley_penetration=data["pulley_penetration"],
+                wall_time=info["wall_time"], steps=info["steps"],
+                newton_iterations=info["newton_iterations"], status=info["status"],
+                failure_time=info["failure_time"], metadata=info.get("metadata", {}),
+            )
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    return str(value)
+
+
+def provenance() -> dict[str, Any]:
+    """Package versions, Python and the date, for every file a run writes."""
+    versions = {}
+    for package in ("cdpr-exu", "exudyn", "numpy", "scipy", "numba"):
+        try:
+            versions[package] = metadata.version(package)
+        except metadata.PackageNotFoundError:
+            versions[package] = None
+    return {
+        "versions": versions,
+        "python": _platform.python_version(),
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    }

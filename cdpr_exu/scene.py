@@ -1,0 +1,638 @@
+"""Scenes: the frozen, validated description of one CDPR simulation.
+
+A :class:`Scene` is a tree of frozen dataclasses (cables, pulleys, platform, winch,
+effects, solver settings and the reference trajectory). It is validated when it is
+made: a bad field raises :class:`~cdpr_exu.errors.SceneError` naming the field and
+its value, before any simulation starts. Scenes load from and save to TOML.
+
+Units are SI throughout (m, kg, s, N, rad). Planar scenes live in the paper's
+vertical x-z plane with gravity along -z; positions are given as ``(x, z)`` pairs.
+Only the Exudyn builder maps them onto Exudyn's x-y plane (paper z -> Exudyn y).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field, fields, replace
+from importlib import resources
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from .errors import SceneError
+from .trajectories import Trajectory, trajectory_from_dict
+
+# --------------------------------------------------------------------------- checks
+
+
+def _finite(path: str, value: Any) -> float:
+    """Return ``value`` as a float, or raise SceneError naming ``path``."""
+    if isinstance(value, bool):
+        raise SceneError(f"{path} must be a number, got {value!r}")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise SceneError(f"{path} must be a number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise SceneError(f"{path} must be finite, got {value!r}")
+    return number
+
+
+def _positive(path: str, value: Any) -> float:
+    number = _finite(path, value)
+    if number <= 0.0:
+        raise SceneError(f"{path} must be positive, got {value!r}")
+    return number
+
+
+def _non_negative(path: str, value: Any) -> float:
+    number = _finite(path, value)
+    if number < 0.0:
+        raise SceneError(f"{path} must be zero or positive, got {value!r}")
+    return number
+
+
+def _vector(path: str, value: Any, length: int) -> tuple[float, ...]:
+    """Return ``value`` as a tuple of ``length`` finite floats."""
+    try:
+        items = list(value)
+    except TypeError:
+        raise SceneError(f"{path} must be a list of {length} numbers, got {value!r}") from None
+    if len(items) != length:
+        raise SceneError(f"{path} must have {length} entries, got {len(items)}: {value!r}")
+    return tuple(_finite(f"{path}[{i}]", v) for i, v in enumerate(items))
+
+
+def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
+    if value not in choices:
+        raise SceneError(f"{path} must be one of {', '.join(map(repr, choices))}, got {value!r}")
+    return value
+
+
+def _set(obj: Any, name: str, value: Any) -> None:
+    """Normalise a field of a frozen dataclass inside ``__post_init__``."""
+    object.__setattr__(obj, name, value)
+
+
+# --------------------------------------------------------------------------- parts
+
+
+@dataclass(frozen=True)
+class CableSpec:
+    """One cable, discretised into ``n_elements`` lumped-mass elements (paper sec. 2.1).
+
+    Parameters
+    ----------
+    unstrained_length : float [m]
+        Total unstrained length l0 of the cable, winch end to platform anchor.
+    radius : float [m]
+        Cable radius r; the cross-section is A0 = pi r^2, J = pi r^4 / 4.
+    linear_density : float [kg/m]
+        Mass per unstrained length rho0.
+    youngs_modulus : float [Pa]
+        Modulus of elasticity E.
+    damping_constant : float [N s/m^2]
+        Normal damping material constant dn (Kelvin-Voigt).
+    n_elements : int
+        Number of elements n (at least 2), each of unstrained length l0 / n.
+    mass_lumping : {"consistent", "paper"}
+        "consistent": each node carries half the mass of each element it touches;
+        "paper": each element's whole mass sits at its far (platform-side) node.
+    """
+
+    unstrained_length: float = 3.75
+    radius: float = 0.005
+    linear_density: float = 0.35
+    youngs_modulus: float = 1.0e9
+    damping_constant: float = 1.0e9
+    n_elements: int = 15
+    mass_lumping: str = "consistent"
+
+    def __post_init__(self) -> None:
+        _set(self, "unstrained_length", _positive("cable.unstrained_length", self.unstrained_length))
+        _set(self, "radius", _positive("cable.radius", self.radius))
+        _set(self, "linear_density", _positive("cable.linear_density", self.linear_density))
+        _set(self, "youngs_modulus", _positive("cable.youngs_modulus", self.youngs_modulus))
+        _set(self, "damping_constant", _non_negative("cable.damping_constant", self.damping_constant))
+        if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
+            raise SceneError(f"cable.n_elements must be a whole number, got {self.n_elements!r}")
+        if self.n_elements < 2:
+            raise SceneError(f"cable.n_elements must be at least 2, got {self.n_elements!r}")
+        _set(self, "n_elements", int(self.n_elements))
+        _choice("cable.mass_lumping", self.mass_lumping, ("consistent", "paper"))
+
+    # Derived quantities of the paper's Table 2 -------------------------------------
+    @property
+    def area(self) -> float:
+        """Unstrained cross-section A0 = pi r^2 [m^2]."""
+        return math.pi * self.radius**2
+
+    @property
+    def second_moment(self) -> float:
+        """Second moment of area J = pi r^4 / 4 [m^4]."""
+        return math.pi * self.radius**4 / 4.0
+
+    @property
+    def element_length(self) -> float:
+        """Unstrained element length l0i = l0 / n [m]."""
+        return self.unstrained_length / self.n_elements
+
+    @property
+    def element_mass(self) -> float:
+        """Element mass m_i = rho0 l0 / n [kg]."""
+        return self.linear_density * self.element_length
+
+    @property
+    def mass(self) -> float:
+        """Total cable mass rho0 l0 [kg]."""
+        return self.linear_density * self.unstrained_length
+
+    @property
+    def axial_rigidity(self) -> float:
+        """EA0 [N]."""
+        return self.youngs_modulus * self.area
+
+    @property
+    def axial_stiffness(self) -> float:
+        """Element axial stiffness k_i = E A0 / l0i [N/m]."""
+        return self.youngs_modulus * self.area / self.element_length
+
+    @property
+    def axial_damping(self) -> float:
+        """Element axial damping c_i = dn A0 / l0i [N s/m]."""
+        return self.damping_constant * self.area / self.element_length
+
+    @property
+    def bending_stiffness(self) -> float:
+        """Joint bending stiffness k_theta = E J / l0i [N m/rad]."""
+        return self.youngs_modulus * self.second_moment / self.element_length
+
+    @property
+    def bending_damping(self) -> float:
+        """Joint bending damping c_theta = dn J / l0i [N m s/rad]."""
+        return self.damping_constant * self.second_moment / self.element_length
+
+    def node_masses(self) -> np.ndarray:
+        """Masses of the n + 1 nodes, winch end first, shape (n + 1,) [kg].
+
+        The consistent lumping puts m_i / 2 on both ends of each element. The paper's
+        lumping puts m_i on the far node of each element; the winch node, whose motion
+        is prescribed, then gets m_i / 2 so that it is not massless (its mass never
+        enters the platform's dynamics).
+        """
+        n, m = self.n_elements, self.element_mass
+        masses = np.full(n + 1, m)
+        if self.mass_lumping == "consistent":
+            masses[0] = masses[-1] = m / 2.0
+        else:
+            masses[0] = m / 2.0
+        return masses
+
+
+@dataclass(frozen=True)
+class PulleySpec:
+    """A pulley the cable runs over, and on which side the cable hangs to its winch.
+
+    The cable comes up from the winch along the vertical line x = x_c + side * radius,
+    wraps over the top of the pulley and leaves it tangentially towards the anchor.
+
+    Parameters
+    ----------
+    center : (x, z) [m]
+    radius : float [m]
+        Rim radius r_p. Must be positive when the cable runs over the pulley.
+    side : {-1, +1}
+        -1: the cable hangs on the pulley's left (x < x_c), +1: on its right.
+    contact_stiffness : float [N/m]
+        Penalty stiffness k_p of the rim contact.
+    contact_damping : float [N s/m]
+        Damping c_p on the normal velocity of a node in contact.
+    """
+
+    center: tuple[float, float] = (0.0, 0.0)
+    radius: float = 0.25
+    side: int = -1
+    contact_stiffness: float = 1.0e7
+    contact_damping: float = 10.0
+
+    def __post_init__(self) -> None:
+        _set(self, "center", _vector("pulley.center", self.center, 2))
+        _set(self, "radius", _positive("pulley.radius", self.radius))
+        if self.side not in (-1, 1) or isinstance(self.side, bool):
+            raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {self.side!r}")
+        _set(self, "side", int(self.side))
+        _set(self, "contact_stiffness", _positive("pulley.contact_stiffness", self.contact_stiffness))
+        _set(self, "contact_damping", _non_negative("pulley.contact_damping", self.contact_damping))
+
+
+@dataclass(frozen=True)
+class PlatformSpec:
+    """The rigid planar platform (paper sec. 2.3).
+
+    Parameters
+    ----------
+    mass : float [kg]
+    inertia : float [kg m^2]
+        Moment of inertia J_MP about the centre of mass, out of the plane.
+    anchors : sequence of (x, z) [m]
+        Cable anchor points b_i in the platform frame, one per cable, shape (m, 2).
+        All zero for a point-mass platform.
+    initial_pose : (x, z, rotation) [m, m, rad]
+        Pose at t = 0; rotation positive counter-clockwise (paper eq. 17).
+    size : (width, height) [m]
+        Rectangle drawn in figures and animations (no effect on the dynamics).
+    """
+
+    mass: float = 2.5
+    inertia: float = 0.0271
+    anchors: tuple[tuple[float, float], ...] = ((-0.15, 0.1), (0.15, 0.1))
+    initial_pose: tuple[float, float, float] = (0.0, -2.0, 0.0)
+    size: tuple[float, float] = (0.3, 0.2)
+
+    def __post_init__(self) -> None:
+        _set(self, "mass", _positive("platform.mass", self.mass))
+        _set(self, "inertia", _positive("platform.inertia", self.inertia))
+        anchors = np.asarray(self.anchors, dtype=object)
+        if anchors.ndim != 2 or anchors.shape[1] != 2 or anchors.shape[0] < 1:
+            raise SceneError(
+                f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), got {self.anchors!r}"
+            )
+        _set(self, "anchors", tuple(_vector(f"platform.anchors[{i}]", a, 2) for i, a in enumerate(self.anchors)))
+        _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3))
+        size = _vector("platform.size", self.size, 2)
+        for i, s in enumerate(size):
+            _non_negative(f"platform.size[{i}]", s)
+        _set(self, "size", size)
+
+    @property
+    def is_point_mass(self) -> bool:
+        """True when every anchor sits at the centre of mass."""
+        return bool(np.allclose(self.anchors, 0.0))
+
+
+@dataclass(frozen=True)
+class WinchSpec:
+    """How the winch end (node 0) of each cable is driven.
+
+    Parameters
+    ----------
+    kind : {"kinematic", "fixed"}
+        "kinematic": node 0 follows the commanded cable length exactly, moving along
+        the vertical line below the pulley (the paper's flow source along -z).
+        "fixed": node 0 is held where it starts (static scenes).
+    """
+
+    kind: str = "kinematic"
+
+    def __post_init__(self) -> None:
+        _choice("winch.kind", self.kind, ("kinematic", "fixed"))
+
+
+#: The model ladder: which effects each preset switches on.
+PRESETS: dict[str, dict[str, bool]] = {
+    "full": dict(
+        cable_mass=True, axial_elasticity=True, axial_damping=True, bending=True,
+        bending_damping=True, pulley_contact=True, slack=False, gravity=True,
+    ),
+    "catenary": dict(
+        cable_mass=True, axial_elasticity=True, axial_damping=True, bending=False,
+        bending_damping=False, pulley_contact=True, slack=False, gravity=True,
+    ),
+}
+
+
+@dataclass(frozen=True)
+class Effects:
+    """The physical effects a scene simulates; the builder adds items only for these.
+
+    Parameters
+    ----------
+    preset : str
+        Name of the preset the flags started from (see :data:`PRESETS`), for reports.
+    cable_mass, axial_elasticity, axial_damping, bending, bending_damping,
+    pulley_contact, slack, gravity : bool
+        Switches of the individual effects. ``slack`` makes the elements tension-only.
+    bending_model : {"exact"}
+        Formulation of the bending spring: "exact" is the paper's relative joint angle.
+    """
+
+    preset: str = "full"
+    cable_mass: bool = True
+    axial_elasticity: bool = True
+    axial_damping: bool = True
+    bending: bool = True
+    bending_damping: bool = True
+    pulley_contact: bool = True
+    slack: bool = False
+    gravity: bool = True
+    bending_model: str = "exact"
+
+    def __post_init__(self) -> None:
+        _choice("effects.preset", self.preset, tuple(PRESETS))
+        for f in fields(self):
+            if f.type in ("bool", bool) and not isinstance(getattr(self, f.name), bool):
+                raise SceneError(f"effects.{f.name} must be true or false, got {getattr(self, f.name)!r}")
+        _choice("effects.bending_model", self.bending_model, ("exact",))
+        if not self.cable_mass:
+            raise SceneError("effects.cable_mass = false (massless cables) is not available in this model yet")
+        if not self.axial_elasticity:
+            raise SceneError("effects.axial_elasticity = false (inextensible cables) is not available yet")
+        if self.slack:
+            raise SceneError("effects.slack = true (tension-only elements) is not available yet")
+        if self.bending_damping and not self.bending:
+            raise SceneError("effects.bending_damping needs effects.bending = true")
+
+    @classmethod
+    def from_preset(cls, preset: str = "full", **overrides: Any) -> "Effects":
+        """Effects of a named preset, with single effects overridden."""
+        _choice("effects.preset", preset, tuple(PRESETS))
+        unknown = set(overrides) - {f.name for f in fields(cls)}
+        if unknown:
+            raise SceneError(f"effects has no field(s) {sorted(unknown)}")
+        return cls(preset=preset, **{**PRESETS[preset], **overrides})
+
+
+@dataclass(frozen=True)
+class SolverSpec:
+    """Settings of Exudyn's implicit generalized-alpha integration.
+
+    Parameters
+    ----------
+    end_time : float [s]
+    step_size : float [s]
+    spectral_radius : float
+        Spectral radius at infinity rho_inf of generalized-alpha, in [0, 1]; below 1
+        damps the stiff axial modes numerically.
+    newton : {"modified", "full"}
+        Modified Newton (Jacobian updated once per step) or full Newton.
+    output_period : float [s]
+        Sampling period of the stored result.
+    max_newton_iterations : int
+        Newton iterations per step before the step counts as failed.
+    """
+
+    end_time: float = 10.0
+    step_size: float = 2.0e-3
+    spectral_radius: float = 0.5
+    newton: str = "modified"
+    output_period: float = 0.01
+    max_newton_iterations: int = 25
+
+    def __post_init__(self) -> None:
+        _set(self, "end_time", _positive("solver.end_time", self.end_time))
+        _set(self, "step_size", _positive("solver.step_size", self.step_size))
+        if self.step_size > self.end_time:
+            raise SceneError(f"solver.step_size ({self.step_size}) must not exceed solver.end_time ({self.end_time})")
+        rho = _finite("solver.spectral_radius", self.spectral_radius)
+        if not 0.0 <= rho <= 1.0:
+            raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {self.spectral_radius!r}")
+        _set(self, "spectral_radius", rho)
+        _choice("solver.newton", self.newton, ("modified", "full"))
+        _set(self, "output_period", _positive("solver.output_period", self.output_period))
+        if self.output_period < self.step_size * (1 - 1e-9):
+            _set(self, "output_period", self.step_size)
+        if isinstance(self.max_newton_iterations, bool) or int(self.max_newton_iterations) < 1:
+            raise SceneError(f"solver.max_newton_iterations must be a positive whole number, got {self.max_newton_iterations!r}")
+        _set(self, "max_newton_iterations", int(self.max_newton_iterations))
+
+    @property
+    def n_steps(self) -> int:
+        """Number of time steps of the run."""
+        return int(round(self.end_time / self.step_size))
+
+
+# --------------------------------------------------------------------------- scene
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A complete CDPR simulation: robot, effects, solver settings and reference.
+
+    Parameters
+    ----------
+    name : str
+    description : str
+    cables : tuple of CableSpec
+        One per cable; cable i runs over ``pulleys[i]`` to ``platform.anchors[i]``.
+    pulleys : tuple of PulleySpec
+    platform : PlatformSpec
+    winch : WinchSpec
+    effects : Effects
+    solver : SolverSpec
+    trajectory : Trajectory
+        Reference pose of the platform over time (x, z, rotation).
+    gravity : float [m/s^2]
+        Magnitude of the gravitational acceleration, acting along -z.
+    cable_exit : {"pulley", "point"}
+        "pulley": each cable wraps over its pulley and hangs to its winch (paper).
+        "point": the cable's winch end is fixed at the pulley centre and there is no
+        pulley contact (used to compare with the catenary's fixed end points).
+    """
+
+    name: str = "scene"
+    description: str = ""
+    cables: tuple[CableSpec, ...] = (CableSpec(), CableSpec())
+    pulleys: tuple[PulleySpec, ...] = (
+        PulleySpec(center=(-1.75, 0.0), side=-1),
+        PulleySpec(center=(1.75, 0.0), side=1),
+    )
+    platform: PlatformSpec = field(default_factory=PlatformSpec)
+    winch: WinchSpec = field(default_factory=WinchSpec)
+    effects: Effects = field(default_factory=Effects)
+    solver: SolverSpec = field(default_factory=SolverSpec)
+    trajectory: Trajectory | None = None
+    gravity: float = 9.81
+    cable_exit: str = "pulley"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise SceneError(f"name must be a non-empty string, got {self.name!r}")
+        _set(self, "cables", tuple(self.cables))
+        _set(self, "pulleys", tuple(self.pulleys))
+        m = len(self.cables)
+        if m < 1:
+            raise SceneError("cables must list at least one cable")
+        if len(self.pulleys) != m:
+            raise SceneError(f"pulleys must list one pulley per cable ({m}), got {len(self.pulleys)}")
+        if len(self.platform.anchors) != m:
+            raise SceneError(
+                f"platform.anchors must list one anchor per cable ({m}), got {len(self.platform.anchors)}"
+            )
+        _set(self, "gravity", _non_negative("gravity", self.gravity))
+        _choice("cable_exit", self.cable_exit, ("pulley", "point"))
+        if self.cable_exit == "point" and self.winch.kind != "fixed":
+            raise SceneError("cable_exit = 'point' needs winch.kind = 'fixed' (the cable starts at the pulley centre)")
+        if self.trajectory is None:
+            from .trajectories import HoldTrajectory
+
+            _set(self, "trajectory", HoldTrajectory(tuple(self.platform.initial_pose)))
+        self._check_reachable()
+
+    def _check_reachable(self) -> None:
+        """Refuse an initial pose the cables cannot reach (before any simulation)."""
+        from .kinematics import anchor_points, ideal_cable_length
+
+        anchors = anchor_points(np.asarray(self.platform.initial_pose), np.asarray(self.platform.anchors))
+        for i, (cable, pulley) in enumerate(zip(self.cables, self.pulleys)):
+            c = np.asarray(pulley.center)
+            if self.cable_exit == "point":
+                needed = float(np.linalg.norm(anchors[i] - c))
+            else:
+                needed = ideal_cable_length(c, pulley.radius, pulley.side, anchors[i])
+            if needed > cable.unstrained_length * (1 + 1e-9):
+                raise SceneError(
+                    f"cables[{i}].unstrained_length = {cable.unstrained_length} m is shorter than the "
+                    f"{needed:.4f} m needed to reach platform.initial_pose {self.platform.initial_pose}"
+                )
+
+    # Convenience -------------------------------------------------------------------
+    @property
+    def n_cables(self) -> int:
+        return len(self.cables)
+
+    def with_changes(self, **changes: Any) -> "Scene":
+        """A copy with top-level fields replaced (validated again)."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (TOML-ready) of the scene."""
+        data: dict[str, Any] = {
+            "name": self.name,
+            "description": self.description,
+            "gravity": self.gravity,
+            "cable_exit": self.cable_exit,
+            "cables": [dataclasses.asdict(c) for c in self.cables],
+            "pulleys": [_listify(dataclasses.asdict(p)) for p in self.pulleys],
+            "platform": _listify(dataclasses.asdict(self.platform)),
+            "winch": dataclasses.asdict(self.winch),
+            "effects": dataclasses.asdict(self.effects),
+            "solver": dataclasses.asdict(self.solver),
+            "trajectory": self.trajectory.to_dict(),
+        }
+        return data
+
+
+def _listify(value: Any) -> Any:
+    """Tuples to lists, recursively (TOML arrays)."""
+    if isinstance(value, dict):
+        return {k: _listify(v) for k, v in value.items()}
+    if isinstance(value, (tuple, list)):
+        return [_listify(v) for v in value]
+    return value
+
+
+# --------------------------------------------------------------------------- TOML
+
+
+def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
+    """Make dataclass ``cls`` from a mapping, refusing unknown keys."""
+    if not isinstance(data, Mapping):
+        raise SceneError(f"{path} must be a table, got {data!r}")
+    known = {f.name for f in fields(cls)}
+    unknown = set(data) - known
+    if unknown:
+        raise SceneError(f"{path} has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
+    try:
+        return cls(**data)
+    except SceneError as err:
+        # Prefix the field path with its position in the tree, e.g. cables[1].radius.
+        message = str(err)
+        head = cls.__name__.replace("Spec", "").lower()
+        if path != head and message.startswith(head + "."):
+            message = path + message[len(head):]
+        raise SceneError(message) from None
+    except TypeError as err:
+        raise SceneError(f"{path}: {err}") from None
+
+
+def _per_cable(data: Mapping[str, Any], single: str, plural: str, count: int | None) -> list[dict[str, Any]]:
+    """Merge the shared table ``[single]`` into each entry of ``[[plural]]``."""
+    shared = dict(data.get(single, {}))
+    entries = data.get(plural)
+    if entries is None:
+        if count is None:
+            raise SceneError(f"scene needs [[{plural}]] entries or a count from another list")
+        entries = [{} for _ in range(count)]
+    if not isinstance(entries, list):
+        raise SceneError(f"{plural} must be an array of tables, got {entries!r}")
+    return [{**shared, **dict(e)} for e in entries]
+
+
+def scene_from_dict(data: Mapping[str, Any]) -> Scene:
+    """Make a validated Scene from plain data (as read from TOML).
+
+    ``[cable]`` and ``[pulley]`` tables hold values shared by every cable or pulley;
+    ``[[cables]]`` and ``[[pulleys]]`` entries override them one by one. ``[effects]``
+    may name a ``preset`` and override single effects.
+    """
+    data = dict(data)
+    top_known = {
+        "name", "description", "gravity", "cable_exit", "cable", "cables", "pulley", "pulleys",
+        "platform", "winch", "effects", "solver", "trajectory",
+    }
+    unknown = set(data) - top_known
+    if unknown:
+        raise SceneError(f"scene has unknown field(s) {sorted(unknown)}; known: {sorted(top_known)}")
+    pulley_dicts = _per_cable(data, "pulley", "pulleys", None)
+    cable_dicts = _per_cable(data, "cable", "cables", len(pulley_dicts))
+    cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
+    pulleys = tuple(_build(PulleySpec, p, f"pulleys[{i}]") for i, p in enumerate(pulley_dicts))
+    platform = _build(PlatformSpec, data.get("platform", {}), "platform")
+    effects_data = dict(data.get("effects", {}))
+    preset = effects_data.pop("preset", "full")
+    effects = Effects.from_preset(preset, **effects_data)
+    trajectory = None
+    if "trajectory" in data:
+        trajectory = trajectory_from_dict(data["trajectory"])
+    kwargs: dict[str, Any] = dict(
+        cables=cables,
+        pulleys=pulleys,
+        platform=platform,
+        winch=_build(WinchSpec, data.get("winch", {}), "winch"),
+        effects=effects,
+        solver=_build(SolverSpec, data.get("solver", {}), "solver"),
+        trajectory=trajectory,
+    )
+    for key in ("name", "description", "gravity", "cable_exit"):
+        if key in data:
+            kwargs[key] = data[key]
+    return Scene(**kwargs)
+
+
+def load_scene(source: str | Path) -> Scene:
+    """Load a scene by shipped name (e.g. ``"paper-circle"``) or from a TOML file path."""
+    path = Path(source)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise SceneError(f"scene file {str(path)!r} does not exist")
+        text = path.read_text()
+    else:
+        name = str(source).replace("-", "_") + ".toml"
+        resource = resources.files("cdpr_exu.scenes").joinpath(name)
+        if not resource.is_file():
+            raise SceneError(f"no scene named {str(source)!r}; shipped scenes: {', '.join(shipped_scenes())}")
+        text = resource.read_text()
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
+    return scene_from_dict(data)
+
+
+def shipped_scenes() -> list[str]:
+    """Names of the scenes shipped with the package."""
+    folder = resources.files("cdpr_exu.scenes")
+    return sorted(p.name[:-5].replace("_", "-") for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def save_scene(scene: Scene, path: str | Path) -> Path:
+    """Write the scene as TOML; :func:`load_scene` reads it back to an equal Scene."""
+    import tomli_w
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(tomli_w.dumps(scene.to_dict()))
+    return path

@@ -1,0 +1,261 @@
+"""Runs a scene through Exudyn's implicit generalized-alpha solver.
+
+:func:`simulate` builds the model, asks the controller for winch commands once per
+time step (a pre-step function), records the state at the output times (a post-step
+function), and returns a :class:`~cdpr_exu.result.Result`. If the solver fails
+mid-run, :class:`~cdpr_exu.errors.SolverFailure` says at what time and why, and
+carries the result up to that time.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from pathlib import Path
+from typing import Callable
+
+import exudyn as exu
+import numpy as np
+
+from controllers.base import Controller, Measurement
+from controllers.ideal_ik import IdealIKController
+
+from .cable import element_tensions
+from .errors import SolverFailure
+from .model import Model, build_model
+from .pulley import penetration
+from .result import Result
+from .scene import Scene
+from .winch import set_paid_out_length
+
+
+def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
+    """Exudyn settings of the implicit run of ``scene``.
+
+    Generalized-alpha with the scene's spectral radius, the sparse LU solver, and
+    (modified) Newton whose Jacobian is updated every step. The contact's own
+    step-size recommendation is switched off (it shrinks steps to about 1e-6 s).
+    """
+    solver = scene.solver
+    settings = exu.SimulationSettings()
+    ti = settings.timeIntegration
+    ti.numberOfSteps = solver.n_steps
+    ti.endTime = solver.end_time
+    ti.verboseMode = 0
+    ti.generalizedAlpha.spectralRadius = solver.spectral_radius
+    ti.newton.useModifiedNewton = solver.newton == "modified"
+    ti.newton.modifiedNewtonJacUpdatePerStep = True
+    ti.newton.maxIterations = solver.max_newton_iterations
+    ti.discontinuous.useRecommendedStepSize = False
+    ti.adaptiveStep = True
+    ti.minimumStepSize = solver.step_size * 1e-4
+    settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    settings.solution.file.write = solution_file is not None
+    if solution_file is not None:
+        settings.solution.file.name = str(solution_file)
+        settings.solution.file.writePeriod = solver.output_period
+        settings.solution.file.binary = True
+    return settings
+
+
+class _Recorder:
+    """Stores Exudyn's coordinates at the output times (called once per step)."""
+
+    def __init__(self, model: Model, output_period: float, end_time: float):
+        self.model = model
+        self.indices = model.coordinate_indices()
+        count = int(math.floor(end_time / output_period + 1e-9)) + 1
+        self.output_times = np.arange(count) * output_period
+        size = model.mbs.systemData.GetODE2Coordinates().size
+        self.q = np.full((count, size), np.nan)
+        self.v = np.full((count, size), np.nan)
+        self.times = np.full(count, np.nan)
+        self.paid_out = np.full((count, len(model.cables)), np.nan)
+        self.count = 0
+
+    def record_if_due(self, t: float, paid_out: np.ndarray) -> None:
+        if self.count < len(self.output_times) and t >= self.output_times[self.count] - 1e-9:
+            data = self.model.mbs.systemData
+            self.q[self.count] = data.GetODE2Coordinates()
+            self.v[self.count] = data.GetODE2Coordinates_t()
+            self.times[self.count] = t
+            self.paid_out[self.count] = paid_out
+            self.count += 1
+
+    def result(self, scene: Scene, controller_name: str) -> Result:
+        """Convert the recorded coordinates to a Result in the x-z plane."""
+        k = self.count
+        q, v = self.q[:k], self.v[:k]
+        times = self.times[:k]
+        ref_q = self.model.mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
+        platform_idx = self.indices["platform"]
+        pose = ref_q[platform_idx] + q[:, platform_idx]
+        velocity = v[:, platform_idx]
+        nodes, tensions, depth = [], [], []
+        for i, cable in enumerate(scene.cables):
+            idx = self.indices[f"cable_{i}"]
+            positions = ref_q[idx] + q[:, idx]
+            velocities = v[:, idx]
+            nodes.append(positions)
+            tensions.append(element_tensions(cable, positions, velocities, scene.effects))
+            if scene.cable_exit == "pulley":
+                depth.append(penetration(scene.pulleys[i], positions).max(axis=1))
+            else:
+                depth.append(np.zeros(k))
+        reference = scene.trajectory.pose(times) if k else np.zeros((0, 3))
+        return Result(
+            scene_name=scene.name, controller=controller_name, time=times, platform_pose=pose,
+            platform_velocity=velocity, reference_pose=np.atleast_2d(reference).reshape(-1, 3),
+            nodes=nodes, tensions=tensions, paid_out=self.paid_out[:k],
+            pulley_penetration=np.column_stack(depth) if depth else np.zeros((k, 0)),
+        )
+
+
+def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
+             progress: bool | Callable[[float, float], None] = False) -> Result:
+    """Simulate ``scene`` under ``controller`` (default: ideal inverse kinematics).
+
+    Parameters
+    ----------
+    scene : Scene
+    controller : Controller, optional
+        Gives the winch commands once per step; default :class:`IdealIKController`.
+    solution_file : path, optional
+        Also write Exudyn's solution file there, for ``SolutionViewer``.
+    progress : bool or callable
+        True shows a progress bar (simulated time, ratio to real time); a callable
+        is called as ``progress(t, wall_time)`` about 100 times per run.
+
+    Returns
+    -------
+    Result
+
+    Raises
+    ------
+    UnreachableError
+        Before the run, if the reference leaves the workspace.
+    SolverFailure
+        If the solver fails; ``.time`` and ``.partial_result`` say when and what was
+        computed up to then.
+    """
+    controller = controller or IdealIKController()
+    controller.reset(scene)
+    model = build_model(scene)
+    mbs = model.mbs
+    solver = scene.solver
+    recorder = _Recorder(model, solver.output_period, solver.end_time)
+    indices = recorder.indices
+    platform_idx = indices["platform"]
+    state = {"paid_out": model.initial_paid_out.copy(), "rate": np.zeros(len(scene.cables))}
+    ref_q = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
+    report = _progress_reporter(progress, scene)
+    start = _time.perf_counter()
+
+    def measurement(t: float) -> Measurement:
+        pose = velocity = tensions = None
+        if controller.uses_pose or controller.uses_tension:
+            q = mbs.systemData.GetODE2Coordinates()
+            v = mbs.systemData.GetODE2Coordinates_t()
+            pose = ref_q[platform_idx] + q[platform_idx]
+            velocity = v[platform_idx]
+            if controller.uses_tension:
+                tensions = np.array([
+                    element_tensions(cable, ref_q[indices[f"cable_{i}"]][-2:] + q[indices[f"cable_{i}"]][-2:],
+                                     v[indices[f"cable_{i}"]][-2:], scene.effects)[-1]
+                    for i, cable in enumerate(scene.cables)
+                ])
+        return Measurement(t, state["paid_out"].copy(), state["rate"].copy(), pose, velocity, tensions)
+
+    def pre_step(mbs_, t):
+        if scene.winch.kind == "kinematic":
+            command = controller.command(measurement(t))
+            state["paid_out"] = np.asarray(command.paid_out, dtype=float)
+            state["rate"] = np.asarray(command.paid_out_rate, dtype=float)
+            for winch, length, initial in zip(model.winches, state["paid_out"], model.initial_paid_out):
+                set_paid_out_length(mbs_, winch, length, initial)
+        return True
+
+    def post_step(mbs_, t):
+        recorder.record_if_due(t, state["paid_out"])
+        if report is not None:
+            report(t, _time.perf_counter() - start)
+        return True
+
+    mbs.SetPreStepUserFunction(pre_step)
+    mbs.SetPostStepUserFunction(post_step)
+    recorder.record_if_due(0.0, state["paid_out"])
+    settings = solver_settings(scene, solution_file)
+    failure = None
+    try:
+        mbs.SolveDynamic(settings)
+    except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
+        failure = " ".join(str(err).split())
+    wall = _time.perf_counter() - start
+    if report is not None:
+        report(None, wall)
+    result = recorder.result(scene, controller.name)
+    iterations = mbs.sys["dynamicSolver"].it
+    result.wall_time = wall
+    result.steps = int(iterations.currentStepIndex)
+    result.newton_iterations = int(iterations.newtonStepsCount)
+    result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
+                       "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts()}
+    last_time = float(result.time[-1]) if len(result.time) else 0.0
+    if failure is None and (not np.all(np.isfinite(result.platform_pose)) or len(result.time) < len(recorder.output_times)):
+        failure = "the solution contains NaN or stopped before the end time"
+    if failure is not None:
+        finite = np.all(np.isfinite(result.platform_pose), axis=1) if len(result.time) else np.zeros(0, bool)
+        last_time = float(result.time[finite][-1]) if finite.any() else 0.0
+        result.status = f"failed: {failure}"
+        result.failure_time = last_time
+        raise SolverFailure(
+            f"the solver failed after t = {last_time:.4f} s of {solver.end_time} s "
+            f"(step size {solver.step_size} s): {failure}. {likely_cause(scene)}",
+            time=last_time, partial_result=result)
+    return result
+
+
+def likely_cause(scene: Scene) -> str:
+    """A hint at the effect most likely to make the integration fail."""
+    cable = scene.cables[0]
+    hints = []
+    if not scene.effects.bending:
+        hints.append("bending is off: the paper scene relies on bending stiffness to stay well-behaved")
+    if scene.effects.pulley_contact and scene.cable_exit == "pulley":
+        pulley = scene.pulleys[0]
+        if pulley.contact_stiffness * scene.solver.step_size**2 / cable.element_mass > 100:
+            hints.append(f"the pulley contact stiffness ({pulley.contact_stiffness:g} N/m) is stiff "
+                         f"for step {scene.solver.step_size} s; try a smaller step")
+    if scene.solver.spectral_radius > 0.9:
+        hints.append("spectral radius near 1 leaves the stiff axial modes undamped; try 0.5")
+    return "Likely cause: " + ("; ".join(hints) if hints else "the step size; try a smaller solver.step_size") + "."
+
+
+def _progress_reporter(progress, scene: Scene):
+    """A per-step callback that updates a tqdm bar or a user callable ~100 times."""
+    if not progress:
+        return None
+    end = scene.solver.end_time
+    every = end / 100.0
+    last = {"t": -1.0}
+    if callable(progress):
+        def report(t, wall):
+            if t is None or t - last["t"] >= every:
+                last["t"] = end if t is None else t
+                progress(end if t is None else t, wall)
+        return report
+    from tqdm import tqdm
+
+    bar = tqdm(total=end, unit="s sim", bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s [{elapsed}, {postfix}]")
+
+    def report(t, wall):
+        if t is None:
+            bar.n = min(bar.n, end)
+            bar.refresh()
+            bar.close()
+            return
+        if t - last["t"] >= every:
+            last["t"] = t
+            bar.n = t
+            bar.set_postfix_str(f"{t / wall:.2f}x real time" if wall > 0 else "")
+    return report

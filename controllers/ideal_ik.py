@@ -1,0 +1,76 @@
+"""Joint-space control from the ideal inverse kinematics (the paper's scheme).
+
+The cables are taken as straight, massless and inextensible: the paid-out length of
+cable i is the straight length from its pulley's tangent point to the anchor plus the
+arc it wraps on the pulley, evaluated on the reference pose. The winch follows it
+open-loop; sag and stretch are ignored, which is the error the paper measures.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cdpr_exu.kinematics import inverse_kinematics, inverse_kinematics_rates, point_exit_inverse_kinematics
+
+from .base import Measurement, WinchCommand
+
+
+def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = None):
+    """Ideal paid-out lengths (and rates) of every cable for reference poses.
+
+    Parameters
+    ----------
+    scene : cdpr_exu.scene.Scene
+    poses : ndarray, shape (N, 3) [m, m, rad]
+    pose_rates : ndarray, shape (N, 3) or None [m/s, m/s, rad/s]
+
+    Returns
+    -------
+    lengths : ndarray, shape (N, m) [m]
+    rates : ndarray, shape (N, m) [m/s] or None
+    """
+    anchors = np.asarray(scene.platform.anchors)
+    centers = np.array([p.center for p in scene.pulleys])
+    if scene.cable_exit == "point":
+        lengths = point_exit_inverse_kinematics(poses, anchors, centers)
+        return lengths, (None if pose_rates is None else np.zeros_like(lengths))
+    radii = np.array([p.radius for p in scene.pulleys])
+    sides = np.array([p.side for p in scene.pulleys])
+    lengths = inverse_kinematics(poses, anchors, centers, radii, sides)
+    rates = None
+    if pose_rates is not None:
+        rates = inverse_kinematics_rates(poses, pose_rates, anchors, centers, radii, sides)
+    return lengths, rates
+
+
+class IdealIKController:
+    """Open-loop winch lengths from ideal (straight, massless, inextensible) cables.
+
+    The command table is computed once per run on the solver's step grid and read by
+    linear interpolation, so a step costs no inverse kinematics.
+    """
+
+    name = "ideal_ik"
+    uses_pose = False
+    uses_tension = False
+
+    def __init__(self) -> None:
+        self._times = None
+        self._lengths = None
+        self._rates = None
+
+    def reset(self, scene) -> None:
+        """Tabulate the ideal paid-out lengths of ``scene.trajectory`` on the step grid."""
+        solver = scene.solver
+        self._times = np.linspace(0.0, solver.end_time, solver.n_steps + 1)
+        poses = scene.trajectory.pose(self._times)
+        rates = scene.trajectory.velocity(self._times)
+        self._lengths, self._rates = ideal_paid_out(scene, poses, rates)
+
+    def command(self, measurement: Measurement) -> WinchCommand:
+        if self._times is None:
+            raise RuntimeError("IdealIKController.reset(scene) must be called before command()")
+        t = measurement.time
+        lengths = np.array([np.interp(t, self._times, column) for column in self._lengths.T])
+        rates = np.array([np.interp(t, self._times, column) for column in self._rates.T])
+        return WinchCommand(lengths, rates)
