@@ -56,6 +56,7 @@ the solvers to use a tighter, physical limit (eg the cable's breaking load).
 """
 
 _RELATIVE_TOLERANCE = 1e-12
+_VERTICAL_TOLERANCE = 1e-12
 _MAX_NEWTON_ITERATIONS = 200
 
 
@@ -294,7 +295,7 @@ def _span_and_jacobian(H, V_B, L, w, EA, with_jacobian=True):
     if b > 0.0:
         c = 1.0 / (T_b + b)
     elif H > 0.0:
-        c = (T_b - b) / (H * H)
+        c = (T_b - b) / H / H  # (not H * H: that underflows first)
     else:
         c = math.inf  # vertical U: the cable folds over at H = 0
     if math.isinf(c):
@@ -454,7 +455,7 @@ def _initial_guess(L, w, EA, dx, dz):
 
 
 def _newton_forward(L, w, EA, dx, dz, H, V_B):
-    """Damped Newton in ``(H, V_B)``; returns ``(H, V_B)`` or raises.
+    """Damped Newton in ``(H, V_B)``; returns ``(H, V_B, converged)``.
 
     The step is scaled as a whole (keeping its direction: near-taut cables have a
     narrow valley along the cable direction, which a change of variables such as
@@ -472,7 +473,7 @@ def _newton_forward(L, w, EA, dx, dz, H, V_B):
     norm = math.hypot(rx, rz)
     for _ in range(_MAX_NEWTON_ITERATIONS):
         if norm <= tolerance:
-            return H, V_B
+            return H, V_B, True
         a11, a12 = jac[0]
         a21, a22 = jac[1]
         det = a11 * a22 - a12 * a21
@@ -497,11 +498,79 @@ def _newton_forward(L, w, EA, dx, dz, H, V_B):
         if not accepted:
             break
         H, V_B, rx, rz, jac, norm = H_new, V_new, rx_new, rz_new, jac_new, norm_new
-    if norm <= 1e3 * tolerance:  # stalled at round-off level
+    return H, V_B, norm <= 10.0 * tolerance  # stalled at round-off level counts
+
+
+def _bracket_root(function, low, high, grow):
+    """Expand ``[low, high]`` (by ``grow(low, high)``) until ``function`` changes sign."""
+    f_low, f_high = function(low), function(high)
+    for _ in range(2000):
+        if f_low <= 0.0 <= f_high:
+            return low, high
+        low, high = grow(low, high, f_low > 0.0)
+        f_low, f_high = function(low), function(high)
+    raise UnreachableError("could not bracket the catenary solution")
+
+
+def _nested_forward(L, w, EA, dx, dz, H_start):
+    """Globally convergent fallback: nested bracketing in ``log H`` and ``V_B``.
+
+    ``dz`` increases strictly with ``V_B`` at fixed ``H`` (``J22 > 0``), and along the
+    curve of fixed ``dz``, ``dx`` increases strictly with ``H`` (``det J / J22 > 0``, the
+    flexibility matrix being positive definite), so two nested Brent solves always
+    find the solution. Used when Newton fails near the singular corners of the
+    catenary (a vertical, just-taut cable whose lower end is at zero tension).
+    """
+    from scipy.optimize import brentq
+
+    weight = max(w * L, 1e-300)
+
+    def vertical_force(H):
+        def mismatch(V):
+            return _span_and_jacobian(H, V, L, w, EA, with_jacobian=False)[1] - dz
+
+        def grow(low, high, too_high):
+            width = high - low
+            return (low - 2.0 * width, high) if too_high else (low, high + 2.0 * width)
+
+        low, high = _bracket_root(mismatch, -weight, 2.0 * weight, grow)
+        return brentq(mismatch, low, high, xtol=1e-300, rtol=1e-15, maxiter=400)
+
+    def horizontal_mismatch(log_H):
+        H = math.exp(log_H)
+        return _span_and_jacobian(H, vertical_force(H), L, w, EA, with_jacobian=False)[0] - dx
+
+    def grow(low, high, too_high):
+        return (low - 5.0, high) if too_high else (low, high + 5.0)
+
+    centre = math.log(H_start)
+    low, high = _bracket_root(horizontal_mismatch, centre - 1.0, centre + 1.0, grow)
+    log_H = brentq(horizontal_mismatch, low, high, xtol=1e-15, rtol=1e-15, maxiter=400)
+    H = math.exp(log_H)
+    return H, vertical_force(H)
+
+
+def _solve_span(L, w, EA, dx, dz, guess):
+    """``(H, V_B)`` for a span with ``dx > 0``: Newton, then the bracketing fallback."""
+    default = _initial_guess(L, w, EA, dx, dz)
+    starts = [default] if guess is None else [guess, default]
+    best = None
+    for H0, V0 in starts:
+        H, V_B, converged = _newton_forward(L, w, EA, dx, dz, H0, V0)
+        if converged:
+            return H, V_B
+        best = (H, V_B)
+    H, V_B = _nested_forward(L, w, EA, dx, dz, max(best[0], default[0], 1e-300))
+    H_polished, V_polished, converged = _newton_forward(L, w, EA, dx, dz, H, V_B)
+    if converged:
+        return H_polished, V_polished
+    rx, rz, _ = _span_and_jacobian(H, V_B, L, w, EA, with_jacobian=False)
+    residual = math.hypot(rx - dx, rz - dz)
+    if residual <= 1e3 * _RELATIVE_TOLERANCE * max(L, math.hypot(dx, dz)):
         return H, V_B
     raise UnreachableError(
         f"elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
-        f"unstrained_length {L:g} m (residual {norm:.3g} m)"
+        f"unstrained_length {L:g} m (residual {residual:.3g} m)"
     )
 
 
@@ -516,9 +585,11 @@ def solve_forward(
 
     Solves Irvine's two equations for ``(H, V_B)`` by Newton's method with the
     analytic Jacobian, with steps limited to keep ``H`` positive and a backtracking
-    line search, from the Peyrot-Goulois / MoorPy initial guess.
-    Vertical spans (``dx == 0``) and massless cables (``w == 0``) are solved in
-    closed form.
+    line search, from the Peyrot-Goulois / MoorPy initial guess. Should Newton
+    stall (near the singular corner of a just-taut, nearly vertical cable whose
+    lower end is at zero tension), a nested bracketing solve, which always converges,
+    takes over. Vertical spans (``|dx| <= 1e-12 L``) and massless cables (``w == 0``)
+    are solved in closed form.
 
     Parameters
     ----------
@@ -541,7 +612,7 @@ def solve_forward(
     ------
     UnreachableError
         If the straight distance between the ends exceeds what the cable reaches at
-        the tension limit, if the solution exceeds it, or if Newton fails.
+        the tension limit, or if the solution exceeds it.
     SceneError
         If ``span`` is not a finite 2-vector or a limit is not positive.
     """
@@ -565,22 +636,17 @@ def solve_forward(
         V_B = tension * dz / chord if chord > 0.0 else 0.0
         if tension == 0.0:
             slack_span = span
-    elif dx == 0.0:
+    elif dx <= _VERTICAL_TOLERANCE * max(L, chord):
+        # vertical: closed form (for dx below 1e-12 of the length the difference from
+        # the true catenary is below the solver tolerance, and Newton is ill-posed)
         H, V_B = 0.0, _vertical_solution(L, w, EA, dz)
     else:
-        if initial_guess is None:
-            H0, V0 = _initial_guess(L, w, EA, dx, dz)
-        else:
+        guess = None
+        if initial_guess is not None:
             H0, V0 = float(initial_guess[0]), float(initial_guess[1])
-            if not (H0 > 0.0 and math.isfinite(H0) and math.isfinite(V0)):
-                H0, V0 = _initial_guess(L, w, EA, dx, dz)
-        try:
-            H, V_B = _newton_forward(L, w, EA, dx, dz, H0, V0)
-        except UnreachableError:
-            if initial_guess is None:
-                raise
-            H0, V0 = _initial_guess(L, w, EA, dx, dz)
-            H, V_B = _newton_forward(L, w, EA, dx, dz, H0, V0)
+            if H0 > 0.0 and math.isfinite(H0) and math.isfinite(V0):
+                guess = (H0, V0)
+        H, V_B = _solve_span(L, w, EA, dx, dz, guess)
 
     state = _make_state(cable, H, V_B, sign_x, slack_span)
     if state.max_tension > tension_limit:
@@ -779,6 +845,49 @@ def profile(cable, state, s):
     return points
 
 
+def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_sign=1.0):
+    """Span of the catenary from its end force, and its derivatives.
+
+    Parameters
+    ----------
+    cable : CatenaryCable
+    horizontal_tension : float [N]
+        ``H >= 0``.
+    vertical_tension_b : float [N]
+        ``V_B``.
+    horizontal_sign : {+1, -1}, optional
+        Side of B relative to A, as in `state_from_end_forces`.
+
+    Returns
+    -------
+    span : ndarray, shape (2,) [m]
+        ``p_B - p_A``.
+    jacobian : ndarray, shape (2, 3)
+        ``d(span)/d(H, V_B, L)`` [m/N, m/N, -]. The last column adds unstrained
+        length at end A with ``(H, V_B)`` fixed: the new piece continues the cable
+        along its direction at A. Entry ``[0, 0]`` is ``inf`` for a slack vertical
+        cable (a U of zero width: no horizontal stiffness).
+    """
+    H, V_B = float(horizontal_tension), float(vertical_tension_b)
+    L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
+    sign = -1.0 if horizontal_sign < 0 else 1.0
+    dx, dz, jac = _span_and_jacobian(H, V_B, L, w, EA)
+    V_A = V_B - w * L
+    T_A = math.hypot(H, V_A)
+    if T_A > 0.0:
+        length_column = (H / T_A + H / EA, V_A / T_A + V_A / EA)
+    else:
+        length_column = (0.0, 0.0)
+    span = np.array([sign * dx, dz])
+    jacobian = np.array(
+        [
+            [sign * jac[0][0], sign * jac[0][1], sign * length_column[0]],
+            [jac[1][0], jac[1][1], length_column[1]],
+        ]
+    )
+    return span, jacobian
+
+
 def span_jacobian(cable, state):
     """``d(span)/d(H, V_B)``: flexibility of the catenary in its end-force parameters.
 
@@ -793,15 +902,10 @@ def span_jacobian(cable, state):
         Rows ``(dx, dz)`` of the signed span, columns ``(H, V_B)``. Entry ``[0, 0]``
         is ``inf`` for a slack vertical cable (zero horizontal stiffness).
     """
-    _, _, jac = _span_and_jacobian(
-        state.horizontal_tension,
-        state.vertical_tension_b,
-        cable.unstrained_length,
-        cable.weight_per_length,
-        cable.axial_stiffness,
+    _, jacobian = span_and_jacobian(
+        cable, state.horizontal_tension, state.vertical_tension_b, state.horizontal_sign
     )
-    sign = state.horizontal_sign
-    return np.array([[sign * jac[0][0], sign * jac[0][1]], [jac[1][0], jac[1][1]]])
+    return jacobian[:, :2]
 
 
 def end_stiffness(cable, state):

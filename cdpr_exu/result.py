@@ -34,6 +34,7 @@ class Result:
     reference_pose : ndarray, shape (N, 3)
     nodes : list of ndarray, each shape (N, n_i + 1, 2) [m]
         Node positions of cable i, winch end first.
+    node_velocities : list of ndarray, each shape (N, n_i + 1, 2) [m/s]
     tensions : list of ndarray, each shape (N, n_i) [N]
         Axial force of each element (tension positive).
     paid_out : ndarray, shape (N, m) [m]
@@ -57,6 +58,7 @@ class Result:
     platform_velocity: np.ndarray
     reference_pose: np.ndarray
     nodes: list[np.ndarray]
+    node_velocities: list[np.ndarray]
     tensions: list[np.ndarray]
     paid_out: np.ndarray
     pulley_penetration: np.ndarray
@@ -125,6 +127,7 @@ class Result:
         }
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"] = nodes
+            arrays[f"node_velocities_{i}"] = self.node_velocities[i]
             arrays[f"tensions_{i}"] = tensions
         info = {
             "scene_name": self.scene_name, "controller": self.controller, "wall_time": self.wall_time,
@@ -154,6 +157,7 @@ class Result:
                 platform_pose=data["platform_pose"], platform_velocity=data["platform_velocity"],
                 reference_pose=data["reference_pose"],
                 nodes=[data[f"nodes_{i}"] for i in range(m)],
+                node_velocities=[data[f"node_velocities_{i}"] for i in range(m)],
                 tensions=[data[f"tensions_{i}"] for i in range(m)],
                 paid_out=data["paid_out"], pulley_penetration=data["pulley_penetration"],
                 wall_time=info["wall_time"], steps=info["steps"],

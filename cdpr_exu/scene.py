@@ -548,17 +548,13 @@ def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
         raise SceneError(f"{path}: {err}") from None
 
 
-def _per_cable(data: Mapping[str, Any], single: str, plural: str, count: int | None) -> list[dict[str, Any]]:
-    """Merge the shared table ``[single]`` into each entry of ``[[plural]]``."""
+def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Merge the shared table ``[single]`` into each entry of ``[[plural]]`` (or of ``defaults``)."""
     shared = dict(data.get(single, {}))
-    entries = data.get(plural)
-    if entries is None:
-        if count is None:
-            raise SceneError(f"scene needs [[{plural}]] entries or a count from another list")
-        entries = [{} for _ in range(count)]
-    if not isinstance(entries, list):
+    entries = data.get(plural, defaults)
+    if not isinstance(entries, list) or not all(isinstance(e, Mapping) for e in entries):
         raise SceneError(f"{plural} must be an array of tables, got {entries!r}")
-    return [{**shared, **dict(e)} for e in entries]
+    return [{**e, **shared} if plural not in data else {**shared, **dict(e)} for e in entries]
 
 
 def scene_from_dict(data: Mapping[str, Any]) -> Scene:
@@ -576,8 +572,10 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     unknown = set(data) - top_known
     if unknown:
         raise SceneError(f"scene has unknown field(s) {sorted(unknown)}; known: {sorted(top_known)}")
-    pulley_dicts = _per_cable(data, "pulley", "pulleys", None)
-    cable_dicts = _per_cable(data, "cable", "cables", len(pulley_dicts))
+    default = Scene.__dataclass_fields__
+    default_pulleys = [_listify(dataclasses.asdict(p)) for p in default["pulleys"].default]
+    pulley_dicts = _per_cable(data, "pulley", "pulleys", default_pulleys)
+    cable_dicts = _per_cable(data, "cable", "cables", [{} for _ in pulley_dicts])
     cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
     pulleys = tuple(_build(PulleySpec, p, f"pulleys[{i}]") for i, p in enumerate(pulley_dicts))
     platform = _build(PlatformSpec, data.get("platform", {}), "platform")

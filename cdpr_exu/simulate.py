@@ -58,6 +58,45 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     return settings
 
 
+#: A run stops when an element's strain exceeds this: the lumped model has left the
+#: range where it describes a steel cable (real cables break near 1-2 % strain).
+MAX_STRAIN = 0.05
+#: A run stops when a node lies deeper than this fraction of the pulley radius inside
+#: a pulley: the cable is slipping through it, which penalty contact on nodes allows
+#: when an element is long compared with the contact's reach.
+MAX_PENETRATION_FRACTION = 0.5
+
+
+class _Monitor:
+    """Checks each recorded sample for states the model cannot describe."""
+
+    def __init__(self, scene: Scene, indices: dict[str, np.ndarray], reference: np.ndarray):
+        self.scene = scene
+        self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
+                       for i, cable in enumerate(scene.cables)]
+        self.check_pulleys = scene.cable_exit == "pulley" and scene.effects.pulley_contact
+
+    def problem(self, t: float, q: np.ndarray) -> str | None:
+        """A description of what is wrong at time ``t``, or None."""
+        if not np.all(np.isfinite(q)):
+            return f"the coordinates are no longer finite at t = {t:.4f} s"
+        for i, (cable, reference, idx) in enumerate(self.cables):
+            positions = reference + q[idx]
+            strain = np.linalg.norm(np.diff(positions, axis=0), axis=1) / cable.element_length - 1.0
+            worst = int(np.argmax(np.abs(strain)))
+            if abs(strain[worst]) > MAX_STRAIN:
+                return (f"element {worst} of cable {i} is strained by {100 * strain[worst]:+.1f} % at t = {t:.4f} s "
+                        f"(limit {100 * MAX_STRAIN:.0f} %): the run has left the model's valid range")
+            if self.check_pulleys:
+                pulley = self.scene.pulleys[i]
+                depth = penetration(pulley, positions)
+                node = int(np.argmax(depth))
+                if depth[node] > MAX_PENETRATION_FRACTION * pulley.radius:
+                    return (f"node {node} of cable {i} is {1000 * depth[node]:.0f} mm inside pulley {i} at "
+                            f"t = {t:.4f} s: the cable is slipping through the pulley (node contact only)")
+        return None
+
+
 class _Recorder:
     """Stores Exudyn's coordinates at the output times (called once per step)."""
 
@@ -73,7 +112,8 @@ class _Recorder:
         self.paid_out = np.full((count, len(model.cables)), np.nan)
         self.count = 0
 
-    def record_if_due(self, t: float, paid_out: np.ndarray) -> None:
+    def record_if_due(self, t: float, paid_out: np.ndarray) -> bool:
+        """Store the state if an output time is due; True if it was stored."""
         if self.count < len(self.output_times) and t >= self.output_times[self.count] - 1e-9:
             data = self.model.mbs.systemData
             self.q[self.count] = data.GetODE2Coordinates()
@@ -81,6 +121,8 @@ class _Recorder:
             self.times[self.count] = t
             self.paid_out[self.count] = paid_out
             self.count += 1
+            return True
+        return False
 
     def result(self, scene: Scene, controller_name: str) -> Result:
         """Convert the recorded coordinates to a Result in the x-z plane."""
@@ -91,12 +133,13 @@ class _Recorder:
         platform_idx = self.indices["platform"]
         pose = ref_q[platform_idx] + q[:, platform_idx]
         velocity = v[:, platform_idx]
-        nodes, tensions, depth = [], [], []
+        nodes, node_velocities, tensions, depth = [], [], [], []
         for i, cable in enumerate(scene.cables):
             idx = self.indices[f"cable_{i}"]
             positions = ref_q[idx] + q[:, idx]
             velocities = v[:, idx]
             nodes.append(positions)
+            node_velocities.append(velocities)
             tensions.append(element_tensions(cable, positions, velocities, scene.effects))
             if scene.cable_exit == "pulley":
                 depth.append(penetration(scene.pulleys[i], positions).max(axis=1))
@@ -106,7 +149,7 @@ class _Recorder:
         return Result(
             scene_name=scene.name, controller=controller_name, time=times, platform_pose=pose,
             platform_velocity=velocity, reference_pose=np.atleast_2d(reference).reshape(-1, 3),
-            nodes=nodes, tensions=tensions, paid_out=self.paid_out[:k],
+            nodes=nodes, node_velocities=node_velocities, tensions=tensions, paid_out=self.paid_out[:k],
             pulley_penetration=np.column_stack(depth) if depth else np.zeros((k, 0)),
         )
 
@@ -149,6 +192,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     state = {"paid_out": model.initial_paid_out.copy(), "rate": np.zeros(len(scene.cables))}
     ref_q = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
     report = _progress_reporter(progress, scene)
+    monitor = _Monitor(scene, indices, ref_q)
+    stop = {"reason": None}
     start = _time.perf_counter()
 
     def measurement(t: float) -> Measurement:
@@ -176,7 +221,10 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         return True
 
     def post_step(mbs_, t):
-        recorder.record_if_due(t, state["paid_out"])
+        if recorder.record_if_due(t, state["paid_out"]):
+            stop["reason"] = monitor.problem(t, recorder.q[recorder.count - 1])
+            if stop["reason"] is not None:
+                return False  # ends the time integration; the samples so far are kept
         if report is not None:
             report(t, _time.perf_counter() - start)
         return True
@@ -190,6 +238,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         mbs.SolveDynamic(settings)
     except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
         failure = " ".join(str(err).split())
+    if stop["reason"] is not None:
+        failure = stop["reason"]
     wall = _time.perf_counter() - start
     if report is not None:
         report(None, wall)
@@ -209,7 +259,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         result.status = f"failed: {failure}"
         result.failure_time = last_time
         raise SolverFailure(
-            f"the solver failed after t = {last_time:.4f} s of {solver.end_time} s "
+            f"the run failed at t = {last_time:.4f} s of {solver.end_time} s "
             f"(step size {solver.step_size} s): {failure}. {likely_cause(scene)}",
             time=last_time, partial_result=result)
     return result

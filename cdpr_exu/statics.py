@@ -1,0 +1,1036 @@
+"""Kineto-static equilibrium of a planar platform hung on elastic catenary cables.
+
+The platform moves in the vertical x-z plane, gravity along -z. Its pose is the
+position ``r = (x, z)`` [m] of its centre of mass and its rotation ``phi`` [rad],
+positive counter-clockwise (the paper's eq. 17): an anchor ``b_i`` given in the
+platform frame sits at ``p_i = r + R(phi) b_i`` with ``R = [[cos, -sin], [sin, cos]]``.
+Moments are about the centre of mass, positive in the sense of ``phi``:
+``m = a_x f_z - a_z f_x`` for a force ``f`` applied at offset ``a``.
+
+Each cable is an elastic catenary (`cdpr_exu.catenary`) from its anchor on the
+platform (end A) to its upper end (end B), which is either
+
+* a fixed exit point, or
+* a pulley: the cable comes up from its winch along the vertical line
+  ``x = c_x + side * r_p``, wraps over the top of the pulley and leaves it
+  tangentially at the point where the catenary's end direction is tangent to the
+  circle. The unstrained length counts from the anchor to the point
+  ``(c_x + side * r_p, c_z)`` and includes the wrapped arc.
+
+Pulley approximations (documented choices):
+
+* frictionless: the tension is the same all along the wrap, equal to the tension at
+  the tangent point; the wrapped arc's unstrained length is
+  ``r_p * wrap_angle / (1 + T / EA)``;
+* the weight of the wrapped part is carried by the pulley and neglected in the wrap's
+  tension. Exactly, a frictionless wrap gains ``w * height`` of tension going up
+  (``dT/ds = w dz/ds``): at most ``w r_p`` (0.86 N for the paper's cable, 12 % of the
+  7 N a 1 kg platform puts on each cable). It only changes the stretch of the wrapped
+  part, by ``r_p * wrap_angle * w r_p / EA`` (7e-6 m for the paper), and the tension
+  that reaches the winch, which is not modelled here. A side effect: length that
+  moves between the wrap and the span gains or loses weight, so the model is
+  slightly non-conservative and its stiffness slightly asymmetric (2.5e-6 relative
+  for the paper's cable; exactly symmetric for w = 0);
+* the pulley is a point-free circle: no bending stiffness, no pulley rotation.
+
+Solvers:
+
+* `solve_forward_statics`: given the unstrained lengths, the pose and the forces;
+  unknowns ``(x, z)`` for a point mass, ``(x, z, phi)`` for a rigid platform.
+* `solve_inverse_statics`: given the position (and the rotation when it is free to
+  choose), the unstrained lengths, forces and, for a rigid platform on two cables,
+  the rotation that equilibrium imposes. Unknowns: the horizontal tension of each
+  cable (each cable's unstrained length follows from `catenary.solve_inverse`) and,
+  when it is not given, the rotation.
+
+Both are damped Newton iterations with analytic Jacobians built from the catenary
+end stiffnesses, and both accept an external wrench on the platform (eg the inertial
+load ``-M a`` for dynamic feed-forward, see `inertial_wrench`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from cdpr_exu.catenary import (
+    DEFAULT_MAX_STRAIN,
+    STANDARD_GRAVITY,
+    CatenaryCable,
+    CatenaryState,
+    end_stiffness,
+    solve_forward,
+    solve_inverse,
+    span_and_jacobian,
+    state_from_end_forces,
+)
+from cdpr_exu.errors import SceneError, UnreachableError
+
+_RELATIVE_TOLERANCE = 1e-12
+
+
+# ---------------------------------------------------------------------------
+# validation helpers
+# ---------------------------------------------------------------------------
+def _finite(name, value):
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise SceneError(f"{name} must be finite, got {value!r}")
+    return number
+
+
+def _positive(name, value):
+    number = _finite(name, value)
+    if number <= 0.0:
+        raise SceneError(f"{name} must be positive, got {value!r}")
+    return number
+
+
+def _non_negative(name, value):
+    number = _finite(name, value)
+    if number < 0.0:
+        raise SceneError(f"{name} must be non-negative, got {value!r}")
+    return number
+
+
+def _point(name, value):
+    try:
+        vector = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a 2-vector (x, z) [m], got {value!r}") from None
+    if vector.shape != (2,) or not np.all(np.isfinite(vector)):
+        raise SceneError(f"{name} must be a finite 2-vector (x, z) [m], got {value!r}")
+    return (float(vector[0]), float(vector[1]))
+
+
+def _wrench(value):
+    if value is None:
+        return np.zeros(3)
+    try:
+        vector = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise SceneError(f"external_wrench must be (fx, fz, moment), got {value!r}") from None
+    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
+        raise SceneError(
+            f"external_wrench must be a finite 3-vector (fx [N], fz [N], moment [N m]), got {value!r}"
+        )
+    return vector
+
+
+def _cross(a, b):
+    """Planar cross product ``a_x b_z - a_z b_x``."""
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def _perpendicular(a):
+    """``a`` turned by +90 degrees: ``d(R b)/d(phi) = perpendicular(R b)``."""
+    return np.array([-a[1], a[0]])
+
+
+def _rotation(phi):
+    c, s = math.cos(phi), math.sin(phi)
+    return np.array([[c, -s], [s, c]])
+
+
+# ---------------------------------------------------------------------------
+# parameters
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Pulley:
+    """A pulley the cable leaves tangentially towards the platform.
+
+    Parameters
+    ----------
+    centre : (float, float) [m]
+        Centre ``(c_x, c_z)``.
+    radius : float [m]
+        ``r_p > 0``.
+    side : {-1, +1}
+        Side where the cable comes up from the winch, along ``x = c_x + side r_p``:
+        -1 on the left (the cable wraps clockwise over the top), +1 on the right
+        (counter-clockwise). For the paper's robot: -1 for the left pulley, +1 for
+        the right one (the winch legs hang outside).
+    """
+
+    centre: tuple
+    radius: float
+    side: int = -1
+
+    def __post_init__(self):
+        object.__setattr__(self, "centre", _point("centre", self.centre))
+        object.__setattr__(self, "radius", _positive("radius", self.radius))
+        if self.side not in (-1, 1):
+            raise SceneError(f"side must be -1 or +1, got {self.side!r}")
+
+    @property
+    def winch_point(self):
+        """Where the vertical winch leg meets the pulley, ``(c_x + side r_p, c_z)`` [m]."""
+        return np.array([self.centre[0] + self.side * self.radius, self.centre[1]])
+
+    def tangent_point(self, angle):
+        """Point of the rim at polar angle ``angle`` [rad], shape (2,) [m]."""
+        return np.array(self.centre) + self.radius * np.array([math.cos(angle), math.sin(angle)])
+
+    def wrap_angle(self, angle):
+        """Angle [rad] wrapped from the winch point over the top to the rim angle ``angle``."""
+        if self.side < 0:
+            return (math.pi - angle) % (2.0 * math.pi)
+        return angle % (2.0 * math.pi)
+
+
+@dataclass(frozen=True)
+class SuspendedCable:
+    """One cable of the platform: its material, its anchor and its upper end.
+
+    Parameters
+    ----------
+    weight_per_length : float [N/m]
+        ``w >= 0``, weight per unstrained length.
+    axial_stiffness : float [N]
+        ``EA > 0``.
+    anchor : (float, float) [m]
+        Anchor point on the platform, in the platform frame (centre of mass at 0).
+    exit_point : (float, float) [m], optional
+        Fixed upper end, world frame. Give exactly one of ``exit_point`` and ``pulley``.
+    pulley : Pulley, optional
+        Pulley the cable leaves from.
+    """
+
+    weight_per_length: float
+    axial_stiffness: float
+    anchor: tuple = (0.0, 0.0)
+    exit_point: tuple | None = None
+    pulley: Pulley | None = None
+
+    def __post_init__(self):
+        object.__setattr__(
+            self, "weight_per_length", _non_negative("weight_per_length", self.weight_per_length)
+        )
+        object.__setattr__(
+            self, "axial_stiffness", _positive("axial_stiffness", self.axial_stiffness)
+        )
+        object.__setattr__(self, "anchor", _point("anchor", self.anchor))
+        if (self.exit_point is None) == (self.pulley is None):
+            raise SceneError(
+                f"give exactly one of exit_point and pulley, got exit_point={self.exit_point!r}, "
+                f"pulley={self.pulley!r}"
+            )
+        if self.exit_point is not None:
+            object.__setattr__(self, "exit_point", _point("exit_point", self.exit_point))
+        elif not isinstance(self.pulley, Pulley):
+            raise SceneError(f"pulley must be a Pulley, got {self.pulley!r}")
+
+    def catenary(self, unstrained_length):
+        """The `CatenaryCable` of this cable with the given unstrained length [m]."""
+        return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
+
+    @property
+    def upper_reference(self):
+        """Exit point, or pulley centre, shape (2,) [m]."""
+        if self.pulley is None:
+            return np.array(self.exit_point)
+        return np.array(self.pulley.centre)
+
+
+@dataclass(frozen=True)
+class SuspendedPlatform:
+    """A planar platform hung on catenary cables.
+
+    Parameters
+    ----------
+    cables : sequence of SuspendedCable
+    mass : float [kg]
+        ``M >= 0``; its weight ``M g`` acts at the centre of mass, along -z.
+    gravity : float [m/s^2], optional
+        Default 9.81.
+    moment_of_inertia : float [kg m^2], optional
+        About the centre of mass; only used by `inertial_wrench`.
+
+    A platform whose anchors are all at the centre of mass is a point mass: its
+    rotation is irrelevant (fixed at 0) and only the force balance is solved.
+    """
+
+    cables: tuple
+    mass: float
+    gravity: float = STANDARD_GRAVITY
+    moment_of_inertia: float = 0.0
+
+    def __post_init__(self):
+        cables = tuple(self.cables)
+        if not cables or not all(isinstance(c, SuspendedCable) for c in cables):
+            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {self.cables!r}")
+        object.__setattr__(self, "cables", cables)
+        object.__setattr__(self, "mass", _non_negative("mass", self.mass))
+        object.__setattr__(self, "gravity", _non_negative("gravity", self.gravity))
+        object.__setattr__(
+            self, "moment_of_inertia", _non_negative("moment_of_inertia", self.moment_of_inertia)
+        )
+
+    @property
+    def is_point_mass(self):
+        """True when every anchor is at the centre of mass."""
+        return all(c.anchor == (0.0, 0.0) for c in self.cables)
+
+    @property
+    def degrees_of_freedom(self):
+        """2 for a point mass ``(x, z)``, 3 for a rigid platform ``(x, z, phi)``."""
+        return 2 if self.is_point_mass else 3
+
+    def anchor_points(self, position, rotation=0.0):
+        """World positions of the anchors, shape (n_cables, 2) [m]."""
+        rotation_matrix = _rotation(rotation)
+        return np.array([np.asarray(position) + rotation_matrix @ c.anchor for c in self.cables])
+
+
+def inertial_wrench(platform, acceleration, angular_acceleration=0.0):
+    """D'Alembert load ``(-M a_x, -M a_z, -J alpha)`` for dynamic feed-forward.
+
+    Parameters
+    ----------
+    platform : SuspendedPlatform
+    acceleration : (float, float) [m/s^2]
+        Acceleration of the centre of mass.
+    angular_acceleration : float [rad/s^2], optional
+
+    Returns
+    -------
+    ndarray, shape (3,) [N, N, N m]
+        To pass as ``external_wrench`` to the statics solvers. Cable inertia is
+        neglected (the cables stay in quasi-static equilibrium).
+    """
+    a = _point("acceleration", acceleration)
+    alpha = _finite("angular_acceleration", angular_acceleration)
+    return np.array(
+        [-platform.mass * a[0], -platform.mass * a[1], -platform.moment_of_inertia * alpha]
+    )
+
+
+# ---------------------------------------------------------------------------
+# results
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class CableEquilibrium:
+    """One cable in a platform equilibrium.
+
+    Attributes
+    ----------
+    catenary : CatenaryState
+        The suspended part, from the anchor (A) to the exit or tangent point (B).
+    unstrained_length : float [m]
+        Total: suspended part plus, with a pulley, the wrapped arc up to the winch
+        point.
+    suspended_length : float [m]
+        Unstrained length of the suspended part.
+    anchor_point : ndarray, shape (2,) [m]
+        World position of the anchor.
+    upper_point : ndarray, shape (2,) [m]
+        Exit point, or the point where the cable leaves the pulley.
+    wrap_angle : float [rad]
+        Angle wrapped on the pulley (0 for a fixed exit point).
+    """
+
+    catenary: CatenaryState
+    unstrained_length: float
+    suspended_length: float
+    anchor_point: np.ndarray
+    upper_point: np.ndarray
+    wrap_angle: float = 0.0
+
+    @property
+    def force_on_platform(self):
+        """Force the cable exerts on the platform at its anchor, shape (2,) [N]."""
+        return self.catenary.force_on_a
+
+    @property
+    def tension_at_anchor(self):
+        """Tension at the anchor [N]."""
+        return self.catenary.tension_a
+
+    @property
+    def tension_at_exit(self):
+        """Tension at the exit or tangent point [N] (uniform along the wrap)."""
+        return self.catenary.tension_b
+
+
+@dataclass(frozen=True, eq=False)
+class PlatformEquilibrium:
+    """A static (or quasi-static) equilibrium of the platform on its cables.
+
+    Attributes
+    ----------
+    position : ndarray, shape (2,) [m]
+        Centre of mass.
+    rotation : float [rad]
+        Counter-clockwise; 0 for a point mass.
+    cables : tuple of CableEquilibrium
+    stiffness : ndarray, shape (k, k)
+        ``-d(wrench on the platform)/d(pose)`` at fixed unstrained lengths, with
+        ``k = 2`` ``(x, z)`` for a point mass, ``k = 3`` ``(x, z, phi)`` otherwise;
+        units N/m, N/rad, N m/m, N m/rad. Positive definite where the equilibrium is
+        stable.
+    external_wrench : ndarray, shape (3,) [N, N, N m]
+    """
+
+    position: np.ndarray
+    rotation: float
+    cables: tuple
+    stiffness: np.ndarray = field(repr=False)
+    external_wrench: np.ndarray = field(repr=False)
+
+    @property
+    def unstrained_lengths(self):
+        """Unstrained length of each cable, shape (n_cables,) [m]."""
+        return np.array([c.unstrained_length for c in self.cables])
+
+    @property
+    def tensions_at_anchor(self):
+        """Tension of each cable at its anchor, shape (n_cables,) [N]."""
+        return np.array([c.tension_at_anchor for c in self.cables])
+
+    @property
+    def forces_on_platform(self):
+        """Force of each cable on the platform, shape (n_cables, 2) [N]."""
+        return np.array([c.force_on_platform for c in self.cables])
+
+    @property
+    def is_stable(self):
+        """True when the symmetric part of `stiffness` is positive definite."""
+        return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
+
+
+# ---------------------------------------------------------------------------
+# a small damped Newton solver
+# ---------------------------------------------------------------------------
+def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium"):
+    """Newton's method with backtracking on the residual norm.
+
+    ``function(x) -> (residual, jacobian)``; it may raise UnreachableError at a trial
+    point, which then counts as a rejected step. Components listed in ``positive``
+    are kept above 10 % of their current value. Returns ``(x, residual, jacobian)``.
+    """
+    x = np.array(x0, dtype=float)
+    residual, jacobian = function(x)
+    norm = float(np.linalg.norm(residual))
+    for _ in range(max_iterations):
+        if norm <= tolerance:
+            return x, residual, jacobian
+        try:
+            step = -np.linalg.solve(jacobian, residual)
+        except np.linalg.LinAlgError:
+            break
+        if not np.all(np.isfinite(step)):
+            break
+        alpha = 1.0
+        for index in positive:
+            if step[index] < -0.9 * x[index]:
+                alpha = min(alpha, 0.9 * x[index] / -step[index])
+        accepted = False
+        for _ in range(50):
+            trial = x + alpha * step
+            try:
+                trial_residual, trial_jacobian = function(trial)
+                trial_norm = float(np.linalg.norm(trial_residual))
+            except UnreachableError:
+                trial_norm = math.inf
+            if trial_norm < (1.0 - 1e-4 * alpha) * norm or trial_norm <= tolerance:
+                accepted = True
+                break
+            alpha *= 0.5
+        if not accepted:
+            break
+        x, residual, jacobian, norm = trial, trial_residual, trial_jacobian, trial_norm
+    if norm <= 1e3 * tolerance:  # stalled at round-off level
+        return x, residual, jacobian
+    raise UnreachableError(f"{what} did not converge (scaled residual {norm:.3g})")
+
+
+# ---------------------------------------------------------------------------
+# one cable: ideal (straight) geometry
+# ---------------------------------------------------------------------------
+def _straight_tangent_angle(pulley, point):
+    """Rim angle where a straight cable from ``point`` leaves ``pulley``."""
+    centre = np.array(pulley.centre)
+    offset = centre - point
+    distance = float(np.hypot(*offset))
+    if distance <= pulley.radius:
+        raise UnreachableError(
+            f"anchor point ({point[0]:g}, {point[1]:g}) m lies inside the pulley of centre "
+            f"{pulley.centre} m and radius {pulley.radius:g} m"
+        )
+    gamma = math.atan2(offset[1], offset[0])
+    spread = math.acos(-pulley.radius / distance)
+    for angle in (gamma + spread, gamma - spread):
+        tangent = pulley.side * np.array([math.sin(angle), -math.cos(angle)])
+        if np.dot(pulley.tangent_point(angle) - point, tangent) > 0.0:
+            return angle
+    raise AssertionError("no tangent with the pulley's orientation")  # pragma: no cover
+
+
+def _ideal_length(cable, point):
+    """Straight, inextensible length from an anchor point to the winch point [m]."""
+    if cable.pulley is None:
+        return float(np.hypot(*(np.array(cable.exit_point) - point)))
+    angle = _straight_tangent_angle(cable.pulley, point)
+    straight = float(np.hypot(*(cable.pulley.tangent_point(angle) - point)))
+    return straight + cable.pulley.radius * cable.pulley.wrap_angle(angle)
+
+
+# ---------------------------------------------------------------------------
+# one cable: forward (given unstrained length) and inverse (given H)
+# ---------------------------------------------------------------------------
+def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_length, tension_scale):
+    """Residual of the pulley cable (span mismatch, tangency) and its partial derivatives.
+
+    Returns ``(residual (3,), d/d(H, V_B, L_c, angle) (3, 4), catenary)``.
+    """
+    catenary = cable.catenary(suspended_length)
+    span, jac = span_and_jacobian(catenary, H, V_B, sign_x)
+    tangent = pulley.tangent_point(angle)
+    c, s = math.cos(angle), math.sin(angle)
+    scale = suspended_length / tension_scale  # tangency residual in metres
+    residual = np.empty(3)
+    residual[:2] = span - (tangent - point)
+    residual[2] = scale * (sign_x * H * c + V_B * s)
+    partial = np.zeros((3, 4))
+    partial[:2, 0] = jac[:, 0]
+    partial[:2, 1] = jac[:, 1]
+    partial[:2, 2] = jac[:, 2]
+    partial[:2, 3] = -pulley.radius * np.array([-s, c])
+    partial[2, 0] = scale * sign_x * c
+    partial[2, 1] = scale * s
+    partial[2, 3] = scale * (-sign_x * H * s + V_B * c)
+    return residual, partial, catenary
+
+
+def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tension):
+    """Cable of given length from an anchor point: equilibrium and ``dF_A/dp_A``.
+
+    Returns ``(CableEquilibrium, d(force on A)/d(anchor point) (2, 2), guess)``.
+    """
+    if cable.pulley is None:
+        catenary_guess = None if guess is None else guess[:2]
+        state = solve_forward(
+            cable.catenary(unstrained_length),
+            np.array(cable.exit_point) - point,
+            initial_guess=catenary_guess,
+            max_strain=max_strain,
+            max_tension=max_tension,
+        )
+        equilibrium = CableEquilibrium(
+            state, unstrained_length, unstrained_length, point.copy(), np.array(cable.exit_point)
+        )
+        stiffness = end_stiffness(cable.catenary(unstrained_length), state)
+        return equilibrium, stiffness, (state.horizontal_tension, state.vertical_tension_b)
+
+    pulley, EA, w, r = cable.pulley, cable.axial_stiffness, cable.weight_per_length, cable.pulley.radius
+    if guess is None:
+        angle = _straight_tangent_angle(pulley, point)
+        suspended = unstrained_length - r * pulley.wrap_angle(angle)
+        if suspended <= 0.0:
+            raise UnreachableError(
+                f"unstrained_length {unstrained_length:g} m is shorter than the wrap on the pulley"
+            )
+        state = solve_forward(
+            cable.catenary(suspended), pulley.tangent_point(angle) - point,
+            max_strain=max_strain, max_tension=max_tension,
+        )
+        H, V_B = state.horizontal_tension, state.vertical_tension_b
+        if H <= 0.0:  # a just-taut massless (or vertical) start: pull a little
+            H = 1e-9 * EA
+    else:
+        H, V_B, angle = guess
+    sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
+    tension_scale = max(math.hypot(H, V_B), w * unstrained_length, 1e-300)
+
+    def suspended_length(x):
+        H_, V_, angle_ = x
+        tension = math.hypot(H_, V_)
+        stretch = 1.0 + tension / EA
+        wrap = pulley.wrap_angle(angle_)
+        length = unstrained_length - r * wrap / stretch
+        # d(length)/d(H, V_B, angle)
+        factor = r * wrap / (EA * stretch**2 * tension) if tension > 0.0 else 0.0
+        derivative = np.array([factor * H_, factor * V_, -r * pulley.side / stretch])
+        return length, derivative, wrap
+
+    def function(x):
+        if x[0] <= 0.0:
+            raise UnreachableError("horizontal tension must stay positive")
+        length, derivative, _ = suspended_length(x)
+        if length <= 0.0:
+            raise UnreachableError("the whole cable would lie on the pulley")
+        residual, partial, _ = _pulley_residual(
+            cable, pulley, sign_x, point, x[0], x[1], x[2], length, tension_scale
+        )
+        jacobian = partial[:, [0, 1, 3]] + np.outer(partial[:, 2], derivative)
+        return residual, jacobian
+
+    tolerance = _RELATIVE_TOLERANCE * unstrained_length
+    x, _, jacobian = _damped_newton(
+        function, (H, V_B, angle), tolerance, positive=(0,), what="pulley cable"
+    )
+    H, V_B, angle = x
+    length, derivative, wrap = suspended_length(x)
+    state = state_from_end_forces(cable.catenary(length), H, V_B, sign_x)
+    if state.max_tension > _tension_limit(cable, max_strain, max_tension):
+        raise UnreachableError(
+            f"cable of unstrained_length {unstrained_length:g} m would need tension "
+            f"{state.max_tension:g} N, above its limit"
+        )
+    # d(H, V_B, angle)/d(point) = -jacobian^-1 d(residual)/d(point), d(residual)/d(point) = [I; 0]
+    sensitivity = -np.linalg.solve(jacobian, np.vstack([np.eye(2), np.zeros((1, 2))]))
+    force_derivative = np.array(
+        [[sign_x, 0.0, 0.0], [-w * derivative[0], 1.0 - w * derivative[1], -w * derivative[2]]]
+    )
+    stiffness = force_derivative @ sensitivity
+    equilibrium = CableEquilibrium(
+        state, unstrained_length, length, point.copy(), pulley.tangent_point(angle), wrap
+    )
+    return equilibrium, stiffness, (H, V_B, angle)
+
+
+def _tension_limit(cable, max_strain, max_tension):
+    limit = max_strain * cable.axial_stiffness
+    return limit if max_tension is None else min(limit, max_tension)
+
+
+def _inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
+    """Cable with given horizontal tension from an anchor point.
+
+    Returns ``(CableEquilibrium, dF_A/dH (2,), dF_A/dp_A at fixed H (2, 2), guess)``.
+    """
+    H, w, EA = horizontal_tension, cable.weight_per_length, cable.axial_stiffness
+    if cable.pulley is None:
+        span = np.array(cable.exit_point) - point
+        length, state = solve_inverse(span, w, EA, H, max_strain=max_strain, max_tension=max_tension)
+        _, jac = span_and_jacobian(cable.catenary(length), H, state.vertical_tension_b, state.horizontal_sign)
+        # residual span(H, V_B, L) - (e - p); unknowns (L, V_B)
+        jacobian = jac[:, [2, 1]]
+        d_residual_dH = jac[:, 0]
+        d_residual_dp = np.eye(2)
+        sign_x = state.horizontal_sign
+        equilibrium = CableEquilibrium(state, length, length, point.copy(), np.array(cable.exit_point))
+        new_guess = None
+    else:
+        pulley, r = cable.pulley, cable.pulley.radius
+        if guess is None:
+            angle = _straight_tangent_angle(pulley, point)
+            length, state = solve_inverse(
+                pulley.tangent_point(angle) - point, w, EA, H,
+                max_strain=max_strain, max_tension=max_tension,
+            )
+            V_B = state.vertical_tension_b
+        else:
+            length, V_B, angle = guess
+        sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
+        tension_scale = max(math.hypot(H, V_B), w * length, 1e-300)
+
+        def function(x):
+            if x[0] <= 0.0:
+                raise UnreachableError("suspended length must stay positive")
+            residual, partial, _ = _pulley_residual(
+                cable, pulley, sign_x, point, H, x[1], x[2], x[0], tension_scale
+            )
+            return residual, partial[:, [2, 1, 3]]
+
+        x, _, jacobian = _damped_newton(
+            function, (length, V_B, angle), _RELATIVE_TOLERANCE * length, positive=(0,),
+            what="pulley cable",
+        )
+        length, V_B, angle = x
+        _, partial, catenary = _pulley_residual(
+            cable, pulley, sign_x, point, H, V_B, angle, length, tension_scale
+        )
+        d_residual_dH = partial[:, 0]
+        d_residual_dp = np.vstack([np.eye(2), np.zeros((1, 2))])
+        state = state_from_end_forces(catenary, H, V_B, sign_x)
+        wrap = pulley.wrap_angle(angle)
+        total = length + r * wrap / (1.0 + state.tension_b / EA)
+        equilibrium = CableEquilibrium(state, total, length, point.copy(), pulley.tangent_point(angle), wrap)
+        new_guess = (length, V_B, angle)
+    if state.max_tension > _tension_limit(cable, max_strain, max_tension):
+        raise UnreachableError(
+            f"horizontal_tension {H:g} N needs tension {state.max_tension:g} N, above the limit"
+        )
+    # unknowns u = (L_c, V_B[, angle]); force on A = (sign_x H, V_B - w L_c)
+    d_u_dH = -np.linalg.solve(jacobian, d_residual_dH)
+    d_u_dp = -np.linalg.solve(jacobian, d_residual_dp)
+    force_dH = np.array([sign_x, d_u_dH[1] - w * d_u_dH[0]])
+    force_dp = np.vstack([np.zeros(2), d_u_dp[1] - w * d_u_dp[0]])
+    return equilibrium, force_dH, force_dp, new_guess
+
+
+# ---------------------------------------------------------------------------
+# the platform
+# ---------------------------------------------------------------------------
+def _scales(platform, lengths, wrench):
+    """Force [N] and length [m] scales of the equilibrium residual."""
+    weight = platform.mass * platform.gravity
+    cable_weight = sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths))
+    force = weight + cable_weight + float(np.hypot(wrench[0], wrench[1]))
+    arm = max((float(np.hypot(*c.anchor)) for c in platform.cables), default=0.0)
+    length = arm if arm > 0.0 else 1.0
+    force = max(force, abs(wrench[2]) / length, 1e-12)
+    return force, length
+
+
+def _platform_tolerance(platform, force_scale):
+    """Relative tolerance of the wrench balance.
+
+    Each cable is solved to ``1e-12`` of its length, which leaves a force error of
+    about ``1e-12 EA``: a stiff cable cannot balance a light platform any better.
+    """
+    stiffest = max(c.axial_stiffness for c in platform.cables)
+    return _RELATIVE_TOLERANCE * (1.0 + stiffest / force_scale)
+
+
+def _wrench_residual(platform, rotation, equilibria, wrench, dof):
+    """Net wrench on the platform ``(fx, fz[, m])`` [N, N, N m]."""
+    rotation_matrix = _rotation(rotation)
+    total = np.array([wrench[0], wrench[1] - platform.mass * platform.gravity, wrench[2]])
+    for cable, equilibrium in zip(platform.cables, equilibria):
+        force = equilibrium.force_on_platform
+        total[:2] += force
+        total[2] += _cross(rotation_matrix @ cable.anchor, force)
+    return total[:dof]
+
+
+def _pose_jacobian(platform, rotation, equilibria, stiffnesses, dof):
+    """``d(net wrench)/d(pose)`` from the cables' ``dF_A/dp_A``, shape (dof, dof)."""
+    rotation_matrix = _rotation(rotation)
+    jacobian = np.zeros((3, 3))
+    for cable, equilibrium, stiffness in zip(platform.cables, equilibria, stiffnesses):
+        arm = rotation_matrix @ cable.anchor
+        d_point = np.column_stack([np.eye(2), _perpendicular(arm)])  # dp/d(x, z, phi)
+        d_force = stiffness @ d_point
+        force = equilibrium.force_on_platform
+        jacobian[:2] += d_force
+        jacobian[2] += arm[0] * d_force[1] - arm[1] * d_force[0]
+        jacobian[2, 2] += _cross(_perpendicular(arm), force)
+    return jacobian[:dof, :dof]
+
+
+def _lengths(platform, unstrained_lengths):
+    try:
+        lengths = np.asarray(unstrained_lengths, dtype=float)
+    except (TypeError, ValueError):
+        raise SceneError(f"unstrained_lengths must be numbers [m], got {unstrained_lengths!r}") from None
+    if lengths.shape != (len(platform.cables),):
+        raise SceneError(
+            f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
+            f"got {unstrained_lengths!r}"
+        )
+    if not np.all(np.isfinite(lengths)) or np.any(lengths <= 0.0):
+        raise SceneError(f"unstrained_lengths must be positive and finite, got {unstrained_lengths!r}")
+    return lengths
+
+
+def ideal_pose(platform, unstrained_lengths, rotation=0.0):
+    """Pose at which straight, inextensible cables have the given lengths.
+
+    Least squares on ``ideal_length_i(pose) - L_i`` from a point below the upper
+    ends (so the hanging solution is found). The rotation is solved only for a rigid
+    platform with three or more cables; otherwise it stays at ``rotation``.
+
+    Returns
+    -------
+    position : ndarray, shape (2,) [m]
+    rotation : float [rad]
+    """
+    lengths = _lengths(platform, unstrained_lengths)
+    uppers = np.array([c.upper_reference for c in platform.cables])
+    solve_rotation = platform.degrees_of_freedom == 3 and len(platform.cables) >= 3
+    start = np.array([uppers[:, 0].mean(), uppers[:, 1].mean() - lengths.mean()])
+
+    def residual(x):
+        phi = x[2] if solve_rotation else rotation
+        points = platform.anchor_points(x[:2], phi)
+        try:
+            return [_ideal_length(c, p) - L for c, p, L in zip(platform.cables, points, lengths)]
+        except UnreachableError:
+            return np.full(len(lengths), 1e6)
+
+    x0 = np.append(start, rotation) if solve_rotation else start
+    solution = least_squares(residual, x0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    phi = float(solution.x[2]) if solve_rotation else float(rotation)
+    return solution.x[:2].copy(), phi
+
+
+def solve_forward_statics(
+    platform,
+    unstrained_lengths,
+    initial_pose=None,
+    external_wrench=None,
+    max_strain=DEFAULT_MAX_STRAIN,
+    max_tension=None,
+):
+    """Equilibrium pose and cable forces of the platform for given cable lengths.
+
+    Solves the force balance (and the moment balance about the centre of mass for a
+    rigid platform) by Newton's method with the analytic Jacobian, assembled from the
+    cables' end stiffnesses; each residual evaluation solves every cable's catenary,
+    warm-started from the previous iterate.
+
+    Parameters
+    ----------
+    platform : SuspendedPlatform
+    unstrained_lengths : array_like, shape (n_cables,) [m]
+        Total unstrained length of each cable (with a pulley: up to its winch point).
+    initial_pose : (x, z) or (x, z, phi), optional
+        Starting pose [m, m, rad]; default: `ideal_pose` of straight cables stretched
+        by an even share of the load.
+    external_wrench : (fx, fz, moment), optional
+        Extra load on the platform [N, N, N m] at its centre of mass, eg
+        `inertial_wrench`.
+    max_strain, max_tension : float, optional
+        Cable tension limits, as in `catenary.solve_forward`.
+
+    Returns
+    -------
+    PlatformEquilibrium
+
+    Raises
+    ------
+    UnreachableError
+        If no equilibrium is found within the tension limits.
+    SceneError
+        If an argument is invalid.
+    """
+    lengths = _lengths(platform, unstrained_lengths)
+    wrench = _wrench(external_wrench)
+    dof = platform.degrees_of_freedom
+    if initial_pose is None:
+        # straight cables, stretched by an even share of the load: starts massless
+        # cables taut rather than on the kink between slack and taut
+        load = platform.mass * platform.gravity + float(np.hypot(wrench[0], wrench[1]))
+        load += sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths))
+        strain = np.array([load / len(lengths) / c.axial_stiffness for c in platform.cables])
+        position, rotation = ideal_pose(platform, lengths * (1.0 + np.minimum(strain, 0.01)))
+    else:
+        pose = np.asarray(initial_pose, dtype=float)
+        if pose.shape not in ((2,), (3,)) or not np.all(np.isfinite(pose)):
+            raise SceneError(f"initial_pose must be (x, z) or (x, z, phi), got {initial_pose!r}")
+        position, rotation = pose[:2], (float(pose[2]) if pose.size == 3 else 0.0)
+    if dof == 2:
+        rotation = 0.0
+    force_scale, length_scale = _scales(platform, lengths, wrench)
+    residual_scale = np.array([force_scale, force_scale, force_scale * length_scale])[:dof]
+    pose_scale = np.array([1.0, 1.0, length_scale])[:dof]  # unknowns in metres
+    guesses = [None] * len(platform.cables)
+    cache = {}
+
+    def evaluate(pose):
+        phi = pose[2] if dof == 3 else 0.0
+        points = platform.anchor_points(pose[:2], phi)
+        equilibria, stiffnesses, new_guesses = [], [], []
+        for i, (cable, point, length) in enumerate(zip(platform.cables, points, lengths)):
+            equilibrium, stiffness, guess = _forward_cable(
+                cable, length, point, guesses[i], max_strain, max_tension
+            )
+            equilibria.append(equilibrium)
+            stiffnesses.append(stiffness)
+            new_guesses.append(guess)
+        guesses[:] = new_guesses
+        residual = _wrench_residual(platform, phi, equilibria, wrench, dof)
+        jacobian = _pose_jacobian(platform, phi, equilibria, stiffnesses, dof)
+        cache["last"] = (equilibria, jacobian)
+        return residual, jacobian
+
+    def function(scaled_pose):
+        residual, jacobian = evaluate(scaled_pose / pose_scale)
+        return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
+
+    start = np.append(position, rotation)[:dof] * pose_scale
+    tolerance = _platform_tolerance(platform, force_scale)
+    scaled, _, _ = _damped_newton(function, start, tolerance, what="forward statics")
+    pose = scaled / pose_scale
+    _, jacobian = evaluate(pose)  # the accepted point, with its own cable states
+    equilibria, _ = cache["last"]
+    return _result(platform, pose, equilibria, jacobian, wrench, dof)
+
+
+def _result(platform, pose, equilibria, jacobian, wrench, dof):
+    return PlatformEquilibrium(
+        position=np.array(pose[:2], dtype=float),
+        rotation=float(pose[2]) if dof == 3 else 0.0,
+        cables=tuple(equilibria),
+        stiffness=-np.array(jacobian),
+        external_wrench=wrench,
+    )
+
+
+def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
+    """Horizontal tensions of straight massless cables balancing the load (start guess)."""
+    points = platform.anchor_points(position, rotation)
+    rotation_matrix = _rotation(rotation)
+    load = -np.array([wrench[0], wrench[1] - platform.mass * platform.gravity, wrench[2]])
+    columns, horizontal = [], []
+    for cable, point in zip(platform.cables, points):
+        if cable.pulley is None:
+            upper = np.array(cable.exit_point)
+        else:
+            upper = cable.pulley.tangent_point(_straight_tangent_angle(cable.pulley, point))
+        direction = upper - point
+        length = float(np.hypot(*direction))
+        unit = direction / length
+        load[1] += 0.5 * cable.weight_per_length * length  # the anchor carries about half
+        arm = rotation_matrix @ cable.anchor
+        columns.append([unit[0], unit[1], _cross(arm, unit)])
+        horizontal.append(abs(unit[0]))
+    structure = np.array(columns).T  # structure matrix, shape (3, n)
+    rows = 2 if (platform.degrees_of_freedom == 2 or free_rotation) else 3
+    tensions, *_ = np.linalg.lstsq(structure[:rows], load[:rows], rcond=None)
+    return tensions * np.array(horizontal), tensions
+
+
+def solve_inverse_statics(
+    platform,
+    position,
+    rotation=None,
+    external_wrench=None,
+    max_strain=DEFAULT_MAX_STRAIN,
+    max_tension=None,
+):
+    """Cable lengths and forces that hold the platform at a given position.
+
+    Unknowns: each cable's horizontal tension, plus the rotation when it is not
+    given; each cable's unstrained length and end forces follow from
+    `catenary.solve_inverse` (or its pulley version). Equations: force balance, and
+    moment balance for a rigid platform. The problem must be square:
+
+    * point mass: 2 cables (more would need a tension distribution);
+    * rigid platform on 2 cables: ``rotation=None`` (3 DOF, 2 cables: equilibrium
+      fixes the rotation);
+    * rigid platform on 3 cables: ``rotation`` given.
+
+    Parameters
+    ----------
+    platform : SuspendedPlatform
+    position : (x, z) [m]
+        Desired position of the centre of mass.
+    rotation : float [rad], optional
+        Desired rotation, when the cables can choose it (see above).
+    external_wrench : (fx, fz, moment), optional
+        Extra load [N, N, N m], eg `inertial_wrench` for dynamic feed-forward.
+    max_strain, max_tension : float, optional
+        Cable tension limits, as in `catenary.solve_forward`.
+
+    Returns
+    -------
+    PlatformEquilibrium
+        With the unstrained lengths, forces, the rotation and the stiffness at fixed
+        lengths.
+
+    Raises
+    ------
+    UnreachableError
+        If a cable would have to push (no equilibrium with positive tensions), a cable
+        would be vertical (its horizontal tension cannot parametrise it), a tension
+        exceeds the limit, or Newton fails.
+    SceneError
+        If an argument is invalid or the problem is not square.
+    """
+    position = np.array(_point("position", position))
+    wrench = _wrench(external_wrench)
+    dof = platform.degrees_of_freedom
+    n = len(platform.cables)
+    if dof == 2:
+        if rotation not in (None, 0, 0.0):
+            raise SceneError(f"a point-mass platform has no rotation, got rotation={rotation!r}")
+        free_rotation = False
+        rotation = 0.0
+    else:
+        free_rotation = rotation is None
+        rotation = 0.0 if rotation is None else _finite("rotation", rotation)
+    if n + int(free_rotation) != dof:
+        raise SceneError(
+            f"inverse statics needs as many unknowns as equations: {n} cables"
+            f"{' + rotation' if free_rotation else ''} for {dof} equations; "
+            f"pass rotation=None for a rigid platform on 2 cables, a rotation on 3"
+        )
+    horizontal, tensions = _ideal_tensions(platform, position, rotation, wrench, free_rotation)
+    if np.any(tensions <= 0.0):
+        # straight massless cables would push; start from a moderate pull and let
+        # Newton decide (it fails, with UnreachableError, if they really must push)
+        weight = max(platform.mass * platform.gravity, 1e-9)
+        horizontal = np.maximum(horizontal, 0.1 * weight)
+    lengths_guess = [_ideal_length(c, p) for c, p in zip(platform.cables, platform.anchor_points(position, rotation))]
+    force_scale, length_scale = _scales(platform, lengths_guess, wrench)
+    residual_scale = np.array([force_scale, force_scale, force_scale * length_scale])[:dof]
+    unknown_scale = np.append(np.full(n, 1.0 / force_scale), [1.0 / math.pi] if free_rotation else [])
+    guesses = [None] * n
+    cache = {}
+
+    def evaluate(u):
+        H = u[:n]
+        phi = u[n] if free_rotation else rotation
+        if np.any(H <= 0.0):
+            raise UnreachableError("a cable would have to push (horizontal tension <= 0)")
+        points = platform.anchor_points(position, phi)
+        rotation_matrix = _rotation(phi)
+        equilibria, new_guesses = [], []
+        jacobian = np.zeros((3, n + 1))
+        for i, (cable, point) in enumerate(zip(platform.cables, points)):
+            equilibrium, force_dH, force_dp, guess = _inverse_cable(
+                cable, H[i], point, guesses[i], max_strain, max_tension
+            )
+            equilibria.append(equilibrium)
+            new_guesses.append(guess)
+            arm = rotation_matrix @ cable.anchor
+            jacobian[:2, i] = force_dH
+            jacobian[2, i] = _cross(arm, force_dH)
+            d_force_dphi = force_dp @ _perpendicular(arm)
+            jacobian[:2, n] += d_force_dphi
+            jacobian[2, n] += _cross(arm, d_force_dphi) + _cross(
+                _perpendicular(arm), equilibrium.force_on_platform
+            )
+        guesses[:] = new_guesses
+        residual = _wrench_residual(platform, phi, equilibria, wrench, dof)
+        columns = list(range(n)) + ([n] if free_rotation else [])
+        cache["last"] = (equilibria, phi)
+        return residual, jacobian[:dof][:, columns]
+
+    def function(scaled):
+        residual, jacobian = evaluate(scaled / unknown_scale)
+        return residual / residual_scale, jacobian / residual_scale[:, None] / unknown_scale[None, :]
+
+    start = np.append(horizontal, [rotation] if free_rotation else []) * unknown_scale
+    try:
+        scaled, _, _ = _damped_newton(
+            function, start, _platform_tolerance(platform, force_scale), positive=tuple(range(n)),
+            what="inverse statics",
+        )
+    except UnreachableError as error:
+        raise UnreachableError(
+            f"no equilibrium with pulling cables at position ({position[0]:g}, {position[1]:g}) m"
+            f" ({error})"
+        ) from None
+    evaluate(scaled / unknown_scale)
+    equilibria, phi = cache["last"]
+    # stiffness at fixed lengths: the forward cable derivatives at the solution
+    stiffnesses = []
+    for cable, equilibrium in zip(platform.cables, equilibria):
+        guess = None
+        if cable.pulley is not None:
+            guess = (
+                equilibrium.catenary.horizontal_tension,
+                equilibrium.catenary.vertical_tension_b,
+                _rim_angle(cable.pulley, equilibrium.upper_point),
+            )
+        _, stiffness, _ = _forward_cable(
+            cable, equilibrium.unstrained_length, equilibrium.anchor_point, guess, max_strain, max_tension
+        )
+        stiffnesses.append(stiffness)
+    jacobian = _pose_jacobian(platform, phi, equilibria, stiffnesses, dof)
+    pose = np.append(position, phi)
+    return _result(platform, pose, equilibria, jacobian, wrench, dof)
+
+
+def _rim_angle(pulley, point):
+    return math.atan2(point[1] - pulley.centre[1], point[0] - pulley.centre[0])

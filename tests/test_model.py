@@ -1,0 +1,298 @@
+"""Tests of the Exudyn model the builder makes (cdpr_exu.model and its builders).
+
+Sections: what items the builder adds; statics of cables at rest on the real solver
+(weight balance, end reactions, Hooke's law); bad input refused before any simulation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import exudyn as exu
+import numpy as np
+import pytest
+
+from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.model import build_model, contact_candidates
+from cdpr_exu.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, WinchSpec, load_scene
+from cdpr_exu.simulate import simulate, solver_settings
+from cdpr_exu.trajectories import CircleTrajectory
+
+from conftest import GRAVITY, settling_solver
+
+
+def settled_model(scene):
+    """Build ``scene`` and integrate it to its end time; returns the Model at rest."""
+    model = build_model(scene)
+    model.mbs.SolveDynamic(solver_settings(scene))
+    return model
+
+
+def end_forces_on_cable(model, i):
+    """Forces (x, z) [N] the winch and the platform joint exert on cable i's end nodes.
+
+    Exudyn's ``ObjectConnectorCoordinate`` reports its Lagrange multiplier lambda; the
+    force on the constrained node coordinate (its marker 1) is -lambda.
+    ``ObjectJointRevolute2D`` reports the force on its marker 0, the platform anchor;
+    the cable's last node (marker 1) receives the opposite force. These conventions
+    are pinned by ``test_winch_and_joint_reactions_hold_a_hanging_cable``.
+
+    Returns
+    -------
+    top : ndarray, shape (2,)
+        On node 0, from the winch constraints.
+    bottom : ndarray, shape (2,)
+        On node n, from the platform joint.
+    """
+    mbs, winch = model.mbs, model.winches[i]
+    force = exu.OutputVariableType.Force
+    top = -np.array([mbs.GetObjectOutput(winch.horizontal, force), mbs.GetObjectOutput(winch.vertical, force)])
+    on_platform = np.asarray(mbs.GetObjectOutput(model.platform.joints[i], force))[:2]
+    return top, -on_platform
+
+
+# ============================================================================ items
+
+
+@pytest.fixture(scope="module")
+def paper_model():
+    return build_model(load_scene("paper-circle"))
+
+
+def test_paper_scene_has_a_mass_point_per_node_and_a_spring_damper_per_element(paper_model):
+    counts = paper_model.item_counts()
+    assert counts["mass_points"] == 2 * 16
+    assert counts["axial_spring_dampers"] == 2 * 15
+    assert counts["gravity_loads"] == 2 * 16 + 1  # every node and the platform
+    assert counts["winch_constraints"] == 2 * 2
+    assert counts["platform_joints"] == 2
+
+
+def test_paper_scene_bends_at_every_interior_node_in_one_object(paper_model):
+    counts = paper_model.item_counts()
+    assert counts["bending_objects"] == 1
+    assert counts["bending_joints"] == 2 * 14
+    joints = paper_model.bending.joints
+    # consecutive triplets (b - 1, b, b + 1), never spanning two cables (nodes 0-15 and 16-31)
+    assert np.all(np.diff(joints, axis=1) == 1)
+    assert not np.any((joints[:, 0] <= 15) & (joints[:, 2] >= 16))
+
+
+def test_pulley_contacts_only_on_nodes_that_can_reach_the_pulley(paper_model):
+    counts = paper_model.item_counts()
+    assert 0 < counts["pulley_contacts"] < 2 * 16
+    for i, (contacts, nodes) in enumerate(zip(paper_model.contacts, paper_model.contact_nodes)):
+        assert len(contacts) == len(nodes)
+        assert 0 not in nodes  # the winch node's motion is prescribed
+        assert 15 not in nodes  # the anchor node stays 1.6 m or more below the pulley
+        np.testing.assert_array_equal(nodes, contact_candidates(paper_model.scene, i))
+
+
+def test_catenary_preset_adds_no_bending_object():
+    scene = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary"))
+    counts = build_model(scene).item_counts()
+    assert counts["bending_objects"] == 0
+    assert counts["bending_joints"] == 0
+    assert counts["axial_spring_dampers"] == 2 * 15
+
+
+def test_point_exit_adds_no_pulley_contact(v_shaped):
+    counts = build_model(v_shaped()).item_counts()
+    assert counts["pulley_contacts"] == 0
+
+
+# ============================================================================ statics
+
+
+def test_hanging_cable_tension_steps_by_the_weight_of_each_node(hanging_cable):
+    scene = hanging_cable()
+    result = simulate(scene)
+    tension = result.tensions[0][-1]
+    weights = GRAVITY * scene.cables[0].node_masses()
+    # Element i holds every node below it: T_i - T_{i+1} = weight of node i + 1.
+    # 1e-6 N: the scene is settled (see settling_solver) and Newton's residual
+    # is far smaller; the node weights are 0.2 to 0.9 N.
+    np.testing.assert_allclose(-np.diff(tension), weights[1:-1], rtol=0, atol=1e-6)
+    assert tension[0] - tension[-1] == pytest.approx(weights[1:-1].sum(), abs=1e-6)
+
+
+def test_hanging_cable_top_tension_carries_everything_below(hanging_cable):
+    scene = hanging_cable(platform_mass=1.0)
+    result = simulate(scene)
+    tension = result.tensions[0][-1]
+    weights = GRAVITY * scene.cables[0].node_masses()
+    platform_weight = GRAVITY * scene.platform.mass
+    # 1e-6 N out of ~13 N: settled, see above.
+    assert tension[0] == pytest.approx(weights[1:].sum() + platform_weight, abs=1e-6)
+    assert tension[-1] == pytest.approx(weights[-1] + platform_weight, abs=1e-6)
+    # straight down: no node leaves the vertical through the suspension point
+    assert np.abs(result.nodes[0][-1][:, 0]).max() < 1e-12
+
+
+def test_winch_and_joint_reactions_hold_a_hanging_cable(hanging_cable):
+    scene = hanging_cable(platform_mass=1.0)
+    model = settled_model(scene)
+    top, bottom = end_forces_on_cable(model, 0)
+    cable_weight = GRAVITY * scene.cables[0].mass
+    platform_weight = GRAVITY * scene.platform.mass
+    # 1e-6 N: settled; the reactions are Lagrange multipliers solved with the state.
+    np.testing.assert_allclose(top, [0.0, cable_weight + platform_weight], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(bottom, [0.0, -platform_weight], rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("preset", ["catenary", "full"])
+def test_v_shaped_cable_end_forces_balance_its_weight(v_shaped, preset):
+    scene = v_shaped(Effects.from_preset(preset))
+    model = settled_model(scene)
+    for i, cable in enumerate(scene.cables):
+        top, bottom = end_forces_on_cable(model, i)
+        # The cable is inclined and sags: both end forces have x components (~9 N here),
+        # which must cancel; the vertical ones must carry its weight (8.5 N).
+        assert abs(top[0]) > 1.0
+        # 1e-6 N: settled to ~1e-10 N; internal (axial, bending) forces cancel in the sum.
+        np.testing.assert_allclose(top + bottom, [0.0, GRAVITY * cable.mass], rtol=0, atol=1e-6)
+
+
+def test_v_shaped_cables_hold_the_platform_weight(v_shaped):
+    scene = v_shaped()
+    model = settled_model(scene)
+    on_platform = -sum(end_forces_on_cable(model, i)[1] for i in range(scene.n_cables))
+    # 1e-6 N: settled, as above. The point mass sits on the symmetry line.
+    np.testing.assert_allclose(on_platform, [0.0, GRAVITY * scene.platform.mass], rtol=0, atol=1e-6)
+
+
+def test_v_shaped_cable_interior_nodes_balance_with_element_tensions(v_shaped):
+    # Bending off, so that the element tensions are the only internal forces.
+    scene = v_shaped(Effects.from_preset("catenary"))
+    result = simulate(scene)
+    for i, cable in enumerate(scene.cables):
+        nodes, tension = result.nodes[i][-1], result.tensions[i][-1]
+        up = (nodes[0] - nodes[1]) / np.linalg.norm(nodes[0] - nodes[1])
+        down = (nodes[-1] - nodes[-2]) / np.linalg.norm(nodes[-1] - nodes[-2])
+        pull = tension[0] * up + tension[-1] * down
+        interior_weight = GRAVITY * cable.node_masses()[1:-1].sum()
+        # 1e-6 N against 5 to 15 N tensions: settled, see settling_solver.
+        np.testing.assert_allclose(pull, [0.0, interior_weight], rtol=0, atol=1e-6)
+        assert nodes[len(nodes) // 2, 1] < -0.9  # it really sags below the chord
+
+
+def test_straight_cable_element_is_a_linear_spring(hanging_cable):
+    """Hooke's law: each element of a straight hanging cable stretches by its load over k_i."""
+    for platform_mass in (1.0, 4.0):
+        scene = hanging_cable(n_elements=2, platform_mass=platform_mass)
+        cable = scene.cables[0]
+        result = simulate(scene)
+        nodes = result.nodes[0][-1]
+        stretch = np.linalg.norm(np.diff(nodes, axis=0), axis=1) - cable.element_length
+        weights = GRAVITY * cable.node_masses()
+        load = np.array([weights[1:].sum(), weights[2:].sum()]) + GRAVITY * platform_mass
+        # 1e-6 relative: stretches of 6e-5 to 2.6e-4 m are resolved to ~1e-11 m in
+        # coordinates of order 1 m (double precision ~1e-16 m, Newton far below 1e-11).
+        np.testing.assert_allclose(stretch, load / cable.axial_stiffness, rtol=1e-6)
+        # and the platform hangs where the two stretched elements put it
+        drop = -result.platform_pose[-1, 1]
+        assert drop == pytest.approx(cable.unstrained_length + stretch.sum(), rel=1e-12)
+
+
+def test_stretch_of_a_straight_cable_is_linear_in_the_load(hanging_cable):
+    stretches = []
+    for platform_mass in (1.0, 2.0, 4.0):
+        result = simulate(hanging_cable(n_elements=2, platform_mass=platform_mass))
+        stretches.append(-result.platform_pose[-1, 1] - 1.0)
+    k_series = CableSpec(unstrained_length=1.0, n_elements=2).axial_stiffness / 2
+    # Equal steps in load give equal steps in stretch, of (delta M g) / (k_i / 2).
+    # 1e-6 relative on steps of 6e-5 m and 1.2e-4 m: see the test above.
+    assert stretches[1] - stretches[0] == pytest.approx(GRAVITY * 1.0 / k_series, rel=1e-6)
+    assert stretches[2] - stretches[1] == pytest.approx(GRAVITY * 2.0 / k_series, rel=1e-6)
+
+
+# ============================================================================ bad input
+# Refused with SceneError naming the field, when the scene is made (no model, no run).
+
+
+@pytest.mark.parametrize(
+    "make, field",
+    [
+        (lambda: PlatformSpec(mass=-2.5), "platform.mass"),
+        (lambda: PlatformSpec(mass=0.0), "platform.mass"),
+        (lambda: PlatformSpec(inertia=0.0), "platform.inertia"),
+        (lambda: CableSpec(linear_density=-0.35), "cable.linear_density"),
+        (lambda: CableSpec(unstrained_length=0.0), "cable.unstrained_length"),
+        (lambda: CableSpec(unstrained_length=-3.75), "cable.unstrained_length"),
+        (lambda: CableSpec(radius=0.0), "cable.radius"),
+        (lambda: CableSpec(radius=-0.005), "cable.radius"),
+        (lambda: CableSpec(youngs_modulus=0.0), "cable.youngs_modulus"),
+        (lambda: CableSpec(youngs_modulus=-1e9), "cable.youngs_modulus"),
+        (lambda: CableSpec(damping_constant=-1.0), "cable.damping_constant"),
+        (lambda: CableSpec(n_elements=1), "cable.n_elements"),
+        (lambda: CableSpec(n_elements=0), "cable.n_elements"),
+        (lambda: CableSpec(n_elements=2.5), "cable.n_elements"),
+        (lambda: PulleySpec(radius=0.0), "pulley.radius"),
+        (lambda: PulleySpec(radius=-0.25), "pulley.radius"),
+        (lambda: PulleySpec(contact_stiffness=0.0), "pulley.contact_stiffness"),
+        (lambda: PulleySpec(contact_stiffness=-1e7), "pulley.contact_stiffness"),
+        (lambda: PulleySpec(side=0), "pulley.side"),
+        (lambda: PlatformSpec(anchors=((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))), "platform.anchors"),
+        (lambda: PlatformSpec(anchors=(0.15, 0.1)), "platform.anchors"),
+        (lambda: PlatformSpec(anchors=()), "platform.anchors"),
+        (lambda: Scene(platform=PlatformSpec(anchors=((0.0, 0.0),))), "platform.anchors"),
+        (lambda: CableSpec(youngs_modulus=math.nan), "cable.youngs_modulus"),
+        (lambda: CableSpec(linear_density=math.inf), "cable.linear_density"),
+        (lambda: PlatformSpec(mass=math.nan), "platform.mass"),
+        (lambda: PlatformSpec(initial_pose=(0.0, math.nan, 0.0)), "platform.initial_pose"),
+        (lambda: PlatformSpec(anchors=((0.0, math.nan), (0.1, 0.1))), "platform.anchors"),
+        (lambda: PulleySpec(center=(math.nan, 0.0)), "pulley.center"),
+        (lambda: Scene(gravity=math.nan), "gravity"),
+        (lambda: SolverSpec(step_size=0.0), "solver.step_size"),
+        (lambda: SolverSpec(step_size=math.nan), "solver.step_size"),
+    ],
+)
+def test_bad_scene_field_is_refused_naming_the_field(make, field):
+    with pytest.raises(SceneError, match=field.replace(".", r"\.").replace("[", r"\[")):
+        make()
+
+
+def test_cable_too_short_for_the_initial_pose_is_refused():
+    with pytest.raises(SceneError, match=r"cables\[0\]\.unstrained_length"):
+        Scene(cables=(CableSpec(unstrained_length=1.0), CableSpec()))
+
+
+class _CountingController:
+    """Ideal-IK-like controller that only counts how often it is asked (it never should be)."""
+
+    name = "counting"
+    uses_pose = False
+    uses_tension = False
+
+    def __init__(self):
+        self.resets = 0
+        self.commands = 0
+
+    def reset(self, scene):
+        self.resets += 1
+
+    def command(self, measurement):  # pragma: no cover - must not be reached
+        self.commands += 1
+        raise AssertionError("the simulation started")
+
+
+def test_reference_the_cables_cannot_reach_is_refused_before_any_step():
+    scene = load_scene("paper-circle")
+    far_circle = CircleTrajectory(center=(0.0, -6.0), radius=0.4)  # anchors 6 m below: cables are 3.75 m
+    scene = scene.with_changes(trajectory=far_circle, solver=dataclasses.replace(scene.solver, end_time=1.0))
+    controller = _CountingController()
+    with pytest.raises(UnreachableError, match=r"cable 0"):
+        simulate(scene, controller)
+    assert controller.commands == 0
+    with pytest.raises(UnreachableError):
+        build_model(scene)
+
+
+def test_reference_through_a_pulley_is_refused():
+    scene = load_scene("paper-circle")
+    # a circle of radius 1.75 about the origin passes over both pulley centres
+    through = CircleTrajectory(center=(0.0, 0.0), radius=1.75, angular_rate=1.0)
+    scene = scene.with_changes(trajectory=through, solver=dataclasses.replace(scene.solver, end_time=7.0))
+    with pytest.raises(UnreachableError):
+        build_model(scene)

@@ -1,0 +1,135 @@
+"""Scenes: TOML round trips, the paper's derived parameters, and refusal of bad input."""
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cdpr_exu.errors import SceneError
+from cdpr_exu.scene import (
+    CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, load_scene, save_scene,
+    scene_from_dict, shipped_scenes,
+)
+from cdpr_exu.trajectories import CircleTrajectory
+
+
+def test_paper_circle_is_shipped_and_has_table_2_parameters():
+    scene = load_scene("paper-circle")
+    cable = scene.cables[0]
+    # Table 2 of the paper, printed to three significant figures there.
+    assert cable.axial_stiffness == pytest.approx(3.14e5, rel=2e-3)
+    assert cable.axial_damping == pytest.approx(3.14e5, rel=2e-3)
+    assert cable.bending_stiffness == pytest.approx(1.96, rel=3e-3)
+    assert cable.bending_damping == pytest.approx(1.96, rel=3e-3)
+    assert cable.element_mass == pytest.approx(0.0875, rel=1e-12)
+    assert scene.platform.mass == 2.5 and scene.platform.inertia == 0.0271
+    assert scene.pulleys[0].center == (-1.75, 0.0) and scene.pulleys[1].center == (1.75, 0.0)
+    assert isinstance(scene.trajectory, CircleTrajectory)
+    np.testing.assert_allclose(scene.trajectory.pose(0.0), [0.0, -2.0, 0.0], atol=1e-15)
+    assert "paper-circle" in shipped_scenes()
+
+
+def test_scene_survives_a_toml_round_trip(tmp_path):
+    scene = load_scene("paper-circle")
+    again = load_scene(save_scene(scene, tmp_path / "scene.toml"))
+    assert again == scene
+
+
+@pytest.mark.parametrize("lumping", ["consistent", "paper"])
+def test_node_masses_add_up_to_the_cable_mass_or_one_half_element_more(lumping):
+    cable = CableSpec(n_elements=15, mass_lumping=lumping)
+    masses = cable.node_masses()
+    assert masses.shape == (16,)
+    # Consistent lumping conserves the mass exactly; the paper's lumping puts a whole
+    # element on every node but the winch node, which gets half an element as well.
+    expected = cable.mass if lumping == "consistent" else cable.mass + cable.element_mass / 2
+    assert masses.sum() == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "make, field",
+    [
+        (lambda: CableSpec(radius=-0.005), "cable.radius"),
+        (lambda: CableSpec(unstrained_length=0.0), "cable.unstrained_length"),
+        (lambda: CableSpec(linear_density=float("nan")), "cable.linear_density"),
+        (lambda: CableSpec(youngs_modulus=-1.0), "cable.youngs_modulus"),
+        (lambda: CableSpec(n_elements=1), "cable.n_elements"),
+        (lambda: CableSpec(n_elements=0), "cable.n_elements"),
+        (lambda: CableSpec(n_elements=2.5), "cable.n_elements"),
+        (lambda: CableSpec(mass_lumping="lumpy"), "cable.mass_lumping"),
+        (lambda: PulleySpec(radius=0.0), "pulley.radius"),
+        (lambda: PulleySpec(contact_stiffness=-1e7), "pulley.contact_stiffness"),
+        (lambda: PulleySpec(side=0), "pulley.side"),
+        (lambda: PulleySpec(center=(0.0,)), "pulley.center"),
+        (lambda: PlatformSpec(mass=-2.5), "platform.mass"),
+        (lambda: PlatformSpec(mass=0.0), "platform.mass"),
+        (lambda: PlatformSpec(inertia=float("inf")), "platform.inertia"),
+        (lambda: PlatformSpec(anchors=((0.1, 0.2, 0.3),)), "platform.anchors"),
+        (lambda: PlatformSpec(anchors=(0.1, 0.2)), "platform.anchors"),
+        (lambda: PlatformSpec(initial_pose=(0.0, float("nan"), 0.0)), "platform.initial_pose"),
+        (lambda: SolverSpec(step_size=0.0), "solver.step_size"),
+        (lambda: SolverSpec(spectral_radius=1.5), "solver.spectral_radius"),
+        (lambda: Effects(bending=False, bending_damping=True), "effects.bending_damping"),
+        (lambda: Effects.from_preset("nonsense"), "effects.preset"),
+    ],
+)
+def test_bad_fields_are_refused_with_their_name(make, field):
+    with pytest.raises(SceneError, match=field.replace(".", r"\.")):
+        make()
+
+
+def test_toml_errors_name_the_cable_they_come_from():
+    data = {
+        "name": "x",
+        "cable": {"radius": 0.005},
+        "cables": [{}, {"radius": -1.0}],
+        "pulleys": [{"center": [-1.75, 0.0], "side": -1}, {"center": [1.75, 0.0], "side": 1}],
+    }
+    with pytest.raises(SceneError, match=r"cables\[1\]\.radius"):
+        scene_from_dict(data)
+
+
+def test_unknown_fields_are_refused():
+    with pytest.raises(SceneError, match="unknown field"):
+        scene_from_dict({"name": "x", "pulleys": [{"center": [0, 0], "colour": "red"}]})
+    with pytest.raises(SceneError, match="unknown field"):
+        scene_from_dict({"name": "x", "solver": {"stepsize": 1e-3}})
+
+
+def test_a_pose_the_cables_cannot_reach_is_refused_before_any_simulation():
+    with pytest.raises(SceneError, match=r"cables\[0\]\.unstrained_length"):
+        Scene(cables=(CableSpec(unstrained_length=2.0), CableSpec(unstrained_length=2.0)))
+
+
+def test_anchor_count_must_match_the_cables():
+    with pytest.raises(SceneError, match="platform.anchors"):
+        Scene(platform=PlatformSpec(anchors=((0.0, 0.0),)))
+
+
+def test_unknown_scene_name_lists_the_shipped_ones():
+    with pytest.raises(SceneError, match="paper-circle"):
+        load_scene("no-such-scene")
+
+
+def test_effects_presets_and_overrides():
+    full = Effects.from_preset("full")
+    assert full.bending and full.pulley_contact
+    catenary = Effects.from_preset("catenary")
+    assert catenary.cable_mass and not catenary.bending and not catenary.bending_damping
+    assert not Effects.from_preset("full", bending=False, bending_damping=False).bending
+
+
+def test_element_properties_follow_the_beam_equivalence_formulas():
+    cable = CableSpec(radius=0.01, unstrained_length=2.0, n_elements=4, youngs_modulus=2e9, damping_constant=3e8)
+    area, second_moment, length = math.pi * 1e-4, math.pi * 1e-8 / 4, 0.5
+    assert cable.axial_stiffness == pytest.approx(2e9 * area / length, rel=1e-14)
+    assert cable.axial_damping == pytest.approx(3e8 * area / length, rel=1e-14)
+    assert cable.bending_stiffness == pytest.approx(2e9 * second_moment / length, rel=1e-14)
+    assert cable.bending_damping == pytest.approx(3e8 * second_moment / length, rel=1e-14)
+
+
+def test_solver_output_period_is_never_finer_than_the_step():
+    solver = SolverSpec(step_size=2e-3, output_period=1e-3)
+    assert solver.output_period == 2e-3
+    assert replace(solver, end_time=1.0).n_steps == 500
