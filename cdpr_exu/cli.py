@@ -10,6 +10,7 @@ Examples::
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from dataclasses import replace
@@ -17,6 +18,10 @@ from pathlib import Path
 
 from .errors import CdprError, SolverFailure
 from .scene import Scene, load_scene, save_scene, shipped_scenes
+
+#: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
+#: parsers whose ``func`` takes the parsed arguments and returns an exit code.
+COMMAND_MODULES: tuple[str, ...] = ()
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
 SETTLED_AFTER = 1.0
@@ -144,6 +149,9 @@ def build_parser() -> argparse.ArgumentParser:
     scenes = sub.add_parser("scenes", help="list the shipped scenes",
                             epilog="example:\n  cdpr scenes\n", formatter_class=argparse.RawDescriptionHelpFormatter)
     scenes.set_defaults(func=_cmd_scenes)
+    for module_name in COMMAND_MODULES:
+        module = importlib.import_module(module_name)
+        module.add_commands(sub)
     return parser
 
 

@@ -296,16 +296,18 @@ def _progress_reporter(progress, scene: Scene):
         return report
     from tqdm import tqdm
 
-    bar = tqdm(total=end, unit="s sim", bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s [{elapsed}, {postfix}]")
+    # disable=None: no bar when the output is not a terminal (logs, CI), so it never floods them.
+    bar = tqdm(total=end, unit="s", disable=None, mininterval=0.25,
+               bar_format="{desc}{percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}{postfix}]",
+               desc=scene.name + " ")
 
     def report(t, wall):
         if t is None:
-            bar.n = min(bar.n, end)
-            bar.refresh()
             bar.close()
             return
-        if t - last["t"] >= every:
+        if t - last["t"] >= every or t >= end - 1e-9:
             last["t"] = t
-            bar.n = t
-            bar.set_postfix_str(f"{t / wall:.2f}x real time" if wall > 0 else "")
+            bar.n = min(t, end)
+            bar.set_postfix_str(f"{t / wall:.1f}x real time" if wall > 0 else "", refresh=False)
+            bar.refresh()
     return report

@@ -407,13 +407,19 @@ class PlatformEquilibrium:
 # ---------------------------------------------------------------------------
 # a small damped Newton solver
 # ---------------------------------------------------------------------------
-def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium"):
+def _damped_newton(
+    function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None
+):
     """Newton's method with backtracking on the residual norm.
 
     ``function(x) -> (residual, jacobian)``; it may raise UnreachableError at a trial
     point, which then counts as a rejected step. Components listed in ``positive``
-    are kept above 10 % of their current value. Returns ``(x, residual, jacobian)``.
+    are kept above 10 % of their current value. Converged when the residual norm is
+    below ``tolerance``, or when no step decreases it any more and it is below
+    ``noise`` (default ``1e3 tolerance``), the precision the residual can have.
+    Returns ``(x, residual, jacobian)``.
     """
+    noise = 1e3 * tolerance if noise is None else max(noise, tolerance)
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
     norm = float(np.linalg.norm(residual))
@@ -445,7 +451,7 @@ def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, wha
         if not accepted:
             break
         x, residual, jacobian, norm = trial, trial_residual, trial_jacobian, trial_norm
-    if norm <= 1e3 * tolerance:  # stalled at round-off level
+    if norm <= noise:  # stalled at round-off level
         return x, residual, jacobian
     raise UnreachableError(f"{what} did not converge (scaled residual {norm:.3g})")
 
@@ -680,14 +686,14 @@ def _scales(platform, lengths, wrench):
     return force, length
 
 
-def _platform_tolerance(platform, force_scale):
-    """Relative tolerance of the wrench balance.
+def _platform_noise(platform, force_scale):
+    """Precision of the relative wrench balance.
 
     Each cable is solved to ``1e-12`` of its length, which leaves a force error of
     about ``1e-12 EA``: a stiff cable cannot balance a light platform any better.
     """
     stiffest = max(c.axial_stiffness for c in platform.cables)
-    return _RELATIVE_TOLERANCE * (1.0 + stiffest / force_scale)
+    return 1e3 * _RELATIVE_TOLERANCE * (1.0 + stiffest / force_scale)
 
 
 def _wrench_residual(platform, rotation, equilibria, wrench, dof):
@@ -758,8 +764,16 @@ def ideal_pose(platform, unstrained_lengths, rotation=0.0):
 
     x0 = np.append(start, rotation) if solve_rotation else start
     solution = least_squares(residual, x0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
-    phi = float(solution.x[2]) if solve_rotation else float(rotation)
+    phi = _wrap_angle(solution.x[2]) if solve_rotation else float(rotation)
     return solution.x[:2].copy(), phi
+
+
+def _wrap_angle(angle):
+    """Angle in ``[-pi, pi)`` [rad] (unchanged, bit for bit, if already there)."""
+    angle = float(angle)
+    if -math.pi <= angle < math.pi:
+        return angle
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def solve_forward_statics(
@@ -847,8 +861,10 @@ def solve_forward_statics(
         return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
 
     start = np.append(position, rotation)[:dof] * pose_scale
-    tolerance = _platform_tolerance(platform, force_scale)
-    scaled, _, _ = _damped_newton(function, start, tolerance, what="forward statics")
+    scaled, _, _ = _damped_newton(
+        function, start, _RELATIVE_TOLERANCE, what="forward statics",
+        noise=_platform_noise(platform, force_scale),
+    )
     pose = scaled / pose_scale
     _, jacobian = evaluate(pose)  # the accepted point, with its own cable states
     equilibria, _ = cache["last"]
@@ -858,7 +874,7 @@ def solve_forward_statics(
 def _result(platform, pose, equilibria, jacobian, wrench, dof):
     return PlatformEquilibrium(
         position=np.array(pose[:2], dtype=float),
-        rotation=float(pose[2]) if dof == 3 else 0.0,
+        rotation=_wrap_angle(pose[2]) if dof == 3 else 0.0,
         cables=tuple(equilibria),
         stiffness=-np.array(jacobian),
         external_wrench=wrench,
@@ -1003,8 +1019,8 @@ def solve_inverse_statics(
     start = np.append(horizontal, [rotation] if free_rotation else []) * unknown_scale
     try:
         scaled, _, _ = _damped_newton(
-            function, start, _platform_tolerance(platform, force_scale), positive=tuple(range(n)),
-            what="inverse statics",
+            function, start, _RELATIVE_TOLERANCE, positive=tuple(range(n)),
+            what="inverse statics", noise=_platform_noise(platform, force_scale),
         )
     except UnreachableError as error:
         raise UnreachableError(
