@@ -19,7 +19,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from . import bending
+from . import axial, bending
 from .scene import CableSpec, Effects
 
 
@@ -78,10 +78,17 @@ def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effec
         items.nodes.append(node)
         items.markers.append(mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
     damping = cable.axial_damping if effects.axial_damping else 0.0
+    if effects.slack:
+        return _add_gravity(mbs, items, masses, effects, gravity)  # axial forces: see add_cable_forces
     for a, b in zip(items.markers[:-1], items.markers[1:]):
         items.springs.append(mbs.AddObject(eii.ObjectConnectorSpringDamper(
             markerNumbers=[a, b], referenceLength=cable.element_length,
             stiffness=cable.axial_stiffness, damping=damping)))
+    return _add_gravity(mbs, items, masses, effects, gravity)
+
+
+def _add_gravity(mbs: exu.MainSystem, items: CableItems, masses: np.ndarray, effects: Effects,
+                 gravity: float) -> CableItems:
     if effects.gravity and gravity > 0.0:
         for marker, mass in zip(items.markers, masses):
             items.loads.append(mbs.AddLoad(eii.LoadForceVector(
@@ -90,53 +97,78 @@ def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effec
 
 
 @dataclass
-class BendingItems:
-    """The one ``ObjectGenericODE2`` that carries the bending of every cable.
+class CableForceItems:
+    """The one ``ObjectGenericODE2`` that carries the cables' numba-computed forces.
 
-    ``user_functions`` keeps the Python callables alive as long as the model.
+    It holds the exact-angle bending springs (``Effects.bending``) and, with
+    ``Effects.slack``, the tension-only axial elements. ``user_functions`` keeps the
+    Python callables alive as long as the model.
     """
 
     object: int
     joints: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
+    slack_elements: np.ndarray
     user_functions: tuple = ()
 
 
-def add_bending(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
-                effects: Effects) -> BendingItems | None:
-    """Add the exact-angle bending spring-dampers of all cables as one generic object.
+def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
+                     effects: Effects) -> CableForceItems | None:
+    """Add the bending (and, with slack, the axial) forces of all cables as one object.
 
-    Returns None when ``effects.bending`` is off (then no item and no cost).
-    The force user function receives Exudyn's displacement coordinates ``q``; the
-    reference positions are added here. Its Jacobian is analytic (numba kernel),
-    ``fODE2 * K + fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
+    Returns None when neither ``effects.bending`` nor ``effects.slack`` is on (then no
+    item and no cost). The force user function receives Exudyn's displacement
+    coordinates ``q``; the reference positions are added here. Its Jacobian is
+    analytic (numba kernels), ``fODE2 * K + fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
     """
-    if not effects.bending:
+    if not (effects.bending or effects.slack):
         return None
     counts = [len(it.nodes) for it in items]
-    joints = bending.cable_joints(counts)
-    stiffness = np.concatenate([np.full(n - 2, c.bending_stiffness) for c, n in zip(cables, counts)])
-    damping = np.concatenate([
-        np.full(n - 2, c.bending_damping if effects.bending_damping else 0.0) for c, n in zip(cables, counts)
-    ])
     reference = np.concatenate([it.reference for it in items]).ravel()
-    spring = bending.BendingSpringDamper(len(reference) // 2, joints, stiffness, damping)
-    positions = np.zeros(reference.size)
+    size = reference.size
+    if effects.bending:
+        joints = bending.cable_joints(counts)
+        stiffness = np.concatenate([np.full(n - 2, c.bending_stiffness) for c, n in zip(cables, counts)])
+        damping = np.concatenate([
+            np.full(n - 2, c.bending_damping if effects.bending_damping else 0.0) for c, n in zip(cables, counts)
+        ])
+    else:
+        joints, stiffness, damping = np.zeros((0, 3), np.int64), np.zeros(0), np.zeros(0)
+    spring = bending.BendingSpringDamper(size // 2, joints, stiffness, damping)
+    if effects.slack:
+        elements = axial.cable_elements(counts)
+        rest = np.concatenate([np.full(n - 1, c.element_length) for c, n in zip(cables, counts)])
+        axial_k = np.concatenate([np.full(n - 1, c.axial_stiffness) for c, n in zip(cables, counts)])
+        axial_c = np.concatenate([
+            np.full(n - 1, c.axial_damping if effects.axial_damping else 0.0) for c, n in zip(cables, counts)
+        ])
+    else:
+        elements = np.zeros((0, 2), np.int64)
+    positions = np.zeros(size)
 
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         np.add(reference, q, out=positions)
-        return spring.force(positions, np.asarray(q_t))
+        velocities = np.asarray(q_t)
+        force = spring.force(positions, velocities)
+        if effects.slack:
+            axial.slack_axial_force(positions, velocities, elements, rest, axial_k, axial_c, force)
+        return force
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
         np.add(reference, q, out=positions)
-        return spring.jacobian_weighted(positions, np.asarray(q_t), f_q, f_q_t)
+        velocities = np.asarray(q_t)
+        jacobian = spring.jacobian_weighted(positions, velocities, f_q, f_q_t)
+        if effects.slack:
+            axial.slack_axial_jacobian(positions, velocities, elements, rest, axial_k, axial_c,
+                                       float(f_q), float(f_q_t), jacobian)
+        return jacobian
 
     nodes = [n for it in items for n in it.nodes]
     obj = mbs.AddObject(eii.ObjectGenericODE2(
-        nodeNumbers=nodes, massMatrix=np.zeros((reference.size, reference.size)),
+        nodeNumbers=nodes, massMatrix=np.zeros((size, size)),
         forceUserFunction=force_function, jacobianUserFunction=jacobian_function))
-    return BendingItems(obj, joints, stiffness, damping, (spring, force_function, jacobian_function))
+    return CableForceItems(obj, joints, stiffness, damping, elements, (spring, force_function, jacobian_function))
 
 
 def element_tensions(cable: CableSpec, positions: np.ndarray, velocities: np.ndarray,
@@ -159,4 +191,6 @@ def element_tensions(cable: CableSpec, positions: np.ndarray, velocities: np.nda
     force = cable.axial_stiffness * (length - cable.element_length)
     if effects.axial_damping:
         force = force + cable.axial_damping * length_rate
+    if effects.slack:
+        force = np.maximum(force, 0.0)
     return force

@@ -17,7 +17,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from .cable import BendingItems, CableItems, add_bending, add_cable
+from .cable import CableForceItems, CableItems, add_cable, add_cable_forces
 from .errors import UnreachableError
 from .kinematics import anchor_points, initial_cable_nodes, pulley_exit, straight_cable_nodes
 from .platform import PlatformItems, add_platform, attach_cable
@@ -38,7 +38,8 @@ class Model:
     cables : list of CableItems
     platform : PlatformItems
     winches : list of WinchItems
-    bending : BendingItems or None
+    cable_forces : CableForceItems or None
+        The generic object of bending and slack-axial forces.
     contacts : list of list of int
         Contact objects of each cable with its pulley.
     contact_nodes : list of ndarray of int
@@ -53,7 +54,7 @@ class Model:
     cables: list[CableItems]
     platform: PlatformItems
     winches: list[WinchItems]
-    bending: BendingItems | None
+    cable_forces: CableForceItems | None
     contacts: list[list[int]] = field(default_factory=list)
     contact_nodes: list[np.ndarray] = field(default_factory=list)
     initial_paid_out: np.ndarray | None = None
@@ -64,8 +65,9 @@ class Model:
             "mass_points": sum(len(c.nodes) for c in self.cables),
             "axial_spring_dampers": sum(len(c.springs) for c in self.cables),
             "gravity_loads": sum(len(c.loads) for c in self.cables) + (self.platform.load is not None),
-            "bending_objects": int(self.bending is not None),
-            "bending_joints": 0 if self.bending is None else len(self.bending.joints),
+            "cable_force_objects": int(self.cable_forces is not None),
+            "bending_joints": 0 if self.cable_forces is None else len(self.cable_forces.joints),
+            "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
             "pulley_contacts": sum(len(c) for c in self.contacts),
             "winch_constraints": 2 * len(self.winches),
             "platform_joints": len(self.platform.joints),
@@ -191,7 +193,7 @@ def build_model(scene: Scene) -> Model:
             paid_out.append(pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side,
                                         nodes_xz[-1]).cable_length)
         cables.append(items)
-    bending = add_bending(mbs, list(scene.cables), cables, effects)
+    cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects)
     mbs.Assemble()
-    return Model(scene, system_container, mbs, cables, platform, winches, bending,
+    return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
                  contacts, contact_nodes, np.asarray(paid_out))

@@ -340,8 +340,6 @@ class Effects:
             raise SceneError("effects.cable_mass = false (massless cables) is not available in this model yet")
         if not self.axial_elasticity:
             raise SceneError("effects.axial_elasticity = false (inextensible cables) is not available yet")
-        if self.slack:
-            raise SceneError("effects.slack = true (tension-only elements) is not available yet")
         if self.bending_damping and not self.bending:
             raise SceneError("effects.bending_damping needs effects.bending = true")
 

@@ -1,0 +1,105 @@
+"""Tension-only (slack) axial spring-dampers of lumped-mass cables: numba kernels.
+
+A real cable cannot push. With ``Effects.slack`` the axial force of element e between
+nodes a and b is
+
+    f = max(0, k (l - l0) + c dl/dt),   l = |p_b - p_a|,
+
+pulling the nodes together along u = (p_b - p_a) / l. Exudyn's built-in spring-damper
+has no tension-only option, so these elements join the bending springs in the one
+``ObjectGenericODE2`` of the cables (:mod:`cdpr_exu.cable`), with an analytic Jacobian.
+
+No Exudyn here: coordinates are flat arrays (x0, y0, x1, y1, ...) [m, m/s].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _element_state(positions, velocities, a, b):
+    dx = positions[2 * b] - positions[2 * a]
+    dy = positions[2 * b + 1] - positions[2 * a + 1]
+    dvx = velocities[2 * b] - velocities[2 * a]
+    dvy = velocities[2 * b + 1] - velocities[2 * a + 1]
+    length = np.sqrt(dx * dx + dy * dy)
+    ux, uy = dx / length, dy / length
+    rate = ux * dvx + uy * dvy
+    return length, ux, uy, rate, dvx, dvy
+
+
+@njit(cache=True)
+def slack_axial_force(positions, velocities, elements, rest_length, stiffness, damping, out):
+    """Add the tension-only axial forces to ``out`` (2N,) [N] and return it.
+
+    Parameters
+    ----------
+    positions, velocities : ndarray, shape (2N,) [m, m/s]
+    elements : ndarray of int, shape (E, 2)
+        Node pairs (a, b) of each element.
+    rest_length, stiffness, damping : ndarray, shape (E,) [m, N/m, N s/m]
+    out : ndarray, shape (2N,)
+        Accumulated into (not zeroed).
+    """
+    for e in range(elements.shape[0]):
+        a, b = elements[e, 0], elements[e, 1]
+        length, ux, uy, rate, _, _ = _element_state(positions, velocities, a, b)
+        force = stiffness[e] * (length - rest_length[e]) + damping[e] * rate
+        if force <= 0.0:
+            continue
+        out[2 * a] += force * ux
+        out[2 * a + 1] += force * uy
+        out[2 * b] -= force * ux
+        out[2 * b + 1] -= force * uy
+    return out
+
+
+@njit(cache=True)
+def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness, damping,
+                         factor_position, factor_velocity, out):
+    """Add ``factor_position * K + factor_velocity * D`` of the slack elements to ``out``.
+
+    K = -df/dq and D = -df/dv (the left-hand-side Jacobians Exudyn expects), shape
+    (2N, 2N); zero for an element whose force is not positive (slack).
+    """
+    for e in range(elements.shape[0]):
+        a, b = elements[e, 0], elements[e, 1]
+        length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
+        k, c = stiffness[e], damping[e]
+        force = k * (length - rest_length[e]) + c * rate
+        if force <= 0.0:
+            continue
+        u = (ux, uy)
+        # d(rate)/d(p_b) = (dv - u rate) / l
+        w = ((dvx - ux * rate) / length, (dvy - uy * rate) / length)
+        for i in range(2):
+            for j in range(2):
+                projector = (1.0 if i == j else 0.0) - u[i] * u[j]
+                g = u[i] * (k * u[j] + c * w[j]) + force * projector / length
+                d = c * u[i] * u[j]
+                value = factor_position * g + factor_velocity * d
+                out[2 * b + i, 2 * b + j] += value
+                out[2 * a + i, 2 * a + j] += value
+                out[2 * a + i, 2 * b + j] -= value
+                out[2 * b + i, 2 * a + j] -= value
+    return out
+
+
+def cable_elements(nodes_per_cable) -> np.ndarray:
+    """Element node pairs (a, b) for cables whose nodes are numbered one after another.
+
+    Parameters
+    ----------
+    nodes_per_cable : sequence of int
+
+    Returns
+    -------
+    ndarray of int64, shape (E, 2)
+    """
+    pairs, start = [], 0
+    for count in nodes_per_cable:
+        pairs.extend((start + j, start + j + 1) for j in range(count - 1))
+        start += count
+    return np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
