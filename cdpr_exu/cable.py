@@ -80,6 +80,11 @@ def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effec
     damping = cable.axial_damping if effects.axial_damping else 0.0
     if effects.slack:
         return _add_gravity(mbs, items, masses, effects, gravity)  # axial forces: see add_cable_forces
+    if not effects.axial_elasticity:  # inextensible elements: distance constraints
+        for a, b in zip(items.markers[:-1], items.markers[1:]):
+            items.springs.append(mbs.AddObject(eii.ObjectConnectorDistance(
+                markerNumbers=[a, b], distance=cable.element_length)))
+        return _add_gravity(mbs, items, masses, effects, gravity)
     for a, b in zip(items.markers[:-1], items.markers[1:]):
         items.springs.append(mbs.AddObject(eii.ObjectConnectorSpringDamper(
             markerNumbers=[a, b], referenceLength=cable.element_length,
@@ -194,3 +199,81 @@ def element_tensions(cable: CableSpec, positions: np.ndarray, velocities: np.nda
     if effects.slack:
         force = np.maximum(force, 0.0)
     return force
+
+
+#: Stiffness of an "inextensible" massless rope, as a multiple of its elastic EA:
+#: stiff enough that its stretch (about 1e-3 of the elastic one) is negligible, soft
+#: enough for the implicit solver's Newton iteration at the usual step sizes.
+INEXTENSIBLE_STIFFNESS_FACTOR = 1.0e3
+
+
+@dataclass
+class RopeItems:
+    """A massless cable: one Exudyn ``ObjectConnectorReevingSystemSprings``.
+
+    Attributes
+    ----------
+    rope : int
+        The reeving-system object (winch point, pulley sheave, platform anchor).
+    drum_node : int
+        A one-coordinate node whose prescribed value is the paid-out length change.
+    drum_marker : int
+        Its coordinate marker.
+    winch_point : ndarray, shape (2,) [m]
+        Fixed start of the rope below the pulley (x, z).
+    """
+
+    rope: int
+    drum_node: int
+    drum_marker: int
+    winch_point: np.ndarray
+
+
+def add_rope(mbs: exu.MainSystem, cable: CableSpec, pulley_center, pulley_radius: float, side: int,
+             anchor_marker: int, winch_point, ground_coordinate_marker: int, effects: Effects) -> RopeItems:
+    """Add a massless rope from a fixed winch point over the pulley to the platform anchor.
+
+    The rope force is uniform along it (frictionless sheave): EA / L times the stretch
+    over the current length L, plus the damping dn A / L times the stretch rate; with
+    ``effects.slack`` compression is cut off (Exudyn's regularisation force, 0.1 N).
+    Exudyn's sheave wraps the rope on the side given by the sign of its axis: +z for a
+    cable hanging on the pulley's right side, -z on its left (``side``). The paid-out
+    length change lambda - lambda(0) is a prescribed coordinate that Exudyn adds to the
+    rope's reference length.
+
+    Parameters
+    ----------
+    cable : CableSpec
+        Unstrained length, EA and dn A of the rope.
+    pulley_center : (x, z) [m]
+    pulley_radius : float [m]
+        0 for a point exit.
+    side : {-1, +1}
+    anchor_marker : int
+        ``MarkerBodyRigid`` of the platform anchor.
+    winch_point : (x, z) [m]
+        Fixed start of the rope, below the pulley on the winch side.
+    ground_coordinate_marker : int
+        A coordinate marker that is always 0 (closes the coordinate pair).
+    """
+    winch_point = np.asarray(winch_point, dtype=float)
+    winch_ground = mbs.AddObject(eii.ObjectGround(referencePosition=[winch_point[0], winch_point[1], 0.0]))
+    winch_marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=winch_ground))
+    pulley_ground = mbs.AddObject(eii.ObjectGround(referencePosition=[pulley_center[0], pulley_center[1], 0.0]))
+    pulley_marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=pulley_ground))
+    drum = mbs.AddNode(eii.NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.0],
+                                           initialCoordinates_t=[0.0], numberOfODE2Coordinates=1))
+    # The drum coordinate is prescribed (winch constraint); this small mass only keeps
+    # the mass matrix regular.
+    mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=[drum], massMatrix=np.eye(1) * 1.0e-3))
+    drum_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=drum, coordinate=0))
+    stiffness = cable.axial_rigidity * (1.0 if effects.axial_elasticity else INEXTENSIBLE_STIFFNESS_FACTOR)
+    damping = cable.damping_constant * cable.area if effects.axial_damping else 0.0
+    rope = mbs.AddObject(eii.ObjectConnectorReevingSystemSprings(
+        markerNumbers=[winch_marker, pulley_marker, anchor_marker, drum_marker, ground_coordinate_marker],
+        hasCoordinateMarkers=True, coordinateFactors=[1.0, 1.0],
+        stiffnessPerLength=stiffness, dampingPerLength=damping, referenceLength=cable.unstrained_length,
+        sheavesAxes=exu.Vector3DList([[0.0, 0.0, float(side)]] * 3),
+        sheavesRadii=[0.0, float(pulley_radius), 0.0],
+        regularizationForce=0.1 if effects.slack else -1.0))
+    return RopeItems(rope, drum, drum_marker, winch_point)

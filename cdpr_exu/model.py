@@ -17,9 +17,9 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from .cable import CableForceItems, CableItems, add_cable, add_cable_forces
+from .cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
 from .errors import UnreachableError
-from .kinematics import anchor_points, initial_cable_nodes, pulley_exit, straight_cable_nodes
+from .kinematics import anchor_points, hang_point, initial_cable_nodes, pulley_exit, straight_cable_nodes
 from .platform import PlatformItems, add_platform, attach_cable
 from .pulley import add_pulley_contact, add_pulley_ground
 from .scene import Scene
@@ -46,6 +46,8 @@ class Model:
         Cable-local indices of the nodes that carry a contact item.
     initial_paid_out : ndarray, shape (m,) [m]
         Paid-out length lambda_i(0) of the initial configuration.
+    ropes : list of RopeItems
+        The massless ropes (``effects.cable_mass`` off); then ``cables`` is empty.
     """
 
     scene: Scene
@@ -58,6 +60,7 @@ class Model:
     contacts: list[list[int]] = field(default_factory=list)
     contact_nodes: list[np.ndarray] = field(default_factory=list)
     initial_paid_out: np.ndarray | None = None
+    ropes: list[RopeItems] = field(default_factory=list)
 
     def item_counts(self) -> dict[str, int]:
         """How many Exudyn items each effect added."""
@@ -69,7 +72,8 @@ class Model:
             "bending_joints": 0 if self.cable_forces is None else len(self.cable_forces.joints),
             "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
             "pulley_contacts": sum(len(c) for c in self.contacts),
-            "winch_constraints": 2 * len(self.winches),
+            "massless_ropes": len(self.ropes),
+            "winch_constraints": sum(1 + (w.horizontal >= 0) for w in self.winches),
             "platform_joints": len(self.platform.joints),
         }
 
@@ -171,6 +175,8 @@ def build_model(scene: Scene) -> Model:
 
     effects = scene.effects
     platform = add_platform(mbs, scene.platform, effects, scene.gravity)
+    if not effects.cable_mass:
+        return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
     use_contact = effects.pulley_contact and scene.cable_exit == "pulley"
     cables, winches, contacts, contact_nodes, paid_out = [], [], [], [], []
     for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
@@ -197,3 +203,55 @@ def build_model(scene: Scene) -> Model:
     mbs.Assemble()
     return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
                  contacts, contact_nodes, np.asarray(paid_out))
+
+
+#: Shortest rope segment kept between the fixed winch point and the pulley [m]; a
+#: cable that starts fully paid out gets this much extra, unstrained rope there.
+MIN_WINCH_SEGMENT = 0.25
+
+
+def rope_geometry(scene: Scene, cable_index: int, anchor) -> tuple[np.ndarray, float, float]:
+    """Hang point, sheave radius and ideal paid-out length of a massless rope.
+
+    Returns
+    -------
+    hang : ndarray, shape (2,) [m]
+        Where the rope leaves its vertical winch line (the pulley centre for a point exit).
+    radius : float [m]
+        Sheave radius given to Exudyn (0 for a point exit).
+    paid_out : float [m]
+        Ideal length from the hang point to the anchor.
+    """
+    pulley = scene.pulleys[cable_index]
+    center = np.asarray(pulley.center)
+    if scene.cable_exit == "point":
+        return center, 0.0, float(np.linalg.norm(np.asarray(anchor) - center))
+    exit_ = pulley_exit(center, pulley.radius, pulley.side, np.asarray(anchor))
+    return hang_point(center, pulley.radius, pulley.side), pulley.radius, float(exit_.cable_length)
+
+
+def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems, ground_coordinate: int) -> Model:
+    """Massless cables: one reeving-system rope per cable, winch point -> pulley -> anchor."""
+    from dataclasses import replace as _replace
+
+    import exudyn.itemInterface as _eii
+
+    anchors = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))
+    ropes, winches, paid_out = [], [], []
+    for i, cable in enumerate(scene.cables):
+        hang, radius, length = rope_geometry(scene, i, anchors[i])
+        hanging = cable.unstrained_length - length
+        segment = max(hanging, MIN_WINCH_SEGMENT)
+        rope_cable = _replace(cable, unstrained_length=cable.unstrained_length + segment - hanging)
+        bx, bz = scene.platform.anchors[i]
+        anchor_marker = mbs.AddMarker(_eii.MarkerBodyRigid(bodyNumber=platform.body, localPosition=[bx, bz, 0.0]))
+        rope = add_rope(mbs, rope_cable, scene.pulleys[i].center, radius, scene.pulleys[i].side, anchor_marker,
+                        hang - np.array([0.0, segment]), ground_coordinate, scene.effects)
+        drive = mbs.AddObject(_eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
+                                                            offset=0.0))
+        winches.append(WinchItems(-1, drive, float(hang[1] - hanging)))
+        ropes.append(rope)
+        paid_out.append(length)
+    mbs.Assemble()
+    return Model(scene, system_container, mbs, [], platform, winches, None, [[] for _ in ropes],
+                 [np.zeros(0, dtype=int) for _ in ropes], np.asarray(paid_out), ropes)

@@ -293,6 +293,14 @@ class WinchSpec:
 
 #: The model ladder: which effects each preset switches on.
 PRESETS: dict[str, dict[str, bool]] = {
+    "ideal": dict(
+        cable_mass=False, axial_elasticity=False, axial_damping=False, bending=False,
+        bending_damping=False, pulley_contact=False, slack=False, gravity=True,
+    ),
+    "elastic": dict(
+        cable_mass=False, axial_elasticity=True, axial_damping=True, bending=False,
+        bending_damping=False, pulley_contact=False, slack=False, gravity=True,
+    ),
     "full": dict(
         cable_mass=True, axial_elasticity=True, axial_damping=True, bending=True,
         bending_damping=True, pulley_contact=True, slack=False, gravity=True,
@@ -311,10 +319,15 @@ class Effects:
     Parameters
     ----------
     preset : str
-        Name of the preset the flags started from (see :data:`PRESETS`), for reports.
+        Name of the preset the flags started from (see :data:`PRESETS`), for reports:
+        "ideal" (massless inextensible ropes), "elastic" (massless elastic ropes),
+        "catenary" (lumped mass and elasticity, no bending), "full" (the paper's model).
     cable_mass, axial_elasticity, axial_damping, bending, bending_damping,
     pulley_contact, slack, gravity : bool
-        Switches of the individual effects. ``slack`` makes the elements tension-only.
+        Switches of the individual effects. Without ``cable_mass`` each cable is one
+        massless rope over its pulley (Exudyn's reeving system); without
+        ``axial_elasticity`` the elements (or the rope) are inextensible. ``slack``
+        makes the elements (or the rope) tension-only.
     bending_model : {"exact"}
         Formulation of the bending spring: "exact" is the paper's relative joint angle.
     """
@@ -337,9 +350,15 @@ class Effects:
                 raise SceneError(f"effects.{f.name} must be true or false, got {getattr(self, f.name)!r}")
         _choice("effects.bending_model", self.bending_model, ("exact",))
         if not self.cable_mass:
-            raise SceneError("effects.cable_mass = false (massless cables) is not available in this model yet")
-        if not self.axial_elasticity:
-            raise SceneError("effects.axial_elasticity = false (inextensible cables) is not available yet")
+            for name in ("bending", "pulley_contact"):
+                if getattr(self, name):
+                    raise SceneError(
+                        f"effects.{name} = true needs effects.cable_mass = true: a massless cable is one "
+                        "straight rope over frictionless sheaves, with no nodes to bend or touch the pulley")
+        if not self.axial_elasticity and self.slack and self.cable_mass:
+            raise SceneError("effects.slack = true needs effects.axial_elasticity = true (slack elements are springs)")
+        if not self.axial_elasticity and self.axial_damping:
+            raise SceneError("effects.axial_damping = true needs effects.axial_elasticity = true")
         if self.bending_damping and not self.bending:
             raise SceneError("effects.bending_damping needs effects.bending = true")
 

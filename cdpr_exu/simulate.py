@@ -73,7 +73,7 @@ class _Monitor:
     def __init__(self, scene: Scene, indices: dict[str, np.ndarray], reference: np.ndarray):
         self.scene = scene
         self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
-                       for i, cable in enumerate(scene.cables)]
+                       for i, cable in enumerate(scene.cables) if f"cable_{i}" in indices]
         self.check_pulleys = scene.cable_exit == "pulley" and scene.effects.pulley_contact
 
     def problem(self, t: float, q: np.ndarray) -> str | None:
@@ -109,7 +109,8 @@ class _Recorder:
         self.q = np.full((count, size), np.nan)
         self.v = np.full((count, size), np.nan)
         self.times = np.full(count, np.nan)
-        self.paid_out = np.full((count, len(model.cables)), np.nan)
+        self.paid_out = np.full((count, len(model.winches)), np.nan)
+        self.rope_forces = np.full((count, len(model.ropes)), np.nan)
         self.count = 0
 
     def record_if_due(self, t: float, paid_out: np.ndarray) -> bool:
@@ -120,6 +121,8 @@ class _Recorder:
             self.v[self.count] = data.GetODE2Coordinates_t()
             self.times[self.count] = t
             self.paid_out[self.count] = paid_out
+            for i, rope in enumerate(self.model.ropes):
+                self.rope_forces[self.count, i] = self.model.mbs.GetObjectOutput(rope.rope, exu.OutputVariableType.ForceLocal)
             self.count += 1
             return True
         return False
@@ -134,7 +137,11 @@ class _Recorder:
         pose = ref_q[platform_idx] + q[:, platform_idx]
         velocity = v[:, platform_idx]
         nodes, node_velocities, tensions, depth = [], [], [], []
-        for i, cable in enumerate(scene.cables):
+        if self.model.ropes:
+            nodes, node_velocities, tensions = _rope_series(scene, self.model, pose, self.paid_out[:k],
+                                                            self.rope_forces[:k], times)
+            depth = [np.zeros(k) for _ in self.model.ropes]
+        for i, cable in enumerate(scene.cables if not self.model.ropes else ()):
             idx = self.indices[f"cable_{i}"]
             positions = ref_q[idx] + q[:, idx]
             velocities = v[:, idx]
@@ -152,6 +159,36 @@ class _Recorder:
             nodes=nodes, node_velocities=node_velocities, tensions=tensions, paid_out=self.paid_out[:k],
             pulley_penetration=np.column_stack(depth) if depth else np.zeros((k, 0)),
         )
+
+
+def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndarray, forces: np.ndarray,
+                 times: np.ndarray):
+    """Polylines (winch end, hang point, tangent point, anchor) and tensions of massless ropes.
+
+    The ropes have no nodes: their points follow from the platform pose and the
+    paid-out length; their velocities are time derivatives of those points.
+    """
+    from .kinematics import anchor_points
+    from .model import rope_geometry
+
+    k = len(times)
+    anchors = anchor_points(pose, np.asarray(scene.platform.anchors)) if k else np.zeros((0, len(model.ropes), 2))
+    nodes, velocities, tensions = [], [], []
+    for i, cable in enumerate(scene.cables):
+        points = np.zeros((k, 4, 2))
+        for row in range(k):
+            hang, radius, _ = rope_geometry(scene, i, anchors[row, i])
+            tangent = hang
+            if radius > 0:
+                from .kinematics import pulley_exit
+
+                tangent = pulley_exit(np.asarray(scene.pulleys[i].center), radius, scene.pulleys[i].side,
+                                      anchors[row, i]).tangent_point
+            points[row] = [hang - [0.0, cable.unstrained_length - paid_out[row, i]], hang, tangent, anchors[row, i]]
+        nodes.append(points)
+        velocities.append(np.gradient(points, times, axis=0) if k > 1 else np.zeros_like(points))
+        tensions.append(forces[:, i:i + 1])
+    return nodes, velocities, tensions
 
 
 def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
@@ -203,7 +240,9 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
             v = mbs.systemData.GetODE2Coordinates_t()
             pose = ref_q[platform_idx] + q[platform_idx]
             velocity = v[platform_idx]
-            if controller.uses_tension:
+            if controller.uses_tension and model.ropes:
+                tensions = np.array([mbs.GetObjectOutput(r.rope, exu.OutputVariableType.ForceLocal) for r in model.ropes])
+            elif controller.uses_tension:
                 tensions = np.array([
                     element_tensions(cable, ref_q[indices[f"cable_{i}"]][-2:] + q[indices[f"cable_{i}"]][-2:],
                                      v[indices[f"cable_{i}"]][-2:], scene.effects)[-1]

@@ -54,7 +54,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import minimize
 
 from cdpr_exu.catenary import (
     DEFAULT_MAX_STRAIN,
@@ -478,15 +478,6 @@ def _straight_tangent_angle(pulley, point):
     raise AssertionError("no tangent with the pulley's orientation")  # pragma: no cover
 
 
-def _ideal_length(cable, point):
-    """Straight, inextensible length from an anchor point to the winch point [m]."""
-    if cable.pulley is None:
-        return float(np.hypot(*(np.array(cable.exit_point) - point)))
-    angle = _straight_tangent_angle(cable.pulley, point)
-    straight = float(np.hypot(*(cable.pulley.tangent_point(angle) - point)))
-    return straight + cable.pulley.radius * cable.pulley.wrap_angle(angle)
-
-
 # ---------------------------------------------------------------------------
 # one cable: forward (given unstrained length) and inverse (given H)
 # ---------------------------------------------------------------------------
@@ -737,35 +728,82 @@ def _lengths(platform, unstrained_lengths):
     return lengths
 
 
-def ideal_pose(platform, unstrained_lengths, rotation=0.0):
-    """Pose at which straight, inextensible cables have the given lengths.
+def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
+    """Equilibrium pose on straight, massless, elastic cables that may go slack.
 
-    Least squares on ``ideal_length_i(pose) - L_i`` from a point below the upper
-    ends (so the hanging solution is found). The rotation is solved only for a rigid
-    platform with three or more cables; otherwise it stays at ``rotation``.
+    Minimises the potential energy ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2``
+    with ``l_i`` the straight (pulley: tangent plus wrap) length from anchor to winch
+    point and ``k_i = EA_i / L_i``. Unlike intersecting the circles of inextensible
+    cables, this always has a solution, also when some cables are too long to be
+    taut; it is the starting guess of `solve_forward_statics`.
+
+    Parameters
+    ----------
+    platform : SuspendedPlatform
+    unstrained_lengths : array_like, shape (n_cables,) [m]
+    external_wrench : (fx, fz, moment), optional
+        [N, N, N m].
 
     Returns
     -------
     position : ndarray, shape (2,) [m]
     rotation : float [rad]
+        0 for a point mass.
     """
     lengths = _lengths(platform, unstrained_lengths)
+    wrench = _wrench(external_wrench)
+    dof = platform.degrees_of_freedom
+    stiffness = np.array([c.axial_stiffness / L for c, L in zip(platform.cables, lengths)])
     uppers = np.array([c.upper_reference for c in platform.cables])
-    solve_rotation = platform.degrees_of_freedom == 3 and len(platform.cables) >= 3
-    start = np.array([uppers[:, 0].mean(), uppers[:, 1].mean() - lengths.mean()])
+    force_scale, length_scale = _scales(platform, lengths, wrench)
+    weight = platform.mass * platform.gravity
 
-    def residual(x):
-        phi = x[2] if solve_rotation else rotation
-        points = platform.anchor_points(x[:2], phi)
-        try:
-            return [_ideal_length(c, p) - L for c, p, L in zip(platform.cables, points, lengths)]
-        except UnreachableError:
-            return np.full(len(lengths), 1e6)
+    def energy(q):
+        phi = q[2] if dof == 3 else 0.0
+        rotation_matrix = _rotation(phi)
+        value = weight * q[1] - wrench[0] * q[0] - wrench[1] * q[1] - wrench[2] * phi
+        gradient = np.array([-wrench[0], weight - wrench[1], -wrench[2]])
+        for cable, L, k in zip(platform.cables, lengths, stiffness):
+            arm = rotation_matrix @ cable.anchor
+            length, direction = _straight_length_and_gradient(cable, q[:2] + arm)
+            extension = length - L
+            if extension > 0.0:
+                value += 0.5 * k * extension**2
+                pull = k * extension * direction
+                gradient[:2] += pull
+                gradient[2] += _cross(arm, pull)
+        return value, gradient[:dof]
 
-    x0 = np.append(start, rotation) if solve_rotation else start
-    solution = least_squares(residual, x0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
-    phi = _wrap_angle(solution.x[2]) if solve_rotation else float(rotation)
+    start = np.array([uppers[:, 0].mean(), uppers[:, 1].mean() - lengths.mean(), 0.0])[:dof]
+    solution = minimize(
+        energy, start, jac=True, method="BFGS",
+        options={"gtol": 1e-9 * force_scale, "maxiter": 2000},
+    )
+    phi = _wrap_angle(solution.x[2]) if dof == 3 else 0.0
     return solution.x[:2].copy(), phi
+
+
+def _straight_length_and_gradient(cable, point):
+    """Straight length from ``point`` to the winch point [m] and its gradient in ``point``.
+
+    With a pulley, the length is tangent plus wrapped arc; its gradient is the unit
+    vector from the tangent point to ``point`` (the wrap change cancels the tangent
+    point's motion to first order). Inside a pulley disc (no tangent) the distance
+    to the centre plus half a turn stands in, to keep the energy continuous-ish.
+    """
+    if cable.pulley is None:
+        offset = point - np.array(cable.exit_point)
+        length = float(np.hypot(*offset))
+        return length, (offset / length if length > 0.0 else np.zeros(2))
+    pulley = cable.pulley
+    offset = point - np.array(pulley.centre)
+    distance = float(np.hypot(*offset))
+    if distance <= pulley.radius:
+        return distance + math.pi * pulley.radius, offset / max(distance, 1e-300)
+    angle = _straight_tangent_angle(pulley, point)
+    offset = point - pulley.tangent_point(angle)
+    straight = float(np.hypot(*offset))
+    return straight + pulley.radius * pulley.wrap_angle(angle), offset / straight
 
 
 def _wrap_angle(angle):
@@ -797,8 +835,8 @@ def solve_forward_statics(
     unstrained_lengths : array_like, shape (n_cables,) [m]
         Total unstrained length of each cable (with a pulley: up to its winch point).
     initial_pose : (x, z) or (x, z, phi), optional
-        Starting pose [m, m, rad]; default: `ideal_pose` of straight cables stretched
-        by an even share of the load.
+        Starting pose [m, m, rad]; default: `straight_cable_pose` (massless elastic
+        cables).
     external_wrench : (fx, fz, moment), optional
         Extra load on the platform [N, N, N m] at its centre of mass, eg
         `inertial_wrench`.
@@ -820,12 +858,7 @@ def solve_forward_statics(
     wrench = _wrench(external_wrench)
     dof = platform.degrees_of_freedom
     if initial_pose is None:
-        # straight cables, stretched by an even share of the load: starts massless
-        # cables taut rather than on the kink between slack and taut
-        load = platform.mass * platform.gravity + float(np.hypot(wrench[0], wrench[1]))
-        load += sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths))
-        strain = np.array([load / len(lengths) / c.axial_stiffness for c in platform.cables])
-        position, rotation = ideal_pose(platform, lengths * (1.0 + np.minimum(strain, 0.01)))
+        position, rotation = straight_cable_pose(platform, lengths, wrench)
     else:
         pose = np.asarray(initial_pose, dtype=float)
         if pose.shape not in ((2,), (3,)) or not np.all(np.isfinite(pose)):
@@ -976,7 +1009,10 @@ def solve_inverse_statics(
         # Newton decide (it fails, with UnreachableError, if they really must push)
         weight = max(platform.mass * platform.gravity, 1e-9)
         horizontal = np.maximum(horizontal, 0.1 * weight)
-    lengths_guess = [_ideal_length(c, p) for c, p in zip(platform.cables, platform.anchor_points(position, rotation))]
+    lengths_guess = [
+        _straight_length_and_gradient(c, p)[0]
+        for c, p in zip(platform.cables, platform.anchor_points(position, rotation))
+    ]
     force_scale, length_scale = _scales(platform, lengths_guess, wrench)
     residual_scale = np.array([force_scale, force_scale, force_scale * length_scale])[:dof]
     unknown_scale = np.append(np.full(n, 1.0 / force_scale), [1.0 / math.pi] if free_rotation else [])

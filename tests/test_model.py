@@ -16,11 +16,9 @@ import pytest
 from cdpr_exu.cable import element_tensions
 from cdpr_exu.errors import SceneError, UnreachableError
 from cdpr_exu.model import build_model, contact_candidates
-from cdpr_exu.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, WinchSpec, load_scene
+from cdpr_exu.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, load_scene
 from cdpr_exu.simulate import simulate, solver_settings
 from cdpr_exu.trajectories import CircleTrajectory
-
-from conftest import GRAVITY, settling_solver
 
 
 def settle(scene):
@@ -103,9 +101,10 @@ def test_paper_scene_has_a_mass_point_per_node_and_a_spring_damper_per_element(p
 
 def test_paper_scene_bends_at_every_interior_node_in_one_object(paper_model):
     counts = paper_model.item_counts()
-    assert counts["bending_objects"] == 1
+    assert counts["cable_force_objects"] == 1
     assert counts["bending_joints"] == 2 * 14
-    joints = paper_model.bending.joints
+    assert counts["slack_elements"] == 0  # the paper's elements push as well as pull
+    joints = paper_model.cable_forces.joints
     # consecutive triplets (b - 1, b, b + 1), never spanning two cables (nodes 0-15 and 16-31)
     assert np.all(np.diff(joints, axis=1) == 1)
     assert not np.any((joints[:, 0] <= 15) & (joints[:, 2] >= 16))
@@ -117,16 +116,25 @@ def test_pulley_contacts_only_on_nodes_that_can_reach_the_pulley(paper_model):
     for i, (contacts, nodes) in enumerate(zip(paper_model.contacts, paper_model.contact_nodes)):
         assert len(contacts) == len(nodes)
         assert 0 not in nodes  # the winch node's motion is prescribed
-        assert 15 not in nodes  # the anchor node stays 1.6 m or more below the pulley
+        assert 15 not in nodes  # the anchor node stays over 1 m below the pulley centre
         np.testing.assert_array_equal(nodes, contact_candidates(paper_model.scene, i))
 
 
 def test_catenary_preset_adds_no_bending_object():
     scene = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary"))
     counts = build_model(scene).item_counts()
-    assert counts["bending_objects"] == 0
+    assert counts["cable_force_objects"] == 0
     assert counts["bending_joints"] == 0
     assert counts["axial_spring_dampers"] == 2 * 15
+
+
+def test_slack_elements_replace_the_spring_dampers_in_the_one_cable_force_object():
+    scene = load_scene("paper-circle").with_changes(effects=Effects.from_preset("full", slack=True))
+    counts = build_model(scene).item_counts()
+    assert counts["axial_spring_dampers"] == 0
+    assert counts["slack_elements"] == 2 * 15
+    assert counts["cable_force_objects"] == 1
+    assert counts["bending_joints"] == 2 * 14
 
 
 def test_point_exit_adds_no_pulley_contact(v_shaped):
@@ -140,7 +148,7 @@ def test_point_exit_adds_no_pulley_contact(v_shaped):
 def test_hanging_cable_tension_steps_by_the_weight_of_each_node(hanging_cable):
     scene = hanging_cable()
     _, [(tension, _)] = settled_tensions(scene)
-    weights = GRAVITY * scene.cables[0].node_masses()
+    weights = scene.gravity * scene.cables[0].node_masses()
     # Element i holds every node below it: T_i - T_{i+1} = weight of node i + 1.
     # 1e-6 N against node weights of 0.4 to 0.9 N: at rest (velocities < 1e-14 m/s),
     # so only Newton's residual is left, which is far smaller.
@@ -151,8 +159,8 @@ def test_hanging_cable_tension_steps_by_the_weight_of_each_node(hanging_cable):
 def test_hanging_cable_top_tension_carries_everything_below(hanging_cable):
     scene = hanging_cable(platform_mass=1.0)
     _, [(tension, positions)] = settled_tensions(scene)
-    weights = GRAVITY * scene.cables[0].node_masses()
-    platform_weight = GRAVITY * scene.platform.mass
+    weights = scene.gravity * scene.cables[0].node_masses()
+    platform_weight = scene.gravity * scene.platform.mass
     # 1e-6 N out of ~13 N: at rest, see above.
     assert tension[0] == pytest.approx(weights[1:].sum() + platform_weight, abs=1e-6)
     assert tension[-1] == pytest.approx(weights[-1] + platform_weight, abs=1e-6)
@@ -173,10 +181,10 @@ def test_creeping_hanging_cable_result_tensions_balance_its_weight(hanging_cable
     result = simulate(scene)
     tension = result.tensions[0][-1]
     assert np.abs(result.node_velocities[0][-1]).max() > 1e-7  # really still creeping
-    weights = GRAVITY * scene.cables[0].node_masses()
+    weights = scene.gravity * scene.cables[0].node_masses()
     # 1e-4 N: the creep decelerates at ~v / (1 s) ~ 1e-5 m/s^2, an inertia force of
     # ~1e-5 N on the 1.4 kg below the top element (measured residual 9e-6 N).
-    assert tension[0] == pytest.approx(weights[1:].sum() + GRAVITY * scene.platform.mass, abs=1e-4)
+    assert tension[0] == pytest.approx(weights[1:].sum() + scene.gravity * scene.platform.mass, abs=1e-4)
     np.testing.assert_allclose(-np.diff(tension), weights[1:-1], rtol=0, atol=1e-4)
 
 
@@ -184,16 +192,17 @@ def test_winch_and_joint_reactions_hold_a_hanging_cable(hanging_cable):
     scene = hanging_cable(platform_mass=1.0)
     model = settle(scene)
     top, bottom = end_forces_on_cable(model, 0)
-    cable_weight = GRAVITY * scene.cables[0].mass
-    platform_weight = GRAVITY * scene.platform.mass
+    cable_weight = scene.gravity * scene.cables[0].mass
+    platform_weight = scene.gravity * scene.platform.mass
     # 1e-6 N: at rest; the reactions are Lagrange multipliers solved with the state.
     np.testing.assert_allclose(top, [0.0, cable_weight + platform_weight], rtol=0, atol=1e-6)
     np.testing.assert_allclose(bottom, [0.0, -platform_weight], rtol=0, atol=1e-6)
 
 
-@pytest.mark.parametrize("preset", ["catenary", "full"])
-def test_v_shaped_cable_end_forces_balance_its_weight(v_shaped, preset):
-    scene = v_shaped(Effects.from_preset(preset))
+@pytest.mark.parametrize("preset, slack", [("catenary", False), ("full", False), ("full", True)],
+                         ids=["catenary", "full", "full_tension_only"])
+def test_v_shaped_cable_end_forces_balance_its_weight(v_shaped, preset, slack):
+    scene = v_shaped(Effects.from_preset(preset, slack=slack))
     model = settle(scene)
     for i, cable in enumerate(scene.cables):
         top, bottom = end_forces_on_cable(model, i)
@@ -202,7 +211,7 @@ def test_v_shaped_cable_end_forces_balance_its_weight(v_shaped, preset):
         assert abs(top[0]) > 1.0
         # 1e-6 N: at rest (measured residual ~1e-10 N); the internal forces (axial,
         # bending) cancel in the sum over the cable.
-        np.testing.assert_allclose(top + bottom, [0.0, GRAVITY * cable.mass], rtol=0, atol=1e-6)
+        np.testing.assert_allclose(top + bottom, [0.0, scene.gravity * cable.mass], rtol=0, atol=1e-6)
 
 
 def test_v_shaped_cables_hold_the_platform_weight(v_shaped):
@@ -210,7 +219,7 @@ def test_v_shaped_cables_hold_the_platform_weight(v_shaped):
     model = settle(scene)
     on_platform = -sum(end_forces_on_cable(model, i)[1] for i in range(scene.n_cables))
     # 1e-6 N: at rest, as above. The point mass sits on the symmetry line.
-    np.testing.assert_allclose(on_platform, [0.0, GRAVITY * scene.platform.mass], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(on_platform, [0.0, scene.gravity * scene.platform.mass], rtol=0, atol=1e-6)
 
 
 def test_v_shaped_cable_interior_nodes_balance_with_element_tensions(v_shaped):
@@ -221,22 +230,27 @@ def test_v_shaped_cable_interior_nodes_balance_with_element_tensions(v_shaped):
         up = (nodes[0] - nodes[1]) / np.linalg.norm(nodes[0] - nodes[1])
         down = (nodes[-1] - nodes[-2]) / np.linalg.norm(nodes[-1] - nodes[-2])
         pull = tension[0] * up + tension[-1] * down
-        interior_weight = GRAVITY * cable.node_masses()[1:-1].sum()
+        interior_weight = scene.gravity * cable.node_masses()[1:-1].sum()
         # 1e-6 N against 10 to 16 N tensions: at rest.
         np.testing.assert_allclose(pull, [0.0, interior_weight], rtol=0, atol=1e-6)
         assert nodes[len(nodes) // 2, 1] < -0.9  # it really sags below the chord
 
 
-def test_straight_cable_element_is_a_linear_spring(hanging_cable):
-    """Hooke's law: each element of a straight hanging cable stretches by its load over k_i."""
+@pytest.mark.parametrize("slack", [False, True], ids=["spring", "tension_only"])
+def test_straight_cable_element_is_a_linear_spring(hanging_cable, slack):
+    """Hooke's law: each element of a straight hanging cable stretches by its load over k_i.
+
+    A tension-only element in tension is the same linear spring.
+    """
     for platform_mass in (1.0, 4.0):
-        scene = hanging_cable(n_elements=2, platform_mass=platform_mass)
+        scene = hanging_cable(n_elements=2, platform_mass=platform_mass,
+                              effects=Effects.from_preset("full", slack=slack))
         cable = scene.cables[0]
         model = settle(scene)
         nodes, _ = cable_state(model, 0)
         stretch = np.linalg.norm(np.diff(nodes, axis=0), axis=1) - cable.element_length
-        weights = GRAVITY * cable.node_masses()
-        load = np.array([weights[1:].sum(), weights[2:].sum()]) + GRAVITY * platform_mass
+        weights = scene.gravity * cable.node_masses()
+        load = np.array([weights[1:].sum(), weights[2:].sum()]) + scene.gravity * platform_mass
         # 1e-6 relative: stretches of 6e-5 to 2.6e-4 m, resolved at rest to ~1e-15 m in
         # coordinates of order 1 m (measured relative error ~1e-12).
         np.testing.assert_allclose(stretch, load / cable.axial_stiffness, rtol=1e-6)
@@ -251,14 +265,14 @@ def test_straight_cable_element_is_a_linear_spring(hanging_cable):
 def test_stretch_of_a_straight_cable_is_linear_in_the_load(hanging_cable):
     stretches = []
     for platform_mass in (1.0, 2.0, 4.0):
-        model = settle(hanging_cable(n_elements=2, platform_mass=platform_mass))
-        nodes, _ = cable_state(model, 0)
-        stretches.append(-nodes[-1, 1] - 1.0)
-    k_series = CableSpec(unstrained_length=1.0, n_elements=2).axial_stiffness / 2
+        scene = hanging_cable(n_elements=2, platform_mass=platform_mass)
+        nodes, _ = cable_state(settle(scene), 0)
+        stretches.append(-nodes[-1, 1] - scene.cables[0].unstrained_length)
+    k_series = scene.cables[0].axial_stiffness / 2
     # Equal steps in load give equal steps in stretch, of (delta M g) / (k_i / 2).
     # 1e-6 relative on steps of 1.2e-4 m and 2.5e-4 m: see the test above.
-    assert stretches[1] - stretches[0] == pytest.approx(GRAVITY * 1.0 / k_series, rel=1e-6)
-    assert stretches[2] - stretches[1] == pytest.approx(GRAVITY * 2.0 / k_series, rel=1e-6)
+    assert stretches[1] - stretches[0] == pytest.approx(scene.gravity * 1.0 / k_series, rel=1e-6)
+    assert stretches[2] - stretches[1] == pytest.approx(scene.gravity * 2.0 / k_series, rel=1e-6)
 
 
 # ============================================================================ bad input
