@@ -73,7 +73,7 @@ class Model:
             "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
             "pulley_contacts": sum(len(c) for c in self.contacts),
             "massless_ropes": len(self.ropes),
-            "winch_constraints": sum(1 + (w.horizontal >= 0) for w in self.winches),
+            "winch_constraints": sum(1 + (int(w.horizontal) >= 0) for w in self.winches),
             "platform_joints": len(self.platform.joints),
         }
 

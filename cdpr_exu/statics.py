@@ -456,6 +456,76 @@ def _damped_newton(
     raise UnreachableError(f"{what} did not converge (scaled residual {norm:.3g})")
 
 
+def _minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="equilibrium"):
+    """Newton's method for a conservative equilibrium, with a line search on the energy.
+
+    ``function(x) -> (residual, jacobian)`` where the residual is the net generalised
+    force, ``-grad(energy)``, and the jacobian ``-hessian``. The energy itself is not
+    needed: along a descent direction ``d`` its slope is ``-residual . d``, and the
+    step length is chosen where that slope stops being (strongly) negative, ie near
+    the energy minimum along the line. Unlike a search on the residual norm, this
+    cannot stall away from an equilibrium, which matters on the curved, stiff valleys
+    of near-vertical cables (a pendulum: stiff along the cable, soft across it).
+    Where the stiffness is not positive definite along the Newton direction, the
+    direction falls back to the (scaled) steepest descent.
+    """
+    x = np.array(x0, dtype=float)
+    residual, jacobian = function(x)
+    norm = float(np.linalg.norm(residual))
+    for _ in range(max_iterations):
+        if norm <= tolerance:
+            return x, residual, jacobian
+        stiffness = -jacobian
+        try:
+            direction = np.linalg.solve(stiffness, residual)
+        except np.linalg.LinAlgError:
+            direction = None
+        if direction is None or not np.all(np.isfinite(direction)) or residual @ direction <= 0.0:
+            scale = max(float(np.abs(np.diag(stiffness)).max()), 1e-300)
+            direction = residual / scale
+        slope0 = -float(residual @ direction)  # < 0: descent
+
+        def slope_at(alpha):
+            try:
+                r, j = function(x + alpha * direction)
+            except UnreachableError:
+                return math.inf, None, None
+            return -float(r @ direction), r, j
+
+        slope1, residual1, jacobian1 = slope_at(1.0)
+        alpha = 1.0
+        if not slope1 <= 0.5 * abs(slope0):
+            # the energy turns up before alpha = 1: find where its slope crosses zero
+            low, high, slope_low, slope_high = 0.0, 1.0, slope0, slope1
+            for _ in range(60):
+                if math.isfinite(slope_high) and slope_high > slope_low:
+                    alpha = low - slope_low * (high - low) / (slope_high - slope_low)
+                    alpha = min(max(alpha, low + 0.1 * (high - low)), high - 0.1 * (high - low))
+                else:
+                    alpha = 0.5 * (low + high)
+                slope1, residual1, jacobian1 = slope_at(alpha)
+                if abs(slope1) <= 0.5 * abs(slope0) and residual1 is not None:
+                    break
+                if slope1 < 0.0:
+                    low, slope_low = alpha, slope1
+                else:
+                    high, slope_high = alpha, slope1
+            else:
+                break
+        if residual1 is None:
+            break
+        step_norm = float(np.linalg.norm(alpha * direction))
+        x, residual, jacobian = x + alpha * direction, residual1, jacobian1
+        new_norm = float(np.linalg.norm(residual))
+        if step_norm <= 1e-15 * max(1.0, float(np.linalg.norm(x))) and new_norm >= norm:
+            norm = new_norm
+            break  # no more progress at round-off level
+        norm = new_norm
+    if norm <= noise:
+        return x, residual, jacobian
+    raise UnreachableError(f"{what} did not converge (scaled residual {norm:.3g})")
+
+
 # ---------------------------------------------------------------------------
 # one cable: ideal (straight) geometry
 # ---------------------------------------------------------------------------
@@ -894,9 +964,9 @@ def solve_forward_statics(
         return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
 
     start = np.append(position, rotation)[:dof] * pose_scale
-    scaled, _, _ = _damped_newton(
-        function, start, _RELATIVE_TOLERANCE, what="forward statics",
-        noise=_platform_noise(platform, force_scale),
+    scaled, _, _ = _minimise_energy(
+        function, start, _RELATIVE_TOLERANCE, _platform_noise(platform, force_scale),
+        what="forward statics",
     )
     pose = scaled / pose_scale
     _, jacobian = evaluate(pose)  # the accepted point, with its own cable states
