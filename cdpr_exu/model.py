@@ -18,7 +18,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from .cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
-from .errors import UnreachableError
+from .errors import SceneError, UnreachableError
 from .kinematics import anchor_points, hang_point, initial_cable_nodes, pulley_exit, straight_cable_nodes
 from .platform import PlatformItems, add_platform, attach_cable
 from .pulley import add_pulley_contact, add_pulley_ground
@@ -159,6 +159,23 @@ def check_trajectory_reachable(scene: Scene) -> None:
                 )
 
 
+def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.ndarray) -> None:
+    """Refuse a cable whose straight elements cut deep into the pulley from the start.
+
+    Contact acts on the nodes: an element much longer than the pulley radius spans the
+    wrap as a chord through the disc, and the cable then slips through the pulley.
+    """
+    from .pulley import segment_penetration
+
+    pulley, cable = scene.pulleys[cable_index], scene.cables[cable_index]
+    depth = segment_penetration(pulley, nodes_xz).max()
+    if depth > 0.5 * pulley.radius:
+        raise SceneError(
+            f"cables[{cable_index}].n_elements = {cable.n_elements} is too coarse: its {cable.element_length:.3f} m "
+            f"elements cut {1000 * depth:.0f} mm into the {pulley.radius} m pulley as chords of the wrap; "
+            f"use elements no longer than about 1.4 pulley radii")
+
+
 def build_model(scene: Scene) -> Model:
     """Build and assemble the Exudyn system of ``scene``.
 
@@ -181,6 +198,8 @@ def build_model(scene: Scene) -> Model:
     cables, winches, contacts, contact_nodes, paid_out = [], [], [], [], []
     for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
         nodes_xz = initial_nodes(scene, i)
+        if scene.cable_exit == "pulley":
+            _check_elements_fit_the_pulley(scene, i, nodes_xz)
         items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
         attach_cable(mbs, platform, i, items.markers[-1])
         winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1])))

@@ -77,3 +77,25 @@ def penetration(pulley: PulleySpec, positions: np.ndarray) -> np.ndarray:
     """
     distance = np.linalg.norm(np.asarray(positions) - np.asarray(pulley.center), axis=-1)
     return np.maximum(pulley.radius - distance, 0.0)
+
+
+def segment_penetration(pulley: PulleySpec, positions: np.ndarray) -> np.ndarray:
+    """Depth by which each element (the segment between two nodes) cuts into the pulley disc [m].
+
+    Parameters
+    ----------
+    positions : ndarray, shape (n + 1, 2) [m]
+        Node positions of one cable.
+
+    Returns
+    -------
+    ndarray, shape (n,) [m]
+        r_p minus the distance of the segment from the pulley centre, 0 if outside.
+    """
+    positions = np.asarray(positions, dtype=float)
+    center = np.asarray(pulley.center)
+    a, b = positions[:-1], positions[1:]
+    d = b - a
+    t = np.clip(np.einsum("ij,ij->i", center - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+    closest = a + t[:, None] * d
+    return np.maximum(pulley.radius - np.linalg.norm(closest - center, axis=1), 0.0)

@@ -23,7 +23,7 @@ from controllers.ideal_ik import IdealIKController
 from .cable import element_tensions
 from .errors import SolverFailure
 from .model import Model, build_model
-from .pulley import penetration
+from .pulley import penetration, segment_penetration
 from .result import Result
 from .scene import Scene
 from .winch import set_paid_out_length
@@ -75,6 +75,19 @@ class _Monitor:
         self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
                        for i, cable in enumerate(scene.cables) if f"cable_{i}" in indices]
         self.check_pulleys = scene.cable_exit == "pulley" and scene.effects.pulley_contact
+        self.platform_index = indices["platform"]
+        self.reference_pose = reference[self.platform_index]
+        # No pose of a platform hung on these cables lies farther from every pulley
+        # than the longest cable; the box of those reaches bounds every sane state.
+        centers = np.array([p.center for p in scene.pulleys])
+        reach = max(c.unstrained_length for c in scene.cables) * (1.0 + MAX_STRAIN) + max(
+            np.abs(np.asarray(scene.platform.anchors)).max(), 0.0)
+        self.box = (centers.min(axis=0) - reach, centers.max(axis=0) + reach)
+        # A suspended platform (starting below every pulley) that rises above the
+        # highest pulley rim is held there only by cables that push.
+        tops = centers[:, 1] + np.array([p.radius for p in scene.pulleys])
+        suspended = scene.platform.initial_pose[1] < centers[:, 1].min()
+        self.ceiling = tops.max() if suspended else np.inf
 
     def problem(self, t: float, q: np.ndarray) -> str | None:
         """A description of what is wrong at time ``t``, or None."""
@@ -89,11 +102,19 @@ class _Monitor:
                         f"(limit {100 * MAX_STRAIN:.0f} %): the run has left the model's valid range")
             if self.check_pulleys:
                 pulley = self.scene.pulleys[i]
-                depth = penetration(pulley, positions)
-                node = int(np.argmax(depth))
-                if depth[node] > MAX_PENETRATION_FRACTION * pulley.radius:
-                    return (f"node {node} of cable {i} is {1000 * depth[node]:.0f} mm inside pulley {i} at "
-                            f"t = {t:.4f} s: the cable is slipping through the pulley (node contact only)")
+                depth = segment_penetration(pulley, positions)
+                element = int(np.argmax(depth))
+                if depth[element] > MAX_PENETRATION_FRACTION * pulley.radius:
+                    return (f"element {element} of cable {i} cuts {1000 * depth[element]:.0f} mm deep into pulley {i} "
+                            f"at t = {t:.4f} s: the cable is slipping through the pulley (contact acts on nodes only; "
+                            f"use more elements)")
+        pose = self.reference_pose + q[self.platform_index]
+        if np.any(pose[:2] < self.box[0]) or np.any(pose[:2] > self.box[1]):
+            return (f"the platform left the reachable region at t = {t:.4f} s (it is at x = {pose[0]:.3f} m, "
+                    f"z = {pose[1]:.3f} m): the integration has diverged")
+        if pose[1] > self.ceiling:
+            return (f"the platform rose above the pulleys at t = {t:.4f} s (z = {pose[1]:.3f} m): only pushing "
+                    f"cables can hold it there; the run has diverged (try a smaller step, or effects.slack = true)")
         return None
 
 
