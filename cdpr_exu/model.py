@@ -45,7 +45,9 @@ class Model:
     contact_nodes : list of ndarray of int
         Cable-local indices of the nodes that carry a contact item.
     initial_paid_out : ndarray, shape (m,) [m]
-        Paid-out length lambda_i(0) of the initial configuration.
+        Paid-out length lambda_i(0) of the initial configuration: the unstrained cable
+        between the pulley's hang point and the anchor (over a pulley, the cable less
+        its straight hanging part; with a point exit, the whole cable).
     ropes : list of RopeItems
         The massless ropes (``effects.cable_mass`` off); then ``cables`` is empty.
     """
@@ -213,10 +215,10 @@ def build_model(scene: Scene) -> Model:
             contacts.append([])
             contact_nodes.append(np.zeros(0, dtype=int))
         if scene.cable_exit == "point":
-            paid_out.append(float(np.linalg.norm(nodes_xz[-1] - nodes_xz[0])))
+            paid_out.append(cable.unstrained_length)
         else:
-            paid_out.append(pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side,
-                                        nodes_xz[-1]).cable_length)
+            # Unstrained cable beyond the hang point: all of it but the hanging part.
+            paid_out.append(cable.unstrained_length - (pulley.center[1] - nodes_xz[0, 1]))
         cables.append(items)
     cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects)
     mbs.Assemble()

@@ -7,7 +7,8 @@ once per time step, not once per Newton iteration.
 
 The winch variable is the *paid-out length* lambda_i [m]: the unstrained cable length
 between the point where cable i leaves its winch-side vertical line on the pulley
-(the hang point) and the platform anchor. Hauling in decreases it.
+(the hang point) and the platform anchor. Hauling in decreases it. The simulation
+tells each controller what was paid out at t = 0 (``reset``).
 """
 
 from __future__ import annotations
@@ -76,8 +77,11 @@ class Controller(Protocol):
     uses_pose: bool
     uses_tension: bool
 
-    def reset(self, scene) -> None:
-        """Prepare for a run of ``scene`` (precompute command tables)."""
+    def reset(self, scene, initial_paid_out) -> None:
+        """Prepare for a run of ``scene`` (precompute command tables).
+
+        ``initial_paid_out`` (shape (m,) [m]) is what the winches have paid out at t = 0.
+        """
 
     def command(self, measurement: Measurement) -> WinchCommand:
         """The winch command for ``measurement.time``."""

@@ -46,7 +46,9 @@ def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = Non
 class IdealIKController:
     """Open-loop winch lengths from ideal (straight, massless, inextensible) cables.
 
-    The command table is computed once per run on the solver's step grid and read by
+    As in the paper, the ideal length is imposed as a velocity (flow) source: the
+    command is the initial paid-out length plus the change of the ideal length since
+    t = 0. The table is computed once per run on the solver's step grid and read by
     linear interpolation, so a step costs no inverse kinematics.
     """
 
@@ -59,13 +61,14 @@ class IdealIKController:
         self._lengths = None
         self._rates = None
 
-    def reset(self, scene) -> None:
-        """Tabulate the ideal paid-out lengths of ``scene.trajectory`` on the step grid."""
+    def reset(self, scene, initial_paid_out) -> None:
+        """Tabulate the commands for ``scene.trajectory`` on the step grid."""
         solver = scene.solver
         self._times = np.linspace(0.0, solver.end_time, solver.n_steps + 1)
         poses = scene.trajectory.pose(self._times)
         rates = scene.trajectory.velocity(self._times)
-        self._lengths, self._rates = ideal_paid_out(scene, poses, rates)
+        lengths, self._rates = ideal_paid_out(scene, poses, rates)
+        self._lengths = np.asarray(initial_paid_out, dtype=float) + lengths - lengths[0]
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if self._times is None:

@@ -1,0 +1,238 @@
+"""Tension-aware winch commands: sag and stretch compensation from catenary statics.
+
+For each reference position the platform's kineto-static equilibrium on elastic
+catenary cables (:func:`cdpr_exu.statics.solve_inverse_statics`) gives the cable
+tensions, the rotation the platform takes, and the unstrained lengths (wrap on the
+pulley included) that put its centre on the reference. Those lengths are the command.
+Options:
+
+* ``dynamic=True`` adds the platform's inertial load -M a from the reference
+  acceleration to the equilibrium (dynamic feed-forward; the cables' own inertia is
+  neglected);
+* ``chordal_correction=True`` accounts for the lumped model's own geometry over the
+  pulley: its straight elements wrap the pulley as a polygon of chords, which needs
+  less cable than the arc (up to 3 cm with the paper's 0.25 m elements on a 0.25 m
+  pulley), by an amount that depends on where the nodes sit. The command is then the
+  length of the straight discretised chain (the chord walk of
+  :func:`cdpr_exu.kinematics.initial_cable_nodes`) plus the catenary's sag and stretch
+  correction (catenary length minus ideal length). A real cable has no such polygon:
+  this option compensates the simulator's discretisation, and says so in its name;
+* :class:`ClosedLoopTensionAwareController` adds a PI correction from the measured
+  platform position, mapped onto the cables by the ideal inverse-kinematics Jacobian.
+
+The commands are tabulated once per run on a coarse time grid and interpolated with a
+cubic spline, so they and their rates are continuous. The cables start straight (the
+paper's initial state), with a paid-out length that differs from the compensated one:
+the command blends from the initial length into the compensated one over
+``start_time`` with a smooth (quintic) ramp instead of jumping.
+
+Plain NumPy/SciPy; no Exudyn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from cdpr_exu import statics
+from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.kinematics import anchor_points, initial_cable_nodes
+
+from .base import Measurement, WinchCommand
+from .ideal_ik import ideal_paid_out
+
+
+def suspended_platform(scene) -> statics.SuspendedPlatform:
+    """The catenary-statics model of a scene's robot (pulleys or fixed exits).
+
+    Parameters
+    ----------
+    scene : cdpr_exu.scene.Scene
+
+    Returns
+    -------
+    statics.SuspendedPlatform
+        Cable weight per length rho0 g [N/m], EA [N], anchors, pulleys, platform mass.
+    """
+    cables = []
+    for cable, pulley, anchor in zip(scene.cables, scene.pulleys, scene.platform.anchors):
+        weight = cable.linear_density * scene.gravity if (scene.effects.cable_mass and scene.effects.gravity) else 0.0
+        stiffness = cable.axial_rigidity
+        if scene.cable_exit == "point":
+            cables.append(statics.SuspendedCable(weight, stiffness, anchor=anchor, exit_point=pulley.center))
+        else:
+            cables.append(statics.SuspendedCable(weight, stiffness, anchor=anchor,
+                                                 pulley=statics.Pulley(pulley.center, pulley.radius, pulley.side)))
+    gravity = scene.gravity if scene.effects.gravity else 0.0
+    return statics.SuspendedPlatform(tuple(cables), scene.platform.mass, gravity, scene.platform.inertia)
+
+
+def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
+    """Paid-out length of each straight, inextensible lumped chain reaching ``anchors``, shape (m,) [m].
+
+    The chain of n elements of length l0/n is laid from the anchor back over the pulley
+    with exact chords (:func:`~cdpr_exu.kinematics.initial_cable_nodes`); what is not
+    hanging below the hang point is paid out.
+    """
+    lengths = []
+    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
+        nodes = initial_cable_nodes(np.asarray(pulley.center), pulley.radius, pulley.side, anchors[i],
+                                    cable.element_length, cable.n_elements)
+        lengths.append(cable.unstrained_length - (pulley.center[1] - nodes[0, 1]))
+    return np.asarray(lengths)
+
+
+def _smoothstep(s: np.ndarray) -> np.ndarray:
+    """Quintic ramp from 0 to 1 on s in [0, 1] with zero first and second derivatives."""
+    s = np.clip(s, 0.0, 1.0)
+    return s**3 * (10.0 - 15.0 * s + 6.0 * s**2)
+
+
+class TensionAwareController:
+    """Open-loop unstrained lengths from the elastic-catenary equilibrium of each reference pose.
+
+    Parameters
+    ----------
+    dynamic : bool
+        Add the inertial load -M a of the reference acceleration (dynamic feed-forward).
+    table_period : float [s]
+        Time grid of the equilibrium table (interpolated by a cubic spline).
+    start_time : float [s]
+        Duration of the blend from the initial (straight-cable) lengths.
+    chordal_correction : bool
+        Correct for the lumped model's polygon over the pulley (see the module notes).
+    """
+
+    uses_pose = False
+    uses_tension = False
+
+    def __init__(self, dynamic: bool = False, table_period: float = 0.02, start_time: float = 0.5,
+                 chordal_correction: bool = False):
+        if not np.isfinite(table_period) or table_period <= 0:
+            raise SceneError(f"table_period must be positive, got {table_period!r}")
+        if not np.isfinite(start_time) or start_time < 0:
+            raise SceneError(f"start_time must be zero or positive, got {start_time!r}")
+        self.dynamic = bool(dynamic)
+        self.chordal_correction = bool(chordal_correction)
+        self.table_period = float(table_period)
+        self.start_time = float(start_time)
+        self.name = "tension_aware" + ("_dynamic" if self.dynamic else "") + ("_chordal" if self.chordal_correction else "")
+        self._spline = None
+        self.equilibria: list = []
+
+    def compensated_lengths(self, scene, times: np.ndarray) -> np.ndarray:
+        """Unstrained paid-out lengths that hold the platform on the reference, shape (N, m) [m].
+
+        Raises
+        ------
+        UnreachableError
+            If a reference pose needs a cable to push or has no equilibrium; the message
+            names the time.
+        """
+        platform = suspended_platform(scene)
+        poses = scene.trajectory.pose(times)
+        accelerations = scene.trajectory.acceleration(times)
+        lengths = np.zeros((len(times), scene.n_cables))
+        self.equilibria = []
+        for k, (t, pose, acceleration) in enumerate(zip(times, poses, accelerations)):
+            wrench = statics.inertial_wrench(platform, acceleration[:2], acceleration[2]) if self.dynamic else None
+            try:
+                equilibrium = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
+            except UnreachableError as err:
+                raise UnreachableError(f"the reference at t = {t:.3f} s, position {np.round(pose[:2], 4).tolist()} m, "
+                                       f"cannot be held by the cables: {err}") from None
+            self.equilibria.append(equilibrium)
+            lengths[k] = equilibrium.unstrained_lengths
+            if self.chordal_correction and scene.cable_exit == "pulley":
+                anchors = anchor_points(np.array([*pose[:2], equilibrium.rotation]), np.asarray(scene.platform.anchors))
+                pose_eq = np.array([*pose[:2], equilibrium.rotation])
+                lengths[k] += chain_length(scene, anchors) - ideal_paid_out(scene, pose_eq[None, :])[0][0]
+        return lengths
+
+    def reset(self, scene, initial_paid_out) -> None:
+        """Solve the equilibria along the reference and tabulate the commands."""
+        end = scene.solver.end_time
+        count = max(int(np.ceil(end / self.table_period)), 3) + 1
+        times = np.linspace(0.0, end, count)
+        lengths = self.compensated_lengths(scene, times)
+        ramp = _smoothstep(times / self.start_time) if self.start_time > 0 else np.ones_like(times)
+        initial = np.asarray(initial_paid_out, dtype=float)
+        commands = ramp[:, None] * lengths + (1.0 - ramp[:, None]) * initial
+        self._spline = CubicSpline(times, commands, axis=0)
+        self._rate = self._spline.derivative()
+
+    def feed_forward(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Tabulated command and its rate at time t [m, m/s]."""
+        if self._spline is None:
+            raise RuntimeError(f"{type(self).__name__}.reset(scene, initial_paid_out) must be called first")
+        return np.asarray(self._spline(t)), np.asarray(self._rate(t))
+
+    def command(self, measurement: Measurement) -> WinchCommand:
+        lengths, rates = self.feed_forward(measurement.time)
+        return WinchCommand(lengths, rates)
+
+
+class ClosedLoopTensionAwareController(TensionAwareController):
+    """Tension-aware feed-forward plus PI feedback on the measured platform position.
+
+    The position error e = r_ref - r (x, z) is turned into length corrections with the
+    ideal inverse-kinematics Jacobian U (rows: unit vectors from each pulley's tangent
+    point to its anchor): a length change U d moves the platform by about d. The
+    correction is dlambda = U (k_p e + k_i integral(e) dt), with the integral
+    running from the end of the start-up blend. (Velocity feedback was tried and
+    dropped: it feeds the start-up jolt into the winch command and the run diverges.)
+
+    Parameters
+    ----------
+    proportional_gain : float [-]
+    integral_gain : float [1/s]
+    dynamic, table_period, start_time
+        As :class:`TensionAwareController`.
+    """
+
+    uses_pose = True
+
+    def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, **kwargs):
+        super().__init__(**kwargs)
+        for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
+            if not np.isfinite(value) or value < 0:
+                raise SceneError(f"{name} must be zero or positive, got {value!r}")
+        self.proportional_gain = float(proportional_gain)
+        self.integral_gain = float(integral_gain)
+        self.name = ("closed_loop_" + self.name)
+
+    def reset(self, scene, initial_paid_out) -> None:
+        super().reset(scene, initial_paid_out)
+        self._scene = scene
+        self._integral = np.zeros(2)
+        self._last_time = 0.0
+
+    def _jacobian(self, pose: np.ndarray) -> np.ndarray:
+        """d(lambda)/d(position) of the ideal cables at ``pose``, shape (m, 2)."""
+        step = 1e-6
+        base, _ = ideal_paid_out(self._scene, pose[None, :])
+        columns = []
+        for axis in range(2):
+            shifted = pose.copy()
+            shifted[axis] += step
+            columns.append((ideal_paid_out(self._scene, shifted[None, :])[0] - base)[0] / step)
+        return np.column_stack(columns)
+
+    def command(self, measurement: Measurement) -> WinchCommand:
+        if measurement.platform_pose is None:
+            raise SceneError(f"{self.name} needs the measured platform pose")
+        lengths, rates = self.feed_forward(measurement.time)
+        reference = self._scene.trajectory.pose(measurement.time)
+        error = reference[:2] - measurement.platform_pose[:2]
+        dt = max(measurement.time - self._last_time, 0.0)
+        self._last_time = measurement.time
+        # Integrate only once the start-up blend is over: the straight start is no error to learn.
+        if measurement.time >= self.start_time:
+            self._integral += error * dt
+        feedback = self.proportional_gain * error + self.integral_gain * self._integral
+        # Fade the feedback in with the start-up blend: a jump of the command in one
+        # step would jolt the axially over-damped cables.
+        if self.start_time > 0:
+            feedback = feedback * _smoothstep(np.array(measurement.time / self.start_time))
+        correction = self._jacobian(reference) @ feedback
+        return WinchCommand(lengths + correction, rates)

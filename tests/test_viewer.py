@@ -1,0 +1,198 @@
+"""Tests of cdpr_exu.viewer: replaying a real run folder (solution file + scene).
+
+One real 0.3 s run of the paper's circle is written into a folder by ``run_scene``,
+then: the solution file reloads and fits the rebuilt model, ``cdpr view`` refuses
+cleanly without a display (in a subprocess, since Exudyn would end the process),
+``cdpr animate`` writes a GIF of the expected frames that are not blank, and the
+drawing helpers (path thinning, camera) keep their promises.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from cdpr_exu import viewer
+from cdpr_exu.cli import main, run_scene
+from cdpr_exu.scene import load_scene, save_scene
+
+#: Simulated time of the test run [s]; with the scene's output period of 0.01 s
+#: the solution file holds 31 rows (t = 0, 0.01, ..., 0.3).
+END_TIME = 0.3
+EXPECTED_ROWS = 31
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory) -> Path:
+    """A run folder of the paper's circle over 0.3 s, written as `cdpr run --out` writes it."""
+    scene = load_scene("paper-circle")
+    scene = scene.with_changes(solver=replace(scene.solver, end_time=END_TIME))
+    out = tmp_path_factory.mktemp("run") / "paper_circle"
+    run_scene(scene, out, quiet=True, figures=False)
+    return out
+
+
+def _env_without_display() -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("DISPLAY", "WAYLAND_DISPLAY", "EXUDYN_SUPPRESS_UI_WINDOW_OPEN")}
+    return env
+
+
+# ============================================================================ solution file
+
+
+def test_solution_file_reloads_with_one_row_per_output_time(run_dir):
+    solution = viewer.load_solution(run_dir / viewer.SOLUTION_FILE)
+    assert solution["nRows"] == EXPECTED_ROWS
+    times = solution["data"][:, 0]
+    np.testing.assert_allclose(times, np.linspace(0.0, END_TIME, EXPECTED_ROWS), atol=1e-9)
+
+
+@pytest.mark.parametrize("decorate", [False, True], ids=["as_built", "decorated"])
+def test_rebuilt_model_has_the_coordinates_of_the_solution_file(run_dir, decorate):
+    """The drawing-only items of decorate_model add no coordinate: the file still fits."""
+    replay = viewer.load_replay(run_dir, decorate=decorate)
+    data = replay.model.mbs.systemData
+    n_ode2, n_vel2, n_acc2, n_ode1, n_vel1, n_algebraic, n_data = replay.solution["columnsExported"]
+    assert n_ode2 == data.ODE2Size() > 0
+    assert n_vel2 in (0, data.ODE2Size()) and n_acc2 in (0, data.ODE2Size())
+    assert (n_ode1, n_algebraic, n_data) == (data.ODE1Size(), data.AEsize(), data.DataSize())
+    assert replay.solution["nColumns"] == sum(replay.solution["columnsExported"])
+    assert replay.solution["data"].shape == (EXPECTED_ROWS, replay.solution["nColumns"] + 1)
+
+
+def test_replayed_platform_pose_matches_the_saved_result(run_dir):
+    """The solution file and result.npz describe the same run: same platform pose."""
+    from cdpr_exu.result import Result
+
+    result = Result.load(run_dir)
+    pose = viewer.load_replay(run_dir, decorate=False).positions()["platform"]
+    # both are the solver's state at the same output times; only float formatting differs
+    np.testing.assert_allclose(pose, result.platform_pose, atol=1e-9)
+
+
+def test_solution_of_another_model_is_refused_naming_the_file(run_dir, tmp_path):
+    changed = tmp_path / "changed"
+    shutil.copytree(run_dir, changed)
+    scene = load_scene(changed / viewer.SCENE_FILE)
+    cables = tuple(replace(c, n_elements=c.n_elements + 1) for c in scene.cables)
+    save_scene(scene.with_changes(cables=cables), changed / viewer.SCENE_FILE)
+    with pytest.raises(viewer.SolutionMismatchError, match="solution.sol.*ODE2 coordinates"):
+        viewer.load_replay(changed)
+
+
+def test_missing_folder_and_files_are_named(run_dir, tmp_path):
+    with pytest.raises(viewer.RunFolderError, match="does not exist"):
+        viewer.run_files(tmp_path / "nowhere")
+    partial = tmp_path / "partial"
+    partial.mkdir()
+    shutil.copy(run_dir / viewer.SCENE_FILE, partial)
+    with pytest.raises(viewer.RunFolderError, match="solution.sol"):
+        viewer.render_animation(partial)
+    assert main(["animate", str(partial)]) == 2
+
+
+# ============================================================================ view
+
+
+def test_display_problem_is_reported_without_display_variables(monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    if sys.platform in ("win32", "darwin"):
+        pytest.skip("DISPLAY only matters on X11/Wayland systems")
+    problem = viewer.display_problem()
+    assert problem is not None and ("DISPLAY" in problem or "switched off" in problem)
+
+
+def test_view_without_display_exits_with_code_1_and_a_hint(run_dir):
+    """Exudyn would end the process on a missing display: the check must come first."""
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "view", str(run_dir)],
+                          env=_env_without_display(), capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1, done.stderr  # not killed by a signal (negative), not a crash
+    assert "no display" in done.stderr
+    assert "cdpr animate" in done.stderr
+
+
+# ============================================================================ animate
+
+
+def test_animate_writes_gif_with_one_frame_per_chosen_row(run_dir, tmp_path):
+    out, frames_dir = tmp_path / "anim.gif", tmp_path / "frames"
+    code = main(["animate", str(run_dir), "--out", str(out), "--every", "5", "--size", "160x120",
+                 "--fps", "10", "--frames-dir", str(frames_dir), "--quiet"])
+    assert code == 0
+    expected = len(range(0, EXPECTED_ROWS, 5))  # rows 0, 5, ..., 30
+    with Image.open(out) as gif:
+        assert gif.n_frames == expected
+        assert gif.size == (160, 120)
+        assert gif.info["duration"] == 100  # 10 frames/s
+        for index in range(gif.n_frames):
+            gif.seek(index)
+            assert np.asarray(gif.convert("L"), dtype=float).var() > 0.0, f"frame {index} is blank"
+    assert sorted(p.name for p in frames_dir.iterdir()) == [f"frame_{i:05d}.png" for i in range(expected)]
+
+
+def test_animation_frames_show_the_pulleys_where_the_camera_puts_them(run_dir, tmp_path):
+    """The raytracer's view and Camera.to_pixels (used for the caption overlay) agree."""
+    size = (320, 240)
+    viewer.render_animation(run_dir, tmp_path / "a.gif", every=100, size=size, frames_dir=tmp_path)
+    frame = np.asarray(Image.open(tmp_path / "frame_00000.png").convert("RGB"), dtype=int)
+    replay = viewer.load_replay(run_dir)
+    camera = viewer.fit_camera(viewer._view_points(replay), size)
+    for pulley in replay.scene.pulleys:
+        inside = camera.to_pixels(np.array(pulley.center) + [0.0, -0.5 * pulley.radius]).round().astype(int)
+        outside = camera.to_pixels(np.array(pulley.center) + [0.0, -1.4 * pulley.radius]).round().astype(int)
+        # disc: shaded grey (measured about 225); background: white
+        assert frame[inside[1], inside[0]].max() < 245
+        assert frame[outside[1], outside[0]].min() == 255
+
+
+def test_mp4_has_one_frame_per_chosen_row(run_dir, tmp_path):
+    imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg")
+    out = viewer.render_animation(run_dir, tmp_path / "anim.mp4", every=10, size=(160, 120), fps=10)
+    reader = imageio_ffmpeg.read_frames(str(out))
+    meta = next(reader)
+    assert tuple(meta["size"]) == (160, 120)
+    assert sum(1 for _ in reader) == len(range(0, EXPECTED_ROWS, 10))
+
+
+def test_unknown_animation_type_is_refused_before_rendering(run_dir, tmp_path):
+    with pytest.raises(viewer.CdprError, match=r"\.gif or \.mp4"):
+        viewer.render_animation(run_dir, tmp_path / "anim.avi")
+    assert not (tmp_path / "anim.avi").exists()
+
+
+# ============================================================================ helpers
+
+
+def test_thin_polyline_keeps_ends_and_spacing():
+    x = np.arange(0.0, 102.0)  # 0, 1, ..., 101: whole numbers, so the spacing is exact
+    points = np.column_stack([x, np.zeros_like(x)])
+    thinned = viewer.thin_polyline(points, 5.0)
+    np.testing.assert_allclose(thinned[:, 0], [*range(0, 100, 5), 101.0])  # 100 gives way to the end, 1 away
+    np.testing.assert_allclose(thinned[[0, -1]], points[[0, -1]])
+
+
+def test_fit_camera_shows_every_point_below_the_caption():
+    points = np.array([[-2.0, 0.3], [2.0, -2.4], [0.5, np.nan]])
+    camera = viewer.fit_camera(points, (640, 480), caption_band=0.1)
+    pixels = camera.to_pixels(points[:2])
+    assert np.all(pixels[:, 0] >= 0) and np.all(pixels[:, 0] <= 640)
+    assert np.all(pixels[:, 1] >= 0.1 * 480) and np.all(pixels[:, 1] <= 480)
+
+
+@pytest.mark.parametrize("text", ["640", "axb", "10x10", "640x480x3"])
+def test_parse_size_refuses_bad_sizes(text):
+    with pytest.raises(ValueError, match="size"):
+        viewer.parse_size(text)
+
