@@ -203,7 +203,7 @@ def build_model(scene: Scene) -> Model:
         if scene.cable_exit == "pulley":
             _check_elements_fit_the_pulley(scene, i, nodes_xz)
         items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
-        attach_cable(mbs, platform, i, items.markers[-1])
+        attach_cable(mbs, platform, i, items.markers[-1], cable, explicit=scene.solver.integrator != "generalized_alpha")
         winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1])))
         if use_contact:
             candidates = contact_candidates(scene, i)

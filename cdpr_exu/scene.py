@@ -72,6 +72,22 @@ def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
     return value
 
 
+def _whole(path: str, value: Any, low: int, high: int) -> int:
+    """Return ``value`` as an int in [low, high], or raise SceneError naming ``path``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
+        raise SceneError(f"{path} must be a whole number from {low} to {high}, got {value!r}")
+    return int(value)
+
+
+#: Most elements per cable a scene may ask for (the paper uses 15; 1000 elements
+#: already take minutes per simulated second).
+MAX_ELEMENTS = 1000
+#: Most time steps of a run (Exudyn counts steps in a 32-bit integer).
+MAX_STEPS = 1.0e9
+#: Most Newton iterations per step (beyond a few dozen, more never converge).
+MAX_NEWTON_ITERATIONS = 1000
+
+
 def _set(obj: Any, name: str, value: Any) -> None:
     """Normalise a field of a frozen dataclass inside ``__post_init__``."""
     object.__setattr__(obj, name, value)
@@ -121,6 +137,8 @@ class CableSpec:
             raise SceneError(f"cable.n_elements must be a whole number, got {self.n_elements!r}")
         if self.n_elements < 2:
             raise SceneError(f"cable.n_elements must be at least 2, got {self.n_elements!r}")
+        if self.n_elements > MAX_ELEMENTS:
+            raise SceneError(f"cable.n_elements must be at most {MAX_ELEMENTS}, got {self.n_elements!r}")
         _set(self, "n_elements", int(self.n_elements))
         _choice("cable.mass_lumping", self.mass_lumping, ("consistent", "paper"))
 
@@ -328,8 +346,11 @@ class Effects:
         massless rope over its pulley (Exudyn's reeving system); without
         ``axial_elasticity`` the elements (or the rope) are inextensible. ``slack``
         makes the elements (or the rope) tension-only.
-    bending_model : {"exact"}
-        Formulation of the bending spring: "exact" is the paper's relative joint angle.
+    bending_model : {"exact", "linear"}
+        Formulation of the bending spring: "exact" is the paper's relative joint angle;
+        "linear" the curvature-vector spring (k_theta / l0i^2) |p_a - 2 p_b + p_c|^2 / 2
+        with constant matrices, cheaper but with moment k_theta sin(theta) (see
+        docs/accuracy.md for how far it moves the answer).
     """
 
     preset: str = "full"
@@ -348,7 +369,7 @@ class Effects:
         for f in fields(self):
             if f.type in ("bool", bool) and not isinstance(getattr(self, f.name), bool):
                 raise SceneError(f"effects.{f.name} must be true or false, got {getattr(self, f.name)!r}")
-        _choice("effects.bending_model", self.bending_model, ("exact",))
+        _choice("effects.bending_model", self.bending_model, ("exact", "linear"))
         if not self.cable_mass:
             for name in ("bending", "pulley_contact"):
                 if getattr(self, name):
@@ -390,7 +411,14 @@ class SolverSpec:
     output_period : float [s]
         Sampling period of the stored result.
     max_newton_iterations : int
-        Newton iterations per step before the step counts as failed.
+        Newton iterations per step before the step counts as failed (1 to
+        :data:`MAX_NEWTON_ITERATIONS`).
+    integrator : {"generalized_alpha", "rk44"}
+        "generalized_alpha": Exudyn's implicit solver (the project's). "rk44": Exudyn's
+        explicit classical Runge-Kutta, for comparison only: it needs steps below about
+        1e-7 s on the paper's cable (c_i / m_i = 3.6e6 1/s), and the cable ends are then
+        joined to the platform by stiff spring-dampers (see :mod:`cdpr_exu.platform`).
+        ``spectral_radius``, ``newton`` and ``max_newton_iterations`` do not apply to it.
     """
 
     end_time: float = 10.0
@@ -399,12 +427,16 @@ class SolverSpec:
     newton: str = "modified"
     output_period: float = 0.01
     max_newton_iterations: int = 25
+    integrator: str = "generalized_alpha"
 
     def __post_init__(self) -> None:
         _set(self, "end_time", _positive("solver.end_time", self.end_time))
         _set(self, "step_size", _positive("solver.step_size", self.step_size))
         if self.step_size > self.end_time:
             raise SceneError(f"solver.step_size ({self.step_size}) must not exceed solver.end_time ({self.end_time})")
+        if self.end_time / self.step_size > MAX_STEPS:
+            raise SceneError(f"solver.step_size ({self.step_size}) and solver.end_time ({self.end_time}) make "
+                             f"{self.end_time / self.step_size:.3g} steps; at most {MAX_STEPS:.0e} are allowed")
         rho = _finite("solver.spectral_radius", self.spectral_radius)
         if not 0.0 <= rho <= 1.0:
             raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {self.spectral_radius!r}")
@@ -413,9 +445,9 @@ class SolverSpec:
         _set(self, "output_period", _positive("solver.output_period", self.output_period))
         if self.output_period < self.step_size * (1 - 1e-9):
             _set(self, "output_period", self.step_size)
-        if isinstance(self.max_newton_iterations, bool) or int(self.max_newton_iterations) < 1:
-            raise SceneError(f"solver.max_newton_iterations must be a positive whole number, got {self.max_newton_iterations!r}")
-        _set(self, "max_newton_iterations", int(self.max_newton_iterations))
+        _set(self, "max_newton_iterations", _whole("solver.max_newton_iterations", self.max_newton_iterations,
+                                                   1, MAX_NEWTON_ITERATIONS))
+        _choice("solver.integrator", self.integrator, ("generalized_alpha", "rk44"))
 
     @property
     def n_steps(self) -> int:

@@ -50,6 +50,16 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     ti.adaptiveStep = True
     ti.minimumStepSize = solver.step_size * 1e-4
     settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    if solver.integrator == "rk44":
+        # Explicit classical Runge-Kutta at the fixed step (comparison runs only).
+        # SolveDynamic takes the solver type from these settings when called without
+        # solverType; ``timeIntegration.explicitIntegration`` is the deprecated name of
+        # ``timeIntegration.explicit``. The winch's ground-coordinate constraints are
+        # eliminated (``explicit.eliminateConstraints``, Exudyn's default); the
+        # platform joints must be spring-dampers (see cdpr_exu.platform).
+        ti.solverType = exu.DynamicSolverType.RK44
+        ti.adaptiveStep = False
+        ti.explicit.eliminateConstraints = True
     settings.solution.file.write = solution_file is not None
     if solution_file is not None:
         settings.solution.file.name = str(solution_file)
@@ -306,7 +316,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     try:
         mbs.SolveDynamic(settings)
     except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
-        failure = " ".join(str(err).split())
+        failure = _solver_report(mbs, " ".join(str(err).split()))
     if stop["reason"] is not None:
         failure = stop["reason"]
     wall = _time.perf_counter() - start
@@ -329,15 +339,84 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         result.failure_time = last_time
         raise SolverFailure(
             f"the run failed at t = {last_time:.4f} s of {solver.end_time} s "
-            f"(step size {solver.step_size} s): {failure}. {likely_cause(scene)}",
+            f"(step size {solver.step_size} s): {failure}. {likely_cause(scene, failure)}",
             time=last_time, partial_result=result)
     return result
 
 
-def likely_cause(scene: Scene) -> str:
-    """A hint at the effect most likely to make the integration fail."""
+def _solver_report(mbs: exu.MainSystem, message: str) -> str:
+    """What Exudyn's solver said when it stopped: its error string, time, step and residual.
+
+    Exudyn's exception text is only "SolveDynamic terminated"; the stored solver
+    (``mbs.sys["dynamicSolver"]``) knows why.
+    """
+    solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
+    if solver is None:
+        return f"Exudyn's solver stopped: {message}"
+    try:
+        reason = solver.GetErrorString().strip() or message
+        it, conv = solver.it, solver.conv
+        details = [f"at t = {it.currentTime:.6g} s", f"step size then {it.currentStepSize:.3g} s"]
+        if not conv.newtonConverged:
+            details.append(f"Newton residual {conv.residual:.3g}")
+        if conv.linearSolverFailed:
+            details.append(f"the linear solver failed (singular Jacobian, row {conv.linearSolverCausingRow})")
+        if conv.massMatrixNotInvertible:
+            details.append("the mass matrix is not invertible")
+    except Exception:  # noqa: BLE001 - the report must never hide the failure itself
+        return f"Exudyn's solver stopped: {message}"
+    return f"Exudyn's solver stopped ({message}): {reason} ({', '.join(details)})"
+
+
+#: Largest step of Exudyn's explicit RK44 on a real negative eigenvalue, times -lambda
+#: (the classical Runge-Kutta stability interval is [-2.785, 0]).
+RK44_STABILITY_LIMIT = 2.785
+
+
+def explicit_step_limit(scene: Scene) -> float:
+    """Estimated largest stable step of explicit RK44 on ``scene``'s cables [s].
+
+    The fastest mode of a chain of over-damped Kelvin-Voigt elements is the zig-zag,
+    eigenvalue about -4 c_i / m_i; undamped, its frequency is 2 sqrt(k_i / m_i), and a
+    pulley contact adds sqrt(k_p / m_i). RK44 needs h |lambda| below about 2.8.
+    """
+    limits = []
+    for cable, pulley in zip(scene.cables, scene.pulleys):
+        mass = float(cable.node_masses()[1:-1].min()) if cable.n_elements > 1 else cable.element_mass
+        damping = cable.axial_damping if scene.effects.axial_damping else 0.0
+        stiffness = cable.axial_stiffness if scene.effects.axial_elasticity else 0.0
+        rate = 4.0 * damping / mass
+        frequency = 2.0 * math.sqrt(stiffness / mass)
+        if scene.effects.pulley_contact and scene.cable_exit == "pulley":
+            frequency = math.hypot(frequency, math.sqrt(pulley.contact_stiffness / mass))
+        limits.append(RK44_STABILITY_LIMIT / max(rate, frequency, 1e-300))
+    return min(limits)
+
+
+def likely_cause(scene: Scene, failure: str = "") -> str:
+    """A hint at the effect most likely to make the integration fail.
+
+    Parameters
+    ----------
+    scene : Scene
+    failure : str
+        What stopped the run (the monitor's or the solver's words), to tailor the hint.
+    """
     cable = scene.cables[0]
     hints = []
+    if scene.solver.integrator == "rk44":
+        limit = explicit_step_limit(scene)
+        if scene.solver.step_size > limit:
+            hints.append(f"explicit RK44 is unstable above a step of about {limit:.2g} s on these cables "
+                         f"(axial damping c_i / m_i and stiffness); use a smaller step or the implicit solver")
+    downward = -_steepest_downward_acceleration(scene)
+    if scene.winch.kind == "kinematic" and downward > scene.gravity > 0.0:
+        hints.append(f"the reference accelerates the platform downwards at up to {downward:.3g} m/s^2, more than "
+                     f"gravity ({scene.gravity} m/s^2): cables can only pull, so they go slack"
+                     + ("" if scene.effects.slack else " (with effects.slack off they push instead)"))
+    if scene.effects.slack and "strained by -" in failure:
+        hints.append("a slack (tension-only) element shortened beyond the monitor's strain limit: the cable "
+                     "went slack and bunched up, which the lumped model does not describe")
     if not scene.effects.bending:
         hints.append("bending is off: the paper scene relies on bending stiffness to stay well-behaved")
     if scene.effects.pulley_contact and scene.cable_exit == "pulley":
@@ -346,11 +425,24 @@ def likely_cause(scene: Scene) -> str:
         if pulley.contact_stiffness * scene.solver.step_size**2 / cable.element_mass > 1e4:
             hints.append(f"the pulley contact stiffness ({pulley.contact_stiffness:g} N/m) is stiff "
                          f"for step {scene.solver.step_size} s; try a smaller step")
-    if scene.solver.spectral_radius > 0.9:
+    if scene.solver.integrator == "generalized_alpha" and scene.solver.spectral_radius > 0.9:
         hints.append("spectral radius near 1 leaves the stiff axial modes undamped; try 0")
+    if "minimum step size" in failure or "Newton" in failure:
+        hints.append("Newton's iteration found no solution even for tiny steps: a force jumps within a step "
+                     "(a winch command that jumps, an impact); check the controller's commands")
     if not hints:
         hints.append("a sudden jump of the winch command or the step size; try a smaller solver.step_size")
     return "Likely cause: " + "; ".join(hints) + "."
+
+
+def _steepest_downward_acceleration(scene: Scene) -> float:
+    """Most negative vertical acceleration of the reference over the run [m/s^2] (0 if none)."""
+    try:
+        times = np.linspace(0.0, scene.solver.end_time, 2001)
+        acceleration = np.asarray(scene.trajectory.acceleration(times), dtype=float)[:, 1]
+        return float(min(acceleration.min(), 0.0))
+    except Exception:  # noqa: BLE001 - a hint must never raise
+        return 0.0
 
 
 def _progress_reporter(progress, scene: Scene):

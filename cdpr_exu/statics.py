@@ -1122,13 +1122,22 @@ def solve_inverse_statics(
         residual, jacobian = evaluate(scaled / unknown_scale)
         return residual / residual_scale, jacobian / residual_scale[:, None] / unknown_scale[None, :]
 
-    start = np.append(horizontal, [rotation] if free_rotation else []) * unknown_scale
-    try:
-        scaled, _, _ = _damped_newton(
-            function, start, _RELATIVE_TOLERANCE, positive=tuple(range(n)),
-            what="inverse statics", noise=_platform_noise(platform, force_scale),
-        )
-    except UnreachableError as error:
+    # With a free rotation, a start where a cable hangs exactly vertical (H = 0
+    # cannot parametrise it) or far from the answer is retried at other rotations.
+    rotation_starts = [rotation] + ([0.05, -0.05, 0.3, -0.3] if free_rotation else [])
+    error = None
+    for rotation_start in rotation_starts:
+        guesses[:] = [None] * n
+        start = np.append(horizontal, [rotation_start] if free_rotation else []) * unknown_scale
+        try:
+            scaled, _, _ = _damped_newton(
+                function, start, _RELATIVE_TOLERANCE, positive=tuple(range(n)),
+                what="inverse statics", noise=_platform_noise(platform, force_scale),
+            )
+            break
+        except UnreachableError as caught:
+            error = caught
+    else:
         raise UnreachableError(
             f"no equilibrium with pulling cables at position ({position[0]:g}, {position[1]:g}) m"
             f" ({error})"

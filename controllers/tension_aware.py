@@ -36,7 +36,7 @@ from scipy.interpolate import CubicSpline
 
 from cdpr_exu import statics
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.kinematics import anchor_points, initial_cable_nodes
+from cdpr_exu.kinematics import anchor_points, cable_unit_vectors, initial_cable_nodes
 
 from .base import Measurement, WinchCommand
 from .ideal_ik import ideal_paid_out
@@ -208,15 +208,21 @@ class ClosedLoopTensionAwareController(TensionAwareController):
         self._last_time = 0.0
 
     def _jacobian(self, pose: np.ndarray) -> np.ndarray:
-        """d(lambda)/d(position) of the ideal cables at ``pose``, shape (m, 2)."""
-        step = 1e-6
-        base, _ = ideal_paid_out(self._scene, pose[None, :])
-        columns = []
-        for axis in range(2):
-            shifted = pose.copy()
-            shifted[axis] += step
-            columns.append((ideal_paid_out(self._scene, shifted[None, :])[0] - base)[0] / step)
-        return np.column_stack(columns)
+        """d(lambda)/d(position) of the ideal cables at ``pose``, shape (m, 2).
+
+        Moving an anchor by d changes the ideal length by u . d, u the unit vector
+        from the cable's exit point to the anchor (with the rotation held).
+        """
+        scene = self._scene
+        anchors = np.asarray(scene.platform.anchors)
+        centers = np.array([p.center for p in scene.pulleys])
+        if scene.cable_exit == "point":
+            points = anchor_points(pose, anchors)
+            directions = points - centers
+            return directions / np.linalg.norm(directions, axis=1, keepdims=True)
+        radii = np.array([p.radius for p in scene.pulleys])
+        sides = np.array([p.side for p in scene.pulleys])
+        return -cable_unit_vectors(pose, anchors, centers, radii, sides)
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if measurement.platform_pose is None:

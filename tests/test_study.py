@@ -26,7 +26,7 @@ END_TIME = 0.3
 
 #: The 2 x 2 grid every study test runs. 8 elements is the coarsest the paper
 #: circle accepts (one element must stay on the winch side of each pulley).
-GRID = ["cables.n_elements=8,15", "platform.mass=1,2.5"]
+GRID = ["cables.n_elements=10,15", "platform.mass=1,2.5"]
 
 #: Figures that do not depend on the machine's load (all but the timings).
 DETERMINISTIC = [f for f in FIGURES if f not in ("wall_time_s", "real_time_factor")]
@@ -155,7 +155,7 @@ def test_cli_grid_writes_one_row_per_run_with_parameter_columns_first(cli_grid):
     rows = _read_csv(cli_grid / "study.csv")
     assert list(rows[0])[:4] == ["cables.n_elements", "platform.mass", "run", "status"]
     assert [(r["cables.n_elements"], r["platform.mass"]) for r in rows] == [
-        ("8", "1"), ("8", "2.5"), ("15", "1"), ("15", "2.5")]
+        ("10", "1"), ("10", "2.5"), ("15", "1"), ("15", "2.5")]
     for row in rows:
         assert row["status"] == "completed"
         assert float(row["simulated_time_s"]) == pytest.approx(END_TIME)
@@ -167,7 +167,7 @@ def test_cli_grid_writes_one_row_per_run_with_parameter_columns_first(cli_grid):
         assert float(row["max_pulley_penetration_m"]) < 1e-3  # contact stiffness 1e7 N/m: sub-mm
         assert float(row["wall_time_s"]) > 0.0
     data = json.loads((cli_grid / "study.json").read_text())
-    assert data["variations"] == [{"path": "cables.n_elements", "values": [8, 15]},
+    assert data["variations"] == [{"path": "cables.n_elements", "values": [10, 15]},
                                   {"path": "platform.mass", "values": [1, 2.5]}]
     assert data["base_scene"]["solver"]["end_time"] == END_TIME and "exudyn" in data["versions"]
     assert len(data["rows"]) == 4

@@ -1,0 +1,156 @@
+"""Controller comparison: the same scene under every controller, tabulated and plotted.
+
+``cdpr compare paper-circle --out results/controllers`` runs the scene under each
+controller of :data:`CONTROLLERS`, writes ``summary.json`` (keyed by controller name),
+``comparison.md`` (a Markdown table), a ``pose.csv`` per controller and the figures
+``comparison_paths.png`` and ``comparison_errors.png``. Errors are actual - reference,
+measured after the start-up (``--after``, default 1 s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from controllers.ideal_ik import IdealIKController
+from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
+
+from .errors import CdprError, SolverFailure
+from .result import Result, provenance
+from .scene import Scene, load_scene
+
+#: The controllers compared by default, by name, each a factory.
+CONTROLLERS: dict[str, Callable[[], object]] = {
+    "ideal_ik": IdealIKController,
+    "tension_aware": TensionAwareController,
+    "tension_aware_chordal": lambda: TensionAwareController(chordal_correction=True),
+    "tension_aware_dynamic_chordal": lambda: TensionAwareController(dynamic=True, chordal_correction=True),
+    "closed_loop_tension_aware": lambda: ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True),
+}
+
+_COLUMNS = (
+    ("max_position_error_m", "max pos. error [mm]", 1000.0),
+    ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
+    ("max_abs_error_x_m", "max \\|err x\\| [mm]", 1000.0),
+    ("max_abs_error_z_m", "max \\|err z\\| [mm]", 1000.0),
+    ("max_abs_rotation_deg", "max \\|rotation\\| [deg]", 1.0),
+    ("min_element_tension_N", "min tension [N]", 1.0),
+    ("wall_time_s", "wall time [s]", 1.0),
+)
+
+
+def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: str | Path | None = None,
+                        after: float = 1.0, progress: bool = False, quiet: bool = True) -> dict[str, dict]:
+    """Run ``scene`` under each named controller; returns their summaries by name.
+
+    A controller that refuses the reference (e.g. a pose that needs a pushing cable)
+    or whose run fails is recorded with its status; the others still run.
+    """
+    from .simulate import simulate
+
+    names = list(names or CONTROLLERS)
+    unknown = [n for n in names if n not in CONTROLLERS]
+    if unknown:
+        from .errors import SceneError
+
+        raise SceneError(f"unknown controller(s) {unknown}; known: {list(CONTROLLERS)}")
+    summaries: dict[str, dict] = {}
+    results: dict[str, Result] = {}
+    for name in names:
+        controller = CONTROLLERS[name]()
+        try:
+            result = simulate(scene, controller, progress=progress)
+        except SolverFailure as err:
+            result = err.partial_result
+        except CdprError as err:  # a refused reference is a result of the comparison too
+            summaries[name] = {"controller": name, "status": f"refused: {err}"}
+            continue
+        results[name] = result
+        summary = result.summary(after=after)
+        summary["controller"] = name
+        summaries[name] = summary
+        if not quiet:
+            print(f"  {name:32s} max {1000 * summary['max_position_error_m']:8.2f} mm   "
+                  f"RMS {1000 * summary['rms_position_error_m']:7.2f} mm   {summary['status']}")
+    if "ideal_ik" in summaries and "max_position_error_m" in summaries["ideal_ik"]:
+        base = summaries["ideal_ik"]["max_position_error_m"]
+        for summary in summaries.values():
+            if "max_position_error_m" in summary and summary["max_position_error_m"] > 0:
+                summary["error_reduction_vs_ideal_ik"] = base / summary["max_position_error_m"]
+    if out is not None:
+        _write(scene, summaries, results, Path(out), after)
+    return summaries
+
+
+def markdown_table(summaries: dict[str, dict]) -> str:
+    """The comparison as a Markdown table."""
+    header = "| controller | " + " | ".join(title for _, title, _ in _COLUMNS) + " | vs ideal IK | status |"
+    lines = [header, "|" + "---|" * (len(_COLUMNS) + 3)]
+    for name, summary in summaries.items():
+        cells = []
+        for key, _, scale in _COLUMNS:
+            value = summary.get(key)
+            cells.append("" if value is None else f"{scale * value:.2f}")
+        ratio = summary.get("error_reduction_vs_ideal_ik")
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {'' if ratio is None else f'{ratio:.1f}x'} | "
+                     f"{summary.get('status', '')} |")
+    return "\n".join(lines) + "\n"
+
+
+def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
+    from .plots import plot_comparison
+    from .scene import save_scene
+
+    out.mkdir(parents=True, exist_ok=True)
+    save_scene(scene, out / "scene.toml")
+    document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
+                "controllers": summaries, **provenance()}
+    (out / "summary.json").write_text(json.dumps(document, indent=2, default=str) + "\n")
+    (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
+                                       + markdown_table(summaries))
+    for name, result in results.items():
+        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
+        table = np.column_stack([result.time, result.platform_pose, result.reference_pose])
+        np.savetxt(out / f"pose_{name}.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+    if results:
+        plot_comparison(scene, results, out)
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    scene = load_scene(args.scene)
+    if args.end_time is not None:
+        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
+    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet)
+    if not args.quiet:
+        print()
+        print(markdown_table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    return 0
+
+
+def add_commands(subparsers) -> None:
+    """Register ``cdpr compare``."""
+    parser = subparsers.add_parser(
+        "compare", help="run a scene under every controller and compare their errors",
+        description="Run a scene under each controller (ideal inverse kinematics, tension-aware variants, "
+        "closed loop) and write a table and figures of their errors.",
+        epilog="examples:\n  cdpr compare paper-circle --out results/controllers\n"
+               "  cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal\n",
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scene", help="shipped scene name or path to a .toml file")
+    parser.add_argument("--out", help="output folder (summary.json, comparison.md, figures)")
+    parser.add_argument("--controllers", help=f"comma-separated subset of: {', '.join(CONTROLLERS)}")
+    parser.add_argument("--after", type=float, default=1.0, help="measure errors after this time [s] (default 1)")
+    parser.add_argument("--end-time", type=float, help="override solver.end_time [s]")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+    parser.set_defaults(func=_cmd_compare)
