@@ -23,7 +23,7 @@ from .kinematics import anchor_points, hang_point, initial_cable_nodes, pulley_e
 from .platform import PlatformItems, add_platform, attach_cable
 from .pulley import add_pulley_contact, add_pulley_ground
 from .scene import Scene
-from .winch import WinchItems, add_winch
+from .winch import ServoItems, WinchItems, add_servo_drum, add_winch
 
 
 @dataclass
@@ -50,6 +50,8 @@ class Model:
         its straight hanging part; with a point exit, the whole cable).
     ropes : list of RopeItems
         The massless ropes (``effects.cable_mass`` off); then ``cables`` is empty.
+    servos : list of ServoItems
+        The winch drums of a servo winch (``winch.kind = "servo"``).
     """
 
     scene: Scene
@@ -63,6 +65,7 @@ class Model:
     contact_nodes: list[np.ndarray] = field(default_factory=list)
     initial_paid_out: np.ndarray | None = None
     ropes: list[RopeItems] = field(default_factory=list)
+    servos: list[ServoItems] = field(default_factory=list)
 
     def item_counts(self) -> dict[str, int]:
         """How many Exudyn items each effect added."""
@@ -75,7 +78,8 @@ class Model:
             "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
             "pulley_contacts": sum(len(c) for c in self.contacts),
             "massless_ropes": len(self.ropes),
-            "winch_constraints": sum(1 + (int(w.horizontal) >= 0) for w in self.winches),
+            "winch_constraints": sum((int(w.horizontal) >= 0) + (int(w.vertical) >= 0) for w in self.winches),
+            "servo_drums": len(self.servos),
             "platform_joints": len(self.platform.joints),
         }
 
@@ -197,14 +201,17 @@ def build_model(scene: Scene) -> Model:
     if not effects.cable_mass:
         return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
     use_contact = effects.pulley_contact and scene.cable_exit == "pulley"
-    cables, winches, contacts, contact_nodes, paid_out = [], [], [], [], []
+    cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
     for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
         nodes_xz = initial_nodes(scene, i)
         if scene.cable_exit == "pulley":
             _check_elements_fit_the_pulley(scene, i, nodes_xz)
         items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
         attach_cable(mbs, platform, i, items.markers[-1], cable, explicit=scene.solver.integrator != "generalized_alpha")
-        winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1])))
+        servo = scene.winch.kind == "servo"
+        winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1]), drive_height=not servo))
+        if servo:
+            servos.append(add_servo_drum(mbs, winches[-1], items.nodes[0], scene.winch))
         if use_contact:
             candidates = contact_candidates(scene, i)
             pulley_marker = add_pulley_ground(mbs, pulley)
@@ -223,7 +230,7 @@ def build_model(scene: Scene) -> Model:
     cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects)
     mbs.Assemble()
     return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
-                 contacts, contact_nodes, np.asarray(paid_out))
+                 contacts, contact_nodes, np.asarray(paid_out), servos=servos)
 
 
 #: Shortest rope segment kept between the fixed winch point and the pulley [m]; a

@@ -141,6 +141,28 @@ class CableSpec:
             raise SceneError(f"cable.n_elements must be at most {MAX_ELEMENTS}, got {self.n_elements!r}")
         _set(self, "n_elements", int(self.n_elements))
         _choice("cable.mass_lumping", self.mass_lumping, ("consistent", "paper"))
+        self._check_derived()
+
+    def _check_derived(self) -> None:
+        """Refuse fields whose derived element properties overflow or underflow (e.g. radius 1e300)."""
+        causes = {  # derived quantity: the fields it grows with, the likeliest culprit first
+            "area": ("radius",), "second_moment": ("radius",),
+            "element_mass": ("linear_density", "unstrained_length"),
+            "axial_stiffness": ("youngs_modulus", "radius", "unstrained_length"),
+            "bending_stiffness": ("youngs_modulus", "radius", "unstrained_length"),
+            "axial_damping": ("damping_constant", "radius", "unstrained_length"),
+            "bending_damping": ("damping_constant", "radius", "unstrained_length"),
+        }
+        for name, fields_ in causes.items():
+            try:
+                value = getattr(self, name)
+            except OverflowError:
+                value = math.inf
+            zero_allowed = name.endswith("damping") and self.damping_constant == 0.0
+            if not math.isfinite(value) or (value <= 0.0 and not zero_allowed):
+                given = ", ".join(f"cable.{f} = {getattr(self, f)!r}" for f in fields_)
+                raise SceneError(f"{given} give(s) an element {name.replace('_', ' ')} of {value!r}, "
+                                 "out of floating-point range")
 
     # Derived quantities of the paper's Table 2 -------------------------------------
     @property
@@ -297,16 +319,39 @@ class WinchSpec:
 
     Parameters
     ----------
-    kind : {"kinematic", "fixed"}
-        "kinematic": node 0 follows the commanded cable length exactly, moving along
+    kind : {"kinematic", "servo", "fixed"}
+        "kinematic": node 0 follows the commanded paid-out length exactly, moving along
         the vertical line below the pulley (the paper's flow source along -z).
-        "fixed": node 0 is held where it starts (static scenes).
+        "servo": a drum of inertia ``drum_inertia`` and radius ``drum_radius`` reels the
+        cable; a motor torque from state feedback with integral action (gains designed
+        with python-control for ``servo_bandwidth``) tracks the command, and the cable
+        tension loads the drum. "fixed": node 0 is held where it starts (static scenes).
+    drum_radius : float [m]
+    drum_inertia : float [kg m^2]
+        Drum and motor inertia about the drum axis.
+    servo_design : {"pole_placement", "lqr"}
+        Pole placement puts the three closed-loop poles near -servo_bandwidth; LQR
+        weights position error against motor force for about that bandwidth.
+    servo_bandwidth : float [rad/s]
     """
 
     kind: str = "kinematic"
+    drum_radius: float = 0.05
+    drum_inertia: float = 0.005
+    servo_design: str = "pole_placement"
+    servo_bandwidth: float = 60.0
 
     def __post_init__(self) -> None:
-        _choice("winch.kind", self.kind, ("kinematic", "fixed"))
+        _choice("winch.kind", self.kind, ("kinematic", "servo", "fixed"))
+        _set(self, "drum_radius", _positive("winch.drum_radius", self.drum_radius))
+        _set(self, "drum_inertia", _positive("winch.drum_inertia", self.drum_inertia))
+        _choice("winch.servo_design", self.servo_design, ("pole_placement", "lqr"))
+        _set(self, "servo_bandwidth", _positive("winch.servo_bandwidth", self.servo_bandwidth))
+
+    @property
+    def drum_mass(self) -> float:
+        """Inertia of the drum seen along the cable, J / r^2 [kg]."""
+        return self.drum_inertia / self.drum_radius**2
 
 
 #: The model ladder: which effects each preset switches on.
@@ -501,8 +546,23 @@ class Scene:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise SceneError(f"name must be a non-empty string, got {self.name!r}")
-        _set(self, "cables", tuple(self.cables))
-        _set(self, "pulleys", tuple(self.pulleys))
+        if not isinstance(self.description, str):
+            raise SceneError(f"description must be a string, got {self.description!r}")
+        for name, kind in (("cables", CableSpec), ("pulleys", PulleySpec)):
+            parts = getattr(self, name)
+            if isinstance(parts, (str, bytes, Mapping)) or not hasattr(parts, "__iter__"):
+                raise SceneError(f"{name} must be a sequence of {kind.__name__}, got {parts!r}")
+            parts = tuple(parts)
+            for i, part in enumerate(parts):
+                if not isinstance(part, kind):
+                    raise SceneError(f"{name}[{i}] must be a {kind.__name__}, got {part!r}")
+            _set(self, name, parts)
+        for name, kind in (("platform", PlatformSpec), ("winch", WinchSpec), ("effects", Effects),
+                           ("solver", SolverSpec)):
+            if not isinstance(getattr(self, name), kind):
+                raise SceneError(f"{name} must be a {kind.__name__}, got {getattr(self, name)!r}")
+        if self.trajectory is not None and not isinstance(self.trajectory, Trajectory):
+            raise SceneError(f"trajectory must be a Trajectory, got {self.trajectory!r}")
         m = len(self.cables)
         if m < 1:
             raise SceneError("cables must list at least one cable")
@@ -514,6 +574,8 @@ class Scene:
             )
         _set(self, "gravity", _non_negative("gravity", self.gravity))
         _choice("cable_exit", self.cable_exit, ("pulley", "point"))
+        if self.winch.kind == "servo" and not self.effects.cable_mass:
+            raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")
         if self.cable_exit == "point" and self.winch.kind != "fixed":
             raise SceneError("cable_exit = 'point' needs winch.kind = 'fixed' (the cable starts at the pulley centre)")
         if self.trajectory is None:
@@ -601,7 +663,10 @@ def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
 
 def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Merge the shared table ``[single]`` into each entry of ``[[plural]]`` (or of ``defaults``)."""
-    shared = dict(data.get(single, {}))
+    shared = data.get(single, {})
+    if not isinstance(shared, Mapping):
+        raise SceneError(f"{single} must be a table, got {shared!r}")
+    shared = dict(shared)
     entries = data.get(plural, defaults)
     if not isinstance(entries, list) or not all(isinstance(e, Mapping) for e in entries):
         raise SceneError(f"{plural} must be an array of tables, got {entries!r}")
@@ -615,6 +680,8 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     ``[[cables]]`` and ``[[pulleys]]`` entries override them one by one. ``[effects]``
     may name a ``preset`` and override single effects.
     """
+    if not isinstance(data, Mapping):
+        raise SceneError(f"a scene must be a table (mapping), got {data!r}")
     data = dict(data)
     top_known = {
         "name", "description", "gravity", "cable_exit", "cable", "cables", "pulley", "pulleys",
@@ -630,7 +697,10 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
     pulleys = tuple(_build(PulleySpec, p, f"pulleys[{i}]") for i, p in enumerate(pulley_dicts))
     platform = _build(PlatformSpec, data.get("platform", {}), "platform")
-    effects_data = dict(data.get("effects", {}))
+    effects_data = data.get("effects", {})
+    if not isinstance(effects_data, Mapping):
+        raise SceneError(f"effects must be a table, got {effects_data!r}")
+    effects_data = dict(effects_data)
     preset = effects_data.pop("preset", "full")
     effects = Effects.from_preset(preset, **effects_data)
     trajectory = None

@@ -26,7 +26,7 @@ from .model import Model, build_model
 from .pulley import penetration, segment_penetration
 from .result import Result
 from .scene import Scene
-from .winch import set_paid_out_length
+from .winch import servo_force, set_paid_out_length
 
 
 def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
@@ -281,14 +281,39 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
                 ])
         return Measurement(t, state["paid_out"].copy(), state["rate"].copy(), pose, velocity, tensions)
 
+    servo_state = {"integral": np.zeros(len(model.servos)), "time": 0.0}
+    drum_index = [mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
+
+    def drive_servos(mbs_, t, command, q, v):
+        """Motor force of each servo drum from the command (once per step)."""
+        dt = t - servo_state["time"]
+        servo_state["time"] = t
+        for i, (servo, index) in enumerate(zip(model.servos, drum_index)):
+            error = q[index] - (command.paid_out[i] - model.initial_paid_out[i])
+            error_rate = v[index] - command.paid_out_rate[i]
+            servo_state["integral"][i] += error * dt
+            idx = indices[f"cable_{i}"][:2]
+            tension = element_tensions(scene.cables[i], ref_q[idx] + q[idx], v[idx], scene.effects)[0]
+            # The cable pulls rope off the drum with its winch-end tension: feed it forward.
+            force = servo_force(servo, servo_state["integral"][i], error, error_rate, -tension)
+            mbs_.SetLoadParameter(servo.load, "load", force)
+
     def pre_step(mbs_, t):
-        if scene.winch.kind != "kinematic":
+        if scene.winch.kind == "fixed":
             return True
         try:
+            if model.servos:
+                q = mbs_.systemData.GetODE2Coordinates()
+                v = mbs_.systemData.GetODE2Coordinates_t()
+                state["paid_out"] = model.initial_paid_out + q[drum_index]
+                state["rate"] = v[drum_index]
             command = controller.command(measurement(t))
             paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
             if paid_out.shape != state["paid_out"].shape or not np.all(np.isfinite(paid_out)):
                 raise ValueError(f"the command must be {state['paid_out'].size} finite lengths, got {command.paid_out!r}")
+            if model.servos:
+                drive_servos(mbs_, t, command, q, v)
+                return True
         except Exception as err:  # noqa: BLE001 - reported as the cause of the stop
             stop["reason"] = f"controller {controller.name!r} raised at t = {t:.4f} s: {type(err).__name__}: {err}"
             stop["exception"] = err
