@@ -6,7 +6,7 @@ curvature-vector bending), over the number of elements per cable and the time st
 and every run is compared with a *reference*: the richest model (``full``) at the
 finest discretisation and step that still finish in reasonable time. Each run gives
 one row: its configuration, its status (a run the builder refuses or the monitor
-stops is a result too), its wall time, and its errors against the reference:
+stops is a result too), its cost, and its errors against the reference:
 
 - ``path`` comparison (moving scenes): the platform position error
   ``|p(t) - p_ref(t)|`` on the reference's output times from ``after`` seconds on
@@ -17,13 +17,17 @@ stops is a result too), its wall time, and its errors against the reference:
   errors of the final state only, and the platform's final speed, which says whether
   the run had come to rest.
 
-From the rows: the Pareto front of error against wall time, the cheapest
+From the rows: the Pareto front of error against cost, the cheapest
 configuration meeting each tolerance, and what each effect changes and costs
 (each model and effect variant against ``full`` at the same discretisation).
 
-Wall times are measured by :func:`~cdpr_exu.simulate.simulate` (the time integration,
-not the model building) in single-threaded worker processes running side by side;
-on a shared machine they are noisy, their ratios less so.
+Cost: every run records its wall time (``wall_time_s``, the time integration as
+:func:`~cdpr_exu.simulate.simulate` measures it) and the CPU time of its
+single-threaded worker process over the whole run, model building included
+(``cpu_time_s``). The front, the tables and the figure use the CPU time (:data:`COST`):
+on an idle core the two agree, but on a shared machine the wall time of the same run
+varied by a factor of two with the load of other processes, the CPU time by a few
+per cent.
 
 Command line: ``cdpr study accuracy SCENE --out DIR [--quick]``.
 """
@@ -51,6 +55,9 @@ from .study import SINGLE_THREAD_ENVIRONMENT, apply_parameters, study_subparsers
 
 #: Position tolerances of the tolerance table [m].
 TOLERANCES = (1.0e-3, 1.0e-2, 5.0e-2)
+
+#: The cost a run is judged by: the CPU time of its single-threaded process [s].
+COST = "cpu_time_s"
 
 #: Presets whose cables are massless ropes: the number of elements does not apply.
 MASSLESS_PRESETS = ("ideal", "elastic")
@@ -98,12 +105,25 @@ class Configuration:
         n = "" if self.n_elements is None else f" n={self.n_elements}"
         return f"{self.model}{n} h={self.step_size:.0e}"
 
-    def assignments(self) -> list[tuple[str, Any]]:
-        """The parameter assignments that make this configuration from the base scene."""
-        out: list[tuple[str, Any]] = [("effects.preset", self.preset), ("solver.step_size", self.step_size)]
+    def scene_data(self, base_data: Mapping[str, Any]) -> dict[str, Any]:
+        """Plain scene data of this configuration made from the base scene's (not validated).
+
+        The effects are the preset's with the ``effects.*`` overrides (the base scene's
+        own effects are replaced); other overrides are parameter paths of
+        :func:`~cdpr_exu.study.apply_parameters`.
+        """
+        assignments: list[tuple[str, Any]] = [("solver.step_size", self.step_size)]
         if self.n_elements is not None:
-            out.append(("cables.n_elements", self.n_elements))
-        return out + list(self.overrides)
+            assignments.append(("cables.n_elements", self.n_elements))
+        effects: dict[str, Any] = {"preset": self.preset}
+        for path, value in self.overrides:
+            if path.startswith("effects."):
+                effects[path[len("effects."):]] = value
+            else:
+                assignments.append((path, value))
+        data = apply_parameters(base_data, assignments)
+        data["effects"] = effects
+        return data
 
 
 def model_name(preset: str, overrides: Sequence[tuple[str, Any]] = ()) -> str:
@@ -177,6 +197,7 @@ LADDER = (("ideal", ()), ("elastic", ()), ("catenary", ()), ("full", ()), ("full
 #: Single-effect variants of the full model compared at the variant resolution.
 EFFECT_VARIANTS = (
     (("effects.bending_damping", False),),
+    (("effects.bending_model", "linear"), ("effects.bending_damping", False)),
     (("effects.slack", True),),
     (("cables.mass_lumping", "paper"),),
 )
@@ -186,7 +207,7 @@ FULL_GRID = AccuracyGrid(
     models=LADDER,
     n_elements=(8, 10, 15, 20, 30, 45, 60),
     step_sizes=(5.0e-4, 1.0e-3, 2.0e-3, 5.0e-3, 1.0e-2),
-    reference=Configuration("full", 90, 2.5e-4),
+    reference=Configuration("full", 90, 5.0e-4),
     variants=EFFECT_VARIANTS,
     variant_resolution=(30, 1.0e-3),
 )
@@ -214,7 +235,7 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     -------
     dict
         ``status`` (``completed``, ``failed: ...``, ``refused: ...``), ``wall_time_s``,
-        ``simulated_time_s``, ``steps``, ``newton_iterations``, ``failure_time_s``, and
+        ``cpu_time_s`` (of the whole run, model building included), ``simulated_time_s``, ``steps``, ``newton_iterations``, ``failure_time_s``, and
         for runs that produced samples: ``time`` (N,) [s], ``pose`` (N, 3) [m, m, rad],
         ``end_tensions`` (N, m) [N] at the platform end of each cable, ``speed`` (N,)
         [m/s] of the platform.
@@ -226,11 +247,12 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     from .simulate import simulate
     from .study import _warm_up
 
-    empty = {"wall_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0, "newton_iterations": 0,
-             "failure_time_s": math.nan}
+    empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
+             "newton_iterations": 0, "failure_time_s": math.nan}
     try:
         scene = scene_from_dict(scene_data)
         _warm_up(scene)
+        cpu = time.process_time()
         try:
             result = simulate(scene, progress=False)
             status = "completed"
@@ -239,6 +261,8 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
             status = "failed: " + " ".join(str(err).split())
             if result is None:
                 return {"status": status, **empty}
+        finally:
+            cpu = time.process_time() - cpu
     except (SceneError, UnreachableError) as err:
         return {"status": "refused: " + " ".join(str(err).split()), **empty}
     except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
@@ -248,6 +272,7 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     return {
         "status": status,
         "wall_time_s": float(result.wall_time),
+        "cpu_time_s": float(cpu),
         "simulated_time_s": float(result.time[finite][-1]) if finite.any() else 0.0,
         "steps": int(result.steps),
         "newton_iterations": int(result.newton_iterations),
@@ -328,8 +353,8 @@ def comparison_for(scene) -> str:
 
 
 def pareto_front(rows: Sequence[Mapping[str, Any]], error: str = "position_error_max_m") -> list[Mapping[str, Any]]:
-    """Completed runs no other run beats in both wall time and ``error``, cheapest first."""
-    candidates = sorted((r for r in rows if _usable(r, error)), key=lambda r: (r["wall_time_s"], r[error]))
+    """Completed runs no other run beats in both cost (:data:`COST`) and ``error``, cheapest first."""
+    candidates = sorted((r for r in rows if _usable(r, error)), key=lambda r: (r[COST], r[error]))
     front, best = [], math.inf
     for row in candidates:
         if row[error] < best:
@@ -340,15 +365,15 @@ def pareto_front(rows: Sequence[Mapping[str, Any]], error: str = "position_error
 
 def cheapest_meeting(rows: Sequence[Mapping[str, Any]], tolerance: float, error: str = "position_error_max_m",
                      model: str | None = None) -> Mapping[str, Any] | None:
-    """The completed run with the least wall time whose ``error`` is within ``tolerance``."""
+    """The completed run of least cost (:data:`COST`) whose ``error`` is within ``tolerance``."""
     meeting = [r for r in rows if _usable(r, error) and r[error] <= tolerance and (model is None or r["model"] == model)]
-    return min(meeting, key=lambda r: r["wall_time_s"]) if meeting else None
+    return min(meeting, key=lambda r: r[COST]) if meeting else None
 
 
 def _usable(row: Mapping[str, Any], error: str) -> bool:
     """A completed, compared run other than the reference."""
     return (row.get("status") == "completed" and not row.get("is_reference")
-            and _finite(row.get(error)) and _finite(row.get("wall_time_s")))
+            and _finite(row.get(error)) and _finite(row.get(COST)))
 
 
 def _finite(value: Any) -> bool:
@@ -445,7 +470,7 @@ def run_accuracy_study(scene, grid: AccuracyGrid = FULL_GRID, *, out: str | Path
                "is_reference": configuration == grid.reference}
         rows.append(row)
         try:
-            data = scene_from_dict(apply_parameters(base_data, configuration.assignments())).to_dict()
+            data = scene_from_dict(configuration.scene_data(base_data)).to_dict()
         except SceneError as err:
             row["status"] = "refused: " + " ".join(str(err).split())
         else:
@@ -478,10 +503,10 @@ def run_accuracy_study(scene, grid: AccuracyGrid = FULL_GRID, *, out: str | Path
     reference = series[reference_index]
     for row in rows:
         row.setdefault("wall_time_s", math.nan)
+        row.setdefault(COST, math.nan)
         simulated = row.get("simulated_time_s", math.nan)
-        row["real_time_factor"] = (simulated / row["wall_time_s"]
-                                   if _finite(simulated) and _finite(row["wall_time_s"]) and row["wall_time_s"] > 0
-                                   else math.nan)
+        row["real_time_factor"] = (simulated / row[COST]
+                                   if _finite(simulated) and _finite(row[COST]) and row[COST] > 0 else math.nan)
         figures = compare(series[row["run"]], reference, comparison, after) if row["run"] in series else {}
         for name in ERROR_FIGURES:
             row[name] = figures.get(name, math.nan)
@@ -519,14 +544,14 @@ def _effects_columns(rows: list[dict[str, Any]], series: Mapping[int, Mapping[st
         row["moved_position_rms_m"] = moved["position_error_rms_m"]
         row["moved_rotation_max_deg"] = moved["rotation_error_max_deg"]
         row["moved_tension_rms_N"] = moved["tension_error_rms_N"]
-        row["cost_relative_to_full"] = row["wall_time_s"] / full["wall_time_s"]
+        row["cost_relative_to_full"] = row[COST] / full[COST]
 
 
 # --------------------------------------------------------------------------- files
 
 COLUMNS = ("run", "model", "preset", "overrides", "n_elements", "step_size_s", "is_reference", "status",
-           "wall_time_s", "real_time_factor", "simulated_time_s", "steps", "newton_iterations", "failure_time_s",
-           *ERROR_FIGURES, "at_variant_resolution", "moved_position_max_m", "moved_position_rms_m",
+           "cpu_time_s", "wall_time_s", "real_time_factor", "simulated_time_s", "steps", "newton_iterations",
+           "failure_time_s", *ERROR_FIGURES, "at_variant_resolution", "moved_position_max_m", "moved_position_rms_m",
            "moved_rotation_max_deg", "moved_tension_rms_N", "cost_relative_to_full")
 
 
@@ -562,7 +587,8 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
         "errors_measured_after_s": study.after if study.comparison == "path" else None,
         "reference": {"configuration": study.reference.label, "preset": study.reference.preset,
                       "n_elements": study.reference.n_elements, "step_size_s": study.reference.step_size,
-                      "wall_time_s": reference_row["wall_time_s"]},
+                      "cpu_time_s": reference_row[COST], "wall_time_s": reference_row["wall_time_s"]},
+        "cost": "cpu_time_s: CPU time of the single-threaded run, model building included",
         "tolerances_m": list(TOLERANCES),
         "grid": {"models": [model_name(p, o) for p, o in study.grid.models],
                  "n_elements": list(study.grid.n_elements), "step_sizes_s": list(study.grid.step_sizes),
@@ -618,9 +644,10 @@ def format_tables(study: AccuracyStudy) -> str:
             else "final platform position error")
     parts = [f"# Accuracy against cost: {study.scene_name}, {study.end_time:g} s",
              "",
-             f"Reference: {study.reference.label} ({ref['wall_time_s']:.1f} s wall time). "
-             f"Error: {what}, against the reference. Wall time: the time integration in one "
-             "single-threaded process, two running side by side on a shared 2-core machine.",
+             f"Reference: {study.reference.label} ({ref[COST]:.1f} s CPU time). "
+             f"Error: {what}, against the reference. Cost: the CPU time of the single-threaded "
+             "run (model building included; about its wall time on an idle core); x real time = "
+             "simulated time / CPU time.",
              "",
              "## Cheapest configuration meeting each tolerance",
              ""]
@@ -630,12 +657,12 @@ def format_tables(study: AccuracyStudy) -> str:
         if best is None:
             lines.append([f"{1000 * tolerance:g} mm", "none", "-", "-", "-", "-", "-", "-"])
             continue
-        lines.append([f"{1000 * tolerance:g} mm", _configuration_cell(best), _seconds(best["wall_time_s"]),
+        lines.append([f"{1000 * tolerance:g} mm", _configuration_cell(best), _seconds(best[COST]),
                       f"{best['real_time_factor']:.1f}", _mm(best["position_error_max_m"]),
                       _mm(best["position_error_rms_m"]), f"{best['tension_error_rms_N']:.3g}"])
-    parts.append(_markdown(["tolerance", "model", "n", "step [s]", "wall [s]", "x real time", "max err [mm]",
+    parts.append(_markdown(["tolerance", "model", "n", "step [s]", "CPU [s]", "x real time", "max err [mm]",
                             "rms err [mm]", "tension rms err [N]"], lines))
-    parts += ["", "## Each model: cheapest run per tolerance (wall time [s]) and its best run", ""]
+    parts += ["", "## Each model: cheapest run per tolerance (CPU time [s]) and its best run", ""]
     lines = []
     for model in dict.fromkeys(r["model"] for r in rows):
         members = [r for r in rows if r["model"] == model]
@@ -643,12 +670,12 @@ def format_tables(study: AccuracyStudy) -> str:
         cells = [model]
         for tolerance in TOLERANCES:
             best = cheapest_meeting(rows, tolerance, model=model)
-            cells.append("-" if best is None else f"{best['wall_time_s']:.2f} (n={best['n_elements'] or '-'}, "
+            cells.append("-" if best is None else f"{best[COST]:.2f} (n={best['n_elements'] or '-'}, "
                          f"h={best['step_size_s']:.0e})")
         if done:
             best = min(done, key=lambda r: r["position_error_max_m"])
             cells += [_mm(best["position_error_max_m"]), f"n={best['n_elements'] or '-'}, h={best['step_size_s']:.0e}",
-                      _seconds(best["wall_time_s"])]
+                      _seconds(best[COST])]
         else:
             cells += ["-", "-", "-"]
         status = {}
@@ -658,24 +685,24 @@ def format_tables(study: AccuracyStudy) -> str:
         cells.append(", ".join(f"{v} {k}" for k, v in status.items()))
         lines.append(cells)
     parts.append(_markdown(["model", *[f"<= {1000 * t:g} mm" for t in TOLERANCES], "best err [mm]", "at",
-                            "its wall [s]", "runs"], lines))
+                            "its CPU [s]", "runs"], lines))
     effects = [r for r in rows if r.get("at_variant_resolution")]
     if effects:
         n, h = study.grid.variant_resolution
         parts += ["", f"## What each model and effect changes, against `full` at n = {n}, h = {h:g} s", "",
                   "(massless presets at the same step; moved = difference of the platform "
                   + ("path after " + f"{study.after:g} s" if study.comparison == "path" else "final position")
-                  + "; cost = wall time / that of full)", ""]
+                  + "; cost = CPU time / that of full)", ""]
         lines = []
         for r in effects:
             lines.append([r["model"], "-" if r["n_elements"] is None else str(r["n_elements"]),
                           r["status"].split(":")[0], _mm(r["moved_position_max_m"]), _mm(r["moved_position_rms_m"]),
                           f"{r['moved_rotation_max_deg']:.3g}" if _finite(r["moved_rotation_max_deg"]) else "-",
                           f"{r['moved_tension_rms_N']:.3g}" if _finite(r["moved_tension_rms_N"]) else "-",
-                          _seconds(r["wall_time_s"]),
+                          _seconds(r[COST]),
                           f"{r['cost_relative_to_full']:.2f}" if _finite(r["cost_relative_to_full"]) else "-"])
         parts.append(_markdown(["model", "n", "status", "moved max [mm]", "moved rms [mm]", "rotation [deg]",
-                                "tension rms [N]", "wall [s]", "cost"], lines))
+                                "tension rms [N]", "CPU [s]", "cost"], lines))
     if study.comparison == "final":
         moving = [r for r in rows if r["status"] == "completed" and _finite(r.get("final_speed_m_s"))
                   and r["final_speed_m_s"] > 1e-3]
@@ -708,7 +735,7 @@ _STEP_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 
 
 def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
-    """Error against wall time, log-log: one marker per run, coloured by model, Pareto front drawn.
+    """Error against cost (CPU time), log-log: one marker per run, coloured by model, Pareto front drawn.
 
     Left: the platform position error; right: the RMS error of the platform-end
     tensions. Marker shapes give the step size; tolerance lines at 1 mm, 1 cm, 5 cm.
@@ -734,11 +761,11 @@ def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
         for r in rows:
             if not _usable(r, quantity) or r[quantity] <= 0:
                 continue
-            axis.plot(r["wall_time_s"], scale * r[quantity], linestyle="none", marker=markers[r["step_size_s"]],
+            axis.plot(r[COST], scale * r[quantity], linestyle="none", marker=markers[r["step_size_s"]],
                       color=colors[r["model"]], markersize=6, alpha=0.8, markeredgecolor="black", markeredgewidth=0.4)
         front = [r for r in pareto_front(rows, quantity) if r[quantity] > 0]
         if front:
-            x = [r["wall_time_s"] for r in front]
+            x = [r[COST] for r in front]
             y = [scale * r[quantity] for r in front]
             axis.step(x, y, where="post", color="black", linewidth=1.0, alpha=0.7, zorder=0)
             for r, xi, yi in zip(front, x, y):
@@ -753,7 +780,7 @@ def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
         axis.set_yscale("log")
         axis.xaxis.set_minor_formatter(NullFormatter())
         axis.yaxis.set_minor_formatter(NullFormatter())
-        axis.set_xlabel("wall time [s]")
+        axis.set_xlabel("CPU time of the run [s] (one core)")
         axis.set_ylabel(label)
         axis.grid(True, which="both", alpha=0.25)
     done = sum(r["status"] == "completed" for r in rows) - 1
@@ -761,7 +788,7 @@ def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
     refused = sum(r["status"].startswith("refused") for r in rows)
     ref = study.reference_row
     figure.suptitle(f"{study.scene_name}, {study.end_time:g} s: error against the reference ({study.reference.label}, "
-                    f"{ref['wall_time_s']:.0f} s) vs wall time; {done} runs compared, {failed} failed, "
+                    f"{ref[COST]:.0f} s) vs CPU time; {done} runs compared, {failed} failed, "
                     f"{refused} refused (see accuracy.csv); black: Pareto front", fontsize=9)
     handles = [Line2D([], [], linestyle="none", marker="o", color=colors[m], label=m) for m in models]
     handles += [Line2D([], [], linestyle="none", marker=markers[h], color="0.4", label=f"h = {h:g} s") for h in steps]
@@ -784,7 +811,7 @@ EPILOG_ACCURACY = """examples:
 
 runs the scene on every preset (ideal, elastic, catenary, full) and the full model
 with linear bending, over elements per cable (8..60) and step sizes (5e-4..1e-2 s),
-against a reference (full, 90 elements, 2.5e-4 s); --quick: a small grid, 1.5 s.
+against a reference (full, 90 elements, 5e-4 s); --quick: a small grid, 1.5 s.
 A static scene (held pose, fixed winches) compares final states, others the path.
 writes accuracy.csv, accuracy.json, tables.md (tolerance table, effects table),
 pareto.png and reference.npz into --out.
@@ -808,10 +835,10 @@ def _cmd_accuracy(args: argparse.Namespace) -> int:
 def add_commands(subparsers: argparse._SubParsersAction) -> None:
     """Add ``cdpr study accuracy`` to the ``cdpr`` command."""
     accuracy = study_subparsers(subparsers).add_parser(
-        "accuracy", help="error against wall time over the model ladder, elements and step sizes",
+        "accuracy", help="error against run time over the model ladder, elements and step sizes",
         description="Run a scene on every model of the ladder over elements per cable and step sizes, "
         "compare each run with a reference (the full model, finest discretisation), and write the "
-        "Pareto front of error against wall time and the cheapest configuration per tolerance.",
+        "Pareto front of error against run time (CPU time) and the cheapest configuration per tolerance.",
         epilog=EPILOG_ACCURACY, formatter_class=argparse.RawDescriptionHelpFormatter)
     accuracy.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
     accuracy.add_argument("--out", required=True, help="output folder (created)")

@@ -21,7 +21,8 @@ from .scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
 #: parsers whose ``func`` takes the parsed arguments and returns an exit code.
-COMMAND_MODULES: tuple[str, ...] = ("cdpr_exu.comparison", "cdpr_exu.study", "cdpr_exu.viewer", "cdpr_exu.accuracy")
+COMMAND_MODULES: tuple[str, ...] = ("cdpr_exu.comparison", "cdpr_exu.study", "cdpr_exu.viewer", "cdpr_exu.accuracy",
+                                   "cdpr_exu.rest")
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
 SETTLED_AFTER = 1.0

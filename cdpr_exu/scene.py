@@ -79,9 +79,11 @@ def _whole(path: str, value: Any, low: int, high: int) -> int:
     return int(value)
 
 
-#: Most elements per cable a scene may ask for (the paper uses 15; 1000 elements
-#: already take minutes per simulated second).
-MAX_ELEMENTS = 1000
+#: Most elements per cable a scene may ask for (the paper uses 15). The cables'
+#: bending object carries dense (2 n_nodes)^2 matrices over all cables: 300 elements
+#: on each of 2 cables are 1204 coordinates, 12 MB per matrix, and cost about 50 s
+#: per simulated second; a few thousand would exhaust memory instead of failing.
+MAX_ELEMENTS = 300
 #: Most time steps of a run (Exudyn counts steps in a 32-bit integer).
 MAX_STEPS = 1.0e9
 #: Most Newton iterations per step (beyond a few dozen, more never converge).
@@ -578,6 +580,11 @@ class Scene:
             raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")
         if self.cable_exit == "point" and self.winch.kind != "fixed":
             raise SceneError("cable_exit = 'point' needs winch.kind = 'fixed' (the cable starts at the pulley centre)")
+        if self.solver.integrator != "generalized_alpha" and self.winch.kind != "fixed":
+            raise SceneError(
+                f"solver.integrator = {self.solver.integrator!r} needs winch.kind = 'fixed', got "
+                f"{self.winch.kind!r}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
+                "and hold them at their initial value, ignoring every winch command")
         if self.trajectory is None:
             from .trajectories import HoldTrajectory
 

@@ -344,6 +344,11 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         failure = _solver_report(mbs, " ".join(str(err).split()))
     if stop["reason"] is not None:
         failure = stop["reason"]
+    if failure is not None:  # the partial result ends at its last finite sample
+        recorded = slice(0, recorder.count)
+        finite_rows = np.all(np.isfinite(recorder.q[recorded]) & np.isfinite(recorder.v[recorded]), axis=1)
+        if not finite_rows.all():
+            recorder.count = int(np.argmin(finite_rows))
     wall = _time.perf_counter() - start
     if report is not None:
         report(None, wall)

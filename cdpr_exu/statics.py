@@ -31,7 +31,11 @@ Pulley approximations (documented choices):
   moves between the wrap and the span gains or loses weight, so the model is
   slightly non-conservative and its stiffness slightly asymmetric (2.5e-6 relative
   for the paper's cable; exactly symmetric for w = 0);
-* the pulley is a point-free circle: no bending stiffness, no pulley rotation.
+* the pulley is a rigid circle; the cable has no bending stiffness; no pulley inertia
+  or friction;
+* a platform directly under the inner rim of a pulley (left of ``c_x + r_p`` for a
+  left pulley wrapped from its outer side) cannot be held: the cable there can only
+  pull it inwards, and `solve_inverse_statics` raises `UnreachableError`.
 
 Solvers:
 
@@ -43,9 +47,15 @@ Solvers:
   cable (each cable's unstrained length follows from `catenary.solve_inverse`) and,
   when it is not given, the rotation.
 
-Both are damped Newton iterations with analytic Jacobians built from the catenary
-end stiffnesses, and both accept an external wrench on the platform (eg the inertial
-load ``-M a`` for dynamic feed-forward, see `inertial_wrench`).
+Both are Newton iterations with analytic Jacobians built from the catenary end
+stiffnesses, and both accept an external wrench on the platform (eg the inertial
+load ``-M a`` for dynamic feed-forward, see `inertial_wrench`). The forward problem
+is an energy minimum: its line search follows the energy (see `_minimise_energy`)
+and starts from `straight_cable_pose`. The inverse problem is a root search on the
+residual norm; for a rigid platform on two cables it is started at the rotations
+where straight massless cables balance the platform (up to a radian near the
+workspace edges). Horizontal tension cannot parametrise an exactly vertical cable,
+so inverse statics needs every cable off the vertical at the solution.
 """
 
 from __future__ import annotations
@@ -527,7 +537,7 @@ def _minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="e
 
 
 # ---------------------------------------------------------------------------
-# one cable: ideal (straight) geometry
+# one cable: straight geometry
 # ---------------------------------------------------------------------------
 def _straight_tangent_angle(pulley, point):
     """Rim angle where a straight cable from ``point`` leaves ``pulley``."""
@@ -1005,7 +1015,40 @@ def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
     structure = np.array(columns).T  # structure matrix, shape (3, n)
     rows = 2 if (platform.degrees_of_freedom == 2 or free_rotation) else 3
     tensions, *_ = np.linalg.lstsq(structure[:rows], load[:rows], rcond=None)
-    return tensions * np.array(horizontal), tensions
+    moment_residual = float(structure[2] @ tensions - load[2])
+    return tensions * np.array(horizontal), tensions, moment_residual
+
+
+def _straight_cable_rotations(platform, position, wrench):
+    """Rotations at which straight massless cables hold the platform with positive tensions.
+
+    Roots of the moment balance (after the force balance fixes the tensions) found by
+    scanning ``[-pi, pi)`` and refining with Brent's method; sorted by size. These
+    start the inverse statics of a rigid platform on two cables, whose equilibrium
+    rotation can be large (near the workspace edge the platform tilts by a radian).
+    """
+    from scipy.optimize import brentq
+
+    def moment(phi):
+        try:
+            _, tensions, residual = _ideal_tensions(platform, position, phi, wrench, True)
+        except (UnreachableError, np.linalg.LinAlgError, ZeroDivisionError):
+            return math.nan, None
+        return residual, tensions
+
+    samples = np.linspace(-math.pi, math.pi, 73)
+    values = [moment(phi)[0] for phi in samples]
+    roots = []
+    for a, b, fa, fb in zip(samples[:-1], samples[1:], values[:-1], values[1:]):
+        if math.isfinite(fa) and math.isfinite(fb) and fa * fb <= 0.0 and fa != fb:
+            try:
+                root = brentq(lambda phi: moment(phi)[0], a, b, xtol=1e-12)
+            except ValueError:
+                continue
+            tensions = moment(root)[1]
+            if tensions is not None and np.all(tensions > 0.0):
+                roots.append(_wrap_angle(root))
+    return sorted(set(roots), key=abs)
 
 
 def solve_inverse_statics(
@@ -1015,6 +1058,7 @@ def solve_inverse_statics(
     external_wrench=None,
     max_strain=DEFAULT_MAX_STRAIN,
     max_tension=None,
+    initial_guess=None,
 ):
     """Cable lengths and forces that hold the platform at a given position.
 
@@ -1039,6 +1083,9 @@ def solve_inverse_statics(
         Extra load [N, N, N m], eg `inertial_wrench` for dynamic feed-forward.
     max_strain, max_tension : float, optional
         Cable tension limits, as in `catenary.solve_forward`.
+    initial_guess : PlatformEquilibrium, optional
+        A nearby solution (eg the previous pose along a trajectory): its horizontal
+        tensions and rotation start the iteration.
 
     Returns
     -------
@@ -1073,7 +1120,7 @@ def solve_inverse_statics(
             f"{' + rotation' if free_rotation else ''} for {dof} equations; "
             f"pass rotation=None for a rigid platform on 2 cables, a rotation on 3"
         )
-    horizontal, tensions = _ideal_tensions(platform, position, rotation, wrench, free_rotation)
+    horizontal, tensions, _ = _ideal_tensions(platform, position, rotation, wrench, free_rotation)
     if np.any(tensions <= 0.0):
         # straight massless cables would push; start from a moderate pull and let
         # Newton decide (it fails, with UnreachableError, if they really must push)
@@ -1124,11 +1171,30 @@ def solve_inverse_statics(
 
     # With a free rotation, a start where a cable hangs exactly vertical (H = 0
     # cannot parametrise it) or far from the answer is retried at other rotations.
-    rotation_starts = [rotation] + ([0.05, -0.05, 0.3, -0.3] if free_rotation else [])
+    if initial_guess is not None:
+        if not isinstance(initial_guess, PlatformEquilibrium) or len(initial_guess.cables) != n:
+            raise SceneError(f"initial_guess must be a PlatformEquilibrium of this platform, got {initial_guess!r}")
+        guessed = np.array([c.catenary.horizontal_tension for c in initial_guess.cables])
+        if np.all(guessed > 0.0):
+            horizontal = guessed
+
+    def rotation_starts():
+        if free_rotation and initial_guess is not None:
+            yield initial_guess.rotation
+        yield rotation
+        if free_rotation:  # only computed when the plain start fails
+            yield from _straight_cable_rotations(platform, position, wrench)
+            yield from (0.05, -0.05, 0.3, -0.3)
+
     error = None
-    for rotation_start in rotation_starts:
+    for rotation_start in rotation_starts():
         guesses[:] = [None] * n
-        start = np.append(horizontal, [rotation_start] if free_rotation else []) * unknown_scale
+        start_tensions = horizontal
+        if free_rotation and not (initial_guess is not None and rotation_start == initial_guess.rotation):
+            start_tensions, tensions, _ = _ideal_tensions(platform, position, rotation_start, wrench, True)
+            if np.any(tensions <= 0.0):
+                start_tensions = np.maximum(start_tensions, 0.1 * max(platform.mass * platform.gravity, 1e-9))
+        start = np.append(start_tensions, [rotation_start] if free_rotation else []) * unknown_scale
         try:
             scaled, _, _ = _damped_newton(
                 function, start, _RELATIVE_TOLERANCE, positive=tuple(range(n)),

@@ -128,6 +128,17 @@ def test_inverse_statics_of_the_forward_returns_the_lengths(pulleys, rigid):
     np.testing.assert_allclose(inverse.unstrained_lengths, lengths, rtol=1e-9)
 
 
+def test_forward_statics_finds_a_pendulum_pulled_aside_by_a_slack_heavy_cable():
+    """Near-vertical stiff cable plus a long sagging one: a curved, ill-conditioned valley."""
+    platform = make_platform()
+    lengths = solve_inverse_statics(platform, (-1.4, -1.85)).unstrained_lengths
+    assert lengths[1] > 2 * lengths[0]  # the right cable hangs in a deep sag
+    equilibrium = solve_forward_statics(platform, lengths)
+    # stiffness ratio ~1e4 between along and across the left cable; the pose is
+    # still found to the Newton tolerance over the soft stiffness (~10 N/m)
+    np.testing.assert_allclose(equilibrium.position, (-1.4, -1.85), atol=1e-9)
+
+
 @pytest.mark.parametrize("pulleys, rigid", ALL_PLATFORMS)
 def test_equilibrium_balances_forces_and_moments(pulleys, rigid):
     platform = make_platform(pulleys, rigid)
@@ -168,6 +179,26 @@ def test_rigid_platform_turns_until_the_cable_moments_cancel():
     # on the other side the platform tilts the other way, by symmetry
     mirrored = solve_inverse_statics(platform, (-0.4, -1.6))
     assert mirrored.rotation == pytest.approx(-equilibrium.rotation, rel=1e-9)
+
+
+def test_rigid_platform_near_the_workspace_edge_tilts_by_about_a_radian():
+    platform = make_platform(rigid=True)
+    # the left anchor would sit right under its exit: the platform turns until the
+    # weight, the near-vertical left cable and the right cable meet at a point
+    equilibrium = solve_inverse_statics(platform, (-1.6, -1.85))
+    assert -1.2 < equilibrium.rotation < -0.8
+    assert equilibrium.is_stable
+    np.testing.assert_allclose(net_wrench(platform, equilibrium), 0.0, atol=1e-9)  # Newton tolerance
+
+
+def test_warm_start_along_a_path_gives_the_same_solution():
+    platform = make_platform(rigid=True)
+    previous = solve_inverse_statics(platform, (0.30, -1.70))
+    cold = solve_inverse_statics(platform, (0.31, -1.70))
+    warm = solve_inverse_statics(platform, (0.31, -1.70), initial_guess=previous)
+    # two Newton runs to the same 1e-12 tolerance from different starts
+    np.testing.assert_allclose(warm.unstrained_lengths, cold.unstrained_lengths, rtol=1e-10)
+    assert warm.rotation == pytest.approx(cold.rotation, abs=1e-10)
 
 
 def test_rigid_platform_with_given_rotation_needs_three_cables():
