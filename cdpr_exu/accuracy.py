@@ -202,7 +202,7 @@ EFFECT_VARIANTS = (
     (("cables.mass_lumping", "paper"),),
 )
 
-#: The grid of ``examples/accuracy_vs_time.py`` (about 8 minutes per scene on 2 cores).
+#: The grid of ``examples/accuracy_vs_time.py`` (about 6 minutes per scene on 2 cores).
 FULL_GRID = AccuracyGrid(
     models=LADDER,
     n_elements=(8, 10, 15, 20, 30, 45, 60),
@@ -791,7 +791,8 @@ def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
                     f"{ref[COST]:.0f} s) vs CPU time; {done} runs compared, {failed} failed, "
                     f"{refused} refused (see accuracy.csv); black: Pareto front", fontsize=9)
     handles = [Line2D([], [], linestyle="none", marker="o", color=colors[m], label=m) for m in models]
-    handles += [Line2D([], [], linestyle="none", marker=markers[h], color="0.4", label=f"h = {h:g} s") for h in steps]
+    handles += [Line2D([], [], linestyle="none", marker=markers[h], color="black", markerfacecolor="none",
+                       label=f"h = {h:g} s") for h in steps]
     figure.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
     return _save(figure, path)
 

@@ -57,6 +57,8 @@ def _non_negative(path: str, value: Any) -> float:
 
 def _vector(path: str, value: Any, length: int) -> tuple[float, ...]:
     """Return ``value`` as a tuple of ``length`` finite floats."""
+    if isinstance(value, (str, bytes, Mapping)):
+        raise SceneError(f"{path} must be a list of {length} numbers, got {value!r}")
     try:
         items = list(value)
     except TypeError:

@@ -106,9 +106,11 @@ class _Monitor:
         for i, (cable, reference, idx) in enumerate(self.cables):
             positions = reference + q[idx]
             strain = np.linalg.norm(np.diff(positions, axis=0), axis=1) / cable.element_length - 1.0
+            if self.scene.effects.slack:
+                strain = np.maximum(strain, 0.0)  # a tension-only element may go slack: shortening is no fault
             worst = int(np.argmax(np.abs(strain)))
             if abs(strain[worst]) > MAX_STRAIN:
-                return (f"element {worst} of cable {i} is strained by {100 * strain[worst]:+.1f} % at t = {t:.4f} s "
+                return (f"element {worst} of cable {i} is strained by {100 * strain[worst]:+.4g} % at t = {t:.4f} s "
                         f"(limit {100 * MAX_STRAIN:.0f} %): the run has left the model's valid range")
             if self.check_pulleys:
                 pulley = self.scene.pulleys[i]
@@ -446,7 +448,8 @@ def likely_cause(scene: Scene, failure: str = "") -> str:
                      + ("" if scene.effects.slack else " (with effects.slack off they push instead)"))
     if scene.effects.slack and "strained by -" in failure:
         hints.append("a slack (tension-only) element shortened beyond the monitor's strain limit: the cable "
-                     "went slack and bunched up, which the lumped model does not describe")
+                     "went slack and bunched up, which the monitor counts as leaving the model's range "
+                     "(simulate.MAX_STRAIN)")
     if not scene.effects.bending:
         hints.append("bending is off: the paper scene relies on bending stiffness to stay well-behaved")
     if scene.effects.pulley_contact and scene.cable_exit == "pulley":

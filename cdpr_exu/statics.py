@@ -418,7 +418,8 @@ class PlatformEquilibrium:
 # a small damped Newton solver
 # ---------------------------------------------------------------------------
 def _damped_newton(
-    function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None
+    function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
+    line_search_steps=50,
 ):
     """Newton's method with backtracking on the residual norm.
 
@@ -433,9 +434,13 @@ def _damped_newton(
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
     norm = float(np.linalg.norm(residual))
-    for _ in range(max_iterations):
+    history = []
+    for iteration in range(max_iterations):
         if norm <= tolerance:
             return x, residual, jacobian
+        history.append(norm)
+        if iteration >= _STAGNATION_WINDOW and norm > 0.1 * history[-1 - _STAGNATION_WINDOW]:
+            break  # no tenfold progress in many damped steps: give up early
         try:
             step = -np.linalg.solve(jacobian, residual)
         except np.linalg.LinAlgError:
@@ -447,7 +452,7 @@ def _damped_newton(
             if step[index] < -0.9 * x[index]:
                 alpha = min(alpha, 0.9 * x[index] / -step[index])
         accepted = False
-        for _ in range(50):
+        for _ in range(line_search_steps):
             trial = x + alpha * step
             try:
                 trial_residual, trial_jacobian = function(trial)
@@ -536,6 +541,21 @@ def _minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="e
     raise UnreachableError(f"{what} did not converge (scaled residual {norm:.3g})")
 
 
+_STAGNATION_WINDOW = 25
+_INNER_NEWTON = {"max_iterations": 40, "line_search_steps": 30}
+"""Budget of a single pulley-cable solve: it starts close, so failing fast is cheaper."""
+
+
+def _warm_then_cold(solve_from, guess):
+    """Run ``solve_from(guess)``, and from the straight-cable start if that fails."""
+    if guess is not None:
+        try:
+            return solve_from(guess)
+        except UnreachableError:
+            pass
+    return solve_from(None)
+
+
 # ---------------------------------------------------------------------------
 # one cable: straight geometry
 # ---------------------------------------------------------------------------
@@ -606,24 +626,6 @@ def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensi
         return equilibrium, stiffness, (state.horizontal_tension, state.vertical_tension_b)
 
     pulley, EA, w, r = cable.pulley, cable.axial_stiffness, cable.weight_per_length, cable.pulley.radius
-    if guess is None:
-        angle = _straight_tangent_angle(pulley, point)
-        suspended = unstrained_length - r * pulley.wrap_angle(angle)
-        if suspended <= 0.0:
-            raise UnreachableError(
-                f"unstrained_length {unstrained_length:g} m is shorter than the wrap on the pulley"
-            )
-        state = solve_forward(
-            cable.catenary(suspended), pulley.tangent_point(angle) - point,
-            max_strain=max_strain, max_tension=max_tension,
-        )
-        H, V_B = state.horizontal_tension, state.vertical_tension_b
-        if H <= 0.0:  # a just-taut massless (or vertical) start: pull a little
-            H = 1e-9 * EA
-    else:
-        H, V_B, angle = guess
-    sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
-    tension_scale = max(math.hypot(H, V_B), w * unstrained_length, 1e-300)
 
     def suspended_length(x):
         H_, V_, angle_ = x
@@ -636,22 +638,46 @@ def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensi
         derivative = np.array([factor * H_, factor * V_, -r * pulley.side / stretch])
         return length, derivative, wrap
 
-    def function(x):
-        if x[0] <= 0.0:
-            raise UnreachableError("horizontal tension must stay positive")
-        length, derivative, _ = suspended_length(x)
-        if length <= 0.0:
-            raise UnreachableError("the whole cable would lie on the pulley")
-        residual, partial, _ = _pulley_residual(
-            cable, pulley, sign_x, point, x[0], x[1], x[2], length, tension_scale
-        )
-        jacobian = partial[:, [0, 1, 3]] + np.outer(partial[:, 2], derivative)
-        return residual, jacobian
+    def solve_from(start_guess):
+        if start_guess is None:
+            angle = _straight_tangent_angle(pulley, point)
+            suspended = unstrained_length - r * pulley.wrap_angle(angle)
+            if suspended <= 0.0:
+                raise UnreachableError(
+                    f"unstrained_length {unstrained_length:g} m is shorter than the wrap on the pulley"
+                )
+            state = solve_forward(
+                cable.catenary(suspended), pulley.tangent_point(angle) - point,
+                max_strain=max_strain, max_tension=max_tension,
+            )
+            H, V_B = state.horizontal_tension, state.vertical_tension_b
+            if H <= 0.0:  # a just-taut massless (or vertical) start: pull a little
+                H = 1e-9 * EA
+        else:
+            H, V_B, angle = start_guess
+        sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
+        tension_scale = max(math.hypot(H, V_B), w * unstrained_length, 1e-300)
 
-    tolerance = _RELATIVE_TOLERANCE * unstrained_length
-    x, _, jacobian = _damped_newton(
-        function, (H, V_B, angle), tolerance, positive=(0,), what="pulley cable"
-    )
+        def function(x):
+            if x[0] <= 0.0:
+                raise UnreachableError("horizontal tension must stay positive")
+            length, derivative, _ = suspended_length(x)
+            if length <= 0.0:
+                raise UnreachableError("the whole cable would lie on the pulley")
+            residual, partial, _ = _pulley_residual(
+                cable, pulley, sign_x, point, x[0], x[1], x[2], length, tension_scale
+            )
+            jacobian = partial[:, [0, 1, 3]] + np.outer(partial[:, 2], derivative)
+            return residual, jacobian
+
+        tolerance = _RELATIVE_TOLERANCE * unstrained_length
+        x, _, jacobian = _damped_newton(
+            function, (H, V_B, angle), tolerance, positive=(0,), what="pulley cable",
+            **_INNER_NEWTON,
+        )
+        return x, jacobian, sign_x, tension_scale
+
+    x, jacobian, sign_x, _ = _warm_then_cold(solve_from, guess)
     H, V_B, angle = x
     length, derivative, wrap = suspended_length(x)
     state = state_from_end_forces(cable.catenary(length), H, V_B, sign_x)
@@ -696,30 +722,35 @@ def _inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tens
         new_guess = None
     else:
         pulley, r = cable.pulley, cable.pulley.radius
-        if guess is None:
-            angle = _straight_tangent_angle(pulley, point)
-            length, state = solve_inverse(
-                pulley.tangent_point(angle) - point, w, EA, H,
-                max_strain=max_strain, max_tension=max_tension,
-            )
-            V_B = state.vertical_tension_b
-        else:
-            length, V_B, angle = guess
-        sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
-        tension_scale = max(math.hypot(H, V_B), w * length, 1e-300)
 
-        def function(x):
-            if x[0] <= 0.0:
-                raise UnreachableError("suspended length must stay positive")
-            residual, partial, _ = _pulley_residual(
-                cable, pulley, sign_x, point, H, x[1], x[2], x[0], tension_scale
-            )
-            return residual, partial[:, [2, 1, 3]]
+        def solve_from(start_guess):
+            if start_guess is None:
+                angle = _straight_tangent_angle(pulley, point)
+                length, state = solve_inverse(
+                    pulley.tangent_point(angle) - point, w, EA, H,
+                    max_strain=max_strain, max_tension=max_tension,
+                )
+                V_B = state.vertical_tension_b
+            else:
+                length, V_B, angle = start_guess
+            sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
+            tension_scale = max(math.hypot(H, V_B), w * length, 1e-300)
 
-        x, _, jacobian = _damped_newton(
-            function, (length, V_B, angle), _RELATIVE_TOLERANCE * length, positive=(0,),
-            what="pulley cable",
-        )
+            def function(x):
+                if x[0] <= 0.0:
+                    raise UnreachableError("suspended length must stay positive")
+                residual, partial, _ = _pulley_residual(
+                    cable, pulley, sign_x, point, H, x[1], x[2], x[0], tension_scale
+                )
+                return residual, partial[:, [2, 1, 3]]
+
+            x, _, jacobian = _damped_newton(
+                function, (length, V_B, angle), _RELATIVE_TOLERANCE * length, positive=(0,),
+                what="pulley cable", **_INNER_NEWTON,
+            )
+            return x, jacobian, sign_x, tension_scale
+
+        x, jacobian, sign_x, tension_scale = _warm_then_cold(solve_from, guess)
         length, V_B, angle = x
         _, partial, catenary = _pulley_residual(
             cable, pulley, sign_x, point, H, V_B, angle, length, tension_scale

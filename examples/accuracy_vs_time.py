@@ -9,7 +9,7 @@ per tolerance, each model's cost, what each effect changes), ``pareto.png`` and 
 reference's series into ``results/accuracy/<scene>/``.
 
 Run: ``python examples/accuracy_vs_time.py [--quick] [--out results/accuracy]``;
-about 15 minutes on two cores (``--quick``: a minute). The same from the command line:
+about 12 minutes on two cores (``--quick``: under a minute). The same from the command line:
 ``cdpr study accuracy paper-circle --out results/accuracy/paper_circle``.
 """
 
@@ -19,7 +19,7 @@ import argparse
 import time
 from pathlib import Path
 
-from cdpr_exu.accuracy import FULL_GRID, QUICK_GRID, cheapest_meeting, TOLERANCES, run_accuracy_study
+from cdpr_exu.accuracy import COST, FULL_GRID, QUICK_GRID, TOLERANCES, cheapest_meeting, run_accuracy_study
 
 SCENES = {"paper-circle": "paper_circle", "paper-catenary": "paper_catenary"}
 
@@ -37,14 +37,14 @@ def main() -> None:
         reference = study.reference_row
         done = sum(r["status"] == "completed" for r in study.rows)
         print(f"\n{scene}: {len(study.rows)} runs ({done} completed), reference {study.reference.label} "
-              f"({reference['wall_time_s']:.0f} s); comparison: {study.comparison}")
+              f"({reference[COST]:.0f} s CPU); comparison: {study.comparison}")
         for tolerance in TOLERANCES:
             best = cheapest_meeting(study.rows, tolerance)
             if best is None:
                 print(f"  {1000 * tolerance:4g} mm: no configuration")
             else:
                 print(f"  {1000 * tolerance:4g} mm: {best['model']}, n = {best['n_elements'] or '-'}, "
-                      f"h = {best['step_size_s']:g} s: {best['wall_time_s']:.2f} s wall "
+                      f"h = {best['step_size_s']:g} s: {best[COST]:.2f} s CPU "
                       f"({best['real_time_factor']:.1f} x real time), error {1000 * best['position_error_max_m']:.2f} mm")
         print(f"  written to {Path(args.out) / folder}/ (tables.md, pareto.png, accuracy.csv)")
     print(f"\nall done in {(time.perf_counter() - start) / 60:.1f} min")

@@ -1,6 +1,6 @@
 """Hard cases stay numerically stable, or stop with a clear SolverFailure (issue 4).
 
-Every test runs the real Exudyn solver on a short version (0.5 to 1.2 s simulated,
+Every test runs the real Exudyn solver on a short version (1 ms to 1.2 s simulated,
 coarse output) of a hard variant of the paper scene: damping scaled by 1e-3 and 1e3,
 pulley stiffness 1e5 to 1e9 N/m, 9 to 100 elements per cable (coarser cables are
 refused), a circle four times faster than the paper's, a 0.1 kg and a 100 kg platform,
@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from functools import lru_cache
 
 import numpy as np
@@ -172,6 +173,7 @@ def assert_clear_failure(scene: Scene, failure: SolverFailure, *causes: str) -> 
     assert failure.time is not None and 0.0 <= failure.time <= scene.solver.end_time
     assert f"t = {failure.time:.4f} s" in message
     assert "Likely cause:" in message
+    assert not re.search(r"\d{13,}", message), "numbers in a message are rounded, not 100 digits long"
     if causes:
         assert any(cause in message for cause in causes), message
     partial = failure.partial_result
@@ -260,24 +262,23 @@ def test_damping_scaled_by_1e3_gives_a_step_converged_answer():
 #: ``generalizedAlpha.computeInitialAccelerations`` on (Exudyn's default, kept by
 #: ``solver_settings``), the consistent initial accelerations are carried into the
 #: first step, although the Kelvin-Voigt damping (c_i / m_i ~ 4e6 1/s) would stop them
-#: within microseconds. The first step then injects energy: measured 0.12 J (50
-#: elements), 2.3 J (100 elements), 8e-4 J (damping x 1e3), 0.08 J (step 5e-3 s),
-#: 1.5 J (1e-2 s) and 13.6 J (2e-2 s, where it ends 4 J above its start). Switching
-#: it off removes it in every case (test_start_up_energy_jolt_is_the_initial_acceleration).
+#: within microseconds. The first steps then inject energy into the held robot:
+#: measured 0.14 J (50 elements), 2.3 J (100 elements), 2e-3 J (damping x 1e3), 0.10 J
+#: (step 5e-3 s), 1.7 J (1e-2 s) and 26 J (2e-2 s, which ends 4 J above its start).
+#: Switching it off removes it (test_start_up_energy_jolt_is_the_initial_acceleration)
+#: and lets 150-element cables start (test_cables_of_150_elements_survive_...).
 START_UP_JOLT = ("Exudyn's generalized-alpha carries the initial accelerations into the first step "
                  "(solver_settings keeps computeInitialAccelerations on) and injects energy there")
 
 ENERGY_CASES = {
     **{name: HARD_CASES[name] for name in HARD_CASES},
     "damping_x1e3": lambda s: with_cables(s, damping_constant=s.cables[0].damping_constant * 1e3),
-    "pulley_stiffness_1e7": lambda s: s,
     "step_1e-4": lambda s: shortened(s, step_size=1e-4),
     "step_1e-3": lambda s: shortened(s, step_size=1e-3),
     "step_5e-3": lambda s: shortened(s, step_size=5e-3),
     "step_1e-2": lambda s: shortened(s, step_size=1e-2),
     "step_2e-2": lambda s: shortened(s, step_size=2e-2),
 }
-ENERGY_CASES.pop("pulley_stiffness_1e7")  # the paper case already has 1e7 N/m
 JOLTED = ("50_elements", "100_elements", "damping_x1e3", "step_5e-3", "step_1e-2", "step_2e-2")
 
 
@@ -322,23 +323,49 @@ def test_energy_never_rises_after_the_start_up_steps(name):
     assert energy_rise(energy[after]) < 1e-4
 
 
-@pytest.mark.parametrize("name", case_params(["100_elements", "step_2e-2"]))
-def test_start_up_energy_jolt_is_the_initial_acceleration(name, monkeypatch):
-    """The diagnosis of START_UP_JOLT: with Exudyn's initial accelerations off, energy never rises."""
+def without_initial_accelerations(monkeypatch) -> None:
+    """Make ``simulate`` start generalized-alpha from zero accelerations (the fix START_UP_JOLT asks for)."""
     import cdpr_exu.simulate as simulate_module
 
     original = simulate_module.solver_settings
 
-    def without_initial_accelerations(scene, solution_file=None):
+    def settings_without(scene, solution_file=None):
         settings = original(scene, solution_file)
         settings.timeIntegration.generalizedAlpha.computeInitialAccelerations = False
         return settings
 
-    monkeypatch.setattr(simulate_module, "solver_settings", without_initial_accelerations)
+    monkeypatch.setattr(simulate_module, "solver_settings", settings_without)
+
+
+@pytest.mark.parametrize("name", case_params(["100_elements", "step_2e-2"]))
+def test_start_up_energy_jolt_is_the_initial_acceleration(name, monkeypatch):
+    """The diagnosis of START_UP_JOLT: with Exudyn's initial accelerations off, energy never rises."""
+    without_initial_accelerations(monkeypatch)
     scene = held_scene(name)
     result, failure = run(scene)
     assert failure is None, str(failure)
     assert energy_rise(mechanical_energy(scene, result)) < 1e-4  # as above; measured 0
+
+
+def fine_cable_scene() -> Scene:
+    """150 elements per cable, 0.05 s of the paper circle at the paper's step."""
+    return with_cables(shortened(PAPER, end_time=0.05, output_period=0.01), n_elements=150)
+
+
+@pytest.mark.xfail(strict=True, reason=START_UP_JOLT + "; with 150 elements (nodes of 9 g) the jolt strains "
+                   "an element by 6 % within 0.01 s and the monitor stops the run (300 elements: 33 %)")
+def test_cables_of_150_elements_survive_the_start_up():
+    result, failure = run(fine_cable_scene())
+    assert failure is None, str(failure)
+
+
+def test_cables_of_150_elements_survive_the_start_up_without_initial_accelerations(monkeypatch):
+    """Measured: completes, 26 steps, 215 Newton iterations (0.35 s against 2 s to the stop)."""
+    without_initial_accelerations(monkeypatch)
+    scene = fine_cable_scene()
+    result, failure = run(scene)
+    assert failure is None, str(failure)
+    assert_plausible(scene, result)
 
 
 # ============================================================================ slack cables

@@ -24,8 +24,9 @@ from cdpr_exu.study import (FIGURES, Variation, apply_parameters, check_paramete
 #: to start moving along the circle.
 END_TIME = 0.3
 
-#: The 2 x 2 grid every study test runs. 8 elements is the coarsest the paper
-#: circle accepts (one element must stay on the winch side of each pulley).
+#: The 2 x 2 grid every study test runs. 10 elements (0.375 m, 1.5 pulley radii) is
+#: about the coarsest the paper circle accepts: longer elements cut into the pulley as
+#: chords of the wrap and are refused by the builder.
 GRID = ["cables.n_elements=10,15", "platform.mass=1,2.5"]
 
 #: Figures that do not depend on the machine's load (all but the timings).

@@ -1,0 +1,462 @@
+"""Bad input gets a clear error naming the field and the value (issue 4).
+
+Sections: every field of every scene dataclass refused on NaN, infinities, signs,
+zero, wrong types and shapes; whole scenes (consistency between parts, wrong part
+types, plain-data and TOML forms); the public functions of kinematics, catenary,
+statics and bending; a property test feeding malformed and extreme scene dicts, each
+of which must be refused with the project's own error or run 0.05 s without a crash,
+a hang or a NaN.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+import re
+import time
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from cdpr_exu import bending, catenary, kinematics, statics
+from cdpr_exu.errors import CdprError, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.scene import (
+    MAX_ELEMENTS,
+    CableSpec,
+    Effects,
+    PlatformSpec,
+    PulleySpec,
+    Scene,
+    SolverSpec,
+    WinchSpec,
+    load_scene,
+    scene_from_dict,
+)
+from cdpr_exu.simulate import simulate
+from cdpr_exu.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
+
+NAN, INF = float("nan"), float("inf")
+
+# ============================================================================ scene fields
+
+#: Values no positive quantity may take, with the words the message must contain.
+NOT_POSITIVE = [0.0, -1.0, NAN, INF, -INF, "abc", None, True, [1.0]]
+NOT_NON_NEGATIVE = [-1.0, -1e-300, NAN, INF, -INF, "abc", None, False, [0.0]]
+NOT_A_PAIR = [[1.0], [1.0, 2.0, 3.0], [NAN, 0.0], [0.0, INF], ["a", 0.0], [None, 0.0], 5.0, None, "ab"]
+NOT_A_TRIPLE = [[1.0, 2.0], [1.0, 2.0, 3.0, 4.0], [0.0, NAN, 0.0], [0.0, -2.0, INF], 5.0, None]
+
+
+def field_cases():
+    """(dataclass, field, bad value) for every field of every scene dataclass."""
+    positive = {
+        CableSpec: ["unstrained_length", "radius", "linear_density", "youngs_modulus"],
+        PulleySpec: ["radius", "contact_stiffness"],
+        PlatformSpec: ["mass", "inertia"],
+        SolverSpec: ["end_time", "step_size", "output_period"],
+    }
+    non_negative = {CableSpec: ["damping_constant"], PulleySpec: ["contact_damping"]}
+    cases = []
+    for cls, names in positive.items():
+        cases += [(cls, name, value) for name in names for value in NOT_POSITIVE]
+    for cls, names in non_negative.items():
+        cases += [(cls, name, value) for name in names for value in NOT_NON_NEGATIVE]
+    cases += [(CableSpec, "n_elements", v) for v in (1, 0, -15, 2.5, 15.0, "15", True, None, MAX_ELEMENTS + 1, 10**30)]
+    cases += [(CableSpec, "mass_lumping", v) for v in ("lumpy", "", None, 1, ["paper"])]
+    cases += [(PulleySpec, "center", v) for v in NOT_A_PAIR]
+    cases += [(PulleySpec, "side", v) for v in (0, 2, -2, 0.5, True, "left", None, NAN)]
+    cases += [(PlatformSpec, "anchors", v) for v in (
+        [[0.1, 0.2, 0.3]], [0.1, 0.2], [], [[0.1]], [[NAN, 0.0]], [[0.0, INF]], [["a", 0.0]], 5.0, None, "ab")]
+    cases += [(PlatformSpec, "initial_pose", v) for v in NOT_A_TRIPLE]
+    cases += [(PlatformSpec, "size", v) for v in NOT_A_PAIR + [[-0.3, 0.2]]]
+    cases += [(WinchSpec, "kind", v) for v in ("hydraulic", "", None, 1)]
+    cases += [(SolverSpec, "spectral_radius", v) for v in (-0.1, 1.5, NAN, INF, "abc", None)]
+    cases += [(SolverSpec, "newton", v) for v in ("quasi", None, 1)]
+    cases += [(SolverSpec, "max_newton_iterations", v) for v in (0, -1, 2.5, "25", None, True, NAN, 10**9)]
+    cases += [(SolverSpec, "integrator", v) for v in ("euler", "RK44", None, 4)]
+    cases += [(Effects, "bending_model", v) for v in ("cubic", None, 1)]
+    for name in ("cable_mass", "axial_elasticity", "axial_damping", "bending", "bending_damping",
+                 "pulley_contact", "slack", "gravity"):
+        cases += [(Effects, name, v) for v in (1, 0, "yes", None)]
+    return cases
+
+
+def _owner(cls) -> str:
+    return {CableSpec: "cable", PulleySpec: "pulley", PlatformSpec: "platform", WinchSpec: "winch",
+            SolverSpec: "solver", Effects: "effects"}[cls]
+
+
+def _scalar_text(value) -> str | None:
+    """What the message must quote for a scalar bad value (None for containers)."""
+    if isinstance(value, (list, tuple, dict)):
+        return None
+    return repr(value)
+
+
+@pytest.mark.parametrize("cls, name, value", [
+    pytest.param(cls, name, value, id=f"{cls.__name__}.{name}={value!r}") for cls, name, value in field_cases()])
+def test_every_scene_field_refuses_bad_values_naming_field_and_value(cls, name, value):
+    with pytest.raises(SceneError) as caught:
+        cls(**{name: value})
+    message = str(caught.value)
+    assert f"{_owner(cls)}.{name}" in message  # the field, e.g. cable.radius or platform.anchors[0][1]
+    quoted = _scalar_text(value)
+    if quoted is not None:
+        assert quoted in message, message  # and its value
+    else:  # a container: its offending entry or its length is quoted
+        assert "got" in message
+
+
+def test_valid_edge_values_are_accepted():
+    """Zero where zero is meaningful: no damping, no gravity, a point-mass platform."""
+    assert CableSpec(damping_constant=0.0).axial_damping == 0.0
+    assert PulleySpec(contact_damping=0.0).contact_damping == 0.0
+    assert SolverSpec(spectral_radius=0.0).spectral_radius == 0.0
+    assert SolverSpec(spectral_radius=1.0).spectral_radius == 1.0
+    assert CableSpec(n_elements=MAX_ELEMENTS).n_elements == MAX_ELEMENTS
+    assert CableSpec(n_elements=np.int64(15)).n_elements == 15
+    assert PulleySpec(side=1.0).side == 1
+    assert PlatformSpec(anchors=((0.0, 0.0), (0.0, 0.0))).is_point_mass
+    assert SolverSpec(integrator="rk44").integrator == "rk44"
+
+
+@pytest.mark.parametrize("radius, word", [(1e300, "inf"), (1e-300, "0.0"), (1e-200, "0.0")])
+def test_cable_fields_that_overflow_the_element_properties_are_refused(radius, word):
+    """radius 1e300 made Exudyn's builder raise OverflowError (pi r^4); 1e-300 a zero area."""
+    with pytest.raises(SceneError, match=rf"cable\.radius = {re.escape(repr(radius))} .* of {word}"):
+        CableSpec(radius=radius)
+
+
+def test_step_counts_beyond_exudyns_integer_are_refused():
+    with pytest.raises(SceneError, match=r"solver\.step_size .* steps; at most"):
+        SolverSpec(end_time=10.0, step_size=1e-300)
+    with pytest.raises(SceneError, match=r"solver\.step_size \(1\.0\) must not exceed solver\.end_time \(0\.5\)"):
+        SolverSpec(end_time=0.5, step_size=1.0)
+
+
+@pytest.mark.parametrize("overrides, field", [
+    (dict(cable_mass=False, bending=True), "effects.bending"),
+    (dict(cable_mass=False, bending=False, bending_damping=False, pulley_contact=True), "effects.pulley_contact"),
+    (dict(axial_elasticity=False, axial_damping=True), "effects.axial_damping"),
+    (dict(axial_elasticity=False, axial_damping=False, slack=True), "effects.slack"),
+    (dict(bending=False, bending_damping=True), "effects.bending_damping"),
+    (dict(colour=True), "colour"),
+])
+def test_inconsistent_effects_are_refused_naming_the_effect(overrides, field):
+    with pytest.raises(SceneError, match=re.escape(field)):
+        Effects.from_preset("full", **overrides)
+
+
+@pytest.mark.parametrize("preset", ["nonsense", None, 1])
+def test_unknown_preset_is_refused(preset):
+    with pytest.raises(SceneError, match=r"effects\.preset"):
+        Effects.from_preset(preset)
+
+
+# ============================================================================ trajectories
+
+
+@pytest.mark.parametrize("make, field", [
+    (lambda v: CircleTrajectory(center=v), "center"),
+    (lambda v: CircleTrajectory(radius=v), "radius"),
+    (lambda v: CircleTrajectory(angular_rate=v), "angular_rate"),
+    (lambda v: CircleTrajectory(ramp_time=v), "ramp_time"),
+    (lambda v: HoldTrajectory(v), "pose"),
+    (lambda v: PointToPointTrajectory(start=v), "start"),
+    (lambda v: PointToPointTrajectory(duration=v), "duration"),
+    (lambda v: PointToPointTrajectory(start_time=v), "start_time"),
+])
+@pytest.mark.parametrize("value", [NAN, INF, "abc", None, [1.0, NAN, 0.0]])
+def test_trajectory_fields_refuse_non_finite_and_non_numeric_values(make, field, value):
+    with pytest.raises(SceneError, match=field):
+        make(value)
+
+
+@pytest.mark.parametrize("make, field", [
+    (lambda: CircleTrajectory(radius=-0.4), "radius"),
+    (lambda: CircleTrajectory(ramp_time=-1.0), "ramp_time"),
+    (lambda: PointToPointTrajectory(duration=0.0), "duration"),
+    (lambda: PointToPointTrajectory(end=(0.0, -1.6)), "end"),
+])
+def test_trajectory_fields_refuse_bad_signs_and_shapes(make, field):
+    with pytest.raises(SceneError, match=field):
+        make()
+
+
+# ============================================================================ whole scenes
+
+
+@pytest.mark.parametrize("changes, field", [
+    (dict(name=""), "name"),
+    (dict(name=3), "name"),
+    (dict(description=3), "description"),
+    (dict(gravity=-9.81), "gravity"),
+    (dict(gravity=NAN), "gravity"),
+    (dict(gravity="g"), "gravity"),
+    (dict(cable_exit="drum"), "cable_exit"),
+    (dict(cables=()), "cables"),
+    (dict(cables=5), "cables"),
+    (dict(cables="ab"), "cables"),
+    (dict(cables=(CableSpec(), "cable")), r"cables\[1\]"),
+    (dict(pulleys=(PulleySpec(),)), "pulleys"),
+    (dict(pulleys=(PulleySpec(), None)), r"pulleys\[1\]"),
+    (dict(platform=PlatformSpec(anchors=((0.0, 0.0),))), "platform.anchors"),
+    (dict(platform={"mass": 2.5}), "platform"),
+    (dict(winch="kinematic"), "winch"),
+    (dict(effects="full"), "effects"),
+    (dict(solver=None), "solver"),
+    (dict(trajectory="circle"), "trajectory"),
+    (dict(cables=(CableSpec(unstrained_length=2.0), CableSpec(unstrained_length=2.0))), r"cables\[0\]\.unstrained_length"),
+    (dict(cable_exit="point"), "winch.kind = 'fixed'"),
+    (dict(solver=SolverSpec(integrator="rk44")), "winch.kind = 'fixed'"),
+])
+def test_inconsistent_or_mistyped_scene_parts_are_refused_naming_them(changes, field):
+    with pytest.raises(SceneError, match=field):
+        Scene(**changes)
+
+
+def test_rk44_with_fixed_winches_is_accepted():
+    scene = Scene(solver=SolverSpec(integrator="rk44"), winch=WinchSpec(kind="fixed"))
+    assert scene.to_dict()["solver"]["integrator"] == "rk44"
+
+
+@pytest.mark.parametrize("data, words", [
+    (5, "a scene must be a table"),
+    (None, "a scene must be a table"),
+    ({"name": "x", "effects": 5}, "effects must be a table"),
+    ({"name": "x", "effects": "full"}, "effects must be a table"),
+    ({"name": "x", "cable": [1, 2]}, "cable must be a table"),
+    ({"name": "x", "cables": {"radius": 1}}, "cables must be an array of tables"),
+    ({"name": "x", "cables": [5, 6]}, "cables must be an array of tables"),
+    ({"name": "x", "platform": 5}, "platform must be a table"),
+    ({"name": "x", "solver": [1]}, "solver must be a table"),
+    ({"name": "x", "trajectory": {"kind": "spiral"}}, "trajectory kind"),
+    ({"name": "x", "trajectory": {"kind": "circle", "speed": 2}}, "unknown key"),
+    ({"name": "x", "trajectory": 5}, "trajectory must be a table"),
+    ({"name": "x", "cables": [{}, {"n_elements": "many"}]}, r"cables\[1\]\.n_elements"),
+    ({"name": "x", "pulleys": [{"center": [-1.75, 0]}, {"center": [1.75, "zero"]}]}, r"pulleys\[1\]\.center\[1\]"),
+    ({"name": "x", "solver": {"step_size": -1e-3}}, r"solver\.step_size"),
+    ({"name": "x", "weather": "rain"}, "unknown field"),
+])
+def test_malformed_plain_data_is_refused_naming_the_field(data, words):
+    with pytest.raises(SceneError, match=words):
+        scene_from_dict(data)
+
+
+def test_malformed_toml_file_is_refused_naming_the_file(tmp_path):
+    path = tmp_path / "broken.toml"
+    path.write_text("name = 'x'\n[cable\nradius = 1\n")
+    with pytest.raises(SceneError, match="is not valid TOML"):
+        load_scene(path)
+    with pytest.raises(SceneError, match="does not exist"):
+        load_scene(tmp_path / "missing.toml")
+
+
+# ============================================================================ public functions
+
+PULLEY = ((-1.75, 0.0), 0.25, -1)
+ANCHORS = [[-0.15, 0.1], [0.15, 0.1]]
+CENTERS = [[-1.75, 0.0], [1.75, 0.0]]
+CABLE = catenary.CatenaryCable(3.75, 0.35 * 9.81, 7.85e4)
+POINT_PLATFORM = statics.SuspendedPlatform(
+    (statics.SuspendedCable(3.43, 7.85e4, exit_point=(-1.75, 0.0)),
+     statics.SuspendedCable(3.43, 7.85e4, exit_point=(1.75, 0.0))), mass=1.0)
+POSITIONS = [0.0, 0.0, 1.0, 0.0, 2.0, 0.1]
+JOINTS = [[0, 1, 2]]
+
+#: (call, error type, words the message must contain): one row per way to get an
+#: argument wrong that the functions catch today.
+PUBLIC_CALLS = {
+    "anchor_points pose NaN": (lambda: kinematics.anchor_points([NAN, 0, 0], ANCHORS), SceneError, "pose must be finite"),
+    "anchor_points pose text": (lambda: kinematics.anchor_points("abc", ANCHORS), SceneError, "pose must be numeric"),
+    "anchor_points pose shape": (lambda: kinematics.anchor_points([0, 0], ANCHORS), SceneError, "pose must have trailing shape"),
+    "anchor_points anchors shape": (lambda: kinematics.anchor_points([0, 0, 0], [[[0, 0]]]), SceneError, "anchors must have shape"),
+    "anchor_velocities rate shape": (lambda: kinematics.anchor_velocities([0, 0, 0], [[0, 0, 0]], ANCHORS), SceneError, "pose_rate"),
+    "pulley_exit inside the disc": (lambda: kinematics.pulley_exit(*PULLEY, [-1.7, 0.0]), UnreachableError, "inside the pulley"),
+    "pulley_exit above the outer side": (lambda: kinematics.pulley_exit(*PULLEY, [-2.5, 1.0]), UnreachableError, "outer side"),
+    "pulley_exit side 0": (lambda: kinematics.pulley_exit((0, 0), 0.25, 0, [1, -1]), SceneError, "side must be -1"),
+    "pulley_exit radius negative": (lambda: kinematics.pulley_exit((0, 0), -1, -1, [1, -1]), SceneError, "radius must be >= 0"),
+    "pulley_exit radius array": (lambda: kinematics.pulley_exit((0, 0), [1, 2], -1, [1, -1]), SceneError, "radius must be a scalar"),
+    "pulley_exit center None": (lambda: kinematics.pulley_exit(None, 0.25, -1, [1, -1]), SceneError, "center"),
+    "ideal_cable_length anchor inf": (lambda: kinematics.ideal_cable_length(*PULLEY, [INF, -1]), SceneError, "anchor must be finite"),
+    "ideal_cable_length_rate shape": (lambda: kinematics.ideal_cable_length_rate(*PULLEY, [0, -2], [1, 2, 3]), SceneError, "anchor_velocity"),
+    "inverse_kinematics sides length": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, CENTERS, 0.25, [1]), SceneError, "sides"),
+    "inverse_kinematics side text": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, CENTERS, 0.25, ["a", "b"]), SceneError, r"sides\[0\]"),
+    "inverse_kinematics radii negative": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, CENTERS, -0.25, [-1, 1]), SceneError, "pulley_radii"),
+    "inverse_kinematics centers shape": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, [[0, 0]], 0.25, [-1, 1]), SceneError, "pulley_centers"),
+    "inverse_kinematics unreachable": (lambda: kinematics.inverse_kinematics([-1.6, -0.1, 0], ANCHORS, CENTERS, 0.25, [-1, 1]), UnreachableError, "inside the pulley"),
+    "structure_matrix units shape": (lambda: kinematics.structure_matrix([0, 0, 0], ANCHORS, [[1, 0]] * 3), SceneError, "unit_vectors"),
+    "straight_cable_nodes n 0": (lambda: kinematics.straight_cable_nodes([0, 0], [1, 1], 0), SceneError, "n_elements"),
+    "straight_cable_nodes n 2.5": (lambda: kinematics.straight_cable_nodes([0, 0], [1, 1], 2.5), SceneError, "n_elements"),
+    "initial_cable_nodes element 0": (lambda: kinematics.initial_cable_nodes(*PULLEY, [0, -2], 0.0, 4), SceneError, "element_length"),
+    "initial_cable_nodes element NaN": (lambda: kinematics.initial_cable_nodes(*PULLEY, [0, -2], NAN, 4), SceneError, "element_length"),
+    "point_exit_inverse_kinematics shape": (lambda: kinematics.point_exit_inverse_kinematics([0, 0, 0], ANCHORS, [[0, 0]]), SceneError, "pulley_centers"),
+    "hang_point side 2": (lambda: kinematics.hang_point((0, 0), 0.25, 2), SceneError, "side"),
+    "CatenaryCable length negative": (lambda: catenary.CatenaryCable(-1, 1, 1), SceneError, "unstrained_length must be positive"),
+    "CatenaryCable weight NaN": (lambda: catenary.CatenaryCable(1, NAN, 1), SceneError, "weight_per_length must be finite"),
+    "CatenaryCable length text": (lambda: catenary.CatenaryCable("a", 1, 1), SceneError, "unstrained_length must be a real number"),
+    "CatenaryCable EA 0": (lambda: catenary.CatenaryCable(1, 1, 0), SceneError, "axial_stiffness must be positive"),
+    "from_material radius 0": (lambda: catenary.CatenaryCable.from_material(1, 0, 1e9, 0.35), SceneError, "radius"),
+    "from_material gravity negative": (lambda: catenary.CatenaryCable.from_material(1, 0.005, 1e9, 0.35, -9.8), SceneError, "gravity"),
+    "solve_forward span NaN": (lambda: catenary.solve_forward(CABLE, [NAN, 0]), SceneError, "span"),
+    "solve_forward span shape": (lambda: catenary.solve_forward(CABLE, [1, 0, 0]), SceneError, "span"),
+    "solve_forward beyond reach": (lambda: catenary.solve_forward(CABLE, [10, 0]), UnreachableError, "beyond the reach"),
+    "solve_forward max_strain 0": (lambda: catenary.solve_forward(CABLE, [2, -2], max_strain=0), SceneError, "max_strain"),
+    "solve_forward max_tension negative": (lambda: catenary.solve_forward(CABLE, [2, -2], max_tension=-1), SceneError, "max_tension"),
+    "solve_inverse vertical span": (lambda: catenary.solve_inverse([0, 1], 1, 1e5, 10), UnreachableError, "vertical"),
+    "solve_inverse tension negative": (lambda: catenary.solve_inverse([1, 1], 1, 1e5, -10), SceneError, "horizontal_tension"),
+    "solve_inverse weight NaN": (lambda: catenary.solve_inverse([1, 1], NAN, 1e5, 10), SceneError, "weight_per_length"),
+    "state_from_end_forces tension negative": (lambda: catenary.state_from_end_forces(CABLE, -1, 1), SceneError, "horizontal_tension"),
+    "state_from_end_forces tension text": (lambda: catenary.state_from_end_forces(CABLE, "a", 1), SceneError, "horizontal_tension"),
+    "profile s beyond the cable": (lambda: catenary.profile(CABLE, catenary.solve_forward(CABLE, [2, -2]), [5.0]), SceneError, "s must lie in"),
+    "statics Pulley side 0": (lambda: statics.Pulley((0, 0), 0.25, 0), SceneError, "side"),
+    "statics Pulley radius 0": (lambda: statics.Pulley((0, 0), 0, -1), SceneError, "radius"),
+    "statics Pulley centre NaN": (lambda: statics.Pulley((NAN, 0), 0.25, -1), SceneError, "centre"),
+    "SuspendedCable both ends": (lambda: statics.SuspendedCable(1, 1e5, exit_point=(0, 0), pulley=statics.Pulley((0, 0), 0.25)), SceneError, "exactly one"),
+    "SuspendedCable no end": (lambda: statics.SuspendedCable(1, 1e5), SceneError, "exactly one"),
+    "SuspendedCable pulley text": (lambda: statics.SuspendedCable(1, 1e5, pulley="p"), SceneError, "pulley must be a Pulley"),
+    "SuspendedPlatform no cables": (lambda: statics.SuspendedPlatform((), 1), SceneError, "cables"),
+    "SuspendedPlatform mass NaN": (lambda: statics.SuspendedPlatform(POINT_PLATFORM.cables, NAN), SceneError, "mass"),
+    "solve_forward_statics lengths count": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [1.0]), SceneError, "unstrained_lengths"),
+    "solve_forward_statics length negative": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [-1.0, 2.0]), SceneError, "unstrained_lengths"),
+    "solve_forward_statics wrench shape": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [2.5, 2.5], external_wrench=[1, 2]), SceneError, "external_wrench"),
+    "solve_forward_statics pose NaN": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [2.5, 2.5], initial_pose=[NAN, 0]), SceneError, "initial_pose"),
+    "inertial_wrench acceleration NaN": (lambda: statics.inertial_wrench(POINT_PLATFORM, (NAN, 0)), SceneError, "acceleration"),
+    "solve_inverse_statics position NaN": (lambda: statics.solve_inverse_statics(POINT_PLATFORM, (NAN, -1)), SceneError, "position"),
+    "solve_inverse_statics above the exits": (lambda: statics.solve_inverse_statics(POINT_PLATFORM, (0, 1)), UnreachableError, "pulling cables"),
+    "bending positions odd": (lambda: bending.bending_energy([0, 0, 1], JOINTS, 1.0), SceneError, "positions"),
+    "bending joints out of range": (lambda: bending.bending_energy(POSITIONS, [[0, 1, 3]], 1.0), SceneError, "joints refer to nodes outside"),
+    "bending joints repeat a node": (lambda: bending.bending_energy(POSITIONS, [[0, 0, 2]], 1.0), SceneError, "must not repeat"),
+    "bending joints shape": (lambda: bending.bending_energy(POSITIONS, [0, 1, 2], 1.0), SceneError, "joints must be an integer array"),
+    "bending stiffness NaN": (lambda: bending.bending_energy(POSITIONS, JOINTS, NAN), SceneError, "stiffness must be finite"),
+    "bending stiffness shape": (lambda: bending.bending_energy(POSITIONS, JOINTS, [1.0, 2.0]), SceneError, "stiffness"),
+    "bending velocities count": (lambda: bending.bending_force(POSITIONS, [0, 0], JOINTS, 1.0, 0.0), SceneError, "velocities"),
+    "bending out buffer shape": (lambda: bending.bending_force(POSITIONS, [0] * 6, JOINTS, 1.0, 0.0, out=np.zeros(5)), SceneError, "out must be"),
+    "cable_joints one node": (lambda: bending.cable_joints([1]), SceneError, "nodes_per_cable"),
+    "curvature matrix element 0": (lambda: bending.curvature_stiffness_matrix(3, JOINTS, 1.0, 0.0), SceneError, "element_length"),
+}
+
+
+@pytest.mark.parametrize("name", list(PUBLIC_CALLS))
+def test_public_functions_refuse_bad_arguments_with_the_projects_errors(name):
+    call, error, words = PUBLIC_CALLS[name]
+    with pytest.raises(error, match=words):
+        call()
+
+
+#: Gaps found: arguments these functions let through, or refuse with a bare Python
+#: error instead of SceneError (they live outside scene.py and are reported, not fixed).
+KNOWN_GAPS = {
+    "bending positions text -> ValueError": lambda: bending.bending_energy("abc", JOINTS, 1.0),
+    "bending positions NaN -> energy NaN": lambda: bending.bending_energy([NAN, 0, 1, 0, 2, 0], JOINTS, 1.0),
+    "bending joints 2.5 truncated to 2": lambda: bending.bending_energy(POSITIONS, [[0, 1, 2.5]], 1.0),
+    "bending joints text -> ValueError": lambda: bending.bending_energy(POSITIONS, "abc", 1.0),
+    "bending stiffness text -> ValueError": lambda: bending.bending_energy(POSITIONS, JOINTS, "k"),
+    "bending stiffness negative accepted": lambda: bending.BendingSpringDamper(3, JOINTS, -1.0, 0.0),
+    "cable_joints 3.7 truncated to 3": lambda: bending.cable_joints([3.7]),
+    "cable_joints text -> ValueError": lambda: bending.cable_joints(["a"]),
+    "rotation_matrix text -> ValueError": lambda: kinematics.rotation_matrix("a"),
+    "solve_forward cable text -> AttributeError": lambda: catenary.solve_forward("cable", [2, -2]),
+    "solve_forward initial_guess text -> ValueError": lambda: catenary.solve_forward(CABLE, [2, -2], initial_guess="ab"),
+    "span_and_jacobian tension NaN -> span NaN": lambda: catenary.span_and_jacobian(CABLE, NAN, 1.0),
+    "span_and_jacobian tension negative accepted": lambda: catenary.span_and_jacobian(CABLE, -5.0, 1.0),
+    "profile s text -> ValueError": lambda: catenary.profile(CABLE, catenary.solve_forward(CABLE, [2, -2]), "a"),
+    "SuspendedPlatform cables 5 -> TypeError": lambda: statics.SuspendedPlatform(5, 1.0),
+    "solve_forward_statics platform text -> AttributeError": lambda: statics.solve_forward_statics("p", [1.0]),
+    "solve_forward_statics pose text -> ValueError": lambda: statics.solve_forward_statics(POINT_PLATFORM, [2.5, 2.5], initial_pose="ab"),
+}
+
+
+@pytest.mark.parametrize("name", [
+    pytest.param(name, marks=pytest.mark.xfail(strict=True, reason="validation gap outside scene.py, reported"))
+    for name in KNOWN_GAPS])
+def test_known_validation_gaps_of_public_functions(name):
+    with pytest.raises(SceneError):
+        KNOWN_GAPS[name]()
+
+
+# ============================================================================ property test
+
+PAPER_DICT = load_scene("paper-circle").to_dict()
+
+
+def _get(data, path):
+    for key in path:
+        data = data[key]
+    return data
+
+
+def _paths(data, path=()):
+    """Every leaf and container of a plain-data scene, as key paths."""
+    if path:
+        yield path
+    if isinstance(data, dict):
+        for key, value in data.items():
+            yield from _paths(value, path + (key,))
+    elif isinstance(data, list):
+        for index, value in enumerate(data):
+            yield from _paths(value, path + (index,))
+
+
+PATHS = sorted(_paths(PAPER_DICT), key=repr)
+#: The numbers among them, drawn half the time: their mutants are accepted more
+#: often, so that the simulation itself meets extreme values, not only the validation.
+NUMBER_PATHS = [path for path in PATHS if isinstance(_get(PAPER_DICT, path), (int, float))
+                and not isinstance(_get(PAPER_DICT, path), bool)]
+
+EXTREME_NUMBERS = st.sampled_from([0.0, -0.0, -1.0, 1e300, -1e300, 1e-300, 5e-324, NAN, INF, -INF, 10**30, 3, 2.5, 1e-9])
+WRONG_TYPES = st.sampled_from([None, True, "abc", "", [], {}, [1.0], {"a": 1}, [[1.0, 2.0]]])
+
+
+@st.composite
+def malformed_scene_dicts(draw):
+    """The paper scene's plain data with one to three fields broken."""
+    data = copy.deepcopy(PAPER_DICT)
+    for _ in range(draw(st.integers(1, 3))):
+        path = draw(st.sampled_from(NUMBER_PATHS) | st.sampled_from(PATHS))
+        try:
+            parent, old = _get(data, path[:-1]), _get(data, path)
+        except (KeyError, IndexError, TypeError):
+            continue  # an earlier mutation removed or replaced this path
+        kind = draw(st.sampled_from(["number", "scaled", "type", "length", "delete"]))
+        if kind == "number":
+            new = draw(EXTREME_NUMBERS | st.floats(allow_nan=True, allow_infinity=True))
+        elif kind == "scaled" and isinstance(old, (int, float)) and not isinstance(old, bool):
+            new = old * draw(st.sampled_from([-1.0, 0.0, 1e-12, 1e-3, 1e3, 1e12, 1.0000001]))
+        elif kind == "length" and isinstance(old, list):
+            new = old[: draw(st.integers(0, max(len(old) - 1, 0)))] if draw(st.booleans()) else old + old[:1] * 2
+        elif kind == "delete" and isinstance(parent, dict):
+            del parent[path[-1]]
+            continue
+        else:
+            new = draw(WRONG_TYPES)
+        parent[path[-1]] = new
+    return data
+
+
+def _short(scene: Scene) -> Scene:
+    """0.05 s, or 500 steps if the step is so small that 0.05 s would take minutes."""
+    step = scene.solver.step_size
+    end = max(step, min(0.05, 500 * step))
+    return scene.with_changes(solver=dataclasses.replace(scene.solver, end_time=end, output_period=end / 5))
+
+
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(malformed_scene_dicts())
+def test_malformed_scenes_are_refused_or_run_without_crash_hang_or_nan(data):
+    try:
+        scene = scene_from_dict(data)
+    except CdprError:
+        return  # refused with the project's own error: fine
+    start = time.perf_counter()
+    try:
+        result = simulate(_short(scene))
+    except (SolverFailure, UnreachableError, SceneError) as err:
+        assert str(err)  # a clear stop is acceptable; it must say something
+        return
+    # At most 500 steps of at most 2 x 301 nodes: seconds, not minutes.
+    assert time.perf_counter() - start < 120.0
+    for series in [result.platform_pose, result.platform_velocity, *result.nodes, *result.tensions]:
+        assert np.all(np.isfinite(series))
