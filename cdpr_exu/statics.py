@@ -1090,6 +1090,7 @@ def solve_inverse_statics(
     max_strain=DEFAULT_MAX_STRAIN,
     max_tension=None,
     initial_guess=None,
+    _continuation=True,
 ):
     """Cable lengths and forces that hold the platform at a given position.
 
@@ -1235,6 +1236,14 @@ def solve_inverse_statics(
         except UnreachableError as caught:
             error = caught
     else:
+        if _continuation and any(c.weight_per_length > 0.0 for c in platform.cables):
+            try:
+                return _inverse_by_weight_continuation(
+                    platform, position, None if free_rotation else rotation, wrench,
+                    max_strain, max_tension,
+                )
+            except UnreachableError:
+                pass
         raise UnreachableError(
             f"no equilibrium with pulling cables at position ({position[0]:g}, {position[1]:g}) m"
             f" ({error})"
@@ -1258,6 +1267,32 @@ def solve_inverse_statics(
     jacobian = _pose_jacobian(platform, phi, equilibria, stiffnesses, dof)
     pose = np.append(position, phi)
     return _result(platform, pose, equilibria, jacobian, wrench, dof)
+
+
+_CONTINUATION_STEPS = (0.0, 0.1, 0.25, 0.45, 0.7, 1.0)
+
+
+def _inverse_by_weight_continuation(platform, position, rotation, wrench, max_strain, max_tension):
+    """Inverse statics by growing the cables' weight from zero, warm-starting each step.
+
+    The last resort when every direct start fails: massless cables are solved
+    reliably from the straight-cable guess, and each step's solution starts the next.
+    Slow (a handful of solves), so only used on failure.
+    """
+    previous = None
+    for fraction in _CONTINUATION_STEPS:
+        cables = tuple(
+            SuspendedCable(
+                c.weight_per_length * fraction, c.axial_stiffness, c.anchor, c.exit_point, c.pulley
+            )
+            for c in platform.cables
+        )
+        scaled = SuspendedPlatform(cables, platform.mass, platform.gravity, platform.moment_of_inertia)
+        previous = solve_inverse_statics(
+            scaled if fraction < 1.0 else platform, position, rotation, wrench, max_strain,
+            max_tension, initial_guess=previous, _continuation=False,
+        )
+    return previous
 
 
 def _rim_angle(pulley, point):

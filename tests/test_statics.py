@@ -191,6 +191,17 @@ def test_rigid_platform_near_the_workspace_edge_tilts_by_about_a_radian():
     np.testing.assert_allclose(net_wrench(platform, equilibrium), 0.0, atol=1e-9)  # Newton tolerance
 
 
+def test_rigid_platform_beside_a_pulley_is_found_by_weight_continuation():
+    platform = make_platform(pulleys=True, rigid=True)
+    # the direct starts fail here (heavy, deeply sagging right cable); growing the
+    # cable weight from zero reaches the equilibrium found by walking to it in 1.7 cm
+    # steps: rotation -1.067 rad
+    equilibrium = solve_inverse_statics(platform, (-1.4, -2.0))
+    assert equilibrium.rotation == pytest.approx(-1.067, abs=1e-3)
+    forward = solve_forward_statics(platform, equilibrium.unstrained_lengths)
+    np.testing.assert_allclose(forward.position, (-1.4, -2.0), atol=1e-9)  # Newton tolerances
+
+
 def test_warm_start_along_a_path_gives_the_same_solution():
     platform = make_platform(rigid=True)
     previous = solve_inverse_statics(platform, (0.30, -1.70))
