@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.validation import finite, non_negative, positive
 
 STANDARD_GRAVITY = 9.81
 """Default gravitational acceleration [m/s^2]."""
@@ -63,30 +64,6 @@ _MAX_NEWTON_ITERATIONS = 200
 # ---------------------------------------------------------------------------
 # validation helpers
 # ---------------------------------------------------------------------------
-def _finite_float(name, value):
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise SceneError(f"{name} must be finite, got {value!r}")
-    return number
-
-
-def _positive_float(name, value):
-    number = _finite_float(name, value)
-    if number <= 0.0:
-        raise SceneError(f"{name} must be positive, got {value!r}")
-    return number
-
-
-def _non_negative_float(name, value):
-    number = _finite_float(name, value)
-    if number < 0.0:
-        raise SceneError(f"{name} must be non-negative, got {value!r}")
-    return number
-
-
 def _span_vector(span):
     try:
         vector = np.asarray(span, dtype=float)
@@ -99,10 +76,10 @@ def _span_vector(span):
 
 def _strain_limits(axial_stiffness, max_strain, max_tension):
     """Largest admissible end tension [N] from a strain and an optional tension limit."""
-    max_strain = _positive_float("max_strain", max_strain)
+    max_strain = positive("max_strain", max_strain)
     limit = max_strain * axial_stiffness
     if max_tension is not None:
-        limit = min(limit, _positive_float("max_tension", max_tension))
+        limit = min(limit, positive("max_tension", max_tension))
     return limit
 
 
@@ -135,15 +112,15 @@ class CatenaryCable:
 
     def __post_init__(self):
         object.__setattr__(
-            self, "unstrained_length", _positive_float("unstrained_length", self.unstrained_length)
+            self, "unstrained_length", positive("unstrained_length", self.unstrained_length)
         )
         object.__setattr__(
             self,
             "weight_per_length",
-            _non_negative_float("weight_per_length", self.weight_per_length),
+            non_negative("weight_per_length", self.weight_per_length),
         )
         object.__setattr__(
-            self, "axial_stiffness", _positive_float("axial_stiffness", self.axial_stiffness)
+            self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness)
         )
 
     @classmethod
@@ -167,10 +144,10 @@ class CatenaryCable:
         -------
         CatenaryCable
         """
-        radius = _positive_float("radius", radius)
-        youngs_modulus = _positive_float("youngs_modulus", youngs_modulus)
-        linear_density = _non_negative_float("linear_density", linear_density)
-        gravity = _non_negative_float("gravity", gravity)
+        radius = positive("radius", radius)
+        youngs_modulus = positive("youngs_modulus", youngs_modulus)
+        linear_density = non_negative("linear_density", linear_density)
+        gravity = non_negative("gravity", gravity)
         return cls(
             unstrained_length=unstrained_length,
             weight_per_length=linear_density * gravity,
@@ -405,8 +382,8 @@ def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizon
     -------
     CatenaryState
     """
-    H = _non_negative_float("horizontal_tension", horizontal_tension)
-    V_B = _finite_float("vertical_tension_b", vertical_tension_b)
+    H = non_negative("horizontal_tension", horizontal_tension)
+    V_B = finite("vertical_tension_b", vertical_tension_b)
     if horizontal_sign not in (1, -1, 1.0, -1.0):
         raise SceneError(f"horizontal_sign must be +1 or -1, got {horizontal_sign!r}")
     return _make_state(cable, H, V_B, float(horizontal_sign))
@@ -715,9 +692,9 @@ def solve_inverse(
         If an argument is invalid.
     """
     span = _span_vector(span)
-    w = _non_negative_float("weight_per_length", weight_per_length)
-    EA = _positive_float("axial_stiffness", axial_stiffness)
-    H = _positive_float("horizontal_tension", horizontal_tension)
+    w = non_negative("weight_per_length", weight_per_length)
+    EA = positive("axial_stiffness", axial_stiffness)
+    H = positive("horizontal_tension", horizontal_tension)
     tension_limit = _strain_limits(EA, max_strain, max_tension)
     sign_x = -1.0 if span[0] < 0.0 else 1.0
     dx, dz = abs(float(span[0])), float(span[1])

@@ -23,36 +23,10 @@ from typing import Any, Mapping
 import numpy as np
 
 from .errors import SceneError
+from .validation import finite, non_negative, positive
 from .trajectories import Trajectory, trajectory_from_dict
 
 # --------------------------------------------------------------------------- checks
-
-
-def _finite(path: str, value: Any) -> float:
-    """Return ``value`` as a float, or raise SceneError naming ``path``."""
-    if isinstance(value, bool):
-        raise SceneError(f"{path} must be a number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise SceneError(f"{path} must be a number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise SceneError(f"{path} must be finite, got {value!r}")
-    return number
-
-
-def _positive(path: str, value: Any) -> float:
-    number = _finite(path, value)
-    if number <= 0.0:
-        raise SceneError(f"{path} must be positive, got {value!r}")
-    return number
-
-
-def _non_negative(path: str, value: Any) -> float:
-    number = _finite(path, value)
-    if number < 0.0:
-        raise SceneError(f"{path} must be zero or positive, got {value!r}")
-    return number
 
 
 def _vector(path: str, value: Any, length: int) -> tuple[float, ...]:
@@ -65,7 +39,7 @@ def _vector(path: str, value: Any, length: int) -> tuple[float, ...]:
         raise SceneError(f"{path} must be a list of {length} numbers, got {value!r}") from None
     if len(items) != length:
         raise SceneError(f"{path} must have {length} entries, got {len(items)}: {value!r}")
-    return tuple(_finite(f"{path}[{i}]", v) for i, v in enumerate(items))
+    return tuple(finite(f"{path}[{i}]", v) for i, v in enumerate(items))
 
 
 def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
@@ -132,11 +106,11 @@ class CableSpec:
     mass_lumping: str = "consistent"
 
     def __post_init__(self) -> None:
-        _set(self, "unstrained_length", _positive("cable.unstrained_length", self.unstrained_length))
-        _set(self, "radius", _positive("cable.radius", self.radius))
-        _set(self, "linear_density", _positive("cable.linear_density", self.linear_density))
-        _set(self, "youngs_modulus", _positive("cable.youngs_modulus", self.youngs_modulus))
-        _set(self, "damping_constant", _non_negative("cable.damping_constant", self.damping_constant))
+        _set(self, "unstrained_length", positive("cable.unstrained_length", self.unstrained_length))
+        _set(self, "radius", positive("cable.radius", self.radius))
+        _set(self, "linear_density", positive("cable.linear_density", self.linear_density))
+        _set(self, "youngs_modulus", positive("cable.youngs_modulus", self.youngs_modulus))
+        _set(self, "damping_constant", non_negative("cable.damping_constant", self.damping_constant))
         if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
             raise SceneError(f"cable.n_elements must be a whole number, got {self.n_elements!r}")
         if self.n_elements < 2:
@@ -264,12 +238,12 @@ class PulleySpec:
 
     def __post_init__(self) -> None:
         _set(self, "center", _vector("pulley.center", self.center, 2))
-        _set(self, "radius", _positive("pulley.radius", self.radius))
+        _set(self, "radius", positive("pulley.radius", self.radius))
         if self.side not in (-1, 1) or isinstance(self.side, bool):
             raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {self.side!r}")
         _set(self, "side", int(self.side))
-        _set(self, "contact_stiffness", _positive("pulley.contact_stiffness", self.contact_stiffness))
-        _set(self, "contact_damping", _non_negative("pulley.contact_damping", self.contact_damping))
+        _set(self, "contact_stiffness", positive("pulley.contact_stiffness", self.contact_stiffness))
+        _set(self, "contact_damping", non_negative("pulley.contact_damping", self.contact_damping))
 
 
 @dataclass(frozen=True)
@@ -297,8 +271,8 @@ class PlatformSpec:
     size: tuple[float, float] = (0.3, 0.2)
 
     def __post_init__(self) -> None:
-        _set(self, "mass", _positive("platform.mass", self.mass))
-        _set(self, "inertia", _positive("platform.inertia", self.inertia))
+        _set(self, "mass", positive("platform.mass", self.mass))
+        _set(self, "inertia", positive("platform.inertia", self.inertia))
         anchors = np.asarray(self.anchors, dtype=object)
         if anchors.ndim != 2 or anchors.shape[1] != 2 or anchors.shape[0] < 1:
             raise SceneError(
@@ -308,7 +282,7 @@ class PlatformSpec:
         _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3))
         size = _vector("platform.size", self.size, 2)
         for i, s in enumerate(size):
-            _non_negative(f"platform.size[{i}]", s)
+            non_negative(f"platform.size[{i}]", s)
         _set(self, "size", size)
 
     @property
@@ -347,10 +321,10 @@ class WinchSpec:
 
     def __post_init__(self) -> None:
         _choice("winch.kind", self.kind, ("kinematic", "servo", "fixed"))
-        _set(self, "drum_radius", _positive("winch.drum_radius", self.drum_radius))
-        _set(self, "drum_inertia", _positive("winch.drum_inertia", self.drum_inertia))
+        _set(self, "drum_radius", positive("winch.drum_radius", self.drum_radius))
+        _set(self, "drum_inertia", positive("winch.drum_inertia", self.drum_inertia))
         _choice("winch.servo_design", self.servo_design, ("pole_placement", "lqr"))
-        _set(self, "servo_bandwidth", _positive("winch.servo_bandwidth", self.servo_bandwidth))
+        _set(self, "servo_bandwidth", positive("winch.servo_bandwidth", self.servo_bandwidth))
 
     @property
     def drum_mass(self) -> float:
@@ -479,19 +453,19 @@ class SolverSpec:
     integrator: str = "generalized_alpha"
 
     def __post_init__(self) -> None:
-        _set(self, "end_time", _positive("solver.end_time", self.end_time))
-        _set(self, "step_size", _positive("solver.step_size", self.step_size))
+        _set(self, "end_time", positive("solver.end_time", self.end_time))
+        _set(self, "step_size", positive("solver.step_size", self.step_size))
         if self.step_size > self.end_time:
             raise SceneError(f"solver.step_size ({self.step_size}) must not exceed solver.end_time ({self.end_time})")
         if self.end_time / self.step_size > MAX_STEPS:
             raise SceneError(f"solver.step_size ({self.step_size}) and solver.end_time ({self.end_time}) make "
                              f"{self.end_time / self.step_size:.3g} steps; at most {MAX_STEPS:.0e} are allowed")
-        rho = _finite("solver.spectral_radius", self.spectral_radius)
+        rho = finite("solver.spectral_radius", self.spectral_radius)
         if not 0.0 <= rho <= 1.0:
             raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {self.spectral_radius!r}")
         _set(self, "spectral_radius", rho)
         _choice("solver.newton", self.newton, ("modified", "full"))
-        _set(self, "output_period", _positive("solver.output_period", self.output_period))
+        _set(self, "output_period", positive("solver.output_period", self.output_period))
         if self.output_period < self.step_size * (1 - 1e-9):
             _set(self, "output_period", self.step_size)
         _set(self, "max_newton_iterations", _whole("solver.max_newton_iterations", self.max_newton_iterations,
@@ -576,7 +550,7 @@ class Scene:
             raise SceneError(
                 f"platform.anchors must list one anchor per cable ({m}), got {len(self.platform.anchors)}"
             )
-        _set(self, "gravity", _non_negative("gravity", self.gravity))
+        _set(self, "gravity", non_negative("gravity", self.gravity))
         _choice("cable_exit", self.cable_exit, ("pulley", "point"))
         if self.winch.kind == "servo" and not self.effects.cable_mass:
             raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")

@@ -78,6 +78,7 @@ from cdpr_exu.catenary import (
     state_from_end_forces,
 )
 from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.validation import finite, non_negative, positive
 
 _RELATIVE_TOLERANCE = 1e-12
 
@@ -85,30 +86,6 @@ _RELATIVE_TOLERANCE = 1e-12
 # ---------------------------------------------------------------------------
 # validation helpers
 # ---------------------------------------------------------------------------
-def _finite(name, value):
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise SceneError(f"{name} must be finite, got {value!r}")
-    return number
-
-
-def _positive(name, value):
-    number = _finite(name, value)
-    if number <= 0.0:
-        raise SceneError(f"{name} must be positive, got {value!r}")
-    return number
-
-
-def _non_negative(name, value):
-    number = _finite(name, value)
-    if number < 0.0:
-        raise SceneError(f"{name} must be non-negative, got {value!r}")
-    return number
-
-
 def _point(name, value):
     try:
         vector = np.asarray(value, dtype=float)
@@ -174,7 +151,7 @@ class Pulley:
 
     def __post_init__(self):
         object.__setattr__(self, "centre", _point("centre", self.centre))
-        object.__setattr__(self, "radius", _positive("radius", self.radius))
+        object.__setattr__(self, "radius", positive("radius", self.radius))
         if self.side not in (-1, 1):
             raise SceneError(f"side must be -1 or +1, got {self.side!r}")
 
@@ -220,10 +197,10 @@ class SuspendedCable:
 
     def __post_init__(self):
         object.__setattr__(
-            self, "weight_per_length", _non_negative("weight_per_length", self.weight_per_length)
+            self, "weight_per_length", non_negative("weight_per_length", self.weight_per_length)
         )
         object.__setattr__(
-            self, "axial_stiffness", _positive("axial_stiffness", self.axial_stiffness)
+            self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness)
         )
         object.__setattr__(self, "anchor", _point("anchor", self.anchor))
         if (self.exit_point is None) == (self.pulley is None):
@@ -276,10 +253,10 @@ class SuspendedPlatform:
         if not cables or not all(isinstance(c, SuspendedCable) for c in cables):
             raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {self.cables!r}")
         object.__setattr__(self, "cables", cables)
-        object.__setattr__(self, "mass", _non_negative("mass", self.mass))
-        object.__setattr__(self, "gravity", _non_negative("gravity", self.gravity))
+        object.__setattr__(self, "mass", non_negative("mass", self.mass))
+        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
         object.__setattr__(
-            self, "moment_of_inertia", _non_negative("moment_of_inertia", self.moment_of_inertia)
+            self, "moment_of_inertia", non_negative("moment_of_inertia", self.moment_of_inertia)
         )
 
     @property
@@ -315,7 +292,7 @@ def inertial_wrench(platform, acceleration, angular_acceleration=0.0):
         neglected (the cables stay in quasi-static equilibrium).
     """
     a = _point("acceleration", acceleration)
-    alpha = _finite("angular_acceleration", angular_acceleration)
+    alpha = finite("angular_acceleration", angular_acceleration)
     return np.array(
         [-platform.mass * a[0], -platform.mass * a[1], -platform.moment_of_inertia * alpha]
     )
@@ -1145,7 +1122,7 @@ def solve_inverse_statics(
         rotation = 0.0
     else:
         free_rotation = rotation is None
-        rotation = 0.0 if rotation is None else _finite("rotation", rotation)
+        rotation = 0.0 if rotation is None else finite("rotation", rotation)
     if n + int(free_rotation) != dof:
         raise SceneError(
             f"inverse statics needs as many unknowns as equations: {n} cables"
