@@ -40,6 +40,7 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu.errors import SceneError
+from cdpr_exu.validation import real_array, whole_array
 
 __all__ = [
     "BendingSpringDamper",
@@ -202,7 +203,7 @@ def bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
 # --------------------------------------------------------------------------- validation
 
 def _as_coordinates(name, values, n_coordinates=None):
-    array = np.ascontiguousarray(values, dtype=np.float64)
+    array = np.ascontiguousarray(real_array(name, values))
     if array.ndim != 1 or array.shape[0] % 2 != 0:
         raise SceneError(f"{name} must be a flat array (2 n_nodes,) x0, y0, x1, ...; got shape {array.shape}")
     if n_coordinates is not None and array.shape[0] != n_coordinates:
@@ -211,7 +212,7 @@ def _as_coordinates(name, values, n_coordinates=None):
 
 
 def _as_joints(joints, n_nodes):
-    array = np.ascontiguousarray(joints, dtype=np.int64)
+    array = np.ascontiguousarray(whole_array("joints", joints))
     if array.ndim != 2 or array.shape[1] != 3:
         raise SceneError(f"joints must be an integer array (n_joints, 3); got shape {array.shape}")
     if array.size:
@@ -224,7 +225,9 @@ def _as_joints(joints, n_nodes):
 
 
 def _as_per_joint(name, values, n_joints):
-    array = np.asarray(values, dtype=np.float64)
+    array = real_array(name, values)
+    if np.any(array < 0):
+        raise SceneError(f"{name} must be zero or positive, got {values!r}")
     if array.ndim == 0:
         array = np.full(n_joints, float(array))
     elif array.shape != (n_joints,):
@@ -276,7 +279,7 @@ def cable_joints(nodes_per_cable):
     """
     rows = []
     first = 0
-    for n in nodes_per_cable:
+    for n in whole_array("nodes_per_cable", nodes_per_cable).reshape(-1):
         n = int(n)
         if n < 2:
             raise SceneError(f"nodes_per_cable entries must be >= 2; got {n}")

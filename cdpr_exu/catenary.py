@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.validation import finite, non_negative, positive
+from cdpr_exu.validation import finite, non_negative, positive, real_array
 
 STANDARD_GRAVITY = 9.81
 """Default gravitational acceleration [m/s^2]."""
@@ -594,6 +594,8 @@ def solve_forward(
         If ``span`` is not a finite 2-vector or a limit is not positive.
     """
     span = _span_vector(span)
+    if not isinstance(cable, CatenaryCable):
+        raise SceneError(f"cable must be a CatenaryCable, got {cable!r}")
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
     tension_limit = _strain_limits(EA, max_strain, max_tension)
     sign_x = -1.0 if span[0] < 0.0 else 1.0
@@ -620,7 +622,7 @@ def solve_forward(
     else:
         guess = None
         if initial_guess is not None:
-            H0, V0 = float(initial_guess[0]), float(initial_guess[1])
+            H0, V0 = real_array("initial_guess", initial_guess).reshape(2)
             if H0 > 0.0 and math.isfinite(H0) and math.isfinite(V0):
                 guess = (H0, V0)
         H, V_B = _solve_span(L, w, EA, dx, dz, guess)
@@ -807,7 +809,7 @@ def profile(cable, state, s):
         If an ``s`` lies outside ``[0, L]`` (beyond round-off).
     """
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
-    s = np.atleast_1d(np.asarray(s, dtype=float))
+    s = np.atleast_1d(real_array("s", s))
     if s.ndim != 1 or not np.all(np.isfinite(s)):
         raise SceneError(f"s must be a finite 1-D array of arc lengths [m], got shape {s.shape}")
     slack = 1e-12 * L
@@ -845,7 +847,9 @@ def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_
         along its direction at A. Entry ``[0, 0]`` is ``inf`` for a slack vertical
         cable (a U of zero width: no horizontal stiffness).
     """
-    H, V_B = float(horizontal_tension), float(vertical_tension_b)
+    if not isinstance(cable, CatenaryCable):
+        raise SceneError(f"cable must be a CatenaryCable, got {cable!r}")
+    H, V_B = positive("horizontal_tension", horizontal_tension), finite("vertical_tension_b", vertical_tension_b)
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
     sign = -1.0 if horizontal_sign < 0 else 1.0
     dx, dz, jac = _span_and_jacobian(H, V_B, L, w, EA)

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.validation import real_array
 
 __all__ = [
     "PulleyExit",
@@ -104,7 +105,7 @@ def rotation_matrix(phi):
     -------
     ndarray, shape (..., 2, 2)
     """
-    phi = np.asarray(phi, dtype=float)
+    phi = real_array("phi", phi)
     c, s = np.cos(phi), np.sin(phi)
     return np.stack([np.stack([c, -s], axis=-1), np.stack([s, c], axis=-1)], axis=-2)
 

@@ -78,7 +78,7 @@ from cdpr_exu.catenary import (
     state_from_end_forces,
 )
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.validation import finite, non_negative, positive
+from cdpr_exu.validation import finite, non_negative, positive, real_array
 
 _RELATIVE_TOLERANCE = 1e-12
 
@@ -249,7 +249,10 @@ class SuspendedPlatform:
     moment_of_inertia: float = 0.0
 
     def __post_init__(self):
-        cables = tuple(self.cables)
+        try:
+            cables = tuple(self.cables)
+        except TypeError:
+            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {self.cables!r}") from None
         if not cables or not all(isinstance(c, SuspendedCable) for c in cables):
             raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {self.cables!r}")
         object.__setattr__(self, "cables", cables)
@@ -942,13 +945,15 @@ def solve_forward_statics(
     SceneError
         If an argument is invalid.
     """
+    if not isinstance(platform, SuspendedPlatform):
+        raise SceneError(f"platform must be a SuspendedPlatform, got {platform!r}")
     lengths = _lengths(platform, unstrained_lengths)
     wrench = _wrench(external_wrench)
     dof = platform.degrees_of_freedom
     if initial_pose is None:
         position, rotation = straight_cable_pose(platform, lengths, wrench)
     else:
-        pose = np.asarray(initial_pose, dtype=float)
+        pose = real_array("initial_pose", initial_pose)
         if pose.shape not in ((2,), (3,)) or not np.all(np.isfinite(pose)):
             raise SceneError(f"initial_pose must be (x, z) or (x, z, phi), got {initial_pose!r}")
         position, rotation = pose[:2], (float(pose[2]) if pose.size == 3 else 0.0)

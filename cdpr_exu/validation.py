@@ -40,3 +40,26 @@ def non_negative(name: str, value: Any) -> float:
     if number < 0.0:
         raise SceneError(f"{name} must be zero or positive, got {value!r}")
     return number
+
+
+def real_array(name: str, value: Any, *, require_finite: bool = True):
+    """``value`` as a float ndarray (any shape); text, objects and NaN/inf are refused."""
+    import numpy as np
+
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be real numbers, got {value!r}") from None
+    if require_finite and not np.all(np.isfinite(array)):
+        raise SceneError(f"{name} must be finite, got {value!r}")
+    return array
+
+
+def whole_array(name: str, value: Any):
+    """``value`` as an int64 ndarray whose entries are whole numbers (2.5 is refused, not truncated)."""
+    import numpy as np
+
+    array = real_array(name, value)
+    if not np.all(array == np.round(array)):
+        raise SceneError(f"{name} must be whole numbers, got {value!r}")
+    return array.astype(np.int64)

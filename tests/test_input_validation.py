@@ -346,9 +346,10 @@ def test_public_functions_refuse_bad_arguments_with_the_projects_errors(name):
         call()
 
 
-#: Gaps found: arguments these functions let through, or refuse with a bare Python
-#: error instead of SceneError (they live outside scene.py and are reported, not fixed).
-KNOWN_GAPS = {
+#: Former gaps: arguments these functions let through, or refused with a bare Python
+#: error instead of SceneError, until cdpr_exu.validation's array checks were used at
+#: their entry points.
+FORMER_GAPS = {
     "bending positions text -> ValueError": lambda: bending.bending_energy("abc", JOINTS, 1.0),
     "bending positions NaN -> energy NaN": lambda: bending.bending_energy([NAN, 0, 1, 0, 2, 0], JOINTS, 1.0),
     "bending joints 2.5 truncated to 2": lambda: bending.bending_energy(POSITIONS, [[0, 1, 2.5]], 1.0),
@@ -369,12 +370,10 @@ KNOWN_GAPS = {
 }
 
 
-@pytest.mark.parametrize("name", [
-    pytest.param(name, marks=pytest.mark.xfail(strict=True, reason="validation gap outside scene.py, reported"))
-    for name in KNOWN_GAPS])
-def test_known_validation_gaps_of_public_functions(name):
+@pytest.mark.parametrize("name", list(FORMER_GAPS))
+def test_former_validation_gaps_are_refused_with_scene_error(name):
     with pytest.raises(SceneError):
-        KNOWN_GAPS[name]()
+        FORMER_GAPS[name]()
 
 
 # ============================================================================ property test
