@@ -431,6 +431,45 @@ def _initial_guess(L, w, EA, dx, dz):
     return H, 0.5 * w * (dz / math.tanh(lam) + L)
 
 
+def _damped_newton_2d(residual, x, y, tolerance, max_drop=None):
+    """Damped Newton on two unknowns ``(x, y)``, ``x`` kept positive.
+
+    ``residual(x, y)`` returns ``(rx, rz, jacobian)``. The step is scaled as a whole
+    (keeping its direction) so that ``x`` drops by at most the fraction ``max_drop``
+    (if given), then halved until the residual norm decreases (Armijo). Returns
+    ``(x, y, norm)`` at convergence (norm <= tolerance) or where the iteration stalls.
+    """
+    rx, rz, jac = residual(x, y)
+    norm = math.hypot(rx, rz)
+    for _ in range(_MAX_NEWTON_ITERATIONS):
+        if norm <= tolerance:
+            break
+        (a11, a12), (a21, a22) = jac
+        det = a11 * a22 - a12 * a21
+        if not math.isfinite(det) or det == 0.0:
+            break
+        step_x = -(a22 * rx - a12 * rz) / det
+        step_y = -(-a21 * rx + a11 * rz) / det
+        alpha = 1.0
+        if max_drop is not None and step_x < -max_drop * x:
+            alpha = max_drop * x / -step_x
+        accepted = False
+        for _ in range(60):
+            x_new = x + alpha * step_x
+            y_new = y + alpha * step_y
+            if x_new > 0.0:
+                rx_new, rz_new, jac_new = residual(x_new, y_new)
+                norm_new = math.hypot(rx_new, rz_new)
+                if norm_new < (1.0 - 1e-4 * alpha) * norm or norm_new <= tolerance:
+                    accepted = True
+                    break
+            alpha *= 0.5
+        if not accepted:
+            break
+        x, y, rx, rz, jac, norm = x_new, y_new, rx_new, rz_new, jac_new, norm_new
+    return x, y, norm
+
+
 def _newton_forward(L, w, EA, dx, dz, H, V_B):
     """Damped Newton in ``(H, V_B)``; returns ``(H, V_B, converged)``.
 
@@ -446,35 +485,7 @@ def _newton_forward(L, w, EA, dx, dz, H, V_B):
         rx, rz, jac = _span_and_jacobian(H_, V_, L, w, EA)
         return rx - dx, rz - dz, jac
 
-    rx, rz, jac = residual(H, V_B)
-    norm = math.hypot(rx, rz)
-    for _ in range(_MAX_NEWTON_ITERATIONS):
-        if norm <= tolerance:
-            return H, V_B, True
-        a11, a12 = jac[0]
-        a21, a22 = jac[1]
-        det = a11 * a22 - a12 * a21
-        if not math.isfinite(det) or det == 0.0:
-            break
-        step_H = -(a22 * rx - a12 * rz) / det
-        step_V = -(-a21 * rx + a11 * rz) / det
-        alpha = 1.0
-        if step_H < -0.9 * H:
-            alpha = 0.9 * H / -step_H
-        accepted = False
-        for _ in range(60):
-            H_new = H + alpha * step_H
-            V_new = V_B + alpha * step_V
-            if H_new > 0.0:
-                rx_new, rz_new, jac_new = residual(H_new, V_new)
-                norm_new = math.hypot(rx_new, rz_new)
-                if norm_new < (1.0 - 1e-4 * alpha) * norm or norm_new <= tolerance:
-                    accepted = True
-                    break
-            alpha *= 0.5
-        if not accepted:
-            break
-        H, V_B, rx, rz, jac, norm = H_new, V_new, rx_new, rz_new, jac_new, norm_new
+    H, V_B, norm = _damped_newton_2d(residual, H, V_B, tolerance, max_drop=0.9)
     return H, V_B, norm <= 10.0 * tolerance  # stalled at round-off level counts
 
 
@@ -747,32 +758,7 @@ def _newton_inverse(w, EA, H, dx, dz, L, V_B):
         dL = (H / T_A + H / EA, V_A / T_A + V_A / EA)
         return rx - dx, rz - dz, ((dL[0], jac[0][1]), (dL[1], jac[1][1]))
 
-    rx, rz, jac = evaluate(L, V_B)
-    norm = math.hypot(rx, rz)
-    for _ in range(_MAX_NEWTON_ITERATIONS):
-        if norm <= tolerance:
-            return L, V_B
-        (a11, a12), (a21, a22) = jac
-        det = a11 * a22 - a12 * a21
-        if not math.isfinite(det) or det == 0.0:
-            break
-        step_L = -(a22 * rx - a12 * rz) / det
-        step_V = -(-a21 * rx + a11 * rz) / det
-        alpha = 1.0
-        accepted = False
-        for _ in range(60):
-            L_new = L + alpha * step_L
-            V_new = V_B + alpha * step_V
-            if L_new > 0.0:
-                rx_new, rz_new, jac_new = evaluate(L_new, V_new)
-                norm_new = math.hypot(rx_new, rz_new)
-                if norm_new < (1.0 - 1e-4 * alpha) * norm or norm_new <= tolerance:
-                    accepted = True
-                    break
-            alpha *= 0.5
-        if not accepted:
-            break
-        L, V_B, rx, rz, jac, norm = L_new, V_new, rx_new, rz_new, jac_new, norm_new
+    L, V_B, norm = _damped_newton_2d(evaluate, L, V_B, tolerance)
     if norm <= 1e3 * tolerance:
         return L, V_B
     raise UnreachableError(
