@@ -43,9 +43,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cdpr_exu.bending import bending_energy, cable_joints
+from cdpr_exu.energy import energy_rise, mechanical_energy
 from cdpr_exu.errors import CdprError, SolverFailure
-from cdpr_exu.pulley import penetration
 from cdpr_exu.scene import Effects, Scene, WinchSpec, load_scene
 from cdpr_exu.simulate import explicit_step_limit, simulate
 from cdpr_exu.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
@@ -138,33 +137,6 @@ def held_scene(name: str, step: float, end_time: float = RUN_TIME, output_period
 # --------------------------------------------------------------------------- checks
 
 
-def mechanical_energy(scene: Scene, result) -> np.ndarray:
-    """Kinetic + gravitational + axial + bending + pulley-contact energy, shape (N,) [J]."""
-    g, platform = scene.gravity, scene.platform
-    v = result.platform_velocity
-    energy = (0.5 * platform.mass * np.sum(v[:, :2] ** 2, axis=1) + 0.5 * platform.inertia * v[:, 2] ** 2
-              + platform.mass * g * result.platform_pose[:, 1])
-    contact = scene.effects.pulley_contact and scene.cable_exit == "pulley"
-    for cable, pulley, x, xv in zip(scene.cables, scene.pulleys, result.nodes, result.node_velocities):
-        masses = cable.node_masses()
-        energy = energy + 0.5 * np.einsum("j,tjk,tjk->t", masses, xv, xv) + g * x[:, :, 1] @ masses
-        stretch = np.linalg.norm(np.diff(x, axis=1), axis=-1) - cable.element_length
-        if scene.effects.slack:
-            stretch = np.maximum(stretch, 0.0)
-        energy = energy + 0.5 * cable.axial_stiffness * np.sum(stretch**2, axis=1)
-        if scene.effects.bending:
-            joints = cable_joints([cable.n_elements + 1])
-            energy = energy + np.array([bending_energy(q.ravel(), joints, cable.bending_stiffness) for q in x])
-        if contact:
-            energy = energy + 0.5 * pulley.contact_stiffness * np.sum(penetration(pulley, x) ** 2, axis=1)
-    return energy
-
-
-def rise(energy: np.ndarray) -> float:
-    """Largest increase over any earlier sample [J]."""
-    return float(np.max(energy - np.minimum.accumulate(energy))) if len(energy) else 0.0
-
-
 def finite(result) -> bool:
     return all(np.all(np.isfinite(a)) for a in [result.platform_pose, result.platform_velocity,
                                                  *result.nodes, *result.tensions])
@@ -230,8 +202,8 @@ def implicit_check(name: str, step: float, reference) -> dict:
         return out
     energy = mechanical_energy(scene, held)
     after = held.time >= START_UP_STEPS * step - 1e-9
-    out["start_up_rise_J"] = rise(energy)
-    late_rise = rise(energy[after])
+    out["start_up_rise_J"] = energy_rise(energy)
+    late_rise = energy_rise(energy[after])
     if late_rise > ENERGY_TOLERANCE:
         out["reason"] = f"held: energy rises by {late_rise:.3g} J after the start-up"
         return out
@@ -295,7 +267,7 @@ def explicit_ladder(name: str) -> dict:
         result, why, wall = attempt(scene)
         total += wall
         if result is not None:
-            energy_rise = rise(mechanical_energy(scene, result))
+            rise = energy_rise(mechanical_energy(scene, result))
             reference_step = min(end / 100, 1e-5)
             implicit, _, wall = attempt(held_scene(name, reference_step, end_time=end, output_period=end / 10))
             total += wall
@@ -304,8 +276,8 @@ def explicit_ladder(name: str) -> dict:
             moved = 0.0 if implicit is None else float(
                 np.abs(implicit.platform_pose[:, :2] - implicit.platform_pose[0, :2]).max())
             tolerance = max(EXPLICIT_TOLERANCE, 0.01 * moved)
-            if energy_rise > ENERGY_TOLERANCE:
-                why = f"energy rises by {energy_rise:.3g} J"
+            if rise > ENERGY_TOLERANCE:
+                why = f"energy rises by {rise:.3g} J"
             elif deviation > tolerance:
                 why = f"{deviation:.2g} m off the implicit answer"
             else:

@@ -13,44 +13,12 @@ import math
 import numpy as np
 import pytest
 
-from cdpr_exu.bending import bending_energy, cable_joints
 from cdpr_exu.errors import SolverFailure
 from cdpr_exu.scene import Effects, load_scene
 from cdpr_exu.simulate import simulate
+from cdpr_exu.energy import energy_parts, mechanical_energy
 from controllers.base import WinchCommand
 from controllers.ideal_ik import IdealIKController
-
-
-def energy_parts(scene, result):
-    """Kinetic, gravitational and elastic energy of a run at each output time, each (N,) [J].
-
-    Kinetic: node masses, platform translation and rotation. Gravitational: height z.
-    Elastic: axial k_i (l - l0i)^2 / 2 per element (only l > l0i with slack), and bending k_theta dtheta^2 / 2
-    per interior node when bending is on.
-    """
-    g = scene.gravity
-    platform = scene.platform
-    velocity = result.platform_velocity
-    kinetic = 0.5 * platform.mass * np.sum(velocity[:, :2] ** 2, axis=1) + 0.5 * platform.inertia * velocity[:, 2] ** 2
-    potential = platform.mass * g * result.platform_pose[:, 1]
-    elastic = np.zeros_like(kinetic)
-    for cable, nodes, node_velocities in zip(scene.cables, result.nodes, result.node_velocities):
-        masses = cable.node_masses()
-        kinetic = kinetic + 0.5 * np.einsum("j,tjk,tjk->t", masses, node_velocities, node_velocities)
-        potential = potential + g * nodes[:, :, 1] @ masses
-        stretch = np.linalg.norm(np.diff(nodes, axis=1), axis=-1) - cable.element_length
-        if scene.effects.slack:  # tension-only: no energy stored in a slack element
-            stretch = np.maximum(stretch, 0.0)
-        elastic = elastic + 0.5 * cable.axial_stiffness * np.sum(stretch**2, axis=1)
-        if scene.effects.bending:
-            joints = cable_joints([cable.n_elements + 1])
-            elastic = elastic + np.array([bending_energy(x.ravel(), joints, cable.bending_stiffness) for x in nodes])
-    return kinetic, potential, elastic
-
-
-def mechanical_energy(scene, result):
-    """Total mechanical energy at each output time, shape (N,) [J]."""
-    return sum(energy_parts(scene, result))
 
 
 # ============================================================================ energy
@@ -64,7 +32,7 @@ def test_undamped_cable_pendulum_conserves_energy_to_second_order_in_the_step(pe
     for step in (5e-3, 2.5e-3):
         scene = pendulum(step, effects=effects)
         result = simulate(scene)
-        kinetic, _, _ = energy_parts(scene, result)
+        kinetic = energy_parts(scene, result).kinetic
         energy = mechanical_energy(scene, result)
         swing = kinetic.max()  # the energy the swing turns into motion (~3.4 J)
         drifts.append(np.abs(energy - energy[0]).max() / swing)

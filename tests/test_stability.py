@@ -28,12 +28,12 @@ import re
 from functools import lru_cache
 
 import numpy as np
+
+from cdpr_exu.energy import energy_rise, mechanical_energy
 import pytest
 
-from cdpr_exu.bending import bending_energy, cable_joints
 from cdpr_exu.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.model import build_model
-from cdpr_exu.pulley import penetration
 from cdpr_exu.result import Result
 from cdpr_exu.scene import Effects, Scene, WinchSpec, load_scene
 from cdpr_exu.simulate import MAX_STRAIN, explicit_step_limit, simulate
@@ -80,44 +80,6 @@ def run(scene: Scene, controller=None) -> tuple[Result, SolverFailure | None]:
     except SolverFailure as failure:
         assert failure.partial_result is not None, "a SolverFailure must carry the partial result"
         return failure.partial_result, failure
-
-
-def mechanical_energy(scene: Scene, result: Result) -> np.ndarray:
-    """Total mechanical energy at each output time, shape (N,) [J].
-
-    Kinetic (cable nodes, platform translation and rotation), gravitational (height z),
-    axial springs k_i (l - l0i)^2 / 2 (only stretched elements when slack), bending
-    k_theta dtheta^2 / 2 and the pulley contact springs k_p depth^2 / 2 (the rim
-    carries the wrapped cable on ~1e-5 m deep penalty springs; left out, their
-    release would look like energy from nowhere).
-    """
-    g = scene.gravity
-    platform = scene.platform
-    velocity = result.platform_velocity
-    energy = (0.5 * platform.mass * np.sum(velocity[:, :2] ** 2, axis=1)
-              + 0.5 * platform.inertia * velocity[:, 2] ** 2
-              + platform.mass * g * result.platform_pose[:, 1])
-    contact = scene.effects.pulley_contact and scene.cable_exit == "pulley"
-    for cable, pulley, nodes, node_velocities in zip(scene.cables, scene.pulleys, result.nodes,
-                                                     result.node_velocities):
-        masses = cable.node_masses()
-        energy = energy + 0.5 * np.einsum("j,tjk,tjk->t", masses, node_velocities, node_velocities)
-        energy = energy + g * nodes[:, :, 1] @ masses
-        stretch = np.linalg.norm(np.diff(nodes, axis=1), axis=-1) - cable.element_length
-        if scene.effects.slack:
-            stretch = np.maximum(stretch, 0.0)
-        energy = energy + 0.5 * cable.axial_stiffness * np.sum(stretch**2, axis=1)
-        if scene.effects.bending:
-            joints = cable_joints([cable.n_elements + 1])
-            energy = energy + np.array([bending_energy(x.ravel(), joints, cable.bending_stiffness) for x in nodes])
-        if contact:
-            energy = energy + 0.5 * pulley.contact_stiffness * np.sum(penetration(pulley, nodes) ** 2, axis=1)
-    return energy
-
-
-def energy_rise(energy: np.ndarray) -> float:
-    """Largest increase of ``energy`` over any earlier sample [J] (0 if it never rises)."""
-    return float(np.max(energy - np.minimum.accumulate(energy)))
 
 
 def assert_finite(result: Result) -> None:
