@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.validation import finite, non_negative, positive, real_array
+from cdpr_exu.validation import finite, non_negative, positive, real_array, vector
 
 STANDARD_GRAVITY = 9.81
 """Default gravitational acceleration [m/s^2]."""
@@ -65,13 +65,7 @@ _MAX_NEWTON_ITERATIONS = 200
 # validation helpers
 # ---------------------------------------------------------------------------
 def _span_vector(span):
-    try:
-        vector = np.asarray(span, dtype=float)
-    except (TypeError, ValueError):
-        raise SceneError(f"span must be a 2-vector (dx, dz) [m], got {span!r}") from None
-    if vector.shape != (2,) or not np.all(np.isfinite(vector)):
-        raise SceneError(f"span must be a finite 2-vector (dx, dz) [m], got {span!r}")
-    return vector
+    return vector("span", span, 2, " (dx, dz) [m]")
 
 
 def _strain_limits(axial_stiffness, max_strain, max_tension):

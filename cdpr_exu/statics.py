@@ -78,7 +78,7 @@ from cdpr_exu.catenary import (
     state_from_end_forces,
 )
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.validation import finite, non_negative, positive, real_array
+from cdpr_exu.validation import finite, non_negative, positive, real_array, vector
 
 _RELATIVE_TOLERANCE = 1e-12
 
@@ -87,27 +87,14 @@ _RELATIVE_TOLERANCE = 1e-12
 # validation helpers
 # ---------------------------------------------------------------------------
 def _point(name, value):
-    try:
-        vector = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a 2-vector (x, z) [m], got {value!r}") from None
-    if vector.shape != (2,) or not np.all(np.isfinite(vector)):
-        raise SceneError(f"{name} must be a finite 2-vector (x, z) [m], got {value!r}")
-    return (float(vector[0]), float(vector[1]))
+    x, z = vector(name, value, 2, " (x, z) [m]")
+    return (float(x), float(z))
 
 
 def _wrench(value):
     if value is None:
         return np.zeros(3)
-    try:
-        vector = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise SceneError(f"external_wrench must be (fx, fz, moment), got {value!r}") from None
-    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
-        raise SceneError(
-            f"external_wrench must be a finite 3-vector (fx [N], fz [N], moment [N m]), got {value!r}"
-        )
-    return vector
+    return vector("external_wrench", value, 3, " (fx [N], fz [N], moment [N m])")
 
 
 def _cross(a, b):

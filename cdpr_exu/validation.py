@@ -63,3 +63,19 @@ def whole_array(name: str, value: Any):
     if not np.all(array == np.round(array)):
         raise SceneError(f"{name} must be whole numbers, got {value!r}")
     return array.astype(np.int64)
+
+
+def vector(name: str, value: Any, length: int, meaning: str = ""):
+    """``value`` as a finite float ndarray of shape ``(length,)``.
+
+    ``meaning`` describes the entries in the message, e.g. ``" (x, z) [m]"``.
+    """
+    import numpy as np
+
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a {length}-vector{meaning}, got {value!r}") from None
+    if array.shape != (length,) or not np.all(np.isfinite(array)):
+        raise SceneError(f"{name} must be a finite {length}-vector{meaning}, got {value!r}")
+    return array
