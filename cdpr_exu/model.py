@@ -129,15 +129,12 @@ def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 
     cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
     times = np.linspace(0.0, scene.solver.end_time, 200)
     anchors = anchor_points(scene.trajectory.pose(times), np.asarray(scene.platform.anchors))[:, cable_index]
-    hang, arc_end = [], []
-    for anchor in anchors:
-        exit_ = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchor)
-        hanging = cable.unstrained_length - exit_.cable_length
-        hang.append(hanging)
-        arc_end.append(hanging + pulley.radius * exit_.wrap_angle)
+    exits = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchors)  # all times at once
+    hang = cable.unstrained_length - exits.cable_length
+    arc_end = hang + pulley.radius * exits.wrap_angle
     margin = margin_elements * cable.element_length + 0.05 * cable.unstrained_length
     s = np.arange(cable.n_elements + 1) * cable.element_length
-    reach = (s >= min(hang) - margin) & (s <= max(arc_end) + margin)
+    reach = (s >= hang.min() - margin) & (s <= arc_end.max() + margin)
     reach[0] = False  # the winch node's motion is prescribed
     return np.flatnonzero(reach)
 
@@ -154,15 +151,16 @@ def check_trajectory_reachable(scene: Scene) -> None:
     poses = scene.trajectory.pose(times)
     anchors = anchor_points(poses, np.asarray(scene.platform.anchors))
     for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
-        for t, anchor in zip(times, anchors[:, i]):
-            exit_ = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchor)
-            if exit_.cable_length > cable.unstrained_length - cable.element_length:
-                raise UnreachableError(
-                    f"the reference pose {np.round(scene.trajectory.pose(t), 4).tolist()} at t = {t:.3f} s "
-                    f"needs {exit_.cable_length:.4f} m of cable {i} between pulley and anchor, but "
-                    f"cables[{i}].unstrained_length is {cable.unstrained_length} m (one element, "
-                    f"{cable.element_length:.4f} m, must stay on the winch side)"
-                )
+        lengths = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchors[:, i]).cable_length
+        too_long = np.flatnonzero(lengths > cable.unstrained_length - cable.element_length)
+        if too_long.size:
+            k = too_long[0]
+            raise UnreachableError(
+                f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s "
+                f"needs {lengths[k]:.4f} m of cable {i} between pulley and anchor, but "
+                f"cables[{i}].unstrained_length is {cable.unstrained_length} m (one element, "
+                f"{cable.element_length:.4f} m, must stay on the winch side)"
+            )
 
 
 def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.ndarray) -> None:
