@@ -1,8 +1,8 @@
 """Benchmark: the paper scene on every model of the ladder, wall time per simulated second.
 
 Runs ``paper-circle`` (10 s, 15 elements per cable) on the presets ``ideal``,
-``elastic``, ``catenary``, ``full`` and on ``full`` with the linear curvature-vector
-bending, at several step sizes, all in this one process (one core), and prints wall
+``elastic``, ``catenary``, ``full``, on ``full`` with the linear curvature-vector
+bending and on ``full`` with the pulley contact on element segments, at several step sizes, all in this one process (one core), and prints wall
 time per simulated second, the ratio to real time (from the wall time and from the
 process's CPU time, which the load of other processes on a shared machine disturbs
 far less), and the cost relative to ``full`` at the smallest step: ratios measured in
@@ -31,14 +31,16 @@ from cdpr_exu.errors import SolverFailure
 from cdpr_exu.scene import Effects, load_scene
 from cdpr_exu.simulate import simulate
 
-MODELS = (("ideal", {}), ("elastic", {}), ("catenary", {}), ("full", {}), ("full", {"bending_model": "linear"}))
+MODELS = (("ideal", {}), ("elastic", {}), ("catenary", {}), ("full", {}), ("full", {"bending_model": "linear"}),
+          ("full", {"pulley_contact_model": "segment"}))
 REFERENCE = Path(__file__).resolve().parent.parent / "results" / "accuracy" / "paper_circle" / "reference.npz"
 #: Errors are measured after the start-up jolt [s].
 AFTER = 1.0
 
 
 def model_label(preset: str, overrides: dict) -> str:
-    return preset + "".join(f", {v} bending" if k == "bending_model" else f", {k}={v}" for k, v in overrides.items())
+    names = {"bending_model": "bending", "pulley_contact_model": "contact"}
+    return preset + "".join(f", {v} {names[k]}" if k in names else f", {k}={v}" for k, v in overrides.items())
 
 
 def run(base, preset: str, overrides: dict, step: float, end_time: float):
@@ -93,12 +95,12 @@ def main() -> None:
     full_wall = next(r[3] / r[5] for r in rows if r[0] == "full" and r[1] == smallest and r[2] == "completed")
     print(f"paper-circle, {args.end_time:g} s, 15 elements per cable, one process (one core)")
     print(f"accuracy: max / RMS platform position error after {AFTER:g} s against {reference_name}")
-    print(f"{'model':22s} {'step [s]':>9s} {'wall/sim s':>11s} {'x real time':>12s} {'(CPU time)':>11s} "
+    print(f"{'model':24s} {'step [s]':>9s} {'wall/sim s':>11s} {'x real time':>12s} {'(CPU time)':>11s} "
           f"{'cost vs full ' + format(smallest, 'g'):>19s} {'Newton/step':>12s} {'max err [mm]':>13s} "
           f"{'rms err [mm]':>13s}  status")
     for label, step, status, wall, cpu, simulated, newton, error_max, error_rms in rows:
         per_second = wall / simulated if simulated > 0 else np.nan
-        print(f"{label:22s} {step:9.0e} {per_second:11.3f} {1 / per_second:12.1f} {simulated / cpu:11.1f} "
+        print(f"{label:24s} {step:9.0e} {per_second:11.3f} {1 / per_second:12.1f} {simulated / cpu:11.1f} "
               f"{per_second / full_wall:19.2f} {newton:12.2f} {1000 * error_max:13.2f} {1000 * error_rms:13.2f}  "
               f"{status}")
     full = [r for r in rows if r[0] == "full" and r[2] == "completed"]

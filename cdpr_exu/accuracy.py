@@ -127,12 +127,15 @@ class Configuration:
 
 
 def model_name(preset: str, overrides: Sequence[tuple[str, Any]] = ()) -> str:
-    """Readable name of a preset with overrides (``full, linear bending``, ``full, slack=true``)."""
+    """Readable name of a preset with overrides (``full, linear bending``, ``full, segment contact``,
+    ``full, slack=true``)."""
     parts = [preset]
     for path, value in overrides:
         key = path.split(".")[-1]
         if key == "bending_model":
             parts.append(f"{value} bending")
+        elif key == "pulley_contact_model":
+            parts.append(f"{value} contact")
         else:
             parts.append(f"{key}={json.dumps(value) if isinstance(value, bool) else value}")
     return ", ".join(parts)
@@ -200,6 +203,7 @@ EFFECT_VARIANTS = (
     (("effects.bending_model", "linear"), ("effects.bending_damping", False)),
     (("effects.slack", True),),
     (("cables.mass_lumping", "paper"),),
+    (("effects.pulley_contact_model", "segment"),),
 )
 
 #: The grid of ``examples/accuracy_vs_time.py`` (about 6 minutes per scene on 2 cores).

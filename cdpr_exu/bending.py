@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu.errors import SceneError
-from cdpr_exu.validation import real_array, whole_array
+from cdpr_exu.validation import flat_coordinates, real_array, whole_array
 
 __all__ = [
     "BendingSpringDamper",
@@ -202,15 +202,6 @@ def bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
 
 # --------------------------------------------------------------------------- validation
 
-def _as_coordinates(name, values, n_coordinates=None):
-    array = np.ascontiguousarray(real_array(name, values))
-    if array.ndim != 1 or array.shape[0] % 2 != 0:
-        raise SceneError(f"{name} must be a flat array (2 n_nodes,) x0, y0, x1, ...; got shape {array.shape}")
-    if n_coordinates is not None and array.shape[0] != n_coordinates:
-        raise SceneError(f"{name} has {array.shape[0]} coordinates, expected {n_coordinates}")
-    return array
-
-
 def _as_joints(joints, n_nodes):
     array = np.ascontiguousarray(whole_array("joints", joints))
     if array.ndim != 2 or array.shape[1] != 3:
@@ -249,8 +240,8 @@ def _check_output(name, out, shape):
 
 
 def _validate(positions, velocities, joints, stiffness, damping):
-    positions = _as_coordinates("positions", positions)
-    velocities = _as_coordinates("velocities", velocities, positions.shape[0])
+    positions = flat_coordinates("positions", positions)
+    velocities = flat_coordinates("velocities", velocities, positions.shape[0])
     joints = _as_joints(joints, positions.shape[0] // 2)
     stiffness = _as_per_joint("stiffness", stiffness, joints.shape[0])
     damping = _as_per_joint("damping", damping, joints.shape[0])
@@ -306,7 +297,7 @@ def bending_angles(positions, joints):
     dtheta : ndarray, shape (n_joints,) [rad], in (-pi, pi]
         Positive when the cable turns counter-clockwise from a-b to b-c.
     """
-    positions = _as_coordinates("positions", positions)
+    positions = flat_coordinates("positions", positions)
     joints = _as_joints(joints, positions.shape[0] // 2)
     p = positions.reshape(-1, 2)
     e1 = p[joints[:, 1]] - p[joints[:, 0]]

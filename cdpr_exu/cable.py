@@ -6,7 +6,9 @@ node carries a rotational spring-damper (k_theta, c_theta) on the relative angle
 its two elements. The axial items are Exudyn's built-in C++ spring-dampers; the
 bending of all cables is one ``ObjectGenericODE2`` whose force and analytic Jacobian
 are numba kernels (:mod:`cdpr_exu.bending`): one Python call per Newton iteration for
-the whole robot.
+the whole robot. The same object carries the tension-only elements (``Effects.slack``,
+:mod:`cdpr_exu.axial`) and the pulley contact on element segments
+(``Effects.pulley_contact_model = "segment"``, :mod:`cdpr_exu.segment_contact`).
 
 Exudyn items live in its x-y plane: the paper's (x, z) maps to Exudyn's (x, y).
 """
@@ -20,7 +22,8 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from . import axial, bending
-from .scene import CableSpec, Effects
+from .scene import CableSpec, Effects, PulleySpec
+from .segment_contact import SegmentPulleyContact
 
 
 @dataclass
@@ -105,9 +108,11 @@ def _add_gravity(mbs: exu.MainSystem, items: CableItems, masses: np.ndarray, eff
 class CableForceItems:
     """The one ``ObjectGenericODE2`` that carries the cables' numba-computed forces.
 
-    It holds the exact-angle bending springs (``Effects.bending``) and, with
-    ``Effects.slack``, the tension-only axial elements. ``user_functions`` keeps the
-    Python callables alive as long as the model.
+    It holds the exact-angle bending springs (``Effects.bending``), with
+    ``Effects.slack`` the tension-only axial elements, and with segment pulley contact
+    the rim contacts of ``contact_segments`` (global node pairs, shape (S, 2), into the
+    object's node list; ``contact`` their :class:`SegmentPulleyContact`). ``user_functions``
+    keeps the Python callables alive as long as the model.
     """
 
     object: int
@@ -116,20 +121,39 @@ class CableForceItems:
     damping: np.ndarray
     slack_elements: np.ndarray
     user_functions: tuple = ()
+    contact_segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    contact: SegmentPulleyContact | None = None
 
 
 def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
-                     effects: Effects) -> CableForceItems | None:
-    """Add the bending (and, with slack, the axial) forces of all cables as one object.
+                     effects: Effects, pulleys: list[PulleySpec] | None = None,
+                     contact_elements: list[np.ndarray] | None = None) -> CableForceItems | None:
+    """Add the bending (with slack, the axial; with segment contact, the pulley) forces of all cables as one object.
 
-    Returns None when neither ``effects.bending`` nor ``effects.slack`` is on (then no
-    item and no cost). The force user function receives Exudyn's displacement
-    coordinates ``q``; the reference positions are added here. Its Jacobian is
-    analytic (numba kernels), ``fODE2 * K + fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    cables : list of CableSpec
+    items : list of CableItems
+        The cables' nodes, in the same order.
+    effects : Effects
+    pulleys : list of PulleySpec, optional
+        Pulley of each cable; needed with ``contact_elements``.
+    contact_elements : list of ndarray of int, optional
+        Cable-local indices of the elements (element j joins nodes j and j + 1) that get
+        a segment rim contact with their cable's pulley (``Effects.pulley_contact_model =
+        "segment"``); None or all empty: no segment contact and no cost for it.
+
+    Returns None when neither ``effects.bending`` nor ``effects.slack`` is on and there
+    is no segment contact (then no item and no cost). The force user function receives
+    Exudyn's displacement coordinates ``q``; the reference positions are added here. Its
+    Jacobian is analytic (numba kernels), ``fODE2 * K + fODE2_t * D`` with K = -df/dq,
+    D = -df/dq_t.
     """
-    if not (effects.bending or effects.slack):
-        return None
     counts = [len(it.nodes) for it in items]
+    contact = _segment_contact(counts, pulleys, contact_elements)
+    if not (effects.bending or effects.slack or contact is not None):
+        return None
     reference = np.concatenate([it.reference for it in items]).ravel()
     size = reference.size
     if effects.bending:
@@ -163,6 +187,8 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         force = spring.force(positions, velocities)
         if effects.slack:
             axial.slack_axial_force(positions, velocities, elements, rest, axial_k, axial_c, force)
+        if contact is not None:
+            contact.add_force(positions, velocities, force)
         return force
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
@@ -172,12 +198,14 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         if effects.slack:
             axial.slack_axial_jacobian(positions, velocities, elements, rest, axial_k, axial_c,
                                        float(f_q), float(f_q_t), jacobian)
+        if contact is not None:
+            contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
         return jacobian
 
     nodes = [n for it in items for n in it.nodes]
     functions = (force_function, jacobian_function)
     mass = np.zeros((size, size))
-    if linear and not effects.slack:
+    if linear and not effects.slack and contact is None:
         # Nothing left for Python per Newton iteration: no force function, and a Jacobian
         # function that returns an empty matrix, so that Exudyn adds the constant K and D
         # itself (without any Jacobian function it would differentiate them numerically).
@@ -193,7 +221,30 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     obj = mbs.AddObject(eii.ObjectGenericODE2(
         nodeNumbers=nodes, massMatrix=mass,
         forceUserFunction=functions[0], jacobianUserFunction=functions[1], **matrices))
-    return CableForceItems(obj, joints, stiffness, damping, elements, (spring, *functions, matrices))
+    segments = np.zeros((0, 2), np.int64) if contact is None else contact.segments
+    return CableForceItems(obj, joints, stiffness, damping, elements, (spring, *functions, matrices),
+                           segments, contact)
+
+
+def _segment_contact(counts: list[int], pulleys: list[PulleySpec] | None,
+                     contact_elements: list[np.ndarray] | None) -> SegmentPulleyContact | None:
+    """The segment rim contacts of the listed elements with their cables' pulleys (None if none)."""
+    if contact_elements is None or not any(len(e) for e in contact_elements):
+        return None
+    if pulleys is None or len(pulleys) != len(counts) or len(contact_elements) != len(counts):
+        raise ValueError("segment contact needs one pulley and one list of contact elements per cable")
+    segments, centers, radii, stiffness, damping = [], [], [], [], []
+    first = 0
+    for count, pulley, elements in zip(counts, pulleys, contact_elements):
+        elements = np.asarray(elements, dtype=np.int64)
+        segments.append(np.column_stack([first + elements, first + elements + 1]))
+        centers.append(np.tile(pulley.center, (len(elements), 1)))
+        radii.append(np.full(len(elements), pulley.radius))
+        stiffness.append(np.full(len(elements), pulley.contact_stiffness))
+        damping.append(np.full(len(elements), pulley.contact_damping))
+        first += count
+    return SegmentPulleyContact(first, np.concatenate(segments), np.concatenate(centers), np.concatenate(radii),
+                                np.concatenate(stiffness), np.concatenate(damping))
 
 
 def _sparse(matrix: np.ndarray) -> exu.MatrixContainer:

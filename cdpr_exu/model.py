@@ -23,6 +23,7 @@ from .kinematics import anchor_points, hang_point, initial_cable_nodes, pulley_e
 from .platform import PlatformItems, add_platform, attach_cable
 from .pulley import add_pulley_contact, add_pulley_ground
 from .scene import Scene
+from .segment_contact import contact_segments
 from .winch import ServoItems, WinchItems, add_servo_drum, add_winch
 
 
@@ -43,7 +44,11 @@ class Model:
     contacts : list of list of int
         Contact objects of each cable with its pulley.
     contact_nodes : list of ndarray of int
-        Cable-local indices of the nodes that carry a contact item.
+        Cable-local indices of the nodes that carry a contact item (node contact).
+    contact_elements : list of ndarray of int
+        Cable-local indices of the elements (element j joins nodes j and j + 1) that
+        carry a segment contact (``effects.pulley_contact_model = "segment"``); their
+        forces live in ``cable_forces``.
     initial_paid_out : ndarray, shape (m,) [m]
         Paid-out length lambda_i(0) of the initial configuration: the unstrained cable
         between the pulley's hang point and the anchor (over a pulley, the cable less
@@ -66,6 +71,7 @@ class Model:
     initial_paid_out: np.ndarray | None = None
     ropes: list[RopeItems] = field(default_factory=list)
     servos: list[ServoItems] = field(default_factory=list)
+    contact_elements: list[np.ndarray] = field(default_factory=list)
 
     def item_counts(self) -> dict[str, int]:
         """How many Exudyn items each effect added."""
@@ -77,6 +83,7 @@ class Model:
             "bending_joints": 0 if self.cable_forces is None else len(self.cable_forces.joints),
             "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
             "pulley_contacts": sum(len(c) for c in self.contacts),
+            "contact_segments": sum(len(e) for e in self.contact_elements),
             "massless_ropes": len(self.ropes),
             "winch_constraints": sum((int(w.horizontal) >= 0) + (int(w.vertical) >= 0) for w in self.winches),
             "servo_drums": len(self.servos),
@@ -104,12 +111,23 @@ def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
     Over a pulley: the paper's ideal configuration, straight from the anchor to the
     pulley, wrapped over it and hanging to the winch, every element at its unstrained
     length. With a point exit: straight from the pulley centre to the anchor.
+
+    With segment contact (``effects.pulley_contact_model = "segment"``) the nodes on the
+    rim of the pulley radius r would make every wrapped element a chord cutting
+    r - sqrt(r^2 - l0i^2 / 4) into the disc (30 mm for the paper's 0.25 m elements),
+    which the segment contact would fire out at the first step. The nodes are then
+    placed the same way on a circle of radius sqrt(r^2 + l0i^2 / 4): the wrap becomes
+    the polygon circumscribed about the pulley, every chord touching the rim, and the
+    winch line moves out by the difference (30 mm for the paper's cable).
     """
     cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
     anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
     if scene.cable_exit == "point":
         return straight_cable_nodes(np.asarray(pulley.center), anchor, cable.n_elements)
-    return initial_cable_nodes(np.asarray(pulley.center), pulley.radius, pulley.side, anchor,
+    radius = pulley.radius
+    if scene.effects.pulley_contact and scene.effects.pulley_contact_model == "segment":
+        radius = float(np.hypot(pulley.radius, cable.element_length / 2.0))
+    return initial_cable_nodes(np.asarray(pulley.center), radius, pulley.side, anchor,
                                cable.element_length, cable.n_elements)
 
 
@@ -166,18 +184,23 @@ def check_trajectory_reachable(scene: Scene) -> None:
 def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.ndarray) -> None:
     """Refuse a cable whose straight elements cut deep into the pulley from the start.
 
-    Contact acts on the nodes: an element much longer than the pulley radius spans the
-    wrap as a chord through the disc, and the cable then slips through the pulley.
+    With node contact an element much longer than the pulley radius spans the wrap as a
+    chord through the disc, and the cable then slips through the pulley. Segment contact
+    pushes the chords themselves out of the disc: no element length is refused then
+    (``effects.pulley_contact_model = "segment"``; the coarsest cables are limited by
+    :func:`check_trajectory_reachable` instead).
     """
     from .pulley import segment_penetration
 
+    if scene.effects.pulley_contact and scene.effects.pulley_contact_model == "segment":
+        return
     pulley, cable = scene.pulleys[cable_index], scene.cables[cable_index]
     depth = segment_penetration(pulley, nodes_xz).max()
     if depth > 0.5 * pulley.radius:
         raise SceneError(
             f"cables[{cable_index}].n_elements = {cable.n_elements} is too coarse: its {cable.element_length:.3f} m "
             f"elements cut {1000 * depth:.0f} mm into the {pulley.radius} m pulley as chords of the wrap; "
-            f"use elements no longer than about 1.4 pulley radii")
+            f"use elements no longer than about 1.4 pulley radii, or effects.pulley_contact_model = 'segment'")
 
 
 def build_model(scene: Scene) -> Model:
@@ -199,7 +222,9 @@ def build_model(scene: Scene) -> Model:
     if not effects.cable_mass:
         return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
     use_contact = effects.pulley_contact and scene.cable_exit == "pulley"
+    on_segments = use_contact and effects.pulley_contact_model == "segment"
     cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
+    contact_elements = []  # cable-local element indices per cable (segment contact only)
     for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
         nodes_xz = initial_nodes(scene, i)
         if scene.cable_exit == "pulley":
@@ -210,13 +235,19 @@ def build_model(scene: Scene) -> Model:
         winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1]), drive_height=not servo))
         if servo:
             servos.append(add_servo_drum(mbs, winches[-1], items.nodes[0], scene.winch))
-        if use_contact:
+        if on_segments:  # forces in the cables' generic object (add_cable_forces): no Exudyn contact items
+            contacts.append([])
+            contact_nodes.append(np.zeros(0, dtype=int))
+            contact_elements.append(contact_segments(contact_candidates(scene, i), cable.n_elements))
+        elif use_contact:
+            contact_elements.append(np.zeros(0, dtype=np.int64))
             candidates = contact_candidates(scene, i)
             pulley_marker = add_pulley_ground(mbs, pulley)
             contacts.append(add_pulley_contact(mbs, pulley, pulley_marker,
                                                [items.markers[j] for j in candidates], nodes_xz[candidates]))
             contact_nodes.append(candidates)
         else:
+            contact_elements.append(np.zeros(0, dtype=np.int64))
             contacts.append([])
             contact_nodes.append(np.zeros(0, dtype=int))
         if scene.cable_exit == "point":
@@ -225,10 +256,11 @@ def build_model(scene: Scene) -> Model:
             # Unstrained cable beyond the hang point: all of it but the hanging part.
             paid_out.append(cable.unstrained_length - (pulley.center[1] - nodes_xz[0, 1]))
         cables.append(items)
-    cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects)
+    cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.pulleys),
+                                    contact_elements if on_segments else None)
     mbs.Assemble()
     return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
-                 contacts, contact_nodes, np.asarray(paid_out), servos=servos)
+                 contacts, contact_nodes, np.asarray(paid_out), servos=servos, contact_elements=contact_elements)
 
 
 #: Shortest rope segment kept between the fixed winch point and the pulley [m]; a

@@ -353,6 +353,10 @@ PRESETS: dict[str, dict[str, bool]] = {
 }
 
 
+#: Where the pulley contact acts: on the nodes or on the element segments.
+PULLEY_CONTACT_MODELS = ("node", "segment")
+
+
 @dataclass(frozen=True)
 class Effects:
     """The physical effects a scene simulates; the builder adds items only for these.
@@ -374,6 +378,13 @@ class Effects:
         "linear" the curvature-vector spring (k_theta / l0i^2) |p_a - 2 p_b + p_c|^2 / 2
         with constant matrices, cheaper but with moment k_theta sin(theta) (see
         docs/accuracy.md for how far it moves the answer).
+    pulley_contact_model : {"node", "segment"}
+        Where the pulley rim contact acts (with ``pulley_contact``): "node" pushes each
+        node that enters the disc back out (Exudyn's sphere contact, k_p [N/m] times the
+        penetration [m] plus c_p [N s/m] on the normal velocity [m/s]); "segment" does the
+        same for the point of each element closest to the pulley centre, shared by the
+        element's two nodes (:mod:`cdpr_exu.segment_contact`), so that straight elements
+        cannot cut the disc as chords and coarser cables can run over the pulley.
     """
 
     preset: str = "full"
@@ -386,6 +397,7 @@ class Effects:
     slack: bool = False
     gravity: bool = True
     bending_model: str = "exact"
+    pulley_contact_model: str = "node"
 
     def __post_init__(self) -> None:
         _choice("effects.preset", self.preset, tuple(PRESETS))
@@ -393,6 +405,7 @@ class Effects:
             if f.type in ("bool", bool) and not isinstance(getattr(self, f.name), bool):
                 raise SceneError(f"effects.{f.name} must be true or false, got {getattr(self, f.name)!r}")
         _choice("effects.bending_model", self.bending_model, ("exact", "linear"))
+        _choice("effects.pulley_contact_model", self.pulley_contact_model, PULLEY_CONTACT_MODELS)
         if not self.cable_mass:
             for name in ("bending", "pulley_contact"):
                 if getattr(self, name):

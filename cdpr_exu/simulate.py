@@ -91,6 +91,7 @@ class _Monitor:
         self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
                        for i, cable in enumerate(scene.cables) if f"cable_{i}" in indices]
         self.check_pulleys = scene.cable_exit == "pulley" and scene.effects.pulley_contact
+        self.on_segments = scene.effects.pulley_contact_model == "segment"
         self.platform_index = indices["platform"]
         self.reference_pose = reference[self.platform_index]
         # No pose of a platform hung on these cables lies farther from every pulley
@@ -123,9 +124,12 @@ class _Monitor:
                 depth = segment_penetration(pulley, positions)
                 element = int(np.argmax(depth))
                 if depth[element] > MAX_PENETRATION_FRACTION * pulley.radius:
+                    advice = ("segment contact: the rim contact is too soft for the cable tension; raise "
+                              f"pulleys[{i}].contact_stiffness" if self.on_segments else
+                              "contact acts on nodes only; use more elements, or "
+                              "effects.pulley_contact_model = 'segment'")
                     return (f"element {element} of cable {i} cuts {1000 * depth[element]:.0f} mm deep into pulley {i} "
-                            f"at t = {t:.4f} s: the cable is slipping through the pulley (contact acts on nodes only; "
-                            f"use more elements)")
+                            f"at t = {t:.4f} s: the cable is slipping through the pulley ({advice})")
         pose = self.reference_pose + q[self.platform_index]
         if np.any(pose[:2] < self.box[0]) or np.any(pose[:2] > self.box[1]):
             return (f"the platform left the reachable region at t = {t:.4f} s (it is at x = {pose[0]:.3f} m, "

@@ -65,6 +65,21 @@ def whole_array(name: str, value: Any):
     return array.astype(np.int64)
 
 
+def flat_coordinates(name: str, value: Any, n_coordinates: int | None = None):
+    """``value`` as a C-contiguous float64 array of planar coordinates ``x0, y0, x1, y1, ...``.
+
+    Shape (2 n_nodes,); with ``n_coordinates`` given, exactly that many entries.
+    """
+    import numpy as np
+
+    array = np.ascontiguousarray(real_array(name, value), dtype=np.float64)
+    if array.ndim != 1 or array.shape[0] % 2 != 0:
+        raise SceneError(f"{name} must be a flat array (2 n_nodes,) x0, y0, x1, ...; got shape {array.shape}")
+    if n_coordinates is not None and array.shape[0] != n_coordinates:
+        raise SceneError(f"{name} has {array.shape[0]} coordinates, expected {n_coordinates}")
+    return array
+
+
 def vector(name: str, value: Any, length: int, meaning: str = ""):
     """``value`` as a finite float ndarray of shape ``(length,)``.
 

@@ -77,6 +77,7 @@ def field_cases():
     cases += [(SolverSpec, "max_newton_iterations", v) for v in (0, -1, 2.5, "25", None, True, NAN, 10**9)]
     cases += [(SolverSpec, "integrator", v) for v in ("euler", "RK44", None, 4)]
     cases += [(Effects, "bending_model", v) for v in ("cubic", None, 1)]
+    cases += [(Effects, "pulley_contact_model", v) for v in ("segments", "", None, 1)]
     for name in ("cable_mass", "axial_elasticity", "axial_damping", "bending", "bending_damping",
                  "pulley_contact", "slack", "gravity"):
         cases += [(Effects, name, v) for v in (1, 0, "yes", None)]
