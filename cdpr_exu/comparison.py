@@ -29,6 +29,7 @@ CONTROLLERS: dict[str, Callable[[], object]] = {
     "tension_aware": TensionAwareController,
     "tension_aware_chordal": lambda: TensionAwareController(chordal_correction=True),
     "tension_aware_dynamic_chordal": lambda: TensionAwareController(dynamic=True, chordal_correction=True),
+    "tension_aware_chain": lambda: TensionAwareController(statics="chain"),
     "closed_loop_tension_aware": lambda: ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True),
 }
 

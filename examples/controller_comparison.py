@@ -3,7 +3,7 @@
 Run:  python examples/controller_comparison.py
 
 Writes ``results/controllers/`` (paper circle, 10 s) and ``results/controllers_slow/``
-(one turn at a fifth of the speed, 21 s): summary.json keyed by controller,
+(one turn at 0.05 rad/s, 126 s; about 4 minutes): summary.json keyed by controller,
 comparison.md, a pose CSV per controller, and the path and error figures.
 Equivalent to ``cdpr compare paper-circle --out results/controllers`` and
 ``cdpr compare paper-circle-slow --out results/controllers_slow``.

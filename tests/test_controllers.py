@@ -58,7 +58,8 @@ def test_tension_aware_adds_cable_for_sag_and_stretch_where_the_platform_hangs_c
 
 
 @pytest.mark.parametrize("controller", [TensionAwareController(), TensionAwareController(dynamic=True),
-                                        TensionAwareController(chordal_correction=True)],
+                                        TensionAwareController(chordal_correction=True),
+                                        TensionAwareController(statics="chain")],
                          ids=lambda c: c.name)
 def test_tension_aware_commands_are_continuous_in_time(controller):
     scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=3.0))
@@ -72,6 +73,32 @@ def test_tension_aware_commands_are_continuous_in_time(controller):
     steps = np.abs(np.diff(lengths, axis=0))
     assert steps.max() <= 1.5 * np.abs(rates).max() * dt
     assert np.abs(rates).max() < 1.0  # m/s: the circle moves at 0.6 m/s
+
+
+def test_chain_statics_lengths_differ_from_the_catenarys_by_the_lumped_geometry():
+    """Same robot, same pose: the lumped chain needs less cable than the catenary (its
+    chords over the pulley are shorter than the arc: 0 to 3 cm with 60 degree chords),
+    and a length within a centimetre of the chordal correction's estimate."""
+    times = np.array([0.0, 1.0, 2.0])
+    catenary = TensionAwareController().compensated_lengths(PAPER, times)
+    chordal = TensionAwareController(chordal_correction=True).compensated_lengths(PAPER, times)
+    chain = TensionAwareController(statics="chain").compensated_lengths(PAPER, times)
+    assert np.all(chain < catenary) and np.all(catenary - chain < 0.04)
+    assert np.abs(chain - chordal).max() < 0.01
+
+
+def test_tension_aware_options_are_checked():
+    from cdpr_exu.errors import SceneError
+
+    with pytest.raises(SceneError, match="statics"):
+        TensionAwareController(statics="lumped")
+    with pytest.raises(SceneError, match="chordal_correction"):
+        TensionAwareController(statics="chain", chordal_correction=True)
+    with pytest.raises(SceneError, match="table_spacing"):
+        TensionAwareController(table_spacing=-1.0)
+    with pytest.raises(SceneError, match="cable_mass"):
+        TensionAwareController(statics="chain").compensated_lengths(
+            PAPER.with_changes(effects=Effects.from_preset("elastic")), np.zeros(1))
 
 
 def test_a_reference_that_needs_a_pushing_cable_is_refused_before_the_run():
@@ -104,19 +131,21 @@ def test_closed_loop_tension_aware_control_cuts_the_paper_circle_error_more_than
 
 
 @pytest.mark.slow
-def test_static_correction_cuts_the_quasi_static_circle_error_threefold():
+def test_static_correction_alone_holds_the_quasi_static_circle_within_5_mm():
     from cdpr_exu.comparison import compare_controllers
 
     scene = load_scene("paper-circle-slow")
-    scene = scene.with_changes(solver=replace(scene.solver, end_time=10.5))  # half a turn
-    summaries = compare_controllers(scene, ["ideal_ik", "tension_aware_chordal", "closed_loop_tension_aware"])
+    scene = scene.with_changes(solver=replace(scene.solver, end_time=20.0))  # a sixth of the turn
+    summaries = compare_controllers(scene, ["ideal_ik", "tension_aware_chordal", "tension_aware_chain"])
     ideal = summaries["ideal_ik"]["max_position_error_m"]
-    static = summaries["tension_aware_chordal"]["max_position_error_m"]
-    closed = summaries["closed_loop_tension_aware"]["max_position_error_m"]
-    # Measured over a full turn: 30.5 mm, 10.2 mm (3.0x) and 1.1 mm. The static
-    # correction leaves the lumped model's bending and the node phase over the pulley.
-    assert static < ideal / 2.5
-    assert closed < 5e-3
+    catenary = summaries["tension_aware_chordal"]["max_position_error_m"]
+    chain = summaries["tension_aware_chain"]["max_position_error_m"]
+    # Measured over the full turn: ideal IK 32 mm, catenary with the chordal correction
+    # 7.8 mm, chain statics 1.5 mm (1.3 mm over these 20 s). The margin (3.5 mm) covers
+    # step-size and platform changes; the ratio asserts the correction does the work.
+    assert chain < 3.5e-3
+    assert ideal / chain > 8.0
+    assert catenary < ideal / 2.5
 
 
 def test_closed_loop_needs_the_measured_pose():
