@@ -43,12 +43,13 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     ti.endTime = solver.end_time
     ti.verboseMode = 0
     ti.generalizedAlpha.spectralRadius = solver.spectral_radius
-    # Start from zero accelerations. The consistent initial acceleration of a straight
-    # cable's free nodes is -g, but the Kelvin-Voigt damping (c_i / m_i ~ 4e6 1/s) cuts
-    # it off within microseconds; carried into the first step it injects a start-up
-    # energy jolt (13 J on the paper scene at 1.7e-2 s steps). Without it the paper
-    # circle's path moves by 0.7 mm and its step-size error halves.
-    ti.generalizedAlpha.computeInitialAccelerations = False
+    # By default start from zero accelerations. The consistent initial acceleration of a
+    # straight cable's free nodes is -g, but the Kelvin-Voigt damping (c_i / m_i ~ 4e6
+    # 1/s) cuts it off within microseconds; carried into the first step it injects a
+    # start-up energy jolt (13 J on the paper scene at 1.7e-2 s steps). Without it the
+    # paper circle's path moves by 0.7 mm and its step-size error halves; a drop from
+    # rest, though, then converges at first order (SolverSpec.initial_accelerations).
+    ti.generalizedAlpha.computeInitialAccelerations = bool(solver.initial_accelerations)
     ti.newton.useModifiedNewton = solver.newton == "modified"
     ti.newton.modifiedNewtonJacUpdatePerStep = True
     ti.newton.maxIterations = solver.max_newton_iterations
