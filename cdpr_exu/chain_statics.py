@@ -236,6 +236,11 @@ class _Layout:
         self.bending = (bending.BendingSpringDamper(self.n_nodes, joints, joint_stiffness, np.zeros_like(joint_stiffness))
                         if np.any(joint_stiffness > 0) else None)
         self.zero_velocities = np.zeros(2 * self.n_nodes)
+        # (2, 2N): sums the anchor nodes' coordinates; its transpose moves every anchor
+        # with the platform position
+        self.anchor_sum = np.zeros((2, 2 * self.n_nodes))
+        for j in self.anchor:
+            self.anchor_sum[:, 2 * j:2 * j + 2] = np.eye(2)
         self.joints, self.joint_stiffness = joints, joint_stiffness
         # per node: the pulley it may touch (stiffness 0: none)
         self.node_center = np.concatenate([np.tile(np.asarray(c.pulley_center, float), (n, 1))
@@ -415,16 +420,19 @@ class _Inner:
         p, rotation = _positions(self.robot, self.layout, self.position, self.rotation, v, self.paid_out)
         return _energy(self.robot, self.layout, p) - self.wrench[2] * rotation
 
-    def gradient(self, v):
-        """dPi/dv without the Hessian."""
-        layout = self.layout
-        p, _ = _positions(self.robot, layout, self.position, self.rotation, v, self.paid_out)
-        F, _, _, _ = _forces(self.robot, layout, p, with_stiffness=False)
-        S, _ = _selection(self.robot, layout, p, self.position)
+    def _gradient(self, S, F):
+        """dPi/dv from dX/dv (2N, n_inner) and the nodal forces (N, 2)."""
         gradient = -(S.T @ F.ravel())
-        if layout.free_rotation:
+        if self.layout.free_rotation:
             gradient[-1] -= self.wrench[2]
         return gradient
+
+    def gradient(self, v):
+        """dPi/dv without the Hessian."""
+        p, _ = _positions(self.robot, self.layout, self.position, self.rotation, v, self.paid_out)
+        F, _, _, _ = _forces(self.robot, self.layout, p, with_stiffness=False)
+        S, _ = _selection(self.robot, self.layout, p, self.position)
+        return self._gradient(S, F)
 
     def evaluate(self, v):
         """Energy, gradient, Hessian and the state they came from."""
@@ -432,10 +440,9 @@ class _Inner:
         p, rotation = _positions(self.robot, layout, self.position, self.rotation, v, self.paid_out)
         F, K, tension, energy = _forces(self.robot, layout, p)
         S, S_lambda = _selection(self.robot, layout, p, self.position)
-        gradient = -(S.T @ F.ravel())
+        gradient = self._gradient(S, F)
         hessian = S.T @ K @ S
         if layout.free_rotation:
-            gradient[-1] -= self.wrench[2]
             arms = p[layout.anchor] - self.position
             hessian[-1, -1] += float(np.sum(arms * F[layout.anchor]))  # the arms turn with the platform
         return {"energy": energy - self.wrench[2] * rotation, "gradient": gradient, "hessian": hessian,
@@ -490,9 +497,10 @@ def _minimise(inner: _Inner, v, tolerance, max_iterations):
                            f"{np.max(np.abs(state['gradient'])):.3g} N after {max_iterations} iterations)")
 
 
-def _platform_force(robot, layout, state, wrench):
-    """Net force on the held platform [N], shape (2,): anchors' pull, weight, external force."""
-    return state["F"][layout.anchor].sum(axis=0) + np.array([0.0, -robot.mass * robot.gravity]) + wrench[:2]
+def _platform_force(robot, layout, F, wrench):
+    """Net force on the held platform [N], shape (2,): anchors' pull (from the nodal forces
+    F, shape (N, 2)), weight, external force."""
+    return F[layout.anchor].sum(axis=0) + np.array([0.0, -robot.mass * robot.gravity]) + wrench[:2]
 
 
 def _platform_force_gradient(layout, state):
@@ -501,7 +509,7 @@ def _platform_force_gradient(layout, state):
     K, S, S_lambda = state["K"], state["S"], state["S_lambda"]
     dv = -np.linalg.solve(state["hessian"], S.T @ K @ S_lambda)  # nodes follow the winches
     dF = -K @ (S @ dv + S_lambda)  # (2N, m)
-    return sum(dF[2 * j:2 * j + 2] for j in layout.anchor), dv
+    return layout.anchor_sum @ dF, dv
 
 
 def chain_forces(robot: ChainRobot, nodes, position, rotation=0.0, external_wrench=None):
@@ -532,7 +540,7 @@ def chain_forces(robot: ChainRobot, nodes, position, rotation=0.0, external_wren
     position = vector("position", position, 2)
     F, _, _, _ = _forces(robot, layout, p, with_stiffness=False)
     arms = p[layout.anchor] - position
-    force = F[layout.anchor].sum(axis=0) + np.array([0.0, -robot.mass * robot.gravity]) + wrench[:2]
+    force = _platform_force(robot, layout, F, wrench)
     moment = _cross(arms, F[layout.anchor]).sum() + wrench[2]
     return F[layout.interior], np.array([*force, moment])
 
@@ -576,12 +584,7 @@ def _predict(robot, layout, guess, interior, rotation, paid_out, position, wrenc
         return interior, rotation, paid_out
     state = _Inner(robot, layout, np.asarray(guess.position), rotation, paid_out, wrench).evaluate(v)
     K, S, S_lambda = state["K"], state["S"], state["S_lambda"]
-    S_position = np.zeros((2 * layout.n_nodes, 2))
-    for j in layout.anchor:
-        S_position[2 * j:2 * j + 2] = np.eye(2)
-    anchor_sum = np.zeros((2, 2 * layout.n_nodes))
-    for j in layout.anchor:
-        anchor_sum[:, 2 * j:2 * j + 2] = np.eye(2)
+    anchor_sum, S_position = layout.anchor_sum, layout.anchor_sum.T  # the anchors move with the position
     n, m = layout.n_inner, len(robot.cables)
     # d(gradient) = H dv + S^T K S_lambda dlambda + S^T K S_p dp = 0
     # d(platform force) = -A K (S dv + S_lambda dlambda + S_p dp) = 0
@@ -682,7 +685,7 @@ def solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rotat
         inner = _Inner(robot, layout, position, rotation, paid_out, wrench)
         v, state, count = _minimise(inner, v, inner_tolerance, max_iterations)
         inner_iterations += count
-        force = _platform_force(robot, layout, state, wrench)
+        force = _platform_force(robot, layout, state["F"], wrench)
         if np.max(np.abs(force)) < tolerance and inner_tolerance <= tolerance:
             break
         # inexact Newton: the nodes need not balance better than the platform does
