@@ -48,7 +48,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .errors import SceneError
+from .errors import EXIT_CODES, SceneError
 from .study import SINGLE_THREAD_ENVIRONMENT, apply_parameters, study_subparsers
 
 # --------------------------------------------------------------------------- configurations
@@ -571,6 +571,7 @@ def _cell(value: Any) -> str:
 
 def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> dict[str, Path]:
     """Write the CSV, JSON, tables, Pareto plot and the reference's series into ``out``."""
+    from .output import write_json
     from .result import provenance
     from .scene import save_scene
 
@@ -602,7 +603,7 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
                  for row in study.rows],
         **provenance(),
     }
-    (out / ACCURACY_FILES["json"]).write_text(json.dumps(info, indent=2) + "\n")
+    write_json(out / ACCURACY_FILES["json"], info)
     paths["json"] = out / ACCURACY_FILES["json"]
     reference = study.series[reference_row["run"]]
     np.savez_compressed(out / ACCURACY_FILES["reference"], **reference)
@@ -827,7 +828,9 @@ def _cmd_accuracy(args: argparse.Namespace) -> int:
     grid = QUICK_GRID if args.quick else FULL_GRID
     if args.end_time is not None:
         grid = replace(grid, end_time=args.end_time)
-    out = Path(args.out)
+    from .output import check_output_folder
+
+    out = check_output_folder(args.out)
     start = time.perf_counter()
     study = run_accuracy_study(args.scene, grid, out=out, workers=args.workers, progress=not args.quiet,
                                comparison=args.compare)
@@ -844,7 +847,7 @@ def add_commands(subparsers: argparse._SubParsersAction) -> None:
         description="Run a scene on every model of the ladder over elements per cable and step sizes, "
         "compare each run with a reference (the full model, finest discretisation), and write the "
         "Pareto front of error against run time (CPU time) and the cheapest configuration per tolerance.",
-        epilog=EPILOG_ACCURACY, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=EPILOG_ACCURACY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     accuracy.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
     accuracy.add_argument("--out", required=True, help="output folder (created)")
     accuracy.add_argument("--quick", action="store_true", help="a small grid over 1.5 s (a minute or less)")

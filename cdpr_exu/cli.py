@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import json
+import re
 import sys
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from .errors import CdprError, SolverFailure
+from .errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
+                     RunInterrupted, SolverFailure)
+from .output import check_output_folder, fixed, write_summary
 from .scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
@@ -30,7 +33,8 @@ SETTLED_AFTER = 1.0
 EPILOG_RUN = """examples:
   cdpr run paper-circle --out results/paper_circle
   cdpr run scene.toml --out out/run1 --end-time 2 --step-size 1e-3 --quiet
-"""
+
+""" + EXIT_CODES
 
 
 def _scene_with_overrides(args: argparse.Namespace) -> Scene:
@@ -45,26 +49,44 @@ def _scene_with_overrides(args: argparse.Namespace) -> Scene:
     return scene
 
 
+def _figure(value, scale: float = 1.0, unit: str = "", digits: int = 2, sign: bool = False) -> str:
+    """A printed figure, or "n/a" when it does not exist (None); never "nan" or "-0.00"."""
+    if value is None:
+        return "n/a"
+    text = fixed(scale * value, digits)
+    if sign and not text.startswith("-"):
+        text = "+" + text
+    return f"{text} {unit}".rstrip()
+
+
 def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
+    def pair(key, scale, unit, digits=2):
+        return _figure(summary[key], scale, unit, digits), _figure(settled[key], scale, unit, digits)
+
+    def z_range(s):
+        if s["min_error_z_m"] is None:
+            return "n/a"
+        return f"{_figure(s['min_error_z_m'], 100, '', sign=True)} .. {_figure(s['max_error_z_m'], 100, '', sign=True)} cm"
+
+    factor = summary["real_time_factor"]
     rows = [
         ("status", summary["status"], ""),
-        ("max |error x|", f"{100 * summary['max_abs_error_x_m']:.2f} cm",
-         f"{100 * settled['max_abs_error_x_m']:.2f} cm"),
-        ("max |error z|", f"{100 * summary['max_abs_error_z_m']:.2f} cm",
-         f"{100 * settled['max_abs_error_z_m']:.2f} cm"),
-        ("error z range", f"{100 * summary['min_error_z_m']:+.2f} .. {100 * summary['max_error_z_m']:+.2f} cm",
-         f"{100 * settled['min_error_z_m']:+.2f} .. {100 * settled['max_error_z_m']:+.2f} cm"),
-        ("max |rotation|", f"{summary['max_abs_rotation_deg']:.2f} deg", f"{settled['max_abs_rotation_deg']:.2f} deg"),
-        ("min element tension", f"{summary['min_element_tension_N']:.2f} N", f"{settled['min_element_tension_N']:.2f} N"),
-        ("max pulley penetration", f"{1000 * summary['max_pulley_penetration_m']:.3f} mm", ""),
+        ("max |error x|", *pair("max_abs_error_x_m", 100, "cm")),
+        ("max |error z|", *pair("max_abs_error_z_m", 100, "cm")),
+        ("error z range", z_range(summary), z_range(settled)),
+        ("max |rotation|", *pair("max_abs_rotation_deg", 1, "deg")),
+        ("min element tension", *pair("min_element_tension_N", 1, "N")),
+        ("max pulley penetration", _figure(summary["max_pulley_penetration_m"], 1000, "mm", 3), ""),
         ("simulated / wall time", f"{summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s",
-         f"{summary['real_time_factor']:.1f}x real time"),
+         "n/a" if factor is None else f"{factor:.1f}x real time"),
         ("steps / Newton iterations", f"{summary['steps']} / {summary['newton_iterations']}", ""),
     ]
     print(f"{summary['scene']} under {summary['controller']} (error = actual - reference)")
     print(f"  {'':26s} {'whole run':>22s}   {'after ' + str(SETTLED_AFTER) + ' s':>18s}")
     for name, whole, after in rows:
         print(f"  {name:26s} {whole:>22s}   {after:>18s}")
+    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
+        print(f"  n/a: {note}")
     if out is not None:
         print(f"  written to {out}/")
 
@@ -75,31 +97,36 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
 
     Writes ``scene.toml``, ``result.npz``, ``pose.csv``, ``summary.json``,
     ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures.
-    A failed run still writes what was computed up to the failure, then re-raises.
+    A failed or interrupted (Ctrl-C) run still writes what was computed up to then,
+    then re-raises. ``out`` is checked before the run starts.
     """
+    from .result import provenance
     from .simulate import simulate
 
     solution_file = None
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
+        out = check_output_folder(out)
         save_scene(scene, out / "scene.toml")
         solution_file = out / "solution.sol"
     failure = None
     try:
         result = simulate(scene, controller, solution_file=solution_file, progress=not quiet)
-    except SolverFailure as err:
+    except (SolverFailure, RunInterrupted) as err:
         failure, result = err, err.partial_result
     summary = result.summary()
     settled = result.summary(after=SETTLED_AFTER)
     if out is not None:
         result.save(out)
-        data = json.loads((out / "summary.json").read_text())
+        data = {**summary, **provenance()}
+        data.update({k: v for k, v in result.metadata.items() if k not in data})
         data["after_start_up"] = {k: settled[k] for k in (
             "errors_measured_after_s", "max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m",
             "max_error_z_m", "max_position_error_m", "rms_position_error_m", "max_abs_rotation_deg",
-            "min_element_tension_N")}
+            "min_element_tension_N", "notes")}
         data["error_convention"] = "actual - reference"
-        (out / "summary.json").write_text(json.dumps(data, indent=2, default=str) + "\n")
+        write_summary(out, data)
+        if solution_file is not None and solution_file.is_file():
+            undate_solution_file(solution_file)
         if figures and len(result.time) > 1:
             from .plots import plot_overview
 
@@ -111,11 +138,26 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     return summary
 
 
+def undate_solution_file(path: Path) -> None:
+    """Blank the date in the header of Exudyn's solution file, so it is stable from run to run.
+
+    The binary header and footer hold the start and end times as ``YYYY-MM-DD,HH:MM:SS``;
+    they are overwritten in place with zeros of the same length (the file stays readable
+    by SolutionViewer).
+    """
+    data = bytearray(path.read_bytes())
+    pattern = re.compile(rb"\d{4}-\d{2}-\d{2},\d{2}:\d{2}:\d{2}")
+    for offset in (0, max(0, len(data) - 256)):
+        for match in pattern.finditer(bytes(data[offset:offset + 1024])):
+            data[offset + match.start():offset + match.end()] = b"0000-00-00,00:00:00"
+    path.write_bytes(bytes(data))
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
+    out = check_output_folder(args.out)
     scene = _scene_with_overrides(args)
-    out = Path(args.out) if args.out else None
     run_scene(scene, out, quiet=args.quiet, figures=not args.no_figures)
-    return 0
+    return EXIT_OK
 
 
 def _cmd_scenes(args: argparse.Namespace) -> int:  # noqa: ARG001
@@ -130,7 +172,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="cdpr", description="Simulate cable-driven parallel robots with massive, elastic, bending cables "
         "over pulleys (Exudyn, implicit solver). Units: SI.",
-        epilog="examples:\n  cdpr run paper-circle --out results/paper_circle\n  cdpr scenes\n",
+        epilog="examples:\n  cdpr run paper-circle --out results/paper_circle\n  cdpr scenes\n\n" + EXIT_CODES,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -156,18 +198,35 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None):  # noqa: ARG001
+    """Print the project's warnings as one line each, without source locations."""
+    print(f"cdpr: warning: {message}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``cdpr`` console script."""
+    """Entry point of the ``cdpr`` console script; returns the exit code (see ``cdpr --help``)."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    shown = warnings.showwarning
+    warnings.showwarning = _show_warning
     try:
-        return args.func(args)
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", CdprWarning)
+            return args.func(args)
+    except RunInterrupted as err:
+        print(f"cdpr: {err}; the partial result is written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except KeyboardInterrupt:
+        print("cdpr: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except SolverFailure as err:
         print(f"cdpr: solver failure: {err}", file=sys.stderr)
-        return 3
+        return EXIT_RUN_FAILED
     except CdprError as err:
         print(f"cdpr: error: {err}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
+    finally:
+        warnings.showwarning = shown
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -10,7 +10,7 @@ measured after the start-up (``--after``, default 1 s).
 from __future__ import annotations
 
 import argparse
-import json
+import sys
 from pathlib import Path
 from typing import Callable
 
@@ -19,7 +19,8 @@ import numpy as np
 from controllers.ideal_ik import IdealIKController
 from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
 
-from .errors import CdprError, SolverFailure
+from .errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SolverFailure
+from .output import fixed
 from .result import Result, provenance
 from .scene import Scene, load_scene
 
@@ -67,6 +68,12 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
             result = simulate(scene, controller, progress=progress)
         except SolverFailure as err:
             result = err.partial_result
+        except RunInterrupted as err:  # Ctrl-C: keep the controllers done so far, and this one's part
+            results[name] = err.partial_result
+            summaries[name] = {**err.partial_result.summary(after=after), "controller": name}
+            if out is not None:
+                _write(scene, summaries, results, Path(out), after)
+            raise
         except CdprError as err:  # a refused reference is a result of the comparison too
             summaries[name] = {"controller": name, "status": f"refused: {err}"}
             continue
@@ -75,12 +82,14 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
         summary["controller"] = name
         summaries[name] = summary
         if not quiet:
-            print(f"  {name:32s} max {1000 * summary['max_position_error_m']:8.2f} mm   "
-                  f"RMS {1000 * summary['rms_position_error_m']:7.2f} mm   {summary['status']}")
-    if "ideal_ik" in summaries and "max_position_error_m" in summaries["ideal_ik"]:
-        base = summaries["ideal_ik"]["max_position_error_m"]
+            def mm(value):
+                return "     n/a" if value is None else f"{1000 * value:8.2f}"
+            print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
+                  f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
+    if base is not None:
         for summary in summaries.values():
-            if "max_position_error_m" in summary and summary["max_position_error_m"] > 0:
+            if (summary.get("max_position_error_m") or 0.0) > 0:
                 summary["error_reduction_vs_ideal_ik"] = base / summary["max_position_error_m"]
     if out is not None:
         _write(scene, summaries, results, Path(out), after)
@@ -95,7 +104,7 @@ def markdown_table(summaries: dict[str, dict]) -> str:
         cells = []
         for key, _, scale in _COLUMNS:
             value = summary.get(key)
-            cells.append("" if value is None else f"{scale * value:.2f}")
+            cells.append("" if value is None else fixed(scale * value, 2))
         ratio = summary.get("error_reduction_vs_ideal_ik")
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {'' if ratio is None else f'{ratio:.1f}x'} | "
                      f"{summary.get('status', '')} |")
@@ -103,6 +112,7 @@ def markdown_table(summaries: dict[str, dict]) -> str:
 
 
 def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
+    from .output import write_summary
     from .plots import plot_comparison
     from .scene import save_scene
 
@@ -110,7 +120,7 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
     save_scene(scene, out / "scene.toml")
     document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
                 "controllers": summaries, **provenance()}
-    (out / "summary.json").write_text(json.dumps(document, indent=2, default=str) + "\n")
+    write_summary(out, document)
     (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
                                        + markdown_table(summaries))
     for name, result in results.items():
@@ -124,6 +134,9 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
 def _cmd_compare(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
+    from .output import check_output_folder
+
+    check_output_folder(args.out)
     scene = load_scene(args.scene)
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
@@ -136,7 +149,12 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         print(markdown_table(summaries))
         if args.out:
             print(f"written to {args.out}/")
-    return 0
+    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    if failed:
+        print(f"cdpr compare: {len(failed)} of {len(summaries)} controllers did not complete: {', '.join(failed)}",
+              file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return EXIT_OK
 
 
 def add_commands(subparsers) -> None:
@@ -146,7 +164,7 @@ def add_commands(subparsers) -> None:
         description="Run a scene under each controller (ideal inverse kinematics, tension-aware variants, "
         "closed loop) and write a table and figures of their errors.",
         epilog="examples:\n  cdpr compare paper-circle --out results/controllers\n"
-               "  cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal\n",
+               "  cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal\n\n" + EXIT_CODES,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scene", help="shipped scene name or path to a .toml file")
     parser.add_argument("--out", help="output folder (summary.json, comparison.md, figures)")

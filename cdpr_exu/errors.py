@@ -1,4 +1,17 @@
-"""The project's own exception types."""
+"""The project's own exception and warning types, and the exit code of the ``cdpr`` command for each."""
+
+#: Exit codes of every ``cdpr`` command (the same convention everywhere).
+EXIT_OK, EXIT_INTERNAL, EXIT_BAD_INPUT, EXIT_RUN_FAILED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+
+EXIT_CODES = """exit codes (every command):
+  0    done
+  1    internal error (a bug: please report it with the traceback); `cdpr view`: no display
+  2    bad input: a scene field, an option, an unreachable pose or an unusable --out;
+       refused before any simulation starts
+  3    a run failed (for compare and sweep: at least one run failed); what was computed
+       up to the failure is written
+  130  interrupted (Ctrl-C); what was computed up to then is written
+"""
 
 
 class CdprError(Exception):
@@ -20,3 +33,24 @@ class SolverFailure(CdprError, RuntimeError):
         super().__init__(message)
         self.time = time
         self.partial_result = partial_result
+
+
+class OutputError(CdprError, OSError):
+    """An output path cannot be used (it names a file, or cannot be created); checked before any work."""
+
+
+class RunInterrupted(CdprError, KeyboardInterrupt):
+    """The user interrupted a run (Ctrl-C); carries the time reached and the partial result."""
+
+    def __init__(self, message, time=None, partial_result=None):
+        super().__init__(message)
+        self.time = time
+        self.partial_result = partial_result
+
+
+class CdprWarning(UserWarning):
+    """Base class of the project's warnings: a run goes on, but something is worth knowing."""
+
+
+class CoarseOutputWarning(CdprWarning):
+    """The output is sampled more coarsely than asked (its error figures come from fewer samples)."""

@@ -175,7 +175,7 @@ def check_trajectory_reachable(scene: Scene) -> None:
             k = too_long[0]
             raise UnreachableError(
                 f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s "
-                f"needs {lengths[k]:.4f} m of cable {i} between pulley and anchor, but "
+                f"needs {lengths[k]:.4f} m of cable {i + 1} between pulley and anchor, but "
                 f"cables[{i}].unstrained_length is {cable.unstrained_length} m (one element, "
                 f"{cable.element_length:.4f} m, must stay on the winch side)"
             )

@@ -14,6 +14,7 @@ counter-clockwise; errors are actual - reference.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
@@ -74,7 +75,9 @@ def _save(figure: Figure, path: str | Path) -> Path:
     """Write ``figure`` as PNG to ``path`` (parent folders made) and return the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=DPI, format="png")
+    # "tight" grows the image to hold every artist (a legend below the axes, a long
+    # title), so that nothing is cut at the edges; the margin is plain background.
+    figure.savefig(path, dpi=DPI, format="png", bbox_inches="tight", pad_inches=0.1)
     return path
 
 
@@ -463,7 +466,8 @@ def plot_snapshots(scene: Scene, result: Result, path: str | Path,
                   bbox_to_anchor=(0.5, 0.0))
     title = f"{scene.name}: robot at several instants ({result.controller})"
     note = _status_note(result)
-    figure.suptitle(title + (f" — {note}" if note else ""), fontsize=11, y=1.0 - 0.12 / figure.get_figheight(),
+    figure.suptitle(textwrap.fill(title + (f" — {note}" if note else ""), width=110), fontsize=11,
+                    y=1.0 - 0.12 / figure.get_figheight(),
                     va="top")
     return _save(figure, path)
 
@@ -592,7 +596,8 @@ def plot_overview(scene: Scene, result: Result, folder: str | Path,
     rows = _valid_rows(result)
     _fading_snapshot_axes(axes[1, 0], scene, result, times, _robot_limits(scene, result, rows))
     note = _status_note(result)
-    figure.suptitle(f"{scene.name} ({result.controller})" + (f" — {note}" if note else ""), fontsize=12,
+    title = f"{scene.name} ({result.controller})" + (f" — {note}" if note else "")
+    figure.suptitle(textwrap.fill(title, width=int(11.0 * 72 / 12 * 1.6)), fontsize=12,
                     y=1.0 - 0.12 / figure.get_figheight(), va="top")
     paths.append(_save(figure, folder / OVERVIEW_FILES["overview"]))
     return paths

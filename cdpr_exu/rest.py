@@ -60,7 +60,7 @@ equilibria of pushing elements instead). ``RestState.method`` says which path wa
 from __future__ import annotations
 
 import argparse
-import json
+import sys
 import math
 import time as _time
 from dataclasses import dataclass, field, replace
@@ -72,9 +72,10 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from .cable import element_tensions
-from .errors import SceneError, SolverFailure
+from .errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure
 from .model import Model, build_model
 from .pulley import penetration
+from .output import write_summary
 from .result import provenance
 from .scene import Scene, load_scene
 
@@ -228,7 +229,7 @@ class RestState:
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         summary = {**self.summary(), **provenance()}
-        (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        write_summary(folder, summary)
         arrays = {
             "platform_position_m": self.platform_position_m,
             "platform_rotation_deg": np.array(self.platform_rotation_deg),
@@ -361,7 +362,7 @@ def _speed_indices(model: Model) -> np.ndarray:
 def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time: float,
                           chunk_time: float) -> tuple[float, float]:
     """Integrate from the model's initial state until at rest; returns (time, speed) [s, m/s]."""
-    from .simulate import solver_settings  # late: simulate imports the controllers
+    from .simulate import _solver_report, likely_cause, quiet_exudyn, solver_settings  # late: imports controllers
 
     mbs = model.mbs
     data = mbs.systemData
@@ -385,10 +386,14 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
             settings.timeIntegration.numberOfSteps = max(1, int(round((end - t) / step)))
             window.update({"from": end - min(SPEED_WINDOW, end - t), "speed": 0.0})
             try:
-                mbs.SolveDynamic(settings)
+                with quiet_exudyn():
+                    mbs.SolveDynamic(settings)
             except (exu.SolverError, RuntimeError, SystemError) as err:
-                raise SolverFailure(f"the run of scene {scene.name!r} to rest failed between t = {t:.3f} s and "
-                                    f"{end:.3f} s: {' '.join(str(err).split())}", time=t) from None
+                cause = _solver_report(mbs, " ".join(str(err).split()))
+                reached = float(mbs.sys["dynamicSolver"].it.currentTime) if "dynamicSolver" in mbs.sys else t
+                raise SolverFailure(f"the run of scene {scene.name!r} to rest failed at t = {reached:.4f} s "
+                                    f"(between {t:.3f} s and {end:.3f} s): {cause}. {likely_cause(scene, cause)}",
+                                    time=reached, partial_result=_last_state(model)) from None
             t = end
             speed = window["speed"]
             if not math.isfinite(speed) or not np.all(np.isfinite(data.GetODE2Coordinates())):
@@ -399,11 +404,25 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
                 raise SolverFailure(
                     f"scene {scene.name!r} is not at rest after {t:.3g} s of simulated time: the largest node "
                     f"speed over the last {SPEED_WINDOW} s is {speed:.3g} m/s, above the tolerance {tolerance:g} m/s. "
-                    "Raise max_time, or check the damping (effects.axial_damping, effects.bending_damping)", time=t)
+                    "Raise max_time, or check the damping (effects.axial_damping, effects.bending_damping)", time=t,
+                    partial_result=_last_state(model))
             data.SetSystemState(data.GetSystemState(), configuration=exu.ConfigurationType.Initial)
             end = min(t + chunk_time, max_time)
     finally:
         mbs.SetPostStepUserFunction(0)
+
+
+def _last_state(model: Model) -> dict[str, Any]:
+    """The platform pose and node positions where a failed run to rest stopped (finite values only)."""
+    data = model.mbs.systemData
+    indices = model.coordinate_indices()
+    reference = np.asarray(data.GetODE2Coordinates(exu.ConfigurationType.Reference))
+    q = np.asarray(data.GetODE2Coordinates())
+    pose = reference[indices["platform"]] + q[indices["platform"]]
+    state = {"platform_pose": pose.tolist() if np.all(np.isfinite(pose)) else None}
+    nodes = [reference[indices[f"cable_{i}"]] + q[indices[f"cable_{i}"]] for i in range(len(model.cables))]
+    state["nodes_m"] = [n.tolist() if np.all(np.isfinite(n)) else None for n in nodes]
+    return state
 
 
 def _static_settings() -> exu.SimulationSettings:
@@ -644,7 +663,7 @@ def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None
     for i, nodes in enumerate(rest.nodes):
         color = colors[i % len(colors)]
         ax.plot(nodes[:, 0], nodes[:, 1], "-o", color=color, markersize=3, linewidth=1.0, zorder=3,
-                label=f"cable {i}: free span {rest.cable_stretched_length_m[i]:.4f} m, "
+                label=f"cable {i + 1}: free span {rest.cable_stretched_length_m[i]:.4f} m, "
                       f"upper force |F| = {np.hypot(*rest.upper_forces_N[i]):.2f} N")
         ax.plot(*rest.upper_points_m[i], marker="x", color=color, markersize=8, zorder=4)
     x, z = rest.platform_position_m
@@ -670,10 +689,28 @@ EPILOG = """examples:
 """
 
 
+def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
+    """Write what a failed ``cdpr static`` knows: the scene, the cause and the last state."""
+    from .scene import save_scene
+
+    save_scene(scene, out / "scene.toml")
+    partial = err.partial_result if isinstance(err.partial_result, dict) else {}
+    write_summary(out, {"scene": scene.name, "status": f"failed: {err}", "failure_time_s": err.time,
+                        "last_state": partial, **provenance()})
+
+
 def _cmd_static(args: argparse.Namespace) -> int:
+    from .output import check_output_folder, fixed
+
+    out = check_output_folder(args.out)
     scene = load_scene(args.scene)
-    rest = solve_rest(scene, tolerance=args.tolerance, max_time=args.max_time, polish=not args.no_polish)
-    out = Path(args.out) if args.out else None
+    try:
+        rest = solve_rest(scene, tolerance=args.tolerance, max_time=args.max_time, polish=not args.no_polish)
+    except SolverFailure as err:
+        if out is not None:
+            _write_static_failure(scene, err, out)
+            print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
+        raise
     if out is not None:
         rest.save(out)
         plot_rest(scene, rest, out / "rest_profile.png")
@@ -681,9 +718,9 @@ def _cmd_static(args: argparse.Namespace) -> int:
         x, z = rest.platform_position_m
         print(f"{scene.name} at rest after {rest.time_s:.2f} s simulated ({rest.method}), "
               f"largest node speed {rest.max_node_speed_m_s:.2g} m/s")
-        print(f"  platform at x = {x:.6f} m, z = {z:.6f} m, rotation {rest.platform_rotation_deg:.4f} deg")
+        print(f"  platform at x = {fixed(x, 6)} m, z = {fixed(z, 6)} m, rotation {fixed(rest.platform_rotation_deg, 4)} deg")
         for i in range(len(rest.nodes)):
-            print(f"  cable {i}: free span {rest.cable_stretched_length_m[i]:.6f} m "
+            print(f"  cable {i + 1}: free span {rest.cable_stretched_length_m[i]:.6f} m "
                   f"(unstrained {rest.cable_unstrained_length_m[i]:.6f} m), force on platform "
                   f"{np.round(rest.platform_forces_N[i], 4).tolist()} N, on upper support "
                   f"{np.round(rest.upper_forces_N[i], 4).tolist()} N")
@@ -691,7 +728,7 @@ def _cmd_static(args: argparse.Namespace) -> int:
             print(f"  note: {note}")
         if out is not None:
             print(f"  written to {out}/")
-    return 0
+    return EXIT_OK
 
 
 def add_commands(subparsers) -> None:
@@ -700,7 +737,7 @@ def add_commands(subparsers) -> None:
         "static", help="bring a scene to rest and write its static state",
         description="Bring a scene to rest (dynamics with its own damping, then Exudyn's static solver) with the "
         "winches held, and write summary.json (platform pose, free-span lengths, end forces, nodes), rest.npz and "
-        "rest_profile.png.", epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+        "rest_profile.png.", epilog=EPILOG + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
     parser.add_argument("--out", help="output folder (created); nothing is written without it")
     parser.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCE,

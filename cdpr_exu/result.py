@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from .output import json_text, write_npz, write_summary
+
 
 @dataclass
 class Result:
@@ -80,36 +82,50 @@ class Result:
         return float(self.time[-1]) if len(self.time) else 0.0
 
     def summary(self, after: float = 0.0) -> dict[str, Any]:
-        """Scalar figures of the run (errors measured from time ``after`` on) [SI, degrees]."""
+        """Scalar figures of the run (errors measured from time ``after`` on) [SI, degrees].
+
+        A figure that does not exist (no sample at or after ``after``: a run shorter than
+        the error window, or one that failed before it) is None, and ``notes`` says why.
+        """
         mask = self.time >= after
         err = self.error[mask]
         position_error = np.linalg.norm(err[:, :2], axis=1) if len(err) else np.zeros(0)
-        taut = [t[mask] for t in self.tensions]
+        taut = np.concatenate([t[mask].ravel() for t in self.tensions]) if self.tensions else np.zeros(0)
+
         def _max(a):
-            return float(np.max(a)) if np.size(a) else float("nan")
+            a = np.asarray(a, dtype=float)
+            return float(np.nanmax(a)) if a.size and np.isfinite(a).any() else None
+
         def _min(a):
-            return float(np.min(a)) if np.size(a) else float("nan")
+            a = np.asarray(a, dtype=float)
+            return float(np.nanmin(a)) if a.size and np.isfinite(a).any() else None
+
+        notes = []
+        if not len(err):
+            notes.append(f"no sample at or after t = {after:g} s (the run reached {self.simulated_time:g} s): "
+                         "its error, rotation and tension figures do not exist and are null")
         return {
             "scene": self.scene_name,
             "controller": self.controller,
             "status": self.status,
             "errors_measured_after_s": after,
-            "max_abs_error_x_m": _max(np.abs(err[:, 0])) if len(err) else float("nan"),
-            "max_abs_error_z_m": _max(np.abs(err[:, 1])) if len(err) else float("nan"),
-            "min_error_z_m": _min(err[:, 1]) if len(err) else float("nan"),
-            "max_error_z_m": _max(err[:, 1]) if len(err) else float("nan"),
+            "max_abs_error_x_m": _max(np.abs(err[:, 0])),
+            "max_abs_error_z_m": _max(np.abs(err[:, 1])),
+            "min_error_z_m": _min(err[:, 1]),
+            "max_error_z_m": _max(err[:, 1]),
             "max_position_error_m": _max(position_error),
-            "rms_position_error_m": float(np.sqrt(np.mean(position_error**2))) if len(err) else float("nan"),
+            "rms_position_error_m": float(np.sqrt(np.mean(position_error**2))) if len(err) else None,
             "max_abs_rotation_deg": _max(np.degrees(np.abs(self.platform_pose[mask, 2]))),
-            "min_element_tension_N": _min(np.concatenate([t.ravel() for t in taut])) if taut else float("nan"),
-            "max_element_tension_N": _max(np.concatenate([t.ravel() for t in taut])) if taut else float("nan"),
+            "min_element_tension_N": _min(taut),
+            "max_element_tension_N": _max(taut),
             "max_pulley_penetration_m": _max(self.pulley_penetration),
             "wall_time_s": self.wall_time,
             "simulated_time_s": self.simulated_time,
-            "real_time_factor": self.simulated_time / self.wall_time if self.wall_time > 0 else float("nan"),
+            "real_time_factor": self.simulated_time / self.wall_time if self.wall_time > 0 else None,
             "steps": int(self.steps),
             "newton_iterations": int(self.newton_iterations),
             "failure_time_s": self.failure_time,
+            "notes": notes,
         }
 
     # ----------------------------------------------------------------- files
@@ -134,13 +150,15 @@ class Result:
             "steps": self.steps, "newton_iterations": self.newton_iterations, "status": self.status,
             "failure_time": self.failure_time, "metadata": self.metadata,
         }
-        np.savez_compressed(folder / "result.npz", info=json.dumps(info, default=str), **arrays)
+        # The wall time lives in timing.json, so that result.npz is the same from run to run.
+        info.pop("wall_time")
+        write_npz(folder / "result.npz", info=np.array(json_text(info)), **arrays)
         header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
         table = np.column_stack([self.time, self.platform_pose, self.reference_pose])
         np.savetxt(folder / "pose.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
         summary = {**self.summary(after=summary_after), **provenance()}
         summary.update({k: v for k, v in self.metadata.items() if k not in summary})
-        (folder / "summary.json").write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
+        write_summary(folder, summary)
         return {"npz": folder / "result.npz", "csv": folder / "pose.csv", "summary": folder / "summary.json"}
 
     @classmethod
@@ -151,6 +169,9 @@ class Result:
             path = path / "result.npz"
         with np.load(path, allow_pickle=False) as data:
             info = json.loads(str(data["info"]))
+            timing = path.parent / "timing.json"
+            if "wall_time" not in info and timing.is_file():
+                info["wall_time"] = json.loads(timing.read_text()).get("wall_time_s") or 0.0
             m = sum(1 for k in data.files if k.startswith("nodes_"))
             return cls(
                 scene_name=info["scene_name"], controller=info["controller"], time=data["time"],
@@ -160,18 +181,10 @@ class Result:
                 node_velocities=[data[f"node_velocities_{i}"] for i in range(m)],
                 tensions=[data[f"tensions_{i}"] for i in range(m)],
                 paid_out=data["paid_out"], pulley_penetration=data["pulley_penetration"],
-                wall_time=info["wall_time"], steps=info["steps"],
+                wall_time=info.get("wall_time", 0.0), steps=info["steps"],
                 newton_iterations=info["newton_iterations"], status=info["status"],
                 failure_time=info["failure_time"], metadata=info.get("metadata", {}),
             )
-
-
-def _json_default(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, (np.floating, np.integer)):
-        return value.item()
-    return str(value)
 
 
 def provenance() -> dict[str, Any]:

@@ -732,6 +732,9 @@ def load_scene(source: str | Path) -> Scene:
     """Load a scene by shipped name (e.g. ``"paper-circle"``) or from a TOML file path."""
     path = Path(source)
     if path.suffix == ".toml" or path.exists():
+        if path.is_dir():
+            raise SceneError(f"scene {str(path)!r} is a directory; give a .toml scene file or a shipped "
+                             "scene name (see `cdpr scenes`)")
         if not path.is_file():
             raise SceneError(f"scene file {str(path)!r} does not exist")
         text = path.read_text()

@@ -9,8 +9,13 @@ carries the result up to that time.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
+import sys
+import threading
 import time as _time
+import types
 from pathlib import Path
 from typing import Callable
 
@@ -21,12 +26,55 @@ from controllers.base import Controller, Measurement
 from controllers.ideal_ik import IdealIKController
 
 from .cable import element_tensions
-from .errors import SolverFailure
+from .errors import RunInterrupted, SolverFailure
 from .model import Model, build_model
 from .pulley import penetration, segment_penetration
 from .result import Result
 from .scene import Scene
 from .winch import servo_force, set_paid_out_length
+
+
+@contextlib.contextmanager
+def quiet_exudyn():
+    """Keep Exudyn's own console messages (failure banners, allocation warnings) to itself.
+
+    The project reports failures in its own words; Exudyn's banner ("DYNAMIC SOLVER
+    FAILED ... use showHints=True") and its memory-allocation warning would only
+    confuse. Both go through ``exudyn.Print``, which ``exu.config.printToConsole``
+    switches off; the setting is restored afterwards.
+    """
+    before = exu.config.printToConsole
+    exu.config.printToConsole = False
+    try:
+        yield
+    finally:
+        exu.config.printToConsole = before
+
+
+@contextlib.contextmanager
+def interrupt_flag():
+    """While active, Ctrl-C (SIGINT) sets ``flag["interrupted"]`` instead of raising.
+
+    The solver's post-step function checks the flag and ends the time integration
+    cleanly, so the samples computed so far are kept. Outside the main thread (where
+    signal handlers cannot be installed) Ctrl-C behaves as usual.
+    """
+    flag = {"interrupted": False}
+    if threading.current_thread() is not threading.main_thread():
+        yield flag
+        return
+    previous = signal.getsignal(signal.SIGINT)
+
+    def handler(signum, frame):  # noqa: ARG001
+        if flag["interrupted"]:  # a second Ctrl-C: the user insists
+            raise KeyboardInterrupt
+        flag["interrupted"] = True
+
+    signal.signal(signal.SIGINT, handler)
+    try:
+        yield flag
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
@@ -118,7 +166,7 @@ class _Monitor:
                 strain = np.maximum(strain, 0.0)  # a tension-only element may go slack: shortening is no fault
             worst = int(np.argmax(np.abs(strain)))
             if abs(strain[worst]) > MAX_STRAIN:
-                return (f"element {worst} of cable {i} is strained by {100 * strain[worst]:+.4g} % at t = {t:.4f} s "
+                return (f"element {worst} of cable {i + 1} is strained by {100 * strain[worst]:+.4g} % at t = {t:.4f} s "
                         f"(limit {100 * MAX_STRAIN:.0f} %): the run has left the model's valid range")
             if self.check_pulleys:
                 pulley = self.scene.pulleys[i]
@@ -129,7 +177,7 @@ class _Monitor:
                               f"pulleys[{i}].contact_stiffness" if self.on_segments else
                               "contact acts on nodes only; use more elements, or "
                               "effects.pulley_contact_model = 'segment'")
-                    return (f"element {element} of cable {i} cuts {1000 * depth[element]:.0f} mm deep into pulley {i} "
+                    return (f"element {element} of cable {i + 1} cuts {1000 * depth[element]:.0f} mm deep into pulley {i + 1} "
                             f"at t = {t:.4f} s: the cable is slipping through the pulley ({advice})")
         pose = self.reference_pose + q[self.platform_index]
         if np.any(pose[:2] < self.box[0]) or np.any(pose[:2] > self.box[1]):
@@ -338,6 +386,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         return True
 
     def post_step(mbs_, t):
+        if interrupted["interrupted"]:
+            return False  # Ctrl-C: end the integration, keep what was computed
         if recorder.record_if_due(t, state["paid_out"]):
             stop["reason"] = monitor.problem(t, recorder.q[recorder.count - 1])
             if stop["reason"] is not None:
@@ -351,10 +401,22 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     recorder.record_if_due(0.0, state["paid_out"])
     settings = solver_settings(scene, solution_file)
     failure = None
-    try:
-        mbs.SolveDynamic(settings)
-    except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
-        failure = _solver_report(mbs, " ".join(str(err).split()))
+    with interrupt_flag() as interrupted, quiet_exudyn():
+        try:
+            mbs.SolveDynamic(settings)
+        except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
+            failure = _solver_report(mbs, " ".join(str(err).split()))
+    if interrupted["interrupted"]:
+        wall = _time.perf_counter() - start
+        if report is not None:
+            report(None, wall)
+        result = recorder.result(scene, controller.name)
+        result.wall_time = wall
+        reached = float(result.time[-1]) if len(result.time) else 0.0
+        result.status = f"interrupted at t = {reached:.4f} s"
+        result.failure_time = reached
+        raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
+                             time=reached, partial_result=result)
     if stop["reason"] is not None:
         failure = stop["reason"]
     if failure is not None:  # the partial result ends at its last finite sample
@@ -519,3 +581,18 @@ def _progress_reporter(progress, scene: Scene):
             bar.set_postfix_str(f"{t / wall:.1f}x real time" if wall > 0 else "", refresh=False)
             bar.refresh()
     return report
+
+
+class _CallableModule(types.ModuleType):
+    """This module, callable as :func:`simulate`.
+
+    ``cdpr_exu.simulate`` names both this module and the function; once the module is
+    imported, Python's import system binds the package attribute to the module, so
+    ``cdpr_exu.simulate(scene)`` must work on the module too.
+    """
+
+    def __call__(self, *args, **kwargs) -> Result:
+        return simulate(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

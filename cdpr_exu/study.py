@@ -55,7 +55,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
-from .errors import CdprError, SceneError
+from .errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, SceneError
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -580,7 +580,7 @@ def _cell(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
-        return repr(value)
+        return repr(value) if math.isfinite(value) else ""  # empty: "not applicable", never "nan"
     return "" if value is None else str(value)
 
 
@@ -602,6 +602,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
                 variations: Sequence[Variation], *, mode: str = "grid", after: float = 1.0,
                 plots: bool = True) -> dict[str, Path]:
     """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
+    from .output import write_json
     from .result import provenance
     from .scene import save_scene
 
@@ -624,7 +625,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
         "base_scene": base_scene.to_dict(),
         **provenance(),
     }
-    (out / STUDY_FILES["json"]).write_text(json.dumps(data, indent=2) + "\n")
+    write_json(out / STUDY_FILES["json"], data)
     paths["json"] = out / STUDY_FILES["json"]
     if plots and variations:
         paths.update(plot_study(rows, variations, out, mode=mode))
@@ -822,7 +823,7 @@ def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubPar
     study = subparsers.add_parser("study", help="parameter studies over a scene, in parallel",
                                   description="Parameter studies: run a scene over many parameter values "
                                   "on all cores or on a Dask cluster, and tabulate and plot the results.",
-                                  epilog=EPILOG_STUDY, formatter_class=argparse.RawDescriptionHelpFormatter)
+                                  epilog=EPILOG_STUDY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     study_sub = study.add_subparsers(dest="study_command", required=True, metavar="COMMAND")
     subparsers._cdpr_study_subparsers = study_sub
     return study_sub
@@ -831,6 +832,7 @@ def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubPar
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
+    from .output import check_output_folder
     from .scene import load_scene
 
     scene = load_scene(args.scene)
@@ -840,14 +842,19 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         print("cdpr study: --workers is ignored with a remote --scheduler (its workers run the study)",
               file=sys.stderr)
     variations = _as_variations(args.param)
-    out = Path(args.out)
+    out = check_output_folder(args.out)
     rows = run_study(scene, variations, out=out, progress=not args.quiet, after=args.after,
                      mode="zip" if args.zip else "grid", workers=args.workers, scheduler=args.scheduler)
     if not args.quiet:
         print(format_table(rows, variations))
         done = sum(row["status"] == "completed" for row in rows)
         print(f"{done} of {len(rows)} runs completed; written to {out}/")
-    return 0
+    failed = sum(row["status"] != "completed" for row in rows)
+    if failed:
+        print(f"cdpr study sweep: {failed} of {len(rows)} runs did not complete (see the status column)",
+              file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return EXIT_OK
 
 
 def add_commands(subparsers: argparse._SubParsersAction) -> None:
@@ -856,7 +863,7 @@ def add_commands(subparsers: argparse._SubParsersAction) -> None:
         "sweep", help="run a scene over a grid of parameter values",
         description="Run a scene once per combination of parameter values (a grid, or --zip), in "
         "parallel, and write a CSV/JSON table and summary plots. Failed and refused runs are recorded, "
-        "not fatal.", epilog=EPILOG_SWEEP, formatter_class=argparse.RawDescriptionHelpFormatter)
+        "not fatal.", epilog=EPILOG_SWEEP + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     sweep.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
     sweep.add_argument("--param", action="append", required=True, metavar="PATH=V1,V2,...",
                        help="a parameter and its values; repeat for more parameters")

@@ -144,16 +144,16 @@ class CircleTrajectory(Trajectory):
     kind = "circle"
 
     def __post_init__(self):
-        object.__setattr__(self, "center", _finite_tuple("center", self.center, 2))
-        radius = _finite_float("radius", self.radius)
+        object.__setattr__(self, "center", _finite_tuple("trajectory.center", self.center, 2))
+        radius = _finite_float("trajectory.radius", self.radius)
         if radius < 0.0:
-            raise SceneError(f"radius must be >= 0 [m], got {self.radius!r}")
+            raise SceneError(f"trajectory.radius must be >= 0 [m], got {self.radius!r}")
         object.__setattr__(self, "radius", radius)
-        object.__setattr__(self, "angular_rate", _finite_float("angular_rate", self.angular_rate))
-        object.__setattr__(self, "rotation", _finite_float("rotation", self.rotation))
-        ramp_time = _finite_float("ramp_time", self.ramp_time)
+        object.__setattr__(self, "angular_rate", _finite_float("trajectory.angular_rate", self.angular_rate))
+        object.__setattr__(self, "rotation", _finite_float("trajectory.rotation", self.rotation))
+        ramp_time = _finite_float("trajectory.ramp_time", self.ramp_time)
         if ramp_time < 0.0:
-            raise SceneError(f"ramp_time must be >= 0 [s], got {self.ramp_time!r}")
+            raise SceneError(f"trajectory.ramp_time must be >= 0 [s], got {self.ramp_time!r}")
         object.__setattr__(self, "ramp_time", ramp_time)
 
     def phase(self, t):
@@ -206,7 +206,7 @@ class HoldTrajectory(Trajectory):
     kind = "hold"
 
     def __post_init__(self):
-        object.__setattr__(self, "held_pose", _finite_tuple("pose", self.held_pose, 3))
+        object.__setattr__(self, "held_pose", _finite_tuple("trajectory.pose", self.held_pose, 3))
 
     def pose(self, t):
         t, _ = _times(t)
@@ -247,13 +247,13 @@ class PointToPointTrajectory(Trajectory):
     kind = "point_to_point"
 
     def __post_init__(self):
-        object.__setattr__(self, "start", _finite_tuple("start", self.start, 3))
-        object.__setattr__(self, "end", _finite_tuple("end", self.end, 3))
-        duration = _finite_float("duration", self.duration)
+        object.__setattr__(self, "start", _finite_tuple("trajectory.start", self.start, 3))
+        object.__setattr__(self, "end", _finite_tuple("trajectory.end", self.end, 3))
+        duration = _finite_float("trajectory.duration", self.duration)
         if duration <= 0.0:
-            raise SceneError(f"duration must be > 0 [s], got {self.duration!r}")
+            raise SceneError(f"trajectory.duration must be > 0 [s], got {self.duration!r}")
         object.__setattr__(self, "duration", duration)
-        object.__setattr__(self, "start_time", _finite_float("start_time", self.start_time))
+        object.__setattr__(self, "start_time", _finite_float("trajectory.start_time", self.start_time))
 
     def _blend(self, t):
         t = np.asarray(t, dtype=float)
@@ -276,6 +276,9 @@ class PointToPointTrajectory(Trajectory):
         _, _, second = self._blend(t)
         return second[..., None] * (np.asarray(self.end) - np.asarray(self.start))
 
+
+#: Fields a trajectory table must give, by kind (no default would be what the user meant).
+REQUIRED_FIELDS = {"point_to_point": ("end",), "hold": ("pose",)}
 
 _KINDS = {
     "circle": CircleTrajectory,
@@ -308,8 +311,9 @@ def trajectory_from_dict(data):
     values = dict(data)
     kind = values.pop("kind", None)
     if not isinstance(kind, str) or kind not in _KINDS:
-        raise SceneError(f"trajectory kind must be one of {sorted(_KINDS)}, got {kind!r}")
+        raise SceneError(f"trajectory.kind must be one of {sorted(_KINDS)}, got {kind!r}")
     cls = _KINDS[kind]
+    missing = [name for name in REQUIRED_FIELDS.get(kind, ()) if name not in values]
     if cls is HoldTrajectory and "pose" in values:
         values["held_pose"] = values.pop("pose")
     allowed = {field.name for field in dataclass_fields(cls)}
@@ -317,4 +321,8 @@ def trajectory_from_dict(data):
     if unknown:
         shown = ["pose" if name == "held_pose" else name for name in sorted(allowed)]
         raise SceneError(f"trajectory of kind {kind!r} has unknown key(s) {unknown}; allowed: {shown}")
-    return cls(**values)
+    trajectory = cls(**values)  # the values given are checked first
+    if missing:
+        raise SceneError(f"trajectory.{missing[0]} is required for kind {kind!r} (a pose x [m], z [m], "
+                         f"rotation [rad]); it has no sensible default")
+    return trajectory

@@ -39,7 +39,7 @@ import exudyn as exu
 import exudyn.graphics as graphics
 import numpy as np
 
-from .errors import CdprError
+from .errors import EXIT_CODES, CdprError
 from .model import Model, build_model
 from .scene import Scene, load_scene
 
@@ -793,7 +793,7 @@ def add_commands(subparsers) -> None:
         "view", help="replay a run in Exudyn's interactive SolutionViewer (needs a display)",
         description="Replay a run folder (written by `cdpr run SCENE --out DIR`) in Exudyn's interactive "
         "SolutionViewer, with pulleys, platform and reference path drawn. Exits with code 1 when no "
-        "window can be opened here.", epilog=EPILOG_VIEW, formatter_class=argparse.RawDescriptionHelpFormatter)
+        "window can be opened here.", epilog=EPILOG_VIEW + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     view.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
     view.add_argument("--every", type=_positive_int, help="show every K-th stored row (default: about real time)")
     view.set_defaults(func=_cmd_view)
@@ -802,7 +802,7 @@ def add_commands(subparsers) -> None:
         "animate", help="render a run to a GIF or MP4 without a display",
         description="Render a run folder (written by `cdpr run SCENE --out DIR`) with Exudyn's software "
         "raytracer, no display needed, into a GIF (or an MP4 with imageio-ffmpeg installed).",
-        epilog=EPILOG_ANIMATE, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=EPILOG_ANIMATE + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     animate.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
     animate.add_argument("--out", help="animation file, .gif or .mp4 (default: RUN_DIR/animation.gif)")
     animate.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per second (default: 25)")

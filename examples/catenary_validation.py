@@ -41,6 +41,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from cdpr_exu.output import write_json
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
@@ -519,7 +520,7 @@ def main(argv=None) -> int:
         "wall_time_s": time.perf_counter() - start,
         **provenance(),
     }
-    (out / "summary.json").write_text(json.dumps(_clean(summary), indent=2) + "\n")
+    write_json(out / "summary.json", _clean(summary))
 
     print("\n(d) cable length at n = 15 (catenary through the lumped rest position; the paper: 0.8 mm)")
     for label, (_, _, c) in cases.items():

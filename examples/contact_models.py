@@ -20,7 +20,6 @@ l^2 / (8 r) off the rim where the cable leaves it; node contact's polygon is ins
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -29,6 +28,7 @@ import numpy as np
 
 from cdpr_exu.errors import CdprError, SolverFailure
 from cdpr_exu.pulley import segment_penetration
+from cdpr_exu.output import write_summary
 from cdpr_exu.result import provenance
 from cdpr_exu.scene import Effects, load_scene
 from cdpr_exu.simulate import simulate
@@ -98,9 +98,8 @@ def main() -> None:
     table = "\n".join(lines) + "\n"
     (OUT / "table.md").write_text(table)
     clean = [{k: v for k, v in row.items() if not k.startswith("_")} for row in rows]
-    (OUT / "summary.json").write_text(json.dumps(
-        {"scene": "paper-circle", "reference": "node contact, 60 elements, h = 2e-3 s", "runs": clean,
-         **provenance()}, indent=2, default=str) + "\n")
+    write_summary(OUT, {"scene": "paper-circle", "reference": "node contact, 60 elements, h = 2e-3 s",
+                        "runs": clean, **provenance()})
     print(table)
 
 

@@ -12,12 +12,12 @@ reported maxima (8.5 cm in x, 11 cm in z, 15 degrees).
 from __future__ import annotations
 
 import argparse
-import json
 from dataclasses import replace
 from pathlib import Path
 
 from cdpr_exu.cli import run_scene
 from cdpr_exu.errors import SolverFailure
+from cdpr_exu.output import write_json
 from cdpr_exu.scene import Effects, load_scene
 from cdpr_exu.simulate import simulate
 
@@ -59,7 +59,7 @@ def main() -> None:
         print(f"{label:50s} {status[:40]:40s} x {100 * summary['max_abs_error_x_m']:6.2f} cm  "
               f"z {100 * summary['max_abs_error_z_m']:6.2f} cm  rot {summary['max_abs_rotation_deg']:6.2f} deg  "
               f"{summary['real_time_factor']:6.1f}x real time")
-    (out / "variants.json").write_text(json.dumps({"paper": PAPER, "rows": rows}, indent=2) + "\n")
+    write_json(out / "variants.json", {"paper": PAPER, "rows": rows})
     lines = [
         "| model variant | max \\|err x\\| [cm] | max \\|err z\\| [cm] | z error range [cm] | max \\|rot\\| [deg] | x real time | status |",
         "|---|---|---|---|---|---|---|",

@@ -21,8 +21,10 @@ def test_run_writes_result_summary_solution_and_figures(tmp_path):
     assert "max |error x|" in done.stdout and "written to" in done.stdout
     summary = json.loads((out / "summary.json").read_text())
     for key in ("max_abs_error_x_m", "max_abs_error_z_m", "max_abs_rotation_deg", "min_element_tension_N",
-                "max_pulley_penetration_m", "wall_time_s", "simulated_time_s", "steps", "versions", "date"):
+                "max_pulley_penetration_m", "simulated_time_s", "steps", "versions"):
         assert key in summary, key
+    timing = json.loads((out / "timing.json").read_text())  # what changes from run to run lives apart
+    assert set(timing) == {"wall_time_s", "real_time_factor", "date"} and timing["wall_time_s"] > 0
     assert summary["simulated_time_s"] == pytest.approx(0.3)
     assert summary["error_convention"] == "actual - reference"
     for name in ("result.npz", "pose.csv", "solution.sol", "scene.toml", "overview.png", "snapshots.png",
@@ -52,3 +54,119 @@ def test_scenes_lists_the_shipped_scenes():
     done = _cdpr("scenes")
     for name in ("paper-circle", "paper-circle-slow", "paper-catenary", "paper-catenary-fixed"):
         assert name in done.stdout
+
+
+# --------------------------------------------------------------------------- a new user's defects (issue 11)
+
+import signal
+import time
+from dataclasses import replace
+
+from cdpr_exu.scene import load_scene, save_scene
+
+
+def _strict_json(path):
+    """Parse ``path`` as strict JSON: the NaN/Infinity tokens are refused, as strict parsers do."""
+    def refuse(token):
+        raise AssertionError(f"{path.name} holds the non-standard token {token}")
+    return json.loads(path.read_text(), parse_constant=refuse)
+
+
+def _scene_file(tmp_path, name, base="paper-circle", **solver):
+    scene = load_scene(base)
+    path = tmp_path / f"{name}.toml"
+    save_scene(scene.with_changes(solver=replace(scene.solver, **solver)), path)
+    return path
+
+
+@pytest.mark.parametrize("command", [["run", "paper-circle"], ["static", "paper-catenary-fixed"],
+                                     ["compare", "paper-circle"],
+                                     ["study", "sweep", "paper-circle", "--param", "platform.mass=2,3"]])
+def test_out_naming_an_existing_file_is_refused_before_any_work(tmp_path, command):
+    taken = tmp_path / "taken.txt"
+    taken.write_text("keep me")
+    done = _cdpr(*command, "--out", str(taken), check=False)
+    assert done.returncode == 2, done.stderr
+    assert "is an existing file" in done.stderr and "Traceback" not in done.stderr
+    assert "comparing controllers" not in done.stdout  # refused before the first controller ran
+    assert taken.read_text() == "keep me"
+
+
+def test_short_run_writes_strict_json_with_null_and_a_reason_instead_of_nan(tmp_path):
+    out = tmp_path / "short"
+    done = _cdpr("run", "paper-circle", "--end-time", "0.2", "--out", str(out), "--no-figures")
+    summary = _strict_json(out / "summary.json")
+    settled = summary["after_start_up"]
+    assert settled["max_position_error_m"] is None and "no sample at or after t = 1 s" in settled["notes"][0]
+    assert summary["max_position_error_m"] > 0  # the whole run's figures exist
+    assert "nan" not in done.stdout.lower() and "n/a" in done.stdout
+    assert "-0.00 " not in done.stdout
+
+
+def test_compare_exits_3_when_every_controller_fails_and_keeps_the_partial_results(tmp_path):
+    scene = _scene_file(tmp_path, "newton", end_time=0.5, max_newton_iterations=1)  # Newton cannot converge
+    out = tmp_path / "cmp"
+    done = _cdpr("compare", str(scene), "--controllers", "ideal_ik", "--out", str(out), check=False)
+    assert done.returncode == 3, done.stderr
+    assert "did not complete: ideal_ik" in done.stderr
+    assert _strict_json(out / "summary.json")["controllers"]["ideal_ik"]["status"].startswith("failed")
+
+
+def test_run_failure_exits_3_and_exudyn_banners_do_not_leak(tmp_path):
+    scene = _scene_file(tmp_path, "newton", end_time=0.5, max_newton_iterations=1)
+    done = _cdpr("run", str(scene), "--out", str(tmp_path / "run"), "-q", check=False)
+    assert done.returncode == 3
+    text = done.stdout + done.stderr
+    for banner in ("SOLVER FAILED", "showHints", "WARNING:", "Traceback"):
+        assert banner not in text, banner
+    assert "Likely cause" in done.stderr
+
+
+def test_static_failure_says_why_and_writes_the_scene_and_the_last_state(tmp_path):
+    base = load_scene("paper-catenary")
+    stiff = base.with_changes(pulleys=[replace(p, contact_stiffness=1e12) for p in base.pulleys],
+                              solver=replace(base.solver, step_size=2e-2))  # Newton fails at the first step
+    path = tmp_path / "stiff.toml"
+    save_scene(stiff, path)
+    out = tmp_path / "static"
+    done = _cdpr("static", str(path), "--out", str(out), "--max-time", "2", check=False)
+    assert done.returncode == 3, done.stderr
+    assert "Likely cause" in done.stderr and "SOLVER FAILED" not in done.stdout + done.stderr
+    summary = _strict_json(out / "summary.json")
+    assert summary["status"].startswith("failed") and summary["failure_time_s"] == pytest.approx(0.0, abs=0.05)
+    assert summary["last_state"]["platform_pose"] is not None and (out / "scene.toml").is_file()
+
+
+def test_a_directory_given_as_the_scene_is_named_a_directory(tmp_path):
+    done = _cdpr("run", str(tmp_path), check=False)
+    assert done.returncode == 2 and "is a directory" in done.stderr
+
+
+def test_static_output_numbers_cables_from_one_and_prints_no_negative_zero():
+    done = _cdpr("static", "paper-catenary-fixed")
+    assert "cable 1:" in done.stdout and "cable 2:" in done.stdout and "cable 0" not in done.stdout
+    assert "-0.000" not in done.stdout
+
+
+def test_every_help_documents_the_exit_codes():
+    for command in (["run"], ["static"], ["compare"], ["study", "sweep"], ["study", "accuracy"], ["animate"]):
+        done = _cdpr(*command, "--help")
+        assert "exit codes" in done.stdout and "130" in done.stdout, command
+
+
+@pytest.mark.slow
+def test_ctrl_c_saves_what_was_computed_prints_one_line_and_exits_130(tmp_path):
+    out = tmp_path / "run"
+    process = subprocess.Popen([sys.executable, "-m", "cdpr_exu.cli", "run", "paper-circle", "--out", str(out), "-q"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    solution = out / "solution.sol"
+    while time.monotonic() < deadline and (not solution.exists() or solution.stat().st_size < 20_000):
+        time.sleep(0.2)  # wait until the solver has written a few samples
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    assert "Traceback" not in stderr and len(stderr.strip().splitlines()) == 1 and "interrupted" in stderr
+    summary = _strict_json(out / "summary.json")
+    assert summary["status"].startswith("interrupted") and 0 < summary["simulated_time_s"] < 10
+    assert Result.load(out).time.size > 1

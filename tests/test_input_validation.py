@@ -233,7 +233,7 @@ def test_rk44_with_fixed_winches_is_accepted():
     ({"name": "x", "cables": [5, 6]}, "cables must be an array of tables"),
     ({"name": "x", "platform": 5}, "platform must be a table"),
     ({"name": "x", "solver": [1]}, "solver must be a table"),
-    ({"name": "x", "trajectory": {"kind": "spiral"}}, "trajectory kind"),
+    ({"name": "x", "trajectory": {"kind": "spiral"}}, "trajectory.kind"),
     ({"name": "x", "trajectory": {"kind": "circle", "speed": 2}}, "unknown key"),
     ({"name": "x", "trajectory": 5}, "trajectory must be a table"),
     ({"name": "x", "cables": [{}, {"n_elements": "many"}]}, r"cables\[1\]\.n_elements"),

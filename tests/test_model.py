@@ -350,7 +350,7 @@ def test_reference_the_cables_cannot_reach_is_refused_before_any_step():
     far_circle = CircleTrajectory(center=(0.0, -6.0), radius=0.4)  # anchors 6 m below: cables are 3.75 m
     scene = scene.with_changes(trajectory=far_circle, solver=dataclasses.replace(scene.solver, end_time=1.0))
     controller = _CountingController()
-    with pytest.raises(UnreachableError, match=r"cable 0"):
+    with pytest.raises(UnreachableError, match=r"cable 1"):
         simulate(scene, controller)
     assert controller.commands == 0
     with pytest.raises(UnreachableError):

@@ -107,3 +107,31 @@ def test_a_run_with_no_valid_sample_still_plots(run, tmp_path):
     assert np.isnan(empty.platform_pose).all()
     for path in plots.plot_overview(scene, empty, tmp_path):
         _assert_png(path, min_width=300, min_height=200)
+
+
+def _edges_are_background(path):
+    """True if the outermost pixel rows and columns of the PNG are plain white background.
+
+    An artist cut at the image border (a legend or a title wider than the figure)
+    leaves ink on the outermost pixels; a figure that holds all its artists has a
+    white margin there.
+    """
+    image = imread(path)[..., :3]
+    edges = np.concatenate([image[0], image[-1], image[:, 0], image[:, -1]])
+    return bool(np.all(edges > 0.97))
+
+
+def test_comparison_legend_with_the_long_controller_names_is_not_cut(run, tmp_path):
+    scene, result = run
+    names = ["reference", "ideal_ik", "tension_aware_dynamic_chordal", "closed_loop_tension_aware",
+             "tension_aware_chain"]
+    results = {name: result for name in names[1:]}
+    for path in plots.plot_comparison(scene, results, tmp_path):
+        assert _edges_are_background(path), path
+
+
+def test_overview_of_a_failed_run_keeps_its_long_title_inside_the_image(run, tmp_path):
+    scene, result = run
+    failed = replace(_cut_short(result), status="failed: " + "the run failed for a reason with a long text " * 4)
+    for path in plots.plot_overview(scene, failed, tmp_path):
+        assert _edges_are_background(path), path

@@ -487,7 +487,7 @@ def test_monitor_stop_mid_run_names_the_element_and_keeps_the_result():
         simulate(scene, _JumpingWinch(0.3, 1.0))
     failure = caught.value
     assert_clear_failure(scene, failure, "strained by")
-    assert "element 1 of cable 0" in str(failure) or "element 0 of cable 0" in str(failure)
+    assert "element 1 of cable 1" in str(failure) or "element 0 of cable 1" in str(failure)
     assert failure.time == pytest.approx(0.3, abs=0.011)
 
 

@@ -1,0 +1,81 @@
+"""The README says what the code does: its links, its example and its claims are checked here."""
+
+import json
+import re
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+README = (ROOT / "README.md").read_text()
+DOCS = {path.name: path.read_text() for path in (ROOT / "docs").glob("*.md")}
+
+
+def _python_example() -> str:
+    """The first ```python block of the README."""
+    return re.search(r"```python\n(.*?)```", README, re.S).group(1)
+
+
+def test_readme_and_docs_never_point_outside_the_repository():
+    for name, text in {"README.md": README, **DOCS}.items():
+        assert "shared/" not in text, name
+
+
+def test_no_image_tag_points_at_a_markdown_file():
+    for name, text in {"README.md": README, **DOCS}.items():
+        assert not re.search(r"!\[[^\]]*\]\([^)]*\.md\)", text), name
+
+
+def test_every_relative_link_of_the_readme_exists():
+    for target in re.findall(r"\]\(((?!https?:)[^)#]+)\)", README):
+        assert (ROOT / target).exists(), target
+
+
+def test_the_paper_is_described_and_its_parameters_are_in_docs():
+    assert "bond graph" in README and "20-sim" in README
+    paper = DOCS["paper.md"]
+    for value in ("0.35 kg/m", "1e9 N/m^2", "1e7 N/m", "0.0271 kg m^2", "(0, -2) m"):
+        assert value in paper, value
+
+
+def test_scene_reference_says_point_to_point_poses_are_x_z_rotation():
+    assert re.search(r"point_to_point.*x \[m\], z \[m\], rotation \[rad\]", README)
+
+
+def test_controllers_table_says_how_the_closed_loop_is_built():
+    from cdpr_exu.comparison import CONTROLLERS
+
+    controller = CONTROLLERS["closed_loop_tension_aware"]()
+    row = next(line for line in README.splitlines() if line.startswith("| `closed_loop_tension_aware`"))
+    assert "tension_aware_dynamic_chordal" in row
+    assert controller.dynamic and controller.chordal_correction
+
+
+@pytest.mark.slow
+def test_bending_free_claim_matches_the_run():
+    """The README says the bending-free run at spectral radius 0.5 stops at 0.91 s, the platform above the pulleys."""
+    from cdpr_exu import SolverFailure, load_scene, simulate
+    from cdpr_exu.scene import Effects
+
+    scene = load_scene("paper-circle")
+    scene = scene.with_changes(effects=Effects.from_preset("catenary"),
+                               solver=replace(scene.solver, spectral_radius=0.5, end_time=1.5))
+    with pytest.raises(SolverFailure, match="rose above the pulleys") as failure:
+        simulate(scene)
+    assert failure.value.time == pytest.approx(0.91, abs=0.005)
+    assert "rises above the" in README and "stopped at 0.91 s" in README
+
+
+@pytest.mark.slow
+def test_python_example_prints_the_controllers_table_figure(tmp_path, monkeypatch, capsys):
+    """The README's example, run as written, prints the max error that the README's table shows."""
+    monkeypatch.chdir(tmp_path)
+    exec(compile(_python_example().replace("progress=True", "progress=False"), "README example", "exec"), {})
+    printed = float(capsys.readouterr().out.split()[0])
+    table = json.loads((ROOT / "results" / "controllers" / "summary.json").read_text())
+    expected = 1000 * table["controllers"]["closed_loop_tension_aware"]["max_position_error_m"]
+    assert printed == pytest.approx(expected, abs=0.006)  # printed to 0.01 mm
+    row = next(line for line in README.splitlines() if line.startswith("| closed_loop_tension_aware |"))
+    assert f"{expected:.2f}" == row.split("|")[2].strip()
+    assert (tmp_path / "out" / "run" / "summary.json").is_file()
