@@ -18,7 +18,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from .cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
-from .errors import SceneError, UnreachableError
+from .errors import SceneError
 from .kinematics import anchor_points, hang_point, initial_cable_nodes, pulley_exit, straight_cable_nodes
 from .platform import PlatformItems, add_platform, attach_cable
 from .pulley import add_pulley_contact, add_pulley_ground
@@ -158,27 +158,13 @@ def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 
 
 
 def check_trajectory_reachable(scene: Scene) -> None:
-    """Refuse a reference the cables cannot follow before any simulation.
+    """Refuse a reference the cables cannot reach or hold, before any simulation.
 
-    Raises UnreachableError when an anchor of the reference enters a pulley, or when
-    the ideal length exceeds the cable (nothing would be left between winch and pulley).
+    See :func:`cdpr_exu.workspace.check_reference` (one check for every controller).
     """
-    if scene.cable_exit == "point":
-        return
-    times = np.linspace(0.0, scene.solver.end_time, 400)
-    poses = scene.trajectory.pose(times)
-    anchors = anchor_points(poses, np.asarray(scene.platform.anchors))
-    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
-        lengths = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchors[:, i]).cable_length
-        too_long = np.flatnonzero(lengths > cable.unstrained_length - cable.element_length)
-        if too_long.size:
-            k = too_long[0]
-            raise UnreachableError(
-                f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s "
-                f"needs {lengths[k]:.4f} m of cable {i + 1} between pulley and anchor, but "
-                f"cables[{i}].unstrained_length is {cable.unstrained_length} m (one element, "
-                f"{cable.element_length:.4f} m, must stay on the winch side)"
-            )
+    from .workspace import check_reference
+
+    check_reference(scene)
 
 
 def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.ndarray) -> None:

@@ -392,7 +392,7 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
                 cause = _solver_report(mbs, " ".join(str(err).split()))
                 reached = float(mbs.sys["dynamicSolver"].it.currentTime) if "dynamicSolver" in mbs.sys else t
                 raise SolverFailure(f"the run of scene {scene.name!r} to rest failed at t = {reached:.4f} s "
-                                    f"(between {t:.3f} s and {end:.3f} s): {cause}. {likely_cause(scene, cause)}",
+                                    f"(between {t:.3f} s and {end:.3f} s): {cause}. {likely_cause(scene, cause, reached)}",
                                     time=reached, partial_result=_last_state(model)) from None
             t = end
             speed = window["speed"]

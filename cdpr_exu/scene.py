@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import tomllib
+import warnings
 from dataclasses import dataclass, field, fields, replace
 from importlib import resources
 from pathlib import Path
@@ -22,7 +23,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .errors import SceneError
+from .errors import CoarseOutputWarning, SceneError, UnreachableError
 from .validation import finite, non_negative, positive
 from .trajectories import Trajectory, trajectory_from_dict
 
@@ -491,6 +492,12 @@ class SolverSpec:
         _choice("solver.newton", self.newton, ("modified", "full"))
         _set(self, "output_period", positive("solver.output_period", self.output_period))
         if self.output_period < self.step_size * (1 - 1e-9):
+            samples = int(math.floor(self.end_time / self.step_size + 1e-9)) + 1
+            warnings.warn(
+                f"solver.step_size = {self.step_size} s is longer than solver.output_period = {self.output_period} s: "
+                f"the result is sampled once per step ({samples} samples over {self.end_time} s), and its error "
+                "figures are maxima over those samples only; lower solver.step_size for a finer output",
+                CoarseOutputWarning, stacklevel=3)
             _set(self, "output_period", self.step_size)
         _set(self, "max_newton_iterations", _whole("solver.max_newton_iterations", self.max_newton_iterations,
                                                    1, MAX_NEWTON_ITERATIONS))
@@ -601,7 +608,13 @@ class Scene:
             if self.cable_exit == "point":
                 needed = float(np.linalg.norm(anchors[i] - c))
             else:
-                needed = ideal_cable_length(c, pulley.radius, pulley.side, anchors[i])
+                try:
+                    needed = ideal_cable_length(c, pulley.radius, pulley.side, anchors[i])
+                except UnreachableError as err:
+                    raise UnreachableError(
+                        f"platform.anchors[{i}] at platform.initial_pose {list(self.platform.initial_pose)} cannot be "
+                        f"reached over pulleys[{i}] (pulleys[{i}].center {list(pulley.center)} m, "
+                        f"pulleys[{i}].radius {pulley.radius} m, pulleys[{i}].side {pulley.side}): {err}") from None
             if needed > cable.unstrained_length * (1 + 1e-9):
                 raise SceneError(
                     f"cables[{i}].unstrained_length = {cable.unstrained_length} m is shorter than the "
@@ -748,7 +761,28 @@ def load_scene(source: str | Path) -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
-    return scene_from_dict(data)
+    scene = scene_from_dict(data)  # the values given are checked first
+    _check_required(data, str(source))
+    return scene
+
+
+#: What a scene file must say: no default would be the robot or the motion its author meant.
+REQUIRED_TABLES: dict[str, str] = {
+    "pulleys": "[[pulleys]] with each pulley's center (where the cables run)",
+    "platform": "[platform] with its anchors and mass",
+    "trajectory": "[trajectory] (the reference motion; kind = \"hold\" with a pose to hold still)",
+}
+
+
+def _check_required(data: Mapping[str, Any], source: str) -> None:
+    """Refuse a scene file that leaves out a table it cannot sensibly do without."""
+    missing = [name for name in REQUIRED_TABLES if name not in data]
+    if "pulleys" in missing and "pulley" in data and "center" in data["pulley"]:
+        missing.remove("pulleys")
+    if missing:
+        raise SceneError(f"scene {source!r} lacks {', '.join(missing)}: a scene file must give "
+                         + "; ".join(REQUIRED_TABLES[name] for name in missing)
+                         + " (see the scene reference in the README)")
 
 
 def shipped_scenes() -> list[str]:

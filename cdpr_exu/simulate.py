@@ -312,6 +312,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     """
     controller = controller or IdealIKController()
     model = build_model(scene)
+
     controller.reset(scene, model.initial_paid_out.copy())
     mbs = model.mbs
     solver = scene.solver
@@ -444,7 +445,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         result.failure_time = last_time
         raise SolverFailure(
             f"the run failed at t = {last_time:.4f} s of {solver.end_time} s "
-            f"(step size {solver.step_size} s): {failure}. {likely_cause(scene, failure)}",
+            f"(step size {solver.step_size} s): {failure}. {likely_cause(scene, failure, last_time)}",
             time=last_time, partial_result=result)
     return result
 
@@ -498,47 +499,96 @@ def explicit_step_limit(scene: Scene) -> float:
     return min(limits)
 
 
-def likely_cause(scene: Scene, failure: str = "") -> str:
-    """A hint at the effect most likely to make the integration fail.
+def _cause_hints(scene: Scene, failure: str) -> list[str]:
+    """Hints that follow the cause the monitor (or Exudyn) named in ``failure``."""
+    hints = []
+    if "is strained by +" in failure:
+        hints.append("an element stretched beyond the strain limit: the cable is too soft for its load "
+                     "(cables[i].youngs_modulus, platform.mass), or the winch command pulls against the platform")
+    elif "is strained by -" in failure:
+        hints.append("a slack (tension-only) element shortened beyond the monitor's strain limit: the cable "
+                     "went slack and bunched up, which the monitor counts as leaving the model's range "
+                     "(simulate.MAX_STRAIN)" if scene.effects.slack else
+                     "an element was compressed beyond the strain limit: the cable pushes, which a real cable "
+                     "cannot (effects.slack = true makes elements tension-only)")
+    if "deep into pulley" in failure:
+        hints.append("a node or element slipped into the pulley: elements too long for the pulley radius "
+                     "(cables[i].n_elements) or a contact too soft for the tension (pulleys[i].contact_stiffness)")
+    if "rose above the pulleys" in failure:
+        hints.append("the platform was thrown upwards: only pushing cables can hold it above the pulleys; "
+                     "a start-up jolt at a large solver.step_size or a reference that accelerates downwards "
+                     "faster than gravity does this (effects.slack = true lets the cables go slack instead)")
+    if "left the reachable region" in failure or "no longer finite" in failure:
+        hints.append("the integration diverged: solver.step_size is too large for the stiffest mode "
+                     "(axial stiffness or pulley contact), or solver.spectral_radius near 1 leaves it undamped")
+    if "minimum step size" in failure or "Newton" in failure:
+        hints.append("Newton's iteration found no solution even for tiny steps: a force jumps within a step "
+                     "(a winch command that jumps, a slack cable snapping taut, a node striking the rim)")
+    return hints
+
+
+def first_step_hints(scene: Scene) -> list[str]:
+    """What in ``scene`` can make the very first step fail (a run that stops at t = 0)."""
+    hints = []
+    solver = scene.solver
+    cable = scene.cables[0]
+    mass = cable.element_mass if scene.effects.cable_mass else scene.platform.mass
+    if scene.effects.pulley_contact and scene.cable_exit == "pulley":
+        worst = max(scene.pulleys, key=lambda p: p.contact_stiffness)
+        # The paper's pulley (1e7 N/m on 0.0875 kg nodes) runs at 2e-3 s: k h^2 / m = 457.
+        ratio = worst.contact_stiffness * solver.step_size**2 / mass
+        if ratio > 1e4:
+            hints.append(f"pulleys[i].contact_stiffness = {worst.contact_stiffness:g} N/m is stiff for "
+                         f"solver.step_size = {solver.step_size} s (k h^2 / m = {ratio:.3g}; the paper scene runs "
+                         "at 457): the nodes resting on the rim cannot be balanced in one step")
+    if scene.effects.axial_elasticity and scene.effects.cable_mass:
+        ratio = cable.axial_stiffness * solver.step_size**2 / cable.element_mass
+        if ratio > 1e5:
+            hints.append(f"cables[i] axial stiffness ({cable.axial_stiffness:.3g} N/m per element) is stiff for "
+                         f"solver.step_size = {solver.step_size} s (k h^2 / m = {ratio:.3g})")
+    if solver.max_newton_iterations < 4:
+        hints.append(f"solver.max_newton_iterations = {solver.max_newton_iterations} is too few for Newton to "
+                     "converge from the initial state")
+    if not hints:
+        hints.append("the initial state is far from balanced (platform.initial_pose against the cables' "
+                     "lengths) or solver.step_size is too large; try a smaller step")
+    return hints
+
+
+def likely_cause(scene: Scene, failure: str = "", failure_time: float | None = None) -> str:
+    """A hint at what most likely made the integration fail.
 
     Parameters
     ----------
     scene : Scene
     failure : str
-        What stopped the run (the monitor's or the solver's words), to tailor the hint.
+        What stopped the run (the monitor's or the solver's words): the hint follows
+        the cause named there.
+    failure_time : float, optional [s]
+        When the run stopped; a stop within the first step gets hints about what in
+        the scene makes the first step fail.
     """
-    cable = scene.cables[0]
     hints = []
     if scene.solver.integrator == "rk44":
         limit = explicit_step_limit(scene)
         if scene.solver.step_size > limit:
             hints.append(f"explicit RK44 is unstable above a step of about {limit:.2g} s on these cables "
                          f"(axial damping c_i / m_i and stiffness); use a smaller step or the implicit solver")
+    if failure_time is not None and failure_time < scene.solver.step_size:
+        hints += ["at t = 0 the first step failed: " + hint for hint in first_step_hints(scene)]
+    hints += _cause_hints(scene, failure)
     downward = -_steepest_downward_acceleration(scene)
     if scene.winch.kind == "kinematic" and downward > scene.gravity > 0.0:
         hints.append(f"the reference accelerates the platform downwards at up to {downward:.3g} m/s^2, more than "
                      f"gravity ({scene.gravity} m/s^2): cables can only pull, so they go slack"
                      + ("" if scene.effects.slack else " (with effects.slack off they push instead)"))
-    if scene.effects.slack and "strained by -" in failure:
-        hints.append("a slack (tension-only) element shortened beyond the monitor's strain limit: the cable "
-                     "went slack and bunched up, which the monitor counts as leaving the model's range "
-                     "(simulate.MAX_STRAIN)")
-    if not scene.effects.bending:
+    if not hints and not scene.effects.bending:
         hints.append("bending is off: the paper scene relies on bending stiffness to stay well-behaved")
-    if scene.effects.pulley_contact and scene.cable_exit == "pulley":
-        pulley = scene.pulleys[0]
-        # The paper's pulley (1e7 N/m on 0.0875 kg nodes) runs at 2e-3 s: k h^2 / m = 457.
-        if pulley.contact_stiffness * scene.solver.step_size**2 / cable.element_mass > 1e4:
-            hints.append(f"the pulley contact stiffness ({pulley.contact_stiffness:g} N/m) is stiff "
-                         f"for step {scene.solver.step_size} s; try a smaller step")
-    if scene.solver.integrator == "generalized_alpha" and scene.solver.spectral_radius > 0.9:
+    if not hints and scene.solver.integrator == "generalized_alpha" and scene.solver.spectral_radius > 0.9:
         hints.append("spectral radius near 1 leaves the stiff axial modes undamped; try 0")
-    if "minimum step size" in failure or "Newton" in failure:
-        hints.append("Newton's iteration found no solution even for tiny steps: a force jumps within a step "
-                     "(a winch command that jumps, a slack cable snapping taut, a node striking the rim)")
     if not hints:
         hints.append("a sudden jump of the winch command or the step size; try a smaller solver.step_size")
-    return "Likely cause: " + "; ".join(hints) + "."
+    return "Likely cause: " + "; ".join(dict.fromkeys(hints)) + "."
 
 
 def _steepest_downward_acceleration(scene: Scene) -> float:

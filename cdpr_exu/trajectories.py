@@ -103,6 +103,13 @@ class Trajectory(ABC):
     def acceleration(self, t):
         """Second derivative of the pose [m/s^2, m/s^2, rad/s^2]: shape (3,) or (N, 3)."""
 
+    def turning_times(self, end_time: float) -> np.ndarray:
+        """Times in [0, end_time] [s] where a pose coordinate may be extreme (for exact workspace checks).
+
+        The default is none: a uniform sampling of the run is used alone.
+        """
+        return np.zeros(0)
+
     def to_dict(self):
         """Plain dict with a ``kind`` key and the fields (tuples as lists), for TOML."""
         data = {"kind": self.kind}
@@ -155,6 +162,13 @@ class CircleTrajectory(Trajectory):
         if ramp_time < 0.0:
             raise SceneError(f"trajectory.ramp_time must be >= 0 [s], got {self.ramp_time!r}")
         object.__setattr__(self, "ramp_time", ramp_time)
+
+    def turning_times(self, end_time: float) -> np.ndarray:
+        """Times where x or z is extreme: the phase at a multiple of pi/2 (no ramp), [s]."""
+        if self.ramp_time > 0.0 or self.angular_rate == 0.0 or self.radius == 0.0:
+            return np.zeros(0)
+        quarter = 0.5 * np.pi / abs(self.angular_rate)
+        return np.arange(0.0, end_time + 1e-12, quarter)
 
     def phase(self, t):
         """Phase ``theta`` [rad] and its first two time derivatives, each of t's shape."""
@@ -254,6 +268,10 @@ class PointToPointTrajectory(Trajectory):
             raise SceneError(f"trajectory.duration must be > 0 [s], got {self.duration!r}")
         object.__setattr__(self, "duration", duration)
         object.__setattr__(self, "start_time", _finite_float("trajectory.start_time", self.start_time))
+
+    def turning_times(self, end_time: float) -> np.ndarray:
+        """The start and the end of the motion [s] (the pose is monotone in between)."""
+        return np.array([self.start_time, self.start_time + self.duration])
 
     def _blend(self, t):
         t = np.asarray(t, dtype=float)

@@ -1,0 +1,153 @@
+"""The workspace check: can the cables reach, and hold, every pose of the reference?
+
+One check for every controller, run when the model is built, before any simulation
+(:func:`check_reference`). A reference pose is refused, with its time and the scene
+fields that conflict, when
+
+* a platform anchor lies inside its pulley's disc (no straight cable leaves the rim
+  towards it);
+* the ideal cable from the pulley to the anchor is longer than the cable (minus one
+  element on the winch side for lumped cables; a massless rope has no elements);
+* the winches follow the reference, and the cables cannot hold the platform's weight
+  with non-negative tensions there: every
+  cable pulls along the line from the anchor to where it leaves its pulley, so a
+  platform above the pulleys, or beyond them to the side, could only be held by
+  cables that push.
+
+The last test is the static wrench-feasible workspace of the planar robot for forces
+(the platform's rotation is free to balance the moment, as a suspended platform does).
+Pure NumPy/SciPy (no Exudyn). Units SI; poses (x, z, rotation) in the paper's x-z plane.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import nnls
+
+from .errors import UnreachableError
+from .kinematics import anchor_points, pulley_exit
+
+#: Samples of the reference over the run (plus its turning times).
+REFERENCE_SAMPLES = 401
+#: Relative residual of the force balance above which the weight counts as not held.
+WEIGHT_BALANCE_TOLERANCE = 1e-6
+
+
+def reference_samples(scene) -> tuple[np.ndarray, np.ndarray]:
+    """Times [s], shape (N,), and reference poses, shape (N, 3), at which the workspace is checked.
+
+    A uniform grid over the run, plus the trajectory's turning times (where a coordinate
+    of the pose is extreme), so that the extreme poses are checked exactly.
+    """
+    end = scene.solver.end_time
+    times = np.linspace(0.0, end, REFERENCE_SAMPLES)
+    turning = np.asarray(scene.trajectory.turning_times(end), dtype=float).reshape(-1)
+    times = np.unique(np.concatenate([times, turning[(turning >= 0.0) & (turning <= end)]]))
+    return times, np.atleast_2d(scene.trajectory.pose(times))
+
+
+def _pose_text(times: np.ndarray, poses: np.ndarray, k: int) -> str:
+    return f"the reference pose {np.round(poses[k], 4).tolist()} (x [m], z [m], rotation [rad]) at t = {times[k]:.3f} s"
+
+
+def _check_anchors_outside_discs(scene, times, poses, anchors) -> None:
+    if scene.cable_exit != "pulley":
+        return
+    for i, pulley in enumerate(scene.pulleys):
+        distance = np.linalg.norm(anchors[:, i] - np.asarray(pulley.center), axis=1)
+        inside = np.flatnonzero(distance <= pulley.radius * (1.0 + 1e-9))
+        if inside.size:
+            k = inside[0]
+            raise UnreachableError(
+                f"platform.anchors[{i}] enters pulleys[{i}] ({_pose_text(times, poses, k)}): the anchor at "
+                f"{np.round(anchors[k, i], 4).tolist()} m lies {distance[k]:.4f} m from pulleys[{i}].center "
+                f"{list(pulley.center)} m, inside pulleys[{i}].radius = {pulley.radius} m")
+
+
+def _pulley_exit_named(scene, i, times, poses, anchors):
+    """:func:`pulley_exit` of cable i at every sample; its refusal names the fields and the time."""
+    pulley = scene.pulleys[i]
+    try:
+        return pulley_exit(np.asarray(pulley.center, dtype=float), pulley.radius, pulley.side, anchors)
+    except UnreachableError as err:
+        for k in range(len(anchors)):
+            try:
+                pulley_exit(np.asarray(pulley.center, dtype=float), pulley.radius, pulley.side, anchors[k])
+            except UnreachableError:
+                raise UnreachableError(
+                    f"platform.anchors[{i}] cannot be reached over pulleys[{i}] ({_pose_text(times, poses, k)}; "
+                    f"pulleys[{i}].center {list(pulley.center)} m, pulleys[{i}].radius {pulley.radius} m, "
+                    f"pulleys[{i}].side {pulley.side}): {err}") from None
+        raise
+
+
+def _exits(scene, times, poses, anchors):
+    """Per cable: ideal lengths, shape (N,) [m], and unit pull directions on the platform, shape (N, 2)."""
+    lengths, pulls = [], []
+    for i, pulley in enumerate(scene.pulleys):
+        center = np.asarray(pulley.center, dtype=float)
+        if scene.cable_exit == "point":
+            offset = center - anchors[:, i]
+            length = np.linalg.norm(offset, axis=1)
+            lengths.append(length)
+            pulls.append(offset / np.maximum(length, 1e-300)[:, None])
+        else:
+            exit_ = _pulley_exit_named(scene, i, times, poses, anchors[:, i])
+            lengths.append(np.asarray(exit_.cable_length))
+            pulls.append(-np.asarray(exit_.unit_vector))
+    return lengths, pulls
+
+
+def _check_lengths(scene, times, poses, lengths) -> None:
+    if scene.cable_exit == "point":
+        return  # a cable fixed at the exit point: its length is checked with the scene (initial pose)
+    lumped = scene.effects.cable_mass
+    for i, (cable, length) in enumerate(zip(scene.cables, lengths)):
+        # A lumped cable keeps at least one element on the winch side of the pulley; a
+        # massless rope has no elements, so its whole length may be paid out.
+        spare = cable.element_length if lumped else 0.0
+        too_long = np.flatnonzero(length > cable.unstrained_length - spare + 1e-12)
+        if too_long.size:
+            k = too_long[0]
+            kept = (f"one element, {cable.element_length:.4f} m, must stay on the winch side"
+                    if lumped else "a massless rope can pay out at most its whole length")
+            raise UnreachableError(
+                f"{_pose_text(times, poses, k)} needs {length[k]:.4f} m of cable {i + 1} between "
+                f"pulleys[{i}] and platform.anchors[{i}], but cables[{i}].unstrained_length is "
+                f"{cable.unstrained_length} m ({kept})")
+
+
+def _check_weight_held(scene, times, poses, pulls) -> None:
+    weight = scene.platform.mass * scene.gravity
+    if weight <= 0.0 or scene.winch.kind == "fixed":
+        return  # fixed winches follow no reference: it only measures the error (a pendulum swings)
+    needed = np.array([0.0, weight])  # the cables must pull the platform up by its weight
+    directions = np.stack(pulls, axis=2)  # (N, 2, m)
+    for k in range(len(times)):
+        tensions, residual = nnls(directions[k], needed)
+        if residual > WEIGHT_BALANCE_TOLERANCE * weight:
+            upward = directions[k][1]
+            reason = ("every cable pulls it downwards (it is above the pulleys)" if np.all(upward <= 0.0)
+                      else "the cables' pulls cannot combine into an upward force without one pushing")
+            raise UnreachableError(
+                f"{_pose_text(times, poses, k)} is outside the workspace: the cables cannot hold the "
+                f"platform's weight ({weight:.4g} N, platform.mass = {scene.platform.mass} kg) with "
+                f"non-negative tensions, because {reason}; an unbalanced force of {residual:.4g} N remains")
+
+
+def check_reference(scene) -> None:
+    """Refuse a reference trajectory the cables cannot follow, before any simulation.
+
+    Raises
+    ------
+    UnreachableError
+        Naming the time, the pose and the scene fields that conflict (``platform.anchors[i]``,
+        ``pulleys[i].center``, ``pulleys[i].radius``, ``cables[i].unstrained_length``,
+        ``platform.mass``).
+    """
+    times, poses = reference_samples(scene)
+    anchors = anchor_points(poses, np.asarray(scene.platform.anchors))
+    _check_anchors_outside_discs(scene, times, poses, anchors)
+    lengths, pulls = _exits(scene, times, poses, anchors)
+    _check_lengths(scene, times, poses, lengths)
+    _check_weight_held(scene, times, poses, pulls)

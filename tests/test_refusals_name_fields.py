@@ -1,0 +1,40 @@
+"""Every refusal of a malformed scene names the field it refuses, as a path (issue 12).
+
+Fuzzed over the project's own ``malformed_scene_dicts`` strategy (the paper scene's
+plain data with one to three fields broken), with a fixed seed: each refusal, by the
+scene validation or by the workspace check that runs before any simulation, must name
+a field path such as ``trajectory.radius``, ``pulleys[0].center`` or ``platform.anchors[1]``.
+"""
+
+import re
+
+from hypothesis import HealthCheck, given, seed, settings
+
+from cdpr_exu.errors import CdprError
+from cdpr_exu.scene import scene_from_dict
+from cdpr_exu.workspace import check_reference
+from test_input_validation import malformed_scene_dicts
+
+TABLES = r"(?:name|description|gravity|cable_exit|cable|cables|pulley|pulleys|platform|winch|effects|solver|trajectory)"
+#: A field path: a scene table with an index or dotted fields (``pulleys[0]``, ``trajectory.radius``,
+#: ``platform.anchors[1]``), or a table named as the subject of the refusal (``winch must be a table``).
+FIELD_PATH = re.compile(r"\b" + TABLES + r"(?:\[\d+\](?:\.[a-z_]+(?:\[\d+\])?)*|(?:\.[a-z_]+(?:\[\d+\])?)+)"
+                        + r"|^(?:scene )?" + TABLES + r"\b (?:must|has|is|lacks)")
+
+
+def test_field_path_pattern_accepts_paths_and_rejects_bare_names():
+    for text in ("trajectory.radius must be >= 0", "pulleys[0].center", "platform.anchors[1] enters",
+                 "gravity must be finite", "winch must be a table, got None", "cables[0] has unknown field(s)"):
+        assert FIELD_PATH.search(text), text
+    for text in ("radius must be >= 0 [m], got -1.0", "anchor [-0.15, -1.9] lies inside the pulley disc"):
+        assert not FIELD_PATH.search(text), text
+
+
+@seed(20261123)
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(malformed_scene_dicts())
+def test_every_refusal_of_a_malformed_scene_names_a_field_path(data):
+    try:
+        check_reference(scene_from_dict(data))
+    except CdprError as err:
+        assert FIELD_PATH.search(str(err)), str(err)

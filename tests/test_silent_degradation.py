@@ -1,0 +1,69 @@
+"""Nothing degrades silently: coarse output warns, scene files must say what they mean,
+and a failure's hint follows its cause (issues 11 and 12)."""
+
+import subprocess
+import sys
+import warnings
+from dataclasses import replace
+
+import pytest
+
+from cdpr_exu.errors import CoarseOutputWarning, SceneError, SolverFailure
+from cdpr_exu.scene import load_scene, shipped_scenes
+from cdpr_exu.simulate import likely_cause, simulate
+
+PAPER = load_scene("paper-circle")
+
+
+def test_a_step_longer_than_the_output_period_warns_with_the_sample_count():
+    with pytest.warns(CoarseOutputWarning, match=r"solver.step_size = 0.5 s .* \(21 samples over 10.0 s\)"):
+        replace(PAPER.solver, step_size=0.5)
+
+
+def test_the_cli_prints_the_coarse_output_warning_as_one_line():
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", "paper-circle", "--step-size", "0.5",
+                           "--end-time", "1", "-q"], capture_output=True, text=True, timeout=300)
+    assert "cdpr: warning: solver.step_size = 0.5 s" in done.stderr and "warnings.warn" not in done.stderr
+
+
+def test_shipped_scenes_load_without_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for name in shipped_scenes():
+            load_scene(name)
+
+
+def test_an_empty_scene_file_is_refused_naming_the_missing_tables(tmp_path):
+    path = tmp_path / "empty.toml"
+    path.write_text("")
+    with pytest.raises(SceneError, match=r"lacks pulleys, platform, trajectory"):
+        load_scene(path)
+
+
+def test_a_point_to_point_without_end_is_refused_naming_trajectory_end(tmp_path):
+    path = tmp_path / "p2p.toml"  # the paper scene with its trajectory replaced
+    source = (tmp_path / "paper.toml")
+    from cdpr_exu.scene import save_scene
+
+    save_scene(PAPER, source)
+    body = source.read_text().split("[trajectory]")[0]
+    path.write_text(body + '[trajectory]\nkind = "point_to_point"\nstart = [0.0, -2.0, 0.0]\n')
+    with pytest.raises(SceneError, match=r"trajectory\.end is required"):
+        load_scene(path)
+
+
+@pytest.mark.parametrize("failure, expected", [
+    ("element 3 of cable 1 is strained by +6.2 % at t = 1.0 s", "too soft"),
+    ("element 3 of cable 1 cuts 140 mm deep into pulley 1 at t = 1.0 s", "slipped into the pulley"),
+    ("the platform rose above the pulleys at t = 0.9 s", "thrown upwards"),
+    ("the coordinates are no longer finite at t = 0.5 s", "diverged"),
+])
+def test_the_hint_follows_the_cause_the_monitor_found(failure, expected):
+    hint = likely_cause(PAPER, failure, failure_time=1.0)
+    assert expected in hint and "a sudden jump of the winch command" not in hint
+
+
+def test_a_run_that_fails_at_t_0_says_what_in_the_scene_makes_the_first_step_fail():
+    scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.2, max_newton_iterations=1))
+    with pytest.raises(SolverFailure, match=r"at t = 0 the first step failed: solver.max_newton_iterations = 1"):
+        simulate(scene)

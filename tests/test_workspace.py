@@ -1,0 +1,86 @@
+"""The workspace check: a reference the cables cannot reach or hold is refused before any run."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cdpr_exu.comparison import CONTROLLERS
+from cdpr_exu.errors import UnreachableError
+from cdpr_exu.scene import Effects, load_scene
+from cdpr_exu.simulate import simulate
+from cdpr_exu.trajectories import CircleTrajectory, PointToPointTrajectory
+from cdpr_exu.workspace import check_reference, reference_samples
+
+PAPER = load_scene("paper-circle")
+
+
+def _moving_to(end, **changes):
+    trajectory = PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=end, duration=2.0)
+    return PAPER.with_changes(trajectory=trajectory, solver=replace(PAPER.solver, end_time=3.0), **changes)
+
+
+@pytest.mark.parametrize("controller", sorted(CONTROLLERS))
+def test_a_reference_above_the_pulleys_is_refused_before_the_run_for_every_controller(controller):
+    scene = _moving_to((0.0, 1.0, 0.0))
+    with pytest.raises(UnreachableError, match=r"at t = \d+\.\d+ s .*cannot hold the platform's weight") as err:
+        simulate(scene, CONTROLLERS[controller]())
+    assert "platform.mass" in str(err.value) and "(x [m], z [m], rotation [rad])" in str(err.value)
+
+
+def test_the_first_pose_refused_is_where_the_anchors_rise_to_the_pulley_tops():
+    """Cables pull along the line to where they leave the rim; above the rim top they pull down only."""
+    times, poses = reference_samples(_moving_to((0.0, 1.0, 0.0)))
+    with pytest.raises(UnreachableError) as err:
+        check_reference(_moving_to((0.0, 1.0, 0.0)))
+    z = float(str(err.value).split("[")[1].split(",")[1])
+    anchor_height = z + 0.1  # anchors sit h_p / 2 = 0.1 m above the platform centre
+    # The pulley top is at z = +0.25; the first refused sample lies within one sample spacing above it.
+    spacing = np.max(np.abs(np.diff(poses[:, 1])))
+    assert 0.0 < anchor_height - 0.25 <= spacing + 1e-9
+
+
+def test_an_anchor_inside_a_pulley_names_the_conflicting_fields_then_the_values():
+    scene = _moving_to((-1.6, -0.3, 0.0))
+    with pytest.raises(UnreachableError) as err:
+        check_reference(scene)
+    message = str(err.value)
+    for field in ("platform.anchors[0]", "pulleys[0].center", "pulleys[0].radius", "t = "):
+        assert field in message, field
+
+
+def test_a_reference_needing_more_cable_than_there_is_names_the_cable_length():
+    with pytest.raises(UnreachableError, match=r"cables\[\d\]\.unstrained_length"):
+        check_reference(_moving_to((0.0, -4.5, 0.0)))
+
+
+@pytest.mark.parametrize("preset", ["elastic", "ideal"])
+def test_massless_ropes_reach_the_same_poses_whatever_n_elements_says(preset):
+    """A massless rope has no elements: a pose needing about 3.5 of its 3.75 m is reachable at n = 4 and n = 80."""
+    low = _moving_to((0.0, -2.6, 0.0), effects=Effects.from_preset(preset))
+    verdicts = []
+    for n in (4, 80):
+        scene = low.with_changes(cables=tuple(replace(c, n_elements=n) for c in low.cables))
+        check_reference(scene)  # must not raise
+        verdicts.append(True)
+    assert verdicts == [True, True]
+    lumped = low.with_changes(effects=Effects.from_preset("full"),
+                              cables=tuple(replace(c, n_elements=4) for c in low.cables))
+    with pytest.raises(UnreachableError, match="one element"):  # a lumped cable keeps one element
+        check_reference(lumped)
+
+
+def test_the_circle_is_checked_at_its_extreme_poses_exactly():
+    scene = PAPER.with_changes(trajectory=CircleTrajectory(angular_rate=1.5))
+    times, poses = reference_samples(scene)
+    quarter = np.pi / 2 / 1.5
+    for k in range(1, 4):
+        assert np.min(np.abs(times - k * quarter)) < 1e-12
+    assert poses[:, 1].max() == pytest.approx(-1.2, abs=1e-12)  # the top of the circle, sampled exactly
+
+
+def test_the_shipped_scenes_pass_the_check():
+    from cdpr_exu.scene import shipped_scenes
+
+    for name in shipped_scenes():
+        check_reference(load_scene(name))
