@@ -1,11 +1,16 @@
 """Tension-only (slack) axial spring-dampers of lumped-mass cables: numba kernels.
 
-A real cable cannot push. With ``Effects.slack`` the axial force of element e between
-nodes a and b is
+A real cable cannot push, and a slack cable carries nothing at all. With
+``Effects.slack`` the axial force of element e between nodes a and b is
 
-    f = max(0, k (l - l0) + c dl/dt),   l = |p_b - p_a|,
+    f = g(s) max(0, k s + c ds/dt),   s = l - l0,   l = |p_b - p_a|,
 
-pulling the nodes together along u = (p_b - p_a) / l. Exudyn's built-in spring-damper
+pulling the nodes together along u = (p_b - p_a) / l (:func:`tension_law`). The switch
+g rises from 0 at the rest length to 1 at a strain of :data:`TAUT_BAND` as a C1
+smoothstep: below the rest length there is no force at all (not even damping: a slack
+element that is pulled straight again does not resist with its Kelvin-Voigt damper),
+and Newton sees a force that is continuous with a continuous slope in the length when
+a cable snaps taut. Exudyn's built-in spring-damper
 has no tension-only option, so these elements join the bending springs in the one
 ``ObjectGenericODE2`` of the cables (:mod:`cdpr_exu.cable`), with an analytic Jacobian.
 
@@ -30,6 +35,44 @@ def _element_state(positions, velocities, a, b):
     return length, ux, uy, rate, dvx, dvy
 
 
+#: Strain over which a tension-only element goes from slack (no force) to taut (the full
+#: Kelvin-Voigt law); 1e-5 is a hundredth of the strain the paper's cable carries under
+#: the platform's weight (about 1e-3), so it moves no taut force noticeably.
+TAUT_BAND = 1e-5
+
+
+@njit(cache=True)
+def tension_law(extension, rate, stiffness, damping, band):
+    """Tension of a tension-only element and its derivatives.
+
+    Parameters
+    ----------
+    extension : float [m]
+        s = l - l0 (negative: shorter than the rest length, slack).
+    rate : float [m/s]
+        ds/dt.
+    stiffness, damping : float [N/m, N s/m]
+    band : float [m]
+        Extension over which the element goes from slack to taut (C1 smoothstep).
+
+    Returns
+    -------
+    (tension, d tension / d extension, d tension / d rate) : floats [N, N/m, N s/m]
+        The tension is never negative; zero below the rest length.
+    """
+    if extension <= 0.0:
+        return 0.0, 0.0, 0.0
+    viscoelastic = stiffness * extension + damping * rate
+    if viscoelastic <= 0.0:
+        return 0.0, 0.0, 0.0
+    if extension >= band:
+        return viscoelastic, stiffness, damping
+    x = extension / band
+    switch = x * x * (3.0 - 2.0 * x)
+    switch_slope = 6.0 * x * (1.0 - x) / band
+    return switch * viscoelastic, switch_slope * viscoelastic + switch * stiffness, switch * damping
+
+
 @njit(cache=True)
 def slack_axial_force(positions, velocities, elements, rest_length, stiffness, damping, out):
     """Add the tension-only axial forces to ``out`` (2N,) [N] and return it.
@@ -46,7 +89,8 @@ def slack_axial_force(positions, velocities, elements, rest_length, stiffness, d
     for e in range(elements.shape[0]):
         a, b = elements[e, 0], elements[e, 1]
         length, ux, uy, rate, _, _ = _element_state(positions, velocities, a, b)
-        force = stiffness[e] * (length - rest_length[e]) + damping[e] * rate
+        force, _, _ = tension_law(length - rest_length[e], rate, stiffness[e], damping[e],
+                                  TAUT_BAND * rest_length[e])
         if force <= 0.0:
             continue
         out[2 * a] += force * ux
@@ -62,13 +106,14 @@ def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness
     """Add ``factor_position * K + factor_velocity * D`` of the slack elements to ``out``.
 
     K = -df/dq and D = -df/dv (the left-hand-side Jacobians Exudyn expects), shape
-    (2N, 2N); zero for an element whose force is not positive (slack).
+    (2N, 2N); zero for an element whose force is not positive (slack). ``k`` and ``c``
+    below are the slopes of :func:`tension_law` in the extension and its rate.
     """
     for e in range(elements.shape[0]):
         a, b = elements[e, 0], elements[e, 1]
         length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
-        k, c = stiffness[e], damping[e]
-        force = k * (length - rest_length[e]) + c * rate
+        force, k, c = tension_law(length - rest_length[e], rate, stiffness[e], damping[e],
+                                  TAUT_BAND * rest_length[e])
         if force <= 0.0:
             continue
         u = (ux, uy)

@@ -123,6 +123,9 @@ class CableForceItems:
     user_functions: tuple = ()
     contact_segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     contact: SegmentPulleyContact | None = None
+    #: The tension-only elements' rest lengths, stiffnesses and dampings [m, N/m, N s/m], shape (E,):
+    #: the arrays the force kernels read (a winch's rope reservoir changes its first element's).
+    slack_arrays: tuple = ()
 
 
 def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
@@ -223,7 +226,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         forceUserFunction=functions[0], jacobianUserFunction=functions[1], **matrices))
     segments = np.zeros((0, 2), np.int64) if contact is None else contact.segments
     return CableForceItems(obj, joints, stiffness, damping, elements, (spring, *functions, matrices),
-                           segments, contact)
+                           segments, contact, (rest, axial_k, axial_c) if effects.slack else ())
 
 
 def _segment_contact(counts: list[int], pulleys: list[PulleySpec] | None,
@@ -280,13 +283,19 @@ def _linear_bending_matrices(cables: list[CableSpec], counts: list[int], joints:
 
 
 def element_tensions(cable: CableSpec, positions: np.ndarray, velocities: np.ndarray,
-                     effects: Effects) -> np.ndarray:
+                     effects: Effects, rest_length: np.ndarray | None = None) -> np.ndarray:
     """Axial force of each element, as the spring-dampers compute it (tension > 0).
 
     Parameters
     ----------
     cable : CableSpec
     positions, velocities : ndarray, shape (..., n + 1, 2) [m, m/s]
+    effects : Effects
+        With ``slack``, the tension-only law of :func:`cdpr_exu.axial.tension_law`.
+    rest_length : ndarray, shape (..., n), optional [m]
+        Rest length of each element when it differs from the nominal one (the winch
+        element holding slack rope, :func:`cdpr_exu.winch.reservoir_split`); stiffness
+        and damping scale as 1 / rest length.
 
     Returns
     -------
@@ -296,11 +305,15 @@ def element_tensions(cable: CableSpec, positions: np.ndarray, velocities: np.nda
     delta_rate = np.diff(velocities, axis=-2)
     length = np.linalg.norm(delta, axis=-1)
     length_rate = np.einsum("...i,...i->...", delta, delta_rate) / np.where(length > 0, length, 1.0)
-    force = cable.axial_stiffness * (length - cable.element_length)
+    rest = cable.element_length if rest_length is None else np.asarray(rest_length, dtype=float)
+    scale = cable.element_length / rest
+    extension = length - rest
+    force = cable.axial_stiffness * scale * extension
     if effects.axial_damping:
-        force = force + cable.axial_damping * length_rate
-    if effects.slack:
-        force = np.maximum(force, 0.0)
+        force = force + cable.axial_damping * scale * length_rate
+    if effects.slack:  # axial.tension_law, vectorised: nothing below the rest length, a C1 switch above
+        x = np.clip(extension / (axial.TAUT_BAND * rest), 0.0, 1.0)
+        force = np.maximum(force, 0.0) * x * x * (3.0 - 2.0 * x)
     return force
 
 

@@ -50,6 +50,10 @@ class Result:
     status : str
         "completed" or "failed: <cause>".
     failure_time : float or None [s]
+    winch_reservoir : ndarray, shape (N, m), or None [m]
+        Slack rope held at each winch drum (tension-only cables under kinematic winches,
+        see :func:`cdpr_exu.winch.reservoir_split`); it lengthens each cable's winch
+        element (element 0). None where there is no reservoir.
     metadata : dict
     """
 
@@ -69,6 +73,7 @@ class Result:
     newton_iterations: int = 0
     status: str = "completed"
     failure_time: float | None = None
+    winch_reservoir: np.ndarray | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
 
     # ----------------------------------------------------------------- derived
@@ -125,6 +130,8 @@ class Result:
             "steps": int(self.steps),
             "newton_iterations": int(self.newton_iterations),
             "failure_time_s": self.failure_time,
+            "max_winch_reservoir_m": (None if self.winch_reservoir is None or not len(self.winch_reservoir)
+                                      else self.winch_reservoir.max(axis=0).tolist()),
             "notes": notes,
         }
 
@@ -141,6 +148,8 @@ class Result:
             "platform_velocity": self.platform_velocity, "reference_pose": self.reference_pose,
             "paid_out": self.paid_out, "pulley_penetration": self.pulley_penetration,
         }
+        if self.winch_reservoir is not None:
+            arrays["winch_reservoir"] = self.winch_reservoir
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"] = nodes
             arrays[f"node_velocities_{i}"] = self.node_velocities[i]
@@ -184,6 +193,7 @@ class Result:
                 wall_time=info.get("wall_time", 0.0), steps=info["steps"],
                 newton_iterations=info["newton_iterations"], status=info["status"],
                 failure_time=info["failure_time"], metadata=info.get("metadata", {}),
+                winch_reservoir=data["winch_reservoir"] if "winch_reservoir" in data.files else None,
             )
 
 

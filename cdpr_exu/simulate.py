@@ -31,7 +31,7 @@ from .model import Model, build_model
 from .pulley import penetration, segment_penetration
 from .result import Result
 from .scene import Scene
-from .winch import servo_force, set_paid_out_length
+from .winch import RopeReservoir, servo_force, set_paid_out_length
 
 
 @contextlib.contextmanager
@@ -101,6 +101,13 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     ti.newton.useModifiedNewton = solver.newton == "modified"
     ti.newton.modifiedNewtonJacUpdatePerStep = True
     ti.newton.maxIterations = solver.max_newton_iterations
+    if not scene.effects.cable_mass:
+        # Massless ropes (one reeving spring each) on a light platform are so stiff that
+        # Exudyn's default relative tolerance (1e-8) sits at the round-off of the residual:
+        # Newton stalls and the adaptive step shrinks 10 to 350 times (measured: 0.05 kg on
+        # E = 1e11 ropes, 322 000 steps instead of 3 000 for 0.3 s at 1e-4 s). 1e-6 is far
+        # below any error these coarse models are used for.
+        ti.newton.relativeTolerance = MASSLESS_NEWTON_TOLERANCE
     ti.discontinuous.useRecommendedStepSize = False
     ti.adaptiveStep = True
     ti.minimumStepSize = solver.step_size * 1e-4
@@ -122,6 +129,9 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
         settings.solution.file.binary = True
     return settings
 
+
+#: Newton's relative tolerance for the massless presets (see :func:`solver_settings`).
+MASSLESS_NEWTON_TOLERANCE = 1e-6
 
 #: A run stops when an element's strain exceeds this: the lumped model has left the
 #: range where it describes a steel cable (real cables break near 1-2 % strain).
@@ -155,13 +165,20 @@ class _Monitor:
         suspended = scene.platform.initial_pose[1] < centers[:, 1].min()
         self.ceiling = tops.max() if suspended else np.inf
 
-    def problem(self, t: float, q: np.ndarray) -> str | None:
-        """A description of what is wrong at time ``t``, or None."""
+    def problem(self, t: float, q: np.ndarray, surplus: np.ndarray | None = None) -> str | None:
+        """A description of what is wrong at time ``t``, or None.
+
+        ``surplus`` [m], shape (m,): slack rope held at each drum, which lengthens the
+        winch element (:func:`cdpr_exu.winch.reservoir_split`).
+        """
         if not np.all(np.isfinite(q)):
             return f"the coordinates are no longer finite at t = {t:.4f} s"
         for i, (cable, reference, idx) in enumerate(self.cables):
             positions = reference + q[idx]
-            strain = np.linalg.norm(np.diff(positions, axis=0), axis=1) / cable.element_length - 1.0
+            rest = np.full(cable.n_elements, cable.element_length)
+            if surplus is not None:
+                rest[0] += surplus[i]
+            strain = np.linalg.norm(np.diff(positions, axis=0), axis=1) / rest - 1.0
             if self.scene.effects.slack:
                 strain = np.maximum(strain, 0.0)  # a tension-only element may go slack: shortening is no fault
             worst = int(np.argmax(np.abs(strain)))
@@ -203,9 +220,10 @@ class _Recorder:
         self.times = np.full(count, np.nan)
         self.paid_out = np.full((count, len(model.winches)), np.nan)
         self.rope_forces = np.full((count, len(model.ropes)), np.nan)
+        self.surplus = np.zeros((count, len(model.winches)))  # slack rope at each drum [m]
         self.count = 0
 
-    def record_if_due(self, t: float, paid_out: np.ndarray) -> bool:
+    def record_if_due(self, t: float, paid_out: np.ndarray, surplus: np.ndarray | None = None) -> bool:
         """Store the state if an output time is due; True if it was stored."""
         if self.count < len(self.output_times) and t >= self.output_times[self.count] - 1e-9:
             data = self.model.mbs.systemData
@@ -213,6 +231,8 @@ class _Recorder:
             self.v[self.count] = data.GetODE2Coordinates_t()
             self.times[self.count] = t
             self.paid_out[self.count] = paid_out
+            if surplus is not None:
+                self.surplus[self.count] = surplus
             for i, rope in enumerate(self.model.ropes):
                 self.rope_forces[self.count, i] = self.model.mbs.GetObjectOutput(rope.rope, exu.OutputVariableType.ForceLocal)
             self.count += 1
@@ -239,7 +259,9 @@ class _Recorder:
             velocities = v[:, idx]
             nodes.append(positions)
             node_velocities.append(velocities)
-            tensions.append(element_tensions(cable, positions, velocities, scene.effects))
+            rest = np.full((k, cable.n_elements), cable.element_length)
+            rest[:, 0] += self.surplus[:k, i]  # the winch element holds the slack rope at the drum
+            tensions.append(element_tensions(cable, positions, velocities, scene.effects, rest))
             if scene.cable_exit == "pulley":
                 depth.append(penetration(scene.pulleys[i], positions).max(axis=1))
             else:
@@ -343,6 +365,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
                 ])
         return Measurement(t, state["paid_out"].copy(), state["rate"].copy(), pose, velocity, tensions)
 
+    reservoir = _rope_reservoir(scene, model)
+    first_nodes = [indices[f"cable_{i}"][:2] for i in range(len(scene.cables))] if reservoir else []
     servo_state = {"integral": np.zeros(len(model.servos)), "time": 0.0}
     drum_index = [mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
 
@@ -382,15 +406,21 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
             return False
         state["paid_out"] = paid_out
         state["rate"] = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
-        for winch, length, initial in zip(model.winches, state["paid_out"], model.initial_paid_out):
+        targets = state["paid_out"]
+        if reservoir is not None:  # slack rope paid out piles up at the drum (winch.reservoir_split)
+            q = mbs_.systemData.GetODE2Coordinates()
+            lengths = np.array([np.linalg.norm(np.diff(ref_q[idx] + q[idx], axis=0)) for idx in first_nodes])
+            targets = model.initial_paid_out + reservoir.update(targets - model.initial_paid_out, lengths)
+        for winch, length, initial in zip(model.winches, targets, model.initial_paid_out):
             set_paid_out_length(mbs_, winch, length, initial)
         return True
 
     def post_step(mbs_, t):
         if interrupted["interrupted"]:
             return False  # Ctrl-C: end the integration, keep what was computed
-        if recorder.record_if_due(t, state["paid_out"]):
-            stop["reason"] = monitor.problem(t, recorder.q[recorder.count - 1])
+        surplus = None if reservoir is None else reservoir.surplus
+        if recorder.record_if_due(t, state["paid_out"], surplus):
+            stop["reason"] = monitor.problem(t, recorder.q[recorder.count - 1], surplus)
             if stop["reason"] is not None:
                 return False  # ends the time integration; the samples so far are kept
         if report is not None:
@@ -433,6 +463,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     result.wall_time = wall
     result.steps = int(iterations.currentStepIndex)
     result.newton_iterations = int(iterations.newtonStepsCount)
+    if reservoir is not None:
+        result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
     result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
                        "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts()}
     last_time = float(result.time[-1]) if len(result.time) else 0.0
@@ -448,6 +480,22 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
             f"(step size {solver.step_size} s): {failure}. {likely_cause(scene, failure, last_time)}",
             time=last_time, partial_result=result)
     return result
+
+
+def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
+    """The slack-rope reservoir of kinematic winches on tension-only lumped cables (else None)."""
+    forces = model.cable_forces
+    if not (scene.effects.slack and scene.winch.kind == "kinematic" and forces is not None and forces.slack_arrays):
+        return None
+    rest, stiffness, damping = forces.slack_arrays
+    counts = [cable.n_elements for cable in scene.cables]
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int)
+    m = len(scene.cables)
+    return RopeReservoir(
+        first_elements=first, nominal_rest_length=rest[first].copy(),
+        axial_rigidity=stiffness[first] * rest[first], damping_rigidity=damping[first] * rest[first],
+        rest_length=rest, stiffness=stiffness, damping=damping,
+        surplus=np.zeros(m), node_offset=np.zeros(m), max_surplus=np.zeros(m))
 
 
 def _solver_report(mbs: exu.MainSystem, message: str) -> str:

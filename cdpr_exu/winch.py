@@ -134,3 +134,93 @@ def servo_force(servo: ServoItems, error_integral: float, error: float, error_ra
                 feed_forward: float) -> float:
     """Motor force on the drum [N]: u = u_ff - K (integral e, e, e')."""
     return float(feed_forward - servo.gains @ np.array([error_integral, error, error_rate]))
+
+
+# --------------------------------------------------------------------------- slack rope at the winch
+
+#: A tension-only winch element (element 0) may shorten to this fraction of its nominal
+#: length while slack; rope that would shorten it further goes into the reservoir.
+RESERVOIR_THRESHOLD = 0.75
+
+
+def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, element_length: float,
+                    rest_length: float, threshold: float = RESERVOIR_THRESHOLD) -> tuple[float, float]:
+    """Split a winch command between moving the winch node and the slack rope at the drum.
+
+    A slack cable cannot keep its rope off the winch: rope paid out while nothing pulls
+    it away, or falling faster than the winch hauls in, piles up at the drum. In the
+    lumped model the winch node would instead run into the next node, and the first
+    element would collapse (and Newton with it when the cable snaps taut). So the winch
+    node never moves where its element would be shorter than ``threshold`` of its
+    nominal length: the rope that does not go into the node's motion is kept as
+    *surplus* at the drum, added to the first element's rest length. Hauling in takes up
+    the surplus first. Rope is conserved: ``node_offset + surplus == paid_out_change``.
+
+    Parameters
+    ----------
+    paid_out_change : float [m]
+        The command: paid-out length minus its initial value (positive: paid out, the
+        node moves up the winch line towards the pulley).
+    node_offset : float [m]
+        The winch node's current offset up the winch line.
+    surplus : float [m]
+        The rope held at the drum so far (>= 0).
+    element_length : float [m]
+        The first element's current length |p_1 - p_0|.
+    rest_length : float [m]
+        Its nominal rest length (without the surplus).
+    threshold : float
+        Shortest length of the first element, as a fraction of ``rest_length``.
+
+    Returns
+    -------
+    (node_offset, surplus) : floats [m]
+        The new offset of the winch node and the new surplus (>= 0).
+    """
+    wanted = paid_out_change - surplus  # where the node goes if the surplus stays
+    node = wanted if wanted > node_offset else min(node_offset, paid_out_change)
+    highest = node_offset + element_length - threshold * rest_length  # the first element at its shortest
+    node = min(node, highest)
+    return node, paid_out_change - node
+
+
+@dataclass
+class RopeReservoir:
+    """The slack rope held at each winch drum, and the first elements it lengthens.
+
+    Attributes
+    ----------
+    first_elements : ndarray of int, shape (m,)
+        Index of each cable's winch element in the tension-only element arrays.
+    nominal_rest_length, axial_rigidity, damping_rigidity : ndarray, shape (m,) [m, N, N s]
+        The winch element's unstrained length, E A and d_n A: its stiffness and damping
+        are E A / l and d_n A / l for its current rest length l.
+    rest_length, stiffness, damping : ndarray
+        The arrays the force kernel reads (changed in place).
+    surplus, node_offset, max_surplus : ndarray, shape (m,) [m]
+    """
+
+    first_elements: np.ndarray
+    nominal_rest_length: np.ndarray
+    axial_rigidity: np.ndarray
+    damping_rigidity: np.ndarray
+    rest_length: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    surplus: np.ndarray
+    node_offset: np.ndarray
+    max_surplus: np.ndarray
+
+    def update(self, paid_out_change: np.ndarray, element_lengths: np.ndarray) -> np.ndarray:
+        """Split this step's commands (shape (m,) [m]); returns the winch nodes' offsets [m]."""
+        for i, e in enumerate(self.first_elements):
+            node, surplus = reservoir_split(float(paid_out_change[i]), float(self.node_offset[i]),
+                                            float(self.surplus[i]), float(element_lengths[i]),
+                                            float(self.nominal_rest_length[i]))
+            self.node_offset[i], self.surplus[i] = node, surplus
+            rest = self.nominal_rest_length[i] + surplus
+            self.rest_length[e] = rest
+            self.stiffness[e] = self.axial_rigidity[i] / rest
+            self.damping[e] = self.damping_rigidity[i] / rest
+            self.max_surplus[i] = max(self.max_surplus[i], surplus)
+        return self.node_offset.copy()

@@ -66,3 +66,55 @@ def test_internal_forces_sum_to_zero():
     p, v, elements, rest = _chain(rng, 8)
     f = _force(p, v, elements, rest, np.full(7, 1e4), np.full(7, 5.0)).reshape(-1, 2)
     np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-9)
+
+
+# --------------------------------------------------------------------------- the tension law
+
+from cdpr_exu.axial import TAUT_BAND, tension_law  # noqa: E402
+
+K, C, BAND = 3.14e5, 3.14e5, TAUT_BAND * 0.25  # the paper's element, a 0.25 m rest length
+
+
+def test_a_slack_element_pulled_straight_fast_carries_nothing():
+    """Below the rest length there is no force at all, not even from the damper."""
+    for extension in (-1e-3, -1e-9, 0.0):
+        assert tension_law(extension, 5.0, K, C, BAND) == (0.0, 0.0, 0.0)
+
+
+def test_above_the_band_the_law_is_kelvin_voigt_and_never_negative():
+    tension, slope, damping = tension_law(2e-4, 0.01, K, C, BAND)
+    assert tension == pytest.approx(K * 2e-4 + C * 0.01, rel=1e-15) and (slope, damping) == (K, C)
+    assert tension_law(2e-4, -1.0, K, C, BAND)[0] == 0.0  # closing faster than it stretches: slack
+
+
+@pytest.mark.parametrize("rate", [0.0, 0.3])
+def test_the_switch_is_continuous_with_a_continuous_slope(rate):
+    """C1 at both ends of the band: value and slope match from either side (to the
+    central-difference error, 1e-6 of the scale), and the slope is the law's own."""
+    for edge in (0.0, BAND):
+        # 1e-16 m either side: the slope changes by at most (6 C rate / BAND^2) 1e-16 = 9 N/m there
+        below, above = tension_law(edge - 1e-16, rate, K, C, BAND), tension_law(edge + 1e-16, rate, K, C, BAND)
+        scale = K * BAND + C * rate
+        assert abs(above[0] - below[0]) <= 1e-6 * scale
+        assert abs(above[1] - below[1]) <= 1e-4 * max(abs(above[1]), K)
+    for extension in np.linspace(0.1 * BAND, 0.9 * BAND, 5):
+        h = 1e-6 * BAND
+        numeric = (tension_law(extension + h, rate, K, C, BAND)[0] - tension_law(extension - h, rate, K, C, BAND)[0]) / (2 * h)
+        assert tension_law(extension, rate, K, C, BAND)[1] == pytest.approx(numeric, rel=1e-6)
+
+
+def test_jacobian_matches_central_differences_inside_the_taut_band():
+    """Elements stretched within the switch band: the smoothstep's slope enters the Jacobian."""
+    p = np.array([0.0, 0.0, 1.0 + 0.5 * TAUT_BAND, 0.0, 2.0 + 0.7 * TAUT_BAND, 0.1])
+    v = np.array([0.0, 0.0, 0.01, 0.0, 0.02, -0.01])
+    elements, rest = cable_elements([3]), np.array([1.0, np.hypot(1.0 + 0.2 * TAUT_BAND, 0.1)])
+    k, c = np.full(2, 3.0e3), np.full(2, 20.0)
+    n = p.size
+    stiffness = slack_axial_jacobian(p, v, elements, rest, k, c, 1.0, 0.0, np.zeros((n, n)))
+    h = 1e-12  # far inside the 1e-5 band
+    fd = np.zeros((n, n))
+    for j in range(n):
+        e = np.zeros(n)
+        e[j] = h
+        fd[:, j] = -(_force(p + e, v, elements, rest, k, c) - _force(p - e, v, elements, rest, k, c)) / (2 * h)
+    np.testing.assert_allclose(stiffness, fd, atol=1e-3 * np.abs(fd).max())

@@ -52,3 +52,51 @@ def test_servo_winch_tracks_the_command_and_matches_the_kinematic_winch():
     # ... so the platform moves as with the exact (kinematic) winch, to 5 mm.
     difference = np.linalg.norm(servo.platform_pose[:, :2] - kinematic.platform_pose[:, :2], axis=1)
     assert difference.max() < 5e-3
+
+
+# --------------------------------------------------------------------------- slack rope at the drum
+
+from cdpr_exu.winch import RESERVOIR_THRESHOLD, reservoir_split  # noqa: E402
+
+
+@pytest.mark.parametrize("change, node, surplus, length", [
+    (0.10, 0.0, 0.0, 0.25), (0.10, 0.0, 0.0, 0.19), (0.12, 0.05, 0.03, 0.20), (-0.02, 0.05, 0.03, 0.30),
+    (0.0, 0.05, 0.0, 0.10)])
+def test_rope_is_conserved_between_the_node_and_the_drum(change, node, surplus, length):
+    new_node, new_surplus = reservoir_split(change, node, surplus, length, 0.25)
+    assert new_node + new_surplus == pytest.approx(change, abs=1e-15)
+    assert new_surplus >= -1e-15
+
+
+def test_a_taut_element_lets_the_node_follow_the_command():
+    assert reservoir_split(0.004, 0.0, 0.0, 0.2501, 0.25) == (0.004, 0.0)
+    assert reservoir_split(-0.004, 0.0, 0.0, 0.2501, 0.25) == (-0.004, 0.0)
+
+
+def test_paying_out_slack_rope_stops_the_node_at_the_shortest_element():
+    """The first element may shorten to RESERVOIR_THRESHOLD of its length, no further."""
+    node, surplus = reservoir_split(0.10, 0.0, 0.0, 0.20, 0.25)
+    assert 0.20 - node == pytest.approx(RESERVOIR_THRESHOLD * 0.25)
+    assert surplus == pytest.approx(0.10 - node)
+
+
+def test_hauling_in_takes_up_the_surplus_before_the_node_moves():
+    node, surplus = reservoir_split(0.06, 0.05, 0.03, 0.30, 0.25)  # hauled in 0.02 of the 0.03 surplus
+    assert (node, surplus) == (pytest.approx(0.05), pytest.approx(0.01))
+    node, surplus = reservoir_split(0.03, 0.05, 0.03, 0.30, 0.25)  # hauled in more than the surplus
+    assert (node, surplus) == (pytest.approx(0.03), pytest.approx(0.0))
+
+
+def test_the_massless_presets_keep_their_step_on_stiff_ropes_and_a_light_platform():
+    """0.05 kg on E = 1e12 ropes at 1e-4 s: Newton converges at every step, so the
+    adaptive step never shrinks (it did 350-fold at Exudyn's default tolerance)."""
+    from cdpr_exu.scene import Effects
+
+    paper = load_scene("paper-circle")
+    scene = paper.with_changes(
+        effects=Effects.from_preset("ideal"),
+        cables=tuple(replace(c, youngs_modulus=1e12) for c in paper.cables),
+        platform=replace(paper.platform, mass=0.05, inertia=paper.platform.inertia * 0.02),
+        solver=replace(paper.solver, end_time=0.05, step_size=1e-4, output_period=1e-3))
+    result = simulate(scene)
+    assert result.steps <= scene.solver.n_steps + 1  # Exudyn counts the initial step too
