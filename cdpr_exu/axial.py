@@ -132,6 +132,55 @@ def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness
     return out
 
 
+@njit(cache=True)
+def slack_triplet_pattern(elements):
+    """Rows and columns of the slack elements' sparse Jacobian triplets: 16 per element, shape (16 E,) each.
+
+    Per element the blocks (b, b), (a, a), (a, b) and (b, a), each 2 x 2, in that order.
+    """
+    n = elements.shape[0]
+    rows = np.empty(16 * n, dtype=np.int64)
+    columns = np.empty(16 * n, dtype=np.int64)
+    for e in range(n):
+        a, b = elements[e, 0], elements[e, 1]
+        pairs = ((b, b), (a, a), (a, b), (b, a))
+        for block in range(4):
+            r, c = pairs[block]
+            for i in range(2):
+                for j in range(2):
+                    rows[16 * e + 4 * block + 2 * i + j] = 2 * r + i
+                    columns[16 * e + 4 * block + 2 * i + j] = 2 * c + j
+    return rows, columns
+
+
+@njit(cache=True)
+def slack_triplet_values(positions, velocities, elements, rest_length, stiffness, damping,
+                         factor_position, factor_velocity, out_values):
+    """Values of ``factor_position * K + factor_velocity * D`` of the slack elements at
+    :func:`slack_triplet_pattern`'s places (overwrites ``out_values``, shape (16 E,))."""
+    out_values[:] = 0.0
+    for e in range(elements.shape[0]):
+        a, b = elements[e, 0], elements[e, 1]
+        length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
+        force, k, c = tension_law(length - rest_length[e], rate, stiffness[e], damping[e],
+                                  TAUT_BAND * rest_length[e])
+        if force <= 0.0:
+            continue
+        u = (ux, uy)
+        w = ((dvx - ux * rate) / length, (dvy - uy * rate) / length)
+        for i in range(2):
+            for j in range(2):
+                projector = (1.0 if i == j else 0.0) - u[i] * u[j]
+                g = u[i] * (k * u[j] + c * w[j]) + force * projector / length
+                value = factor_position * g + factor_velocity * c * u[i] * u[j]
+                base = 16 * e + 2 * i + j
+                out_values[base] = value
+                out_values[base + 4] = value
+                out_values[base + 8] = -value
+                out_values[base + 12] = -value
+    return out_values
+
+
 def cable_elements(nodes_per_cable) -> np.ndarray:
     """Element node pairs (a, b) for cables whose nodes are numbered one after another.
 

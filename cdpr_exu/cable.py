@@ -130,7 +130,8 @@ class CableForceItems:
 
 def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
                      effects: Effects, pulleys: list[PulleySpec] | None = None,
-                     contact_elements: list[np.ndarray] | None = None) -> CableForceItems | None:
+                     contact_elements: list[np.ndarray] | None = None,
+                     sparse_jacobian: bool = True) -> CableForceItems | None:
     """Add the bending (with slack, the axial; with segment contact, the pulley) forces of all cables as one object.
 
     Parameters
@@ -146,6 +147,10 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         Cable-local indices of the elements (element j joins nodes j and j + 1) that get
         a segment rim contact with their cable's pulley (``Effects.pulley_contact_model =
         "segment"``); None or all empty: no segment contact and no cost for it.
+    sparse_jacobian : bool
+        Return the Jacobian as sparse triplets (36 per bending joint, 16 per tension-only
+        element: cost linear in the number of nodes) instead of a dense (2N, 2N) matrix.
+        With segment contact the dense form is kept.
 
     Returns None when neither ``effects.bending`` nor ``effects.slack`` is on and there
     is no segment contact (then no item and no cost). The force user function receives
@@ -208,6 +213,12 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     nodes = [n for it in items for n in it.nodes]
     functions = (force_function, jacobian_function)
     mass = np.zeros((size, size))
+    if sparse_jacobian and contact is None and not linear:
+        functions = (force_function, _sparse_jacobian_function(spring, elements, rest if effects.slack else None,
+                                                               axial_k if effects.slack else None,
+                                                               axial_c if effects.slack else None,
+                                                               reference, positions))
+        mass = _sparse(np.zeros((size, size)))
     if linear and not effects.slack and contact is None:
         # Nothing left for Python per Newton iteration: no force function, and a Jacobian
         # function that returns an empty matrix, so that Exudyn adds the constant K and D
@@ -227,6 +238,38 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     segments = np.zeros((0, 2), np.int64) if contact is None else contact.segments
     return CableForceItems(obj, joints, stiffness, damping, elements, (spring, *functions, matrices),
                            segments, contact, (rest, axial_k, axial_c) if effects.slack else ())
+
+
+def _sparse_jacobian_function(spring, elements, rest, axial_k, axial_c, reference, positions):
+    """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets (an
+    ``exu.MatrixContainer``): the bending joints' 6 x 6 blocks and the tension-only
+    elements' 4 x 4 blocks, filled by numba kernels into a fixed pattern."""
+    size = reference.size
+    joint_rows, joint_columns = bending.bending_triplet_pattern(spring.joints)
+    slack = rest is not None and len(elements) > 0
+    element_rows, element_columns = (axial.slack_triplet_pattern(elements) if slack
+                                     else (np.zeros(0, np.int64), np.zeros(0, np.int64)))
+    split = joint_rows.size
+    triplets = np.zeros((split + element_rows.size, 3))
+    triplets[:, 0] = np.concatenate([joint_rows, element_rows])
+    triplets[:, 1] = np.concatenate([joint_columns, element_columns])
+    joint_values, element_values = np.zeros(split), np.zeros(element_rows.size)
+    container = exu.MatrixContainer()
+
+    def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001 - Exudyn's signature
+        np.add(reference, q, out=positions)
+        velocities = np.asarray(q_t)
+        bending.bending_triplet_values(positions, velocities, spring.joints, spring.stiffness, spring.damping,
+                                       float(f_q), float(f_q_t), joint_values)
+        triplets[:split, 2] = joint_values
+        if slack:
+            axial.slack_triplet_values(positions, velocities, elements, rest, axial_k, axial_c,
+                                       float(f_q), float(f_q_t), element_values)
+            triplets[split:, 2] = element_values
+        container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
+        return container
+
+    return jacobian_function
 
 
 def _segment_contact(counts: list[int], pulleys: list[PulleySpec] | None,

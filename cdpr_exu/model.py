@@ -189,8 +189,20 @@ def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.
             f"use elements no longer than about 1.4 pulley radii, or effects.pulley_contact_model = 'segment'")
 
 
-def build_model(scene: Scene) -> Model:
+#: Above this many cable nodes (all cables) the cables' Jacobian is handed to Exudyn as
+#: sparse triplets; below, the dense matrix is cheaper (measured: 0.45x at 2 x 16 nodes,
+#: 1.06x at 2 x 31, 3.2x at 2 x 121, 5.5x at 2 x 241; see benchmarks/bench_sparse_jacobian.py).
+SPARSE_JACOBIAN_MIN_NODES = 50
+
+
+def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
     """Build and assemble the Exudyn system of ``scene``.
+
+    ``sparse_jacobian`` hands Exudyn the Jacobian of the cables' Python-side forces
+    (exact bending, tension-only elements) as sparse triplets, whose cost grows with the
+    number of elements rather than its square; False keeps the dense (2N)^2 matrix (the
+    same numbers to round-off); None (default) chooses sparse above
+    :data:`SPARSE_JACOBIAN_MIN_NODES` nodes.
 
     Raises
     ------
@@ -242,8 +254,10 @@ def build_model(scene: Scene) -> Model:
             # Unstrained cable beyond the hang point: all of it but the hanging part.
             paid_out.append(cable.unstrained_length - (pulley.center[1] - nodes_xz[0, 1]))
         cables.append(items)
+    if sparse_jacobian is None:
+        sparse_jacobian = sum(c.n_elements + 1 for c in scene.cables) > SPARSE_JACOBIAN_MIN_NODES
     cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.pulleys),
-                                    contact_elements if on_segments else None)
+                                    contact_elements if on_segments else None, sparse_jacobian=sparse_jacobian)
     mbs.Assemble()
     return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
                  contacts, contact_nodes, np.asarray(paid_out), servos=servos, contact_elements=contact_elements)

@@ -306,7 +306,8 @@ def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndar
 
 
 def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
-             progress: bool | Callable[[float, float], None] = False) -> Result:
+             progress: bool | Callable[[float, float], None] = False,
+             sparse_jacobian: bool | None = None) -> Result:
     """Simulate ``scene`` under ``controller`` (default: ideal inverse kinematics).
 
     Parameters
@@ -319,6 +320,9 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     progress : bool or callable
         True shows a progress bar (simulated time, ratio to real time); a callable
         is called as ``progress(t, wall_time)`` about 100 times per run.
+    sparse_jacobian : bool, optional
+        Hand Exudyn the cables' Jacobian as sparse triplets (True) or a dense matrix
+        (False); default: sparse for fine cables (see :func:`cdpr_exu.model.build_model`).
 
     Returns
     -------
@@ -333,7 +337,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         computed up to then.
     """
     controller = controller or IdealIKController()
-    model = build_model(scene)
+    model = build_model(scene, sparse_jacobian=sparse_jacobian)
 
     controller.reset(scene, model.initial_paid_out.copy())
     mbs = model.mbs
