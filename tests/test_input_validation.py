@@ -460,3 +460,9 @@ def test_malformed_scenes_are_refused_or_run_without_crash_hang_or_nan(data):
     assert time.perf_counter() - start < 120.0
     for series in [result.platform_pose, result.platform_velocity, *result.nodes, *result.tensions]:
         assert np.all(np.isfinite(series))
+
+
+@pytest.mark.parametrize("value", [0.0, -1e-6, 1e-2, float("nan"), "tight"])
+def test_newton_tolerance_out_of_range_is_refused_naming_the_field(value):
+    with pytest.raises(SceneError, match=r"solver\.newton_tolerance"):
+        SolverSpec(newton_tolerance=value)
