@@ -92,13 +92,14 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
 
 
 def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: bool = True,
-              controller=None) -> dict:
+              controller=None, error_estimate: bool = False) -> dict:
     """Run ``scene`` and write its files into ``out``; returns the summary.
 
     Writes ``scene.toml``, ``result.npz``, ``pose.csv``, ``summary.json``,
     ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures.
     A failed or interrupted (Ctrl-C) run still writes what was computed up to then,
-    then re-raises. ``out`` is checked before the run starts.
+    then re-raises. ``out`` is checked before the run starts. With ``error_estimate``
+    a companion run estimates the discretisation error (:mod:`cdpr_exu.error_estimate`).
     """
     from .result import provenance
     from .simulate import simulate
@@ -115,9 +116,20 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         failure, result = err, err.partial_result
     summary = result.summary()
     settled = result.summary(after=SETTLED_AFTER)
+    estimate = None
+    if error_estimate and failure is None:
+        from .error_estimate import estimate_error
+
+        if not quiet:
+            print("estimating the discretisation error (a companion run) ...", flush=True)
+        estimate = estimate_error(scene, result, None if controller is None else type(controller),
+                                  after=SETTLED_AFTER)
     if out is not None:
         result.save(out)
         data = {**summary, **provenance()}
+        if estimate is not None:
+            data["error_estimate"] = {k: v for k, v in estimate.to_dict().items() if k != "companion_wall_time_s"}
+            data["companion_wall_time_s"] = estimate.companion_wall_time_s
         data.update({k: v for k, v in result.metadata.items() if k not in data})
         data["after_start_up"] = {k: settled[k] for k in (
             "errors_measured_after_s", "max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m",
@@ -133,6 +145,10 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
             plot_overview(scene, result, out)
     if not quiet:
         _print_summary(summary, settled, out)
+        if estimate is not None:
+            value = estimate.max_position_error_m
+            print(f"  estimated discretisation error after {SETTLED_AFTER} s: "
+                  + ("n/a" if value is None else f"{1000 * value:.2f} mm") + f" ({estimate.note})")
     if failure is not None:
         raise failure
     return summary
@@ -153,10 +169,33 @@ def undate_solution_file(path: Path) -> None:
     path.write_bytes(bytes(data))
 
 
+def _elements_for(scene: Scene, tolerance: float, quiet: bool) -> Scene:
+    """The scene with the fewest elements per cable that the error model says meet ``tolerance`` [m]."""
+    from .error_estimate import elements_for_tolerance, estimate_error
+    from .simulate import simulate
+
+    n = max(c.n_elements for c in scene.cables)
+    pilot = estimate_error(scene, simulate(scene), after=SETTLED_AFTER)
+    if pilot.max_position_error_m is None:
+        raise CdprError(f"--tolerance: no error estimate for this scene ({pilot.note})")
+    needed = elements_for_tolerance(n, pilot.max_position_error_m, tolerance)
+    if not quiet:
+        print(f"--tolerance {1000 * tolerance:g} mm: estimated {1000 * pilot.max_position_error_m:.2f} mm at {n} "
+              f"elements per cable; the error model e ~ n^-2 asks for {needed} elements"
+              + (" (kept)" if needed == n else ""))
+    return scene.with_changes(cables=tuple(replace(c, n_elements=needed) for c in scene.cables))
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
+    from .error_estimate import parse_length
+
     out = check_output_folder(args.out)
+    tolerance = None if args.tolerance is None else parse_length(args.tolerance)
     scene = _scene_with_overrides(args)
-    run_scene(scene, out, quiet=args.quiet, figures=not args.no_figures)
+    if tolerance is not None:
+        scene = _elements_for(scene, tolerance, args.quiet)
+    run_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,
+              error_estimate=not args.no_error_estimate)
     return EXIT_OK
 
 
@@ -186,6 +225,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--end-time", type=float, help="override solver.end_time [s]")
     run.add_argument("--step-size", type=float, help="override solver.step_size [s]")
     run.add_argument("--no-figures", action="store_true", help="skip the figures")
+    run.add_argument("--no-error-estimate", action="store_true",
+                     help="skip the companion run that estimates the discretisation error")
+    run.add_argument("--tolerance", metavar="LENGTH",
+                     help="position error to meet, e.g. 5mm: the fewest elements per cable the error model "
+                     "says meet it are chosen (a pilot run and its estimate first) and printed")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     run.set_defaults(func=_cmd_run)
 

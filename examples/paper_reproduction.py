@@ -43,7 +43,7 @@ def main() -> None:
     args = parser.parse_args()
     out = Path(args.out)
     scene = load_scene("paper-circle")
-    run_scene(scene, out)
+    run_scene(scene, out, error_estimate=True)  # as the README command writes it
 
     rows = []
     for label, variant in variants(scene):
