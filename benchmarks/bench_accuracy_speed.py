@@ -1,0 +1,81 @@
+"""Accuracy against speed of the paper circle: x real time, Newton iterations and error over n.
+
+For n = 15, 30, 60, 120 and 240 elements per cable, at the shipped step (2e-3 s) and at
+1e-2 s, runs the paper circle (full model) and prints: times faster than real time (wall
+clock), Newton iterations per step, and the largest position error after 1 s against
+the converged reference of the accuracy study (``results/accuracy/paper_circle/reference.npz``:
+90 elements, 5e-4 s). It also fits the exponent of the cost in n from 30 to 240 elements,
+and says which issue-14 targets the run meets. All ratios come from one run on one
+machine; the machines are shared and noisy, so compare ratios, not seconds.
+
+Run: ``python benchmarks/bench_accuracy_speed.py [--end-time 10]``; writes
+``benchmarks/results/accuracy_speed.md``. A shorter ``--end-time`` compares the error
+over that part of the circle only.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from cdpr_exu.scene import load_scene
+from cdpr_exu.simulate import simulate
+
+ELEMENTS = (15, 30, 60, 120, 240)
+STEPS = (2e-3, 1e-2)
+REFERENCE = Path(__file__).resolve().parents[1] / "results" / "accuracy" / "paper_circle" / "reference.npz"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--end-time", type=float, default=10.0, help="simulated time per run [s] (default 10)")
+    parser.add_argument("--out", default="benchmarks/results/accuracy_speed.md")
+    args = parser.parse_args()
+    paper = load_scene("paper-circle")
+    reference = np.load(REFERENCE)
+    simulate(paper.with_changes(solver=replace(paper.solver, end_time=0.05)))  # warm-up: numba, imports
+    rows = []
+    for step in STEPS:
+        for n in ELEMENTS:
+            scene = paper.with_changes(cables=tuple(replace(c, n_elements=n) for c in paper.cables),
+                                       solver=replace(paper.solver, end_time=args.end_time, step_size=step))
+            result = simulate(scene)
+            reference_pose = np.array([np.interp(result.time, reference["time"], reference["pose"][:, k])
+                                       for k in range(2)]).T
+            after = result.time >= 1.0 - 1e-9
+            error = float(np.linalg.norm(result.platform_pose[after, :2] - reference_pose[after], axis=1).max())
+            speed = result.simulated_time / result.wall_time
+            iterations = result.newton_iterations / max(result.steps, 1)
+            rows.append((step, n, speed, iterations, error, result.wall_time))
+            print(f"step {step:.0e} s, n = {n:3d}: {speed:6.2f}x real time, {iterations:5.2f} Newton iterations "
+                  f"per step, error {1000 * error:7.3f} mm", flush=True)
+    lines = [f"# Accuracy against speed, paper circle (full model, {args.end_time} s, one run each)", "",
+             "Error: largest platform position error after 1 s against the converged reference "
+             "(90 elements, 5e-4 s). Wall-clock times of one run on a shared machine: compare ratios.", "",
+             "| step [s] | elements per cable | x real time | Newton iterations / step | error [mm] |",
+             "|---|---|---|---|---|"]
+    for step, n, speed, iterations, error, _ in rows:
+        lines.append(f"| {step:g} | {n} | {speed:.2f} | {iterations:.2f} | {error * 1000:.3f} |")
+    lines.append("")
+    for step in STEPS:
+        fit = [(n, wall) for s, n, _, _, _, wall in rows if s == step and n >= 30]
+        exponent = np.polyfit(np.log([n for n, _ in fit]), np.log([w for _, w in fit]), 1)[0]
+        lines.append(f"Cost from 30 to 240 elements at step {step:g} s grows as n^{exponent:.2f} "
+                     f"(target: no faster than n^1.2).")
+    within = [(speed, step, n) for step, n, speed, _, error, _ in rows if error <= 1e-3]
+    if within:
+        speed, step, n = max(within)
+        lines.append(f"Fastest run within 1 mm of the converged answer: {speed:.2f}x real time "
+                     f"({n} elements, step {step:g} s; target: 20x).")
+    shipped = next(speed for step, n, speed, _, _, _ in rows if step == 2e-3 and n == 15)
+    lines.append(f"The shipped scene (15 elements, 2e-3 s): {shipped:.2f}x real time (target: 15x).")
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text("\n".join(lines) + "\n")
+    print("\n".join(lines[-4:]))
+
+
+if __name__ == "__main__":
+    main()
