@@ -101,34 +101,47 @@ def slack_axial_force(positions, velocities, elements, rest_length, stiffness, d
 
 
 @njit(cache=True)
+def _element_block(positions, velocities, a, b, rest_length, stiffness, damping, factor_position,
+                   factor_velocity, block):
+    """The (b, b) block, shape (2, 2), of ``factor_position * K + factor_velocity * D`` of one
+    element into ``block``; the (a, a) block is the same, (a, b) and (b, a) its negative.
+    Returns False (block untouched) when the element carries no force (slack)."""
+    length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
+    force, k, c = tension_law(length - rest_length, rate, stiffness, damping, TAUT_BAND * rest_length)
+    if force <= 0.0:
+        return False
+    u = (ux, uy)
+    # d(rate)/d(p_b) = (dv - u rate) / l
+    w = ((dvx - ux * rate) / length, (dvy - uy * rate) / length)
+    for i in range(2):
+        for j in range(2):
+            projector = (1.0 if i == j else 0.0) - u[i] * u[j]
+            g = u[i] * (k * u[j] + c * w[j]) + force * projector / length
+            block[i, j] = factor_position * g + factor_velocity * c * u[i] * u[j]
+    return True
+
+
+@njit(cache=True)
 def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness, damping,
                          factor_position, factor_velocity, out):
     """Add ``factor_position * K + factor_velocity * D`` of the slack elements to ``out``.
 
     K = -df/dq and D = -df/dv (the left-hand-side Jacobians Exudyn expects), shape
-    (2N, 2N); zero for an element whose force is not positive (slack). ``k`` and ``c``
-    below are the slopes of :func:`tension_law` in the extension and its rate.
+    (2N, 2N); zero for an element whose force is not positive (slack). The element's
+    stiffness and damping are the slopes of :func:`tension_law` in the extension and its rate.
     """
+    block = np.empty((2, 2))
     for e in range(elements.shape[0]):
         a, b = elements[e, 0], elements[e, 1]
-        length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
-        force, k, c = tension_law(length - rest_length[e], rate, stiffness[e], damping[e],
-                                  TAUT_BAND * rest_length[e])
-        if force <= 0.0:
+        if not _element_block(positions, velocities, a, b, rest_length[e], stiffness[e], damping[e],
+                              factor_position, factor_velocity, block):
             continue
-        u = (ux, uy)
-        # d(rate)/d(p_b) = (dv - u rate) / l
-        w = ((dvx - ux * rate) / length, (dvy - uy * rate) / length)
         for i in range(2):
             for j in range(2):
-                projector = (1.0 if i == j else 0.0) - u[i] * u[j]
-                g = u[i] * (k * u[j] + c * w[j]) + force * projector / length
-                d = c * u[i] * u[j]
-                value = factor_position * g + factor_velocity * d
-                out[2 * b + i, 2 * b + j] += value
-                out[2 * a + i, 2 * a + j] += value
-                out[2 * a + i, 2 * b + j] -= value
-                out[2 * b + i, 2 * a + j] -= value
+                out[2 * b + i, 2 * b + j] += block[i, j]
+                out[2 * a + i, 2 * a + j] += block[i, j]
+                out[2 * a + i, 2 * b + j] -= block[i, j]
+                out[2 * b + i, 2 * a + j] -= block[i, j]
     return out
 
 
@@ -159,25 +172,16 @@ def slack_triplet_values(positions, velocities, elements, rest_length, stiffness
     """Values of ``factor_position * K + factor_velocity * D`` of the slack elements at
     :func:`slack_triplet_pattern`'s places (overwrites ``out_values``, shape (16 E,))."""
     out_values[:] = 0.0
+    block = np.empty((2, 2))
     for e in range(elements.shape[0]):
-        a, b = elements[e, 0], elements[e, 1]
-        length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
-        force, k, c = tension_law(length - rest_length[e], rate, stiffness[e], damping[e],
-                                  TAUT_BAND * rest_length[e])
-        if force <= 0.0:
+        if not _element_block(positions, velocities, elements[e, 0], elements[e, 1], rest_length[e], stiffness[e],
+                              damping[e], factor_position, factor_velocity, block):
             continue
-        u = (ux, uy)
-        w = ((dvx - ux * rate) / length, (dvy - uy * rate) / length)
         for i in range(2):
             for j in range(2):
-                projector = (1.0 if i == j else 0.0) - u[i] * u[j]
-                g = u[i] * (k * u[j] + c * w[j]) + force * projector / length
-                value = factor_position * g + factor_velocity * c * u[i] * u[j]
                 base = 16 * e + 2 * i + j
-                out_values[base] = value
-                out_values[base + 4] = value
-                out_values[base + 8] = -value
-                out_values[base + 12] = -value
+                out_values[base] = out_values[base + 4] = block[i, j]
+                out_values[base + 8] = out_values[base + 12] = -block[i, j]
     return out_values
 
 

@@ -140,6 +140,23 @@ def bending_force_kernel(positions, velocities, joints, stiffness, damping, out)
 
 
 @njit(cache=True)
+def _joint_terms(positions, velocities, joints, j, stiffness, damping, grad, hess, index, hess_v):
+    """Geometry of joint j for the tangent matrices: fills grad (6,), hess (6, 6), the
+    coordinate indices ``index`` (6,) and ``hess_v`` = H v (6,) = d(dtheta_dot)/dq; returns
+    the moment k dtheta + d dtheta_dot [N m]."""
+    dtheta, dtheta_dot = _joint_geometry(positions, velocities, joints[j, 0], joints[j, 1], joints[j, 2], grad, hess)
+    for node in range(3):
+        index[2 * node] = 2 * joints[j, node]
+        index[2 * node + 1] = 2 * joints[j, node] + 1
+    for i in range(6):
+        s = 0.0
+        for m in range(6):
+            s += hess[i, m] * velocities[index[m]]
+        hess_v[i] = s  # d(dtheta_dot)/dq_i (H symmetric)
+    return stiffness[j] * dtheta + damping[j] * dtheta_dot
+
+
+@njit(cache=True)
 def bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
                             factor_position, factor_velocity, out_force, out_k, out_d):
     """Unchecked kernel of the force and tangent matrices.
@@ -158,29 +175,11 @@ def bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
     grad = np.empty(6)
     hess = np.empty((6, 6))
     index = np.empty(6, dtype=np.int64)
-    v_local = np.empty(6)
     hess_v = np.empty(6)
     for j in range(joints.shape[0]):
-        a = joints[j, 0]
-        b = joints[j, 1]
-        c = joints[j, 2]
-        dtheta, dtheta_dot = _joint_geometry(positions, velocities, a, b, c, grad, hess)
+        moment = _joint_terms(positions, velocities, joints, j, stiffness, damping, grad, hess, index, hess_v)
         k = stiffness[j]
         d = damping[j]
-        moment = k * dtheta + d * dtheta_dot
-        index[0] = 2 * a
-        index[1] = 2 * a + 1
-        index[2] = 2 * b
-        index[3] = 2 * b + 1
-        index[4] = 2 * c
-        index[5] = 2 * c + 1
-        for i in range(6):
-            v_local[i] = velocities[index[i]]
-        for i in range(6):
-            s = 0.0
-            for m in range(6):
-                s += hess[i, m] * v_local[m]
-            hess_v[i] = s  # d(dtheta_dot)/dq_i (H symmetric)
         if want_force:
             for i in range(6):
                 out_force[index[i]] -= moment * grad[i]
@@ -229,21 +228,9 @@ def bending_triplet_values(positions, velocities, joints, stiffness, damping, fa
     index = np.empty(6, dtype=np.int64)
     hess_v = np.empty(6)
     for j in range(joints.shape[0]):
-        a = joints[j, 0]
-        b = joints[j, 1]
-        c = joints[j, 2]
-        dtheta, dtheta_dot = _joint_geometry(positions, velocities, a, b, c, grad, hess)
+        moment = _joint_terms(positions, velocities, joints, j, stiffness, damping, grad, hess, index, hess_v)
         k = stiffness[j]
         d = damping[j]
-        moment = k * dtheta + d * dtheta_dot
-        for node in range(3):
-            index[2 * node] = 2 * joints[j, node]
-            index[2 * node + 1] = 2 * joints[j, node] + 1
-        for i in range(6):
-            s = 0.0
-            for m in range(6):
-                s += hess[i, m] * velocities[index[m]]
-            hess_v[i] = s
         for i in range(6):
             gi = grad[i]
             for m in range(6):
