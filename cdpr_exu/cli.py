@@ -129,7 +129,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         data = {**summary, **provenance()}
         if estimate is not None:
             data["error_estimate"] = {k: v for k, v in estimate.to_dict().items() if k != "companion_wall_time_s"}
-            data["companion_wall_time_s"] = estimate.companion_wall_time_s
+            if estimate.companion_n_elements is not None:  # a companion run was made
+                data["companion_wall_time_s"] = estimate.companion_wall_time_s
         data.update({k: v for k, v in result.metadata.items() if k not in data})
         data["after_start_up"] = {k: settled[k] for k in (
             "errors_measured_after_s", "max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m",
