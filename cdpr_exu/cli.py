@@ -76,6 +76,9 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
         ("error z range", z_range(summary), z_range(settled)),
         ("max |rotation|", *pair("max_abs_rotation_deg", 1, "deg")),
         ("min element tension", *pair("min_element_tension_N", 1, "N")),
+        ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]),
+         " / ".join(_figure(v, 1, "N") for v in settled["min_tension_per_cable_N"])),
+        ("slack time per cable", " / ".join(_figure(v, 1, "s") for v in summary["slack_time_per_cable_s"]), ""),
         ("max pulley penetration", _figure(summary["max_pulley_penetration_m"], 1000, "mm", 3), ""),
         ("simulated / wall time", f"{summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s",
          "n/a" if factor is None else f"{factor:.1f}x real time"),
@@ -86,7 +89,7 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
     for name, whole, after in rows:
         print(f"  {name:26s} {whole:>22s}   {after:>18s}")
     for note in dict.fromkeys(summary["notes"] + settled["notes"]):
-        print(f"  n/a: {note}")
+        print(f"  note: {note}")
     if out is not None:
         print(f"  written to {out}/")
 

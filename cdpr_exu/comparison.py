@@ -41,6 +41,7 @@ _COLUMNS = (
     ("max_abs_error_z_m", "max \\|err z\\| [mm]", 1000.0),
     ("max_abs_rotation_deg", "max \\|rotation\\| [deg]", 1.0),
     ("min_element_tension_N", "min tension [N]", 1.0),
+    ("slack_time_s", "slack time [s]", 1.0),
     ("wall_time_s", "wall time [s]", 1.0),
 )
 
@@ -80,6 +81,8 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
         results[name] = result
         summary = result.summary(after=after)
         summary["controller"] = name
+        slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
+        summary["slack_time_s"] = max(slack) if slack else None
         summaries[name] = summary
         if not quiet:
             def mm(value):
@@ -106,8 +109,9 @@ def markdown_table(summaries: dict[str, dict]) -> str:
             value = summary.get(key)
             cells.append("" if value is None else fixed(scale * value, 2))
         ratio = summary.get("error_reduction_vs_ideal_ik")
+        flag = "; cables pushed" if summary.get("elements_pushed") else ""  # a real cable cannot
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {'' if ratio is None else f'{ratio:.1f}x'} | "
-                     f"{summary.get('status', '')} |")
+                     f"{summary.get('status', '')}{flag} |")
     return "\n".join(lines) + "\n"
 
 

@@ -106,6 +106,10 @@ class Result:
             return float(np.nanmin(a)) if a.size and np.isfinite(a).any() else None
 
         notes = []
+        pushing = bool(taut.size) and float(np.nanmin(taut)) < 0.0
+        if pushing:
+            notes.append(f"elements pushed (lowest tension {float(np.nanmin(taut)):.3g} N): this model lets cables "
+                         "carry compression, which a real cable cannot; effects.slack = true makes them tension-only")
         if not len(err):
             notes.append(f"no sample at or after t = {after:g} s (the run reached {self.simulated_time:g} s): "
                          "its error, rotation and tension figures do not exist and are null")
@@ -123,6 +127,9 @@ class Result:
             "max_abs_rotation_deg": _max(np.degrees(np.abs(self.platform_pose[mask, 2]))),
             "min_element_tension_N": _min(taut),
             "max_element_tension_N": _max(taut),
+            "min_tension_per_cable_N": [_min(t[mask]) for t in self.tensions],
+            "slack_time_per_cable_s": [self._slack_time(t, mask) for t in self.tensions],
+            "elements_pushed": pushing,
             "max_pulley_penetration_m": _max(self.pulley_penetration),
             "wall_time_s": self.wall_time,
             "simulated_time_s": self.simulated_time,
@@ -134,6 +141,15 @@ class Result:
                                       else self.winch_reservoir.max(axis=0).tolist()),
             "notes": notes,
         }
+
+    def _slack_time(self, tensions: np.ndarray, mask: np.ndarray) -> float | None:
+        """Time [s] during which some element of a cable carries no tension (slack, or pushing)."""
+        times = self.time[mask]
+        if len(times) < 2:
+            return None
+        slack = np.any(tensions[mask] <= 0.0, axis=1)
+        widths = np.diff(times, append=times[-1])  # each sample stands for the interval after it
+        return float(np.sum(widths[slack]))
 
     # ----------------------------------------------------------------- files
     def save(self, folder: str | Path, summary_after: float = 0.0) -> dict[str, Path]:

@@ -67,3 +67,19 @@ def test_a_run_that_fails_at_t_0_says_what_in_the_scene_makes_the_first_step_fai
     scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.2, max_newton_iterations=1))
     with pytest.raises(SolverFailure, match=r"at t = 0 the first step failed: solver.max_newton_iterations = 1"):
         simulate(scene)
+
+
+def test_a_result_that_needs_cables_to_push_is_flagged_and_tension_only_cables_are_not():
+    """The paper's spring elements push at the start-up (lowest tension -6.5 N measured);
+    tension-only elements never do. Every summary gives each cable's lowest tension and
+    the time any of its elements carried no tension."""
+    short = PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.5))
+    spring = simulate(short).summary()
+    assert spring["elements_pushed"] and spring["min_element_tension_N"] < 0
+    assert any("pushed" in note for note in spring["notes"])
+    assert min(spring["min_tension_per_cable_N"]) == spring["min_element_tension_N"]
+    assert all(0.0 < t <= 0.5 for t in spring["slack_time_per_cable_s"])
+    from cdpr_exu.scene import Effects
+
+    tension_only = simulate(short.with_changes(effects=Effects.from_preset("full", slack=True))).summary()
+    assert not tension_only["elements_pushed"] and tension_only["min_element_tension_N"] >= 0.0
