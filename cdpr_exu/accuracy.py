@@ -571,7 +571,7 @@ def _cell(value: Any) -> str:
 
 def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> dict[str, Path]:
     """Write the CSV, JSON, tables, Pareto plot and the reference's series into ``out``."""
-    from .output import write_json
+    from .output import write_npz, write_summary
     from .result import provenance
     from .scene import save_scene
 
@@ -603,10 +603,10 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
                  for row in study.rows],
         **provenance(),
     }
-    write_json(out / ACCURACY_FILES["json"], info)
+    write_summary(out, info, name=ACCURACY_FILES["json"])  # the date goes to timing.json
     paths["json"] = out / ACCURACY_FILES["json"]
     reference = study.series[reference_row["run"]]
-    np.savez_compressed(out / ACCURACY_FILES["reference"], **reference)
+    write_npz(out / ACCURACY_FILES["reference"], **reference)
     paths["reference"] = out / ACCURACY_FILES["reference"]
     (out / ACCURACY_FILES["tables"]).write_text(format_tables(study) + "\n")
     paths["tables"] = out / ACCURACY_FILES["tables"]

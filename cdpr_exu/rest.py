@@ -75,7 +75,7 @@ from .cable import element_tensions
 from .errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure
 from .model import Model, build_model
 from .pulley import penetration
-from .output import write_summary
+from .output import write_npz, write_summary
 from .result import provenance
 from .scene import Scene, load_scene
 
@@ -246,7 +246,7 @@ class RestState:
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"] = nodes
             arrays[f"tensions_{i}"] = tensions
-        np.savez_compressed(folder / "rest.npz", **arrays)
+        write_npz(folder / "rest.npz", **arrays)
         return {"summary": folder / "summary.json", "npz": folder / "rest.npz"}
 
 

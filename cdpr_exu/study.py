@@ -602,7 +602,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
                 variations: Sequence[Variation], *, mode: str = "grid", after: float = 1.0,
                 plots: bool = True) -> dict[str, Path]:
     """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
-    from .output import write_json
+    from .output import write_summary
     from .result import provenance
     from .scene import save_scene
 
@@ -625,7 +625,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
         "base_scene": base_scene.to_dict(),
         **provenance(),
     }
-    write_json(out / STUDY_FILES["json"], data)
+    write_summary(out, data, name=STUDY_FILES["json"])  # the date goes to timing.json
     paths["json"] = out / STUDY_FILES["json"]
     if plots and variations:
         paths.update(plot_study(rows, variations, out, mode=mode))

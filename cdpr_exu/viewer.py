@@ -600,6 +600,8 @@ class _Writer:
                                 "or write a GIF: --out animation.gif") from None
             if size[0] % 2 or size[1] % 2:
                 raise CdprError(f"an MP4 needs an even width and height, got --size {size[0]}x{size[1]}")
+        if path.parent.exists() and not path.parent.is_dir():
+            raise CdprError(f"--out {str(path)!r}: {str(path.parent)!r} is a file, not a folder")
         if not path.parent.is_dir():
             raise CdprError(f"the folder of the animation file {str(path)!r} does not exist")
 

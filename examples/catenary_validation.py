@@ -41,7 +41,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from cdpr_exu.output import write_json
+from cdpr_exu.output import write_summary
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
@@ -520,7 +520,7 @@ def main(argv=None) -> int:
         "wall_time_s": time.perf_counter() - start,
         **provenance(),
     }
-    write_json(out / "summary.json", _clean(summary))
+    write_summary(out, _clean(summary))  # wall time and date go to timing.json
 
     print("\n(d) cable length at n = 15 (catenary through the lumped rest position; the paper: 0.8 mm)")
     for label, (_, _, c) in cases.items():

@@ -11,6 +11,7 @@ import csv
 import json
 import math
 import subprocess
+import zipfile
 
 import numpy as np
 import pytest
@@ -18,6 +19,7 @@ import pytest
 from cdpr_exu.accuracy import (ACCURACY_FILES, FULL_GRID, QUICK_GRID, Configuration, cheapest_meeting, compare,
                                pareto_front)
 from cdpr_exu.errors import SceneError
+from cdpr_exu.output import ZIP_DATE
 
 
 @pytest.fixture(scope="module")
@@ -46,6 +48,10 @@ def test_quick_study_writes_its_files(quick_study):
     tables = (quick_study / ACCURACY_FILES["tables"]).read_text()
     assert "Cheapest configuration meeting each tolerance" in tables
     assert (quick_study / ACCURACY_FILES["pareto"]).stat().st_size > 10_000
+    with zipfile.ZipFile(quick_study / ACCURACY_FILES["reference"]) as archive:  # same data, same bytes
+        assert {info.date_time for info in archive.infolist()} == {ZIP_DATE}
+    assert "date" not in json.loads((quick_study / ACCURACY_FILES["json"]).read_text())
+    assert "date" in json.loads((quick_study / "timing.json").read_text())  # the date lives apart
 
 
 @pytest.mark.slow

@@ -10,6 +10,7 @@ inertia of a residual motion are left.
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import replace
 
 import numpy as np
@@ -17,6 +18,7 @@ import pytest
 
 from cdpr_exu.cli import main
 from cdpr_exu.errors import SceneError, SolverFailure
+from cdpr_exu.output import ZIP_DATE
 from cdpr_exu.rest import RestState, solve_rest
 from cdpr_exu.scene import Effects, load_scene
 
@@ -153,6 +155,8 @@ def test_rest_state_saves_summary_and_arrays(fixed, tmp_path):
     summary = json.loads(paths["summary"].read_text())
     assert summary["cable_stretched_length_m"] == rest.cable_stretched_length_m.tolist()
     assert isinstance(rest, RestState)
+    with zipfile.ZipFile(paths["npz"]) as archive:  # a fixed member date: the same state gives the same bytes
+        assert {info.date_time for info in archive.infolist()} == {ZIP_DATE}
 
 
 def test_cli_static_writes_the_summary_keys_npz_and_figure(tmp_path, capsys):

@@ -173,6 +173,7 @@ def test_cli_grid_writes_one_row_per_run_with_parameter_columns_first(cli_grid):
                                   {"path": "platform.mass", "values": [1, 2.5]}]
     assert data["base_scene"]["solver"]["end_time"] == END_TIME and "exudyn" in data["versions"]
     assert len(data["rows"]) == 4
+    assert "date" not in data and "date" in json.loads((cli_grid / "timing.json").read_text())  # kept apart
     assert load_scene(cli_grid / "base_scene.toml").to_dict() == data["base_scene"]
     for name in ("vs_cables_n_elements.png", "vs_platform_mass.png", "heatmap.png"):
         assert (cli_grid / name).stat().st_size > 10_000

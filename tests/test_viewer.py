@@ -172,6 +172,14 @@ def test_unknown_animation_type_is_refused_before_rendering(run_dir, tmp_path):
     assert not (tmp_path / "anim.avi").exists()
 
 
+def test_animation_inside_a_file_is_refused_naming_the_file(run_dir, tmp_path):
+    taken = tmp_path / "taken.txt"
+    taken.write_text("keep me")
+    with pytest.raises(viewer.CdprError, match="is a file, not a folder"):
+        viewer.render_animation(run_dir, taken / "anim.gif")
+    assert taken.read_text() == "keep me"
+
+
 # ============================================================================ helpers
 
 
