@@ -289,9 +289,11 @@ class ClosedLoopTensionAwareController(TensionAwareController):
         error = reference[:2] - measurement.platform_pose[:2]
         dt = max(measurement.time - self._last_time, 0.0)
         self._last_time = measurement.time
-        # Integrate only once the start-up blend is over: the straight start is no error to learn.
-        if measurement.time >= self.start_time:
-            self._integral += error * dt
+        # The integral fades in with the start-up blend (weight 0 at t = 0, 1 from start_time on):
+        # switched on at once, its rate k_i e jumps the winch speed by metres per second and the
+        # axially over-damped winch element pushes (-62 N measured at the switch).
+        weight = _smoothstep(np.array(measurement.time / self.start_time)) if self.start_time > 0 else 1.0
+        self._integral += error * dt * weight
         feedback = self.proportional_gain * error + self.integral_gain * self._integral
         # Fade the feedback in with the start-up blend: a jump of the command in one
         # step would jolt the axially over-damped cables.

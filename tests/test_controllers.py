@@ -169,3 +169,16 @@ def test_comparison_writes_its_table_and_summary(tmp_path):
         assert np.isfinite(data["controllers"][name]["rms_position_error_m"])
     assert "| ideal_ik |" in (tmp_path / "comparison.md").read_text()
     assert (tmp_path / "comparison_paths.png").stat().st_size > 0
+
+
+def test_the_closed_loop_switches_on_without_pushing_its_cables():
+    """The integral fades in with the start-up blend: at the switch-on (0.5 s) the winch
+    element no longer pushes (-62 N before; +14 N measured as the lowest tension of any
+    element from 0.45 to 0.6 s)."""
+    from cdpr_exu.simulate import simulate
+
+    paper = load_scene("paper-circle")
+    scene = paper.with_changes(solver=replace(paper.solver, end_time=0.7))
+    result = simulate(scene, ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True))
+    near = (result.time > 0.45) & (result.time < 0.6)
+    assert min(t[near].min() for t in result.tensions) > 0.0
