@@ -122,3 +122,19 @@ def test_a_spatial_chain_conserves_energy_to_second_order_in_the_step():
     orders = np.log2(np.array(drifts[:-1]) / np.array(drifts[1:]))
     assert np.all((orders > 1.8) & (orders < 2.2)), drifts
     assert drifts[0] < 2e-3
+
+
+@pytest.mark.parametrize("theta_deg", [10.0, 30.0, 60.0])
+def test_the_relative_angular_velocity_damper_candidate_would_damp_a_rigid_rotation(theta_deg):
+    """The issue's candidate w2 - w1 (w_i = e_i x de_i/dt / |e_i|^2) measured on a joint bent
+    by theta, turning rigidly at 1 rad/s: about the joint plane's normal it is zero (good);
+    about an axis in the plane (along e1) it is sin(theta) - a damper on it would dissipate
+    d sin^2(theta) from a cable that only turns. So it is not used (docs/spatial.md)."""
+    from cdpr_exu.physics.bending_3d import relative_angular_velocity
+
+    theta = np.radians(theta_deg)
+    points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0 + np.cos(theta), np.sin(theta), 0.0]])
+    for axis, expected in (([0.0, 0.0, 1.0], 0.0), ([1.0, 0.0, 0.0], np.sin(theta))):
+        velocities = np.cross(axis, points)  # rigid rotation about the origin
+        relative = relative_angular_velocity(points.ravel(), velocities.ravel(), 0, 1, 2)
+        assert np.linalg.norm(relative) == pytest.approx(expected, abs=1e-12)

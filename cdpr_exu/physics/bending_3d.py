@@ -12,8 +12,12 @@ is not differentiable. The stiffness matrix is K = -df/dq = -k (phi'(c) g g^T + 
 with g, H the gradient and Hessian of c; it is handed to Exudyn as sparse triplets,
 81 per joint, in a fixed pattern.
 
-Damping is not here yet: a damper on the relative angle either damps rigid rotations or
-is not smooth at a straight cable (see docs/spatial.md).
+Damping is not here yet. The candidate damper on the relative angular velocity of the
+two segments, w2 - w1 with w_i = e_i x de_i/dt / |e_i|^2 (:func:`relative_angular_velocity`),
+damps a rigid rotation of a bent joint about an axis in its plane: there
+|w2 - w1| = Omega sin(theta), a dissipation d Omega^2 sin^2(theta). A damper on dc/dt
+ignores every rigid motion but its torque vanishes as theta^2 at a straight cable (see
+docs/spatial.md).
 
 Coordinates: flat arrays (x0, y0, z0, x1, ...) [m]; spatial scenes have z up.
 """
@@ -143,6 +147,17 @@ def spatial_bending_stiffness(positions, joints, stiffness, factor, out_values):
             for m in range(9):
                 out_values[81 * j + 9 * i + m] = -factor * k * (slope * grad[i] * grad[m] + phi * hess[i, m])
     return out_values
+
+
+def relative_angular_velocity(positions, velocities, a, b, c) -> np.ndarray:
+    """w2 - w1 [rad/s], shape (3,): the angular velocities w_i = e_i x de_i/dt / |e_i|^2 of the
+    segments e1 = p_b - p_a and e2 = p_c - p_b of the joint (a, b, c), a damper candidate."""
+    p = np.asarray(positions, dtype=float).reshape(-1, 3)
+    v = np.asarray(velocities, dtype=float).reshape(-1, 3)
+    e1, e2 = p[b] - p[a], p[c] - p[b]
+    w1 = np.cross(e1, v[b] - v[a]) / (e1 @ e1)
+    w2 = np.cross(e2, v[c] - v[b]) / (e2 @ e2)
+    return w2 - w1
 
 
 def chain_joints(nodes_per_cable) -> np.ndarray:
