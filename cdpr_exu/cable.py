@@ -23,6 +23,8 @@ import numpy as np
 
 from . import axial, bending
 from .scene import CableSpec, Effects, PulleySpec
+from . import node_contact as node_contact_module
+from .node_contact import NodePulleyContact
 from .segment_contact import SegmentPulleyContact
 
 
@@ -126,12 +128,15 @@ class CableForceItems:
     #: The tension-only elements' rest lengths, stiffnesses and dampings [m, N/m, N s/m], shape (E,):
     #: the arrays the force kernels read (a winch's rope reservoir changes its first element's).
     slack_arrays: tuple = ()
+    #: The smooth node rim contacts (``Effects.pulley_contact_model = "node_smooth"``), or None.
+    node_contact: NodePulleyContact | None = None
 
 
 def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
                      effects: Effects, pulleys: list[PulleySpec] | None = None,
                      contact_elements: list[np.ndarray] | None = None,
-                     sparse_jacobian: bool = True) -> CableForceItems | None:
+                     sparse_jacobian: bool = True,
+                     contact_nodes: list[np.ndarray] | None = None) -> CableForceItems | None:
     """Add the bending (with slack, the axial; with segment contact, the pulley) forces of all cables as one object.
 
     Parameters
@@ -149,8 +154,12 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         "segment"``); None or all empty: no segment contact and no cost for it.
     sparse_jacobian : bool
         Return the Jacobian as sparse triplets (36 per bending joint, 16 per tension-only
-        element: cost linear in the number of nodes) instead of a dense (2N, 2N) matrix.
-        With segment contact the dense form is kept.
+        element, 4 per contact node: cost linear in the number of nodes) instead of a
+        dense (2N, 2N) matrix. With segment contact the dense form is kept.
+    contact_nodes : list of ndarray of int, optional
+        Cable-local indices of the nodes that get a rim contact with their cable's pulley
+        (``Effects.pulley_contact_model = "node_smooth"``, :mod:`cdpr_exu.node_contact`); None or
+        all empty: no node contact and no cost for it.
 
     Returns None when neither ``effects.bending`` nor ``effects.slack`` is on and there
     is no segment contact (then no item and no cost). The force user function receives
@@ -160,7 +169,8 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     """
     counts = [len(it.nodes) for it in items]
     contact = _segment_contact(counts, pulleys, contact_elements)
-    if not (effects.bending or effects.slack or contact is not None):
+    node_contact = _node_contact(counts, pulleys, contact_nodes)
+    if not (effects.bending or effects.slack or contact is not None or node_contact is not None):
         return None
     reference = np.concatenate([it.reference for it in items]).ravel()
     size = reference.size
@@ -197,6 +207,8 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
             axial.slack_axial_force(positions, velocities, elements, rest, axial_k, axial_c, force)
         if contact is not None:
             contact.add_force(positions, velocities, force)
+        if node_contact is not None:
+            node_contact.add_force(positions, velocities, force)
         return force
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
@@ -208,18 +220,22 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
                                        float(f_q), float(f_q_t), jacobian)
         if contact is not None:
             contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
+        if node_contact is not None:
+            node_contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
         return jacobian
 
     nodes = [n for it in items for n in it.nodes]
     functions = (force_function, jacobian_function)
     mass = np.zeros((size, size))
     if sparse_jacobian and contact is None and not linear:
-        functions = (force_function, _sparse_jacobian_function(spring, elements, rest if effects.slack else None,
-                                                               axial_k if effects.slack else None,
-                                                               axial_c if effects.slack else None,
-                                                               reference, positions))
+        blocks = [_bending_blocks(spring)]
+        if effects.slack and len(elements):
+            blocks.append(_slack_blocks(elements, rest, axial_k, axial_c))
+        if node_contact is not None:
+            blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
+        functions = (force_function, _sparse_jacobian_function(blocks, reference, positions))
         mass = _sparse(np.zeros((size, size)))
-    if linear and not effects.slack and contact is None:
+    if linear and not effects.slack and contact is None and node_contact is None:
         # Nothing left for Python per Newton iteration: no force function, and a Jacobian
         # function that returns an empty matrix, so that Exudyn adds the constant K and D
         # itself (without any Jacobian function it would differentiate them numerically).
@@ -237,39 +253,70 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         forceUserFunction=functions[0], jacobianUserFunction=functions[1], **matrices))
     segments = np.zeros((0, 2), np.int64) if contact is None else contact.segments
     return CableForceItems(obj, joints, stiffness, damping, elements, (spring, *functions, matrices),
-                           segments, contact, (rest, axial_k, axial_c) if effects.slack else ())
+                           segments, contact, (rest, axial_k, axial_c) if effects.slack else (), node_contact)
 
 
-def _sparse_jacobian_function(spring, elements, rest, axial_k, axial_c, reference, positions):
+def _bending_blocks(spring):
+    """Sparse pattern and value filler of the bending joints' 6 x 6 blocks."""
+    rows, columns = bending.bending_triplet_pattern(spring.joints)
+
+    def fill(positions, velocities, factor_position, factor_velocity, out_values):
+        bending.bending_triplet_values(positions, velocities, spring.joints, spring.stiffness, spring.damping,
+                                       factor_position, factor_velocity, out_values)
+    return rows, columns, fill
+
+
+def _slack_blocks(elements, rest, axial_k, axial_c):
+    """Sparse pattern and value filler of the tension-only elements' 4 x 4 blocks."""
+    rows, columns = axial.slack_triplet_pattern(elements)
+
+    def fill(positions, velocities, factor_position, factor_velocity, out_values):
+        axial.slack_triplet_values(positions, velocities, elements, rest, axial_k, axial_c,
+                                   factor_position, factor_velocity, out_values)
+    return rows, columns, fill
+
+
+def _sparse_jacobian_function(blocks, reference, positions):
     """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets (an
-    ``exu.MatrixContainer``): the bending joints' 6 x 6 blocks and the tension-only
-    elements' 4 x 4 blocks, filled by numba kernels into a fixed pattern."""
+    ``exu.MatrixContainer``) in a fixed pattern.
+
+    ``blocks`` lists ``(rows, columns, fill)`` per force (bending joints, tension-only
+    elements, contact nodes): the places of its triplets and a numba-backed function
+    ``fill(positions, velocities, f_q, f_q_t, out_values)`` that writes their values.
+    """
     size = reference.size
-    joint_rows, joint_columns = bending.bending_triplet_pattern(spring.joints)
-    slack = rest is not None and len(elements) > 0
-    element_rows, element_columns = (axial.slack_triplet_pattern(elements) if slack
-                                     else (np.zeros(0, np.int64), np.zeros(0, np.int64)))
-    split = joint_rows.size
-    triplets = np.zeros((split + element_rows.size, 3))
-    triplets[:, 0] = np.concatenate([joint_rows, element_rows])
-    triplets[:, 1] = np.concatenate([joint_columns, element_columns])
-    joint_values, element_values = np.zeros(split), np.zeros(element_rows.size)
+    bounds = np.cumsum([0] + [rows.size for rows, _, _ in blocks])
+    triplets = np.zeros((int(bounds[-1]), 3))
+    triplets[:, 0] = np.concatenate([rows for rows, _, _ in blocks])
+    triplets[:, 1] = np.concatenate([columns for _, columns, _ in blocks])
+    values = [np.zeros(rows.size) for rows, _, _ in blocks]
     container = exu.MatrixContainer()
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001 - Exudyn's signature
         np.add(reference, q, out=positions)
         velocities = np.asarray(q_t)
-        bending.bending_triplet_values(positions, velocities, spring.joints, spring.stiffness, spring.damping,
-                                       float(f_q), float(f_q_t), joint_values)
-        triplets[:split, 2] = joint_values
-        if slack:
-            axial.slack_triplet_values(positions, velocities, elements, rest, axial_k, axial_c,
-                                       float(f_q), float(f_q_t), element_values)
-            triplets[split:, 2] = element_values
+        for (_, _, fill), out_values, first, last in zip(blocks, values, bounds[:-1], bounds[1:]):
+            fill(positions, velocities, float(f_q), float(f_q_t), out_values)
+            triplets[first:last, 2] = out_values
         container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
         return container
 
     return jacobian_function
+
+
+def _node_contact(counts: list[int], pulleys: list[PulleySpec] | None,
+                  contact_nodes: list[np.ndarray] | None) -> NodePulleyContact | None:
+    """The node rim contacts of the listed nodes with their cables' pulleys (None if none)."""
+    if contact_nodes is None or not any(len(n) for n in contact_nodes):
+        return None
+    if pulleys is None or len(pulleys) != len(counts) or len(contact_nodes) != len(counts):
+        raise ValueError("node contact needs one pulley and one list of contact nodes per cable")
+    first = np.cumsum([0] + list(counts[:-1]))
+    nodes = np.concatenate([start + np.asarray(n, dtype=np.int64) for start, n in zip(first, contact_nodes)])
+    per_node = [np.repeat(np.array([getattr(p, name) for p in pulleys], dtype=float),
+                          [len(n) for n in contact_nodes], axis=0)
+                for name in ("center", "radius", "contact_stiffness", "contact_damping")]
+    return NodePulleyContact(sum(counts), nodes, *per_node, band=node_contact_module.CONTACT_ONSET_DEPTH)
 
 
 def _segment_contact(counts: list[int], pulleys: list[PulleySpec] | None,

@@ -42,9 +42,11 @@ class Model:
     cable_forces : CableForceItems or None
         The generic object of bending and slack-axial forces.
     contacts : list of list of int
-        Contact objects of each cable with its pulley.
+        Exudyn contact objects of each cable with its pulley
+        (``effects.pulley_contact_model = "node"`` only).
     contact_nodes : list of ndarray of int
-        Cable-local indices of the nodes that carry a contact item (node contact).
+        Cable-local indices of the nodes that carry a rim contact (node contact: in
+        Exudyn's items with "node", in ``cable_forces`` with "node_smooth").
     contact_elements : list of ndarray of int
         Cable-local indices of the elements (element j joins nodes j and j + 1) that
         carry a segment contact (``effects.pulley_contact_model = "segment"``); their
@@ -82,7 +84,7 @@ class Model:
             "cable_force_objects": int(self.cable_forces is not None),
             "bending_joints": 0 if self.cable_forces is None else len(self.cable_forces.joints),
             "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
-            "pulley_contacts": sum(len(c) for c in self.contacts),
+            "pulley_contacts": sum(len(n) for n in self.contact_nodes),
             "contact_segments": sum(len(e) for e in self.contact_elements),
             "massless_ropes": len(self.ropes),
             "winch_constraints": sum((int(w.horizontal) >= 0) + (int(w.vertical) >= 0) for w in self.winches),
@@ -240,9 +242,12 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
         elif use_contact:
             contact_elements.append(np.zeros(0, dtype=np.int64))
             candidates = contact_candidates(scene, i)
-            pulley_marker = add_pulley_ground(mbs, pulley)
-            contacts.append(add_pulley_contact(mbs, pulley, pulley_marker,
-                                               [items.markers[j] for j in candidates], nodes_xz[candidates]))
+            if effects.pulley_contact_model == "node":
+                pulley_marker = add_pulley_ground(mbs, pulley)
+                contacts.append(add_pulley_contact(mbs, pulley, pulley_marker,
+                                                   [items.markers[j] for j in candidates], nodes_xz[candidates]))
+            else:  # forces in the cables' generic object (add_cable_forces)
+                contacts.append([])
             contact_nodes.append(candidates)
         else:
             contact_elements.append(np.zeros(0, dtype=np.int64))
@@ -256,8 +261,10 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
         cables.append(items)
     if sparse_jacobian is None:
         sparse_jacobian = sum(c.n_elements + 1 for c in scene.cables) > SPARSE_JACOBIAN_MIN_NODES
+    on_nodes = use_contact and effects.pulley_contact_model == "node_smooth"
     cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.pulleys),
-                                    contact_elements if on_segments else None, sparse_jacobian=sparse_jacobian)
+                                    contact_elements if on_segments else None, sparse_jacobian=sparse_jacobian,
+                                    contact_nodes=contact_nodes if on_nodes else None)
     mbs.Assemble()
     return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
                  contacts, contact_nodes, np.asarray(paid_out), servos=servos, contact_elements=contact_elements)

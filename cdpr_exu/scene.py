@@ -354,8 +354,9 @@ PRESETS: dict[str, dict[str, bool]] = {
 }
 
 
-#: Where the pulley contact acts: on the nodes or on the element segments.
-PULLEY_CONTACT_MODELS = ("node", "segment")
+#: Where the pulley contact acts: on the nodes (Exudyn's sphere contact items), on the
+#: element segments, or on the nodes with a smooth onset in the cables' numba object.
+PULLEY_CONTACT_MODELS = ("node", "segment", "node_smooth")
 
 
 @dataclass(frozen=True)
@@ -379,13 +380,17 @@ class Effects:
         "linear" the curvature-vector spring (k_theta / l0i^2) |p_a - 2 p_b + p_c|^2 / 2
         with constant matrices, cheaper but with moment k_theta sin(theta) (see
         docs/accuracy.md for how far it moves the answer).
-    pulley_contact_model : {"node", "segment"}
+    pulley_contact_model : {"node", "segment", "node_smooth"}
         Where the pulley rim contact acts (with ``pulley_contact``): "node" pushes each
         node that enters the disc back out (Exudyn's sphere contact, k_p [N/m] times the
-        penetration [m] plus c_p [N s/m] on the normal velocity [m/s]); "segment" does the
-        same for the point of each element closest to the pulley centre, shared by the
-        element's two nodes (:mod:`cdpr_exu.segment_contact`), so that straight elements
-        cannot cut the disc as chords and coarser cables can run over the pulley.
+        penetration [m] plus c_p [N s/m] on the normal velocity [m/s], switched on and off
+        in Exudyn's discontinuous iterations); "node_smooth" is the same law switched on
+        smoothly over the first 1e-5 m of penetration, computed in the cables' numba
+        object (:mod:`cdpr_exu.node_contact`; measured slower, see docs/accuracy.md);
+        "segment" does the same for the point of each element closest to the pulley
+        centre, shared by the element's two nodes (:mod:`cdpr_exu.segment_contact`), so
+        that straight elements cannot cut the disc as chords and coarser cables can run
+        over the pulley.
     """
 
     preset: str = "full"
