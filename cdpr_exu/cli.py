@@ -101,12 +101,17 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     Writes ``scene.toml``, ``result.npz``, ``pose.csv``, ``summary.json``,
     ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures.
     A failed or interrupted (Ctrl-C) run still writes what was computed up to then,
-    then re-raises. ``out`` is checked before the run starts. With ``error_estimate``
+    then re-raises. ``out`` and the reference (:func:`cdpr_exu.workspace.check_reference`)
+    are checked before anything is written. With ``error_estimate``
     a companion run estimates the discretisation error (:mod:`cdpr_exu.error_estimate`).
     """
     from .result import provenance
     from .simulate import simulate
+    from .workspace import check_reference
 
+    # A reference the cables cannot reach or hold is refused before anything is written
+    # (simulate checks it too, but only after scene.toml would be in the folder).
+    check_reference(scene)
     solution_file = None
     if out is not None:
         out = check_output_folder(out)
@@ -125,8 +130,11 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
 
         if not quiet:
             print("estimating the discretisation error (a companion run) ...", flush=True)
-        estimate = estimate_error(scene, result, None if controller is None else type(controller),
-                                  after=SETTLED_AFTER)
+        try:
+            estimate = estimate_error(scene, result, None if controller is None else type(controller),
+                                      after=SETTLED_AFTER)
+        except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
+            failure = err
     if out is not None:
         result.save(out)
         data = {**summary, **provenance()}
@@ -238,7 +246,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.set_defaults(func=_cmd_run)
 
     scenes = sub.add_parser("scenes", help="list the shipped scenes",
-                            epilog="example:\n  cdpr scenes\n", formatter_class=argparse.RawDescriptionHelpFormatter)
+                            epilog="example:\n  cdpr scenes\n\n" + EXIT_CODES,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     scenes.set_defaults(func=_cmd_scenes)
     for module_name in COMMAND_MODULES:
         module = importlib.import_module(module_name)

@@ -63,32 +63,35 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
         raise SceneError(f"unknown controller(s) {unknown}; known: {list(CONTROLLERS)}")
     summaries: dict[str, dict] = {}
     results: dict[str, Result] = {}
-    for name in names:
-        controller = CONTROLLERS[name]()
-        try:
-            result = simulate(scene, controller, progress=progress)
-        except SolverFailure as err:
-            result = err.partial_result
-        except RunInterrupted as err:  # Ctrl-C: keep the controllers done so far, and this one's part
-            results[name] = err.partial_result
-            summaries[name] = {**err.partial_result.summary(after=after), "controller": name}
-            if out is not None:
-                _write(scene, summaries, results, Path(out), after)
-            raise
-        except CdprError as err:  # a refused reference is a result of the comparison too
-            summaries[name] = {"controller": name, "status": f"refused: {err}"}
-            continue
-        results[name] = result
-        summary = result.summary(after=after)
-        summary["controller"] = name
-        slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
-        summary["slack_time_s"] = max(slack) if slack else None
-        summaries[name] = summary
-        if not quiet:
-            def mm(value):
-                return "     n/a" if value is None else f"{1000 * value:8.2f}"
-            print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
-                  f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+    try:
+        for name in names:
+            controller = CONTROLLERS[name]()
+            try:
+                result = simulate(scene, controller, progress=progress)
+            except SolverFailure as err:
+                result = err.partial_result
+            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
+                results[name] = err.partial_result
+                summaries[name] = {**err.partial_result.summary(after=after), "controller": name}
+                raise
+            except CdprError as err:  # a refused reference is a result of the comparison too
+                summaries[name] = {"controller": name, "status": f"refused: {err}"}
+                continue
+            results[name] = result
+            summary = result.summary(after=after)
+            summary["controller"] = name
+            slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
+            summary["slack_time_s"] = max(slack) if slack else None
+            summaries[name] = summary
+            if not quiet:
+                def mm(value):
+                    return "     n/a" if value is None else f"{1000 * value:8.2f}"
+                print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
+                      f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+    except KeyboardInterrupt:  # Ctrl-C, inside a run or between two: keep the controllers done so far
+        if out is not None and summaries:
+            _write(scene, summaries, {k: r for k, r in results.items() if k in summaries}, Path(out), after)
+        raise
     base = summaries.get("ideal_ik", {}).get("max_position_error_m")
     if base is not None:
         for summary in summaries.values():
@@ -139,11 +142,14 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from .output import check_output_folder
+    from .workspace import check_reference
 
     check_output_folder(args.out)
     scene = load_scene(args.scene)
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
+    # A reference no controller can follow is bad input (exit 2), not six failed runs.
+    check_reference(scene)
     names = args.controllers.split(",") if args.controllers else None
     if not args.quiet:
         print(f"{scene.name}: comparing controllers (errors after {args.after} s)")

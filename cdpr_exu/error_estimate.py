@@ -28,7 +28,7 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import CdprError, SceneError, SolverFailure
+from .errors import CdprError, RunInterrupted, SceneError, SolverFailure
 
 #: Order of the error in the number of elements assumed by the estimate (see above).
 ORDER = 2.0
@@ -136,6 +136,8 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     start = time.perf_counter()
     try:
         companion = simulate(companion_scene, controller)
+    except RunInterrupted:  # Ctrl-C is the user's, not a failed companion
+        raise
     except (SolverFailure, CdprError) as err:
         return _not_applicable(f"the companion run at {n_companion} elements did not complete: {str(err)[:200]}")
     wall = time.perf_counter() - start

@@ -1,6 +1,7 @@
 """The ``cdpr`` command as a user runs it (subprocess), and the files it writes."""
 
 import json
+import re
 import subprocess
 import sys
 
@@ -121,6 +122,8 @@ def test_run_failure_exits_3_and_exudyn_banners_do_not_leak(tmp_path):
     for banner in ("SOLVER FAILED", "showHints", "WARNING:", "Traceback"):
         assert banner not in text, banner
     assert "Likely cause" in done.stderr
+    summary = _strict_json(tmp_path / "run" / "summary.json")  # the failed run's figures: null, never NaN
+    assert summary["status"].startswith("failed") and summary["after_start_up"]["max_position_error_m"] is None
 
 
 def test_static_failure_says_why_and_writes_the_scene_and_the_last_state(tmp_path):
@@ -161,7 +164,8 @@ def test_static_output_numbers_cables_from_one_and_prints_no_negative_zero():
 
 
 def test_every_help_documents_the_exit_codes():
-    for command in (["run"], ["static"], ["compare"], ["study", "sweep"], ["study", "accuracy"], ["animate"]):
+    for command in (["run"], ["static"], ["compare"], ["study", "sweep"], ["study", "accuracy"], ["animate"],
+                    ["view"], ["scenes"], []):
         done = _cdpr(*command, "--help")
         assert "exit codes" in done.stdout and "130" in done.stdout, command
 
@@ -182,3 +186,111 @@ def test_ctrl_c_saves_what_was_computed_prints_one_line_and_exits_130(tmp_path):
     summary = _strict_json(out / "summary.json")
     assert summary["status"].startswith("interrupted") and 0 < summary["simulated_time_s"] < 10
     assert Result.load(out).time.size > 1
+
+
+def test_an_unreachable_reference_exits_2_naming_time_and_pose_before_anything_is_written(tmp_path):
+    """Issue 11.1: a point_to_point ending at z = +1 m (above the pulleys, at z = 0) ran under
+    ideal IK with a 168.5 cm error and exit 0. It is refused before any simulation, with the
+    time and the pose; the output folder holds nothing (no scene.toml of a run that never ran)."""
+    from cdpr_exu.trajectories import PointToPointTrajectory
+
+    base = load_scene("paper-circle")
+    scene = base.with_changes(trajectory=PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.0, 1.0, 0.0),
+                                                                duration=2.0),
+                              solver=replace(base.solver, end_time=3.0))
+    path = tmp_path / "above.toml"
+    save_scene(scene, path)
+    out = tmp_path / "above"
+    done = _cdpr("run", str(path), "--out", str(out), check=False)
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
+    assert re.search(r"the reference pose \[0\.0, 0\.\d+, 0\.0\] \(x \[m\], z \[m\], rotation \[rad\]\) at t = 1\.\d{3} s",
+                     done.stderr), done.stderr
+    assert "cannot hold the platform's weight" in done.stderr and "platform.mass" in done.stderr
+    assert list(out.iterdir()) == []  # nothing written: no scene.toml, no summary
+
+
+def test_compare_refuses_an_unreachable_reference_with_exit_2_before_any_run(tmp_path):
+    """Issue 11.1 and 11.4: `cdpr compare` on a reference above the pulleys exited 3 with six
+    identical "refused" rows; it is bad input (exit 2), refused once, before any run."""
+    from cdpr_exu.trajectories import PointToPointTrajectory
+
+    base = load_scene("paper-circle")
+    scene = base.with_changes(trajectory=PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.0, 1.0, 0.0),
+                                                                duration=2.0),
+                              solver=replace(base.solver, end_time=3.0))
+    path = tmp_path / "above.toml"
+    save_scene(scene, path)
+    out = tmp_path / "above"
+    done = _cdpr("compare", str(path), "--out", str(out), check=False)
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
+    assert "cannot hold the platform's weight" in done.stderr
+    assert "refused" not in done.stdout  # no per-controller rows: nothing ran
+    assert not out.exists() or list(out.iterdir()) == []
+
+
+def test_sweep_csv_leaves_not_applicable_cells_empty_and_its_json_is_strict(tmp_path):
+    """Issue 11.2: study.csv wrote `nan` (failure_time_s of completed runs, every figure of a
+    refused run); such cells are empty now, and study.json holds null."""
+    import csv
+
+    out = tmp_path / "sweep"
+    done = _cdpr("study", "sweep", "paper-circle", "--end-time", "0.2", "--param", "platform.mass=2.5,-1",
+                 "--workers", "1", "--out", str(out), "-q", check=False)
+    assert done.returncode == 3, done.stderr  # one run refused: "at least one run failed"
+    text = (out / "study.csv").read_text()
+    assert "nan" not in text.lower()
+    with open(out / "study.csv", newline="") as handle:
+        completed, refused = list(csv.DictReader(handle))
+    assert completed["status"] == "completed" and completed["failure_time_s"] == ""
+    assert float(completed["max_position_error_m"]) > 0.0 and float(completed["simulated_time_s"]) == 0.2
+    assert refused["status"].startswith("refused: platform.mass must be positive")
+    assert refused["max_position_error_m"] == "" and refused["failure_time_s"] == ""
+    rows = _strict_json(out / "study.json")["rows"]
+    assert rows[0]["failure_time_s"] is None and rows[1]["max_position_error_m"] is None
+
+
+@pytest.mark.slow
+def test_the_readme_command_writes_the_committed_result_folder_byte_for_byte(tmp_path):
+    """Issue 11.12, as the README promises: `cdpr run paper-circle --out results/paper_circle`
+    leaves `git status` clean. The same command into a fresh folder writes every tracked file
+    of results/paper_circle byte for byte (timing.json is untracked; variants.* come from
+    examples/paper_reproduction.py). Fails when the code moved the answer and the committed
+    results were not regenerated."""
+    from pathlib import Path
+
+    committed = Path(__file__).resolve().parents[1] / "results" / "paper_circle"
+    out = tmp_path / "paper_circle"
+    _cdpr("run", "paper-circle", "--out", str(out), "-q")
+    written = sorted(p.name for p in out.iterdir() if p.name != "timing.json")
+    assert {"summary.json", "result.npz", "solution.sol", "pose.csv", "scene.toml", "overview.png"} <= set(written)
+    changed = [name for name in written
+               if not (committed / name).is_file() or (committed / name).read_bytes() != (out / name).read_bytes()]
+    assert changed == [], f"regenerate results/paper_circle: {changed} differ from what the code writes"
+
+
+def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, monkeypatch):
+    """Issue 11.6: a Ctrl-C that fell between two runs of `cdpr compare` left an empty
+    folder. The interrupt is sent the moment the first controller's row is printed."""
+    import io
+    import os
+    import signal
+
+    from cdpr_exu.comparison import compare_controllers
+
+    class InterruptAfterFirstRow(io.StringIO):
+        def write(self, text):
+            if "ideal_ik" in text:
+                os.kill(os.getpid(), signal.SIGINT)  # Python raises KeyboardInterrupt right after this call
+            return super().write(text)
+
+    scene = load_scene("paper-circle")
+    scene = scene.with_changes(solver=replace(scene.solver, end_time=0.3))
+    out = tmp_path / "compare"
+    monkeypatch.setattr("sys.stdout", InterruptAfterFirstRow())
+    with pytest.raises(KeyboardInterrupt):
+        compare_controllers(scene, ["ideal_ik", "tension_aware"], out=out, after=0.0, progress=False, quiet=False)
+    summary = _strict_json(out / "summary.json")
+    assert list(summary["controllers"]) == ["ideal_ik"]
+    assert summary["controllers"]["ideal_ik"]["status"] == "completed"

@@ -97,3 +97,22 @@ def test_cli_tolerance_prints_the_choice_and_bad_values_exit_2(tmp_path):
     assert "--tolerance 10 mm: estimated" in done.stdout and "elements" in done.stdout
     bad = _cdpr("run", "paper-circle", "--tolerance", "five")
     assert bad.returncode == 2 and "--tolerance must be a length" in bad.stderr
+
+
+def test_ctrl_c_during_the_companion_run_is_the_users_not_a_failed_estimate():
+    """Issue 11.6: Ctrl-C while `cdpr run` made its companion run gave exit 0 and the
+    estimate "n/a": the interrupt was taken for a failed companion. It reaches the caller."""
+    import os
+    import signal
+    import threading
+
+    scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=5.0))
+    result = simulate(scene)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))  # the companion (30 elements) takes ~1 s
+    timer.start()
+    try:
+        # RunInterrupted inside the solver, a bare KeyboardInterrupt elsewhere: either way not swallowed
+        with pytest.raises(KeyboardInterrupt):
+            estimate_error(scene, result, after=1.0)
+    finally:
+        timer.cancel()

@@ -133,3 +133,56 @@ def test_solver_output_period_is_never_finer_than_the_step():
     solver = SolverSpec(step_size=2e-3, output_period=1e-3)
     assert solver.output_period == 2e-3
     assert replace(solver, end_time=1.0).n_steps == 500
+
+
+def test_an_initial_pose_with_an_anchor_inside_a_pulley_names_the_fields_then_the_values():
+    """Issue 12.2: the refusal said only "anchor [-0.15, -1.9] lies inside the pulley disc
+    (centre [-1.75, 0.0], radius 2.5 m)"; it names the conflicting fields first now."""
+    from cdpr_exu.errors import UnreachableError
+
+    data = load_scene("paper-circle").to_dict()
+    data["pulleys"][0]["radius"] = 2.5  # the disc reaches the anchor at the initial pose
+    with pytest.raises(UnreachableError) as err:
+        scene_from_dict(data)
+    message = str(err.value)
+    assert message.startswith("platform.anchors[0] at platform.initial_pose [0.0, -2.0, 0.0]")
+    for field in ("pulleys[0].center [-1.75, 0.0] m", "pulleys[0].radius 2.5 m"):
+        assert field in message, field
+    assert message.index("pulleys[0].radius") < message.index("lies inside the pulley disc")
+
+
+def test_the_package_exports_what_a_user_needs_and_imports_without_exudyn():
+    """Issue 11.13: ``cdpr_exu.load_scene`` raised AttributeError. The names a user needs
+    are importable from the package (loaded on first use, so the import stays cheap)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, cdpr_exu; assert 'exudyn' not in sys.modules, 'import cdpr_exu loaded Exudyn'; "
+            "print(cdpr_exu.load_scene.__module__)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout.strip() == "cdpr_exu.scene", done.stderr
+
+    import importlib
+
+    import cdpr_exu
+    from controllers import ideal_ik, tension_aware
+
+    errors, result, scene = (importlib.import_module(f"cdpr_exu.{m}") for m in ("errors", "result", "scene"))
+    # ``cdpr_exu.simulate`` is the function, or the module once imported (a callable module).
+    assert callable(cdpr_exu.simulate) and "simulate" in cdpr_exu.__all__
+    expected = {"load_scene": scene.load_scene, "save_scene": scene.save_scene, "Scene": scene.Scene,
+                "Result": result.Result, "CdprError": errors.CdprError,
+                "SceneError": errors.SceneError, "UnreachableError": errors.UnreachableError,
+                "SolverFailure": errors.SolverFailure, "RunInterrupted": errors.RunInterrupted,
+                "OutputError": errors.OutputError, "IdealIKController": ideal_ik.IdealIKController,
+                "TensionAwareController": tension_aware.TensionAwareController,
+                "ClosedLoopTensionAwareController": tension_aware.ClosedLoopTensionAwareController}
+    for name, value in expected.items():
+        assert getattr(cdpr_exu, name) is value, name
+        assert name in cdpr_exu.__all__ and name in dir(cdpr_exu), name
+    for name in cdpr_exu.__all__:  # every advertised name resolves
+        assert getattr(cdpr_exu, name) is not None, name
+    controller = cdpr_exu.CONTROLLERS["closed_loop_tension_aware"]()  # the README example's form
+    assert isinstance(controller, cdpr_exu.ClosedLoopTensionAwareController)
+    with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
+        cdpr_exu.no_such_name  # noqa: B018

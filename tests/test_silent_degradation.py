@@ -83,3 +83,19 @@ def test_a_result_that_needs_cables_to_push_is_flagged_and_tension_only_cables_a
 
     tension_only = simulate(short.with_changes(effects=Effects.from_preset("full", slack=True))).summary()
     assert not tension_only["elements_pushed"] and tension_only["min_element_tension_N"] >= 0.0
+
+
+def test_a_real_run_thrown_above_the_pulleys_gets_the_hint_for_that_cause():
+    """Issue 12.4 on the real solver: the bending-free paper circle at spectral radius 0.5 is
+    thrown off at the start-up (the README's claim); the monitor stops it with the platform
+    above the pulleys, and the hint speaks of that, not of the generic winch jump."""
+    from cdpr_exu.scene import Effects
+
+    scene = PAPER.with_changes(effects=Effects.from_preset("catenary"),
+                               solver=replace(PAPER.solver, spectral_radius=0.5, end_time=1.5))
+    with pytest.raises(SolverFailure, match="rose above the pulleys") as failure:
+        simulate(scene)
+    message = str(failure.value)
+    hint = message.split("Likely cause:")[1]
+    assert "thrown upwards" in hint and "a sudden jump of the winch command" not in hint
+    assert 0.0 < failure.value.time < 1.5 and len(failure.value.partial_result.time) > 1

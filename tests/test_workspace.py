@@ -84,3 +84,19 @@ def test_the_shipped_scenes_pass_the_check():
 
     for name in shipped_scenes():
         check_reference(load_scene(name))
+
+
+@pytest.mark.parametrize("preset", ["elastic", "ideal"])
+def test_massless_ropes_run_to_the_same_path_whatever_n_elements_says(preset):
+    """Issue 12.3 end to end: the same massless scene was refused at n_elements = 4 and ran at
+    80. Both run now (a pose needing about 3.5 m of the 3.75 m ropes), to the same path: a
+    massless rope has no elements, so n_elements changes nothing (measured: bit-identical)."""
+    low = _moving_to((0.0, -2.6, 0.0), effects=Effects.from_preset(preset))
+    paths = []
+    for n in (4, 80):
+        scene = low.with_changes(cables=tuple(replace(c, n_elements=n) for c in low.cables))
+        result = simulate(scene)
+        assert result.status == "completed" and result.time[-1] == pytest.approx(3.0)
+        paths.append(result.platform_pose)
+    np.testing.assert_allclose(paths[0], paths[1], rtol=0.0, atol=1e-12)
+    assert paths[0][-1, 1] == pytest.approx(-2.6, abs=2e-3)  # it got there (elastic ropes stretch 0.8 mm)
