@@ -188,10 +188,9 @@ def test_ctrl_c_saves_what_was_computed_prints_one_line_and_exits_130(tmp_path):
     assert Result.load(out).time.size > 1
 
 
-def test_an_unreachable_reference_exits_2_naming_time_and_pose_before_anything_is_written(tmp_path):
-    """Issue 11.1: a point_to_point ending at z = +1 m (above the pulleys, at z = 0) ran under
-    ideal IK with a 168.5 cm error and exit 0. It is refused before any simulation, with the
-    time and the pose; the output folder holds nothing (no scene.toml of a run that never ran)."""
+def _scene_ending_above_the_pulleys(tmp_path):
+    """A paper scene whose point_to_point ends at z = +1 m, above the pulleys (z = 0):
+    its file, and an output folder path that does not exist yet."""
     from cdpr_exu.trajectories import PointToPointTrajectory
 
     base = load_scene("paper-circle")
@@ -200,7 +199,14 @@ def test_an_unreachable_reference_exits_2_naming_time_and_pose_before_anything_i
                               solver=replace(base.solver, end_time=3.0))
     path = tmp_path / "above.toml"
     save_scene(scene, path)
-    out = tmp_path / "above"
+    return path, tmp_path / "above"
+
+
+def test_an_unreachable_reference_exits_2_naming_time_and_pose_before_anything_is_written(tmp_path):
+    """Issue 11.1: a point_to_point ending at z = +1 m (above the pulleys, at z = 0) ran under
+    ideal IK with a 168.5 cm error and exit 0. It is refused before any simulation, with the
+    time and the pose; the output folder holds nothing (no scene.toml of a run that never ran)."""
+    path, out = _scene_ending_above_the_pulleys(tmp_path)
     done = _cdpr("run", str(path), "--out", str(out), check=False)
     assert done.returncode == 2, done.stderr
     assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
@@ -213,15 +219,7 @@ def test_an_unreachable_reference_exits_2_naming_time_and_pose_before_anything_i
 def test_compare_refuses_an_unreachable_reference_with_exit_2_before_any_run(tmp_path):
     """Issue 11.1 and 11.4: `cdpr compare` on a reference above the pulleys exited 3 with six
     identical "refused" rows; it is bad input (exit 2), refused once, before any run."""
-    from cdpr_exu.trajectories import PointToPointTrajectory
-
-    base = load_scene("paper-circle")
-    scene = base.with_changes(trajectory=PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.0, 1.0, 0.0),
-                                                                duration=2.0),
-                              solver=replace(base.solver, end_time=3.0))
-    path = tmp_path / "above.toml"
-    save_scene(scene, path)
-    out = tmp_path / "above"
+    path, out = _scene_ending_above_the_pulleys(tmp_path)
     done = _cdpr("compare", str(path), "--out", str(out), check=False)
     assert done.returncode == 2, done.stderr
     assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
