@@ -36,7 +36,7 @@ from numba import njit
 
 from cdpr_exu.axial import tension_law
 from cdpr_exu.errors import SceneError
-from cdpr_exu.validation import real_array, whole_array
+from cdpr_exu.validation import per_item, points_per_item, whole_array
 
 __all__ = ["CONTACT_ONSET_DEPTH", "NodePulleyContact", "node_contact_force_kernel",
            "node_contact_triplet_pattern", "node_contact_triplet_values"]
@@ -155,15 +155,6 @@ def node_contact_jacobian_kernel(positions, velocities, nodes, centers, radii, s
     return out
 
 
-def _per_node(name, values, count, positive=False):
-    array = real_array(name, values)
-    array = np.full(count, float(array)) if array.ndim == 0 else np.asarray(array, dtype=np.float64)
-    if array.shape != (count,) or not np.isfinite(array).all() or (array <= 0.0 if positive else array < 0.0).any():
-        raise SceneError(f"{name} must be finite and {'positive' if positive else 'zero or positive'}, a scalar "
-                         f"or shape ({count},); got {values!r}")
-    return np.ascontiguousarray(array)
-
-
 class NodePulleyContact:
     """Rim contacts of a set of nodes with their pulleys, validated once, for the hot path.
 
@@ -187,14 +178,10 @@ class NodePulleyContact:
         count = self.nodes.size
         if count and (self.nodes.min() < 0 or self.nodes.max() >= int(n_nodes)):
             raise SceneError(f"nodes must lie in 0..{int(n_nodes) - 1}; got {self.nodes.min()}..{self.nodes.max()}")
-        centers = np.asarray(real_array("centers", centers), dtype=np.float64)
-        centers = np.tile(centers, (count, 1)) if centers.shape == (2,) else centers
-        if centers.shape != (count, 2) or not np.isfinite(centers).all():
-            raise SceneError(f"centers must be finite, shape (2,) or ({count}, 2); got shape {centers.shape}")
-        self.centers = np.ascontiguousarray(centers)
-        self.radii = _per_node("radii", radii, count, positive=True)
-        self.stiffness = _per_node("stiffness", stiffness, count)
-        self.damping = _per_node("damping", damping, count)
+        self.centers = points_per_item("centers", centers, count)
+        self.radii = per_item("radii", radii, count, positive=True)
+        self.stiffness = per_item("stiffness", stiffness, count)
+        self.damping = per_item("damping", damping, count)
         band = float(band)
         if not np.isfinite(band) or band < 0.0:
             raise SceneError(f"band must be a finite length >= 0 [m]; got {band!r}")

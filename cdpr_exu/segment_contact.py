@@ -50,7 +50,7 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu.errors import SceneError
-from cdpr_exu.validation import flat_coordinates, real_array, whole_array
+from cdpr_exu.validation import flat_coordinates, per_item, points_per_item, whole_array
 
 __all__ = [
     "SegmentPulleyContact",
@@ -253,27 +253,6 @@ def _segments(segments, n_nodes):
     return array
 
 
-def _per_segment(name, values, n_segments, positive=False):
-    array = real_array(name, values)
-    if array.ndim == 0:
-        array = np.full(n_segments, float(array))
-    elif array.shape != (n_segments,):
-        raise SceneError(f"{name} must be a scalar or have shape ({n_segments},); got shape {array.shape}")
-    array = np.ascontiguousarray(array, dtype=np.float64)
-    if not np.isfinite(array).all() or (array <= 0.0 if positive else array < 0.0).any():
-        raise SceneError(f"{name} must be finite and {'positive' if positive else 'zero or positive'}; got {values!r}")
-    return array
-
-
-def _centers(centers, n_segments):
-    array = np.asarray(real_array("centers", centers), dtype=np.float64)
-    if array.shape == (2,):
-        array = np.tile(array, (n_segments, 1))
-    if array.shape != (n_segments, 2) or not np.isfinite(array).all():
-        raise SceneError(f"centers must be finite, shape (2,) or ({n_segments}, 2); got shape {array.shape}")
-    return np.ascontiguousarray(array)
-
-
 # --------------------------------------------------------------------------- public API
 
 def contact_segments(candidate_nodes, n_elements: int) -> np.ndarray:
@@ -327,10 +306,10 @@ class SegmentPulleyContact:
         self.n_coordinates = 2 * n_nodes
         self.segments = _segments(segments, n_nodes)
         n = self.segments.shape[0]
-        self.centers = _centers(centers, n)
-        self.radii = _per_segment("radii", radii, n, positive=True)
-        self.stiffness = _per_segment("stiffness", stiffness, n)
-        self.damping = _per_segment("damping", damping, n)
+        self.centers = points_per_item("centers", centers, n)
+        self.radii = per_item("radii", radii, n, positive=True)
+        self.stiffness = per_item("stiffness", stiffness, n)
+        self.damping = per_item("damping", damping, n)
 
     def _check(self, name, values):
         if not (type(values) is np.ndarray and values.dtype == np.float64 and values.flags.c_contiguous):

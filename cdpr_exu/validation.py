@@ -94,3 +94,33 @@ def vector(name: str, value: Any, length: int, meaning: str = ""):
     if array.shape != (length,) or not np.all(np.isfinite(array)):
         raise SceneError(f"{name} must be a finite {length}-vector{meaning}, got {value!r}")
     return array
+
+
+def per_item(name: str, values: Any, count: int, positive: bool = False):
+    """One finite, non-negative (or positive) value per item: a scalar is repeated.
+
+    Returns a contiguous float64 ndarray, shape (count,); raises SceneError naming ``name``.
+    """
+    import numpy as np
+
+    array = real_array(name, values)
+    if array.ndim == 0:
+        array = np.full(count, float(array))
+    elif array.shape != (count,):
+        raise SceneError(f"{name} must be a scalar or have shape ({count},); got shape {array.shape}")
+    array = np.ascontiguousarray(array, dtype=np.float64)
+    if not np.isfinite(array).all() or (array <= 0.0 if positive else array < 0.0).any():
+        raise SceneError(f"{name} must be finite and {'positive' if positive else 'zero or positive'}; got {values!r}")
+    return array
+
+
+def points_per_item(name: str, values: Any, count: int):
+    """One finite planar point per item, shape (count, 2) [m]: a single (2,) point is repeated."""
+    import numpy as np
+
+    array = np.asarray(real_array(name, values), dtype=np.float64)
+    if array.shape == (2,):
+        array = np.tile(array, (count, 1))
+    if array.shape != (count, 2) or not np.isfinite(array).all():
+        raise SceneError(f"{name} must be finite, shape (2,) or ({count}, 2); got shape {array.shape}")
+    return np.ascontiguousarray(array)
