@@ -40,6 +40,7 @@ from numba import njit
 
 from cdpr_exu import bending
 from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.geometry import Pulley, rotation_matrix
 from cdpr_exu.kinematics import initial_cable_nodes, straight_cable_nodes
 from cdpr_exu.validation import finite, vector
 
@@ -63,11 +64,8 @@ class ChainCable:
         k_theta of each interior joint (0: no bending).
     slack : bool
         Tension-only elements.
-    pulley_center : (x, z) [m]
-    pulley_radius : float [m]
-        0 for a fixed exit point.
-    side : {-1, +1}
-        Side of the pulley on which the cable hangs to its winch.
+    pulley : Pulley
+        Where the cable leaves the frame (radius 0: a fixed exit point).
     contact_stiffness : float [N/m]
         Pulley penalty k_p (0: no contact).
     anchor : (x, z) [m]
@@ -79,9 +77,7 @@ class ChainCable:
     axial_stiffness: float
     bending_stiffness: float
     slack: bool
-    pulley_center: tuple
-    pulley_radius: float
-    side: int
+    pulley: Pulley
     contact_stiffness: float
     anchor: tuple
 
@@ -92,14 +88,13 @@ class ChainCable:
             value = finite(name, getattr(self, name))
             if value <= 0:
                 raise SceneError(f"{name} must be positive and finite, got {value!r}")
-        for name in ("bending_stiffness", "pulley_radius", "contact_stiffness"):
+        for name in ("bending_stiffness", "contact_stiffness"):
             if finite(name, getattr(self, name)) < 0:
                 raise SceneError(f"{name} must be zero or positive, got {getattr(self, name)!r}")
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
             raise SceneError(f"node_masses must be finite and non-negative, got {self.node_masses!r}")
-        if self.side not in (-1, 1):
-            raise SceneError(f"side must be -1 or +1, got {self.side!r}")
-        vector("pulley_center", self.pulley_center, 2)
+        if not isinstance(self.pulley, Pulley):
+            raise SceneError(f"pulley must be a Pulley, got {self.pulley!r}")
         vector("anchor", self.anchor, 2)
 
     @property
@@ -113,8 +108,7 @@ class ChainCable:
 
     def winch_node(self, paid_out: float) -> np.ndarray:
         """Position of node 0 for a paid-out length lambda [m], shape (2,) [m]."""
-        cx, cz = self.pulley_center
-        return np.array([cx + self.side * self.pulley_radius, cz - (self.unstrained_length - paid_out)])
+        return self.pulley.winch_end(self.unstrained_length, paid_out)
 
 
 @dataclass(frozen=True)
@@ -158,17 +152,15 @@ def chain_robot(scene) -> ChainRobot:
         raise SceneError("chain statics models the node contact on pulleys only, got "
                          f"effects.pulley_contact_model = {effects.pulley_contact_model!r}")
     gravity = scene.gravity if effects.gravity else 0.0
-    point_exit = scene.cable_exit == "point"
     cables = []
-    for cable, pulley, anchor in zip(scene.cables, scene.pulleys, scene.platform.anchors):
+    for cable, pulley, exit_, anchor in zip(scene.cables, scene.pulleys, scene.exits, scene.platform.anchors):
         masses = cable.node_masses() if gravity > 0 else np.zeros(cable.n_elements + 1)
-        contact = pulley.contact_stiffness if (effects.pulley_contact and not point_exit) else 0.0
+        contact = pulley.contact_stiffness if scene.pulley_contact else 0.0
         cables.append(ChainCable(
             node_masses=tuple(float(m) for m in masses), element_length=cable.element_length,
             axial_stiffness=cable.axial_stiffness,
             bending_stiffness=cable.bending_stiffness if effects.bending else 0.0,
-            slack=effects.slack, pulley_center=tuple(pulley.center),
-            pulley_radius=0.0 if point_exit else pulley.radius, side=pulley.side,
+            slack=effects.slack, pulley=Pulley(exit_.center, exit_.radius, exit_.side),
             contact_stiffness=contact, anchor=tuple(anchor)))
     return ChainRobot(tuple(cables), scene.platform.mass, gravity)
 
@@ -206,11 +198,6 @@ class ChainEquilibrium:
         return np.array([t[-1] for t in self.tensions])
 
 
-def _rotation(phi):
-    c, s = np.cos(phi), np.sin(phi)
-    return np.array([[c, -s], [s, c]])
-
-
 class _Layout:
     """Index bookkeeping: global nodes of all cables and the inner unknowns.
 
@@ -243,11 +230,12 @@ class _Layout:
             self.anchor_sum[:, 2 * j:2 * j + 2] = np.eye(2)
         self.joints, self.joint_stiffness = joints, joint_stiffness
         # per node: the pulley it may touch (stiffness 0: none)
-        self.node_center = np.concatenate([np.tile(np.asarray(c.pulley_center, float), (n, 1))
+        self.node_center = np.concatenate([np.tile(np.asarray(c.pulley.center, float), (n, 1))
                                            for c, n in zip(robot.cables, self.counts)])
-        self.node_radius = np.concatenate([np.full(n, c.pulley_radius) for c, n in zip(robot.cables, self.counts)])
+        self.node_radius = np.concatenate([np.full(n, c.pulley.radius) for c, n in zip(robot.cables, self.counts)])
         self.node_contact = np.concatenate([
-            np.full(n, c.contact_stiffness if c.pulley_radius > 0 else 0.0) for c, n in zip(robot.cables, self.counts)])
+            np.full(n, 0.0 if c.pulley.is_point_exit else c.contact_stiffness)
+            for c, n in zip(robot.cables, self.counts)])
         elements = [np.stack([np.arange(f, f + n - 1), np.arange(f + 1, f + n)], axis=1)
                     for f, n in zip(self.first, self.counts)]
         self.elements = np.concatenate(elements).astype(int)
@@ -264,7 +252,7 @@ def _positions(robot, layout, position, rotation, v, paid_out):
         rotation = v[layout.n_interior]
     p = np.empty((layout.n_nodes, 2))
     p[layout.interior] = v[:layout.n_interior].reshape(-1, 2)
-    R = _rotation(rotation)
+    R = rotation_matrix(rotation)
     for i, cable in enumerate(robot.cables):
         p[layout.winch[i]] = cable.winch_node(paid_out[i])
         p[layout.anchor[i]] = position + R @ np.asarray(cable.anchor)
@@ -553,20 +541,20 @@ def _straight_guess(robot, position, rotation, tensions):
     every element carries the tension T; the paid-out length follows from where node
     0 lands. Returns the interior node coordinates (flat) and the paid-out lengths.
     """
-    R = _rotation(rotation)
+    R = rotation_matrix(rotation)
     interior, paid_out = [], []
     for cable, tension in zip(robot.cables, tensions):
         anchor = np.asarray(position) + R @ np.asarray(cable.anchor)
         stretched = cable.element_length * (1.0 + tension / (cable.axial_stiffness * cable.element_length))
-        if cable.pulley_radius > 0:
-            nodes = initial_cable_nodes(np.asarray(cable.pulley_center), cable.pulley_radius, cable.side, anchor,
-                                        stretched, cable.n_elements)
+        pulley = cable.pulley
+        if not pulley.is_point_exit:
+            nodes = initial_cable_nodes(pulley.center, pulley.radius, pulley.side, anchor, stretched, cable.n_elements)
         else:
-            direction = anchor - np.asarray(cable.pulley_center)
+            direction = anchor - np.asarray(pulley.center)
             start = anchor - direction / np.linalg.norm(direction) * stretched * cable.n_elements
             nodes = straight_cable_nodes(start, anchor, cable.n_elements)
         interior.append(nodes[1:-1].ravel())
-        paid_out.append(cable.unstrained_length - (cable.pulley_center[1] - nodes[0, 1]))
+        paid_out.append(pulley.paid_out_length(cable.unstrained_length, nodes[0]))
     return np.concatenate(interior), np.array(paid_out)
 
 

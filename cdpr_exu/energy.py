@@ -60,7 +60,7 @@ def energy_parts(scene: Scene, result: Result) -> EnergyParts:
     axial = np.zeros_like(kinetic)
     bending = np.zeros_like(kinetic)
     contact = np.zeros_like(kinetic)
-    with_contact = scene.effects.pulley_contact and scene.cable_exit == "pulley"
+    with_contact = scene.pulley_contact
     for cable, pulley, nodes, node_velocities in zip(scene.cables, scene.pulleys, result.nodes,
                                                      result.node_velocities):
         masses = cable.node_masses()

@@ -19,7 +19,7 @@ import numpy as np
 
 from .cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
 from .errors import SceneError
-from .kinematics import anchor_points, hang_point, initial_cable_nodes, pulley_exit, straight_cable_nodes
+from .kinematics import anchor_points, initial_cable_nodes, straight_cable_nodes
 from .platform import PlatformItems, add_platform, attach_cable
 from .pulley import add_pulley_contact, add_pulley_ground
 from .scene import Scene
@@ -124,7 +124,7 @@ def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
     """
     cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
     anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
-    if scene.cable_exit == "point":
+    if scene.exits[cable_index].is_point_exit:
         return straight_cable_nodes(np.asarray(pulley.center), anchor, cable.n_elements)
     radius = pulley.radius
     if scene.effects.pulley_contact and scene.effects.pulley_contact_model == "segment":
@@ -149,7 +149,7 @@ def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 
     cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
     times = np.linspace(0.0, scene.solver.end_time, 200)
     anchors = anchor_points(scene.trajectory.pose(times), np.asarray(scene.platform.anchors))[:, cable_index]
-    exits = pulley_exit(np.asarray(pulley.center), pulley.radius, pulley.side, anchors)  # all times at once
+    exits = pulley.exit(anchors)  # all times at once
     hang = cable.unstrained_length - exits.cable_length
     arc_end = hang + pulley.radius * exits.wrap_angle
     margin = margin_elements * cable.element_length + 0.05 * cable.unstrained_length
@@ -221,13 +221,13 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
     platform = add_platform(mbs, scene.platform, effects, scene.gravity)
     if not effects.cable_mass:
         return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
-    use_contact = effects.pulley_contact and scene.cable_exit == "pulley"
+    use_contact = scene.pulley_contact
     on_segments = use_contact and effects.pulley_contact_model == "segment"
     cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
     contact_elements = []  # cable-local element indices per cable (segment contact only)
-    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
+    for i, (cable, pulley, exit_) in enumerate(zip(scene.cables, scene.pulleys, scene.exits)):
         nodes_xz = initial_nodes(scene, i)
-        if scene.cable_exit == "pulley":
+        if not exit_.is_point_exit:
             _check_elements_fit_the_pulley(scene, i, nodes_xz)
         items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
         attach_cable(mbs, platform, i, items.markers[-1], cable, explicit=scene.solver.integrator != "generalized_alpha")
@@ -253,11 +253,7 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
             contact_elements.append(np.zeros(0, dtype=np.int64))
             contacts.append([])
             contact_nodes.append(np.zeros(0, dtype=int))
-        if scene.cable_exit == "point":
-            paid_out.append(cable.unstrained_length)
-        else:
-            # Unstrained cable beyond the hang point: all of it but the hanging part.
-            paid_out.append(cable.unstrained_length - (pulley.center[1] - nodes_xz[0, 1]))
+        paid_out.append(exit_.paid_out_length(cable.unstrained_length, nodes_xz[0]))
         cables.append(items)
     if sparse_jacobian is None:
         sparse_jacobian = sum(c.n_elements + 1 for c in scene.cables) > SPARSE_JACOBIAN_MIN_NODES
@@ -287,12 +283,8 @@ def rope_geometry(scene: Scene, cable_index: int, anchor) -> tuple[np.ndarray, f
     paid_out : float [m]
         Ideal length from the hang point to the anchor.
     """
-    pulley = scene.pulleys[cable_index]
-    center = np.asarray(pulley.center)
-    if scene.cable_exit == "point":
-        return center, 0.0, float(np.linalg.norm(np.asarray(anchor) - center))
-    exit_ = pulley_exit(center, pulley.radius, pulley.side, np.asarray(anchor))
-    return hang_point(center, pulley.radius, pulley.side), pulley.radius, float(exit_.cable_length)
+    exit_ = scene.exits[cable_index]
+    return exit_.hang_point, exit_.radius, float(exit_.cable_length(np.asarray(anchor)))
 
 
 def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems, ground_coordinate: int) -> Model:

@@ -27,7 +27,7 @@ from matplotlib.patches import Circle, Polygon
 from matplotlib.transforms import ScaledTranslation
 
 from .errors import CdprError
-from .kinematics import pulley_exit
+from .geometry import anchor_points
 from .result import Result
 from .scene import Scene
 
@@ -120,16 +120,12 @@ def _platform_corners(scene: Scene, pose: np.ndarray) -> np.ndarray:
     """World corners of the platform rectangle at ``pose`` (x, z, phi), shape (4, 2) [m]."""
     width, height = scene.platform.size
     local = np.array([[-width, -height], [width, -height], [width, height], [-width, height]]) / 2.0
-    c, s = np.cos(pose[2]), np.sin(pose[2])
-    rotation = np.array([[c, -s], [s, c]])
-    return pose[:2] + local @ rotation.T
+    return anchor_points(pose, local)
 
 
 def _anchor_world(scene: Scene, pose: np.ndarray) -> np.ndarray:
     """World anchor points r + R(phi) b_i at ``pose``, shape (m, 2) [m]."""
-    c, s = np.cos(pose[2]), np.sin(pose[2])
-    rotation = np.array([[c, -s], [s, c]])
-    return pose[:2] + np.asarray(scene.platform.anchors, dtype=float) @ rotation.T
+    return anchor_points(pose, np.asarray(scene.platform.anchors, dtype=float))
 
 
 def _robot_limits(scene: Scene, result: Result, rows: np.ndarray, margin: float = 0.12):
@@ -183,12 +179,11 @@ def _free_span_sag(scene: Scene, i: int, nodes: np.ndarray):
     """
     if not np.all(np.isfinite(nodes)):
         return None
-    pulley = scene.pulleys[i]
-    center = np.asarray(pulley.center, dtype=float)
     anchor = nodes[-1]
-    radius = pulley.radius if scene.cable_exit == "pulley" else 0.0
+    pulley = scene.exits[i]
+    center, radius = np.asarray(pulley.center, dtype=float), pulley.radius
     try:
-        start = np.asarray(pulley_exit(center, radius, pulley.side, anchor).tangent_point, dtype=float)
+        start = np.asarray(pulley.exit(anchor).tangent_point, dtype=float)
     except (CdprError, ValueError):
         return None
     chord = anchor - start

@@ -598,7 +598,7 @@ def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method
         platform_forces.append(reaction_sign * np.asarray(mbs.GetObjectOutput(model.platform.joints[i], force))[:2])
         anchor_tensions.append(tension[-1])
         pulley = scene.pulleys[i]
-        touching = np.flatnonzero(penetration(pulley, nodes) > 0.0) if scene.cable_exit == "pulley" else []
+        touching = [] if scene.exits[i].is_point_exit else np.flatnonzero(penetration(pulley, nodes) > 0.0)
         if len(touching) == 0 or touching[-1] >= len(nodes) - 1:
             winch = model.winches[i]
             if int(winch.horizontal) >= 0 and int(winch.vertical) >= 0:
@@ -656,8 +656,8 @@ def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None
     FigureCanvasAgg(figure)
     ax = figure.add_subplot(1, 1, 1)
     colors = ("tab:blue", "tab:red", "tab:green", "tab:purple")
-    for pulley in scene.pulleys:
-        if scene.cable_exit == "pulley":
+    for pulley in scene.exits:
+        if not pulley.is_point_exit:
             ax.add_patch(Circle(pulley.center, pulley.radius, facecolor="0.92", edgecolor="0.55", zorder=1))
         ax.plot(*pulley.center, marker="+", color="0.55", zorder=1)
     for i, nodes in enumerate(rest.nodes):

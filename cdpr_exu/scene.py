@@ -24,6 +24,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .errors import CoarseOutputWarning, SceneError, UnreachableError
+from .geometry import Pulley, anchor_points
 from .validation import finite, non_negative, positive
 from .trajectories import Trajectory, trajectory_from_dict
 
@@ -212,11 +213,13 @@ class CableSpec:
 
 
 @dataclass(frozen=True)
-class PulleySpec:
+class PulleySpec(Pulley):
     """A pulley the cable runs over, and on which side the cable hangs to its winch.
 
     The cable comes up from the winch along the vertical line x = x_c + side * radius,
-    wraps over the top of the pulley and leaves it tangentially towards the anchor.
+    wraps over the top of the pulley and leaves it tangentially towards the anchor. A
+    :class:`~cdpr_exu.geometry.Pulley` (its geometry: hang point, exit, wrap) with the
+    parameters of the rim contact.
 
     Parameters
     ----------
@@ -619,16 +622,13 @@ class Scene:
 
     def _check_reachable(self) -> None:
         """Refuse an initial pose the cables cannot reach (before any simulation)."""
-        from .kinematics import anchor_points, ideal_cable_length
-
         anchors = anchor_points(np.asarray(self.platform.initial_pose), np.asarray(self.platform.anchors))
-        for i, (cable, pulley) in enumerate(zip(self.cables, self.pulleys)):
-            c = np.asarray(pulley.center)
-            if self.cable_exit == "point":
-                needed = float(np.linalg.norm(anchors[i] - c))
+        for i, (cable, pulley, exit_) in enumerate(zip(self.cables, self.pulleys, self.exits)):
+            if exit_.is_point_exit:
+                needed = float(np.linalg.norm(anchors[i] - np.asarray(exit_.center)))
             else:
                 try:
-                    needed = ideal_cable_length(c, pulley.radius, pulley.side, anchors[i])
+                    needed = exit_.cable_length(anchors[i])
                 except UnreachableError as err:
                     raise UnreachableError(
                         f"platform.anchors[{i}] at platform.initial_pose {list(self.platform.initial_pose)} cannot be "
@@ -641,6 +641,22 @@ class Scene:
                 )
 
     # Convenience -------------------------------------------------------------------
+    @property
+    def exits(self) -> tuple[Pulley, ...]:
+        """Where each cable leaves the frame, decided once from ``cable_exit``.
+
+        The cable's pulley, or for ``cable_exit = "point"`` a point exit (a
+        :class:`~cdpr_exu.geometry.Pulley` of radius 0) at the pulley's centre.
+        """
+        if self.cable_exit == "point":
+            return tuple(Pulley(p.center, 0.0, p.side) for p in self.pulleys)
+        return tuple(self.pulleys)
+
+    @property
+    def pulley_contact(self) -> bool:
+        """True when the cables touch their pulleys: contact is on and the cables run over pulleys."""
+        return self.effects.pulley_contact and self.cable_exit == "pulley"
+
     @property
     def n_cables(self) -> int:
         return len(self.cables)

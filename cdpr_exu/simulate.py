@@ -143,7 +143,7 @@ class _Monitor:
         self.scene = scene
         self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
                        for i, cable in enumerate(scene.cables) if f"cable_{i}" in indices]
-        self.check_pulleys = scene.cable_exit == "pulley" and scene.effects.pulley_contact
+        self.check_pulleys = scene.pulley_contact
         self.on_segments = scene.effects.pulley_contact_model == "segment"
         self.platform_index = indices["platform"]
         self.reference_pose = reference[self.platform_index]
@@ -256,7 +256,7 @@ class _Recorder:
             rest = np.full((k, cable.n_elements), cable.element_length)
             rest[:, 0] += self.surplus[:k, i]  # the winch element holds the slack rope at the drum
             tensions.append(element_tensions(cable, positions, velocities, scene.effects, rest))
-            if scene.cable_exit == "pulley":
+            if not scene.exits[i].is_point_exit:
                 depth.append(penetration(scene.pulleys[i], positions).max(axis=1))
             else:
                 depth.append(np.zeros(k))
@@ -277,22 +277,17 @@ def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndar
     paid-out length; their velocities are time derivatives of those points.
     """
     from .kinematics import anchor_points
-    from .model import rope_geometry
 
     k = len(times)
     anchors = anchor_points(pose, np.asarray(scene.platform.anchors)) if k else np.zeros((0, len(model.ropes), 2))
     nodes, velocities, tensions = [], [], []
     for i, cable in enumerate(scene.cables):
         points = np.zeros((k, 4, 2))
+        exit_ = scene.exits[i]
+        hang = exit_.hang_point
         for row in range(k):
-            hang, radius, _ = rope_geometry(scene, i, anchors[row, i])
-            tangent = hang
-            if radius > 0:
-                from .kinematics import pulley_exit
-
-                tangent = pulley_exit(np.asarray(scene.pulleys[i].center), radius, scene.pulleys[i].side,
-                                      anchors[row, i]).tangent_point
-            points[row] = [hang - [0.0, cable.unstrained_length - paid_out[row, i]], hang, tangent, anchors[row, i]]
+            tangent = exit_.exit(anchors[row, i]).tangent_point
+            points[row] = [exit_.winch_end(cable.unstrained_length, paid_out[row, i]), hang, tangent, anchors[row, i]]
         nodes.append(points)
         velocities.append(np.gradient(points, times, axis=0) if k > 1 else np.zeros_like(points))
         tensions.append(forces[:, i:i + 1])
@@ -539,7 +534,7 @@ def explicit_step_limit(scene: Scene) -> float:
         stiffness = cable.axial_stiffness if scene.effects.axial_elasticity else 0.0
         rate = 4.0 * damping / mass
         frequency = 2.0 * math.sqrt(stiffness / mass)
-        if scene.effects.pulley_contact and scene.cable_exit == "pulley":
+        if scene.pulley_contact:
             frequency = math.hypot(frequency, math.sqrt(pulley.contact_stiffness / mass))
         limits.append(RK44_STABILITY_LIMIT / max(rate, frequency, 1e-300))
     return min(limits)
@@ -579,7 +574,7 @@ def first_step_hints(scene: Scene) -> list[str]:
     solver = scene.solver
     cable = scene.cables[0]
     mass = cable.element_mass if scene.effects.cable_mass else scene.platform.mass
-    if scene.effects.pulley_contact and scene.cable_exit == "pulley":
+    if scene.pulley_contact:
         worst = max(scene.pulleys, key=lambda p: p.contact_stiffness)
         # The paper's pulley (1e7 N/m on 0.0875 kg nodes) runs at 2e-3 s: k h^2 / m = 457.
         ratio = worst.contact_stiffness * solver.step_size**2 / mass

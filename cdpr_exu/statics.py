@@ -78,6 +78,7 @@ from cdpr_exu.catenary import (
     state_from_end_forces,
 )
 from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.geometry import Pulley, perpendicular, planar_cross, rotation_matrix
 from cdpr_exu.validation import finite, non_negative, positive, real_array, vector
 
 _RELATIVE_TOLERANCE = 1e-12
@@ -97,67 +98,9 @@ def _wrench(value):
     return vector("external_wrench", value, 3, " (fx [N], fz [N], moment [N m])")
 
 
-def _cross(a, b):
-    """Planar cross product ``a_x b_z - a_z b_x``."""
-    return a[0] * b[1] - a[1] * b[0]
-
-
-def _perpendicular(a):
-    """``a`` turned by +90 degrees: ``d(R b)/d(phi) = perpendicular(R b)``."""
-    return np.array([-a[1], a[0]])
-
-
-def _rotation(phi):
-    c, s = math.cos(phi), math.sin(phi)
-    return np.array([[c, -s], [s, c]])
-
-
 # ---------------------------------------------------------------------------
 # parameters
 # ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Pulley:
-    """A pulley the cable leaves tangentially towards the platform.
-
-    Parameters
-    ----------
-    centre : (float, float) [m]
-        Centre ``(c_x, c_z)``.
-    radius : float [m]
-        ``r_p > 0``.
-    side : {-1, +1}
-        Side where the cable comes up from the winch, along ``x = c_x + side r_p``:
-        -1 on the left (the cable wraps clockwise over the top), +1 on the right
-        (counter-clockwise). For the paper's robot: -1 for the left pulley, +1 for
-        the right one (the winch legs hang outside).
-    """
-
-    centre: tuple
-    radius: float
-    side: int = -1
-
-    def __post_init__(self):
-        object.__setattr__(self, "centre", _point("centre", self.centre))
-        object.__setattr__(self, "radius", positive("radius", self.radius))
-        if self.side not in (-1, 1):
-            raise SceneError(f"side must be -1 or +1, got {self.side!r}")
-
-    @property
-    def winch_point(self):
-        """Where the vertical winch leg meets the pulley, ``(c_x + side r_p, c_z)`` [m]."""
-        return np.array([self.centre[0] + self.side * self.radius, self.centre[1]])
-
-    def tangent_point(self, angle):
-        """Point of the rim at polar angle ``angle`` [rad], shape (2,) [m]."""
-        return np.array(self.centre) + self.radius * np.array([math.cos(angle), math.sin(angle)])
-
-    def wrap_angle(self, angle):
-        """Angle [rad] wrapped from the winch point over the top to the rim angle ``angle``."""
-        if self.side < 0:
-            return (math.pi - angle) % (2.0 * math.pi)
-        return angle % (2.0 * math.pi)
-
-
 @dataclass(frozen=True)
 class SuspendedCable:
     """One cable of the platform: its material, its anchor and its upper end.
@@ -173,7 +116,8 @@ class SuspendedCable:
     exit_point : (float, float) [m], optional
         Fixed upper end, world frame. Give exactly one of ``exit_point`` and ``pulley``.
     pulley : Pulley, optional
-        Pulley the cable leaves from.
+        Pulley the cable leaves from (:class:`cdpr_exu.geometry.Pulley`); one of radius 0
+        is taken as the fixed ``exit_point`` at its centre.
     """
 
     weight_per_length: float
@@ -199,6 +143,9 @@ class SuspendedCable:
             object.__setattr__(self, "exit_point", _point("exit_point", self.exit_point))
         elif not isinstance(self.pulley, Pulley):
             raise SceneError(f"pulley must be a Pulley, got {self.pulley!r}")
+        elif self.pulley.is_point_exit:  # a pulley of radius 0 is a fixed exit point
+            object.__setattr__(self, "exit_point", self.pulley.center)
+            object.__setattr__(self, "pulley", None)
 
     def catenary(self, unstrained_length):
         """The `CatenaryCable` of this cable with the given unstrained length [m]."""
@@ -209,7 +156,7 @@ class SuspendedCable:
         """Exit point, or pulley centre, shape (2,) [m]."""
         if self.pulley is None:
             return np.array(self.exit_point)
-        return np.array(self.pulley.centre)
+        return np.array(self.pulley.center)
 
 
 @dataclass(frozen=True)
@@ -261,8 +208,8 @@ class SuspendedPlatform:
 
     def anchor_points(self, position, rotation=0.0):
         """World positions of the anchors, shape (n_cables, 2) [m]."""
-        rotation_matrix = _rotation(rotation)
-        return np.array([np.asarray(position) + rotation_matrix @ c.anchor for c in self.cables])
+        turn = rotation_matrix(rotation)
+        return np.array([np.asarray(position) + turn @ c.anchor for c in self.cables])
 
 
 def inertial_wrench(platform, acceleration, angular_acceleration=0.0):
@@ -528,19 +475,19 @@ def _warm_then_cold(solve_from, guess):
 # ---------------------------------------------------------------------------
 def _straight_tangent_angle(pulley, point):
     """Rim angle where a straight cable from ``point`` leaves ``pulley``."""
-    centre = np.array(pulley.centre)
+    centre = np.array(pulley.center)
     offset = centre - point
     distance = float(np.hypot(*offset))
     if distance <= pulley.radius:
         raise UnreachableError(
             f"anchor point ({point[0]:g}, {point[1]:g}) m lies inside the pulley of centre "
-            f"{pulley.centre} m and radius {pulley.radius:g} m"
+            f"{pulley.center} m and radius {pulley.radius:g} m"
         )
     gamma = math.atan2(offset[1], offset[0])
     spread = math.acos(-pulley.radius / distance)
     for angle in (gamma + spread, gamma - spread):
         tangent = pulley.side * np.array([math.sin(angle), -math.cos(angle)])
-        if np.dot(pulley.tangent_point(angle) - point, tangent) > 0.0:
+        if np.dot(pulley.rim_point(angle) - point, tangent) > 0.0:
             return angle
     raise AssertionError("no tangent with the pulley's orientation")  # pragma: no cover
 
@@ -555,7 +502,7 @@ def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_leng
     """
     catenary = cable.catenary(suspended_length)
     span, jac = span_and_jacobian(catenary, H, V_B, sign_x)
-    tangent = pulley.tangent_point(angle)
+    tangent = pulley.rim_point(angle)
     c, s = math.cos(angle), math.sin(angle)
     scale = suspended_length / tension_scale  # tangency residual in metres
     residual = np.empty(3)
@@ -598,7 +545,7 @@ def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensi
         H_, V_, angle_ = x
         tension = math.hypot(H_, V_)
         stretch = 1.0 + tension / EA
-        wrap = pulley.wrap_angle(angle_)
+        wrap = pulley.wrap_to(angle_)
         length = unstrained_length - r * wrap / stretch
         # d(length)/d(H, V_B, angle)
         factor = r * wrap / (EA * stretch**2 * tension) if tension > 0.0 else 0.0
@@ -608,13 +555,13 @@ def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensi
     def solve_from(start_guess):
         if start_guess is None:
             angle = _straight_tangent_angle(pulley, point)
-            suspended = unstrained_length - r * pulley.wrap_angle(angle)
+            suspended = unstrained_length - r * pulley.wrap_to(angle)
             if suspended <= 0.0:
                 raise UnreachableError(
                     f"unstrained_length {unstrained_length:g} m is shorter than the wrap on the pulley"
                 )
             state = solve_forward(
-                cable.catenary(suspended), pulley.tangent_point(angle) - point,
+                cable.catenary(suspended), pulley.rim_point(angle) - point,
                 max_strain=max_strain, max_tension=max_tension,
             )
             H, V_B = state.horizontal_tension, state.vertical_tension_b
@@ -622,7 +569,7 @@ def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensi
                 H = 1e-9 * EA
         else:
             H, V_B, angle = start_guess
-        sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
+        sign_x = -1.0 if pulley.rim_point(angle)[0] < point[0] else 1.0
         tension_scale = max(math.hypot(H, V_B), w * unstrained_length, 1e-300)
 
         def function(x):
@@ -660,7 +607,7 @@ def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensi
     )
     stiffness = force_derivative @ sensitivity
     equilibrium = CableEquilibrium(
-        state, unstrained_length, length, point.copy(), pulley.tangent_point(angle), wrap
+        state, unstrained_length, length, point.copy(), pulley.rim_point(angle), wrap
     )
     return equilibrium, stiffness, (H, V_B, angle)
 
@@ -694,13 +641,13 @@ def _inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tens
             if start_guess is None:
                 angle = _straight_tangent_angle(pulley, point)
                 length, state = solve_inverse(
-                    pulley.tangent_point(angle) - point, w, EA, H,
+                    pulley.rim_point(angle) - point, w, EA, H,
                     max_strain=max_strain, max_tension=max_tension,
                 )
                 V_B = state.vertical_tension_b
             else:
                 length, V_B, angle = start_guess
-            sign_x = -1.0 if pulley.tangent_point(angle)[0] < point[0] else 1.0
+            sign_x = -1.0 if pulley.rim_point(angle)[0] < point[0] else 1.0
             tension_scale = max(math.hypot(H, V_B), w * length, 1e-300)
 
             def function(x):
@@ -725,9 +672,9 @@ def _inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tens
         d_residual_dH = partial[:, 0]
         d_residual_dp = np.vstack([np.eye(2), np.zeros((1, 2))])
         state = state_from_end_forces(catenary, H, V_B, sign_x)
-        wrap = pulley.wrap_angle(angle)
+        wrap = pulley.wrap_to(angle)
         total = length + r * wrap / (1.0 + state.tension_b / EA)
-        equilibrium = CableEquilibrium(state, total, length, point.copy(), pulley.tangent_point(angle), wrap)
+        equilibrium = CableEquilibrium(state, total, length, point.copy(), pulley.rim_point(angle), wrap)
         new_guess = (length, V_B, angle)
     if state.max_tension > _tension_limit(cable, max_strain, max_tension):
         raise UnreachableError(
@@ -767,27 +714,27 @@ def _platform_noise(platform, force_scale):
 
 def _wrench_residual(platform, rotation, equilibria, wrench, dof):
     """Net wrench on the platform ``(fx, fz[, m])`` [N, N, N m]."""
-    rotation_matrix = _rotation(rotation)
+    turn = rotation_matrix(rotation)
     total = np.array([wrench[0], wrench[1] - platform.mass * platform.gravity, wrench[2]])
     for cable, equilibrium in zip(platform.cables, equilibria):
         force = equilibrium.force_on_platform
         total[:2] += force
-        total[2] += _cross(rotation_matrix @ cable.anchor, force)
+        total[2] += planar_cross(turn @ cable.anchor, force)
     return total[:dof]
 
 
 def _pose_jacobian(platform, rotation, equilibria, stiffnesses, dof):
     """``d(net wrench)/d(pose)`` from the cables' ``dF_A/dp_A``, shape (dof, dof)."""
-    rotation_matrix = _rotation(rotation)
+    turn = rotation_matrix(rotation)
     jacobian = np.zeros((3, 3))
     for cable, equilibrium, stiffness in zip(platform.cables, equilibria, stiffnesses):
-        arm = rotation_matrix @ cable.anchor
-        d_point = np.column_stack([np.eye(2), _perpendicular(arm)])  # dp/d(x, z, phi)
+        arm = turn @ cable.anchor
+        d_point = np.column_stack([np.eye(2), perpendicular(arm)])  # dp/d(x, z, phi)
         d_force = stiffness @ d_point
         force = equilibrium.force_on_platform
         jacobian[:2] += d_force
         jacobian[2] += arm[0] * d_force[1] - arm[1] * d_force[0]
-        jacobian[2, 2] += _cross(_perpendicular(arm), force)
+        jacobian[2, 2] += planar_cross(perpendicular(arm), force)
     return jacobian[:dof, :dof]
 
 
@@ -838,18 +785,18 @@ def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
 
     def energy(q):
         phi = q[2] if dof == 3 else 0.0
-        rotation_matrix = _rotation(phi)
+        turn = rotation_matrix(phi)
         value = weight * q[1] - wrench[0] * q[0] - wrench[1] * q[1] - wrench[2] * phi
         gradient = np.array([-wrench[0], weight - wrench[1], -wrench[2]])
         for cable, L, k in zip(platform.cables, lengths, stiffness):
-            arm = rotation_matrix @ cable.anchor
+            arm = turn @ cable.anchor
             length, direction = _straight_length_and_gradient(cable, q[:2] + arm)
             extension = length - L
             if extension > 0.0:
                 value += 0.5 * k * extension**2
                 pull = k * extension * direction
                 gradient[:2] += pull
-                gradient[2] += _cross(arm, pull)
+                gradient[2] += planar_cross(arm, pull)
         return value, gradient[:dof]
 
     start = np.array([uppers[:, 0].mean(), uppers[:, 1].mean() - lengths.mean(), 0.0])[:dof]
@@ -874,14 +821,14 @@ def _straight_length_and_gradient(cable, point):
         length = float(np.hypot(*offset))
         return length, (offset / length if length > 0.0 else np.zeros(2))
     pulley = cable.pulley
-    offset = point - np.array(pulley.centre)
+    offset = point - np.array(pulley.center)
     distance = float(np.hypot(*offset))
     if distance <= pulley.radius:
         return distance + math.pi * pulley.radius, offset / max(distance, 1e-300)
     angle = _straight_tangent_angle(pulley, point)
-    offset = point - pulley.tangent_point(angle)
+    offset = point - pulley.rim_point(angle)
     straight = float(np.hypot(*offset))
-    return straight + pulley.radius * pulley.wrap_angle(angle), offset / straight
+    return straight + pulley.radius * pulley.wrap_to(angle), offset / straight
 
 
 def _wrap_angle(angle):
@@ -997,20 +944,20 @@ def _result(platform, pose, equilibria, jacobian, wrench, dof):
 def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
     """Horizontal tensions of straight massless cables balancing the load (start guess)."""
     points = platform.anchor_points(position, rotation)
-    rotation_matrix = _rotation(rotation)
+    turn = rotation_matrix(rotation)
     load = -np.array([wrench[0], wrench[1] - platform.mass * platform.gravity, wrench[2]])
     columns, horizontal = [], []
     for cable, point in zip(platform.cables, points):
         if cable.pulley is None:
             upper = np.array(cable.exit_point)
         else:
-            upper = cable.pulley.tangent_point(_straight_tangent_angle(cable.pulley, point))
+            upper = cable.pulley.rim_point(_straight_tangent_angle(cable.pulley, point))
         direction = upper - point
         length = float(np.hypot(*direction))
         unit = direction / length
         load[1] += 0.5 * cable.weight_per_length * length  # the anchor carries about half
-        arm = rotation_matrix @ cable.anchor
-        columns.append([unit[0], unit[1], _cross(arm, unit)])
+        arm = turn @ cable.anchor
+        columns.append([unit[0], unit[1], planar_cross(arm, unit)])
         horizontal.append(abs(unit[0]))
     structure = np.array(columns).T  # structure matrix, shape (3, n)
     rows = 2 if (platform.degrees_of_freedom == 2 or free_rotation) else 3
@@ -1143,7 +1090,7 @@ def solve_inverse_statics(
         if np.any(H <= 0.0):
             raise UnreachableError("a cable would have to push (horizontal tension <= 0)")
         points = platform.anchor_points(position, phi)
-        rotation_matrix = _rotation(phi)
+        turn = rotation_matrix(phi)
         equilibria, new_guesses = [], []
         jacobian = np.zeros((3, n + 1))
         for i, (cable, point) in enumerate(zip(platform.cables, points)):
@@ -1152,13 +1099,13 @@ def solve_inverse_statics(
             )
             equilibria.append(equilibrium)
             new_guesses.append(guess)
-            arm = rotation_matrix @ cable.anchor
+            arm = turn @ cable.anchor
             jacobian[:2, i] = force_dH
-            jacobian[2, i] = _cross(arm, force_dH)
-            d_force_dphi = force_dp @ _perpendicular(arm)
+            jacobian[2, i] = planar_cross(arm, force_dH)
+            d_force_dphi = force_dp @ perpendicular(arm)
             jacobian[:2, n] += d_force_dphi
-            jacobian[2, n] += _cross(arm, d_force_dphi) + _cross(
-                _perpendicular(arm), equilibrium.force_on_platform
+            jacobian[2, n] += planar_cross(arm, d_force_dphi) + planar_cross(
+                perpendicular(arm), equilibrium.force_on_platform
             )
         guesses[:] = new_guesses
         residual = _wrench_residual(platform, phi, equilibria, wrench, dof)
@@ -1265,4 +1212,4 @@ def _inverse_by_weight_continuation(platform, position, rotation, wrench, max_st
 
 
 def _rim_angle(pulley, point):
-    return math.atan2(point[1] - pulley.centre[1], point[0] - pulley.centre[0])
+    return math.atan2(point[1] - pulley.center[1], point[0] - pulley.center[0])

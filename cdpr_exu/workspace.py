@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from .errors import UnreachableError
-from .kinematics import anchor_points, pulley_exit
+from .kinematics import anchor_points
 
 #: Samples of the reference over the run (plus its turning times).
 REFERENCE_SAMPLES = 401
@@ -51,9 +51,9 @@ def _pose_text(times: np.ndarray, poses: np.ndarray, k: int) -> str:
 
 
 def _check_anchors_outside_discs(scene, times, poses, anchors) -> None:
-    if scene.cable_exit != "pulley":
-        return
-    for i, pulley in enumerate(scene.pulleys):
+    for i, pulley in enumerate(scene.exits):
+        if pulley.is_point_exit:
+            continue
         distance = np.linalg.norm(anchors[:, i] - np.asarray(pulley.center), axis=1)
         inside = np.flatnonzero(distance <= pulley.radius * (1.0 + 1e-9))
         if inside.size:
@@ -64,15 +64,15 @@ def _check_anchors_outside_discs(scene, times, poses, anchors) -> None:
                 f"{list(pulley.center)} m, inside pulleys[{i}].radius = {pulley.radius} m")
 
 
-def _pulley_exit_named(scene, i, times, poses, anchors):
-    """:func:`pulley_exit` of cable i at every sample; its refusal names the fields and the time."""
-    pulley = scene.pulleys[i]
+def _exit_named(scene, i, times, poses, anchors):
+    """The exit of cable i at every sample; its refusal names the fields and the time."""
+    pulley = scene.exits[i]
     try:
-        return pulley_exit(np.asarray(pulley.center, dtype=float), pulley.radius, pulley.side, anchors)
+        return pulley.exit(anchors)
     except UnreachableError as err:
         for k in range(len(anchors)):
             try:
-                pulley_exit(np.asarray(pulley.center, dtype=float), pulley.radius, pulley.side, anchors[k])
+                pulley.exit(anchors[k])
             except UnreachableError:
                 raise UnreachableError(
                     f"platform.anchors[{i}] cannot be reached over pulleys[{i}] ({_pose_text(times, poses, k)}; "
@@ -84,17 +84,10 @@ def _pulley_exit_named(scene, i, times, poses, anchors):
 def _exits(scene, times, poses, anchors):
     """Per cable: ideal lengths, shape (N,) [m], and unit pull directions on the platform, shape (N, 2)."""
     lengths, pulls = [], []
-    for i, pulley in enumerate(scene.pulleys):
-        center = np.asarray(pulley.center, dtype=float)
-        if scene.cable_exit == "point":
-            offset = center - anchors[:, i]
-            length = np.linalg.norm(offset, axis=1)
-            lengths.append(length)
-            pulls.append(offset / np.maximum(length, 1e-300)[:, None])
-        else:
-            exit_ = _pulley_exit_named(scene, i, times, poses, anchors[:, i])
-            lengths.append(np.asarray(exit_.cable_length))
-            pulls.append(-np.asarray(exit_.unit_vector))
+    for i in range(scene.n_cables):
+        exit_ = _exit_named(scene, i, times, poses, anchors[:, i])
+        lengths.append(np.asarray(exit_.cable_length))
+        pulls.append(-np.asarray(exit_.unit_vector))
     return lengths, pulls
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cdpr_exu.kinematics import inverse_kinematics, inverse_kinematics_rates, point_exit_inverse_kinematics
+from cdpr_exu.kinematics import inverse_kinematics, inverse_kinematics_rates, pulley_arrays
 
 from .base import Measurement, WinchCommand
 
@@ -30,12 +30,7 @@ def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = Non
     rates : ndarray, shape (N, m) [m/s] or None
     """
     anchors = np.asarray(scene.platform.anchors)
-    centers = np.array([p.center for p in scene.pulleys])
-    if scene.cable_exit == "point":
-        lengths = point_exit_inverse_kinematics(poses, anchors, centers)
-        return lengths, (None if pose_rates is None else np.zeros_like(lengths))
-    radii = np.array([p.radius for p in scene.pulleys])
-    sides = np.array([p.side for p in scene.pulleys])
+    centers, radii, sides = pulley_arrays(scene.exits)
     lengths = inverse_kinematics(poses, anchors, centers, radii, sides)
     rates = None
     if pose_rates is not None:

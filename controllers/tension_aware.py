@@ -44,7 +44,7 @@ from scipy.interpolate import CubicSpline
 
 from cdpr_exu import chain_statics, statics
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.kinematics import anchor_points, cable_unit_vectors, initial_cable_nodes
+from cdpr_exu.kinematics import anchor_points, cable_unit_vectors, initial_cable_nodes, pulley_arrays
 
 from .base import Measurement, WinchCommand
 from .ideal_ik import ideal_paid_out
@@ -63,14 +63,9 @@ def suspended_platform(scene) -> statics.SuspendedPlatform:
         Cable weight per length rho0 g [N/m], EA [N], anchors, pulleys, platform mass.
     """
     cables = []
-    for cable, pulley, anchor in zip(scene.cables, scene.pulleys, scene.platform.anchors):
+    for cable, pulley, anchor in zip(scene.cables, scene.exits, scene.platform.anchors):
         weight = cable.linear_density * scene.gravity if (scene.effects.cable_mass and scene.effects.gravity) else 0.0
-        stiffness = cable.axial_rigidity
-        if scene.cable_exit == "point":
-            cables.append(statics.SuspendedCable(weight, stiffness, anchor=anchor, exit_point=pulley.center))
-        else:
-            cables.append(statics.SuspendedCable(weight, stiffness, anchor=anchor,
-                                                 pulley=statics.Pulley(pulley.center, pulley.radius, pulley.side)))
+        cables.append(statics.SuspendedCable(weight, cable.axial_rigidity, anchor=anchor, pulley=pulley))
     gravity = scene.gravity if scene.effects.gravity else 0.0
     return statics.SuspendedPlatform(tuple(cables), scene.platform.mass, gravity, scene.platform.inertia)
 
@@ -83,10 +78,10 @@ def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
     hanging below the hang point is paid out.
     """
     lengths = []
-    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
-        nodes = initial_cable_nodes(np.asarray(pulley.center), pulley.radius, pulley.side, anchors[i],
+    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.exits)):
+        nodes = initial_cable_nodes(pulley.center, pulley.radius, pulley.side, anchors[i],
                                     cable.element_length, cable.n_elements)
-        lengths.append(cable.unstrained_length - (pulley.center[1] - nodes[0, 1]))
+        lengths.append(pulley.paid_out_length(cable.unstrained_length, nodes[0]))
     return np.asarray(lengths)
 
 
@@ -272,14 +267,7 @@ class ClosedLoopTensionAwareController(TensionAwareController):
         """
         scene = self._scene
         anchors = np.asarray(scene.platform.anchors)
-        centers = np.array([p.center for p in scene.pulleys])
-        if scene.cable_exit == "point":
-            points = anchor_points(pose, anchors)
-            directions = points - centers
-            return directions / np.linalg.norm(directions, axis=1, keepdims=True)
-        radii = np.array([p.radius for p in scene.pulleys])
-        sides = np.array([p.side for p in scene.pulleys])
-        return -cable_unit_vectors(pose, anchors, centers, radii, sides)
+        return -cable_unit_vectors(pose, anchors, *pulley_arrays(scene.exits))
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if measurement.platform_pose is None:

@@ -96,11 +96,11 @@ def test_massless_straight_cables_give_hookes_law():
     position = np.array([0.2, -1.6])
     solution = solve_chain_statics(robot, position, tension_guess=[10.0, 10.0])
     for cable, nodes, tensions, paid in zip(robot.cables, solution.nodes, solution.tensions, solution.paid_out):
-        span = np.linalg.norm(position - np.asarray(cable.pulley_center))
+        span = np.linalg.norm(position - np.asarray(cable.pulley.center))
         ea = cable.axial_stiffness * cable.element_length
         assert np.ptp(tensions) < 1e-9 * tensions.max()  # no weight: one tension along the cable
         # node 0 sits on the vertical through the exit point, lambda - L0 above it
-        assert nodes[0] == pytest.approx(np.asarray(cable.pulley_center) + [0.0, paid - cable.unstrained_length],
+        assert nodes[0] == pytest.approx(np.asarray(cable.pulley.center) + [0.0, paid - cable.unstrained_length],
                                          abs=1e-12)
         straight = np.linalg.norm(nodes[-1] - nodes[0])
         assert straight / (1.0 + tensions[0] / ea) == pytest.approx(cable.unstrained_length, rel=1e-9)
@@ -141,8 +141,8 @@ def test_bad_input_is_refused_with_the_parameter_named():
         solve_chain_statics(robot, (0.0, -1.8), free_rotation=False, tension_guess=[10.0, 10.0])
     with pytest.raises(SceneError, match="node_masses"):
         replace(robot.cables[0], node_masses=(0.1, -0.1, 0.1))
-    with pytest.raises(SceneError, match="side"):
-        replace(robot.cables[0], side=0)
+    with pytest.raises(SceneError, match="pulley"):
+        replace(robot.cables[0], pulley=(0.0, 0.0))
     with pytest.raises(SceneError, match="cable_mass"):
         chain_robot(PAPER.with_changes(effects=Effects.from_preset("elastic")))
     with pytest.raises(SceneError, match="bending_model"):

@@ -68,7 +68,7 @@ def test_invalid_parameters_raise_scene_error_naming_them():
     with pytest.raises(SceneError, match="axial_stiffness"):
         SuspendedCable(W, float("nan"), exit_point=(0, 0))
     with pytest.raises(SceneError, match="radius"):
-        Pulley((0, 0), 0.0)
+        Pulley((0, 0), -0.2)
     with pytest.raises(SceneError, match="side"):
         Pulley((0, 0), 0.2, side=0)
     with pytest.raises(SceneError, match="mass"):
@@ -284,7 +284,7 @@ def test_cable_leaves_the_pulley_tangentially(position):
     platform = make_platform(pulleys=True)
     equilibrium = solve_inverse_statics(platform, position)
     for cable, spec in zip(equilibrium.cables, platform.cables):
-        radius = cable.upper_point - np.array(spec.pulley.centre)
+        radius = cable.upper_point - np.array(spec.pulley.center)
         assert np.hypot(*radius) == pytest.approx(PULLEY_RADIUS, rel=1e-14)  # on the rim
         direction = cable.catenary.force_on_b / cable.catenary.tension_b
         # tangency solved to 1e-12 of the length: the direction is normal to the radius
