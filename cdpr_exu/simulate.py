@@ -294,6 +294,131 @@ def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndar
     return nodes, velocities, tensions
 
 
+class _Stepper:
+    """The per-step state of one run and Exudyn's pre- and post-step functions.
+
+    Before each step it asks the controller for the winch commands (from a
+    :class:`Measurement`) and drives the winches (kinematic lengths, servo motor forces,
+    the slack-rope reservoir); after each step it records the outputs that are due,
+    checks them (:class:`_Monitor`), reports progress and ends the integration on a
+    problem or a Ctrl-C, keeping what was computed.
+
+    Attributes
+    ----------
+    paid_out, rate : ndarray, shape (m,) [m, m/s]
+        The last commanded (or, for servos, measured) paid-out lengths and rates.
+    stop_reason : str or None
+        Why the run was stopped early (a monitor problem or a controller error).
+    stop_exception : Exception or None
+        The controller's exception, when it raised.
+    interrupted : dict
+        ``{"interrupted": bool}``, set by :func:`interrupt_flag` during the solve.
+    """
+
+    def __init__(self, scene: Scene, model: Model, controller: Controller, recorder: "_Recorder",
+                 monitor: "_Monitor", report, ref_q: np.ndarray):
+        self.scene, self.model, self.controller = scene, model, controller
+        self.recorder, self.monitor, self.report = recorder, monitor, report
+        self.ref_q = ref_q
+        self.indices = recorder.indices
+        self.paid_out = model.initial_paid_out.copy()
+        self.rate = np.zeros(len(scene.cables))
+        self.stop_reason: str | None = None
+        self.stop_exception: Exception | None = None
+        self.interrupted = {"interrupted": False}
+        self.reservoir = _rope_reservoir(scene, model)
+        self.first_nodes = ([self.indices[f"cable_{i}"][:2] for i in range(len(scene.cables))]
+                            if self.reservoir else [])
+        self.drum_index = [model.mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
+        self.servo_integral = np.zeros(len(model.servos))
+        self.servo_time = 0.0
+        self.start = _time.perf_counter()
+
+    def _cable_tensions(self, q: np.ndarray, v: np.ndarray, i: int, which: slice) -> np.ndarray:
+        """Tensions [N] of the elements of cable i between the nodes ``which`` (a slice of its nodes)."""
+        idx = self.indices[f"cable_{i}"][which]
+        return element_tensions(self.scene.cables[i], self.ref_q[idx] + q[idx], v[idx], self.scene.effects)
+
+    def measurement(self, t: float) -> Measurement:
+        """What the controller may see at time ``t`` [s]."""
+        controller, model = self.controller, self.model
+        pose = velocity = tensions = None
+        if controller.uses_pose or controller.uses_tension:
+            q = model.mbs.systemData.GetODE2Coordinates()
+            v = model.mbs.systemData.GetODE2Coordinates_t()
+            platform = self.indices["platform"]
+            pose = self.ref_q[platform] + q[platform]
+            velocity = v[platform]
+            if controller.uses_tension and model.ropes:
+                tensions = np.array([model.mbs.GetObjectOutput(r.rope, exu.OutputVariableType.ForceLocal)
+                                     for r in model.ropes])
+            elif controller.uses_tension:
+                tensions = np.array([self._cable_tensions(q, v, i, slice(-2, None))[-1]
+                                     for i in range(len(self.scene.cables))])
+        return Measurement(t, self.paid_out.copy(), self.rate.copy(), pose, velocity, tensions)
+
+    def drive_servos(self, mbs_, t: float, command, q: np.ndarray, v: np.ndarray) -> None:
+        """Motor force of each servo drum from the command (once per step)."""
+        dt = t - self.servo_time
+        self.servo_time = t
+        for i, (servo, index) in enumerate(zip(self.model.servos, self.drum_index)):
+            error = q[index] - (command.paid_out[i] - self.model.initial_paid_out[i])
+            error_rate = v[index] - command.paid_out_rate[i]
+            self.servo_integral[i] += error * dt
+            tension = self._cable_tensions(q, v, i, slice(0, 2))[0]
+            # The cable pulls rope off the drum with its winch-end tension: feed it forward.
+            force = servo_force(servo, self.servo_integral[i], error, error_rate, -tension)
+            mbs_.SetLoadParameter(servo.load, "load", force)
+
+    def pre_step(self, mbs_, t: float) -> bool:
+        """Exudyn's pre-step function: command and drive the winches; False stops the run."""
+        model = self.model
+        if self.scene.winch.kind == "fixed":
+            return True
+        try:
+            if model.servos:
+                q = mbs_.systemData.GetODE2Coordinates()
+                v = mbs_.systemData.GetODE2Coordinates_t()
+                self.paid_out = model.initial_paid_out + q[self.drum_index]
+                self.rate = v[self.drum_index]
+            command = self.controller.command(self.measurement(t))
+            paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
+            if paid_out.shape != self.paid_out.shape or not np.all(np.isfinite(paid_out)):
+                raise ValueError(f"the command must be {self.paid_out.size} finite lengths, got {command.paid_out!r}")
+            if model.servos:
+                self.drive_servos(mbs_, t, command, q, v)
+                return True
+        except Exception as err:  # noqa: BLE001 - reported as the cause of the stop
+            self.stop_reason = (f"controller {self.controller.name!r} raised at t = {t:.4f} s: "
+                                f"{type(err).__name__}: {err}")
+            self.stop_exception = err
+            return False
+        self.paid_out = paid_out
+        self.rate = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
+        targets = self.paid_out
+        if self.reservoir is not None:  # slack rope paid out piles up at the drum (winch.reservoir_split)
+            q = mbs_.systemData.GetODE2Coordinates()
+            lengths = np.array([np.linalg.norm(np.diff(self.ref_q[idx] + q[idx], axis=0)) for idx in self.first_nodes])
+            targets = model.initial_paid_out + self.reservoir.update(targets - model.initial_paid_out, lengths)
+        for winch, length, initial in zip(model.winches, targets, model.initial_paid_out):
+            set_paid_out_length(mbs_, winch, length, initial)
+        return True
+
+    def post_step(self, mbs_, t: float) -> bool:  # noqa: ARG002 - Exudyn's signature
+        """Exudyn's post-step function: record, check, report; False ends the integration."""
+        if self.interrupted["interrupted"]:
+            return False  # Ctrl-C: end the integration, keep what was computed
+        surplus = None if self.reservoir is None else self.reservoir.surplus
+        recorder = self.recorder
+        if recorder.record_if_due(t, self.paid_out, surplus):
+            self.stop_reason = self.monitor.problem(t, recorder.q[recorder.count - 1], surplus)
+            if self.stop_reason is not None:
+                return False  # ends the time integration; the samples so far are kept
+        if self.report is not None:
+            self.report(t, _time.perf_counter() - self.start)
+        return True
+
+
 def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
              progress: bool | Callable[[float, float], None] = False,
              sparse_jacobian: bool | None = None) -> Result:
@@ -332,100 +457,17 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     mbs = model.mbs
     solver = scene.solver
     recorder = _Recorder(model, solver.output_period, solver.end_time)
-    indices = recorder.indices
-    platform_idx = indices["platform"]
-    state = {"paid_out": model.initial_paid_out.copy(), "rate": np.zeros(len(scene.cables))}
     ref_q = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
     report = _progress_reporter(progress, scene)
-    monitor = _Monitor(scene, indices, ref_q)
-    stop = {"reason": None, "exception": None}
-    start = _time.perf_counter()
-
-    def measurement(t: float) -> Measurement:
-        pose = velocity = tensions = None
-        if controller.uses_pose or controller.uses_tension:
-            q = mbs.systemData.GetODE2Coordinates()
-            v = mbs.systemData.GetODE2Coordinates_t()
-            pose = ref_q[platform_idx] + q[platform_idx]
-            velocity = v[platform_idx]
-            if controller.uses_tension and model.ropes:
-                tensions = np.array([mbs.GetObjectOutput(r.rope, exu.OutputVariableType.ForceLocal) for r in model.ropes])
-            elif controller.uses_tension:
-                tensions = np.array([
-                    element_tensions(cable, ref_q[indices[f"cable_{i}"]][-2:] + q[indices[f"cable_{i}"]][-2:],
-                                     v[indices[f"cable_{i}"]][-2:], scene.effects)[-1]
-                    for i, cable in enumerate(scene.cables)
-                ])
-        return Measurement(t, state["paid_out"].copy(), state["rate"].copy(), pose, velocity, tensions)
-
-    reservoir = _rope_reservoir(scene, model)
-    first_nodes = [indices[f"cable_{i}"][:2] for i in range(len(scene.cables))] if reservoir else []
-    servo_state = {"integral": np.zeros(len(model.servos)), "time": 0.0}
-    drum_index = [mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
-
-    def drive_servos(mbs_, t, command, q, v):
-        """Motor force of each servo drum from the command (once per step)."""
-        dt = t - servo_state["time"]
-        servo_state["time"] = t
-        for i, (servo, index) in enumerate(zip(model.servos, drum_index)):
-            error = q[index] - (command.paid_out[i] - model.initial_paid_out[i])
-            error_rate = v[index] - command.paid_out_rate[i]
-            servo_state["integral"][i] += error * dt
-            idx = indices[f"cable_{i}"][:2]
-            tension = element_tensions(scene.cables[i], ref_q[idx] + q[idx], v[idx], scene.effects)[0]
-            # The cable pulls rope off the drum with its winch-end tension: feed it forward.
-            force = servo_force(servo, servo_state["integral"][i], error, error_rate, -tension)
-            mbs_.SetLoadParameter(servo.load, "load", force)
-
-    def pre_step(mbs_, t):
-        if scene.winch.kind == "fixed":
-            return True
-        try:
-            if model.servos:
-                q = mbs_.systemData.GetODE2Coordinates()
-                v = mbs_.systemData.GetODE2Coordinates_t()
-                state["paid_out"] = model.initial_paid_out + q[drum_index]
-                state["rate"] = v[drum_index]
-            command = controller.command(measurement(t))
-            paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
-            if paid_out.shape != state["paid_out"].shape or not np.all(np.isfinite(paid_out)):
-                raise ValueError(f"the command must be {state['paid_out'].size} finite lengths, got {command.paid_out!r}")
-            if model.servos:
-                drive_servos(mbs_, t, command, q, v)
-                return True
-        except Exception as err:  # noqa: BLE001 - reported as the cause of the stop
-            stop["reason"] = f"controller {controller.name!r} raised at t = {t:.4f} s: {type(err).__name__}: {err}"
-            stop["exception"] = err
-            return False
-        state["paid_out"] = paid_out
-        state["rate"] = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
-        targets = state["paid_out"]
-        if reservoir is not None:  # slack rope paid out piles up at the drum (winch.reservoir_split)
-            q = mbs_.systemData.GetODE2Coordinates()
-            lengths = np.array([np.linalg.norm(np.diff(ref_q[idx] + q[idx], axis=0)) for idx in first_nodes])
-            targets = model.initial_paid_out + reservoir.update(targets - model.initial_paid_out, lengths)
-        for winch, length, initial in zip(model.winches, targets, model.initial_paid_out):
-            set_paid_out_length(mbs_, winch, length, initial)
-        return True
-
-    def post_step(mbs_, t):
-        if interrupted["interrupted"]:
-            return False  # Ctrl-C: end the integration, keep what was computed
-        surplus = None if reservoir is None else reservoir.surplus
-        if recorder.record_if_due(t, state["paid_out"], surplus):
-            stop["reason"] = monitor.problem(t, recorder.q[recorder.count - 1], surplus)
-            if stop["reason"] is not None:
-                return False  # ends the time integration; the samples so far are kept
-        if report is not None:
-            report(t, _time.perf_counter() - start)
-        return True
-
-    mbs.SetPreStepUserFunction(pre_step)
-    mbs.SetPostStepUserFunction(post_step)
-    recorder.record_if_due(0.0, state["paid_out"])
+    stepper = _Stepper(scene, model, controller, recorder, _Monitor(scene, recorder.indices, ref_q), report, ref_q)
+    start = stepper.start
+    mbs.SetPreStepUserFunction(stepper.pre_step)
+    mbs.SetPostStepUserFunction(stepper.post_step)
+    recorder.record_if_due(0.0, stepper.paid_out)
     settings = solver_settings(scene, solution_file)
     failure = None
     with interrupt_flag() as interrupted, quiet_exudyn():
+        stepper.interrupted = interrupted
         try:
             mbs.SolveDynamic(settings)
         except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
@@ -441,8 +483,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         result.failure_time = reached
         raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
                              time=reached, partial_result=result)
-    if stop["reason"] is not None:
-        failure = stop["reason"]
+    if stepper.stop_reason is not None:
+        failure = stepper.stop_reason
     if failure is not None:  # the partial result ends at its last finite sample
         recorded = slice(0, recorder.count)
         finite_rows = np.all(np.isfinite(recorder.q[recorded]) & np.isfinite(recorder.v[recorded]), axis=1)
@@ -456,7 +498,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     result.wall_time = wall
     result.steps = int(iterations.currentStepIndex)
     result.newton_iterations = int(iterations.newtonStepsCount)
-    if reservoir is not None:
+    if stepper.reservoir is not None:
         result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
     result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
                        "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts()}
