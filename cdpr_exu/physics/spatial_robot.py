@@ -221,7 +221,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     position = [float(x) for x in initial.position]
     if platform.is_point_mass:
         platform_node = mbs.AddNode(eii.NodePoint(referenceCoordinates=position))
-        platform_body = mbs.AddObject(eii.ObjectMassPoint(physicsMass=platform.mass, nodeNumber=platform_node))
+        platform_body = mbs.AddObject(eii.ObjectMassPoint(mass=platform.mass, nodeNumber=platform_node))
         centre = mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=platform_node))
         anchor_markers = [centre] * len(platform.cables)
         if platform.mass > 0.0:
