@@ -96,7 +96,8 @@ class SpatialChainSpec:
                            non_negative("axial_damping_constant", self.axial_damping_constant))
         object.__setattr__(self, "flexural_rigidity", non_negative("flexural_rigidity", self.flexural_rigidity))
         if self.anchor_spring_factor is not None:
-            object.__setattr__(self, "anchor_spring_factor", positive("anchor_spring_factor", self.anchor_spring_factor))
+            factor = positive("anchor_spring_factor", self.anchor_spring_factor)
+            object.__setattr__(self, "anchor_spring_factor", factor)
 
 
 @dataclass
