@@ -86,7 +86,10 @@ def test_exudyn_static_symmetric_robot_hangs_on_the_axis_with_equal_tensions():
 
 
 def test_static_solver_on_exact_spherical_joints_of_a_rigid_platform_fails_with_the_remedy_named():
-    """Measured limitation of Exudyn's static solver (see the module notes); the message names the fix."""
+    """Measured limitation of Exudyn's static solver (see the module notes); the message names the fix.
+
+    Should this start to converge, Exudyn has changed: the penalty joint may then go.
+    """
     platform = four_cable_robot(True)
     mbs, items = build(platform, ASYMMETRIC_LENGTHS, SpatialChainSpec(n_elements=5))
     with pytest.raises(SolverFailure, match="anchor_spring_factor"):

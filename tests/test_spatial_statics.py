@@ -74,7 +74,8 @@ def test_robot_in_one_vertical_plane_reproduces_the_planar_statics(rigid, azimut
     expected = solve_forward_statics(planar, lengths)
     found = solve_spatial_statics(spatial, lengths)
     # Both solvers stop at a scaled residual of 1e-12 (or the 1e3 x noise floor of the
-    # stiff cables, 2e-6 N on 30 N): the poses agree to 1e-9 m, the tensions to 1e-7 N.
+    # stiff cables, 2e-6 N on 30 N): the poses agree to 1e-9 m, the tensions to 1e-7 N
+    # (measured: 1.2e-13 m, 1e-16 rad, 2e-10 N).
     np.testing.assert_allclose(found.position @ along, expected.position[0], atol=1e-9)
     np.testing.assert_allclose(found.position[2], expected.position[1], atol=1e-9)
     normal = np.cross(along, [0.0, 0.0, 1.0])

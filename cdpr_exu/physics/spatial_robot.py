@@ -11,8 +11,8 @@ spherical joint transmits no moment, like a cable end on a swivel eye), or, when
 
 Why the penalty joint exists (measured): Exudyn's static solver does not converge
 when an ``ObjectJointSpherical`` holds a rigid body's ``MarkerBodyPosition`` and the
-body must turn: from the catenary pose, 1e-4 rad from the answer, the first Newton
-step turned the platform by 1e-2 rad and the iteration diverged, with Exudyn's
+body must turn: from the catenary pose, 3e-4 rad from the answer (5 elements per
+cable), the first Newton step turned the platform by 1e-2 rad and the iteration diverged, with Exudyn's
 analytic and with its system-wide numerical Jacobian, for Euler parameters, rotation
 vector and Tait-Bryan nodes alike; four springs fixed straight to the body converge
 in 3 steps. It behaves as if the joint's geometric stiffness (the derivative of
