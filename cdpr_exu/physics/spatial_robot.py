@@ -11,15 +11,16 @@ spherical joint transmits no moment, like a cable end on a swivel eye), or, when
 
 Why the penalty joint exists (measured): Exudyn's static solver does not converge
 when an ``ObjectJointSpherical`` holds a rigid body's ``MarkerBodyPosition`` and the
-body must turn: from the catenary pose, 3e-4 rad from the answer (5 elements per
-cable), the first Newton step turned the platform by 1e-2 rad and the iteration diverged, with Exudyn's
-analytic and with its system-wide numerical Jacobian, for Euler parameters, rotation
-vector and Tait-Bryan nodes alike; four springs fixed straight to the body converge
-in 3 steps. It behaves as if the joint's geometric stiffness (the derivative of
-``C_q^T lambda`` in the body's rotation, the pendulum stiffness of a hanging body)
-were missing from the static Jacobian. The dynamic solver, whose Jacobian the mass
-matrix dominates, runs with the exact joint. A point-mass platform solves
-statically with the exact joint.
+body must turn. From the catenary pose, 3e-4 rad from the answer (5 elements per
+cable), the first Newton step turned the platform by 1e-2 rad and the iteration
+diverged, with Exudyn's analytic and with its system-wide numerical Jacobian, for
+Euler-parameter, rotation-vector and Tait-Bryan nodes alike. A bare rigid body hung
+on four springs fixed straight to it converged in 3 steps; the same body with each
+spring joined to it through a mass point and a spherical joint diverged. It behaves
+as if the joint's geometric stiffness (the derivative of ``C_q^T lambda`` in the
+body's rotation, the pendulum stiffness of a hanging body) were missing from the
+static Jacobian. The dynamic solver, whose Jacobian the mass matrix dominates, runs
+with the exact joint; a point-mass platform solves statically with it.
 
 Platform
 --------
