@@ -1,0 +1,609 @@
+"""Elastic-catenary statics of a spatial cable robot: the platform's pose from the cables' lengths.
+
+Each cable runs from a fixed exit point ``e_i`` (world frame, a point exit: no pulley)
+to an anchor ``b_i`` on the platform (platform frame), and hangs in the vertical plane
+through its two ends. In that plane it is the 2-D elastic catenary of
+:mod:`cdpr_exu.catenary` (Irvine's model: weight, axial elasticity, no bending), with
+end A at the anchor and end B at the exit point; the 2-D answer is rotated back to
+3-D (MoorPy's trick for its mooring lines). z is up, gravity along -z, SI units.
+
+With ``a_i`` the anchor's world position, ``d = e_i - a_i`` the span, ``h`` its
+horizontal length and ``u = (d_x, d_y) / h`` its horizontal direction, the cable's
+2-D span is ``(h, d_z)`` and its force on the platform is ``H u + V_A e_z``. Its
+3-D end stiffness follows from the 2-D one ``K2`` (:func:`cdpr_exu.catenary.end_stiffness`)
+and the turning of ``u``::
+
+    dF/da = Q K2 Q^T - (H / h) (P_h - u u^T),   Q = [u, e_z],  P_h = diag(1, 1, 0)
+
+(a sideways step of the anchor turns the horizontal pull). For a vertical cable
+(``h -> 0``) the sideways stiffness ``H / h`` tends to the in-plane one, ``-K2[0, 0]``.
+
+Platform
+--------
+* a **point mass** (every anchor at the centre of mass): unknowns the position
+  ``r`` (3);
+* a **rigid body**: unknowns ``r`` and a **rotation vector** ``theta`` (6), anchors at
+  ``r + R(theta) b_i`` with ``R = exp([theta]x)`` (Rodrigues). A rotation vector is
+  minimal (no constraint to carry, unlike Euler parameters, whose unit norm would be
+  a seventh equation), zero at the reference orientation where a symmetric robot
+  hangs, smooth there, and singular only at ``|theta| = 2 pi``, far from any hanging
+  pose (Tait-Bryan angles lock at a pitch of 90 degrees). Its derivative enters via
+  the left Jacobian of SO(3): a change ``d theta`` turns the body by the world-frame
+  angle ``J_l(theta) d theta``, so the generalised force on ``theta`` is
+  ``J_l^T M`` with ``M`` the moment about the centre of mass.
+
+The equilibrium is the minimum of the potential energy (cables are conservative
+elastic catenaries with fixed exits, the platform weight is ``M g z``); it is found by
+Newton's method with the analytic stiffness and the energy line search of
+:mod:`cdpr_exu.statics`, started from the pose on straight, massless, elastic cables
+(which exists also when some cables are slack). This covers statically indeterminate
+robots (4 cables on a point mass, 8 on a rigid body): the cables' elasticity picks
+the equilibrium, no tension distribution is assumed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize
+
+from cdpr_exu.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
+    profile, solve_forward
+from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.statics import _minimise_energy  # the energy line search of the planar statics, reused as is
+from cdpr_exu.validation import non_negative, positive, real_array, vector
+
+_RELATIVE_TOLERANCE = 1e-12
+"""Target of the scaled wrench residual (the cables are solved to 1e-12 of their length)."""
+
+_E_Z = np.array([0.0, 0.0, 1.0])
+_HORIZONTAL = np.diag([1.0, 1.0, 0.0])
+
+
+# ---------------------------------------------------------------------------
+# rotations (rotation vector, SO(3))
+# ---------------------------------------------------------------------------
+def skew(vector_):
+    """``[v]x``, the matrix of ``v x ...``, shape (3, 3)."""
+    x, y, z = vector_
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def rotation_matrix(rotation_vector):
+    """``R = exp([theta]x)`` of a rotation vector ``theta`` [rad] (Rodrigues), shape (3, 3)."""
+    theta = np.asarray(rotation_vector, dtype=float)
+    angle = float(np.linalg.norm(theta))
+    k = skew(theta)
+    if angle < 1e-8:  # series: 1 - a^2/6 and 1/2 - a^2/24, exact to round-off here
+        return np.eye(3) + (1.0 - angle**2 / 6.0) * k + (0.5 - angle**2 / 24.0) * (k @ k)
+    return np.eye(3) + math.sin(angle) / angle * k + (1.0 - math.cos(angle)) / angle**2 * (k @ k)
+
+
+def rotation_vector(matrix):
+    """The rotation vector [rad] (angle in [0, pi]) of a rotation matrix, shape (3,)."""
+    matrix = np.asarray(matrix, dtype=float)
+    cosine = min(max(0.5 * (np.trace(matrix) - 1.0), -1.0), 1.0)
+    angle = math.acos(cosine)
+    axial = 0.5 * np.array([matrix[2, 1] - matrix[1, 2], matrix[0, 2] - matrix[2, 0], matrix[1, 0] - matrix[0, 1]])
+    if angle < 1e-8:
+        return axial  # sin(a) ~ a
+    if angle > math.pi - 1e-6:  # near a half turn: axis from the symmetric part
+        symmetric = 0.5 * (matrix + matrix.T) - cosine * np.eye(3)
+        column = int(np.argmax(np.diag(symmetric)))
+        axis = symmetric[:, column] / math.sqrt(max(symmetric[column, column], 1e-300))
+        if axis @ axial < 0.0:
+            axis = -axis
+        return angle * axis / np.linalg.norm(axis)
+    return angle / math.sin(angle) * axial
+
+
+def left_jacobian(rotation_vector_):
+    """``J_l(theta)``: ``exp([theta + d]x) = exp([J_l d]x) exp([theta]x)`` to first order in ``d``."""
+    theta = np.asarray(rotation_vector_, dtype=float)
+    angle = float(np.linalg.norm(theta))
+    k = skew(theta)
+    if angle < 1e-6:
+        return np.eye(3) + 0.5 * k + (k @ k) / 6.0
+    return (np.eye(3) + (1.0 - math.cos(angle)) / angle**2 * k
+            + (angle - math.sin(angle)) / angle**3 * (k @ k))
+
+
+# ---------------------------------------------------------------------------
+# parameters
+# ---------------------------------------------------------------------------
+def _point3(name, value):
+    return vector(name, value, 3, " (x, y, z) [m]")
+
+
+@dataclass(frozen=True)
+class SpatialCable:
+    """One cable of a spatial robot: where it leaves the frame, where it holds the platform, its material.
+
+    Parameters
+    ----------
+    exit_point : (float, float, float) [m]
+        Fixed exit point, world frame (a point exit; no pulley).
+    weight_per_length : float [N/m]
+        ``w >= 0``, weight per unstrained length.
+    axial_stiffness : float [N]
+        ``EA > 0``.
+    anchor : (float, float, float) [m], optional
+        Anchor on the platform, platform frame (centre of mass at 0); default the centre.
+
+    Raises
+    ------
+    SceneError
+        Naming the field, if a value is not finite or out of range.
+    """
+
+    exit_point: tuple
+    weight_per_length: float
+    axial_stiffness: float
+    anchor: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "exit_point", tuple(_point3("exit_point", self.exit_point)))
+        object.__setattr__(self, "weight_per_length", non_negative("weight_per_length", self.weight_per_length))
+        object.__setattr__(self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness))
+        object.__setattr__(self, "anchor", tuple(_point3("anchor", self.anchor)))
+
+    def catenary(self, unstrained_length):
+        """The :class:`~cdpr_exu.catenary.CatenaryCable` of this cable with the given unstrained length [m]."""
+        return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
+
+
+@dataclass(frozen=True)
+class SpatialPlatform:
+    """A platform hung on spatial cables: a point mass, or a rigid body when some anchor is off its centre.
+
+    Parameters
+    ----------
+    cables : sequence of SpatialCable
+    mass : float [kg]
+        ``M >= 0``; its weight acts at the centre of mass along -z.
+    gravity : float [m/s^2], optional
+        Default 9.81.
+    inertia : (float, float, float) [kg m^2], optional
+        Principal moments of inertia about the centre of mass, along the platform axes;
+        only the dynamics (:mod:`cdpr_exu.physics.spatial_robot`) use them.
+
+    Raises
+    ------
+    SceneError
+        Naming the field: no cables, a negative mass, two cables sharing an exit point,
+        two cables of a rigid platform sharing an anchor, too few cables to hang it (a
+        point mass needs one; a rigid body two, and anchors not all on one line
+        through its centre of mass, around which it would turn freely).
+    """
+
+    cables: tuple
+    mass: float
+    gravity: float = STANDARD_GRAVITY
+    inertia: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        try:
+            cables = tuple(self.cables)
+        except TypeError:
+            raise SceneError(f"cables must be a sequence of SpatialCable, got {self.cables!r}") from None
+        if not all(isinstance(c, SpatialCable) for c in cables):
+            raise SceneError(f"cables must be a sequence of SpatialCable, got {self.cables!r}")
+        object.__setattr__(self, "cables", cables)
+        object.__setattr__(self, "mass", non_negative("mass", self.mass))
+        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
+        inertia = vector("inertia", self.inertia, 3, " (principal moments) [kg m^2]")
+        if np.any(inertia < 0.0):
+            raise SceneError(f"inertia must be zero or positive, got {self.inertia!r}")
+        object.__setattr__(self, "inertia", tuple(inertia))
+        exits = np.array([c.exit_point for c in cables]).reshape(-1, 3)
+        anchors = np.array([c.anchor for c in cables]).reshape(-1, 3)
+        size = max(1.0, float(np.abs(exits).max(initial=0.0)))
+        for i in range(len(cables)):
+            for j in range(i):
+                if np.linalg.norm(exits[i] - exits[j]) <= 1e-9 * size:
+                    raise SceneError(f"cables[{j}] and cables[{i}] share the exit_point {tuple(exits[i])} m")
+        needed = 1 if self.is_point_mass else 2
+        if len(cables) < needed:
+            kind = "a point mass" if needed == 1 else "a rigid platform"
+            raise SceneError(f"cables: {kind} needs at least {needed} cable(s) to hang, got {len(cables)}")
+        if not self.is_point_mass:
+            arm = max(float(np.linalg.norm(anchors, axis=1).max()), 1e-300)
+            for i in range(len(cables)):
+                for j in range(i):
+                    if np.linalg.norm(anchors[i] - anchors[j]) <= 1e-9 * arm:
+                        raise SceneError(f"cables[{j}] and cables[{i}] share the anchor {tuple(anchors[i])} m "
+                                         f"on a rigid platform")
+            if np.linalg.matrix_rank(anchors, tol=1e-9 * arm) < 2:
+                raise SceneError(f"cables: the anchors {anchors.tolist()} m lie on one line through the centre "
+                                 f"of mass; the platform would turn freely about it")
+
+    @property
+    def is_point_mass(self):
+        """True when every anchor is at the centre of mass."""
+        return all(c.anchor == (0.0, 0.0, 0.0) for c in self.cables)
+
+    @property
+    def degrees_of_freedom(self):
+        """3 for a point mass ``r``, 6 for a rigid body ``(r, theta)``."""
+        return 3 if self.is_point_mass else 6
+
+    @property
+    def exit_points(self):
+        """Exit points, shape (n_cables, 3) [m]."""
+        return np.array([c.exit_point for c in self.cables])
+
+    @property
+    def anchors(self):
+        """Anchors in the platform frame, shape (n_cables, 3) [m]."""
+        return np.array([c.anchor for c in self.cables])
+
+    def anchor_points(self, position, rotation=None):
+        """World positions of the anchors, shape (n_cables, 3) [m], for a rotation matrix (default identity)."""
+        rotation = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
+        return np.asarray(position, dtype=float) + self.anchors @ rotation.T
+
+
+# ---------------------------------------------------------------------------
+# results
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SpatialCableEquilibrium:
+    """One cable in a platform equilibrium.
+
+    Attributes
+    ----------
+    catenary : CatenaryState
+        The 2-D catenary in the cable's vertical plane, A at the anchor, B at the exit.
+    unstrained_length : float [m]
+    anchor_point, exit_point : ndarray, shape (3,) [m]
+        World positions of the two ends.
+    horizontal_direction : ndarray, shape (3,)
+        ``u``: unit horizontal vector from the anchor towards the exit (the plane's x
+        axis); any horizontal unit vector for a vertical cable.
+    force_on_platform : ndarray, shape (3,) [N]
+        Force the cable exerts on the platform at its anchor.
+    force_on_exit : ndarray, shape (3,) [N]
+        Force the cable exerts on its exit point.
+    cable : CatenaryCable
+        The cable's 2-D catenary parameters (its unstrained length, weight, ``EA``).
+    """
+
+    catenary: CatenaryState
+    unstrained_length: float
+    anchor_point: np.ndarray
+    exit_point: np.ndarray
+    horizontal_direction: np.ndarray
+    force_on_platform: np.ndarray
+    force_on_exit: np.ndarray
+    cable: CatenaryCable = field(repr=False)
+
+    @property
+    def tension_at_anchor(self):
+        """Tension at the anchor [N]."""
+        return self.catenary.tension_a
+
+    @property
+    def tension_at_exit(self):
+        """Tension at the exit point [N]."""
+        return self.catenary.tension_b
+
+    def points(self, s):
+        """Points of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor, shape (n, 3) [m]."""
+        planar = profile(self.cable, self.catenary, s)
+        return self.anchor_point + np.outer(planar[:, 0], self.horizontal_direction) + np.outer(planar[:, 1], _E_Z)
+
+
+@dataclass(frozen=True, eq=False)
+class SpatialEquilibrium:
+    """A static equilibrium of the platform on its cables.
+
+    Attributes
+    ----------
+    position : ndarray, shape (3,) [m]
+        Centre of mass.
+    rotation_vector : ndarray, shape (3,) [rad]
+        Zero for a point mass.
+    rotation : ndarray, shape (3, 3)
+        ``R``: platform frame to world frame.
+    cables : tuple of SpatialCableEquilibrium
+    stiffness : ndarray, shape (k, k)
+        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths, ``k = 3``
+        (``r``) or 6 (``r``, ``theta``); N/m, N/rad, N m/m, N m/rad.
+    net_wrench : ndarray, shape (6,) [N, N m]
+        Remaining force and moment (about the centre of mass) on the platform:
+        cables, weight and external load; zero to solver tolerance.
+    """
+
+    position: np.ndarray
+    rotation_vector: np.ndarray
+    rotation: np.ndarray
+    cables: tuple
+    stiffness: np.ndarray = field(repr=False)
+    net_wrench: np.ndarray = field(repr=False)
+
+    @property
+    def tensions_at_anchor(self):
+        """Tension of each cable at its anchor, shape (n_cables,) [N]."""
+        return np.array([c.tension_at_anchor for c in self.cables])
+
+    @property
+    def tensions_at_exit(self):
+        """Tension of each cable at its exit point, shape (n_cables,) [N]."""
+        return np.array([c.tension_at_exit for c in self.cables])
+
+    @property
+    def forces_on_platform(self):
+        """Force of each cable on the platform, shape (n_cables, 3) [N]."""
+        return np.array([c.force_on_platform for c in self.cables])
+
+    @property
+    def anchor_points(self):
+        """World positions of the anchors, shape (n_cables, 3) [m]."""
+        return np.array([c.anchor_point for c in self.cables])
+
+    @property
+    def is_stable(self):
+        """True when the symmetric part of `stiffness` is positive definite."""
+        return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
+
+
+# ---------------------------------------------------------------------------
+# one cable
+# ---------------------------------------------------------------------------
+def solve_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
+                max_tension=None):
+    """Solve one cable from a given anchor point to its exit point.
+
+    Parameters
+    ----------
+    cable : SpatialCable
+    unstrained_length : float [m]
+    anchor_point : ndarray, shape (3,) [m]
+        World position of the anchor.
+    guess : (H, V_B) [N], optional
+        Warm start of the 2-D catenary.
+    max_strain, max_tension : float, optional
+        As in :func:`cdpr_exu.catenary.solve_forward`.
+
+    Returns
+    -------
+    equilibrium : SpatialCableEquilibrium
+    stiffness : ndarray, shape (3, 3) [N/m]
+        ``d(force on platform)/d(anchor point)``.
+
+    Raises
+    ------
+    UnreachableError
+        If the span is beyond the cable's reach at its tension limit.
+    """
+    catenary_cable = cable.catenary(unstrained_length)
+    exit_point = np.array(cable.exit_point)
+    span = exit_point - anchor_point
+    horizontal = float(math.hypot(span[0], span[1]))
+    direction = np.array([span[0], span[1], 0.0]) / horizontal if horizontal > 0.0 else np.array([1.0, 0.0, 0.0])
+    state = solve_forward(catenary_cable, (horizontal, span[2]), initial_guess=guess, max_strain=max_strain,
+                          max_tension=max_tension)
+    planar = end_stiffness(catenary_cable, state)
+    basis = np.column_stack([direction, _E_Z])
+    stiffness = basis @ planar @ basis.T
+    vertical = horizontal <= 1e-9 * max(unstrained_length, float(np.linalg.norm(span)))
+    sideways = -planar[0, 0] if vertical else state.horizontal_tension / horizontal
+    stiffness -= sideways * (_HORIZONTAL - np.outer(direction, direction))
+    equilibrium = SpatialCableEquilibrium(
+        catenary=state,
+        unstrained_length=float(unstrained_length),
+        anchor_point=np.array(anchor_point, dtype=float),
+        exit_point=exit_point,
+        horizontal_direction=direction,
+        force_on_platform=state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
+        force_on_exit=state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
+        cable=catenary_cable,
+    )
+    return equilibrium, stiffness
+
+
+# ---------------------------------------------------------------------------
+# the platform
+# ---------------------------------------------------------------------------
+def _lengths(platform, unstrained_lengths):
+    lengths = real_array("unstrained_lengths", unstrained_lengths)
+    if lengths.shape != (len(platform.cables),):
+        raise SceneError(f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
+                         f"got {unstrained_lengths!r}")
+    if np.any(lengths <= 0.0):
+        raise SceneError(f"unstrained_lengths must be positive, got {unstrained_lengths!r}")
+    return lengths
+
+
+def _wrench(external_wrench):
+    if external_wrench is None:
+        return np.zeros(6)
+    return vector("external_wrench", external_wrench, 6, " (fx, fy, fz, mx, my, mz) [N, N m]")
+
+
+def _check_reach(platform, lengths, max_strain, max_tension):
+    """Refuse cables that cannot all meet the platform: exits farther apart than two cables and the anchors reach."""
+    reaches = []
+    for cable, length in zip(platform.cables, lengths):
+        limit = max_strain * cable.axial_stiffness
+        if max_tension is not None:
+            limit = min(limit, max_tension)
+        reaches.append(length * (1.0 + limit / cable.axial_stiffness))
+    exits, anchors = platform.exit_points, platform.anchors
+    for i in range(len(lengths)):
+        for j in range(i):
+            gap = float(np.linalg.norm(exits[i] - exits[j]))
+            reach = reaches[i] + reaches[j] + float(np.linalg.norm(anchors[i] - anchors[j]))
+            if gap > reach:
+                raise UnreachableError(
+                    f"unstrained_lengths: cables[{j}] and cables[{i}] cannot both reach the platform: their exit "
+                    f"points are {gap:g} m apart, beyond the {reach:g} m their lengths ({lengths[j]:g}, "
+                    f"{lengths[i]:g} m, at the tension limit) and anchors span")
+
+
+def _pose(platform, coordinates):
+    """Position, rotation matrix and rotation vector from the unknowns."""
+    position = coordinates[:3]
+    theta = coordinates[3:6] if platform.degrees_of_freedom == 6 else np.zeros(3)
+    return position, rotation_matrix(theta), theta
+
+
+def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
+    """Equilibrium pose on straight, massless, elastic cables that may go slack (the starting guess).
+
+    Minimises ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2`` with ``l_i``
+    the straight anchor-exit distance and ``k_i = EA_i / L_i``.
+
+    Parameters
+    ----------
+    platform : SpatialPlatform
+    unstrained_lengths : array_like, shape (n_cables,) [m]
+    external_wrench : array_like, shape (6,) [N, N m], optional
+
+    Returns
+    -------
+    ndarray, shape (3,) or (6,)
+        ``r`` [m] (and the rotation vector ``theta`` [rad] for a rigid body).
+    """
+    lengths = _lengths(platform, unstrained_lengths)
+    wrench = _wrench(external_wrench)
+    dof = platform.degrees_of_freedom
+    stiffness = np.array([c.axial_stiffness for c in platform.cables]) / lengths
+    exits = platform.exit_points
+    weight = platform.mass * platform.gravity
+    scale = weight + sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths)) + 1e-12
+
+    def energy(q):
+        position, rotation, theta = _pose(platform, q)
+        arms = platform.anchors @ rotation.T
+        value = weight * position[2] - wrench[:3] @ position - (wrench[3:] @ theta if dof == 6 else 0.0)
+        force = np.array([0.0, 0.0, weight]) - wrench[:3]
+        moment = -wrench[3:].copy()
+        for arm, exit_point, length, k in zip(arms, exits, lengths, stiffness):
+            span = position + arm - exit_point
+            distance = float(np.linalg.norm(span))
+            if distance > length:
+                value += 0.5 * k * (distance - length) ** 2
+                pull = k * (distance - length) * span / distance
+                force += pull
+                moment += np.cross(arm, pull)
+        gradient = force if dof == 3 else np.concatenate([force, left_jacobian(theta).T @ moment])
+        return value / scale, gradient / scale
+
+    start = np.zeros(dof)
+    start[:3] = exits.mean(axis=0) - np.array([0.0, 0.0, lengths.mean()])
+    solution = minimize(energy, start, jac=True, method="BFGS", options={"gtol": 1e-10, "maxiter": 5000})
+    return solution.x.copy()
+
+
+def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, external_wrench=None,
+                          max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
+    """Equilibrium pose of the platform and every cable's forces, for given unstrained lengths.
+
+    Newton's method on the net generalised force (force, and ``J_l^T`` moment for a
+    rigid body), with the analytic stiffness assembled from the cables' 3-D end
+    stiffnesses and a line search on the energy; every evaluation solves each cable's
+    catenary, warm-started from the previous iterate.
+
+    Parameters
+    ----------
+    platform : SpatialPlatform
+    unstrained_lengths : array_like, shape (n_cables,) [m]
+    initial_pose : array_like, shape (3,) or (6,), optional
+        Start ``r`` [m] (and ``theta`` [rad]); default :func:`straight_cable_pose`.
+    external_wrench : array_like, shape (6,) [N, N m], optional
+        Extra force and moment (about the centre of mass) on the platform.
+    max_strain, max_tension : float, optional
+        Cable tension limits, as in :func:`cdpr_exu.catenary.solve_forward`.
+
+    Returns
+    -------
+    SpatialEquilibrium
+
+    Raises
+    ------
+    SceneError
+        Naming the argument, if an input is invalid (checked before any solve).
+    UnreachableError
+        If two cables cannot both reach the platform (checked before any solve), or if
+        no equilibrium is found within the tension limits.
+    """
+    if not isinstance(platform, SpatialPlatform):
+        raise SceneError(f"platform must be a SpatialPlatform, got {platform!r}")
+    lengths = _lengths(platform, unstrained_lengths)
+    wrench = _wrench(external_wrench)
+    max_strain = positive("max_strain", max_strain)
+    if max_tension is not None:
+        max_tension = positive("max_tension", max_tension)
+    dof = platform.degrees_of_freedom
+    if initial_pose is not None:
+        start = real_array("initial_pose", initial_pose)
+        if start.shape != (dof,):
+            raise SceneError(f"initial_pose must have {dof} entries for this platform, got {initial_pose!r}")
+    _check_reach(platform, lengths, max_strain, max_tension)
+    if initial_pose is None:
+        start = straight_cable_pose(platform, lengths, wrench)
+
+    weight = platform.mass * platform.gravity
+    force_scale = max(weight + sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths))
+                      + float(np.linalg.norm(wrench[:3])), 1e-12)
+    arm = float(np.linalg.norm(platform.anchors, axis=1).max())
+    length_scale = arm if arm > 0.0 else 1.0
+    residual_scale = np.array([force_scale] * 3 + [force_scale * length_scale] * 3)[:dof]
+    pose_scale = np.array([1.0] * 3 + [length_scale] * 3)[:dof]  # unknowns in metres
+    stiffest = max(c.axial_stiffness for c in platform.cables)
+    noise = 1e3 * _RELATIVE_TOLERANCE * (1.0 + stiffest / force_scale)
+    guesses = [None] * len(platform.cables)
+    cache = {}
+
+    def evaluate(coordinates):
+        position, rotation, theta = _pose(platform, coordinates)
+        arms = platform.anchors @ rotation.T
+        wrench_total = wrench.copy()
+        wrench_total[2] -= weight
+        jacobian = np.zeros((6, 6))  # d(force, moment)/d(r, world rotation)
+        equilibria = []
+        for i, (cable, length, arm_) in enumerate(zip(platform.cables, lengths, arms)):
+            equilibrium, stiffness = solve_cable(cable, length, position + arm_, guesses[i], max_strain, max_tension)
+            guesses[i] = (equilibrium.catenary.horizontal_tension, equilibrium.catenary.vertical_tension_b)
+            equilibria.append(equilibrium)
+            force = equilibrium.force_on_platform
+            wrench_total[:3] += force
+            wrench_total[3:] += np.cross(arm_, force)
+            arm_skew = skew(arm_)
+            jacobian[:3, :3] += stiffness
+            jacobian[:3, 3:] -= stiffness @ arm_skew
+            jacobian[3:, :3] += arm_skew @ stiffness
+            jacobian[3:, 3:] += -arm_skew @ stiffness @ arm_skew + skew(force) @ arm_skew
+        cache["last"] = (position, rotation, theta, equilibria, wrench_total)
+        if dof == 3:
+            return wrench_total[:3], jacobian[:3, :3]
+        tangent = left_jacobian(theta)
+        residual = np.concatenate([wrench_total[:3], tangent.T @ wrench_total[3:]])
+        # d(J_l^T M)/d(theta) also has a term in dJ_l/d(theta) M, which vanishes at equilibrium: left out
+        generalised = jacobian @ np.block([[np.eye(3), np.zeros((3, 3))], [np.zeros((3, 3)), tangent]])
+        generalised[3:] = tangent.T @ generalised[3:]
+        return residual, generalised
+
+    def function(scaled):
+        residual, jacobian = evaluate(scaled / pose_scale)
+        return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
+
+    try:
+        scaled, _, _ = _minimise_energy(function, start * pose_scale, _RELATIVE_TOLERANCE, noise,
+                                        what="spatial statics")
+    except UnreachableError as error:
+        raise UnreachableError(f"no equilibrium found for unstrained_lengths {lengths.tolist()} m: {error}") from None
+    coordinates = scaled / pose_scale
+    _, jacobian = evaluate(coordinates)  # the accepted point, with its own cable states
+    position, rotation, theta, equilibria, wrench_total = cache["last"]
+    return SpatialEquilibrium(
+        position=np.array(position, dtype=float),
+        rotation_vector=rotation_vector(rotation) if dof == 6 else np.zeros(3),
+        rotation=rotation,
+        cables=tuple(equilibria),
+        stiffness=-jacobian,
+        net_wrench=wrench_total,
+    )
