@@ -1,11 +1,15 @@
-"""Geometry of a planar cable robot: poses, rotations, anchor points, pulley exits.
+"""Geometry of a cable robot: poses, rotations, anchor points, pulley exits.
 
 One home for each geometric concept, used by the builder, the statics, the chain
 statics, the controllers and the plots. Pure NumPy/SciPy; no Exudyn. Units SI.
 
+Spatial robots (z up, gravity along -z) turn their platform by a rotation vector
+``theta`` [rad], ``R = exp([theta]x)`` (:func:`rotation_from_vector`), the planar
+robot by the angle ``phi`` below (:func:`rotation_matrix`).
+
 Frame
 -----
-Everything lives in the paper's vertical x-z plane with gravity along -z (the
+A planar robot lives in the paper's vertical x-z plane with gravity along -z (the
 builder maps it onto Exudyn's x-y plane: Exudyn's y is the paper's z). A platform
 pose is ``(x, z, phi)`` [m, m, rad], ``phi`` positive counter-clockwise, and a
 platform anchor is ``p_i = r + R(phi) b_i`` (paper eq. 16) with
@@ -44,6 +48,10 @@ __all__ = [
     "Pulley",
     "PulleyExit",
     "rotation_matrix",
+    "rotation_from_vector",
+    "rotation_vector",
+    "left_jacobian",
+    "skew",
     "planar_cross",
     "perpendicular",
     "anchor_points",
@@ -394,6 +402,54 @@ def ideal_cable_length_rate(center, radius, side, anchor, anchor_velocity):
         )
     rate = np.sum(exit_.unit_vector * velocity, axis=-1)
     return float(rate) if rate.ndim == 0 else rate
+
+
+# ----------------------------------------------------------------------------------
+# spatial rotations (rotation vector, SO(3))
+# ----------------------------------------------------------------------------------
+def skew(vector_):
+    """``[v]x``, the matrix of ``v x ...``, shape (3, 3)."""
+    x, y, z = vector_
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def rotation_from_vector(rotation_vector):
+    """Spatial rotation matrix ``R = exp([theta]x)`` of a rotation vector ``theta`` [rad] (Rodrigues), shape (3, 3)."""
+    theta = np.asarray(rotation_vector, dtype=float)
+    angle = float(np.linalg.norm(theta))
+    k = skew(theta)
+    if angle < 1e-8:  # series: 1 - a^2/6 and 1/2 - a^2/24, exact to round-off here
+        return np.eye(3) + (1.0 - angle**2 / 6.0) * k + (0.5 - angle**2 / 24.0) * (k @ k)
+    return np.eye(3) + math.sin(angle) / angle * k + (1.0 - math.cos(angle)) / angle**2 * (k @ k)
+
+
+def rotation_vector(matrix):
+    """The rotation vector [rad] (angle in [0, pi]) of a rotation matrix, shape (3,)."""
+    matrix = np.asarray(matrix, dtype=float)
+    cosine = min(max(0.5 * (np.trace(matrix) - 1.0), -1.0), 1.0)
+    angle = math.acos(cosine)
+    axial = 0.5 * np.array([matrix[2, 1] - matrix[1, 2], matrix[0, 2] - matrix[2, 0], matrix[1, 0] - matrix[0, 1]])
+    if angle < 1e-8:
+        return axial  # sin(a) ~ a
+    if angle > math.pi - 1e-6:  # near a half turn: axis from the symmetric part
+        symmetric = 0.5 * (matrix + matrix.T) - cosine * np.eye(3)
+        column = int(np.argmax(np.diag(symmetric)))
+        axis = symmetric[:, column] / math.sqrt(max(symmetric[column, column], 1e-300))
+        if axis @ axial < 0.0:
+            axis = -axis
+        return angle * axis / np.linalg.norm(axis)
+    return angle / math.sin(angle) * axial
+
+
+def left_jacobian(rotation_vector_):
+    """``J_l(theta)``: ``exp([theta + d]x) = exp([J_l d]x) exp([theta]x)`` to first order in ``d``."""
+    theta = np.asarray(rotation_vector_, dtype=float)
+    angle = float(np.linalg.norm(theta))
+    k = skew(theta)
+    if angle < 1e-6:
+        return np.eye(3) + 0.5 * k + (k @ k) / 6.0
+    return (np.eye(3) + (1.0 - math.cos(angle)) / angle**2 * k
+            + (angle - math.sin(angle)) / angle**3 * (k @ k))
 
 
 # ----------------------------------------------------------------------------------

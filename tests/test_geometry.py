@@ -5,7 +5,8 @@ import pytest
 
 from cdpr_exu import statics
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import Pulley, anchor_points, pulley_exit, rotation_matrix
+from cdpr_exu.geometry import (Pulley, anchor_points, left_jacobian, pulley_exit, rotation_from_vector,
+                               rotation_matrix, rotation_vector)
 from cdpr_exu.scene import PulleySpec, load_scene
 
 # Geometry is closed-form: the only error is rounding, a few ulp of metre-sized lengths.
@@ -100,3 +101,18 @@ def test_one_angle_and_an_array_of_angles_give_the_same_rotation():
     pose = np.array([0.1, -1.8, 0.4])
     assert anchor_points(pose, [[0.2, 0.0]])[0] == pytest.approx(pose[:2] + rotation_matrix(0.4) @ [0.2, 0.0],
                                                                  abs=1e-15)
+
+
+@pytest.mark.parametrize("theta", [[0.0, 0.0, 0.0], [1e-9, -2e-9, 3e-9], [0.3, -0.2, 0.5], [0.0, 3.0, 0.1]])
+def test_rotation_vector_and_matrix_are_inverse_and_left_jacobian_is_their_derivative(theta):
+    theta = np.array(theta)
+    rotation = rotation_from_vector(theta)
+    # orthonormal and inverse of each other to round-off (angles of order 1)
+    np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-14)
+    np.testing.assert_allclose(rotation_vector(rotation), theta, atol=1e-12)
+    h = 1e-7
+    for e in np.eye(3):
+        # exp([theta + h e]) R^T = exp([J_l h e]) to first order: central differences, error O(h^2)
+        change = (rotation_from_vector(theta + h * e) - rotation_from_vector(theta - h * e)) / (2 * h) @ rotation.T
+        axial = 0.5 * np.array([change[2, 1] - change[1, 2], change[0, 2] - change[2, 0], change[1, 0] - change[0, 1]])
+        np.testing.assert_allclose(axial, left_jacobian(theta) @ e, atol=1e-8)

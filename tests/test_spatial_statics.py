@@ -8,8 +8,8 @@ import pytest
 import cdpr_exu.physics.spatial_statics as spatial_statics
 from cdpr_exu.catenary import CatenaryCable
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.physics.spatial_statics import (SpatialCable, SpatialPlatform, left_jacobian, rotation_matrix,
-                                              rotation_vector, solve_cable, solve_spatial_statics)
+from cdpr_exu.geometry import left_jacobian, rotation_from_vector
+from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform, solve_cable, solve_spatial_statics
 from cdpr_exu.statics import SuspendedCable, SuspendedPlatform, solve_forward_statics
 
 # The paper's cable (radius 5 mm, E = 1e9 Pa, 0.35 kg/m): w = 3.43 N/m, EA = 7.85e4 N.
@@ -37,24 +37,6 @@ def net_wrench(platform, equilibrium):
 
 
 BOTH = [pytest.param(False, id="point-mass"), pytest.param(True, id="rigid")]
-
-
-# ---------------------------------------------------------------------------
-# rotations
-# ---------------------------------------------------------------------------
-@pytest.mark.parametrize("theta", [[0.0, 0.0, 0.0], [1e-9, -2e-9, 3e-9], [0.3, -0.2, 0.5], [0.0, 3.0, 0.1]])
-def test_rotation_vector_and_matrix_are_inverse_and_left_jacobian_is_their_derivative(theta):
-    theta = np.array(theta)
-    rotation = rotation_matrix(theta)
-    # orthonormal and inverse of each other to round-off (angles of order 1)
-    np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-14)
-    np.testing.assert_allclose(rotation_vector(rotation), theta, atol=1e-12)
-    h = 1e-7
-    for e in np.eye(3):
-        # exp([theta + h e]) R^T = exp([J_l h e]) to first order: central differences, error O(h^2)
-        change = (rotation_matrix(theta + h * e) - rotation_matrix(theta - h * e)) / (2 * h) @ rotation.T
-        axial = 0.5 * np.array([change[2, 1] - change[1, 2], change[0, 2] - change[2, 0], change[1, 0] - change[0, 1]])
-        np.testing.assert_allclose(axial, left_jacobian(theta) @ e, atol=1e-8)
 
 
 # ---------------------------------------------------------------------------
@@ -132,7 +114,7 @@ def test_stiffness_is_minus_the_derivative_of_the_generalised_force(rigid):
 
     def generalised_force(x):
         theta = x[3:] if dof == 6 else np.zeros(3)
-        rotation = rotation_matrix(theta)
+        rotation = rotation_from_vector(theta)
         force, moment = np.array([0.0, 0.0, -platform.mass * platform.gravity]), np.zeros(3)
         for cable, length in zip(platform.cables, ASYMMETRIC_LENGTHS):
             arm = rotation @ np.array(cable.anchor)

@@ -66,7 +66,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     nodes, masses, markers, springs = [], [], [], []
     for point, mass in zip(positions, node_masses):
         node = mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point)))
-        masses.append(mbs.AddObject(eii.ObjectMassPoint(physicsMass=float(mass), nodeNumber=node)))
+        masses.append(mbs.AddObject(eii.ObjectMassPoint(mass=float(mass), nodeNumber=node)))
         marker = mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node))
         if gravity:
             mbs.AddLoad(eii.LoadForceVector(markerNumber=marker, loadVector=[0.0, 0.0, -float(mass) * gravity]))

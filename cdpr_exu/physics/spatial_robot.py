@@ -57,7 +57,8 @@ from cdpr_exu.errors import SceneError, SolverFailure
 from cdpr_exu.validation import non_negative, positive
 
 from .chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
-from .spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, rotation_vector, solve_spatial_statics
+from ..geometry import rotation_vector
+from .spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, solve_spatial_statics
 
 
 @dataclass(frozen=True)

@@ -52,6 +52,7 @@ from scipy.optimize import minimize
 from cdpr_exu.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
     profile, solve_forward
 from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
 from cdpr_exu.statics import _minimise_energy  # the energy line search of the planar statics, reused as is
 from cdpr_exu.validation import non_negative, positive, real_array, vector
 
@@ -60,54 +61,6 @@ _RELATIVE_TOLERANCE = 1e-12
 
 _E_Z = np.array([0.0, 0.0, 1.0])
 _HORIZONTAL = np.diag([1.0, 1.0, 0.0])
-
-
-# ---------------------------------------------------------------------------
-# rotations (rotation vector, SO(3))
-# ---------------------------------------------------------------------------
-def skew(vector_):
-    """``[v]x``, the matrix of ``v x ...``, shape (3, 3)."""
-    x, y, z = vector_
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-
-
-def rotation_matrix(rotation_vector):
-    """``R = exp([theta]x)`` of a rotation vector ``theta`` [rad] (Rodrigues), shape (3, 3)."""
-    theta = np.asarray(rotation_vector, dtype=float)
-    angle = float(np.linalg.norm(theta))
-    k = skew(theta)
-    if angle < 1e-8:  # series: 1 - a^2/6 and 1/2 - a^2/24, exact to round-off here
-        return np.eye(3) + (1.0 - angle**2 / 6.0) * k + (0.5 - angle**2 / 24.0) * (k @ k)
-    return np.eye(3) + math.sin(angle) / angle * k + (1.0 - math.cos(angle)) / angle**2 * (k @ k)
-
-
-def rotation_vector(matrix):
-    """The rotation vector [rad] (angle in [0, pi]) of a rotation matrix, shape (3,)."""
-    matrix = np.asarray(matrix, dtype=float)
-    cosine = min(max(0.5 * (np.trace(matrix) - 1.0), -1.0), 1.0)
-    angle = math.acos(cosine)
-    axial = 0.5 * np.array([matrix[2, 1] - matrix[1, 2], matrix[0, 2] - matrix[2, 0], matrix[1, 0] - matrix[0, 1]])
-    if angle < 1e-8:
-        return axial  # sin(a) ~ a
-    if angle > math.pi - 1e-6:  # near a half turn: axis from the symmetric part
-        symmetric = 0.5 * (matrix + matrix.T) - cosine * np.eye(3)
-        column = int(np.argmax(np.diag(symmetric)))
-        axis = symmetric[:, column] / math.sqrt(max(symmetric[column, column], 1e-300))
-        if axis @ axial < 0.0:
-            axis = -axis
-        return angle * axis / np.linalg.norm(axis)
-    return angle / math.sin(angle) * axial
-
-
-def left_jacobian(rotation_vector_):
-    """``J_l(theta)``: ``exp([theta + d]x) = exp([J_l d]x) exp([theta]x)`` to first order in ``d``."""
-    theta = np.asarray(rotation_vector_, dtype=float)
-    angle = float(np.linalg.norm(theta))
-    k = skew(theta)
-    if angle < 1e-6:
-        return np.eye(3) + 0.5 * k + (k @ k) / 6.0
-    return (np.eye(3) + (1.0 - math.cos(angle)) / angle**2 * k
-            + (angle - math.sin(angle)) / angle**3 * (k @ k))
 
 
 # ---------------------------------------------------------------------------
@@ -447,7 +400,7 @@ def _pose(platform, coordinates):
     """Position, rotation matrix and rotation vector from the unknowns."""
     position = coordinates[:3]
     theta = coordinates[3:6] if platform.degrees_of_freedom == 6 else np.zeros(3)
-    return position, rotation_matrix(theta), theta
+    return position, rotation_from_vector(theta), theta
 
 
 def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
