@@ -212,9 +212,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_scenes(args: argparse.Namespace) -> int:  # noqa: ARG001
+    from .spatial_scene import load_spatial_scene, shipped_spatial_scenes
+
     for name in shipped_scenes():
         scene = load_scene(name)
         print(f"{name:24s} {scene.description}")
+    for name in shipped_spatial_scenes():
+        print(f"{name:24s} {load_spatial_scene(name).description}")
     return 0
 
 

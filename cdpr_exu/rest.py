@@ -78,6 +78,7 @@ from .pulley import penetration
 from .output import write_npz, write_summary
 from .result import provenance
 from .scene import Scene, load_scene
+from .spatial_scene import is_spatial, load_any_scene
 
 #: Default tolerance on the largest node speed at rest [m/s].
 DEFAULT_TOLERANCE = 1.0e-6
@@ -686,6 +687,11 @@ def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None
 EPILOG = """examples:
   cdpr static paper-catenary-fixed --out results/static_fixed
   cdpr static paper-catenary --out results/static_pulleys --tolerance 1e-7
+  cdpr static spatial-four-cable --out results/static_spatial
+
+A spatial scene (dimension = 3) is solved directly by Exudyn's static solver, started on
+its elastic-catenary statics (--tolerance, --max-time and --no-polish do not apply), and
+reports the platform's position and rotation beside the catenary answer.
 """
 
 
@@ -699,11 +705,25 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
                         "last_state": partial, **provenance()})
 
 
+def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
+    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.spatial_rest`)."""
+    from .spatial_rest import print_spatial_rest, solve_spatial_rest
+
+    rest = solve_spatial_rest(scene)
+    if out is not None:
+        rest.save(out)
+    if not quiet:
+        print_spatial_rest(rest, out)
+    return EXIT_OK
+
+
 def _cmd_static(args: argparse.Namespace) -> int:
     from .output import check_output_folder, fixed
 
     out = check_output_folder(args.out)
-    scene = load_scene(args.scene)
+    scene = load_any_scene(args.scene)
+    if is_spatial(scene):
+        return _static_spatial(scene, out, args.quiet)
     try:
         rest = solve_rest(scene, tolerance=args.tolerance, max_time=args.max_time, polish=not args.no_polish)
     except SolverFailure as err:

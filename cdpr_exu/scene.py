@@ -738,6 +738,9 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {data!r}")
     data = dict(data)
+    if data.get("dimension", 2) != 2:
+        raise SceneError(f"dimension must be 2 (planar) or 3 (spatial), got {data['dimension']!r}")
+    data.pop("dimension", None)
     top_known = {
         "name", "description", "gravity", "cable_exit", "cable", "cables", "pulley", "pulleys",
         "platform", "winch", "effects", "solver", "trajectory",
@@ -776,8 +779,24 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     return Scene(**kwargs)
 
 
+class SpatialSceneError(SceneError):
+    """A spatial scene (``dimension = 3``) given where only planar scenes are taken."""
+
+
+def _refuse_spatial(source: str | Path) -> None:
+    raise SpatialSceneError(
+        f"scene {str(source)!r} is spatial (dimension = 3): so far `cdpr static` takes spatial scenes; run, compare, "
+        "study, view and animate take planar scenes only (see docs/spatial.md)")
+
+
 def load_scene(source: str | Path) -> Scene:
-    """Load a scene by shipped name (e.g. ``"paper-circle"``) or from a TOML file path."""
+    """Load a planar scene by shipped name (e.g. ``"paper-circle"``) or from a TOML file path.
+
+    Raises
+    ------
+    SpatialSceneError
+        For a spatial scene (:func:`cdpr_exu.spatial_scene.load_spatial_scene` loads those).
+    """
     path = Path(source)
     if path.suffix == ".toml" or path.exists():
         if path.is_dir():
@@ -789,6 +808,8 @@ def load_scene(source: str | Path) -> Scene:
     else:
         name = str(source).replace("-", "_") + ".toml"
         resource = resources.files("cdpr_exu.scenes").joinpath(name)
+        if not resource.is_file() and resources.files("cdpr_exu.scenes").joinpath("spatial", name).is_file():
+            _refuse_spatial(source)
         if not resource.is_file():
             raise SceneError(f"no scene named {str(source)!r}; shipped scenes: {', '.join(shipped_scenes())}")
         text = resource.read_text()
@@ -796,6 +817,8 @@ def load_scene(source: str | Path) -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
+    if isinstance(data, Mapping) and data.get("dimension") == 3:
+        _refuse_spatial(source)
     scene = scene_from_dict(data)  # the values given are checked first
     _check_required(data, str(source))
     return scene

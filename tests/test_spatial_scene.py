@@ -1,0 +1,112 @@
+"""Spatial scenes in TOML and their static mode (cdpr_exu.spatial_scene, cdpr_exu.spatial_rest), real solver."""
+
+import json
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cdpr_exu.errors import SceneError
+from cdpr_exu.rest import solve_rest
+from cdpr_exu.scene import SpatialSceneError, load_scene
+from cdpr_exu.spatial_rest import solve_spatial_rest
+from cdpr_exu.spatial_scene import load_any_scene, load_spatial_scene, shipped_spatial_scenes, spatial_scene_from_dict
+
+#: The paper's catenary scene with fixed cable ends, written as a spatial scene in the
+#: vertical x-z plane (y = 0): the same cables, elements, masses and bending.
+PLANAR_AS_SPATIAL = {
+    "name": "paper-catenary-fixed-3d", "dimension": 3, "gravity": 9.8,
+    "cable": {"unstrained_length": 2.4748737341529163, "radius": 0.005, "linear_density": 0.35,
+              "youngs_modulus": 1.0e9, "damping_constant": 1.0e9, "n_elements": 15},
+    "cables": [{}, {}],
+    "exits": [{"point": [-1.75, 0.0, 0.0]}, {"point": [1.75, 0.0, 0.0]}],
+    "platform": {"mass": 1.0, "anchors": [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]},
+}
+
+
+def _cdpr(*args):
+    return subprocess.run([sys.executable, "-m", "cdpr_exu.cli", *args], capture_output=True, text=True, timeout=300)
+
+
+def test_the_shipped_spatial_scene_loads_and_the_planar_loader_refuses_it_naming_the_static_mode():
+    assert "spatial-four-cable" in shipped_spatial_scenes()
+    scene = load_any_scene("spatial-four-cable")
+    assert scene.dimension == 3 and scene.n_cables == 4 and not scene.platform.is_point_mass
+    with pytest.raises(SpatialSceneError, match="cdpr static"):
+        load_scene("spatial-four-cable")
+
+
+def test_cdpr_run_refuses_a_spatial_scene_with_exit_code_2():
+    done = _cdpr("run", "spatial-four-cable")
+    assert done.returncode == 2
+    assert "spatial (dimension = 3)" in done.stderr and "cdpr static" in done.stderr
+
+
+def test_a_planar_robot_written_as_a_spatial_scene_rests_where_the_planar_model_rests():
+    spatial = solve_spatial_rest(spatial_scene_from_dict(PLANAR_AS_SPATIAL))
+    planar = solve_rest(load_scene("paper-catenary-fixed"))
+    x, z = planar.platform_position_m
+    # Both are exact static equilibria of the same discrete model (the 3-D bending force of a
+    # cable in a vertical plane is the planar one to 1e-12 N, tests/test_bending_3d.py); the
+    # planar state is polished by Exudyn's static solver too. Measured 2.5e-12 m and 3e-10 N;
+    # the bounds leave room for the Newton tolerance (1e-9 relative) and are far below the
+    # 4.5 mm that bending moves the platform here and the 1e-5 m discretisation error.
+    assert spatial.position == pytest.approx([x, 0.0, z], abs=1e-9)
+    assert np.abs(spatial.rotation_vector).max() < 1e-12  # a point mass does not turn
+    for i in range(2):  # the joint reactions, bending shear included
+        assert spatial.forces_on_platform[i][[0, 2]] == pytest.approx(planar.platform_forces_N[i], abs=1e-7)
+        assert spatial.forces_on_platform[i][1] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_without_bending_the_lumped_robot_rests_within_its_discretisation_error_of_the_catenaries():
+    scene = load_spatial_scene("spatial-four-cable")
+    scene = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False))
+    rest = solve_spatial_rest(scene)
+    # tests/test_spatial_robot.py measures the lumped robot against the catenaries as n^-2,
+    # 1.9e-5 m, 1.7e-5 rad and 0.016 N at 20 elements: 2.5e-5 and 0.025 N bound them.
+    assert np.linalg.norm(rest.position - rest.catenary.position) < 2.5e-5
+    assert np.linalg.norm(rest.rotation_vector - rest.catenary.rotation_vector) < 2.5e-5
+    assert rest.tensions_at_anchor == pytest.approx(rest.catenary.tensions_at_anchor, abs=0.025)
+
+
+def test_the_cables_hold_the_platform_in_force_and_moment_balance():
+    scene = load_spatial_scene("spatial-four-cable")
+    rest = solve_spatial_rest(scene)
+    weight = scene.platform.mass * scene.gravity
+    forces = rest.forces_on_platform
+    arms = np.asarray(scene.platform.anchors) @ rest.rotation.T
+    # Exudyn's static solver converges to 1e-9 (relative); the penalty joints move nothing
+    # in the balance: 1e-6 N of a 49 N weight.
+    assert forces.sum(axis=0) == pytest.approx([0.0, 0.0, weight], abs=1e-6)
+    assert np.cross(arms, forces).sum(axis=0) == pytest.approx(np.zeros(3), abs=1e-6)
+    assert rest.position[2] < -1.0 and np.all(rest.tensions_at_anchor > 0.0)
+
+
+def test_cdpr_static_on_a_spatial_scene_prints_the_pose_and_writes_a_strict_summary(tmp_path):
+    out = tmp_path / "static"
+    done = _cdpr("static", "spatial-four-cable", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "platform at x =" in done.stdout and "rotation vector" in done.stdout
+    summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
+    assert len(summary["platform_position_m"]) == 3 and len(summary["platform_rotation_vector_rad"]) == 3
+    assert summary["dimension"] == 3 and (out / "rest_profile.png").stat().st_size > 20_000
+
+
+@pytest.mark.parametrize("change, field", [
+    (lambda d: d.update(exits=d["exits"][:1]), "exits"),
+    (lambda d: d.update(effects={"slack": True}), "effects.slack"),
+    (lambda d: d.update(cables=[{}, {"n_elements": 20}]), "cables\\[1\\].n_elements"),
+    (lambda d: d.update(dimension=4), "dimension"),
+    (lambda d: d.pop("exits"), "exits"),
+    (lambda d: d.update(exits=[{"point": [0.0, 0.0, 0.0]}, {"point": [0.0, 0.0, 0.0]}]), "exit_point"),
+    (lambda d: d["platform"].update(anchors=[[0.0, 0.0, 0.0], [0.0, float("nan"), 0.0]]), "platform.anchors\\[1\\]"),
+    (lambda d: d["platform"].update(mass=-1.0), "platform.mass"),
+    (lambda d: d["cable"].update(radius=-0.005), "cables\\[0\\].radius"),
+])
+def test_a_bad_spatial_scene_is_refused_naming_the_field(change, field):
+    data = json.loads(json.dumps(PLANAR_AS_SPATIAL))
+    change(data)
+    with pytest.raises(SceneError, match=field):
+        spatial_scene_from_dict(data)
