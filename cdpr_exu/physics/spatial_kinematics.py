@@ -1,0 +1,849 @@
+"""Ideal kinematics and statics of a spatial cable robot over swivel pulleys: lengths, rates, wrenches, tensions.
+
+Pure NumPy/SciPy; no Exudyn. The cables are ideal: straight, massless and
+inextensible. z is up, gravity along -z, SI units. A platform pose is
+``(r, theta)``, shape (6,): the position ``r`` of its reference point [m] and a
+rotation vector ``theta`` [rad]; anchor i is at ``r + R(theta) b_i`` with
+``R = exp([theta]x)``, the conventions of :mod:`cdpr_exu.physics.spatial_statics`,
+whose SO(3) helpers (``rotation_matrix``, ``left_jacobian``) are reused here. A
+point-mass platform (every cable on one point) has the pose ``r``, shape (3,).
+
+Swivel pulley
+-------------
+A swivel pulley turns about the vertical axis through its **inlet** ``e`` (3,): the
+point where the cable leaves the axis and starts to wrap on the disc. The winch side
+of the cable hangs straight down that axis to the winch, as in the planar model,
+where it hangs down the vertical winch line (:mod:`cdpr_exu.geometry`). The disc, of
+radius ``r_p``, lies in the vertical plane through the axis and the anchor ``p``; its
+centre is at ``e + r_p e_rho``, ``r_p`` from the axis towards the anchor.
+
+* The **azimuth** ``psi`` of the pulley is the direction of ``p`` seen from the axis,
+  ``atan2(p_y - e_y, p_x - e_x)``; ``e_rho = (cos psi, sin psi, 0)``.
+* In that plane, with coordinates ``(rho, z) = ((p - e) . e_rho, p_z - e_z)``, the
+  cable is exactly the planar one: :class:`cdpr_exu.geometry.Pulley` with centre
+  ``(r_p, 0)``, radius ``r_p`` and ``side = -1``. Its hang point ``(c_x + s r_p, c_z)
+  = (0, 0)`` is the inlet, its vertical winch line ``x = 0`` is the swivel axis, and
+  the cable wraps from the axis over the top of the disc towards the anchor. The
+  tangent point, wrap angle, free length and ideal cable length
+  ``L = r_p * wrap + |p - t|`` (from the inlet) are the planar ones, mapped back
+  with ``(rho, z) -> e + rho e_rho + z e_z``. ``r_p = 0`` gives ``L = |p - e|``.
+* Since ``rho >= 0``, the anchor is never beyond the planar pulley's outer vertical
+  line: every anchor outside the disc is reachable, above the inlet too (wrap below
+  pi / 2), and below it (wrap up to 3 pi / 2 when the anchor is under the disc).
+  Only a cable coming *down* to the pulley from a winch above is not covered: that
+  is the mirror image ``z -> -z`` of this geometry and no scene needs it yet.
+* **Anchor on the axis** (``rho`` below 1e-12 of ``|p - e| + r_p``): the azimuth is
+  undefined. The cable length does not depend on it, but for ``r_p > 0`` the
+  direction of the cable does. The azimuth is then kept from the previous pose of
+  the same call (a trajectory passing under a pulley) or taken from
+  ``azimuth_hint``; with neither, the pose is refused (``UnreachableError``). For a
+  point exit (``r_p = 0``) the cable is vertical whatever the azimuth, which is
+  then reported as the hint, the previous one, or 0.
+
+Sign conventions
+----------------
+``SwivelExit.unit_vector`` points from the tangent point to the anchor, as in the
+planar :class:`cdpr_exu.geometry.PulleyExit`. :func:`cable_unit_vectors` returns
+``u_i``, the opposite: the direction in which cable i pulls the platform. The
+length rate is ``dL_i/dt = -u_i . v_i`` (``v_i`` the anchor's velocity: a change of
+wrap exactly cancels the motion of the tangent point along the rim, and a change of
+azimuth moves the tangent point sideways, perpendicular to the cable). The
+structure matrix ``A`` has columns ``[u_i; (R b_i) x u_i]``: tensions ``f`` exert
+the wrench ``A f`` on the platform (moment about ``r``). With the pose rate
+``(dr/dt, dtheta/dt)`` and the angular velocity ``omega = J_l(theta) dtheta/dt``::
+
+    dL/d(r, theta) = -A^T blockdiag(I, J_l(theta))
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import nnls
+
+from cdpr_exu.catenary import STANDARD_GRAVITY
+from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.geometry import Pulley, finite_array
+from cdpr_exu.physics.spatial_statics import left_jacobian
+from cdpr_exu.physics.spatial_statics import rotation_matrix as spatial_rotation_matrix
+from cdpr_exu.validation import non_negative, positive, vector
+
+__all__ = [
+    "SwivelExit",
+    "SwivelPulley",
+    "swivel_pulley_exit",
+    "rotation_matrices",
+    "anchor_points",
+    "anchor_velocities",
+    "inverse_kinematics",
+    "inverse_kinematics_rates",
+    "cable_unit_vectors",
+    "structure_matrix",
+    "gravity_wrench",
+    "tension_distribution",
+    "IdealSpatialRobot",
+]
+
+_ON_AXIS = 1e-12
+"""An anchor closer to the swivel axis than this fraction of its distance (plus r_p) is on the axis."""
+
+_INFEASIBLE_RESIDUAL = 1e-6
+"""NNLS residual below which the least-distance problem is infeasible (a feasible one has more than 0.1)."""
+
+_BOUND_ROUNDING = 1e-9
+"""A tension this fraction of the tension range outside its bounds is rounding (and is clipped)."""
+
+
+# ----------------------------------------------------------------------------------
+# one cable over one swivel pulley
+# ----------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)  # array fields
+class SwivelExit:
+    """Where and how an ideal cable leaves a swivel pulley towards its anchor.
+
+    Attributes
+    ----------
+    azimuth : float or ndarray, shape (N,) [rad]
+        Direction of the anchor seen from the swivel axis, ``atan2(dy, dx)``.
+    tangent_point : ndarray, shape (3,) or (N, 3) [m]
+        Where the cable leaves the rim (the inlet for a point exit).
+    wrap_angle : float or ndarray, shape (N,) [rad]
+        Arc from the inlet over the top of the disc to the tangent point, in ``[0, 3 pi / 2)``.
+    free_length : float or ndarray, shape (N,) [m]
+        Straight length ``|p - t|``.
+    unit_vector : ndarray, shape (3,) or (N, 3)
+        Unit vector from the tangent point towards the anchor (opposite to the pull on the platform).
+    arc_length : float or ndarray, shape (N,) [m]
+        Wrapped length ``r_p * wrap_angle``.
+    """
+
+    azimuth: float | np.ndarray
+    tangent_point: np.ndarray
+    wrap_angle: float | np.ndarray
+    free_length: float | np.ndarray
+    unit_vector: np.ndarray
+    arc_length: float | np.ndarray
+
+    @property
+    def cable_length(self):
+        """Ideal cable length from the inlet to the anchor, ``free_length + arc_length`` [m]."""
+        return self.free_length + self.arc_length
+
+
+def _point3(name, value):
+    array = finite_array(name, value, (3,))
+    if array.ndim != 1:
+        raise SceneError(f"{name} must have shape (3,), got shape {array.shape}")
+    return array
+
+
+def _fill_azimuths(azimuth, on_axis, azimuth_hint, radius, anchor, inlet):
+    """Azimuths of on-axis anchors: the previous one in the batch, else the hint, else refuse (r_p > 0)."""
+    flat_azimuth = azimuth.reshape(-1)
+    flat_on_axis = on_axis.reshape(-1)
+    flat_anchor = anchor.reshape(-1, 3)
+    previous = azimuth_hint
+    for k in range(flat_azimuth.size):
+        if not flat_on_axis[k]:
+            previous = flat_azimuth[k]
+            continue
+        if previous is None:
+            if radius > 0.0:
+                raise UnreachableError(
+                    f"anchor {flat_anchor[k].tolist()} lies on the axis of the swivel pulley (inlet "
+                    f"{inlet.tolist()}, radius {radius} m): its azimuth is undefined; give azimuth_hint "
+                    "(the previous azimuth) or start the trajectory off the axis")
+            previous = 0.0  # a point exit: the vertical cable does not depend on it
+        flat_azimuth[k] = previous
+    return flat_azimuth.reshape(azimuth.shape)
+
+
+def _swivel_exit(inlet, radius, anchor, azimuth_hint=None):
+    """Vectorised core of :func:`swivel_pulley_exit` on checked arguments; anchor (..., 3)."""
+    delta = anchor - inlet
+    distance = np.linalg.norm(delta, axis=-1)
+    if radius == 0.0 and np.any(distance == 0.0):
+        bad = anchor[distance == 0.0] if anchor.ndim > 1 else anchor
+        raise UnreachableError(f"anchor {np.asarray(bad).tolist()} coincides with the point exit {inlet.tolist()}")
+    rho = np.hypot(delta[..., 0], delta[..., 1])
+    azimuth = np.arctan2(delta[..., 1], delta[..., 0])
+    on_axis = rho <= _ON_AXIS * (distance + radius)
+    if np.any(on_axis):
+        azimuth = _fill_azimuths(np.array(azimuth, dtype=float), on_axis, azimuth_hint, radius, anchor, inlet)
+        rho = np.where(on_axis, 0.0, rho)
+    height = delta[..., 2]
+    if radius > 0.0:
+        inside = np.hypot(rho - radius, height) <= radius
+        if np.any(inside):
+            bad = anchor[inside] if anchor.ndim > 1 else anchor
+            raise UnreachableError(f"anchor {np.asarray(bad).tolist()} lies inside the disc of the swivel pulley "
+                                   f"(inlet {inlet.tolist()}, radius {radius} m)")
+    # the planar pulley in the plane (rho, z), origin at the inlet: its hang point is the inlet
+    planar = Pulley((radius, 0.0), radius, -1).exit(np.stack([rho, height], axis=-1))
+    e_rho = np.stack([np.cos(azimuth), np.sin(azimuth), np.zeros_like(azimuth)], axis=-1)
+    e_z = np.array([0.0, 0.0, 1.0])
+
+    def to_world(planar_vector):
+        return planar_vector[..., :1] * e_rho + planar_vector[..., 1:] * e_z
+
+    return SwivelExit(
+        azimuth=float(azimuth) if np.ndim(azimuth) == 0 else azimuth,
+        tangent_point=inlet + to_world(planar.tangent_point),
+        wrap_angle=planar.wrap_angle,
+        free_length=planar.free_length,
+        unit_vector=to_world(planar.unit_vector),
+        arc_length=planar.arc_length,
+    )
+
+
+def swivel_pulley_exit(inlet, radius, anchor, azimuth_hint=None):
+    """Azimuth, tangent point, wrap and free length of an ideal cable over a swivel pulley to an anchor.
+
+    Parameters
+    ----------
+    inlet : array_like, shape (3,) [m]
+        Point where the cable leaves the vertical swivel axis onto the disc (it hangs
+        down the axis to its winch).
+    radius : float [m]
+        Disc radius ``r_p >= 0``; 0 is a point exit at the inlet.
+    anchor : array_like, shape (3,) or (N, 3) [m]
+        Platform anchor(s) in the world frame.
+    azimuth_hint : float [rad], optional
+        Azimuth to use for an anchor on the swivel axis when no earlier anchor of
+        this call is off the axis (see the module notes).
+
+    Returns
+    -------
+    SwivelExit
+        Scalars and (3,) vectors, or (N,) and (N, 3) arrays for N anchors.
+
+    Raises
+    ------
+    SceneError
+        If an argument is malformed or not finite, or ``radius`` is negative.
+    UnreachableError
+        If an anchor is inside the disc (or on a point exit), or on the axis of a
+        pulley of positive radius with no azimuth to keep.
+
+    Notes
+    -----
+    The cable lies in the vertical plane of azimuth ``psi`` through the axis, where
+    it is the planar cable of :class:`cdpr_exu.geometry.Pulley` (centre ``(r_p, 0)``,
+    side -1, hang point at the inlet; Pott, "Cable-Driven Parallel Robots: Theory
+    and Application", Springer 2018, pulley kinematics).
+    """
+    inlet = _point3("inlet", inlet)
+    radius = non_negative("radius", radius)
+    anchor = finite_array("anchor", anchor, (3,))
+    if anchor.ndim > 2:
+        raise SceneError(f"anchor must have shape (3,) or (N, 3), got shape {anchor.shape}")
+    if azimuth_hint is not None:
+        azimuth_hint = float(finite_array("azimuth_hint", azimuth_hint))
+    return _swivel_exit(inlet, radius, anchor, azimuth_hint)
+
+
+@dataclass(frozen=True)
+class SwivelPulley:
+    """A swivel pulley: a disc of radius ``radius`` turning about the vertical axis through ``inlet``.
+
+    Parameters
+    ----------
+    inlet : (x, y, z) [m]
+        Where the cable leaves the vertical axis (it hangs down the axis to its winch).
+    radius : float [m]
+        Disc radius ``r_p >= 0``; 0 is a point exit at the inlet.
+
+    Raises
+    ------
+    SceneError
+        Naming the field, if a value is not finite or ``radius`` is negative.
+    """
+
+    inlet: tuple = (0.0, 0.0, 0.0)
+    radius: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "inlet", tuple(float(x) for x in _point3("inlet", self.inlet)))
+        object.__setattr__(self, "radius", non_negative("radius", self.radius))
+
+    def exit(self, anchor, azimuth_hint=None) -> SwivelExit:
+        """The cable's exit towards ``anchor`` (3,) or (N, 3) [m]; see :func:`swivel_pulley_exit`."""
+        return swivel_pulley_exit(self.inlet, self.radius, anchor, azimuth_hint)
+
+    def cable_length(self, anchor, azimuth_hint=None):
+        """Ideal cable length [m] from the inlet to ``anchor`` (3,) or (N, 3) [m]."""
+        return self.exit(anchor, azimuth_hint).cable_length
+
+
+# ----------------------------------------------------------------------------------
+# the platform
+# ----------------------------------------------------------------------------------
+def rotation_matrices(rotation_vectors):
+    """``R = exp([theta]x)`` for rotation vectors (..., 3) [rad] -> (..., 3, 3).
+
+    Each is :func:`cdpr_exu.physics.spatial_statics.rotation_matrix`.
+    """
+    theta = np.asarray(rotation_vectors, dtype=float)
+    flat = theta.reshape(-1, 3)
+    return np.array([spatial_rotation_matrix(t) for t in flat]).reshape(theta.shape[:-1] + (3, 3))
+
+
+def _left_jacobians(rotation_vectors):
+    theta = np.asarray(rotation_vectors, dtype=float)
+    return np.array([left_jacobian(t) for t in theta.reshape(-1, 3)]).reshape(theta.shape[:-1] + (3, 3))
+
+
+def _check_pose(pose, anchors, pose_name="pose"):
+    """Pose (6,)/(N, 6) and anchors (m, 3), or pose (3,)/(N, 3) for a point mass (anchors None)."""
+    width = 3 if anchors is None else 6
+    pose = finite_array(pose_name, pose, (width,))
+    if pose.ndim > 2:
+        raise SceneError(f"{pose_name} must have shape ({width},) or (N, {width}), got shape {pose.shape}")
+    if anchors is not None:
+        anchors = finite_array("anchors", anchors, (3,))
+        if anchors.ndim != 2:
+            raise SceneError(f"anchors must have shape (m, 3), got shape {anchors.shape}")
+    return pose, anchors
+
+
+def _arms(pose, anchors):
+    """``R(theta) b_i``, shape (..., m, 3)."""
+    return np.einsum("...jk,mk->...mj", rotation_matrices(pose[..., 3:6]), anchors)
+
+
+def anchor_points(pose, anchors):
+    """World positions of the platform anchors, ``p_i = r + R(theta) b_i``.
+
+    Parameters
+    ----------
+    pose : array_like, shape (6,) or (N, 6) [m, rad]
+        Platform pose(s) ``(r, theta)``.
+    anchors : array_like, shape (m, 3) [m]
+        Anchor points ``b_i`` in the platform frame.
+
+    Returns
+    -------
+    ndarray, shape (m, 3) or (N, m, 3) [m]
+    """
+    pose, anchors = _check_pose(pose, anchors)
+    return pose[..., None, :3] + _arms(pose, anchors)
+
+
+def anchor_velocities(pose, pose_rate, anchors):
+    """World velocities of the platform anchors, ``v_i = dr/dt + omega x (R b_i)``, ``omega = J_l(theta) dtheta/dt``.
+
+    Parameters
+    ----------
+    pose : array_like, shape (6,) or (N, 6) [m, rad]
+        Platform pose(s) ``(r, theta)``.
+    pose_rate : array_like, same shape as ``pose`` [m/s, rad/s]
+        Rate(s) of the pose, ``(dr/dt, dtheta/dt)`` (the rotation vector's rate, not
+        the angular velocity).
+    anchors : array_like, shape (m, 3) [m]
+
+    Returns
+    -------
+    ndarray, shape (m, 3) or (N, m, 3) [m/s]
+    """
+    pose, anchors = _check_pose(pose, anchors)
+    pose_rate = finite_array("pose_rate", pose_rate, (6,))
+    if pose_rate.shape != pose.shape:
+        raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
+    omega = np.einsum("...jk,...k->...j", _left_jacobians(pose[..., 3:6]), pose_rate[..., 3:6])
+    return pose_rate[..., None, :3] + np.cross(omega[..., None, :], _arms(pose, anchors))
+
+
+def _check_pulleys(n_cables, inlets, pulley_radii):
+    inlets = finite_array("inlets", inlets, (3,))
+    if inlets.shape != (n_cables, 3):
+        raise SceneError(f"inlets must have shape ({n_cables}, 3), got shape {inlets.shape}")
+    radii = finite_array("pulley_radii", pulley_radii)
+    if radii.ndim == 0:
+        radii = np.full(n_cables, float(radii))
+    if radii.shape != (n_cables,):
+        raise SceneError(f"pulley_radii must be a scalar or have shape ({n_cables},), got {pulley_radii!r}")
+    if np.any(radii < 0.0):
+        raise SceneError(f"pulley_radii must be >= 0 [m], got {pulley_radii!r}")
+    return inlets, radii
+
+
+def _check_hints(n_cables, azimuth_hints):
+    if azimuth_hints is None:
+        return [None] * n_cables
+    hints = finite_array("azimuth_hints", azimuth_hints)
+    if hints.shape != (n_cables,):
+        raise SceneError(f"azimuth_hints must have shape ({n_cables},), got {azimuth_hints!r}")
+    return [float(h) for h in hints]
+
+
+def robot_exits(pose, anchors, inlets, pulley_radii, azimuth_hints=None):
+    """The :class:`SwivelExit` of every cable for pose(s) (6,)/(N, 6), or positions (3,)/(N, 3) with ``anchors=None``.
+
+    Returns the checked pose, the checked anchors (None for a point mass) and the list of exits.
+    """
+    pose, anchors = _check_pose(pose, anchors)
+    n_cables = len(finite_array("inlets", inlets, (3,)).reshape(-1, 3)) if anchors is None else len(anchors)
+    inlets, radii = _check_pulleys(n_cables, inlets, pulley_radii)
+    hints = _check_hints(n_cables, azimuth_hints)
+    if anchors is None:
+        points = np.broadcast_to(pose[..., None, :], pose.shape[:-1] + (n_cables, 3))
+    else:
+        points = pose[..., None, :3] + _arms(pose, anchors)
+    exits = [_swivel_exit(inlets[i], float(radii[i]), np.ascontiguousarray(points[..., i, :]), hints[i])
+             for i in range(n_cables)]
+    return pose, anchors, exits
+
+
+def inverse_kinematics(pose, anchors, inlets, pulley_radii, azimuth_hints=None):
+    """Ideal cable lengths (inlet over the swivel pulley to the anchor) for platform pose(s).
+
+    Parameters
+    ----------
+    pose : array_like, shape (6,) or (N, 6) [m, rad]
+        Platform pose(s) ``(r, theta)``; a position (3,) or (N, 3) [m] for a point mass.
+    anchors : array_like, shape (m, 3) [m], or None
+        Anchor points ``b_i`` in the platform frame; None for a point mass (every cable at ``r``).
+    inlets : array_like, shape (m, 3) [m]
+        Inlet of each cable's swivel pulley (its exit point for a point exit).
+    pulley_radii : float or array_like, shape (m,) [m]
+        Disc radii; 0 is a point exit.
+    azimuth_hints : array_like, shape (m,) [rad], optional
+        Azimuth of each pulley for an anchor on its axis (see the module notes).
+
+    Returns
+    -------
+    ndarray, shape (m,) or (N, m) [m]
+
+    Raises
+    ------
+    SceneError
+        If an argument is malformed; the message names it.
+    UnreachableError
+        If an anchor is inside a disc, on a point exit, or on a swivel axis with no azimuth to keep.
+    """
+    _, _, exits = robot_exits(pose, anchors, inlets, pulley_radii, azimuth_hints)
+    return np.stack([e.cable_length for e in exits], axis=-1)
+
+
+def cable_unit_vectors(pose, anchors, inlets, pulley_radii, azimuth_hints=None):
+    """Unit vectors ``u_i`` along each cable at its anchor, towards its pulley: the direction it pulls the platform.
+
+    Parameters
+    ----------
+    pose, anchors, inlets, pulley_radii, azimuth_hints
+        As :func:`inverse_kinematics`.
+
+    Returns
+    -------
+    ndarray, shape (m, 3) or (N, m, 3)
+    """
+    _, _, exits = robot_exits(pose, anchors, inlets, pulley_radii, azimuth_hints)
+    return np.stack([-e.unit_vector for e in exits], axis=-2)
+
+
+def inverse_kinematics_rates(pose, pose_rate, anchors, inlets, pulley_radii, azimuth_hints=None):
+    """Rates of the ideal cable lengths, ``dL_i/dt = -u_i . v_i`` (positive: the winch pays out).
+
+    Parameters
+    ----------
+    pose : array_like, shape (6,) or (N, 6) [m, rad]
+        Platform pose(s); a position (3,) or (N, 3) [m] for a point mass.
+    pose_rate : array_like, same shape as ``pose`` [m/s, rad/s]
+        ``(dr/dt, dtheta/dt)``, the rate of the rotation vector (see :func:`anchor_velocities`).
+    anchors, inlets, pulley_radii, azimuth_hints
+        As :func:`inverse_kinematics`.
+
+    Returns
+    -------
+    ndarray, shape (m,) or (N, m) [m/s]
+    """
+    pose, anchors, exits = robot_exits(pose, anchors, inlets, pulley_radii, azimuth_hints)
+    if anchors is None:
+        pose_rate = finite_array("pose_rate", pose_rate, (3,))
+        if pose_rate.shape != pose.shape:
+            raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
+        velocities = np.broadcast_to(pose_rate[..., None, :], pose.shape[:-1] + (len(exits), 3))
+    else:
+        velocities = anchor_velocities(pose, pose_rate, anchors)
+    return np.stack([np.sum(e.unit_vector * velocities[..., i, :], axis=-1) for i, e in enumerate(exits)], axis=-1)
+
+
+def structure_matrix(pose, anchors, unit_vectors):
+    """Structure (wrench) matrix ``A`` of the platform: cable tensions ``f`` exert the wrench ``A f``.
+
+    Column i is ``[u_i; (R(theta) b_i) x u_i]``: the force and the moment about the
+    platform's reference point ``r`` of a unit tension in cable i. For a point mass
+    (``anchors=None``) it is the force part only, ``[u_1 ... u_m]``, shape (3, m).
+
+    Parameters
+    ----------
+    pose : array_like, shape (6,) or (N, 6) [m, rad]
+        Platform pose(s); a position (3,) or (N, 3) [m] for a point mass.
+    anchors : array_like, shape (m, 3) [m], or None
+        Anchor points ``b_i`` in the platform frame; None for a point mass.
+    unit_vectors : array_like, shape (m, 3) or (N, m, 3)
+        Pull directions ``u_i`` (:func:`cable_unit_vectors`); not re-normalised.
+
+    Returns
+    -------
+    ndarray, shape (6, m) or (N, 6, m) [1, m]; (3, m) or (N, 3, m) for a point mass
+        Rows: force x, y, z; moment x, y, z.
+
+    Notes
+    -----
+    ``dL/d(r, theta) = -A^T blockdiag(I, J_l(theta))`` (module notes).
+    """
+    pose, anchors = _check_pose(pose, anchors)
+    units = finite_array("unit_vectors", unit_vectors, (3,))
+    n_cables = units.shape[-2] if units.ndim >= 2 else 0
+    if anchors is not None and (units.ndim < 2 or n_cables != len(anchors)):
+        raise SceneError(f"unit_vectors must have shape ({len(anchors)}, 3) or (N, {len(anchors)}, 3), "
+                         f"got shape {units.shape}")
+    shape = pose.shape[:-1] + (n_cables, 3)
+    try:
+        units = np.broadcast_to(units, shape)
+    except ValueError as exc:
+        raise SceneError(f"unit_vectors must have shape {shape}, got shape {units.shape}") from exc
+    forces = np.swapaxes(units, -1, -2)
+    if anchors is None:
+        return np.array(forces)
+    moments = np.swapaxes(np.cross(_arms(pose, anchors), units), -1, -2)
+    return np.concatenate([forces, moments], axis=-2)
+
+
+def gravity_wrench(pose, mass, center_of_mass=(0.0, 0.0, 0.0), gravity=STANDARD_GRAVITY):
+    """Wrench of the platform's weight about its reference point: ``[(0, 0, -M g); (R c) x (0, 0, -M g)]``.
+
+    Parameters
+    ----------
+    pose : array_like, shape (6,) [m, rad]
+        Platform pose ``(r, theta)``; a position (3,) [m] for a point mass (then the force only).
+    mass : float [kg]
+    center_of_mass : (float, float, float) [m], optional
+        Centre of mass ``c`` in the platform frame (the reference point is at 0).
+    gravity : float [m/s^2], optional
+
+    Returns
+    -------
+    ndarray, shape (6,) [N, N m], or (3,) [N] for a point mass
+    """
+    pose = finite_array("pose", pose)
+    if pose.shape not in ((3,), (6,)):
+        raise SceneError(f"pose must have shape (6,) (or (3,) for a point mass), got shape {pose.shape}")
+    weight = np.array([0.0, 0.0, -non_negative("mass", mass) * non_negative("gravity", gravity)])
+    if pose.shape == (3,):
+        return weight
+    arm = spatial_rotation_matrix(pose[3:]) @ _point3("center_of_mass", center_of_mass)
+    return np.concatenate([weight, np.cross(arm, weight)])
+
+
+# ----------------------------------------------------------------------------------
+# tension distribution
+# ----------------------------------------------------------------------------------
+def _tension_limits(min_tension, max_tension, n_cables):
+    limits = []
+    for name, value in (("min_tension", min_tension), ("max_tension", max_tension)):
+        array = finite_array(name, value)
+        if array.ndim == 0:
+            array = np.full(n_cables, float(array))
+        if array.shape != (n_cables,):
+            raise SceneError(f"{name} must be a scalar or have shape ({n_cables},), got {value!r}")
+        if np.any(array < 0.0):
+            raise SceneError(f"{name} must be >= 0 [N] (cables cannot push), got {value!r}")
+        limits.append(array)
+    lower, upper = limits
+    if np.any(lower > upper):
+        raise SceneError(f"min_tension must not exceed max_tension, got min_tension {min_tension!r} "
+                         f"and max_tension {max_tension!r} [N]")
+    return lower, upper
+
+
+def _outside(pose, wrench, lower, upper, reason):
+    where = "the pose" if pose is None else f"pose {np.asarray(pose).tolist()}"
+    span = (f"[{lower[0]:g}, {upper[0]:g}] N" if np.all(lower == lower[0]) and np.all(upper == upper[0])
+            else "their bounds")
+    return UnreachableError(f"{where} is outside the wrench-feasible workspace: no cable tensions within {span} "
+                            f"balance the wrench {np.asarray(wrench).tolist()} [N, N m] ({reason})")
+
+
+def tension_distribution(structure_matrix, wrench, min_tension, max_tension, pose=None):
+    """Cable tensions within their bounds that balance a wrench: ``A f + w = 0``, closest to the mid tensions.
+
+    Solves the quadratic programme::
+
+        minimise ||f - f_mid||^2   subject to   A f = -w,   t_min <= f <= t_max,
+
+    ``f_mid = (t_min + t_max) / 2``, for any number of cables: redundant (m > n),
+    square, or too few (then only wrenches in the range of ``A`` are balanced).
+
+    Parameters
+    ----------
+    structure_matrix : array_like, shape (n, m)
+        ``A`` (:func:`structure_matrix`): n = 6 for a rigid platform, 3 for a point mass.
+    wrench : array_like, shape (n,) [N, N m]
+        Everything but the cables acting on the platform (weight, external load,
+        inertia), about the platform's reference point.
+    min_tension, max_tension : float or array_like, shape (m,) [N]
+        Tension bounds, ``0 <= t_min <= t_max``.
+    pose : array_like, optional
+        Only named in the error message.
+
+    Returns
+    -------
+    ndarray, shape (m,) [N]
+
+    Raises
+    ------
+    SceneError
+        Naming the argument: wrong shapes, non-finite values, negative bounds,
+        ``min_tension > max_tension``.
+    UnreachableError
+        "outside the wrench-feasible workspace", naming the pose, if no tensions
+        within the bounds balance the wrench.
+
+    Notes
+    -----
+    **Why this QP and not the improved closed-form method** (Pott, Springer 2018).
+    The closed-form method takes ``f = f_mid - A^+ (w + A f_mid)``; that is exactly
+    this QP's minimiser whenever no bound is active, so the two agree inside the
+    workspace. When a bound is active, the improved closed-form method fixes the
+    violating cable at its limit and repeats with the others: a greedy reduction,
+    not guaranteed to find a distribution whenever one exists. The QP is: it has a
+    unique solution (strictly convex objective) and reports infeasibility only for an
+    empty feasible set, so "outside the wrench-feasible workspace" means what it
+    says; its solution is the same for symmetric poses of a symmetric robot. The cost
+    (a few NNLS iterations on a (m - n + 1) x 2m matrix) is no concern here.
+
+    **How it is solved, exactly and without tolerances to tune.** With the SVD of
+    ``A``, ``f = f_p + N lambda``: ``f_p = f_mid + A^+ (-w - A f_mid)`` the point of
+    the equality set closest to ``f_mid`` and ``N`` an orthonormal basis of the null
+    space of ``A``. Since ``f_p - f_mid`` is orthogonal to ``N``, the QP becomes the
+    least-distance programme ``min ||lambda|| s.t. G lambda >= h`` (the bounds), and
+    ``A f = -w`` holds to round-off whatever ``lambda``. Lawson and Hanson's LDP
+    algorithm (Solving Least Squares Problems, 1974, ch. 23) solves it with one
+    non-negative least-squares problem (``scipy.optimize.nnls``, an active-set method
+    with finite termination): ``min ||E u - e_last||, u >= 0``, ``E = [G^T; h^T]``.
+    A zero residual ``r`` certifies infeasibility; otherwise
+    ``lambda = -r[:-1] / r[-1]`` and ``||r||^2 = 1 / (1 + ||lambda||^2)``. With
+    tensions scaled by the tension range, a feasible ``lambda`` has
+    ``||lambda|| <= sqrt(m) / 2``, so a feasible problem has ``||r|| >= 0.1`` for up to
+    m = 396 cables: the threshold 1e-6 on ``||r||`` separates the two cases by orders
+    of magnitude.
+    """
+    matrix = finite_array("structure_matrix", structure_matrix)
+    if matrix.ndim != 2 or matrix.shape[1] < 1:
+        raise SceneError(f"structure_matrix must have shape (n, m), got shape {matrix.shape}")
+    n_rows, n_cables = matrix.shape
+    wrench = finite_array("wrench", wrench)
+    if wrench.shape != (n_rows,):
+        raise SceneError(f"wrench must have shape ({n_rows},) to match structure_matrix, got shape {wrench.shape}")
+    lower, upper = _tension_limits(min_tension, max_tension, n_cables)
+    target = -wrench
+    middle = 0.5 * (lower + upper)
+
+    u_matrix, singular, v_transposed = np.linalg.svd(matrix)
+    largest = singular[0] if singular.size else 0.0
+    rank = int(np.sum(singular > max(matrix.shape) * np.finfo(float).eps * largest))
+    shortfall = u_matrix[:, :rank].T @ (target - matrix @ middle)
+    particular = middle + v_transposed[:rank].T @ (shortfall / singular[:rank])
+    scale = float(np.linalg.norm(target)) + largest * float(np.linalg.norm(particular)) + 1e-300
+    if np.linalg.norm(matrix @ particular - target) > 1e-9 * scale:
+        raise _outside(pose, wrench, lower, upper,
+                       f"the cables cannot exert it at all: the structure matrix has rank {rank} < {n_rows}")
+    null_space = v_transposed[rank:].T  # (m, m - rank), orthonormal columns
+    tension_scale = float(np.max(upper - lower))
+    if tension_scale <= 0.0:
+        tension_scale = max(float(np.max(upper)), 1.0)
+    if null_space.shape[1] == 0:
+        tensions = particular
+    else:
+        # G lambda >= h: f_p + N lambda >= t_min and -(f_p + N lambda) >= -t_max, tensions in units of the range
+        g_matrix = np.vstack([null_space, -null_space])
+        h_vector = np.concatenate([lower - particular, particular - upper]) / tension_scale
+        e_matrix = np.vstack([g_matrix.T, h_vector[None, :]])
+        rhs = np.zeros(e_matrix.shape[0])
+        rhs[-1] = 1.0
+        solution, _ = nnls(e_matrix, rhs, maxiter=50 * e_matrix.shape[1])
+        residual = e_matrix @ solution - rhs
+        if np.linalg.norm(residual) <= _INFEASIBLE_RESIDUAL:
+            raise _outside(pose, wrench, lower, upper, "the bounds and the balance have no common point")
+        tensions = particular + tension_scale * (null_space @ (-residual[:-1] / residual[-1]))
+    rounding = _BOUND_ROUNDING * tension_scale
+    if np.any(tensions < lower - rounding) or np.any(tensions > upper + rounding):
+        raise _outside(pose, wrench, lower, upper, f"the balancing tensions {tensions.tolist()} N leave the bounds")
+    return np.clip(tensions, lower, upper)
+
+
+# ----------------------------------------------------------------------------------
+# a whole robot
+# ----------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)  # array fields
+class IdealSpatialRobot:
+    """A spatial cable robot with ideal cables over swivel pulleys: geometry, mass and tension limits, checked once.
+
+    Parameters
+    ----------
+    inlets : array_like, shape (m, 3) [m]
+        Inlet of each cable's swivel pulley (the exit point when its radius is 0).
+    anchors : array_like, shape (m, 3) [m], or None
+        Anchors ``b_i`` in the platform frame; None for a point mass (pose = position (3,)).
+    pulley_radii : float or array_like, shape (m,) [m]
+        Disc radii, 0 for point exits.
+    mass : float [kg]
+    min_tension, max_tension : float or array_like, shape (m,) [N]
+        Tension bounds, ``0 <= min_tension <= max_tension``.
+    center_of_mass : (float, float, float) [m], optional
+        In the platform frame; ignored for a point mass.
+    gravity : float [m/s^2], optional
+
+    Raises
+    ------
+    SceneError
+        Naming the field, if a value is malformed, not finite or out of range.
+    """
+
+    inlets: np.ndarray
+    anchors: np.ndarray | None
+    pulley_radii: float | np.ndarray = 0.0
+    mass: float = 0.0
+    min_tension: float | np.ndarray = 0.0
+    max_tension: float | np.ndarray = np.inf
+    center_of_mass: tuple = (0.0, 0.0, 0.0)
+    gravity: float = STANDARD_GRAVITY
+
+    def __post_init__(self):
+        inlets = finite_array("inlets", self.inlets, (3,))
+        if inlets.ndim != 2:
+            raise SceneError(f"inlets must have shape (m, 3), got shape {inlets.shape}")
+        n_cables = len(inlets)
+        if self.anchors is not None:
+            anchors = finite_array("anchors", self.anchors, (3,))
+            if anchors.shape != (n_cables, 3):
+                raise SceneError(f"anchors must have shape ({n_cables}, 3), one per inlet, got shape {anchors.shape}")
+            object.__setattr__(self, "anchors", anchors)
+        inlets, radii = _check_pulleys(n_cables, inlets, self.pulley_radii)
+        lower, upper = _tension_limits(self.min_tension, self.max_tension, n_cables)
+        object.__setattr__(self, "inlets", inlets)
+        object.__setattr__(self, "pulley_radii", radii)
+        object.__setattr__(self, "min_tension", lower)
+        object.__setattr__(self, "max_tension", upper)
+        object.__setattr__(self, "mass", non_negative("mass", self.mass))
+        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
+        object.__setattr__(self, "center_of_mass", tuple(vector("center_of_mass", self.center_of_mass, 3, " [m]")))
+
+    @property
+    def is_point_mass(self):
+        """True when the platform is a point mass (no anchors)."""
+        return self.anchors is None
+
+    @property
+    def n_cables(self):
+        return len(self.inlets)
+
+    def lengths(self, pose, azimuth_hints=None):
+        """Ideal cable lengths (m,) or (N, m) [m]; see :func:`inverse_kinematics`."""
+        return inverse_kinematics(pose, self.anchors, self.inlets, self.pulley_radii, azimuth_hints)
+
+    def length_rates(self, pose, pose_rate, azimuth_hints=None):
+        """Ideal cable length rates (m,) or (N, m) [m/s]; see :func:`inverse_kinematics_rates`."""
+        return inverse_kinematics_rates(pose, pose_rate, self.anchors, self.inlets, self.pulley_radii, azimuth_hints)
+
+    def unit_vectors(self, pose, azimuth_hints=None):
+        """Pull directions at the anchors (m, 3) or (N, m, 3); see :func:`cable_unit_vectors`."""
+        return cable_unit_vectors(pose, self.anchors, self.inlets, self.pulley_radii, azimuth_hints)
+
+    def structure_matrix(self, pose, azimuth_hints=None):
+        """``A``, shape (6, m) or (N, 6, m); (3, m) or (N, 3, m) for a point mass."""
+        return structure_matrix(pose, self.anchors, self.unit_vectors(pose, azimuth_hints))
+
+    def gravity_wrench(self, pose):
+        """The weight's wrench about the reference point, (6,) [N, N m] or (3,) [N] for a point mass."""
+        return gravity_wrench(pose, self.mass, self.center_of_mass, self.gravity)
+
+    def _external(self, external_wrench):
+        n_rows = 3 if self.is_point_mass else 6
+        if external_wrench is None:
+            return np.zeros(n_rows)
+        return vector("external_wrench", external_wrench, n_rows, " [N, N m]")
+
+    def tensions(self, pose, external_wrench=None, azimuth_hints=None):
+        """Cable tensions (m,) [N] holding the platform at ``pose`` against its weight and ``external_wrench``.
+
+        Parameters
+        ----------
+        pose : array_like, shape (6,) [m, rad], or (3,) [m] for a point mass
+        external_wrench : array_like, shape (6,) [N, N m] (or (3,) [N]), optional
+            Extra force and moment about the reference point, world frame.
+        azimuth_hints : array_like, shape (m,) [rad], optional
+
+        Raises
+        ------
+        UnreachableError
+            "outside the wrench-feasible workspace" naming the pose (see :func:`tension_distribution`).
+        """
+        pose_array = finite_array("pose", pose)
+        if pose_array.shape != ((3,) if self.is_point_mass else (6,)):
+            raise SceneError(f"pose must have shape {(3,) if self.is_point_mass else (6,)}, "
+                             f"got shape {pose_array.shape}")
+        wrench = self.gravity_wrench(pose_array) + self._external(external_wrench)
+        return tension_distribution(self.structure_matrix(pose_array, azimuth_hints), wrench,
+                                    self.min_tension, self.max_tension, pose=pose_array)
+
+    def _trajectory(self, poses, external_wrench):
+        """Tensions (N, m) along the poses, and the index and error of the first infeasible one (or None)."""
+        poses = finite_array("poses", poses, ((3,) if self.is_point_mass else (6,)))
+        if poses.ndim != 2:
+            raise SceneError(f"poses must have shape (N, {poses.shape[-1]}), got shape {poses.shape}")
+        matrices = self.structure_matrix(poses)  # one call: on-axis anchors keep the previous azimuth
+        external = self._external(external_wrench)
+        result = np.empty((len(poses), self.n_cables))
+        for k, (pose, matrix) in enumerate(zip(poses, matrices)):
+            try:
+                result[k] = tension_distribution(matrix, self.gravity_wrench(pose) + external,
+                                                 self.min_tension, self.max_tension, pose=pose)
+            except UnreachableError as error:
+                return poses, result[:k], (k, error)
+        return poses, result, None
+
+    def trajectory_tensions(self, poses, external_wrench=None):
+        """Tensions along sampled poses (N, 6) or (N, 3), shape (N, m) [N].
+
+        An anchor on a swivel axis keeps the pulley's azimuth of the previous sample.
+
+        Raises
+        ------
+        UnreachableError
+            At the first pose outside the wrench-feasible workspace, naming its index
+            and the pose; or if an anchor is inside a pulley disc.
+        """
+        _, result, failure = self._trajectory(poses, external_wrench)
+        if failure is not None:
+            index, error = failure
+            raise UnreachableError(f"poses[{index}]: {error}") from None
+        return result
+
+    def first_infeasible_pose(self, poses, external_wrench=None):
+        """Index and pose of the first sample outside the wrench-feasible workspace, or None if all are inside.
+
+        Parameters
+        ----------
+        poses : array_like, shape (N, 6) [m, rad], or (N, 3) [m] for a point mass
+        external_wrench : array_like, optional
+
+        Returns
+        -------
+        None, or (int, ndarray)
+            The index of the first infeasible sample and its pose.
+
+        Raises
+        ------
+        SceneError
+            If an argument is malformed.
+        UnreachableError
+            If an anchor is inside a pulley disc (a geometric, not a static, failure).
+        """
+        poses, _, failure = self._trajectory(poses, external_wrench)
+        if failure is None:
+            return None
+        return failure[0], poses[failure[0]].copy()
