@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import minimize
+from scipy.optimize import linprog, minimize
 
 from cdpr_exu import kinematics as planar
 from cdpr_exu.errors import SceneError, UnreachableError
@@ -292,6 +292,46 @@ def test_wrench_feasibility_along_a_trajectory_names_the_first_infeasible_pose()
         COGIRO.trajectory_tensions(poses)
     assert COGIRO.first_infeasible_pose(COGIRO_POSES) is None
     assert COGIRO.trajectory_tensions(COGIRO_POSES).shape == (len(COGIRO_POSES), 8)
+
+
+def test_refusal_agrees_with_an_lp_feasibility_check_at_random_poses():
+    # HiGHS (scipy.optimize.linprog) decides feasibility of A f = -w, bounds, by another method (simplex)
+    rng = np.random.default_rng(5)
+    verdicts = []
+    for robot in (COGIRO, COGIRO_SWIVEL):
+        for _ in range(100):
+            pose = np.r_[rng.uniform(-7, 7), rng.uniform(-5, 5), rng.uniform(-1, 6), rng.uniform(-0.5, 0.5, 3)]
+            matrix, wrench = robot.structure_matrix(pose), robot.gravity_wrench(pose)
+            lp = linprog(np.zeros(8), A_eq=matrix, b_eq=-wrench, bounds=[(100.0, 5000.0)] * 8, method="highs")
+            try:
+                tension_distribution(matrix, wrench, 100.0, 5000.0)
+                feasible = True
+            except UnreachableError:
+                feasible = False
+            verdicts.append((feasible, lp.status == 0))
+    verdicts = np.array(verdicts)
+    np.testing.assert_array_equal(verdicts[:, 0], verdicts[:, 1])
+    assert 0.2 < verdicts[:, 0].mean() < 0.8  # both verdicts are exercised (measured: about half feasible)
+
+
+def test_workspace_boundary_is_sharp_and_never_gives_nan():
+    # bisect the height where CoGiRo leaves the wrench-feasible workspace on its centre line, then step across it
+    lower, upper = 2.0, 7.0
+    with np.errstate(all="raise"):  # no division by zero near the boundary, where NNLS's multipliers grow
+        for _ in range(60):
+            middle = 0.5 * (lower + upper)
+            try:
+                tensions = COGIRO.tensions([0.0, 0.0, middle, 0.0, 0.0, 0.0])
+                assert np.all((tensions >= 100.0) & (tensions <= 5000.0))  # never NaN
+                lower = middle
+            except UnreachableError:
+                upper = middle
+        assert upper - lower < 1e-14 and 4.6 < lower < 4.8  # measured 4.686458 m
+        for exponent in range(1, 13):
+            tensions = COGIRO.tensions([0.0, 0.0, lower - 10.0**-exponent, 0.0, 0.0, 0.0])
+            assert np.all((tensions >= 100.0) & (tensions <= 5000.0))
+            with pytest.raises(UnreachableError, match="outside the wrench-feasible workspace"):
+                COGIRO.tensions([0.0, 0.0, upper + 10.0**-exponent, 0.0, 0.0, 0.0])
 
 
 # ----------------------------------------------------------------------------------

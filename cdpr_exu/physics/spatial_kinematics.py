@@ -89,7 +89,7 @@ _ON_AXIS = 1e-12
 """An anchor closer to the swivel axis than this fraction of its distance (plus r_p) is on the axis."""
 
 _INFEASIBLE_RESIDUAL = 1e-6
-"""NNLS residual below which the least-distance problem is infeasible (a feasible one has more than 0.1)."""
+"""NNLS residual below which the least-distance problem is infeasible (a feasible one has ||r|| >= 1/sqrt(1 + m/4))."""
 
 _BOUND_ROUNDING = 1e-9
 """A tension this fraction of the tension range outside its bounds is rounding (and is clipped)."""
@@ -625,11 +625,15 @@ def tension_distribution(structure_matrix, wrench, min_tension, max_tension, pos
     non-negative least-squares problem (``scipy.optimize.nnls``, an active-set method
     with finite termination): ``min ||E u - e_last||, u >= 0``, ``E = [G^T; h^T]``.
     A zero residual ``r`` certifies infeasibility; otherwise
-    ``lambda = -r[:-1] / r[-1]`` and ``||r||^2 = 1 / (1 + ||lambda||^2)``. With
-    tensions scaled by the tension range, a feasible ``lambda`` has
-    ``||lambda|| <= sqrt(m) / 2``, so a feasible problem has ``||r|| >= 0.1`` for up to
-    m = 396 cables: the threshold 1e-6 on ``||r||`` separates the two cases by orders
-    of magnitude.
+    ``lambda = -r[:-1] / r[-1]`` and ``-r[-1] = ||r||^2 = 1 / (1 + ||lambda||^2)``.
+    With tensions scaled by the largest tension range, a feasible ``lambda`` has
+    ``||lambda|| <= sqrt(m) / 2`` (``||f - f_mid||^2 = ||f_p - f_mid||^2 + ||lambda||^2``
+    and every feasible ``f`` is within ``sqrt(m) / 2`` ranges of ``f_mid``), so a
+    feasible problem has ``-r[-1] >= 1 / (1 + m / 4)`` (1/3 for 8 cables). The pose is
+    refused when ``-r[-1]`` is below half of that (or NNLS reports a residual below
+    1e-6); an accepted solution is then checked against the bounds (to 1e-9 of the
+    tension range, then clipped onto them), so a rounding error can only refuse, never
+    return tensions outside the bounds.
     """
     matrix = finite_array("structure_matrix", structure_matrix)
     if matrix.ndim != 2 or matrix.shape[1] < 1:
@@ -664,13 +668,15 @@ def tension_distribution(structure_matrix, wrench, min_tension, max_tension, pos
         e_matrix = np.vstack([g_matrix.T, h_vector[None, :]])
         rhs = np.zeros(e_matrix.shape[0])
         rhs[-1] = 1.0
-        solution, _ = nnls(e_matrix, rhs, maxiter=50 * e_matrix.shape[1])
+        solution, residual_norm = nnls(e_matrix, rhs, maxiter=50 * e_matrix.shape[1])
         residual = e_matrix @ solution - rhs
-        if np.linalg.norm(residual) <= _INFEASIBLE_RESIDUAL:
+        # feasible: -r_last = ||r||^2 >= 1 / (1 + m / 4); infeasible: r = 0 (up to the rounding of E u, which
+        # grows with u near the workspace's boundary: 1e-4 there, measured); half the floor separates them
+        if residual_norm <= _INFEASIBLE_RESIDUAL or -residual[-1] < 0.5 / (1.0 + n_cables / 4.0):
             raise _outside(pose, wrench, lower, upper, "the bounds and the balance have no common point")
         tensions = particular + tension_scale * (null_space @ (-residual[:-1] / residual[-1]))
     rounding = _BOUND_ROUNDING * tension_scale
-    if np.any(tensions < lower - rounding) or np.any(tensions > upper + rounding):
+    if not np.all((tensions >= lower - rounding) & (tensions <= upper + rounding)):  # NaN fails too
         raise _outside(pose, wrench, lower, upper, f"the balancing tensions {tensions.tolist()} N leave the bounds")
     return np.clip(tensions, lower, upper)
 
