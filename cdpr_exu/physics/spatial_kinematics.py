@@ -67,12 +67,13 @@ from cdpr_exu.errors import SceneError, UnreachableError
 from cdpr_exu.geometry import Pulley, finite_array
 from cdpr_exu.physics.spatial_statics import left_jacobian
 from cdpr_exu.physics.spatial_statics import rotation_matrix as spatial_rotation_matrix
-from cdpr_exu.validation import non_negative, positive, vector
+from cdpr_exu.validation import non_negative, vector
 
 __all__ = [
     "SwivelExit",
     "SwivelPulley",
     "swivel_pulley_exit",
+    "robot_exits",
     "rotation_matrices",
     "anchor_points",
     "anchor_velocities",
@@ -745,6 +746,7 @@ class IdealSpatialRobot:
 
     @property
     def n_cables(self):
+        """Number of cables m."""
         return len(self.inlets)
 
     def lengths(self, pose, azimuth_hints=None):
