@@ -8,11 +8,11 @@ from scipy.optimize import linprog, minimize
 
 from cdpr_exu import kinematics as planar
 from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.geometry import left_jacobian
 from cdpr_exu.physics import cogiro
 from cdpr_exu.physics.spatial_kinematics import (IdealSpatialRobot, SwivelPulley, cable_unit_vectors, gravity_wrench,
                                                  inverse_kinematics, inverse_kinematics_rates, structure_matrix,
                                                  swivel_pulley_exit, tension_distribution)
-from cdpr_exu.physics.spatial_statics import left_jacobian
 
 # The paper's planar robot (as tests/test_kinematics.py)
 PLANAR_CENTERS = np.array([[-1.75, 0.0], [1.75, 0.0]])

@@ -4,8 +4,9 @@ Pure NumPy/SciPy; no Exudyn. The cables are ideal: straight, massless and
 inextensible. z is up, gravity along -z, SI units. A platform pose is
 ``(r, theta)``, shape (6,): the position ``r`` of its reference point [m] and a
 rotation vector ``theta`` [rad]; anchor i is at ``r + R(theta) b_i`` with
-``R = exp([theta]x)``, the conventions of :mod:`cdpr_exu.physics.spatial_statics`,
-whose SO(3) helpers (``rotation_matrix``, ``left_jacobian``) are reused here. A
+``R = exp([theta]x)``, the conventions of :mod:`cdpr_exu.physics.spatial_statics`;
+the SO(3) helpers are :mod:`cdpr_exu.geometry`'s (``rotation_from_vector``,
+``left_jacobian``). A
 point-mass platform (every cable on one point) has the pose ``r``, shape (3,).
 
 Swivel pulley
@@ -64,9 +65,7 @@ from scipy.optimize import nnls
 
 from cdpr_exu.catenary import STANDARD_GRAVITY
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import Pulley, finite_array
-from cdpr_exu.physics.spatial_statics import left_jacobian
-from cdpr_exu.physics.spatial_statics import rotation_matrix as spatial_rotation_matrix
+from cdpr_exu.geometry import Pulley, finite_array, left_jacobian, rotation_from_vector
 from cdpr_exu.validation import non_negative, vector
 
 __all__ = [
@@ -283,11 +282,11 @@ class SwivelPulley:
 def rotation_matrices(rotation_vectors):
     """``R = exp([theta]x)`` for rotation vectors (..., 3) [rad] -> (..., 3, 3).
 
-    Each is :func:`cdpr_exu.physics.spatial_statics.rotation_matrix`.
+    Each is :func:`cdpr_exu.geometry.rotation_from_vector`.
     """
     theta = np.asarray(rotation_vectors, dtype=float)
     flat = theta.reshape(-1, 3)
-    return np.array([spatial_rotation_matrix(t) for t in flat]).reshape(theta.shape[:-1] + (3, 3))
+    return np.array([rotation_from_vector(t) for t in flat]).reshape(theta.shape[:-1] + (3, 3))
 
 
 def _left_jacobians(rotation_vectors):
@@ -535,7 +534,7 @@ def gravity_wrench(pose, mass, center_of_mass=(0.0, 0.0, 0.0), gravity=STANDARD_
     weight = np.array([0.0, 0.0, -non_negative("mass", mass) * non_negative("gravity", gravity)])
     if pose.shape == (3,):
         return weight
-    arm = spatial_rotation_matrix(pose[3:]) @ _point3("center_of_mass", center_of_mass)
+    arm = rotation_from_vector(pose[3:]) @ _point3("center_of_mass", center_of_mass)
     return np.concatenate([weight, np.cross(arm, weight)])
 
 
