@@ -445,10 +445,23 @@ def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
         gradient = force if dof == 3 else np.concatenate([force, left_jacobian(theta).T @ moment])
         return value / scale, gradient / scale
 
+    # Unknowns in metres (the rotation vector times the largest arm), so that a step turns
+    # the anchors as far as it moves them: with stiff cables (EA / L of 3e5 N/m, CoGiRo)
+    # unscaled steps spun the platform through several turns.
+    arm = float(np.linalg.norm(platform.anchors, axis=1).max()) if dof == 6 else 1.0
+    unit = np.array([1.0] * 3 + [max(arm, 1e-3)] * 3)[:dof]
+
+    def scaled_energy(x):
+        value, gradient = energy(x / unit)
+        return value, gradient / unit
+
+    # Start at the exits' centroid, unrotated: inside the frame, the cables slack or short of
+    # their lengths, so the weight and the taut cables pull the platform onto its equilibrium.
+    # (Starting a cable length below the exits stretched CoGiRo's stiff cables by metres.)
     start = np.zeros(dof)
-    start[:3] = exits.mean(axis=0) - np.array([0.0, 0.0, lengths.mean()])
-    solution = minimize(energy, start, jac=True, method="BFGS", options={"gtol": 1e-10, "maxiter": 5000})
-    return solution.x.copy()
+    start[:3] = exits.mean(axis=0)
+    solution = minimize(scaled_energy, start * unit, jac=True, method="BFGS", options={"gtol": 1e-10, "maxiter": 5000})
+    return solution.x / unit
 
 
 def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, external_wrench=None,
