@@ -39,6 +39,7 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu import bending
+from cdpr_exu.contact_models import CONTACT_MODELS
 from cdpr_exu.errors import SceneError, UnreachableError
 from cdpr_exu.geometry import Pulley, rotation_matrix
 from cdpr_exu.kinematics import initial_cable_nodes, straight_cable_nodes
@@ -148,7 +149,7 @@ def chain_robot(scene) -> ChainRobot:
     if effects.bending and effects.bending_model != "exact":
         raise SceneError("chain statics models the exact-angle bending only, "
                          f"got effects.bending_model = {effects.bending_model!r}")
-    if effects.pulley_contact and getattr(effects, "pulley_contact_model", "node") != "node":
+    if scene.contact_model not in (None, CONTACT_MODELS["node"]):
         raise SceneError("chain statics models the node contact on pulleys only, got "
                          f"effects.pulley_contact_model = {effects.pulley_contact_model!r}")
     gravity = scene.gravity if effects.gravity else 0.0

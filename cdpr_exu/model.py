@@ -126,9 +126,8 @@ def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
     anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
     if scene.exits[cable_index].is_point_exit:
         return straight_cable_nodes(np.asarray(pulley.center), anchor, cable.n_elements)
-    radius = pulley.radius
-    if scene.effects.pulley_contact and scene.effects.pulley_contact_model == "segment":
-        radius = float(np.hypot(pulley.radius, cable.element_length / 2.0))
+    contact = scene.contact_model
+    radius = pulley.radius if contact is None else contact.wrap_radius(pulley.radius, cable.element_length)
     return initial_cable_nodes(np.asarray(pulley.center), radius, pulley.side, anchor,
                                cable.element_length, cable.n_elements)
 
@@ -180,7 +179,7 @@ def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.
     """
     from .pulley import segment_penetration
 
-    if scene.effects.pulley_contact and scene.effects.pulley_contact_model == "segment":
+    if scene.contact_model is not None and not scene.contact_model.limits_element_length:
         return
     pulley, cable = scene.pulleys[cable_index], scene.cables[cable_index]
     depth = segment_penetration(pulley, nodes_xz).max()
@@ -221,8 +220,8 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
     platform = add_platform(mbs, scene.platform, effects, scene.gravity)
     if not effects.cable_mass:
         return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
-    use_contact = scene.pulley_contact
-    on_segments = use_contact and effects.pulley_contact_model == "segment"
+    contact = scene.contact_model
+    on_segments = contact is not None and contact.on_segments
     cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
     contact_elements = []  # cable-local element indices per cable (segment contact only)
     for i, (cable, pulley, exit_) in enumerate(zip(scene.cables, scene.pulleys, scene.exits)):
@@ -239,10 +238,10 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
             contacts.append([])
             contact_nodes.append(np.zeros(0, dtype=int))
             contact_elements.append(contact_segments(contact_candidates(scene, i), cable.n_elements))
-        elif use_contact:
+        elif contact is not None:
             contact_elements.append(np.zeros(0, dtype=np.int64))
             candidates = contact_candidates(scene, i)
-            if effects.pulley_contact_model == "node":
+            if contact.exudyn_items:
                 pulley_marker = add_pulley_ground(mbs, pulley)
                 contacts.append(add_pulley_contact(mbs, pulley, pulley_marker,
                                                    [items.markers[j] for j in candidates], nodes_xz[candidates]))
@@ -257,7 +256,7 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
         cables.append(items)
     if sparse_jacobian is None:
         sparse_jacobian = sum(c.n_elements + 1 for c in scene.cables) > SPARSE_JACOBIAN_MIN_NODES
-    on_nodes = use_contact and effects.pulley_contact_model == "node_smooth"
+    on_nodes = contact is not None and contact.smooth_nodes
     cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.pulleys),
                                     contact_elements if on_segments else None, sparse_jacobian=sparse_jacobian,
                                     contact_nodes=contact_nodes if on_nodes else None)

@@ -24,6 +24,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .errors import CoarseOutputWarning, SceneError, UnreachableError
+from .contact_models import CONTACT_MODELS, PulleyContactModel
 from .geometry import Pulley, anchor_points
 from .validation import finite, non_negative, positive
 from .trajectories import Trajectory, trajectory_from_dict
@@ -358,8 +359,9 @@ PRESETS: dict[str, dict[str, bool]] = {
 
 
 #: Where the pulley contact acts: on the nodes (Exudyn's sphere contact items), on the
-#: element segments, or on the nodes with a smooth onset in the cables' numba object.
-PULLEY_CONTACT_MODELS = ("node", "segment", "node_smooth")
+#: element segments, or on the nodes with a smooth onset in the cables' numba object
+#: (:mod:`cdpr_exu.contact_models`).
+PULLEY_CONTACT_MODELS = tuple(CONTACT_MODELS)
 
 
 @dataclass(frozen=True)
@@ -656,6 +658,11 @@ class Scene:
     def pulley_contact(self) -> bool:
         """True when the cables touch their pulleys: contact is on and the cables run over pulleys."""
         return self.effects.pulley_contact and self.cable_exit == "pulley"
+
+    @property
+    def contact_model(self) -> PulleyContactModel | None:
+        """The pulley contact model the cables run with, decided once (None: no contact)."""
+        return CONTACT_MODELS[self.effects.pulley_contact_model] if self.pulley_contact else None
 
     @property
     def n_cables(self) -> int:

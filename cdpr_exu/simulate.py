@@ -144,7 +144,7 @@ class _Monitor:
         self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
                        for i, cable in enumerate(scene.cables) if f"cable_{i}" in indices]
         self.check_pulleys = scene.pulley_contact
-        self.on_segments = scene.effects.pulley_contact_model == "segment"
+        self.on_segments = scene.contact_model is not None and scene.contact_model.on_segments
         self.platform_index = indices["platform"]
         self.reference_pose = reference[self.platform_index]
         # No pose of a platform hung on these cables lies farther from every pulley
