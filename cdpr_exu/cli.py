@@ -84,10 +84,17 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
          "n/a" if factor is None else f"{factor:.1f}x real time"),
         ("steps / Newton iterations", f"{summary['steps']} / {summary['newton_iterations']}", ""),
     ]
+    if "tension_limit_violations" in summary:
+        def count(s):
+            return f"{len(s['tension_limit_violations'])} violation(s)" if s["tension_limit_violations"] else "none"
+        rows.append(("tension limits", count(summary), count(settled)))
     print(f"{summary['scene']} under {summary['controller']} (error = actual - reference)")
     print(f"  {'':26s} {'whole run':>22s}   {'after ' + str(SETTLED_AFTER) + ' s':>18s}")
     for name, whole, after in rows:
         print(f"  {name:26s} {whole:>22s}   {after:>18s}")
+    for v in summary.get("tension_limit_violations", []):
+        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
+              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
     for note in dict.fromkeys(summary["notes"] + settled["notes"]):
         print(f"  note: {note}")
     if out is not None:

@@ -82,6 +82,8 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
             summary["controller"] = name
             slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
             summary["slack_time_s"] = max(slack) if slack else None
+            if "tension_limit_violations" in summary:
+                summary["tension_limit_violation_count"] = len(summary["tension_limit_violations"])
             summaries[name] = summary
             if not quiet:
                 def mm(value):
@@ -104,13 +106,16 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
 
 def markdown_table(summaries: dict[str, dict]) -> str:
     """The comparison as a Markdown table."""
-    header = "| controller | " + " | ".join(title for _, title, _ in _COLUMNS) + " | vs ideal IK | status |"
-    lines = [header, "|" + "---|" * (len(_COLUMNS) + 3)]
+    columns = _COLUMNS
+    if any("tension_limit_violation_count" in s for s in summaries.values()):  # a scene with tension limits
+        columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
+    header = "| controller | " + " | ".join(title for _, title, _ in columns) + " | vs ideal IK | status |"
+    lines = [header, "|" + "---|" * (len(columns) + 3)]
     for name, summary in summaries.items():
         cells = []
-        for key, _, scale in _COLUMNS:
+        for key, _, scale in columns:
             value = summary.get(key)
-            cells.append("" if value is None else fixed(scale * value, 2))
+            cells.append("" if value is None else (str(value) if isinstance(value, int) else fixed(scale * value, 2)))
         ratio = summary.get("error_reduction_vs_ideal_ik")
         flag = "; cables pushed" if summary.get("elements_pushed") else ""  # a real cable cannot
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {'' if ratio is None else f'{ratio:.1f}x'} | "

@@ -140,7 +140,38 @@ class Result:
             "max_winch_reservoir_m": (None if self.winch_reservoir is None or not len(self.winch_reservoir)
                                       else self.winch_reservoir.max(axis=0).tolist()),
             "notes": notes,
+            **self._violations(mask),
         }
+
+    def _violations(self, mask: np.ndarray) -> dict[str, Any]:
+        """``tension_limit_violations``: each cable's element tensions outside its (t_min, t_max), if any are set.
+
+        One entry per cable and limit crossed: the limit, when it was first crossed, the
+        most extreme tension and for how long some element was beyond it. Absent from the
+        summary of a scene without tension limits.
+        """
+        limits = self.metadata.get("tension_limits_N")
+        if limits is None:
+            return {}
+        times = self.time[mask]
+        widths = np.diff(times, append=times[-1]) if len(times) else np.zeros(0)
+        violations = []
+        for i, (tensions, (low, high)) in enumerate(zip(self.tensions, limits)):
+            series = np.asarray(tensions[mask], dtype=float)
+            if not series.size:
+                continue
+            for name, limit, extreme, beyond in (
+                    ("min_tension", low, np.nanmin(series, axis=1), lambda x, v: x < v),
+                    ("max_tension", high, np.nanmax(series, axis=1), lambda x, v: x > v)):
+                if limit is None:
+                    continue
+                crossed = beyond(extreme, limit)
+                if np.any(crossed):
+                    worst = extreme[crossed].min() if name == "min_tension" else extreme[crossed].max()
+                    violations.append({"cable": i + 1, "limit": name, "limit_N": float(limit),
+                                       "first_time_s": float(times[np.argmax(crossed)]), "extreme_N": float(worst),
+                                       "duration_s": float(np.sum(widths[crossed]))})
+        return {"tension_limits_N": limits, "tension_limit_violations": violations}
 
     def _slack_time(self, tensions: np.ndarray, mask: np.ndarray) -> float | None:
         """Time [s] during which some element of a cable carries no tension (slack, or pushing)."""

@@ -98,6 +98,11 @@ class CableSpec:
     mass_lumping : {"consistent", "paper"}
         "consistent": each node carries half the mass of each element it touches;
         "paper": each element's whole mass sits at its far (platform-side) node.
+    min_tension, max_tension : float or None [N]
+        The cable's tension limits t_min and t_max (None: no limit). A reference the
+        limits cannot hold is refused before the run
+        (:func:`cdpr_exu.workspace.check_reference`); a run reports every element
+        tension outside them (``tension_limit_violations`` in its summary).
     """
 
     unstrained_length: float = 3.75
@@ -107,9 +112,17 @@ class CableSpec:
     damping_constant: float = 1.0e9
     n_elements: int = 15
     mass_lumping: str = "consistent"
+    min_tension: float | None = None
+    max_tension: float | None = None
 
     def __post_init__(self) -> None:
         _set(self, "unstrained_length", positive("cable.unstrained_length", self.unstrained_length))
+        for name in ("min_tension", "max_tension"):
+            if getattr(self, name) is not None:
+                _set(self, name, non_negative(f"cable.{name}", getattr(self, name)))
+        if self.min_tension is not None and self.max_tension is not None and self.min_tension >= self.max_tension:
+            raise SceneError(f"cable.min_tension = {self.min_tension!r} N must be below cable.max_tension = "
+                             f"{self.max_tension!r} N")
         _set(self, "radius", positive("cable.radius", self.radius))
         _set(self, "linear_density", positive("cable.linear_density", self.linear_density))
         _set(self, "youngs_modulus", positive("cable.youngs_modulus", self.youngs_modulus))
@@ -668,6 +681,14 @@ class Scene:
     def n_cables(self) -> int:
         return len(self.cables)
 
+    @property
+    def tension_limits(self) -> np.ndarray | None:
+        """Each cable's (t_min, t_max) [N], shape (m, 2), 0 and inf where not given; None without any limit."""
+        if all(c.min_tension is None and c.max_tension is None for c in self.cables):
+            return None
+        return np.array([[c.min_tension or 0.0, math.inf if c.max_tension is None else c.max_tension]
+                         for c in self.cables])
+
     def with_changes(self, **changes: Any) -> "Scene":
         """A copy with top-level fields replaced (validated again)."""
         return replace(self, **changes)
@@ -679,7 +700,7 @@ class Scene:
             "description": self.description,
             "gravity": self.gravity,
             "cable_exit": self.cable_exit,
-            "cables": [dataclasses.asdict(c) for c in self.cables],
+            "cables": [{k: v for k, v in dataclasses.asdict(c).items() if v is not None} for c in self.cables],
             "pulleys": [_listify(dataclasses.asdict(p)) for p in self.pulleys],
             "platform": _listify(dataclasses.asdict(self.platform)),
             "winch": dataclasses.asdict(self.winch),

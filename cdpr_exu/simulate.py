@@ -502,6 +502,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
     result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
                        "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts()}
+    if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
+        result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     last_time = float(result.time[-1]) if len(result.time) else 0.0
     if failure is None and (not np.all(np.isfinite(result.platform_pose)) or len(result.time) < len(recorder.output_times)):
         failure = "the solution contains NaN or stopped before the end time"

@@ -14,7 +14,12 @@ fields that conflict, when
   platform above the pulleys, or beyond them to the side, could only be held by
   cables that push.
 
-The last test is the static wrench-feasible workspace of the planar robot for forces
+* the cables have tension limits (``cables[i].min_tension``, ``max_tension``), and no
+  tensions within them hold the platform on the reference: the ideal (straight,
+  massless) cables must give the platform its weight and the reference's acceleration,
+  ``M (a_ref + g e_z)``.
+
+The last two tests are the wrench-feasible workspace of the planar robot for forces
 (the platform's rotation is free to balance the moment, as a suspended platform does).
 Pure NumPy/SciPy (no Exudyn). Units SI; poses (x, z, rotation) in the paper's x-z plane.
 """
@@ -22,7 +27,7 @@ Pure NumPy/SciPy (no Exudyn). Units SI; poses (x, z, rotation) in the paper's x-
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import nnls
+from scipy.optimize import lsq_linear, nnls
 
 from .errors import UnreachableError
 from .kinematics import anchor_points
@@ -128,6 +133,31 @@ def _check_weight_held(scene, times, poses, pulls) -> None:
                 f"non-negative tensions, because {reason}; an unbalanced force of {residual:.4g} N remains")
 
 
+def _check_tension_limits(scene, times, poses, pulls) -> None:
+    limits = scene.tension_limits
+    if limits is None or scene.winch.kind == "fixed":
+        return
+    mass, gravity = scene.platform.mass, scene.gravity
+    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :2]
+    needed = mass * (acceleration + np.array([0.0, gravity]))  # (N, 2): what the cables must give the platform
+    directions = np.stack(pulls, axis=2)  # (N, 2, m)
+    scale = max(float(np.abs(needed).max()), 1e-300)
+    for k in range(len(times)):
+        fit = lsq_linear(directions[k], needed[k], bounds=(limits[:, 0], limits[:, 1]))
+        residual = float(np.linalg.norm(directions[k] @ fit.x - needed[k]))
+        if residual <= WEIGHT_BALANCE_TOLERANCE * scale:
+            continue
+        free, *_ = np.linalg.lstsq(directions[k], needed[k], rcond=None)  # the tensions the limits forbid
+        outside = [f"cable {i + 1} needs {free[i]:.4g} N (cables[{i}].min_tension = {limits[i, 0]:g} N, "
+                   f"cables[{i}].max_tension = {limits[i, 1]:g} N)"
+                   for i in range(len(free)) if not limits[i, 0] <= free[i] <= limits[i, 1]]
+        raise UnreachableError(
+            f"{_pose_text(times, poses, k)} cannot be held within the cables' tension limits: "
+            f"{'; '.join(outside) or 'no tensions within the limits balance the platform'} to give the platform "
+            f"its weight and the reference's acceleration ({np.round(needed[k], 4).tolist()} N); "
+            f"{residual:.4g} N would remain unbalanced")
+
+
 def check_reference(scene) -> None:
     """Refuse a reference trajectory the cables cannot follow, before any simulation.
 
@@ -136,7 +166,7 @@ def check_reference(scene) -> None:
     UnreachableError
         Naming the time, the pose and the scene fields that conflict (``platform.anchors[i]``,
         ``pulleys[i].center``, ``pulleys[i].radius``, ``cables[i].unstrained_length``,
-        ``platform.mass``).
+        ``platform.mass``, ``cables[i].min_tension``, ``cables[i].max_tension``).
     """
     times, poses = reference_samples(scene)
     anchors = anchor_points(poses, np.asarray(scene.platform.anchors))
@@ -144,3 +174,4 @@ def check_reference(scene) -> None:
     lengths, pulls = _exits(scene, times, poses, anchors)
     _check_lengths(scene, times, poses, lengths)
     _check_weight_held(scene, times, poses, pulls)
+    _check_tension_limits(scene, times, poses, pulls)
