@@ -14,6 +14,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from cdpr_exu.errors import SceneError
+from cdpr_exu.validation import per_item
 from cdpr_exu.geometry import (
     PulleyExit,
     Pulley,
@@ -52,13 +53,7 @@ def _check_pulleys(n_cables, pulley_centers, pulley_radii, sides):
     centers = finite_array("pulley_centers", pulley_centers, (2,))
     if centers.shape != (n_cables, 2):
         raise SceneError(f"pulley_centers must have shape ({n_cables}, 2), got shape {centers.shape}")
-    radii = finite_array("pulley_radii", pulley_radii)
-    if radii.ndim == 0:
-        radii = np.full(n_cables, float(radii))
-    if radii.shape != (n_cables,):
-        raise SceneError(f"pulley_radii must be a scalar or have shape ({n_cables},), got {pulley_radii!r}")
-    if np.any(radii < 0.0):
-        raise SceneError(f"pulley_radii must be >= 0 [m], got {pulley_radii!r}")
+    radii = per_item("pulley_radii", pulley_radii, n_cables)
     sides_array = np.broadcast_to(np.asarray(sides), (n_cables,)) if np.ndim(sides) == 0 else np.asarray(sides)
     if sides_array.shape != (n_cables,):
         raise SceneError(f"sides must have shape ({n_cables},), got {sides!r}")

@@ -76,6 +76,7 @@ from .errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure
 from .model import Model, build_model
 from .pulley import penetration
 from .output import write_npz, write_summary
+from .physics.spatial_robot import static_settings
 from .result import provenance
 from .scene import Scene, load_scene
 from .spatial_scene import is_spatial, load_any_scene
@@ -426,19 +427,6 @@ def _last_state(model: Model) -> dict[str, Any]:
     return state
 
 
-def _static_settings() -> exu.SimulationSettings:
-    settings = exu.SimulationSettings()
-    settings.solution.file.write = False  # else Exudyn writes solution/ into the working folder
-    settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-    static = settings.staticSolver
-    static.verboseMode = 0
-    static.numberOfLoadSteps = 1
-    static.newton.maxIterations = 50
-    static.newton.relativeTolerance = 1e-10
-    static.newton.absoluteTolerance = 1e-10
-    return settings
-
-
 def _static_solve(model: Model, max_shift: float | None) -> float | None:
     """Exudyn's static solver from the model's current state, velocities zeroed.
 
@@ -455,7 +443,7 @@ def _static_solve(model: Model, max_shift: float | None) -> float | None:
     printing = exu.config.printToConsole
     exu.config.printToConsole = False  # a failed static solve prints a page of hints
     try:
-        converged = bool(mbs.SolveStatic(_static_settings(), showHints=False, showCausingItems=False))
+        converged = bool(mbs.SolveStatic(static_settings(1e-10), showHints=False, showCausingItems=False))
     except (exu.SolverError, RuntimeError, SystemError):
         converged = False
     finally:

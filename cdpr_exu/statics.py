@@ -282,8 +282,31 @@ class CableEquilibrium:
         return self.catenary.tension_b
 
 
+class PlatformEquilibriumViews:
+    """Per-cable views of a platform equilibrium that holds ``cables`` and ``stiffness``.
+
+    Shared by the planar :class:`PlatformEquilibrium` and the spatial
+    :class:`~cdpr_exu.physics.spatial_statics.SpatialEquilibrium`.
+    """
+
+    @property
+    def tensions_at_anchor(self):
+        """Tension of each cable at its anchor, shape (n_cables,) [N]."""
+        return np.array([c.tension_at_anchor for c in self.cables])
+
+    @property
+    def forces_on_platform(self):
+        """Force of each cable on the platform, shape (n_cables, 2) or (n_cables, 3) [N]."""
+        return np.array([c.force_on_platform for c in self.cables])
+
+    @property
+    def is_stable(self):
+        """True when the symmetric part of `stiffness` is positive definite."""
+        return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
+
+
 @dataclass(frozen=True, eq=False)
-class PlatformEquilibrium:
+class PlatformEquilibrium(PlatformEquilibriumViews):
     """A static (or quasi-static) equilibrium of the platform on its cables.
 
     Attributes
@@ -311,21 +334,6 @@ class PlatformEquilibrium:
     def unstrained_lengths(self):
         """Unstrained length of each cable, shape (n_cables,) [m]."""
         return np.array([c.unstrained_length for c in self.cables])
-
-    @property
-    def tensions_at_anchor(self):
-        """Tension of each cable at its anchor, shape (n_cables,) [N]."""
-        return np.array([c.tension_at_anchor for c in self.cables])
-
-    @property
-    def forces_on_platform(self):
-        """Force of each cable on the platform, shape (n_cables, 2) [N]."""
-        return np.array([c.force_on_platform for c in self.cables])
-
-    @property
-    def is_stable(self):
-        """True when the symmetric part of `stiffness` is positive definite."""
-        return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
 
 
 # ---------------------------------------------------------------------------

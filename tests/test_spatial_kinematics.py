@@ -341,7 +341,7 @@ def test_bad_tension_bounds_are_refused_naming_the_argument():
     matrix, wrench = COGIRO.structure_matrix(cogiro.INITIAL_POSE), COGIRO.gravity_wrench(cogiro.INITIAL_POSE)
     with pytest.raises(SceneError, match="min_tension must not exceed max_tension"):
         tension_distribution(matrix, wrench, 600.0, 500.0)
-    with pytest.raises(SceneError, match="min_tension must be >= 0"):
+    with pytest.raises(SceneError, match="min_tension must be finite and zero or positive"):
         tension_distribution(matrix, wrench, -1.0, 500.0)
     with pytest.raises(SceneError, match="max_tension"):
         tension_distribution(matrix, wrench, 100.0, np.nan)
@@ -365,7 +365,7 @@ def test_bad_shapes_and_values_are_refused_naming_the_argument():
         COGIRO.tensions(np.zeros((2, 6)))
     with pytest.raises(SceneError, match="anchors must have shape"):
         IdealSpatialRobot(cogiro.EXIT_POINTS, cogiro.ANCHORS[:7], 0.0, 91.0, 100.0, 5000.0)
-    with pytest.raises(SceneError, match="pulley_radii must be >= 0"):
+    with pytest.raises(SceneError, match="pulley_radii must be finite and zero or positive"):
         inverse_kinematics(cogiro.INITIAL_POSE, cogiro.ANCHORS, cogiro.EXIT_POINTS, -0.1)
     with pytest.raises(SceneError, match="radius must be zero or positive"):
         SwivelPulley((0.0, 0.0, 5.0), -0.1)

@@ -65,8 +65,8 @@ from scipy.optimize import nnls
 
 from cdpr_exu.catenary import STANDARD_GRAVITY
 from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import Pulley, finite_array, left_jacobian, rotation_from_vector
-from cdpr_exu.validation import non_negative, vector
+from cdpr_exu.geometry import Pulley, PulleyExit, finite_array, left_jacobian, rotation_from_vector
+from cdpr_exu.validation import non_negative, per_item, vector
 
 __all__ = [
     "SwivelExit",
@@ -99,8 +99,9 @@ _BOUND_ROUNDING = 1e-9
 # one cable over one swivel pulley
 # ----------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)  # array fields
-class SwivelExit:
-    """Where and how an ideal cable leaves a swivel pulley towards its anchor.
+class SwivelExit(PulleyExit):
+    """Where and how an ideal cable leaves a swivel pulley towards its anchor: a
+    :class:`~cdpr_exu.geometry.PulleyExit` in 3-D, with the pulley's azimuth.
 
     Attributes
     ----------
@@ -119,16 +120,6 @@ class SwivelExit:
     """
 
     azimuth: float | np.ndarray
-    tangent_point: np.ndarray
-    wrap_angle: float | np.ndarray
-    free_length: float | np.ndarray
-    unit_vector: np.ndarray
-    arc_length: float | np.ndarray
-
-    @property
-    def cable_length(self):
-        """Ideal cable length from the inlet to the anchor, ``free_length + arc_length`` [m]."""
-        return self.free_length + self.arc_length
 
 
 def _point3(name, value):
@@ -358,14 +349,7 @@ def _check_pulleys(n_cables, inlets, pulley_radii):
     inlets = finite_array("inlets", inlets, (3,))
     if inlets.shape != (n_cables, 3):
         raise SceneError(f"inlets must have shape ({n_cables}, 3), got shape {inlets.shape}")
-    radii = finite_array("pulley_radii", pulley_radii)
-    if radii.ndim == 0:
-        radii = np.full(n_cables, float(radii))
-    if radii.shape != (n_cables,):
-        raise SceneError(f"pulley_radii must be a scalar or have shape ({n_cables},), got {pulley_radii!r}")
-    if np.any(radii < 0.0):
-        raise SceneError(f"pulley_radii must be >= 0 [m], got {pulley_radii!r}")
-    return inlets, radii
+    return inlets, per_item("pulley_radii", pulley_radii, n_cables)
 
 
 def _check_hints(n_cables, azimuth_hints):
@@ -544,14 +528,7 @@ def gravity_wrench(pose, mass, center_of_mass=(0.0, 0.0, 0.0), gravity=STANDARD_
 def _tension_limits(min_tension, max_tension, n_cables):
     limits = []
     for name, value in (("min_tension", min_tension), ("max_tension", max_tension)):
-        array = finite_array(name, value)
-        if array.ndim == 0:
-            array = np.full(n_cables, float(array))
-        if array.shape != (n_cables,):
-            raise SceneError(f"{name} must be a scalar or have shape ({n_cables},), got {value!r}")
-        if np.any(array < 0.0):
-            raise SceneError(f"{name} must be >= 0 [N] (cables cannot push), got {value!r}")
-        limits.append(array)
+        limits.append(per_item(name, value, n_cables))  # >= 0: cables cannot push
     lower, upper = limits
     if np.any(lower > upper):
         raise SceneError(f"min_tension must not exceed max_tension, got min_tension {min_tension!r} "

@@ -359,7 +359,7 @@ class SpatialStaticResult:
 
 
 def static_settings(tolerance=1e-9):
-    """Settings of Exudyn's static solver for the robot (one load step, tight Newton)."""
+    """Settings of Exudyn's static solver (one load step, Newton to ``tolerance``), planar or spatial."""
     settings = exu.SimulationSettings()
     settings.solution.file.write = False  # else Exudyn writes solution/ into the working folder
     settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse

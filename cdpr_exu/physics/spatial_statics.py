@@ -53,7 +53,7 @@ from cdpr_exu.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCabl
     profile, solve_forward
 from cdpr_exu.errors import SceneError, UnreachableError
 from cdpr_exu.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
-from cdpr_exu.statics import _minimise_energy  # the energy line search of the planar statics, reused as is
+from cdpr_exu.statics import PlatformEquilibriumViews, _minimise_energy  # the planar statics' line search, reused
 from cdpr_exu.validation import non_negative, positive, real_array, vector
 
 _RELATIVE_TOLERANCE = 1e-12
@@ -249,7 +249,7 @@ class SpatialCableEquilibrium:
 
 
 @dataclass(frozen=True, eq=False)
-class SpatialEquilibrium:
+class SpatialEquilibrium(PlatformEquilibriumViews):
     """A static equilibrium of the platform on its cables.
 
     Attributes
@@ -277,29 +277,14 @@ class SpatialEquilibrium:
     net_wrench: np.ndarray = field(repr=False)
 
     @property
-    def tensions_at_anchor(self):
-        """Tension of each cable at its anchor, shape (n_cables,) [N]."""
-        return np.array([c.tension_at_anchor for c in self.cables])
-
-    @property
     def tensions_at_exit(self):
         """Tension of each cable at its exit point, shape (n_cables,) [N]."""
         return np.array([c.tension_at_exit for c in self.cables])
 
     @property
-    def forces_on_platform(self):
-        """Force of each cable on the platform, shape (n_cables, 3) [N]."""
-        return np.array([c.force_on_platform for c in self.cables])
-
-    @property
     def anchor_points(self):
         """World positions of the anchors, shape (n_cables, 3) [m]."""
         return np.array([c.anchor_point for c in self.cables])
-
-    @property
-    def is_stable(self):
-        """True when the symmetric part of `stiffness` is positive definite."""
-        return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
 
 
 # ---------------------------------------------------------------------------
