@@ -18,7 +18,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from .errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
-                     RunInterrupted, SolverFailure)
+                     RunInterrupted, SceneError, SolverFailure)
 from .output import check_output_folder, fixed, write_summary
 from .scene import Scene, load_scene, save_scene, shipped_scenes
 
@@ -210,6 +210,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     out = check_output_folder(args.out)
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
+    from .spatial_scene import is_spatial, load_any_scene
+
+    spatial = load_any_scene(args.scene)
+    if is_spatial(spatial):
+        from .spatial_run import run_spatial_scene
+
+        changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
+        if tolerance is not None:
+            raise SceneError("--tolerance: the error model is planar only so far; give a spatial scene's n_elements")
+        run_spatial_scene(replace(spatial, solver=replace(spatial.solver, **changes)), out, quiet=args.quiet,
+                          figures=not args.no_figures)
+        return EXIT_OK
     scene = _scene_with_overrides(args)
     if tolerance is not None:
         scene = _elements_for(scene, tolerance, args.quiet)

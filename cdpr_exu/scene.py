@@ -684,10 +684,7 @@ class Scene:
     @property
     def tension_limits(self) -> np.ndarray | None:
         """Each cable's (t_min, t_max) [N], shape (m, 2), 0 and inf where not given; None without any limit."""
-        if all(c.min_tension is None and c.max_tension is None for c in self.cables):
-            return None
-        return np.array([[c.min_tension or 0.0, math.inf if c.max_tension is None else c.max_tension]
-                         for c in self.cables])
+        return tension_limits(self.cables)
 
     def with_changes(self, **changes: Any) -> "Scene":
         """A copy with top-level fields replaced (validated again)."""
@@ -807,14 +804,21 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     return Scene(**kwargs)
 
 
+def tension_limits(cables) -> np.ndarray | None:
+    """Each cable's (t_min, t_max) [N], shape (m, 2), 0 and inf where not given; None without any limit."""
+    if all(c.min_tension is None and c.max_tension is None for c in cables):
+        return None
+    return np.array([[c.min_tension or 0.0, math.inf if c.max_tension is None else c.max_tension] for c in cables])
+
+
 class SpatialSceneError(SceneError):
     """A spatial scene (``dimension = 3``) given where only planar scenes are taken."""
 
 
 def _refuse_spatial(source: str | Path) -> None:
     raise SpatialSceneError(
-        f"scene {str(source)!r} is spatial (dimension = 3): so far `cdpr static` takes spatial scenes; run, compare, "
-        "study, view and animate take planar scenes only (see docs/spatial.md)")
+        f"scene {str(source)!r} is spatial (dimension = 3): so far `cdpr static` and `cdpr run` take spatial scenes; "
+        "compare, study, view and animate take planar scenes only (see docs/spatial.md)")
 
 
 def load_scene(source: str | Path) -> Scene:

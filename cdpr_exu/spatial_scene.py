@@ -21,8 +21,11 @@ exit; swivel pulleys come later) given in ``[[exits]]``; the platform is a point
     inertia = [0.05, 0.05, 0.08]       # principal moments about the centre of mass
     anchors = [[0.1, 0.1, 0.05], ...]  # platform frame
 
-So far spatial scenes have a static mode (``cdpr static``, :mod:`cdpr_exu.spatial_rest`);
-the other commands refuse them with a message that says so.
+``cdpr static`` brings a spatial scene to rest (:mod:`cdpr_exu.spatial_rest`); ``cdpr run``
+follows its ``[trajectory]`` (a 6-DOF reference, :mod:`cdpr_exu.spatial_trajectories`) with
+``[winch] kind = "kinematic"`` winches under ideal inverse kinematics, with its ``[solver]``
+settings (:mod:`cdpr_exu.spatial_run`). The other commands refuse spatial scenes with a
+message that says so.
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ from .catenary import STANDARD_GRAVITY
 from .errors import SceneError
 from .physics.spatial_robot import SpatialChainSpec
 from .physics.spatial_statics import SpatialCable, SpatialPlatform
-from .scene import CableSpec, Effects, Scene, SpatialSceneError, _build, _per_cable, load_scene
+from .scene import CableSpec, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec, _build, _per_cable, load_scene
 from .validation import non_negative, vector
 
 __all__ = ["SpatialPlatformSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
@@ -106,6 +109,14 @@ class SpatialScene:
         Which physics the lumped model includes: cable mass and gravity, axial elasticity
         and damping, bending; tension-only (``slack``) elements are planar only so far,
         and point exits have no pulley contact.
+    trajectory : spatial trajectory or None
+        The reference of ``cdpr run`` (:mod:`cdpr_exu.spatial_trajectories`); None: the
+        scene has a static mode only.
+    solver : SolverSpec
+        The implicit integration of ``cdpr run`` (as in planar scenes).
+    winch : WinchSpec
+        ``kind = "kinematic"`` (the winches pay out what the controller commands) or
+        ``"fixed"``; servo drums are planar only so far.
 
     Raises
     ------
@@ -122,6 +133,9 @@ class SpatialScene:
     platform: SpatialPlatformSpec = field(default_factory=SpatialPlatformSpec)
     gravity: float = STANDARD_GRAVITY
     effects: Effects = field(default_factory=lambda: Effects.from_preset("full"))
+    trajectory: Any = None
+    solver: SolverSpec = field(default_factory=SolverSpec)
+    winch: WinchSpec = field(default_factory=WinchSpec)
 
     #: Spatial scenes are 3-D; planar :class:`~cdpr_exu.scene.Scene` objects have no such attribute.
     dimension: ClassVar[int] = 3
@@ -155,6 +169,10 @@ class SpatialScene:
                                      f"{getattr(first, name)!r}: the cables of a spatial scene share one "
                                      "discretisation, damping and bending so far")
         self.catenary_platform()  # refuses coincident exits, too few cables, anchors on one line
+        if self.winch.kind == "servo":
+            raise SceneError("winch.kind = 'servo': servo drums are planar only so far; use 'kinematic' or 'fixed'")
+        if not isinstance(self.solver, SolverSpec) or self.solver.integrator != "generalized_alpha":
+            raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
 
     @property
     def n_cables(self) -> int:
@@ -197,7 +215,8 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
     """
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {data!r}")
-    known = {"name", "description", "dimension", "gravity", "cable", "cables", "exits", "platform", "effects"}
+    known = {"name", "description", "dimension", "gravity", "cable", "cables", "exits", "platform", "effects",
+             "trajectory", "solver", "winch"}
     unknown = set(data) - known
     if unknown:
         raise SceneError(f"spatial scene has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
@@ -218,7 +237,13 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
     effects_data = dict(effects_data)
     effects = Effects.from_preset(effects_data.pop("preset", "full"), **effects_data)
     kwargs: dict[str, Any] = dict(cables=cables, exits=tuple(e["point"] for e in exits),
-                                  platform=_build(SpatialPlatformSpec, data["platform"], "platform"), effects=effects)
+                                  platform=_build(SpatialPlatformSpec, data["platform"], "platform"), effects=effects,
+                                  solver=_build(SolverSpec, data.get("solver", {}), "solver"),
+                                  winch=_build(WinchSpec, data.get("winch", {}), "winch"))
+    if "trajectory" in data:
+        from .spatial_trajectories import spatial_trajectory_from_dict
+
+        kwargs["trajectory"] = spatial_trajectory_from_dict(data["trajectory"])
     for key in ("name", "description", "gravity"):
         if key in data:
             kwargs[key] = data[key]

@@ -115,22 +115,61 @@ def _check_lengths(scene, times, poses, lengths) -> None:
                 f"{cable.unstrained_length} m ({kept})")
 
 
+def first_unheld(directions: np.ndarray, needed: np.ndarray, limits: np.ndarray | None = None):
+    """The first sample where no allowed cable tensions give the platform the force it needs.
+
+    Parameters
+    ----------
+    directions : ndarray, shape (N, d, m)
+        Unit pull of each of the m cables on the platform (d = 2 planar, 3 spatial).
+    needed : ndarray, shape (N, d) or (d,) [N]
+        Force the cables must give the platform (its weight, plus its mass times the
+        reference's acceleration).
+    limits : ndarray, shape (m, 2) [N], optional
+        Each cable's (t_min, t_max); default: non-negative tensions.
+
+    Returns
+    -------
+    None, or (k, residual [N], tensions [N] the limits forbid, shape (m,)) for the first sample k
+    whose force balance leaves more than :data:`WEIGHT_BALANCE_TOLERANCE` of the need unbalanced.
+    """
+    needed = np.broadcast_to(np.asarray(needed, dtype=float), directions.shape[:2])
+    scale = max(float(np.abs(needed).max()), 1e-300)
+    for k in range(len(directions)):
+        if limits is None:
+            _, residual = nnls(directions[k], needed[k])
+        else:
+            fit = lsq_linear(directions[k], needed[k], bounds=(limits[:, 0], limits[:, 1]))
+            residual = float(np.linalg.norm(directions[k] @ fit.x - needed[k]))
+        if residual > WEIGHT_BALANCE_TOLERANCE * scale:
+            free, *_ = np.linalg.lstsq(directions[k], needed[k], rcond=None)
+            return k, float(residual), free
+    return None
+
+
 def _check_weight_held(scene, times, poses, pulls) -> None:
     weight = scene.platform.mass * scene.gravity
     if weight <= 0.0 or scene.winch.kind == "fixed":
         return  # fixed winches follow no reference: it only measures the error (a pendulum swings)
-    needed = np.array([0.0, weight])  # the cables must pull the platform up by its weight
     directions = np.stack(pulls, axis=2)  # (N, 2, m)
-    for k in range(len(times)):
-        tensions, residual = nnls(directions[k], needed)
-        if residual > WEIGHT_BALANCE_TOLERANCE * weight:
-            upward = directions[k][1]
-            reason = ("every cable pulls it downwards (it is above the pulleys)" if np.all(upward <= 0.0)
-                      else "the cables' pulls cannot combine into an upward force without one pushing")
-            raise UnreachableError(
-                f"{_pose_text(times, poses, k)} is outside the workspace: the cables cannot hold the "
-                f"platform's weight ({weight:.4g} N, platform.mass = {scene.platform.mass} kg) with "
-                f"non-negative tensions, because {reason}; an unbalanced force of {residual:.4g} N remains")
+    unheld = first_unheld(directions, np.array([0.0, weight]))  # the cables must pull the platform up by its weight
+    if unheld is not None:
+        k, residual, _ = unheld
+        upward = directions[k][1]
+        reason = ("every cable pulls it downwards (it is above the pulleys)" if np.all(upward <= 0.0)
+                  else "the cables' pulls cannot combine into an upward force without one pushing")
+        raise UnreachableError(
+            f"{_pose_text(times, poses, k)} is outside the workspace: the cables cannot hold the "
+            f"platform's weight ({weight:.4g} N, platform.mass = {scene.platform.mass} kg) with "
+            f"non-negative tensions, because {reason}; an unbalanced force of {residual:.4g} N remains")
+
+
+def limits_text(free: np.ndarray, limits: np.ndarray) -> str:
+    """The cables whose needed tension lies outside their limits, naming the scene fields."""
+    outside = [f"cable {i + 1} needs {free[i]:.4g} N (cables[{i}].min_tension = {limits[i, 0]:g} N, "
+               f"cables[{i}].max_tension = {limits[i, 1]:g} N)"
+               for i in range(len(free)) if not limits[i, 0] <= free[i] <= limits[i, 1]]
+    return "; ".join(outside) or "no tensions within the limits balance the platform"
 
 
 def _check_tension_limits(scene, times, poses, pulls) -> None:
@@ -140,22 +179,13 @@ def _check_tension_limits(scene, times, poses, pulls) -> None:
     mass, gravity = scene.platform.mass, scene.gravity
     acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :2]
     needed = mass * (acceleration + np.array([0.0, gravity]))  # (N, 2): what the cables must give the platform
-    directions = np.stack(pulls, axis=2)  # (N, 2, m)
-    scale = max(float(np.abs(needed).max()), 1e-300)
-    for k in range(len(times)):
-        fit = lsq_linear(directions[k], needed[k], bounds=(limits[:, 0], limits[:, 1]))
-        residual = float(np.linalg.norm(directions[k] @ fit.x - needed[k]))
-        if residual <= WEIGHT_BALANCE_TOLERANCE * scale:
-            continue
-        free, *_ = np.linalg.lstsq(directions[k], needed[k], rcond=None)  # the tensions the limits forbid
-        outside = [f"cable {i + 1} needs {free[i]:.4g} N (cables[{i}].min_tension = {limits[i, 0]:g} N, "
-                   f"cables[{i}].max_tension = {limits[i, 1]:g} N)"
-                   for i in range(len(free)) if not limits[i, 0] <= free[i] <= limits[i, 1]]
+    unheld = first_unheld(np.stack(pulls, axis=2), needed, limits)
+    if unheld is not None:
+        k, residual, free = unheld
         raise UnreachableError(
             f"{_pose_text(times, poses, k)} cannot be held within the cables' tension limits: "
-            f"{'; '.join(outside) or 'no tensions within the limits balance the platform'} to give the platform "
-            f"its weight and the reference's acceleration ({np.round(needed[k], 4).tolist()} N); "
-            f"{residual:.4g} N would remain unbalanced")
+            f"{limits_text(free, limits)} to give the platform its weight and the reference's acceleration "
+            f"({np.round(needed[k], 4).tolist()} N); {residual:.4g} N would remain unbalanced")
 
 
 def check_reference(scene) -> None:

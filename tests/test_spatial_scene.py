@@ -39,10 +39,12 @@ def test_the_shipped_spatial_scene_loads_and_the_planar_loader_refuses_it_naming
         load_scene("spatial-four-cable")
 
 
-def test_cdpr_run_refuses_a_spatial_scene_with_exit_code_2():
-    done = _cdpr("run", "spatial-four-cable")
+def test_the_planar_only_commands_refuse_a_spatial_scene_and_run_needs_a_trajectory():
+    done = _cdpr("compare", "spatial-four-cable")
     assert done.returncode == 2
     assert "spatial (dimension = 3)" in done.stderr and "cdpr static" in done.stderr
+    done = _cdpr("run", "spatial-four-cable")  # a static scene: no reference to follow
+    assert done.returncode == 2 and "no [trajectory]" in done.stderr
 
 
 def test_a_planar_robot_written_as_a_spatial_scene_rests_where_the_planar_model_rests():

@@ -32,6 +32,11 @@ class SpatialChainItems:
     joints : ndarray of int, shape (J, 3)
     user_functions : tuple
         Keeps the Python callables alive as long as the model.
+    loads : list of int
+        The nodes' gravity ``LoadForceVector`` items (empty without gravity).
+    bending_stiffness : ndarray, shape (J,) [N m/rad] or None
+        The joints' stiffnesses, the very array the bending force reads (a winch that
+        changes the cable's length scales it in place).
     """
 
     nodes: list
@@ -42,6 +47,8 @@ class SpatialChainItems:
     reference: np.ndarray
     joints: np.ndarray
     user_functions: tuple = field(default_factory=tuple)
+    loads: list = field(default_factory=list)
+    bending_stiffness: np.ndarray | None = None
 
 
 def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: np.ndarray, axial_stiffness: float,
@@ -63,13 +70,14 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         Hold the first node in place.
     """
     positions = np.asarray(positions, dtype=float)
-    nodes, masses, markers, springs = [], [], [], []
+    nodes, masses, markers, springs, loads = [], [], [], [], []
     for point, mass in zip(positions, node_masses):
         node = mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point)))
         masses.append(mbs.AddObject(eii.ObjectMassPoint(mass=float(mass), nodeNumber=node)))
         marker = mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node))
         if gravity:
-            mbs.AddLoad(eii.LoadForceVector(markerNumber=marker, loadVector=[0.0, 0.0, -float(mass) * gravity]))
+            loads.append(mbs.AddLoad(eii.LoadForceVector(markerNumber=marker,
+                                                         loadVector=[0.0, 0.0, -float(mass) * gravity])))
         nodes.append(node)
         markers.append(marker)
     for i in range(len(nodes) - 1):
@@ -85,7 +93,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     joints = bending_3d.chain_joints([len(nodes)])
     reference = positions.ravel().copy()
     if bending_stiffness <= 0.0 or len(joints) == 0:
-        return SpatialChainItems(nodes, masses, markers, springs, None, reference, joints)
+        return SpatialChainItems(nodes, masses, markers, springs, None, reference, joints, loads=loads)
     stiffness = np.full(len(joints), float(bending_stiffness))
     size = reference.size
     rows, columns = bending_3d.spatial_bending_pattern(joints)
@@ -112,7 +120,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
                                                    forceUserFunction=force_function,
                                                    jacobianUserFunction=jacobian_function))
     return SpatialChainItems(nodes, masses, markers, springs, bending, reference, joints,
-                             (force_function, jacobian_function, container))
+                             (force_function, jacobian_function, container), loads, stiffness)
 
 
 def chain_energy(items: SpatialChainItems, node_masses: np.ndarray, q: np.ndarray, v: np.ndarray,

@@ -1,0 +1,108 @@
+"""Dynamic runs of spatial scenes (cdpr_exu.spatial_run), real solver: the variable-length winch and ideal IK."""
+
+import json
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.spatial_run import simulate_spatial
+from cdpr_exu.spatial_scene import load_spatial_scene
+from cdpr_exu.spatial_trajectories import SpatialHoldTrajectory, SpatialPointToPointTrajectory
+
+
+def four_cable(n_elements=10, bending=False, **solver):
+    """The shipped four-cable robot, coarser, without bending (so the catenary is its continuum limit)."""
+    scene = load_spatial_scene("spatial-four-cable")
+    effects = replace(scene.effects, bending=bending, bending_damping=bending)
+    cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
+    return replace(scene, cables=cables, effects=effects,
+                   solver=replace(scene.solver, step_size=1e-2, output_period=0.05, **solver))
+
+
+def start_pose(scene):
+    start = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    return np.concatenate([start.position, start.rotation_vector])
+
+
+def test_a_robot_told_to_hold_its_equilibrium_stays_there():
+    scene = four_cable(end_time=2.0)
+    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    result = simulate_spatial(scene)
+    # It starts on the catenary, which the 10-element chains meet to their discretisation
+    # error (6.6e-5 m measured for this robot, tests/test_spatial_robot.py); it settles there.
+    assert np.abs(result.position_error).max() < 1.5e-4
+    assert np.ptp(result.paid_out, axis=0).max() < 1e-12  # the winches did not move (round-off of the IK)
+
+
+def ipanema(n_elements=10, **solver):
+    """The shipped IPAnema robot (8 taut cables from above and below), coarser, without bending."""
+    scene = load_spatial_scene("spatial-ipanema")
+    effects = replace(scene.effects, bending=False, bending_damping=False)
+    cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
+    return replace(scene, cables=cables, effects=effects, solver=replace(scene.solver, **solver))
+
+
+def test_after_a_move_the_robot_rests_where_the_catenaries_of_the_paid_out_lengths_put_it():
+    scene = ipanema(end_time=3.0)
+    start = start_pose(scene)
+    end = start + np.array([0.2, -0.15, 0.1, 0.0, 0.0, 0.05])
+    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=2.0))
+    result = simulate_spatial(scene)
+    final = result.paid_out[-1]
+    assert np.abs(final - scene.unstrained_lengths).max() > 0.25  # the winches moved decimetres
+    rest = solve_spatial_statics(scene.catenary_platform(), final, initial_pose=result.pose[-1])
+    # The variable-length chains (rest lengths, stiffness, masses and weights all follow the
+    # paid-out length) rest on the elastic catenaries of those lengths. Measured 4e-9 m and
+    # 4e-9 rad after 1 s of settling (the same at 3 s more): the light rope's discretisation
+    # error is that small; 1e-7 leaves room for the settling and still catches a chain whose
+    # lengths, stiffness or weights did not follow its winch (micrometres and more).
+    assert result.pose[-1, :3] == pytest.approx(rest.position, abs=1e-7)
+    assert result.pose[-1, 3:] == pytest.approx(rest.rotation_vector, abs=1e-7)
+    assert [t[-1, -1] for t in result.tensions] == pytest.approx(rest.tensions_at_anchor, abs=0.5)
+
+
+def test_paying_out_at_speed_does_not_damp_the_cable():
+    # 0.3 m in 1 s (0.56 m/s at most). With Exudyn's damper on dl/dt, the damping constant
+    # (d_n A / L = 2.7e3 N s/m per cable) pulls and pushes: measured -699 to 1486 N, and 14 mm
+    # of error. On the strain rate (velocityOffset = dl0/dt) the tensions stay near their
+    # static 300-480 N (measured 293 to 481 N) and the error below 0.4 mm.
+    scene = ipanema(end_time=1.5)
+    start = start_pose(scene)
+    end = start + np.array([0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
+    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.0))
+    result = simulate_spatial(scene)
+    tensions = np.concatenate([t.ravel() for t in result.tensions])
+    assert 250.0 < tensions.min() and tensions.max() < 550.0
+    assert np.abs(result.position_error).max() < 1e-3
+
+
+def test_a_scene_without_trajectory_is_refused_before_the_run():
+    with pytest.raises(SceneError, match=r"no \[trajectory\]"):
+        simulate_spatial(load_spatial_scene("spatial-four-cable"))
+
+
+def test_cdpr_run_on_a_spatial_scene_writes_its_summary_and_overview(tmp_path):
+    out = tmp_path / "run"
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", "spatial-ipanema", "--end-time", "2.5",
+                           "--out", str(out), "-q"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
+    assert summary["dimension"] == 3 and summary["status"] == "completed"
+    # IPAnema is held by 8 taut cables: ideal IK keeps it within millimetres (1.05 mm over
+    # the shipped 10 s circle), and no cable goes slack
+    assert summary["max_position_error_m"] < 5e-3 and summary["min_element_tension_N"] > 0.0
+    assert (out / "overview.png").stat().st_size > 20_000 and (out / "result.npz").exists()
+
+
+def test_a_reference_above_the_exits_is_refused_before_the_run_naming_the_time_and_pose():
+    scene = load_spatial_scene("spatial-cogiro")  # exits at z = 5.4 m; the platform starts at 2.265 m
+    start = (-0.034, -0.013, 2.265, 0.0, 0.0, 0.0)
+    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(start, (-0.034, -0.013, 6.5, 0.0, 0.0, 0.0),
+                                                                     duration=5.0))
+    with pytest.raises(UnreachableError, match=r"at t = 3\.\d+ s is outside the workspace.*non-negative tensions"):
+        simulate_spatial(scene)
