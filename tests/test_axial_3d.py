@@ -204,6 +204,35 @@ def test_a_tension_only_chain_has_no_springs_one_generic_object_and_live_paramet
     assert len(plain.springs) == 2 and plain.generic is None and not plain.tension_only
 
 
+def test_exudyns_system_jacobian_with_tension_only_elements_is_the_one_with_its_own_spring_dampers():
+    """The sign convention: Exudyn's Newton matrix of a free, taut, moving chain (bending on), its
+    ODE2 right-hand side differentiated in positions and in velocities, is the same whether the
+    axial elements are ObjectConnectorSpringDamper or tension-only in the ObjectGenericODE2."""
+    rng = np.random.default_rng(7)
+    n = 5
+    points = np.cumsum(rng.normal(0.0, 0.1, size=(n, 3)) + [0.5, 0.0, 0.0], axis=0)
+    displacements = np.vstack([np.zeros(3), np.cumsum(0.01 * np.diff(points, axis=0), axis=0)])  # 1 % strain
+    velocities = rng.normal(0.0, 0.01, size=(n, 3))
+    matrices = []
+    for tension_only in (False, True):
+        mbs = exu.SystemContainer().AddSystem()
+        items = add_spatial_chain(mbs, points, np.full(n, 0.1), 1e4, 5.0, 0.3, gravity=0.0, hold_first=False,
+                                  tension_only=tension_only)
+        for node, q, v in zip(items.nodes, displacements, velocities):
+            mbs.SetNodeParameter(node, "initialCoordinates", list(q))
+            mbs.SetNodeParameter(node, "initialVelocities", list(v))
+        mbs.Assemble()
+        solver = exu.MainSolverImplicitSecondOrder()
+        solver.InitializeSolver(mbs, dynamic_settings(1e-3, 1e-3))
+        solver.ComputeJacobianODE2RHS(mbs, 1.0, 0.0)
+        stiffness = np.array(solver.GetSystemJacobian())
+        solver.ComputeJacobianODE2RHS(mbs, 0.0, 1.0)
+        matrices.append((stiffness, np.array(solver.GetSystemJacobian())))
+    for exudyn_springs, tension_only in zip(*matrices):
+        # measured 1e-16 of the largest entry (2e4 N/m, 10 N s/m): both analytic
+        np.testing.assert_allclose(tension_only, exudyn_springs, rtol=0, atol=1e-12 * np.abs(exudyn_springs).max())
+
+
 def test_a_bad_tension_only_flag_is_refused_naming_the_field():
     with pytest.raises(SceneError, match="tension_only"):
         SpatialChainSpec(tension_only="yes")
