@@ -15,7 +15,10 @@ angles), its tensions and end forces, and how far the catenary answer lies from 
 cable ends are held by stiff penalty joints in the static solve (Exudyn's static
 solver diverges on ``ObjectJointSpherical`` when the body must turn, see
 :mod:`cdpr_exu.physics.spatial_robot`); they add 1 / (:data:`PENALTY` n) of a cable's
-compliance. Units SI; z up, gravity along -z.
+compliance. The static solve uses spring elements also where the scene's cables are
+tension-only (``effects.slack``): a slack element has no stiffness, and Exudyn's static
+solver fails from such a start; while every element is taut the two give the same
+equilibrium, and a compressed element is reported. Units SI; z up, gravity along -z.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from .output import write_summary
-from .physics.spatial_robot import build_spatial_robot, chain_positions, solve_static
+from .physics.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static
 from .physics.spatial_statics import solve_spatial_statics
 from .result import provenance
 from .spatial_scene import SpatialScene
@@ -73,6 +76,9 @@ class SpatialRest:
         Node positions of each cable, exit first.
     catenary : SpatialEquilibrium
         The catenary statics of the same scene.
+    element_tensions : tuple of ndarray, each shape (n,) [N]
+        Axial force of each element, exit first (negative: compressed, which a real cable
+        cannot be; the static solve uses spring elements, see the module notes).
     anchor_joint : str
         How the cable ends are held in the static solve.
     wall_time : float [s]
@@ -86,6 +92,7 @@ class SpatialRest:
     tensions_at_anchor: np.ndarray
     forces_on_platform: np.ndarray
     nodes: tuple
+    element_tensions: tuple
     catenary: object
     anchor_joint: str
     wall_time: float
@@ -107,6 +114,8 @@ class SpatialRest:
             "catenary_platform_position_m": catenary.position.tolist(),
             "catenary_platform_rotation_vector_rad": catenary.rotation_vector.tolist(),
             "catenary_tension_at_anchor_N": catenary.tensions_at_anchor.tolist(),
+            "min_element_tension_N": float(min(t.min() for t in self.element_tensions)),
+            "elements_pushed": bool(min(t.min() for t in self.element_tensions) < 0.0),
             "lumped_minus_catenary_position_m": float(np.linalg.norm(self.position - catenary.position)),
             "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(self.rotation_vector - catenary.rotation_vector)),
             "wall_time_s": self.wall_time,
@@ -135,15 +144,16 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     lengths = scene.unstrained_lengths
     catenary = solve_spatial_statics(platform, lengths)
     rigid = not platform.is_point_mass
-    chain = scene.chain_spec(anchor_spring_factor=PENALTY if rigid else None)
+    chain = scene.chain_spec(anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary)
     mbs.Assemble()
     static = solve_static(mbs, items)
     nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
+    tensions = tuple(element_forces(mbs, items, i) for i in range(scene.n_cables))
     joint = f"penalty spherical joints of {PENALTY:g} element stiffnesses" if rigid else "exact spherical joints"
     return SpatialRest(scene, static.position, static.rotation, static.rotation_vector, static.tensions_at_anchor,
-                       static.forces_on_platform, nodes, catenary, joint, _time.perf_counter() - start)
+                       static.forces_on_platform, nodes, tensions, catenary, joint, _time.perf_counter() - start)
 
 
 def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
@@ -210,6 +220,10 @@ def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
     print(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
           f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
           f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation_vector)):.4f} deg from the lumped robot")
+    lowest = min(t.min() for t in rest.element_tensions)
+    if lowest < 0.0:
+        print(f"  note: an element is compressed ({lowest:.3g} N), which a real cable cannot be: that cable is "
+              "slack at rest, and its length is longer than the catenary the lumped model can hang")
     if out is not None:
         print(f"  written to {out}/")
 

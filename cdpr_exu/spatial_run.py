@@ -244,6 +244,8 @@ class _SpatialWinches:
         """
         mbs, items = self.mbs, self.items
         for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
+            if chain.tension_only:  # the arrays the cable's numba kernels read
+                chain.axial_rest_rate[:] = float(rate) / self.n
             for spring in chain.springs:
                 mbs.SetObjectParameter(spring, "velocityOffset", float(rate) / self.n)
             if length == self.applied[i]:
@@ -251,6 +253,10 @@ class _SpatialWinches:
             element = float(length) / self.n
             stiffness = cable.axial_rigidity / element
             damping = items.axial_dampings[i] * items.unstrained_lengths[i] / self.n / element
+            if chain.tension_only:
+                chain.axial_rest_length[:] = element
+                chain.axial_stiffness[:] = stiffness
+                chain.axial_damping[:] = damping
             for spring in chain.springs:
                 mbs.SetObjectParameter(spring, "referenceLength", element)
                 mbs.SetObjectParameter(spring, "stiffness", stiffness)
@@ -265,10 +271,13 @@ class _SpatialWinches:
             self.applied[i] = length
 
 
-def _element_tensions(nodes: np.ndarray, length: float, axial_rigidity: float, n: int) -> np.ndarray:
-    """Spring force of each element [N], shape (n,), for node positions (n + 1, 3) and paid-out length L."""
+def _element_tensions(nodes: np.ndarray, length: float, axial_rigidity: float, n: int,
+                      tension_only: bool) -> np.ndarray:
+    """Spring force of each element [N], shape (n,), for node positions (n + 1, 3) and paid-out length L
+    (tension-only elements: nothing below the rest length)."""
     element = length / n
-    return axial_rigidity / element * (np.linalg.norm(np.diff(nodes, axis=0), axis=1) - element)
+    force = axial_rigidity / element * (np.linalg.norm(np.diff(nodes, axis=0), axis=1) - element)
+    return np.maximum(force, 0.0) if tension_only else force
 
 
 def simulate_spatial(scene: SpatialScene, progress=False) -> SpatialResult:
@@ -348,7 +357,7 @@ def simulate_spatial(scene: SpatialScene, progress=False) -> SpatialResult:
     pose = np.asarray(poses)
     paid_out = np.asarray(paid)
     nodes = [np.asarray(series) for series in node_series]
-    tensions = [np.array([_element_tensions(frame, length, cable.axial_rigidity, n)
+    tensions = [np.array([_element_tensions(frame, length, cable.axial_rigidity, n, scene.effects.slack)
                           for frame, length in zip(nodes[i], paid_out[:, i])])
                 for i, cable in enumerate(scene.cables)]
     iterations = mbs.sys["dynamicSolver"].it

@@ -107,8 +107,8 @@ class SpatialScene:
         Along -z.
     effects : Effects
         Which physics the lumped model includes: cable mass and gravity, axial elasticity
-        and damping, bending; tension-only (``slack``) elements are planar only so far,
-        and point exits have no pulley contact.
+        and damping, bending, tension-only elements (``slack``: the cables cannot push,
+        :mod:`cdpr_exu.physics.axial_3d`); point exits have no pulley contact.
     trajectory : spatial trajectory or None
         The reference of ``cdpr run`` (:mod:`cdpr_exu.spatial_trajectories`); None: the
         scene has a static mode only.
@@ -155,9 +155,6 @@ class SpatialScene:
             raise SceneError(f"platform.anchors must give one anchor per cable ({m}), got {len(self.platform.anchors)}")
         if not isinstance(self.effects, Effects):
             raise SceneError(f"effects must be an effects table, got {self.effects!r}")
-        if self.effects.slack:
-            raise SceneError("effects.slack = true: tension-only elements are planar only so far; "
-                             "set effects.slack = false for a spatial scene")
         if not (self.effects.cable_mass and self.effects.axial_elasticity):
             raise SceneError(f"effects.preset = {self.effects.preset!r}: a spatial scene needs lumped, elastic cables "
                              "(effects.cable_mass and effects.axial_elasticity); use the 'full' or 'catenary' preset")
@@ -191,10 +188,15 @@ class SpatialScene:
                   for c, e, a in zip(self.cables, self.exits, self.platform.anchors)]
         return SpatialPlatform(cables, self.platform.mass, gravity, self.platform.inertia)
 
-    def chain_spec(self, anchor_spring_factor: float | None = None) -> SpatialChainSpec:
-        """The lumped cables (:mod:`cdpr_exu.physics.spatial_robot`), with the scene's effects."""
+    def chain_spec(self, anchor_spring_factor: float | None = None, tension_only: bool | None = None) -> SpatialChainSpec:
+        """The lumped cables (:mod:`cdpr_exu.physics.spatial_robot`), with the scene's effects.
+
+        ``tension_only`` defaults to ``effects.slack``; the static mode asks for False (Exudyn's
+        static solver needs every element's stiffness, which a slack element has not).
+        """
         cable = self.cables[0]
         return SpatialChainSpec(
+            tension_only=self.effects.slack if tension_only is None else bool(tension_only),
             n_elements=cable.n_elements,
             axial_damping_constant=cable.damping_constant * cable.area if self.effects.axial_damping else 0.0,
             flexural_rigidity=cable.youngs_modulus * cable.second_moment if self.effects.bending else 0.0,

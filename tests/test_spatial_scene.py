@@ -115,7 +115,7 @@ def test_cdpr_static_on_a_spatial_scene_prints_the_pose_and_writes_a_strict_summ
 
 @pytest.mark.parametrize("change, field", [
     (lambda d: d.update(exits=d["exits"][:1]), "exits"),
-    (lambda d: d.update(effects={"slack": True}), "effects.slack"),
+    (lambda d: d.update(effects={"preset": "ideal"}), "effects.preset"),
     (lambda d: d.update(cables=[{}, {"n_elements": 20}]), "cables\\[1\\].n_elements"),
     (lambda d: d.update(dimension=4), "dimension"),
     (lambda d: d.pop("exits"), "exits"),
@@ -144,3 +144,11 @@ def test_the_ipanema_scene_is_held_from_above_and_below_at_its_design_pose():
     assert np.all(upper[:, 2] > 0.0) and np.all(lower[:, 2] < 0.0)  # pulled up and pulled down
     assert np.all(rest.tensions_at_anchor > 50.0)  # the pretension floor the lengths were made with
 
+
+
+def test_the_static_mode_reports_every_element_taut_on_the_shipped_robots():
+    for name in ("spatial-four-cable", "spatial-cogiro", "spatial-ipanema"):
+        summary = solve_spatial_rest(load_spatial_scene(name)).summary()
+        # the lowest of all elements (4 x 20 or 8 x 20): the four-cable robot's slackest cable
+        # still carries about 10 N; nothing is compressed
+        assert summary["min_element_tension_N"] > 5.0 and not summary["elements_pushed"], name

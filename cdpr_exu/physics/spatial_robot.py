@@ -7,7 +7,10 @@ held at the cable's exit point (a point exit, no pulley). Its last node is joine
 the platform's anchor by an ``ObjectJointSpherical`` (the three translations; a
 spherical joint transmits no moment, like a cable end on a swivel eye), or, when
 ``SpatialChainSpec.anchor_spring_factor`` is given, by a stiff
-``ObjectConnectorCartesianSpringDamper`` (a penalty spherical joint).
+``ObjectConnectorCartesianSpringDamper`` (a penalty spherical joint). With
+``SpatialChainSpec.tension_only`` the axial elements are tension-only
+(:mod:`cdpr_exu.physics.axial_3d`, in the chain's ``ObjectGenericODE2``) instead of
+Exudyn's spring-dampers, which push when compressed.
 
 Why the penalty joint exists (measured): Exudyn's static solver does not converge
 when an ``ObjectJointSpherical`` holds a rigid body's ``MarkerBodyPosition`` and the
@@ -56,6 +59,7 @@ from exudyn.rigidBodyUtilities import RigidBodyInertia
 from cdpr_exu.errors import SceneError, SolverFailure
 from cdpr_exu.validation import non_negative, positive
 
+from . import axial_3d
 from .chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
 from ..geometry import rotation_vector
 from .spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, solve_spatial_statics
@@ -81,14 +85,22 @@ class SpatialChainSpec:
         adds ``1 / (f n)`` of the cable's compliance (1000: a 20-element cable
         stretches 5e-5 of its stretch more). Needed for Exudyn's static solver on a
         rigid platform (see the module notes).
+    tension_only : bool
+        Tension-only axial elements (a cable cannot push; a slack element carries
+        nothing, :mod:`cdpr_exu.physics.axial_3d`) instead of Exudyn's
+        ``ObjectConnectorSpringDamper``; a taut element is the same spring-damper.
     """
 
     n_elements: int = 20
     axial_damping_constant: float = 0.0
     flexural_rigidity: float = 0.0
     anchor_spring_factor: float | None = None
+    tension_only: bool = False
 
     def __post_init__(self):
+        if not isinstance(self.tension_only, (bool, np.bool_)):
+            raise SceneError(f"tension_only must be True or False, got {self.tension_only!r}")
+        object.__setattr__(self, "tension_only", bool(self.tension_only))
         if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
             raise SceneError(f"n_elements must be a whole number, got {self.n_elements!r}")
         if self.n_elements < 2:
@@ -215,7 +227,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         masses[[0, -1]] = 0.5 * element_mass
         reference, current = _chain_positions(equilibrium_cable, length, n)
         items = add_spatial_chain(mbs, reference, masses, float(k), float(c), float(k_theta), gravity=gravity,
-                                  hold_first=True)
+                                  hold_first=True, tension_only=chain.tension_only)
         for node, displacement in zip(items.nodes, current - reference):
             mbs.SetNodeParameter(node, "initialCoordinates", [float(x) for x in displacement])
         chains.append(items)
@@ -293,13 +305,44 @@ def anchor_forces(mbs, items):
                      for joint in items.joints])
 
 
+def element_forces(mbs, items, cable, current=True):
+    """Axial force of each element of one cable [N], shape (n,), exit first (tension > 0).
+
+    As the model computes it: Exudyn's spring-damper k (l - l0) + c dl/dt with the
+    parameters the connectors hold now (negative when compressed), or, with
+    ``tension_only``, the tension-only law with the arrays the chain's force reads
+    (never negative).
+    """
+    chain = items.chains[cable]
+    configuration = _configuration(current)
+    q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
+                        for node in chain.nodes])
+    v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
+                        for node in chain.nodes])
+    positions = chain.reference + q
+    if chain.tension_only:
+        return axial_3d.tension_only_tensions(positions, v, chain.axial_elements, chain.axial_rest_length,
+                                              chain.axial_stiffness, chain.axial_damping, chain.axial_rest_rate,
+                                              np.zeros(len(chain.axial_elements)))
+    points, velocities = positions.reshape(-1, 3), v.reshape(-1, 3)
+    delta, delta_rate = np.diff(points, axis=0), np.diff(velocities, axis=0)
+    length = np.linalg.norm(delta, axis=1)
+    rate = np.einsum("ij,ij->i", delta, delta_rate) / length
+    rest, stiffness, damping = (np.array([mbs.GetObjectParameter(spring, name) for spring in chain.springs])
+                                for name in ("referenceLength", "stiffness", "damping"))
+    return stiffness * (length - rest) + damping * rate
+
+
 def anchor_points(mbs, items):
     """World positions of the anchors on the platform, shape (n_cables, 3) [m] (current state)."""
     return np.array([mbs.GetMarkerOutput(marker, exu.OutputVariableType.Position) for marker in items.anchor_markers])
 
 
 def robot_energy(mbs, items, current=True):
-    """Mechanical energy [J] of cables and platform: kinetic, gravity (z up), axial and bending springs."""
+    """Mechanical energy [J] of cables and platform: kinetic, gravity (z up), axial and bending springs.
+
+    Tension-only elements store the potential of their undamped law
+    (:func:`cdpr_exu.physics.axial_3d.tension_only_energy`: 0 below the rest length)."""
     configuration = _configuration(current)
     gravity = items.platform.gravity
     energy = 0.0

@@ -1,0 +1,169 @@
+"""Tension-only (slack) axial spring-dampers of spatial lumped-mass cables: numba kernels.
+
+The spatial counterpart of :mod:`cdpr_exu.axial`, with the same law
+(:func:`cdpr_exu.axial.tension_law`, imported, not copied): element e between nodes
+a and b pulls them together along u = (p_b - p_a) / l with
+
+    T = g(s) max(0, k s + c ds/dt),   s = l - l0,   ds/dt = u . (v_b - v_a) - dl0/dt,
+
+g a C1 smoothstep from 0 at the rest length to 1 at a strain of
+:data:`cdpr_exu.axial.TAUT_BAND`. Below the rest length there is no force at all, not
+even damping. Above the band a taut element is exactly Exudyn's
+``ObjectConnectorSpringDamper`` (k (l - l0) + c (dl/dt - dl0/dt) along the element, its
+``velocityOffset`` the rest length's rate ``rest_rate``, nonzero while a winch pays the
+cable out: the damper acts on the strain rate).
+
+The left-hand-side Jacobians K = -df/dq and D = -df/dv are handed to Exudyn as
+``f_q K + f_q_t D`` (the convention of :mod:`cdpr_exu.physics.bending_3d` and of the
+planar :mod:`cdpr_exu.cable`), as sparse triplets in a fixed pattern: one 6 x 6 block
+per element on the coordinates (p_a, p_b). With G the (b, b) block,
+
+    G_ij = f_q [u_i (k' u_j + c' w_j) + T (delta_ij - u_i u_j) / l] + f_q_t c' u_i u_j,
+    w = (dv - u ds/dt) / l = d(ds/dt)/dp_b,
+
+(k', c' the slopes of the law in s and ds/dt) the block is [[G, -G], [-G, G]]; it is
+zero for a slack element.
+
+No Exudyn here: coordinates are flat arrays (x0, y0, z0, x1, ...) [m, m/s].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from cdpr_exu.axial import TAUT_BAND, tension_law
+
+#: Triplets per element: the 6 x 6 block on (p_a, p_b).
+TRIPLETS_PER_ELEMENT = 36
+
+
+@njit(cache=True)
+def _element_state(positions, velocities, a, b, u, dv):
+    """Length [m] and length rate [m/s] of element (a, b); its unit vector into ``u`` (3,)
+    and the relative velocity v_b - v_a into ``dv`` (3,)."""
+    length2 = 0.0
+    for k in range(3):
+        d = positions[3 * b + k] - positions[3 * a + k]
+        u[k] = d
+        dv[k] = velocities[3 * b + k] - velocities[3 * a + k]
+        length2 += d * d
+    length = np.sqrt(length2)
+    rate = 0.0
+    for k in range(3):
+        u[k] /= length
+        rate += u[k] * dv[k]
+    return length, rate
+
+
+@njit(cache=True)
+def tension_only_tensions(positions, velocities, elements, rest_length, stiffness, damping, rest_rate, out):
+    """Tension [N] of each element (E,) into ``out`` (never negative; 0 when slack)."""
+    u = np.empty(3)
+    dv = np.empty(3)
+    for e in range(elements.shape[0]):
+        length, rate = _element_state(positions, velocities, elements[e, 0], elements[e, 1], u, dv)
+        out[e], _, _ = tension_law(length - rest_length[e], rate - rest_rate[e], stiffness[e], damping[e],
+                                   TAUT_BAND * rest_length[e])
+    return out
+
+
+@njit(cache=True)
+def tension_only_force(positions, velocities, elements, rest_length, stiffness, damping, rest_rate, out):
+    """Add the tension-only axial forces [N] to ``out`` (3N,) (accumulated, not zeroed) and return it.
+
+    Parameters
+    ----------
+    positions, velocities : ndarray, shape (3N,) [m, m/s]
+    elements : ndarray of int, shape (E, 2)
+        Node pairs (a, b).
+    rest_length, stiffness, damping : ndarray, shape (E,) [m, N/m, N s/m]
+    rest_rate : ndarray, shape (E,) [m/s]
+        dl0/dt of each element (0 but while a winch changes the cable's length).
+    out : ndarray, shape (3N,)
+    """
+    u = np.empty(3)
+    dv = np.empty(3)
+    for e in range(elements.shape[0]):
+        a, b = elements[e, 0], elements[e, 1]
+        length, rate = _element_state(positions, velocities, a, b, u, dv)
+        force, _, _ = tension_law(length - rest_length[e], rate - rest_rate[e], stiffness[e], damping[e],
+                                  TAUT_BAND * rest_length[e])
+        if force <= 0.0:
+            continue
+        for k in range(3):
+            out[3 * a + k] += force * u[k]
+            out[3 * b + k] -= force * u[k]
+    return out
+
+
+@njit(cache=True)
+def tension_only_energy(positions, elements, rest_length, stiffness):
+    """Elastic energy [J] of the elements: the potential of the undamped law, k int_0^s g(x) x dx.
+
+    Zero at and below the rest length; inside the band (x = s / b, b = TAUT_BAND l0)
+    k b^2 (3 x^4 / 4 - 2 x^5 / 5); above it k (s^2 - b^2) / 2 + 0.35 k b^2, which differs
+    from Exudyn's spring energy k s^2 / 2 by 0.15 k b^2 (1.5e-11 k l0^2). The damper's
+    force has no potential; with damping the law's cut-off max(0, k s + c ds/dt) also
+    acts on the elastic part, which this energy does not see.
+    """
+    energy = 0.0
+    for e in range(elements.shape[0]):
+        a, b = elements[e, 0], elements[e, 1]
+        length2 = 0.0
+        for k in range(3):
+            d = positions[3 * b + k] - positions[3 * a + k]
+            length2 += d * d
+        extension = np.sqrt(length2) - rest_length[e]
+        if extension <= 0.0:
+            continue
+        band = TAUT_BAND * rest_length[e]
+        if extension >= band:
+            energy += stiffness[e] * (0.5 * (extension * extension - band * band) + 0.35 * band * band)
+        else:
+            x = extension / band
+            energy += stiffness[e] * band * band * x ** 4 * (0.75 - 0.4 * x)
+    return energy
+
+
+@njit(cache=True)
+def tension_only_pattern(elements):
+    """Rows and columns of the triplets: the 6 x 6 block on (p_a, p_b) per element, shape (36 E,) each."""
+    n = elements.shape[0]
+    rows = np.empty(TRIPLETS_PER_ELEMENT * n, dtype=np.int64)
+    columns = np.empty(TRIPLETS_PER_ELEMENT * n, dtype=np.int64)
+    for e in range(n):
+        for i in range(6):
+            for j in range(6):
+                rows[36 * e + 6 * i + j] = 3 * elements[e, i // 3] + i % 3
+                columns[36 * e + 6 * i + j] = 3 * elements[e, j // 3] + j % 3
+    return rows, columns
+
+
+@njit(cache=True)
+def tension_only_triplet_values(positions, velocities, elements, rest_length, stiffness, damping, rest_rate,
+                                factor_position, factor_velocity, out_values):
+    """``factor_position * K + factor_velocity * D`` (K = -df/dq, D = -df/dv) at
+    :func:`tension_only_pattern`'s places; overwrites ``out_values`` (36 E,)."""
+    out_values[:] = 0.0
+    u = np.empty(3)
+    dv = np.empty(3)
+    for e in range(elements.shape[0]):
+        length, rate = _element_state(positions, velocities, elements[e, 0], elements[e, 1], u, dv)
+        force, k, c = tension_law(length - rest_length[e], rate - rest_rate[e], stiffness[e], damping[e],
+                                  TAUT_BAND * rest_length[e])
+        if force <= 0.0:
+            continue
+        for i in range(3):
+            for j in range(3):
+                w_j = (dv[j] - u[j] * rate) / length
+                projector = (1.0 if i == j else 0.0) - u[i] * u[j]
+                g = u[i] * (k * u[j] + c * w_j) + force * projector / length
+                value = factor_position * g + factor_velocity * c * u[i] * u[j]
+                base = 36 * e + 6 * i + j
+                out_values[base] = value  # (a, a)
+                out_values[base + 21] = value  # (b, b): 3 rows and 3 columns on
+                out_values[base + 3] = -value  # (a, b)
+                out_values[base + 18] = -value  # (b, a)
+    return out_values
+
