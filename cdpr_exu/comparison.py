@@ -19,7 +19,7 @@ import numpy as np
 from controllers.ideal_ik import IdealIKController
 from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
 
-from .errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SolverFailure
+from .errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SceneError, SolverFailure
 from .output import fixed
 from .result import Result, provenance
 from .scene import Scene, load_scene
@@ -143,6 +143,30 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
         plot_comparison(scene, results, out)
 
 
+def _compare_spatial(scene, args: argparse.Namespace) -> int:
+    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.spatial_run.compare_spatial`)."""
+    from dataclasses import replace
+
+    from .spatial_run import check_spatial_reference, compare_spatial, spatial_comparison_table
+
+    if args.end_time is not None:
+        scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr compare` needs one")
+    check_spatial_reference(scene)
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
+    summaries = compare_spatial(scene, names, args.out, args.after, quiet=args.quiet)
+    if not args.quiet:
+        print()
+        print(spatial_comparison_table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    return EXIT_RUN_FAILED if failed else EXIT_OK
+
+
 def _cmd_compare(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
@@ -150,6 +174,11 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from .workspace import check_reference
 
     check_output_folder(args.out)
+    from .spatial_scene import is_spatial, load_any_scene
+
+    spatial = load_any_scene(args.scene)
+    if is_spatial(spatial):
+        return _compare_spatial(spatial, args)
     scene = load_scene(args.scene)
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))

@@ -40,39 +40,18 @@ from matplotlib.figure import Figure
 from .errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from .geometry import rotation_from_vector, rotation_vector
 from .output import write_npz, write_summary
-from .physics.spatial_kinematics import inverse_kinematics, inverse_kinematics_rates
 from .physics.spatial_robot import build_spatial_robot, chain_positions, platform_pose
 from .physics.spatial_statics import solve_spatial_statics
+from controllers.base import Controller, Measurement
+from controllers.ideal_ik import IdealIKController, ideal_paid_out
+
 from .result import provenance
 from .simulate import interrupt_flag, quiet_exudyn, solver_settings
 from .scene import tension_limits
 from .spatial_scene import SpatialScene
 from .workspace import first_unheld, limits_text
 
-__all__ = ["SpatialResult", "simulate_spatial", "ideal_paid_out_spatial"]
-
-
-def _ik_arguments(scene: SpatialScene, poses: np.ndarray):
-    """Poses (N, 3) or (N, 6) and anchors (or None) as the spatial kinematics takes them."""
-    poses = np.atleast_2d(poses)
-    if scene.platform.is_point_mass:
-        return poses[:, :3], None
-    return poses, np.asarray(scene.platform.anchors)
-
-
-def ideal_paid_out_spatial(scene: SpatialScene, poses: np.ndarray, start_lengths: np.ndarray) -> np.ndarray:
-    """Ideal paid-out lengths [m], shape (N, m), for reference poses (N, 6): the start lengths plus the
-    change of each straight exit-to-anchor distance from the first pose."""
-    points, anchors = _ik_arguments(scene, poses)
-    lengths = inverse_kinematics(points, anchors, np.asarray(scene.exits), 0.0)
-    return start_lengths + lengths - lengths[0]
-
-
-def ideal_paid_out_rate_spatial(scene: SpatialScene, pose: np.ndarray, pose_rate: np.ndarray) -> np.ndarray:
-    """Rate [m/s], shape (m,), of the ideal paid-out lengths at one reference pose (6,) and its rate (6,)."""
-    points, anchors = _ik_arguments(scene, pose)
-    rates, _ = _ik_arguments(scene, pose_rate)
-    return np.asarray(inverse_kinematics_rates(points, rates, anchors, np.asarray(scene.exits), 0.0)).reshape(-1)
+__all__ = ["SpatialResult", "simulate_spatial", "check_spatial_reference", "run_spatial_scene"]
 
 
 #: Samples of the reference checked before a run.
@@ -96,7 +75,8 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     """
     times = np.linspace(0.0, scene.solver.end_time, REFERENCE_SAMPLES)
     poses = np.atleast_2d(scene.trajectory.pose(times))
-    lengths = ideal_paid_out_spatial(scene, poses, scene.unstrained_lengths)
+    ideal, _ = ideal_paid_out(scene, poses)
+    lengths = scene.unstrained_lengths + ideal - ideal[0]
     short = np.argwhere(lengths <= 0.0)
     if short.size:
         k, i = short[0]
@@ -280,8 +260,13 @@ def _element_tensions(nodes: np.ndarray, length: float, axial_rigidity: float, n
     return np.maximum(force, 0.0) if tension_only else force
 
 
-def simulate_spatial(scene: SpatialScene, progress=False) -> SpatialResult:
-    """Run ``scene``'s reference under ideal inverse kinematics (kinematic winches).
+def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False) -> SpatialResult:
+    """Run ``scene``'s reference under ``controller`` (default: ideal inverse kinematics).
+
+    The controller is any :class:`controllers.base.Controller` that works on spatial
+    scenes (:class:`controllers.ideal_ik.IdealIKController`,
+    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController`); it is asked
+    for the winch commands before every step. Open loop so far: it reads no pose.
 
     Raises
     ------
@@ -307,6 +292,11 @@ def simulate_spatial(scene: SpatialScene, progress=False) -> SpatialResult:
     m, n = scene.n_cables, scene.cables[0].n_elements
     times, poses, paid, node_series = [], [], [], [[] for _ in range(m)]
     kinematic = scene.winch.kind == "kinematic"
+    controller = controller or IdealIKController()
+    if controller.uses_pose or controller.uses_tension:
+        raise SceneError(f"controller {controller.name!r} reads the pose or the tensions: spatial runs give "
+                         "open-loop controllers only so far")
+    controller.reset(scene, lengths.copy())
     state = {"next": 0, "failure": None}
 
     def record(t: float) -> None:
@@ -321,11 +311,15 @@ def simulate_spatial(scene: SpatialScene, progress=False) -> SpatialResult:
         if not kinematic:
             return True
         try:
-            pose = scene.trajectory.pose(t)
-            winches.set_lengths(ideal_paid_out_spatial(scene, np.vstack([scene.trajectory.pose(0.0), pose]), lengths)[1],
-                                ideal_paid_out_rate_spatial(scene, pose, scene.trajectory.velocity(t)))
+            command = controller.command(Measurement(t, winches.applied.copy(), np.zeros(len(lengths))))
+            paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
+            rates = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
+            if paid_out.shape != lengths.shape or not (np.all(np.isfinite(paid_out)) and np.all(paid_out > 0.0)):
+                raise ValueError(f"the command must be {lengths.size} finite positive lengths, got {command.paid_out!r}")
+            winches.set_lengths(paid_out, rates)
         except Exception as err:  # noqa: BLE001 - reported as the cause of the stop, with the partial result
-            state["failure"] = f"the winch commands failed at t = {t:.4f} s: {type(err).__name__}: {err}"
+            state["failure"] = (f"controller {controller.name!r} raised at t = {t:.4f} s: "
+                                f"{type(err).__name__}: {err}")
             return False
         return True
 
@@ -361,7 +355,7 @@ def simulate_spatial(scene: SpatialScene, progress=False) -> SpatialResult:
                           for frame, length in zip(nodes[i], paid_out[:, i])])
                 for i, cable in enumerate(scene.cables)]
     iterations = mbs.sys["dynamicSolver"].it
-    result = SpatialResult(scene.name, "ideal_ik" if kinematic else "fixed winches", time_array, pose,
+    result = SpatialResult(scene.name, controller.name if kinematic else "fixed winches", time_array, pose,
                            np.atleast_2d(scene.trajectory.pose(time_array)), paid_out, nodes, tensions, wall,
                            int(iterations.currentStepIndex), int(iterations.newtonStepsCount))
     reached = float(time_array[-1])
@@ -465,4 +459,60 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
         if out is not None:
             print(f"  written to {out}/")
     return result
+
+
+#: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
+SPATIAL_CONTROLLERS = {
+    "ideal_ik": IdealIKController,
+    "tension_aware": lambda: __import__("controllers.spatial_tension_aware",
+                                        fromlist=["SpatialTensionAwareController"]).SpatialTensionAwareController(),
+}
+
+_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
+            ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
+            ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
+
+
+def spatial_comparison_table(summaries: dict) -> str:
+    """The spatial comparison as a Markdown table (errors after the summaries' ``after``)."""
+    lines = ["| controller | " + " | ".join(title for _, title, _ in _COLUMNS) + " | vs ideal IK | status |",
+             "|" + "---|" * (len(_COLUMNS) + 3)]
+    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
+    for name, s in summaries.items():
+        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in _COLUMNS]
+        worst = s.get("max_position_error_m")
+        ratio = f"{base / worst:.1f}x" if base and worst else ""
+        pushed = "; cables pushed" if s.get("elements_pushed") else ""
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{pushed} |")
+    return "\n".join(lines) + "\n"
+
+
+def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
+                    after: float = 1.0, quiet: bool = True) -> dict[str, dict]:
+    """Run a spatial scene under each named controller; write summary.json, comparison.md and each
+    controller's overview figure to ``out``. Returns the summaries by name."""
+    from .output import write_summary as _write
+
+    names = list(names or SPATIAL_CONTROLLERS)
+    unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
+    if unknown:
+        raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
+    summaries = {}
+    for name in names:
+        try:
+            result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
+        except SolverFailure as err:
+            result = err.partial_result
+        summaries[name] = result.summary(after)
+        if out is not None:
+            Path(out).mkdir(parents=True, exist_ok=True)
+            plot_spatial_run(result, Path(out) / f"overview_{name}.png", after)
+        if not quiet:
+            worst = summaries[name]["max_position_error_m"]
+            print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   {summaries[name]['status']}")
+    if out is not None:
+        _write(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
+                     "error_convention": "actual - reference", "controllers": summaries, **provenance()})
+        (Path(out) / "comparison.md").write_text(spatial_comparison_table(summaries))
+    return summaries
 

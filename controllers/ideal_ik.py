@@ -15,6 +15,25 @@ from cdpr_exu.kinematics import inverse_kinematics, inverse_kinematics_rates, pu
 from .base import Measurement, WinchCommand
 
 
+def _spatial_ideal_lengths(scene, poses, pose_rates=None):
+    """:func:`ideal_paid_out` of a spatial scene: straight distances from the exit points to the
+    anchors, poses (N, 6) (x, y, z, rotation vector); a point-mass platform's rotation is ignored."""
+    from cdpr_exu.physics.spatial_kinematics import inverse_kinematics, inverse_kinematics_rates
+
+    poses = np.atleast_2d(poses)
+    exits = np.asarray(scene.exits)
+    if scene.platform.is_point_mass:
+        points, anchors = poses[:, :3], None
+        rates = None if pose_rates is None else np.atleast_2d(pose_rates)[:, :3]
+    else:
+        points, anchors = poses, np.asarray(scene.platform.anchors)
+        rates = None if pose_rates is None else np.atleast_2d(pose_rates)
+    lengths = inverse_kinematics(points, anchors, exits, 0.0)
+    if rates is None:
+        return lengths, None
+    return lengths, inverse_kinematics_rates(points, rates, anchors, exits, 0.0)
+
+
 def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = None):
     """Ideal paid-out lengths (and rates) of every cable for reference poses.
 
@@ -29,6 +48,8 @@ def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = Non
     lengths : ndarray, shape (N, m) [m]
     rates : ndarray, shape (N, m) [m/s] or None
     """
+    if getattr(scene, "dimension", 2) == 3:
+        return _spatial_ideal_lengths(scene, poses, pose_rates)
     anchors = np.asarray(scene.platform.anchors)
     centers, radii, sides = pulley_arrays(scene.exits)
     lengths = inverse_kinematics(poses, anchors, centers, radii, sides)

@@ -245,3 +245,38 @@ def test_no_equilibrium_within_the_tension_limit_is_a_clear_error():
     # short cables: the platform can only hang from them at tensions far above 10 N
     with pytest.raises(UnreachableError, match="no equilibrium found for unstrained_lengths"):
         solve_spatial_statics(four_cable_robot(False), [2.3] * 4, max_tension=10.0)
+
+
+# ---------------------------------------------------------------------------
+# the inverse: lengths that hold a pose
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["spatial-cogiro", "spatial-ipanema"])
+def test_the_catenaries_of_the_inverse_lengths_hold_the_platform_at_the_asked_pose(name):
+    from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics
+    from cdpr_exu.spatial_scene import load_spatial_scene
+
+    scene = load_spatial_scene(name)
+    platform = scene.catenary_platform()
+    rest = solve_spatial_statics(platform, scene.unstrained_lengths)
+    tensions = np.array([c.catenary.horizontal_tension for c in rest.cables])
+    pose = np.concatenate([rest.position, rest.rotation_vector])
+    # at the rest pose, with the rest's tensions: the scene's own lengths come back
+    back = solve_inverse_spatial_statics(platform, pose, tensions)
+    np.testing.assert_allclose(back.unstrained_lengths, scene.unstrained_lengths, atol=1e-9)
+    # elsewhere: the forward statics of the inverse lengths put the platform there (measured
+    # 5e-12 m and rad for both robots: two solvers of the same equations, each to 1e-9 or better)
+    target = pose + np.array([0.1, -0.05, 0.02, 0.0, 0.0, 0.02])
+    inverse = solve_inverse_spatial_statics(platform, target, back.horizontal_tensions)
+    forward = solve_spatial_statics(platform, inverse.unstrained_lengths, initial_pose=target)
+    np.testing.assert_allclose(forward.position, target[:3], atol=1e-9)
+    np.testing.assert_allclose(forward.rotation_vector, target[3:], atol=1e-9)
+    # the tensions stay nearest the start: an over-constrained robot keeps its internal tension
+    assert np.abs(inverse.horizontal_tensions - tensions).max() < 0.5 * tensions.max()
+
+
+def test_the_inverse_refuses_a_pose_only_a_pushing_cable_could_hold():
+    from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics
+
+    platform = four_cable_robot(rigid=False)
+    with pytest.raises(UnreachableError, match="outside the wrench-feasible workspace|did not converge"):
+        solve_inverse_spatial_statics(platform, [0.0, 0.0, 0.5], np.full(4, 10.0))  # above the exits

@@ -50,7 +50,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from cdpr_exu.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
-    profile, solve_forward
+    profile, solve_forward, solve_inverse
 from cdpr_exu.errors import SceneError, UnreachableError
 from cdpr_exu.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
 from cdpr_exu.statics import PlatformEquilibriumViews, _minimise_energy  # the planar statics' line search, reused
@@ -558,3 +558,120 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
         stiffness=-jacobian,
         net_wrench=wrench_total,
     )
+
+
+# ---------------------------------------------------------------------------
+# the inverse: lengths that hold a pose
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SpatialInverse:
+    """Unstrained lengths that hold the platform at a pose on elastic catenaries.
+
+    Attributes
+    ----------
+    unstrained_lengths : ndarray, shape (n_cables,) [m]
+    horizontal_tensions : ndarray, shape (n_cables,) [N]
+    forces_on_platform : ndarray, shape (n_cables, 3) [N]
+    residual : float [N]
+        Largest remaining force (and moment / arm) imbalance of the platform.
+    """
+
+    unstrained_lengths: np.ndarray
+    horizontal_tensions: np.ndarray
+    forces_on_platform: np.ndarray
+    residual: float
+
+
+def _inverse_cable(cable, anchor_point, horizontal_tension):
+    """Unstrained length [m] and force on the platform (3,) [N] of one cable at horizontal tension H."""
+    exit_point = np.array(cable.exit_point)
+    span = exit_point - anchor_point
+    horizontal = float(math.hypot(span[0], span[1]))
+    if horizontal <= 0.0:
+        raise UnreachableError(f"cable from {tuple(exit_point)} hangs vertically above its anchor: its horizontal "
+                               "tension is zero and the inverse catenary has no answer")
+    direction = np.array([span[0], span[1], 0.0]) / horizontal
+    length, state = solve_inverse((horizontal, span[2]), cable.weight_per_length, cable.axial_stiffness,
+                                  horizontal_tension)
+    return length, state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z
+
+
+def solve_inverse_spatial_statics(platform, pose, horizontal_guess, external_wrench=None, tolerance=1e-9,
+                                  max_iterations=30):
+    """Unstrained lengths that hold ``platform`` at ``pose`` on elastic catenaries, tensions nearest a guess.
+
+    The cables' horizontal tensions ``H`` (m,) are chosen closest to ``horizontal_guess``
+    (least squares) among those whose catenaries balance the platform: the force, and for
+    a rigid platform held by at least six cables the moment too (with fewer, the rotation is
+    left free, as a suspended platform does). Gauss-Newton on the balance, each cable's
+    force derivative by a forward difference of its inverse catenary
+    (:func:`cdpr_exu.catenary.solve_inverse`). Continuing from the previous sample's tensions
+    along a trajectory gives the tension path with the least change: an over-constrained
+    robot keeps the internal tension it started with.
+
+    Parameters
+    ----------
+    platform : SpatialPlatform
+    pose : array_like, shape (3,) or (6,) [m, rad]
+        Centre of mass and (rigid) rotation vector.
+    horizontal_guess : array_like, shape (n_cables,) [N]
+        Positive horizontal tensions to stay close to (eg the previous sample's).
+    external_wrench : array_like, shape (6,) [N, N m], optional
+        Extra load on the platform (eg the d'Alembert force of an acceleration).
+
+    Returns
+    -------
+    SpatialInverse
+
+    Raises
+    ------
+    UnreachableError
+        If no positive tensions balance the platform there (the balance does not converge,
+        or a tension would have to be negative: outside the wrench-feasible workspace).
+    """
+    pose = real_array("pose", pose)
+    dof = platform.degrees_of_freedom
+    if pose.shape != (6,) and not (dof == 3 and pose.shape == (3,)):
+        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {pose.tolist()!r}")
+    guess = real_array("horizontal_guess", horizontal_guess)
+    if guess.shape != (len(platform.cables),) or np.any(guess <= 0.0):
+        raise SceneError(f"horizontal_guess must be one positive tension per cable, got {horizontal_guess!r}")
+    wrench = _wrench(external_wrench)
+    position = pose[:3]
+    rotation = rotation_from_vector(pose[3:6]) if pose.shape == (6,) and dof == 6 else np.eye(3)
+    arms = platform.anchors @ rotation.T
+    anchor_points = position + arms
+    rows = 6 if (dof == 6 and len(platform.cables) >= 6) else 3
+    weight = platform.mass * platform.gravity
+    arm_scale = max(float(np.linalg.norm(platform.anchors, axis=1).max()), 1e-3)
+    scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
+
+    def balance(tensions):
+        lengths, forces = zip(*(_inverse_cable(c, p, h) for c, p, h in zip(platform.cables, anchor_points, tensions)))
+        forces = np.array(forces)
+        total = np.concatenate([forces.sum(axis=0) + wrench[:3] - [0.0, 0.0, weight],
+                                np.cross(arms, forces).sum(axis=0) + wrench[3:]])[:rows] * scale
+        return np.array(lengths), forces, total
+
+    tensions = guess.copy()
+    for _ in range(max_iterations):
+        lengths, forces, total = balance(tensions)
+        residual = float(np.abs(total).max())
+        if residual <= tolerance * max(weight, float(np.abs(forces).max()), 1e-12):
+            return SpatialInverse(lengths, tensions, forces, residual)
+        jacobian = np.zeros((rows, len(tensions)))
+        for i, (cable, point, h) in enumerate(zip(platform.cables, anchor_points, tensions)):
+            step = 1e-6 * h
+            _, shifted = _inverse_cable(cable, point, h + step)
+            derivative = (shifted - forces[i]) / step
+            jacobian[:, i] = np.concatenate([derivative, np.cross(arms[i], derivative)])[:rows] * scale
+        # the change nearest the guess that cancels the imbalance to first order
+        offset = tensions - guess
+        correction = -offset + np.linalg.pinv(jacobian) @ (jacobian @ offset - total)
+        tensions = tensions + correction
+        if np.any(tensions <= 0.0):
+            raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: the catenaries balance the platform only if "
+                                   f"a cable pushes (horizontal tensions {np.round(tensions, 3).tolist()} N): it is "
+                                   "outside the wrench-feasible workspace")
+    raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: the catenaries' balance did not converge "
+                           f"(imbalance {residual:.3g} N after {max_iterations} iterations)")
