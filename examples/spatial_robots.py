@@ -1,0 +1,40 @@
+"""The shipped spatial robots at rest and under both controllers.
+
+Run:  python examples/spatial_robots.py
+
+Writes ``results/spatial/<scene>/static/`` (``cdpr static``: summary.json and the 3-D rest
+figure of spatial-four-cable, spatial-cogiro and spatial-ipanema) and
+``results/spatial/<scene>/compare/`` (``cdpr compare``: summary.json, comparison.md and an
+overview figure per controller, for spatial-cogiro and spatial-ipanema), and the table
+``results/spatial/controllers.md`` that the README and docs/spatial.md show. About a
+minute on one core.
+"""
+
+from pathlib import Path
+
+from cdpr_exu.spatial_rest import solve_spatial_rest
+from cdpr_exu.spatial_run import compare_spatial
+from cdpr_exu.spatial_scene import load_spatial_scene
+
+RESULTS = Path("results/spatial")
+
+
+def main() -> None:
+    for name in ("spatial-four-cable", "spatial-cogiro", "spatial-ipanema"):
+        rest = solve_spatial_rest(load_spatial_scene(name))
+        rest.save(RESULTS / name / "static")
+        print(f"{name}: at rest at {rest.position.round(6).tolist()} m")
+    rows = ["| robot | controller | max position error [mm] | RMS position error [mm] | max rotation error [deg] "
+            "| min element tension [N] |", "|---|---|---|---|---|---|"]
+    for name in ("spatial-cogiro", "spatial-ipanema"):
+        summaries = compare_spatial(load_spatial_scene(name), out=RESULTS / name / "compare", quiet=False)
+        for controller, s in summaries.items():
+            rows.append(f"| {name} | {controller} | {1000 * s['max_position_error_m']:.3f} | "
+                        f"{1000 * s['rms_position_error_m']:.3f} | {s['max_rotation_error_deg']:.4f} | "
+                        f"{s['min_element_tension_N']:.1f} |")
+    (RESULTS / "controllers.md").write_text("\n".join(rows) + "\n")
+    print("\n".join(rows))
+
+
+if __name__ == "__main__":
+    main()
