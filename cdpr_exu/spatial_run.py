@@ -189,16 +189,18 @@ class SpatialResult:
             "failure_time_s": self.failure_time, "notes": notes,
         }
 
-    def save(self, folder: str | Path, after: float = 1.0) -> list[Path]:
-        """Write result.npz, summary.json and the figures into ``folder``; returns the paths."""
+    def save(self, folder: str | Path, after: float = 1.0, figures: bool = True) -> list[Path]:
+        """Write result.npz, summary.json and (``figures``) overview.png into ``folder``; returns the paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = nodes, tensions
-        return [write_npz(folder / "result.npz", **arrays),
-                write_summary(folder, {**self.summary(after), **provenance()}),
-                plot_spatial_run(self, folder / "overview.png", after)]
+        written = [write_npz(folder / "result.npz", **arrays),
+                   write_summary(folder, {**self.summary(after), **provenance()})]
+        if figures:
+            written.append(plot_spatial_run(self, folder / "overview.png", after))
+        return written
 
 
 class _SpatialWinches:
@@ -426,12 +428,8 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
     On a solver failure the partial result is written before the error propagates.
     """
     def write(result: SpatialResult) -> None:
-        if out is None:
-            return
-        if figures:
-            result.save(out, after)
-        else:
-            write_summary(out, {**result.summary(after), **provenance()})
+        if out is not None:
+            result.save(out, after, figures)
 
     try:
         result = simulate_spatial(scene, progress=not quiet)

@@ -780,6 +780,13 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
 
 def _cmd_animate(args: argparse.Namespace) -> int:
+    from .spatial_animation import is_spatial_run, render_spatial_animation
+
+    if is_spatial_run(args.run_dir):  # matplotlib's 3-D axes, not Exudyn's renderer
+        out, frames = render_spatial_animation(args.run_dir, args.out, fps=args.fps, every=args.every, size=args.size)
+        if not args.quiet:
+            print(f"wrote {out}: {frames} frames of {args.size[0]}x{args.size[1]} at {args.fps:g} frames/s")
+        return 0
     out, frames, seconds = _render_animation(args.run_dir, args.out, fps=args.fps, every=args.every,
                                              size=args.size, frames_dir=args.frames_dir,
                                              progress=not args.quiet, multi_sampling=2)
@@ -803,7 +810,8 @@ def add_commands(subparsers) -> None:
     animate = subparsers.add_parser(
         "animate", help="render a run to a GIF or MP4 without a display",
         description="Render a run folder (written by `cdpr run SCENE --out DIR`) with Exudyn's software "
-        "raytracer, no display needed, into a GIF (or an MP4 with imageio-ffmpeg installed).",
+        "raytracer, no display needed, into a GIF (or an MP4 with imageio-ffmpeg installed); a spatial run "
+        "folder is drawn with matplotlib's 3-D axes into a GIF.",
         epilog=EPILOG_ANIMATE + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     animate.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
     animate.add_argument("--out", help="animation file, .gif or .mp4 (default: RUN_DIR/animation.gif)")

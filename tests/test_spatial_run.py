@@ -132,3 +132,18 @@ def test_cdpr_compare_on_a_spatial_scene_writes_the_table_and_each_controller(tm
     assert set(summary["controllers"]) == {"ideal_ik", "tension_aware"}
     assert "| tension_aware |" in (out / "comparison.md").read_text()
     assert (out / "overview_tension_aware.png").exists()
+
+
+def test_cdpr_animate_renders_a_spatial_run_headless(tmp_path):
+    from PIL import Image
+
+    run = tmp_path / "run"
+    assert subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", "spatial-ipanema", "--end-time", "1",
+                           "--out", str(run), "-q", "--no-figures"], timeout=300).returncode == 0
+    # no summary figures asked, so the folder holds result.npz and summary.json only
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "animate", str(run), "--fps", "10", "-q"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    with Image.open(run / "animation.gif") as gif:
+        # 1 s stored every 0.02 s (51 rows), played in real time at 10 frames/s: every 5th row
+        assert gif.n_frames == 11 and gif.size == (640, 480)
