@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cdpr_exu.scene import load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.scenes.scene import load_scene
+from cdpr_exu.run.simulate import simulate
 
 ELEMENTS = (15, 30, 60, 120, 240)
 STEPS = (2e-3, 1e-2)

@@ -8,7 +8,7 @@ import timeit
 
 import numpy as np
 
-from cdpr_exu.bending import (
+from cdpr_exu.physics.bending import (
     BendingSpringDamper,
     bending_force,
     bending_force_and_jacobian,

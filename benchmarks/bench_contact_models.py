@@ -8,7 +8,7 @@ fastest setting that met the 1 mm accuracy before this study, it runs:
 - the same with Exudyn's discontinuous settings loosened
   (``timeIntegration.discontinuous.maxIterations`` 1 and 2);
 - ``node_smooth``: the same penalty law in the cables' numba object, switched on
-  smoothly over a penetration band b (:mod:`cdpr_exu.node_contact`), for b = 0 (sharp),
+  smoothly over a penetration band b (:mod:`cdpr_exu.physics.node_contact`), for b = 0 (sharp),
   1e-5 m (the shipped band), 1e-4 m and 1e-3 m.
 
 It prints x real time, Newton iterations, Jacobian updates and discontinuous
@@ -28,53 +28,53 @@ from pathlib import Path
 
 import numpy as np
 
-import cdpr_exu.model
-import cdpr_exu.node_contact
-import cdpr_exu.simulate
-from cdpr_exu.scene import load_scene
+import cdpr_exu.builder.model
+import cdpr_exu.physics.node_contact
+import cdpr_exu.run.simulate
+from cdpr_exu.scenes.scene import load_scene
 
 
 @contextlib.contextmanager
 def discontinuous_iterations(limit):
     """Run with Exudyn's ``discontinuous.maxIterations`` set to ``limit`` (None: unchanged)."""
-    original = cdpr_exu.simulate.solver_settings
+    original = cdpr_exu.run.simulate.solver_settings
 
     def settings(*args, **kwargs):
         result = original(*args, **kwargs)
         if limit is not None:
             result.timeIntegration.discontinuous.maxIterations = limit
         return result
-    cdpr_exu.simulate.solver_settings = settings
+    cdpr_exu.run.simulate.solver_settings = settings
     try:
         yield
     finally:
-        cdpr_exu.simulate.solver_settings = original
+        cdpr_exu.run.simulate.solver_settings = original
 
 
 @contextlib.contextmanager
 def onset_band(band):
     """Build ``node_smooth`` contacts with onset band ``band`` [m] (None: the shipped one)."""
-    original = cdpr_exu.node_contact.CONTACT_ONSET_DEPTH
-    cdpr_exu.node_contact.CONTACT_ONSET_DEPTH = original if band is None else band
+    original = cdpr_exu.physics.node_contact.CONTACT_ONSET_DEPTH
+    cdpr_exu.physics.node_contact.CONTACT_ONSET_DEPTH = original if band is None else band
     try:
         yield
     finally:
-        cdpr_exu.node_contact.CONTACT_ONSET_DEPTH = original
+        cdpr_exu.physics.node_contact.CONTACT_ONSET_DEPTH = original
 
 
 def run(scene):
     """One run: (result, Exudyn's iteration statistics)."""
     captured = {}
-    build = cdpr_exu.simulate.build_model
+    build = cdpr_exu.run.simulate.build_model
 
     def capture(*args, **kwargs):
         captured["model"] = build(*args, **kwargs)
         return captured["model"]
-    cdpr_exu.simulate.build_model = capture
+    cdpr_exu.run.simulate.build_model = capture
     try:
-        result = cdpr_exu.simulate.simulate(scene)
+        result = cdpr_exu.run.simulate.simulate(scene)
     finally:
-        cdpr_exu.simulate.build_model = build
+        cdpr_exu.run.simulate.build_model = build
     return result, captured["model"].mbs.sys["dynamicSolver"].it
 
 

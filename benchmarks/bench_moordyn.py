@@ -119,8 +119,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
 
 END_TIME = 10.0
 #: MoorDyn's scene sits this far below its free surface [m] (no fluid anyway).

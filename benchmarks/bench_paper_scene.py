@@ -13,8 +13,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from cdpr_exu.scene import load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.scenes.scene import load_scene
+from cdpr_exu.run.simulate import simulate
 
 
 def main() -> None:

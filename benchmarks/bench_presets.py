@@ -27,9 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from cdpr_exu.errors import SolverFailure
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.core.errors import SolverFailure
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
 
 MODELS = (("ideal", {}), ("elastic", {}), ("catenary", {}), ("full", {}), ("full", {"bending_model": "linear"}),
           ("full", {"pulley_contact_model": "segment"}))

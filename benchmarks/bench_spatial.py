@@ -19,8 +19,8 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from cdpr_exu.spatial_run import simulate_spatial
-from cdpr_exu.spatial_scene import load_spatial_scene
+from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.scenes.spatial_scene import load_spatial_scene
 
 RESULTS = Path(__file__).resolve().parent / "results" / "spatial.md"
 

@@ -17,15 +17,15 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from .errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
+from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
                      RunInterrupted, SceneError, SolverFailure)
-from .output import check_output_folder, fixed, write_summary
-from .scene import Scene, load_scene, save_scene, shipped_scenes
+from cdpr_exu.core.output import check_output_folder, fixed, write_summary
+from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
 #: parsers whose ``func`` takes the parsed arguments and returns an exit code.
-COMMAND_MODULES: tuple[str, ...] = ("cdpr_exu.comparison", "cdpr_exu.study", "cdpr_exu.viewer", "cdpr_exu.accuracy",
-                                   "cdpr_exu.rest")
+COMMAND_MODULES: tuple[str, ...] = ("cdpr_exu.studies.comparison", "cdpr_exu.studies.study", "cdpr_exu.post.viewer", "cdpr_exu.studies.accuracy",
+                                   "cdpr_exu.run.rest")
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
 SETTLED_AFTER = 1.0
@@ -108,13 +108,13 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     Writes ``scene.toml``, ``result.npz``, ``pose.csv``, ``summary.json``,
     ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures.
     A failed or interrupted (Ctrl-C) run still writes what was computed up to then,
-    then re-raises. ``out`` and the reference (:func:`cdpr_exu.workspace.check_reference`)
+    then re-raises. ``out`` and the reference (:func:`cdpr_exu.statics.workspace.check_reference`)
     are checked before anything is written. With ``error_estimate``
-    a companion run estimates the discretisation error (:mod:`cdpr_exu.error_estimate`).
+    a companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`).
     """
-    from .result import provenance
-    from .simulate import simulate
-    from .workspace import check_reference
+    from cdpr_exu.results.result import provenance
+    from cdpr_exu.run.simulate import simulate
+    from cdpr_exu.statics.workspace import check_reference
 
     # A reference the cables cannot reach or hold is refused before anything is written
     # (simulate checks it too, but only after scene.toml would be in the folder).
@@ -133,7 +133,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     settled = result.summary(after=SETTLED_AFTER)
     estimate = None
     if error_estimate and failure is None:
-        from .error_estimate import estimate_error
+        from cdpr_exu.run.error_estimate import estimate_error
 
         if not quiet:
             print("estimating the discretisation error (a companion run) ...", flush=True)
@@ -159,7 +159,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         if solution_file is not None and solution_file.is_file():
             undate_solution_file(solution_file)
         if figures and len(result.time) > 1:
-            from .plots import plot_overview
+            from cdpr_exu.post.plots import plot_overview
 
             plot_overview(scene, result, out)
     if not quiet:
@@ -190,8 +190,8 @@ def undate_solution_file(path: Path) -> None:
 
 def _elements_for(scene: Scene, tolerance: float, quiet: bool) -> Scene:
     """The scene with the fewest elements per cable that the error model says meet ``tolerance`` [m]."""
-    from .error_estimate import elements_for_tolerance, estimate_error
-    from .simulate import simulate
+    from cdpr_exu.run.error_estimate import elements_for_tolerance, estimate_error
+    from cdpr_exu.run.simulate import simulate
 
     n = max(c.n_elements for c in scene.cables)
     pilot = estimate_error(scene, simulate(scene), after=SETTLED_AFTER)
@@ -206,15 +206,15 @@ def _elements_for(scene: Scene, tolerance: float, quiet: bool) -> Scene:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .error_estimate import parse_length
+    from cdpr_exu.run.error_estimate import parse_length
 
     out = check_output_folder(args.out)
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
-    from .spatial_scene import is_spatial, load_any_scene
+    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
     spatial = load_any_scene(args.scene)
     if is_spatial(spatial):
-        from .spatial_run import run_spatial_scene
+        from cdpr_exu.run.spatial_run import run_spatial_scene
 
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
         if tolerance is not None:
@@ -231,7 +231,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_scenes(args: argparse.Namespace) -> int:  # noqa: ARG001
-    from .spatial_scene import load_spatial_scene, shipped_spatial_scenes
+    from cdpr_exu.scenes.spatial_scene import load_spatial_scene, shipped_spatial_scenes
 
     for name in shipped_scenes():
         scene = load_scene(name)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cdpr_exu.kinematics import inverse_kinematics, inverse_kinematics_rates, pulley_arrays
+from cdpr_exu.statics.kinematics import inverse_kinematics, inverse_kinematics_rates, pulley_arrays
 
 from .base import Measurement, WinchCommand
 
@@ -39,7 +39,7 @@ def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = Non
 
     Parameters
     ----------
-    scene : cdpr_exu.scene.Scene
+    scene : cdpr_exu.scenes.scene.Scene
     poses : ndarray, shape (N, 3) [m, m, rad]
     pose_rates : ndarray, shape (N, 3) or None [m/s, m/s, rad/s]
 

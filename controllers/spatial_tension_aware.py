@@ -41,7 +41,7 @@ class SpatialTensionAwareController:
         UnreachableError
             If a sampled reference pose cannot be held by cables that pull.
         """
-        from cdpr_exu.errors import UnreachableError
+        from cdpr_exu.core.errors import UnreachableError
         from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics, solve_spatial_statics
 
         platform = scene.catenary_platform()

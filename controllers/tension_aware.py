@@ -1,7 +1,7 @@
 """Tension-aware winch commands: sag and stretch compensation from catenary statics.
 
 For each reference position the platform's kineto-static equilibrium on elastic
-catenary cables (:func:`cdpr_exu.statics.solve_inverse_statics`) gives the cable
+catenary cables (:func:`cdpr_exu.statics.statics.solve_inverse_statics`) gives the cable
 tensions, the rotation the platform takes, and the unstrained lengths (wrap on the
 pulley included) that put its centre on the reference. Those lengths are the command.
 Options:
@@ -14,11 +14,11 @@ Options:
   less cable than the arc (up to 3 cm with the paper's 0.25 m elements on a 0.25 m
   pulley), by an amount that depends on where the nodes sit. The command is then the
   length of the straight discretised chain (the chord walk of
-  :func:`cdpr_exu.kinematics.initial_cable_nodes`) plus the catenary's sag and stretch
+  :func:`cdpr_exu.statics.kinematics.initial_cable_nodes`) plus the catenary's sag and stretch
   correction (catenary length minus ideal length). A real cable has no such polygon:
   this option compensates the simulator's discretisation, and says so in its name;
 * ``statics="chain"`` solves each equilibrium on the simulator's own lumped cables
-  instead of continuous catenaries (:mod:`cdpr_exu.chain_statics`): chains of straight
+  instead of continuous catenaries (:mod:`cdpr_exu.statics.chain_statics`): chains of straight
   elements with the nodes' weight, exact-angle bending springs and the penalty contact
   of the nodes on the pulleys. It has the polygon over the pulley, where the nodes sit
   on it, and the bending of the cable where it leaves the pulley, which the continuous
@@ -42,9 +42,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from cdpr_exu import chain_statics, statics
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.kinematics import anchor_points, cable_unit_vectors, initial_cable_nodes, pulley_arrays
+from cdpr_exu.statics import chain_statics
+from cdpr_exu.statics import statics
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.statics.kinematics import anchor_points, cable_unit_vectors, initial_cable_nodes, pulley_arrays
 
 from .base import Measurement, WinchCommand
 from .ideal_ik import ideal_paid_out
@@ -55,7 +56,7 @@ def suspended_platform(scene) -> statics.SuspendedPlatform:
 
     Parameters
     ----------
-    scene : cdpr_exu.scene.Scene
+    scene : cdpr_exu.scenes.scene.Scene
 
     Returns
     -------
@@ -74,7 +75,7 @@ def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
     """Paid-out length of each straight, inextensible lumped chain reaching ``anchors``, shape (m,) [m].
 
     The chain of n elements of length l0/n is laid from the anchor back over the pulley
-    with exact chords (:func:`~cdpr_exu.kinematics.initial_cable_nodes`); what is not
+    with exact chords (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`); what is not
     hanging below the hang point is paid out.
     """
     lengths = []
@@ -86,8 +87,8 @@ def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
 
 
 #: Cable models the equilibria can be solved with: "catenary" (continuous elastic
-#: catenaries, :mod:`cdpr_exu.statics`) or "chain" (the simulator's own lumped chains,
-#: :mod:`cdpr_exu.chain_statics`).
+#: catenaries, :mod:`cdpr_exu.statics.statics`) or "chain" (the simulator's own lumped chains,
+#: :mod:`cdpr_exu.statics.chain_statics`).
 STATICS_MODELS = ("catenary", "chain")
 
 

@@ -1,6 +1,6 @@
 """What accuracy costs in time: the model ladder over elements and step sizes.
 
-Runs the accuracy study (:mod:`cdpr_exu.accuracy`) on the paper's circle and on its
+Runs the accuracy study (:mod:`cdpr_exu.studies.accuracy`) on the paper's circle and on its
 static catenary scene: every preset (ideal, elastic, catenary, full) and the full
 model with linear bending, over 8..60 elements per cable and steps of 5e-4..1e-2 s,
 each run compared with the reference (full, 90 elements, 5e-4 s). Writes, for each
@@ -19,7 +19,7 @@ import argparse
 import time
 from pathlib import Path
 
-from cdpr_exu.accuracy import COST, FULL_GRID, QUICK_GRID, TOLERANCES, cheapest_meeting, run_accuracy_study
+from cdpr_exu.studies.accuracy import COST, FULL_GRID, QUICK_GRID, TOLERANCES, cheapest_meeting, run_accuracy_study
 
 SCENES = {"paper-circle": "paper_circle", "paper-catenary": "paper_catenary"}
 

@@ -24,7 +24,7 @@ Two catenaries are compared with each lumped rest state:
   of this kind; with the same unstrained length (forward), the stretched lengths of the
   two models differ only through their tensions (/EA), by nanometres.
 
-Cable lengths are free-span lengths (see :mod:`cdpr_exu.rest`): for the pulley scene
+Cable lengths are free-span lengths (see :mod:`cdpr_exu.run.rest`): for the pulley scene
 from the point where the cable leaves the rim to the anchor, against the catenary's
 suspended part. Profile distances are the distances of the free-span nodes from the
 catenary curve (sampled at 4001 points; sampling error below 1e-7 m).
@@ -41,16 +41,16 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from cdpr_exu.output import write_summary
+from cdpr_exu.core.output import write_summary
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from cdpr_exu import catenary
-from cdpr_exu.rest import RestState, solve_rest
-from cdpr_exu.result import provenance
-from cdpr_exu.scene import Effects, Scene, load_scene
-from cdpr_exu.statics import solve_forward_statics, solve_inverse_statics
+from cdpr_exu.physics import catenary
+from cdpr_exu.run.rest import RestState, solve_rest
+from cdpr_exu.results.result import provenance
+from cdpr_exu.scenes.scene import Effects, Scene, load_scene
+from cdpr_exu.statics.statics import solve_forward_statics, solve_inverse_statics
 from controllers.tension_aware import suspended_platform
 
 #: What the paper reports for Fig. 8 with 15 elements [m].

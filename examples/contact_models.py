@@ -26,12 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-from cdpr_exu.errors import CdprError, SolverFailure
-from cdpr_exu.pulley import segment_penetration
-from cdpr_exu.output import write_summary
-from cdpr_exu.result import provenance
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.core.errors import CdprError, SolverFailure
+from cdpr_exu.core.geometry import segment_penetration
+from cdpr_exu.core.output import write_summary
+from cdpr_exu.results.result import provenance
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
 
 OUT = Path("results/contact_models")
 RUNS = [("node", 60), ("segment", 60), ("node", 30), ("segment", 30), ("node", 15), ("segment", 15),

@@ -9,8 +9,8 @@ Equivalent to ``cdpr compare paper-circle --out results/controllers`` and
 ``cdpr compare paper-circle-slow --out results/controllers_slow``.
 """
 
-from cdpr_exu.comparison import compare_controllers, markdown_table
-from cdpr_exu.scene import load_scene
+from cdpr_exu.studies.comparison import compare_controllers, markdown_table
+from cdpr_exu.scenes.scene import load_scene
 
 
 def main() -> None:

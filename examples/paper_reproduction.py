@@ -16,10 +16,10 @@ from dataclasses import replace
 from pathlib import Path
 
 from cdpr_exu.cli import run_scene
-from cdpr_exu.errors import SolverFailure
-from cdpr_exu.output import write_json
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.core.errors import SolverFailure
+from cdpr_exu.core.output import write_json
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
 
 PAPER = {"max_abs_error_x_m": 0.085, "max_abs_error_z_m": 0.11, "max_abs_rotation_deg": 15.0}
 

@@ -32,8 +32,8 @@ import argparse
 from dataclasses import replace
 from pathlib import Path
 
-from cdpr_exu.scene import load_scene
-from cdpr_exu.study import format_table, parse_parameter, run_study
+from cdpr_exu.scenes.scene import load_scene
+from cdpr_exu.studies.study import format_table, parse_parameter, run_study
 
 OUT = Path(__file__).resolve().parents[1] / "results" / "parameter_study"
 

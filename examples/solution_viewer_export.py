@@ -20,8 +20,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from cdpr_exu.cli import run_scene
-from cdpr_exu.scene import load_scene
-from cdpr_exu.viewer import NoDisplayError, display_problem, render_animation, view_solution
+from cdpr_exu.scenes.scene import load_scene
+from cdpr_exu.post.viewer import NoDisplayError, display_problem, render_animation, view_solution
 
 
 def main() -> None:

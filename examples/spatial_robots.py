@@ -12,9 +12,9 @@ minute on one core.
 
 from pathlib import Path
 
-from cdpr_exu.spatial_rest import solve_spatial_rest
-from cdpr_exu.spatial_run import compare_spatial
-from cdpr_exu.spatial_scene import load_spatial_scene
+from cdpr_exu.run.spatial_rest import solve_spatial_rest
+from cdpr_exu.run.spatial_run import compare_spatial
+from cdpr_exu.scenes.spatial_scene import load_spatial_scene
 
 RESULTS = Path("results/spatial")
 

@@ -25,7 +25,7 @@ its cables go slack, a winch paying out several elements over the pulley):
   answer at a step of min(run / 100, 1e-5 s) (the stiff joint spring of explicit runs stretches by 7.8e-6 m under the
   platform's weight). Below 1e-8 s the runs would take hours: reported as
   "< 1e-8". Also shown: the estimate 2.8 m_i / (4 c_i) of
-  ``cdpr_exu.simulate.explicit_step_limit``.
+  ``cdpr_exu.run.simulate.explicit_step_limit``.
 
 Writes ``stability.csv`` and ``stability.md`` (the table and these criteria) into
 ``results/stability/``. Run: ``python examples/stability_table.py [--quick]``;
@@ -43,11 +43,11 @@ from pathlib import Path
 
 import numpy as np
 
-from cdpr_exu.energy import energy_rise, mechanical_energy
-from cdpr_exu.errors import CdprError, SolverFailure
-from cdpr_exu.scene import Effects, Scene, WinchSpec, load_scene
-from cdpr_exu.simulate import explicit_step_limit, simulate
-from cdpr_exu.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
+from cdpr_exu.results.energy import energy_rise, mechanical_energy
+from cdpr_exu.core.errors import CdprError, SolverFailure
+from cdpr_exu.scenes.scene import Effects, Scene, WinchSpec, load_scene
+from cdpr_exu.run.simulate import explicit_step_limit, simulate
+from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 
 PAPER = load_scene("paper-circle")
 
@@ -367,7 +367,7 @@ def write(rows: list[dict], out: Path, wall: float) -> None:
         "",
         "## Criteria",
         "",
-        "**Implicit** (Exudyn's generalized-alpha as `cdpr_exu.simulate` sets it up): steps "
+        "**Implicit** (Exudyn's generalized-alpha as `cdpr_exu.run.simulate` sets it up): steps "
         f"{', '.join(f'{h:g}' for h in IMPLICIT_STEPS)} s, climbed up to the first unstable rung, then "
         "two geometric bisections between it and the last stable rung; larger rungs that pass again "
         "are listed in brackets but not counted (stability must hold for every smaller step). "
@@ -392,7 +392,7 @@ def write(rows: list[dict], out: Path, wall: float) -> None:
         "**Explicit RK44** (Exudyn's classical Runge-Kutta, `solver.integrator = \"rk44\"`): on the held "
         "robot only, since Exudyn's explicit solvers eliminate the winch constraints and ignore their "
         "commands; the platform joints are the stiff spring-dampers of "
-        "`cdpr_exu.platform.explicit_joint_spring`. Steps "
+        "`cdpr_exu.builder.platform.explicit_joint_spring`. Steps "
         f"{', '.join(f'{h:g}' for h in EXPLICIT_STEPS)} s from the top, each run {EXPLICIT_TIME:g} s "
         f"long but at least {EXPLICIT_MIN_STEPS} and at most {EXPLICIT_MAX_STEPS} steps (an unstable "
         "step grows the error by a fixed factor per step, so thousands of steps show it); the first "
@@ -400,7 +400,7 @@ def write(rows: list[dict], out: Path, wall: float) -> None:
         f"never rises by more than {ENERGY_TOLERANCE:g} J, and the platform stays within "
         f"{EXPLICIT_TOLERANCE:g} m (or 1 % of its motion) of the implicit solver's answer (step "
         "min(run / 100, 1e-5 s)). *RK44 estimate*: 2.8 / max(4 c_i / m_i, 2 sqrt(k_i / m_i) (+) sqrt(k_p / m_i)) "
-        "(`cdpr_exu.simulate.explicit_step_limit`): the zig-zag mode of the over-damped axial chain. "
+        "(`cdpr_exu.run.simulate.explicit_step_limit`): the zig-zag mode of the over-damped axial chain. "
         f"'< {EXPLICIT_STEPS[-1]:g}': not stable at any rung; smaller steps would take hours.",
     ]
     (out / "stability.md").write_text("\n".join(lines) + "\n")

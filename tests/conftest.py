@@ -12,7 +12,7 @@ import math
 
 import pytest
 
-from cdpr_exu.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, WinchSpec
+from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, WinchSpec
 
 #: Gravity used by the small scenes [m/s^2].
 GRAVITY = 9.81

@@ -1,4 +1,4 @@
-"""Tests of the accuracy-against-cost study (cdpr_exu.accuracy).
+"""Tests of the accuracy-against-cost study (cdpr_exu.studies.accuracy).
 
 The ``--quick`` study runs on the real solver through the ``cdpr`` command (1.5 s of
 the paper circle, 10 runs on two worker processes, about 20 s); the error measures
@@ -16,10 +16,10 @@ import zipfile
 import numpy as np
 import pytest
 
-from cdpr_exu.accuracy import (ACCURACY_FILES, FULL_GRID, QUICK_GRID, Configuration, cheapest_meeting, compare,
+from cdpr_exu.studies.accuracy import (ACCURACY_FILES, FULL_GRID, QUICK_GRID, Configuration, cheapest_meeting, compare,
                                pareto_front)
-from cdpr_exu.errors import SceneError
-from cdpr_exu.output import ZIP_DATE
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.output import ZIP_DATE
 
 
 @pytest.fixture(scope="module")

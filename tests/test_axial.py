@@ -1,9 +1,9 @@
-"""Tension-only axial elements (cdpr_exu.axial): forces and their analytic Jacobian."""
+"""Tension-only axial elements (cdpr_exu.physics.axial): forces and their analytic Jacobian."""
 
 import numpy as np
 import pytest
 
-from cdpr_exu.axial import cable_elements, slack_axial_force, slack_axial_jacobian
+from cdpr_exu.physics.axial import cable_elements, slack_axial_force, slack_axial_jacobian
 
 
 def _chain(rng, n_nodes=5):
@@ -70,7 +70,7 @@ def test_internal_forces_sum_to_zero():
 
 # --------------------------------------------------------------------------- the tension law
 
-from cdpr_exu.axial import TAUT_BAND, tension_law  # noqa: E402
+from cdpr_exu.physics.axial import TAUT_BAND, tension_law  # noqa: E402
 
 K, C, BAND = 3.14e5, 3.14e5, TAUT_BAND * 0.25  # the paper's element, a 0.25 m rest length
 

@@ -9,12 +9,12 @@ import exudyn.itemInterface as eii
 import numpy as np
 import pytest
 
-from cdpr_exu.axial import TAUT_BAND, cable_elements, slack_axial_force
-from cdpr_exu.catenary import CatenaryCable
-from cdpr_exu.errors import SceneError, SolverFailure
+from cdpr_exu.physics.axial import TAUT_BAND, cable_elements, slack_axial_force
+from cdpr_exu.physics.catenary import CatenaryCable
+from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.physics import axial_3d
-from cdpr_exu.physics.chain_3d import add_spatial_chain
-from cdpr_exu.physics.spatial_robot import (SpatialChainSpec, anchor_forces, build_spatial_robot, dynamic_settings,
+from cdpr_exu.builder.chain_3d import add_spatial_chain
+from cdpr_exu.builder.spatial_robot import (SpatialChainSpec, anchor_forces, build_spatial_robot, dynamic_settings,
                                             element_forces, robot_energy, solve_static)
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 

@@ -1,9 +1,9 @@
-"""Tests of the exact-angle bending spring-damper (cdpr_exu.bending)."""
+"""Tests of the exact-angle bending spring-damper (cdpr_exu.physics.bending)."""
 
 import numpy as np
 import pytest
 
-from cdpr_exu.bending import (
+from cdpr_exu.physics.bending import (
     BendingSpringDamper,
     bending_angles,
     bending_energy,
@@ -15,7 +15,7 @@ from cdpr_exu.bending import (
     curvature_damping_matrix,
     curvature_stiffness_matrix,
 )
-from cdpr_exu.errors import SceneError
+from cdpr_exu.core.errors import SceneError
 
 
 def bent_cable(n_nodes=6, element_length=0.1, turn_per_joint=0.5, seed=0):

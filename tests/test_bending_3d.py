@@ -4,10 +4,10 @@ import exudyn as exu
 import numpy as np
 import pytest
 
-from cdpr_exu.bending import bending_force_kernel, cable_joints
+from cdpr_exu.physics.bending import bending_force_kernel, cable_joints
 from cdpr_exu.physics.bending_3d import (SERIES_BELOW, angle_factor, chain_joints, spatial_bending_energy,
                                          spatial_bending_force, spatial_bending_pattern, spatial_bending_stiffness)
-from cdpr_exu.physics.chain_3d import add_spatial_chain, chain_energy
+from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
 
 
 def _curve(seed, nodes=7):

@@ -1,4 +1,4 @@
-"""Tests of the elastic catenary (cdpr_exu.catenary) against its physics and limits."""
+"""Tests of the elastic catenary (cdpr_exu.physics.catenary) against its physics and limits."""
 
 import math
 
@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cdpr_exu.catenary import (
+from cdpr_exu.physics.catenary import (
     CatenaryCable,
     end_stiffness,
     profile,
@@ -18,7 +18,7 @@ from cdpr_exu.catenary import (
     state_from_end_forces,
     stretched_length,
 )
-from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.core.errors import SceneError, UnreachableError
 
 # The paper's cable: radius 5 mm, E = 1e9 Pa, 0.35 kg/m (EA = 7.85e4 N, w = 3.43 N/m).
 PAPER_CABLE = CatenaryCable.from_material(1.75 * math.sqrt(2), 0.005, 1e9, 0.35)

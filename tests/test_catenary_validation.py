@@ -16,10 +16,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu import catenary
-from cdpr_exu.rest import solve_rest
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.statics import solve_forward_statics
+from cdpr_exu.physics import catenary
+from cdpr_exu.run.rest import solve_rest
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.statics.statics import solve_forward_statics
 from controllers.tension_aware import suspended_platform
 
 pytestmark = pytest.mark.slow

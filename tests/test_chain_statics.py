@@ -5,11 +5,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu import statics
-from cdpr_exu.chain_statics import ChainRobot, chain_forces, chain_robot, solve_chain_statics
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.model import initial_nodes
-from cdpr_exu.scene import Effects, PlatformSpec, load_scene
+from cdpr_exu.statics import statics
+from cdpr_exu.statics.chain_statics import ChainRobot, chain_forces, chain_robot, solve_chain_statics
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.builder.model import initial_nodes
+from cdpr_exu.scenes.scene import Effects, PlatformSpec, load_scene
 from controllers.tension_aware import suspended_platform
 
 PAPER = load_scene("paper-circle")
@@ -42,7 +42,7 @@ def test_it_finds_the_rest_that_exudyn_finds_with_the_same_winch_lengths():
     """Independent check: the scene settled by the real solver (dynamics, then Exudyn's
     static solver) with the winches held; chain statics at that platform position must
     give back the winches' lengths, the rotation and every node."""
-    from cdpr_exu.rest import solve_rest
+    from cdpr_exu.run.rest import solve_rest
 
     scene = PAPER.with_changes(platform=replace(PAPER.platform, initial_pose=(0.3, -1.8, 0.0)))
     rest = solve_rest(scene)

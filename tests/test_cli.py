@@ -8,8 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from cdpr_exu.output import TIMING_KEYS
-from cdpr_exu.result import Result
+from cdpr_exu.core.output import TIMING_KEYS
+from cdpr_exu.results.result import Result
 
 
 def _cdpr(*args, check=True):
@@ -64,7 +64,7 @@ import signal
 import time
 from dataclasses import replace
 
-from cdpr_exu.scene import load_scene, save_scene
+from cdpr_exu.scenes.scene import load_scene, save_scene
 
 
 def _strict_json(path):
@@ -191,7 +191,7 @@ def test_ctrl_c_saves_what_was_computed_prints_one_line_and_exits_130(tmp_path):
 def _scene_ending_above_the_pulleys(tmp_path):
     """A paper scene whose point_to_point ends at z = +1 m, above the pulleys (z = 0):
     its file, and an output folder path that does not exist yet."""
-    from cdpr_exu.trajectories import PointToPointTrajectory
+    from cdpr_exu.scenes.trajectories import PointToPointTrajectory
 
     base = load_scene("paper-circle")
     scene = base.with_changes(trajectory=PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.0, 1.0, 0.0),
@@ -275,7 +275,7 @@ def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, m
     import os
     import signal
 
-    from cdpr_exu.comparison import compare_controllers
+    from cdpr_exu.studies.comparison import compare_controllers
 
     class InterruptAfterFirstRow(io.StringIO):
         def write(self, text):

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from cdpr_exu.output import TIMING_KEYS
-from cdpr_exu.scene import load_scene, save_scene
+from cdpr_exu.core.output import TIMING_KEYS
+from cdpr_exu.scenes.scene import load_scene, save_scene
 
 RESULTS = Path(__file__).resolve().parents[1] / "results"
 SCENES = sorted(RESULTS.glob("**/*scene.toml"))

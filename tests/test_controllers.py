@@ -5,9 +5,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import UnreachableError
-from cdpr_exu.scene import CableSpec, Effects, PlatformSpec, load_scene
-from cdpr_exu.trajectories import CircleTrajectory, HoldTrajectory
+from cdpr_exu.core.errors import UnreachableError
+from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, load_scene
+from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory
 from controllers import IdealIKController, Measurement
 from controllers.ideal_ik import ideal_paid_out
 from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
@@ -88,7 +88,7 @@ def test_chain_statics_lengths_differ_from_the_catenarys_by_the_lumped_geometry(
 
 
 def test_tension_aware_options_are_checked():
-    from cdpr_exu.errors import SceneError
+    from cdpr_exu.core.errors import SceneError
 
     with pytest.raises(SceneError, match="statics"):
         TensionAwareController(statics="lumped")
@@ -111,7 +111,7 @@ def test_a_reference_that_needs_a_pushing_cable_is_refused_before_the_run():
 
 
 def test_a_reference_the_cables_cannot_reach_is_refused_before_the_run():
-    from cdpr_exu.simulate import simulate
+    from cdpr_exu.run.simulate import simulate
 
     scene = PAPER.with_changes(trajectory=CircleTrajectory(center=(0.0, -4.0), radius=0.4, angular_rate=1.5))
     with pytest.raises(UnreachableError):
@@ -120,7 +120,7 @@ def test_a_reference_the_cables_cannot_reach_is_refused_before_the_run():
 
 @pytest.mark.slow
 def test_closed_loop_tension_aware_control_cuts_the_paper_circle_error_more_than_fivefold():
-    from cdpr_exu.comparison import compare_controllers
+    from cdpr_exu.studies.comparison import compare_controllers
 
     summaries = compare_controllers(PAPER, ["ideal_ik", "closed_loop_tension_aware"])
     ideal = summaries["ideal_ik"]["max_position_error_m"]
@@ -132,7 +132,7 @@ def test_closed_loop_tension_aware_control_cuts_the_paper_circle_error_more_than
 
 @pytest.mark.slow
 def test_static_correction_alone_holds_the_quasi_static_circle_within_5_mm():
-    from cdpr_exu.comparison import compare_controllers
+    from cdpr_exu.studies.comparison import compare_controllers
 
     scene = load_scene("paper-circle-slow")
     scene = scene.with_changes(solver=replace(scene.solver, end_time=20.0))  # a sixth of the turn
@@ -156,7 +156,7 @@ def test_closed_loop_needs_the_measured_pose():
 
 
 def test_comparison_writes_its_table_and_summary(tmp_path):
-    from cdpr_exu.comparison import compare_controllers
+    from cdpr_exu.studies.comparison import compare_controllers
 
     scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.4), effects=Effects.from_preset("elastic"))
     summaries = compare_controllers(scene, ["ideal_ik", "tension_aware"], out=tmp_path, after=0.1)
@@ -175,7 +175,7 @@ def test_the_closed_loop_switches_on_without_pushing_its_cables():
     """The integral fades in with the start-up blend: at the switch-on (0.5 s) the winch
     element no longer pushes (-62 N before; +14 N measured as the lowest tension of any
     element from 0.45 to 0.6 s)."""
-    from cdpr_exu.simulate import simulate
+    from cdpr_exu.run.simulate import simulate
 
     paper = load_scene("paper-circle")
     scene = paper.with_changes(solver=replace(paper.solver, end_time=0.7))

@@ -1,4 +1,4 @@
-"""Tests of the effects a scene calls for (cdpr_exu.scene.Effects and the builder).
+"""Tests of the effects a scene calls for (cdpr_exu.scenes.scene.Effects and the builder).
 
 Sections: switching an effect off removes its items (counted with
 ``Model.item_counts``); every preset runs the paper scene; physics limits of the
@@ -15,9 +15,9 @@ import exudyn as exu
 import numpy as np
 import pytest
 
-from cdpr_exu.model import build_model
-from cdpr_exu.scene import PRESETS, Effects, load_scene
-from cdpr_exu.simulate import simulate, solver_settings
+from cdpr_exu.builder.model import build_model
+from cdpr_exu.scenes.scene import PRESETS, Effects, load_scene
+from cdpr_exu.run.simulate import simulate, solver_settings
 
 from conftest import settling_solver
 
@@ -105,7 +105,7 @@ def test_linear_bending_of_a_straight_cable_is_zero():
     The reference configuration over a pulley is bent; K (q_ref + q) must vanish for
     any straight configuration, so the force vector -K q_ref has to cancel K q_ref.
     """
-    from cdpr_exu.bending import cable_joints, curvature_stiffness_matrix
+    from cdpr_exu.physics.bending import cable_joints, curvature_stiffness_matrix
 
     joints = cable_joints([6])
     k_matrix = curvature_stiffness_matrix(6, joints, 2.0, 0.1)
@@ -167,7 +167,7 @@ def test_very_stiff_massless_cables_hold_the_platform_at_its_ideal_inverse_kinem
     (0.34 mm at the paper's E); 100 times stiffer, 100 times less; the ideal rope is
     1000 EA.
     """
-    from cdpr_exu.model import MIN_WINCH_SEGMENT
+    from cdpr_exu.builder.model import MIN_WINCH_SEGMENT
 
     scene = load_scene("paper-catenary-fixed")
     # 8 s: the Kelvin-Voigt creep of the stretch (time constant dn / E = 1 s) has

@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cdpr_exu.error_estimate import (elements_for_tolerance, estimate_error, parse_length,
+from cdpr_exu.run.error_estimate import (elements_for_tolerance, estimate_error, parse_length,
                                      richardson_factor)
-from cdpr_exu.errors import SceneError
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
 
 PAPER = load_scene("paper-circle")
 REFERENCE = Path(__file__).resolve().parents[1] / "results" / "accuracy" / "paper_circle" / "reference.npz"

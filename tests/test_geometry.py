@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from cdpr_exu import statics
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import (Pulley, anchor_points, left_jacobian, pulley_exit, rotation_from_vector,
+from cdpr_exu.statics import statics
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.geometry import (Pulley, anchor_points, left_jacobian, pulley_exit, rotation_from_vector,
                                rotation_matrix, rotation_vector)
-from cdpr_exu.scene import PulleySpec, load_scene
+from cdpr_exu.scenes.scene import PulleySpec, load_scene
 
 # Geometry is closed-form: the only error is rounding, a few ulp of metre-sized lengths.
 ROUNDING = 1e-12

@@ -21,9 +21,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cdpr_exu import bending, catenary, kinematics, statics
-from cdpr_exu.errors import CdprError, SceneError, SolverFailure, UnreachableError
-from cdpr_exu.scene import (
+from cdpr_exu.physics import bending
+from cdpr_exu.physics import catenary
+from cdpr_exu.statics import kinematics
+from cdpr_exu.statics import statics
+from cdpr_exu.core.errors import CdprError, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.scenes.scene import (
     MAX_ELEMENTS,
     CableSpec,
     Effects,
@@ -35,8 +38,8 @@ from cdpr_exu.scene import (
     load_scene,
     scene_from_dict,
 )
-from cdpr_exu.simulate import simulate
-from cdpr_exu.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 
 NAN, INF = float("nan"), float("inf")
 
@@ -348,7 +351,7 @@ def test_public_functions_refuse_bad_arguments_with_the_projects_errors(name):
 
 
 #: Former gaps: arguments these functions let through, or refused with a bare Python
-#: error instead of SceneError, until cdpr_exu.validation's array checks were used at
+#: error instead of SceneError, until cdpr_exu.core.validation's array checks were used at
 #: their entry points.
 FORMER_GAPS = {
     "bending positions text -> ValueError": lambda: bending.bending_energy("abc", JOINTS, 1.0),

@@ -1,10 +1,10 @@
-"""Tests of cdpr_exu.kinematics: pulley tangents, ideal lengths, rates, wrench matrix, nodes."""
+"""Tests of cdpr_exu.statics.kinematics: pulley tangents, ideal lengths, rates, wrench matrix, nodes."""
 
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.kinematics import (
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.statics.kinematics import (
     anchor_points,
     anchor_velocities,
     cable_unit_vectors,

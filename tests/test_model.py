@@ -1,4 +1,4 @@
-"""Tests of the Exudyn model the builder makes (cdpr_exu.model and its builders).
+"""Tests of the Exudyn model the builder makes (cdpr_exu.builder.model and its builders).
 
 Sections: what items the builder adds; statics of cables at rest on the real solver
 (weight balance, end reactions, Hooke's law); bad input refused before any simulation.
@@ -13,12 +13,12 @@ import exudyn as exu
 import numpy as np
 import pytest
 
-from cdpr_exu.cable import element_tensions
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.model import build_model, contact_candidates
-from cdpr_exu.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, load_scene
-from cdpr_exu.simulate import simulate, solver_settings
-from cdpr_exu.trajectories import CircleTrajectory
+from cdpr_exu.builder.cable import element_tensions
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.builder.model import build_model, contact_candidates
+from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, load_scene
+from cdpr_exu.run.simulate import simulate, solver_settings
+from cdpr_exu.scenes.trajectories import CircleTrajectory
 
 
 def settle(scene):

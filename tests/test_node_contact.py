@@ -1,4 +1,4 @@
-"""Node contact with a smooth onset (cdpr_exu.node_contact, Effects.pulley_contact_model = "node_smooth").
+"""Node contact with a smooth onset (cdpr_exu.physics.node_contact, Effects.pulley_contact_model = "node_smooth").
 
 The kernels against finite differences and the closed-form law; the sparse triplets
 against the dense Jacobian; which Exudyn items the model gets; and the paper's circle on
@@ -13,11 +13,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError
-from cdpr_exu.model import build_model, contact_candidates
-from cdpr_exu.node_contact import CONTACT_ONSET_DEPTH, NodePulleyContact
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.builder.model import build_model, contact_candidates
+from cdpr_exu.physics.node_contact import CONTACT_ONSET_DEPTH, NodePulleyContact
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
 
 PAPER = load_scene("paper-circle")
 CENTER = np.array([0.1, -0.2])  # [m]

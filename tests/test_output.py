@@ -7,8 +7,8 @@ import zipfile
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import OutputError
-from cdpr_exu.output import check_output_folder, csv_cell, fixed, json_text, split_timing, write_npz
+from cdpr_exu.core.errors import OutputError
+from cdpr_exu.core.output import check_output_folder, csv_cell, fixed, json_text, split_timing, write_npz
 
 
 def _strict_loads(text):

@@ -1,4 +1,4 @@
-"""Tests of cdpr_exu.plots: every figure is written as a readable PNG of a sensible size,
+"""Tests of cdpr_exu.post.plots: every figure is written as a readable PNG of a sensible size,
 from one short real run of the paper's circle, also when the run is cut short."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from matplotlib.image import imread
 
-from cdpr_exu import plots
-from cdpr_exu.scene import load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.post import plots
+from cdpr_exu.scenes.scene import load_scene
+from cdpr_exu.run.simulate import simulate
 
 
 @pytest.fixture(scope="module")

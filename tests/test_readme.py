@@ -44,7 +44,7 @@ def test_scene_reference_says_point_to_point_poses_are_x_z_rotation():
 
 
 def test_controllers_table_says_how_the_closed_loop_is_built():
-    from cdpr_exu.comparison import CONTROLLERS
+    from cdpr_exu.studies.comparison import CONTROLLERS
 
     controller = CONTROLLERS["closed_loop_tension_aware"]()
     row = next(line for line in README.splitlines() if line.startswith("| `closed_loop_tension_aware`"))
@@ -56,7 +56,7 @@ def test_controllers_table_says_how_the_closed_loop_is_built():
 def test_bending_free_claim_matches_the_run():
     """The README says the bending-free run at spectral radius 0.5 stops at 0.27 s, the platform above the pulleys."""
     from cdpr_exu import SolverFailure, load_scene, simulate
-    from cdpr_exu.scene import Effects
+    from cdpr_exu.scenes.scene import Effects
 
     scene = load_scene("paper-circle")
     scene = scene.with_changes(effects=Effects.from_preset("catenary"),

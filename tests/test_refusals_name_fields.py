@@ -10,9 +10,9 @@ import re
 
 from hypothesis import HealthCheck, given, seed, settings
 
-from cdpr_exu.errors import CdprError
-from cdpr_exu.scene import scene_from_dict
-from cdpr_exu.workspace import check_reference
+from cdpr_exu.core.errors import CdprError
+from cdpr_exu.scenes.scene import scene_from_dict
+from cdpr_exu.statics.workspace import check_reference
 from test_input_validation import malformed_scene_dicts
 
 TABLES = r"(?:name|description|gravity|cable_exit|cable|cables|pulley|pulleys|platform|winch|effects|solver|trajectory)"

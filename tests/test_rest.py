@@ -1,4 +1,4 @@
-"""The static mode (``cdpr_exu.rest``) on the real solver: the paper's scenario-2 scenes at rest.
+"""The static mode (``cdpr_exu.run.rest``) on the real solver: the paper's scenario-2 scenes at rest.
 
 The force balances below need no reference solution: at rest, the forces the supports
 exert on a free span (the platform joint, the winch constraints or the cut at the
@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 from cdpr_exu.cli import main
-from cdpr_exu.errors import SceneError, SolverFailure
-from cdpr_exu.output import ZIP_DATE
-from cdpr_exu.rest import RestState, solve_rest
-from cdpr_exu.scene import Effects, load_scene
+from cdpr_exu.core.errors import SceneError, SolverFailure
+from cdpr_exu.core.output import ZIP_DATE
+from cdpr_exu.run.rest import RestState, solve_rest
+from cdpr_exu.scenes.scene import Effects, load_scene
 
 pytestmark = pytest.mark.slow
 

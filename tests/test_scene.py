@@ -6,12 +6,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError
-from cdpr_exu.scene import (
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.scenes.scene import (
     CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, load_scene, save_scene,
     scene_from_dict, shipped_scenes,
 )
-from cdpr_exu.trajectories import CircleTrajectory
+from cdpr_exu.scenes.trajectories import CircleTrajectory
 
 
 def test_paper_circle_is_shipped_and_has_table_2_parameters():
@@ -138,7 +138,7 @@ def test_solver_output_period_is_never_finer_than_the_step():
 def test_an_initial_pose_with_an_anchor_inside_a_pulley_names_the_fields_then_the_values():
     """Issue 12.2: the refusal said only "anchor [-0.15, -1.9] lies inside the pulley disc
     (centre [-1.75, 0.0], radius 2.5 m)"; it names the conflicting fields first now."""
-    from cdpr_exu.errors import UnreachableError
+    from cdpr_exu.core.errors import UnreachableError
 
     data = load_scene("paper-circle").to_dict()
     data["pulleys"][0]["radius"] = 2.5  # the disc reaches the anchor at the initial pose
@@ -160,15 +160,16 @@ def test_the_package_exports_what_a_user_needs_and_imports_without_exudyn():
     code = ("import sys, cdpr_exu; assert 'exudyn' not in sys.modules, 'import cdpr_exu loaded Exudyn'; "
             "print(cdpr_exu.load_scene.__module__)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0 and done.stdout.strip() == "cdpr_exu.scene", done.stderr
+    assert done.returncode == 0 and done.stdout.strip() == "cdpr_exu.scenes.scene", done.stderr
 
     import importlib
 
     import cdpr_exu
     from controllers import ideal_ik, tension_aware
 
-    errors, result, scene = (importlib.import_module(f"cdpr_exu.{m}") for m in ("errors", "result", "scene"))
-    # ``cdpr_exu.simulate`` is the function, or the module once imported (a callable module).
+    errors, result, scene = (importlib.import_module(f"cdpr_exu.{m}")
+                             for m in ("core.errors", "results.result", "scenes.scene"))
+    # ``cdpr_exu.simulate`` is the function (the module is ``cdpr_exu.run.simulate``).
     assert callable(cdpr_exu.simulate) and "simulate" in cdpr_exu.__all__
     expected = {"load_scene": scene.load_scene, "save_scene": scene.save_scene, "Scene": scene.Scene,
                 "Result": result.Result, "CdprError": errors.CdprError,

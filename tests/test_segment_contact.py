@@ -1,4 +1,4 @@
-"""Pulley contact on element segments (cdpr_exu.segment_contact, Effects.pulley_contact_model).
+"""Pulley contact on element segments (cdpr_exu.physics.segment_contact, Effects.pulley_contact_model).
 
 The kernels against finite differences and closed-form forces; the scene field; which
 Exudyn items each contact model adds; and the paper's circle on the real Exudyn solver
@@ -14,14 +14,14 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError, SolverFailure
-from cdpr_exu.model import build_model, contact_candidates
-from cdpr_exu.pulley import segment_penetration
-from cdpr_exu.scene import Effects, load_scene, save_scene, scene_from_dict
-from cdpr_exu.segment_contact import (
+from cdpr_exu.core.errors import SceneError, SolverFailure
+from cdpr_exu.builder.model import build_model, contact_candidates
+from cdpr_exu.core.geometry import segment_penetration
+from cdpr_exu.scenes.scene import Effects, load_scene, save_scene, scene_from_dict
+from cdpr_exu.physics.segment_contact import (
     SegmentPulleyContact, contact_segments, segment_contact_force, segment_contact_jacobian, segment_contact_state,
 )
-from cdpr_exu.simulate import simulate
+from cdpr_exu.run.simulate import simulate
 
 PAPER = load_scene("paper-circle")
 CENTER = np.array([0.1, -0.2])  # [m]
@@ -168,7 +168,7 @@ def test_contact_segments_are_the_elements_touching_a_candidate_node():
 
 
 def test_the_accuracy_study_compares_segment_contact_as_an_effect_variant():
-    from cdpr_exu.accuracy import EFFECT_VARIANTS, FULL_GRID, Configuration, model_name
+    from cdpr_exu.studies.accuracy import EFFECT_VARIANTS, FULL_GRID, Configuration, model_name
 
     variant = (("effects.pulley_contact_model", "segment"),)
     assert variant in EFFECT_VARIANTS

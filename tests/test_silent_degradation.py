@@ -8,9 +8,9 @@ from dataclasses import replace
 
 import pytest
 
-from cdpr_exu.errors import CoarseOutputWarning, SceneError, SolverFailure
-from cdpr_exu.scene import load_scene, shipped_scenes
-from cdpr_exu.simulate import likely_cause, simulate
+from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure
+from cdpr_exu.scenes.scene import load_scene, shipped_scenes
+from cdpr_exu.run.simulate import likely_cause, simulate
 
 PAPER = load_scene("paper-circle")
 
@@ -43,7 +43,7 @@ def test_an_empty_scene_file_is_refused_naming_the_missing_tables(tmp_path):
 def test_a_point_to_point_without_end_is_refused_naming_trajectory_end(tmp_path):
     path = tmp_path / "p2p.toml"  # the paper scene with its trajectory replaced
     source = (tmp_path / "paper.toml")
-    from cdpr_exu.scene import save_scene
+    from cdpr_exu.scenes.scene import save_scene
 
     save_scene(PAPER, source)
     body = source.read_text().split("[trajectory]")[0]
@@ -79,7 +79,7 @@ def test_a_result_that_needs_cables_to_push_is_flagged_and_tension_only_cables_a
     assert any("pushed" in note for note in spring["notes"])
     assert min(spring["min_tension_per_cable_N"]) == spring["min_element_tension_N"]
     assert all(0.0 < t <= 0.5 for t in spring["slack_time_per_cable_s"])
-    from cdpr_exu.scene import Effects
+    from cdpr_exu.scenes.scene import Effects
 
     tension_only = simulate(short.with_changes(effects=Effects.from_preset("full", slack=True))).summary()
     assert not tension_only["elements_pushed"] and tension_only["min_element_tension_N"] >= 0.0
@@ -89,7 +89,7 @@ def test_a_real_run_thrown_above_the_pulleys_gets_the_hint_for_that_cause():
     """Issue 12.4 on the real solver: the bending-free paper circle at spectral radius 0.5 is
     thrown off at the start-up (the README's claim); the monitor stops it with the platform
     above the pulleys, and the hint speaks of that, not of the generic winch jump."""
-    from cdpr_exu.scene import Effects
+    from cdpr_exu.scenes.scene import Effects
 
     scene = PAPER.with_changes(effects=Effects.from_preset("catenary"),
                                solver=replace(PAPER.solver, spectral_radius=0.5, end_time=1.5))

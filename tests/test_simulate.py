@@ -1,4 +1,4 @@
-"""Tests of runs on the real Exudyn solver (cdpr_exu.simulate).
+"""Tests of runs on the real Exudyn solver (cdpr_exu.run.simulate).
 
 Sections: energy of a swinging cable (conserved without damping, never rising with
 it); the paper scene over 10 s (finite, nodes outside the pulleys, taut free spans);
@@ -13,10 +13,10 @@ import math
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SolverFailure
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
-from cdpr_exu.energy import energy_parts, mechanical_energy
+from cdpr_exu.core.errors import SolverFailure
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.results.energy import energy_parts, mechanical_energy
 from controllers.base import WinchCommand
 from controllers.ideal_ik import IdealIKController
 
@@ -117,7 +117,7 @@ def test_paper_scene_nodes_stay_outside_the_pulleys_to_within_the_contact_compli
 
 @pytest.mark.slow
 def test_every_node_that_reaches_a_pulley_carries_a_contact(paper_run):
-    from cdpr_exu.model import contact_candidates
+    from cdpr_exu.builder.model import contact_candidates
 
     scene, result = paper_run
     for i, pulley in enumerate(scene.pulleys):
@@ -234,8 +234,8 @@ def test_newton_tolerance_reaches_exudyn_and_moves_the_paper_path_by_less_than_a
     0.14 micrometres over the 10 s circle; bound 1 micrometre."""
     from dataclasses import replace
 
-    from cdpr_exu.scene import load_scene
-    from cdpr_exu.simulate import solver_settings
+    from cdpr_exu.scenes.scene import load_scene
+    from cdpr_exu.run.simulate import solver_settings
 
     paper = load_scene("paper-circle")
     short = paper.with_changes(solver=replace(paper.solver, end_time=1.0))

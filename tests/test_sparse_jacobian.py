@@ -5,10 +5,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu import axial, bending
-from cdpr_exu.model import build_model
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
+from cdpr_exu.physics import axial
+from cdpr_exu.physics import bending
+from cdpr_exu.builder.model import build_model
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
 
 
 def _assembled(rows, columns, values, size):

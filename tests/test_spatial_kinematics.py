@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog, minimize
 
-from cdpr_exu import kinematics as planar
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import left_jacobian
+from cdpr_exu.statics import kinematics as planar
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.geometry import left_jacobian
 from cdpr_exu.physics import cogiro
 from cdpr_exu.physics.spatial_kinematics import (IdealSpatialRobot, SwivelPulley, cable_unit_vectors, gravity_wrench,
                                                  inverse_kinematics, inverse_kinematics_rates, structure_matrix,

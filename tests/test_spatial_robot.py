@@ -1,12 +1,12 @@
-"""A spatial robot in Exudyn (cdpr_exu.physics.spatial_robot), real solver: statics against the catenary, energy."""
+"""A spatial robot in Exudyn (cdpr_exu.builder.spatial_robot), real solver: statics against the catenary, energy."""
 
 import exudyn as exu
 import numpy as np
 import pytest
 
-from cdpr_exu.catenary import CatenaryCable
-from cdpr_exu.errors import SceneError, SolverFailure
-from cdpr_exu.physics.spatial_robot import SpatialChainSpec, build_spatial_robot, run_dynamic, solve_static
+from cdpr_exu.physics.catenary import CatenaryCable
+from cdpr_exu.core.errors import SceneError, SolverFailure
+from cdpr_exu.builder.spatial_robot import SpatialChainSpec, build_spatial_robot, run_dynamic, solve_static
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform, solve_spatial_statics
 
 # The paper's cable (radius 5 mm, E = 1e9 Pa, 0.35 kg/m) on a 3 m x 3 m frame, a 5 kg platform.

@@ -1,4 +1,4 @@
-"""Dynamic runs of spatial scenes (cdpr_exu.spatial_run), real solver: the variable-length winch and ideal IK."""
+"""Dynamic runs of spatial scenes (cdpr_exu.run.spatial_run), real solver: the variable-length winch and ideal IK."""
 
 import json
 import subprocess
@@ -8,11 +8,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError, UnreachableError
+from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
-from cdpr_exu.spatial_run import simulate_spatial
-from cdpr_exu.spatial_scene import load_spatial_scene
-from cdpr_exu.spatial_trajectories import SpatialHoldTrajectory, SpatialPointToPointTrajectory
+from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialPointToPointTrajectory
 
 
 def four_cable(n_elements=10, bending=False, **solver):

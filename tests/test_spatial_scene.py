@@ -1,4 +1,4 @@
-"""Spatial scenes in TOML and their static mode (cdpr_exu.spatial_scene, cdpr_exu.spatial_rest), real solver."""
+"""Spatial scenes in TOML and their static mode (cdpr_exu.scenes.spatial_scene, cdpr_exu.run.spatial_rest), real solver."""
 
 import json
 import subprocess
@@ -8,12 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError
+from cdpr_exu.core.errors import SceneError
 from cdpr_exu.physics import cogiro
-from cdpr_exu.rest import solve_rest
-from cdpr_exu.scene import SpatialSceneError, load_scene
-from cdpr_exu.spatial_rest import solve_spatial_rest
-from cdpr_exu.spatial_scene import load_any_scene, load_spatial_scene, shipped_spatial_scenes, spatial_scene_from_dict
+from cdpr_exu.run.rest import solve_rest
+from cdpr_exu.scenes.scene import SpatialSceneError, load_scene
+from cdpr_exu.run.spatial_rest import solve_spatial_rest
+from cdpr_exu.scenes.spatial_scene import load_any_scene, load_spatial_scene, shipped_spatial_scenes, spatial_scene_from_dict
 
 #: The paper's catenary scene with fixed cable ends, written as a spatial scene in the
 #: vertical x-z plane (y = 0): the same cables, elements, masses and bending.

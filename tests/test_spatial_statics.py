@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 import cdpr_exu.physics.spatial_statics as spatial_statics
-from cdpr_exu.catenary import CatenaryCable
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import left_jacobian, rotation_from_vector
+from cdpr_exu.physics.catenary import CatenaryCable
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform, solve_cable, solve_spatial_statics
-from cdpr_exu.statics import SuspendedCable, SuspendedPlatform, solve_forward_statics
+from cdpr_exu.statics.statics import SuspendedCable, SuspendedPlatform, solve_forward_statics
 
 # The paper's cable (radius 5 mm, E = 1e9 Pa, 0.35 kg/m): w = 3.43 N/m, EA = 7.85e4 N.
 CABLE = CatenaryCable.from_material(1.0, 0.005, 1e9, 0.35)
@@ -45,7 +45,7 @@ BOTH = [pytest.param(False, id="point-mass"), pytest.param(True, id="rigid")]
 @pytest.mark.parametrize("rigid", BOTH)
 @pytest.mark.parametrize("azimuth", [0.0, math.radians(35.0)])
 def test_robot_in_one_vertical_plane_reproduces_the_planar_statics(rigid, azimuth):
-    """Two cables and the platform in a vertical plane at any azimuth: the planar answer of cdpr_exu.statics."""
+    """Two cables and the platform in a vertical plane at any azimuth: the planar answer of cdpr_exu.statics.statics."""
     along = np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
     planar_anchors = [(-0.15, 0.1), (0.15, 0.1)] if rigid else [(0.0, 0.0), (0.0, 0.0)]
     planar = SuspendedPlatform([SuspendedCable(W, EA, anchor=anchor, exit_point=(sign * 1.75, 0.0))
@@ -253,7 +253,7 @@ def test_no_equilibrium_within_the_tension_limit_is_a_clear_error():
 @pytest.mark.parametrize("name", ["spatial-cogiro", "spatial-ipanema"])
 def test_the_catenaries_of_the_inverse_lengths_hold_the_platform_at_the_asked_pose(name):
     from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics
-    from cdpr_exu.spatial_scene import load_spatial_scene
+    from cdpr_exu.scenes.spatial_scene import load_spatial_scene
 
     scene = load_spatial_scene(name)
     platform = scene.catenary_platform()

@@ -1,17 +1,17 @@
-"""Tests of cdpr_exu.spatial_trajectories: horizontal circles, holds, quintic moves, dicts, planar agreement."""
+"""Tests of cdpr_exu.scenes.spatial_trajectories: horizontal circles, holds, quintic moves, dicts, planar agreement."""
 
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError
-from cdpr_exu.geometry import left_jacobian, rotation_from_vector, rotation_matrix, rotation_vector
-from cdpr_exu.spatial_trajectories import (
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_matrix, rotation_vector
+from cdpr_exu.scenes.spatial_trajectories import (
     SpatialCircleTrajectory,
     SpatialHoldTrajectory,
     SpatialPointToPointTrajectory,
     spatial_trajectory_from_dict,
 )
-from cdpr_exu.trajectories import CircleTrajectory, PointToPointTrajectory
+from cdpr_exu.scenes.trajectories import CircleTrajectory, PointToPointTrajectory
 
 RAMPED_TILTED_CIRCLE = SpatialCircleTrajectory(center=(0.1, -0.2, 1.5), radius=0.3, angular_rate=-0.7,
                                                rotation=(0.05, 0.0, 0.2), tilt=(0.04, -0.03, 0.0), ramp_time=2.0)

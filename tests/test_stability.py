@@ -29,15 +29,15 @@ from functools import lru_cache
 
 import numpy as np
 
-from cdpr_exu.energy import energy_rise, mechanical_energy
+from cdpr_exu.results.energy import energy_rise, mechanical_energy
 import pytest
 
-from cdpr_exu.errors import SceneError, SolverFailure, UnreachableError
-from cdpr_exu.model import build_model
-from cdpr_exu.result import Result
-from cdpr_exu.scene import Effects, Scene, WinchSpec, load_scene
-from cdpr_exu.simulate import MAX_STRAIN, explicit_step_limit, simulate
-from cdpr_exu.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
+from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
+from cdpr_exu.builder.model import build_model
+from cdpr_exu.results.result import Result
+from cdpr_exu.scenes.scene import Effects, Scene, WinchSpec, load_scene
+from cdpr_exu.run.simulate import MAX_STRAIN, explicit_step_limit, simulate
+from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 from controllers.base import WinchCommand
 from controllers.ideal_ik import IdealIKController
 
@@ -275,7 +275,7 @@ def test_energy_never_rises_while_the_winches_hold_still(name):
 
 def with_initial_accelerations(monkeypatch) -> None:
     """Make ``simulate`` use Exudyn's default: start from the consistent initial accelerations."""
-    import cdpr_exu.simulate as simulate_module
+    import cdpr_exu.run.simulate as simulate_module
 
     original = simulate_module.solver_settings
 
@@ -516,7 +516,7 @@ def test_explicit_rk44_runs_below_its_step_limit_and_matches_the_implicit_solver
     (10 000 steps), winches held (RK44 cannot drive them, see the SceneError below):
     the platform starts to sink as with the implicit solver. Measured difference 4e-7 m;
     bound: the static stretch of the explicit joint spring under the platform's weight,
-    M g / k = 24.5 N / 3.1e6 N/m = 7.8e-6 m (cdpr_exu.platform.explicit_joint_spring),
+    M g / k = 24.5 N / 3.1e6 N/m = 7.8e-6 m (cdpr_exu.builder.platform.explicit_joint_spring),
     the only modelling difference between the two runs."""
     held = holding_still(PAPER)
     scene = shortened(held, end_time=1e-3, output_period=1e-4, step_size=1e-7, integrator="rk44")

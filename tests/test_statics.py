@@ -1,13 +1,13 @@
-"""Tests of the kineto-static equilibrium of a platform on catenary cables (cdpr_exu.statics)."""
+"""Tests of the kineto-static equilibrium of a platform on catenary cables (cdpr_exu.statics.statics)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from cdpr_exu.catenary import CatenaryCable, solve_forward
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.statics import (
+from cdpr_exu.physics.catenary import CatenaryCable, solve_forward
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.statics.statics import (
     Pulley,
     SuspendedCable,
     SuspendedPlatform,

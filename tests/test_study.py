@@ -1,4 +1,4 @@
-"""Tests of parameter studies (cdpr_exu.study): paths, grids, files, failures, Dask.
+"""Tests of parameter studies (cdpr_exu.studies.study): paths, grids, files, failures, Dask.
 
 Real runs of the paper's circle, cut to 0.3 s so that the whole file stays well
 under a minute on two cores. Wall times are never asserted; the physics is checked
@@ -15,9 +15,9 @@ import sys
 
 import pytest
 
-from cdpr_exu.errors import SceneError
-from cdpr_exu.scene import load_scene, scene_from_dict
-from cdpr_exu.study import (FIGURES, Variation, apply_parameters, check_parameter_path, combinations,
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.scenes.scene import load_scene, scene_from_dict
+from cdpr_exu.studies.study import (FIGURES, Variation, apply_parameters, check_parameter_path, combinations,
                             parse_parameter, run_study)
 
 #: Simulated time of every run here [s]: 150 steps of 2 ms, enough for the platform

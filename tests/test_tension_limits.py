@@ -8,12 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.comparison import markdown_table
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.output import json_text
-from cdpr_exu.scene import CableSpec, load_scene, save_scene
-from cdpr_exu.simulate import simulate
-from cdpr_exu.workspace import check_reference
+from cdpr_exu.studies.comparison import markdown_table
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.output import json_text
+from cdpr_exu.scenes.scene import CableSpec, load_scene, save_scene
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.statics.workspace import check_reference
 
 PAPER = load_scene("paper-circle")
 

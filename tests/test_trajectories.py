@@ -1,10 +1,10 @@
-"""Tests of cdpr_exu.trajectories: the paper's circle, holds, quintic moves, dict round-trips."""
+"""Tests of cdpr_exu.scenes.trajectories: the paper's circle, holds, quintic moves, dict round-trips."""
 
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError
-from cdpr_exu.trajectories import (
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.scenes.trajectories import (
     CircleTrajectory,
     HoldTrajectory,
     PointToPointTrajectory,

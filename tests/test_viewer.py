@@ -1,4 +1,4 @@
-"""Tests of cdpr_exu.viewer: replaying a real run folder (solution file + scene).
+"""Tests of cdpr_exu.post.viewer: replaying a real run folder (solution file + scene).
 
 One real 0.3 s run of the paper's circle is written into a folder by ``run_scene``,
 then: the solution file reloads and fits the rebuilt model, ``cdpr view`` refuses
@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from cdpr_exu import viewer
+from cdpr_exu.post import viewer
 from cdpr_exu.cli import main, run_scene
-from cdpr_exu.scene import load_scene, save_scene
+from cdpr_exu.scenes.scene import load_scene, save_scene
 
 #: Simulated time of the test run [s]; with the scene's output period of 0.01 s
 #: the solution file holds 31 rows (t = 0, 0.01, ..., 0.3).
@@ -73,7 +73,7 @@ def test_rebuilt_model_has_the_coordinates_of_the_solution_file(run_dir, decorat
 
 def test_replayed_platform_pose_matches_the_saved_result(run_dir):
     """The solution file and result.npz describe the same run: same platform pose."""
-    from cdpr_exu.result import Result
+    from cdpr_exu.results.result import Result
 
     result = Result.load(run_dir)
     pose = viewer.load_replay(run_dir, decorate=False).positions()["platform"]

@@ -5,10 +5,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.errors import SceneError
-from cdpr_exu.scene import WinchSpec, load_scene
-from cdpr_exu.simulate import simulate
-from cdpr_exu.winch import servo_gains
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.scenes.scene import WinchSpec, load_scene
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.builder.winch import servo_gains
 
 
 def _closed_loop_poles(spec):
@@ -56,7 +56,7 @@ def test_servo_winch_tracks_the_command_and_matches_the_kinematic_winch():
 
 # --------------------------------------------------------------------------- slack rope at the drum
 
-from cdpr_exu.winch import RESERVOIR_THRESHOLD, reservoir_split  # noqa: E402
+from cdpr_exu.builder.winch import RESERVOIR_THRESHOLD, reservoir_split  # noqa: E402
 
 
 @pytest.mark.parametrize("change, node, surplus, length", [
@@ -90,7 +90,7 @@ def test_hauling_in_takes_up_the_surplus_before_the_node_moves():
 def test_the_massless_presets_keep_their_step_on_stiff_ropes_and_a_light_platform():
     """0.05 kg on E = 1e12 ropes at 1e-4 s: Newton converges at every step, so the
     adaptive step never shrinks (it did 350-fold at Exudyn's default tolerance)."""
-    from cdpr_exu.scene import Effects
+    from cdpr_exu.scenes.scene import Effects
 
     paper = load_scene("paper-circle")
     scene = paper.with_changes(

@@ -5,12 +5,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.comparison import CONTROLLERS
-from cdpr_exu.errors import UnreachableError
-from cdpr_exu.scene import Effects, load_scene
-from cdpr_exu.simulate import simulate
-from cdpr_exu.trajectories import CircleTrajectory, PointToPointTrajectory
-from cdpr_exu.workspace import check_reference, reference_samples
+from cdpr_exu.studies.comparison import CONTROLLERS
+from cdpr_exu.core.errors import UnreachableError
+from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.scenes.trajectories import CircleTrajectory, PointToPointTrajectory
+from cdpr_exu.statics.workspace import check_reference, reference_samples
 
 PAPER = load_scene("paper-circle")
 
@@ -80,7 +80,7 @@ def test_the_circle_is_checked_at_its_extreme_poses_exactly():
 
 
 def test_the_shipped_scenes_pass_the_check():
-    from cdpr_exu.scene import shipped_scenes
+    from cdpr_exu.scenes.scene import shipped_scenes
 
     for name in shipped_scenes():
         check_reference(load_scene(name))

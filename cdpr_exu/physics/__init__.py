@@ -1,6 +1,11 @@
-"""Physics of spatial (3-D) cables and robots, the first layer of the spatial robots (issue 15).
+"""The physics of the cables, pure maths without Exudyn.
 
-Numba kernels without Exudyn (``bending_3d``), elastic-catenary statics without Exudyn
-(``spatial_statics``), and their Exudyn assemblies (``chain_3d``, ``spatial_robot``).
-Positions are flat arrays (x0, y0, z0, x1, ...) [m]; z up, gravity along -z.
+Planar: the elastic catenary (``catenary``), the numba kernels of exact-angle bending
+(``bending``), tension-only axial elements (``axial``) and pulley contact on nodes or
+segments (``node_contact``, ``segment_contact``). Spatial: exact-angle bending and
+tension-only elements in 3-D (``bending_3d``, ``axial_3d``), the elastic-catenary statics
+of a spatial robot and its inverse (``spatial_statics``), the ideal kinematics with
+swivel pulleys, the structure matrix and the tension distribution
+(``spatial_kinematics``), and CoGiRo's published geometry (``cogiro``). Their Exudyn
+assemblies are in :mod:`cdpr_exu.builder`. Units SI; spatial: z up, gravity along -z.
 """

@@ -1,13 +1,13 @@
 """Tension-only (slack) axial spring-dampers of spatial lumped-mass cables: numba kernels.
 
-The spatial counterpart of :mod:`cdpr_exu.axial`, with the same law
-(:func:`cdpr_exu.axial.tension_law`, imported, not copied): element e between nodes
+The spatial counterpart of :mod:`cdpr_exu.physics.axial`, with the same law
+(:func:`cdpr_exu.physics.axial.tension_law`, imported, not copied): element e between nodes
 a and b pulls them together along u = (p_b - p_a) / l with
 
     T = g(s) max(0, k s + c ds/dt),   s = l - l0,   ds/dt = u . (v_b - v_a) - dl0/dt,
 
 g a C1 smoothstep from 0 at the rest length to 1 at a strain of
-:data:`cdpr_exu.axial.TAUT_BAND`. Below the rest length there is no force at all, not
+:data:`cdpr_exu.physics.axial.TAUT_BAND`. Below the rest length there is no force at all, not
 even damping. Above the band a taut element is exactly Exudyn's
 ``ObjectConnectorSpringDamper`` (k (l - l0) + c (dl/dt - dl0/dt) along the element, its
 ``velocityOffset`` the rest length's rate ``rest_rate``, nonzero while a winch pays the
@@ -15,7 +15,7 @@ cable out: the damper acts on the strain rate).
 
 The left-hand-side Jacobians K = -df/dq and D = -df/dv are handed to Exudyn as
 ``f_q K + f_q_t D`` (the convention of :mod:`cdpr_exu.physics.bending_3d` and of the
-planar :mod:`cdpr_exu.cable`), as sparse triplets in a fixed pattern: one 6 x 6 block
+planar :mod:`cdpr_exu.builder.cable`), as sparse triplets in a fixed pattern: one 6 x 6 block
 per element on the coordinates (p_a, p_b). With G the (b, b) block,
 
     G_ij = f_q [u_i (k' u_j + c' w_j) + T (delta_ij - u_i u_j) / l] + f_q_t c' u_i u_j,
@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from cdpr_exu.axial import TAUT_BAND, tension_law
+from cdpr_exu.physics.axial import TAUT_BAND, tension_law
 
 #: Triplets per element: the 6 x 6 block on (p_a, p_b).
 TRIPLETS_PER_ELEMENT = 36

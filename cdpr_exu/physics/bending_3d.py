@@ -2,7 +2,7 @@
 
 At the joint of node b between the segments a -> b and b -> c the cable bends by the
 angle theta between e1 = p_b - p_a and e2 = p_c - p_b, whatever the plane it bends in.
-The spring stores U = k theta^2 / 2 (the planar model's law, :mod:`cdpr_exu.bending`,
+The spring stores U = k theta^2 / 2 (the planar model's law, :mod:`cdpr_exu.physics.bending`,
 for a cable that stays in a plane). Written through c = cos(theta),
 
     f = -dU/dq = k phi(c) dc/dq,      phi(c) = theta / sin(theta) = arccos(c) / sqrt(1 - c^2),

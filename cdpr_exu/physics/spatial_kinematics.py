@@ -5,7 +5,7 @@ inextensible. z is up, gravity along -z, SI units. A platform pose is
 ``(r, theta)``, shape (6,): the position ``r`` of its reference point [m] and a
 rotation vector ``theta`` [rad]; anchor i is at ``r + R(theta) b_i`` with
 ``R = exp([theta]x)``, the conventions of :mod:`cdpr_exu.physics.spatial_statics`;
-the SO(3) helpers are :mod:`cdpr_exu.geometry`'s (``rotation_from_vector``,
+the SO(3) helpers are :mod:`cdpr_exu.core.geometry`'s (``rotation_from_vector``,
 ``left_jacobian``). A
 point-mass platform (every cable on one point) has the pose ``r``, shape (3,).
 
@@ -14,14 +14,14 @@ Swivel pulley
 A swivel pulley turns about the vertical axis through its **inlet** ``e`` (3,): the
 point where the cable leaves the axis and starts to wrap on the disc. The winch side
 of the cable hangs straight down that axis to the winch, as in the planar model,
-where it hangs down the vertical winch line (:mod:`cdpr_exu.geometry`). The disc, of
+where it hangs down the vertical winch line (:mod:`cdpr_exu.core.geometry`). The disc, of
 radius ``r_p``, lies in the vertical plane through the axis and the anchor ``p``; its
 centre is at ``e + r_p e_rho``, ``r_p`` from the axis towards the anchor.
 
 * The **azimuth** ``psi`` of the pulley is the direction of ``p`` seen from the axis,
   ``atan2(p_y - e_y, p_x - e_x)``; ``e_rho = (cos psi, sin psi, 0)``.
 * In that plane, with coordinates ``(rho, z) = ((p - e) . e_rho, p_z - e_z)``, the
-  cable is exactly the planar one: :class:`cdpr_exu.geometry.Pulley` with centre
+  cable is exactly the planar one: :class:`cdpr_exu.core.geometry.Pulley` with centre
   ``(r_p, 0)``, radius ``r_p`` and ``side = -1``. Its hang point ``(c_x + s r_p, c_z)
   = (0, 0)`` is the inlet, its vertical winch line ``x = 0`` is the swivel axis, and
   the cable wraps from the axis over the top of the disc towards the anchor. The
@@ -44,7 +44,7 @@ centre is at ``e + r_p e_rho``, ``r_p`` from the axis towards the anchor.
 Sign conventions
 ----------------
 ``SwivelExit.unit_vector`` points from the tangent point to the anchor, as in the
-planar :class:`cdpr_exu.geometry.PulleyExit`. :func:`cable_unit_vectors` returns
+planar :class:`cdpr_exu.core.geometry.PulleyExit`. :func:`cable_unit_vectors` returns
 ``u_i``, the opposite: the direction in which cable i pulls the platform. The
 length rate is ``dL_i/dt = -u_i . v_i`` (``v_i`` the anchor's velocity: a change of
 wrap exactly cancels the motion of the tangent point along the rim, and a change of
@@ -63,10 +63,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import nnls
 
-from cdpr_exu.catenary import STANDARD_GRAVITY
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import Pulley, PulleyExit, finite_array, left_jacobian, rotation_from_vector
-from cdpr_exu.validation import non_negative, per_item, vector
+from cdpr_exu.physics.catenary import STANDARD_GRAVITY
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.geometry import Pulley, PulleyExit, finite_array, left_jacobian, rotation_from_vector
+from cdpr_exu.core.validation import non_negative, per_item, vector
 
 __all__ = [
     "SwivelExit",
@@ -101,7 +101,7 @@ _BOUND_ROUNDING = 1e-9
 @dataclass(frozen=True, eq=False)  # array fields
 class SwivelExit(PulleyExit):
     """Where and how an ideal cable leaves a swivel pulley towards its anchor: a
-    :class:`~cdpr_exu.geometry.PulleyExit` in 3-D, with the pulley's azimuth.
+    :class:`~cdpr_exu.core.geometry.PulleyExit` in 3-D, with the pulley's azimuth.
 
     Attributes
     ----------
@@ -220,7 +220,7 @@ def swivel_pulley_exit(inlet, radius, anchor, azimuth_hint=None):
     Notes
     -----
     The cable lies in the vertical plane of azimuth ``psi`` through the axis, where
-    it is the planar cable of :class:`cdpr_exu.geometry.Pulley` (centre ``(r_p, 0)``,
+    it is the planar cable of :class:`cdpr_exu.core.geometry.Pulley` (centre ``(r_p, 0)``,
     side -1, hang point at the inlet; Pott, "Cable-Driven Parallel Robots: Theory
     and Application", Springer 2018, pulley kinematics).
     """
@@ -273,7 +273,7 @@ class SwivelPulley:
 def rotation_matrices(rotation_vectors):
     """``R = exp([theta]x)`` for rotation vectors (..., 3) [rad] -> (..., 3, 3).
 
-    Each is :func:`cdpr_exu.geometry.rotation_from_vector`.
+    Each is :func:`cdpr_exu.core.geometry.rotation_from_vector`.
     """
     theta = np.asarray(rotation_vectors, dtype=float)
     flat = theta.reshape(-1, 3)

@@ -3,14 +3,14 @@
 Each cable runs from a fixed exit point ``e_i`` (world frame, a point exit: no pulley)
 to an anchor ``b_i`` on the platform (platform frame), and hangs in the vertical plane
 through its two ends. In that plane it is the 2-D elastic catenary of
-:mod:`cdpr_exu.catenary` (Irvine's model: weight, axial elasticity, no bending), with
+:mod:`cdpr_exu.physics.catenary` (Irvine's model: weight, axial elasticity, no bending), with
 end A at the anchor and end B at the exit point; the 2-D answer is rotated back to
 3-D (MoorPy's trick for its mooring lines). z is up, gravity along -z, SI units.
 
 With ``a_i`` the anchor's world position, ``d = e_i - a_i`` the span, ``h`` its
 horizontal length and ``u = (d_x, d_y) / h`` its horizontal direction, the cable's
 2-D span is ``(h, d_z)`` and its force on the platform is ``H u + V_A e_z``. Its
-3-D end stiffness follows from the 2-D one ``K2`` (:func:`cdpr_exu.catenary.end_stiffness`)
+3-D end stiffness follows from the 2-D one ``K2`` (:func:`cdpr_exu.physics.catenary.end_stiffness`)
 and the turning of ``u``::
 
     dF/da = Q K2 Q^T - (H / h) (P_h - u u^T),   Q = [u, e_z],  P_h = diag(1, 1, 0)
@@ -35,7 +35,7 @@ Platform
 The equilibrium is the minimum of the potential energy (cables are conservative
 elastic catenaries with fixed exits, the platform weight is ``M g z``); it is found by
 Newton's method with the analytic stiffness and the energy line search of
-:mod:`cdpr_exu.statics`, started from the pose on straight, massless, elastic cables
+:mod:`cdpr_exu.statics.statics`, started from the pose on straight, massless, elastic cables
 (which exists also when some cables are slack). This covers statically indeterminate
 robots (4 cables on a point mass, 8 on a rigid body): the cables' elasticity picks
 the equilibrium, no tension distribution is assumed.
@@ -49,12 +49,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize
 
-from cdpr_exu.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
+from cdpr_exu.physics.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
     profile, solve_forward, solve_inverse
-from cdpr_exu.errors import SceneError, UnreachableError
-from cdpr_exu.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
-from cdpr_exu.statics import PlatformEquilibriumViews, _minimise_energy  # the planar statics' line search, reused
-from cdpr_exu.validation import non_negative, positive, real_array, vector
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
+from cdpr_exu.statics.statics import PlatformEquilibriumViews, _minimise_energy  # the planar statics' line search, reused
+from cdpr_exu.core.validation import non_negative, positive, real_array, vector
 
 _RELATIVE_TOLERANCE = 1e-12
 """Target of the scaled wrench residual (the cables are solved to 1e-12 of their length)."""
@@ -103,7 +103,7 @@ class SpatialCable:
         object.__setattr__(self, "anchor", tuple(_point3("anchor", self.anchor)))
 
     def catenary(self, unstrained_length):
-        """The :class:`~cdpr_exu.catenary.CatenaryCable` of this cable with the given unstrained length [m]."""
+        """The :class:`~cdpr_exu.physics.catenary.CatenaryCable` of this cable with the given unstrained length [m]."""
         return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
 
 
@@ -120,7 +120,7 @@ class SpatialPlatform:
         Default 9.81.
     inertia : (float, float, float) [kg m^2], optional
         Principal moments of inertia about the centre of mass, along the platform axes;
-        only the dynamics (:mod:`cdpr_exu.physics.spatial_robot`) use them.
+        only the dynamics (:mod:`cdpr_exu.builder.spatial_robot`) use them.
 
     Raises
     ------
@@ -303,7 +303,7 @@ def solve_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=D
     guess : (H, V_B) [N], optional
         Warm start of the 2-D catenary.
     max_strain, max_tension : float, optional
-        As in :func:`cdpr_exu.catenary.solve_forward`.
+        As in :func:`cdpr_exu.physics.catenary.solve_forward`.
 
     Returns
     -------
@@ -467,7 +467,7 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
     external_wrench : array_like, shape (6,) [N, N m], optional
         Extra force and moment (about the centre of mass) on the platform.
     max_strain, max_tension : float, optional
-        Cable tension limits, as in :func:`cdpr_exu.catenary.solve_forward`.
+        Cable tension limits, as in :func:`cdpr_exu.physics.catenary.solve_forward`.
 
     Returns
     -------
@@ -605,7 +605,7 @@ def solve_inverse_spatial_statics(platform, pose, horizontal_guess, external_wre
     a rigid platform held by at least six cables the moment too (with fewer, the rotation is
     left free, as a suspended platform does). Gauss-Newton on the balance, each cable's
     force derivative by a forward difference of its inverse catenary
-    (:func:`cdpr_exu.catenary.solve_inverse`). Continuing from the previous sample's tensions
+    (:func:`cdpr_exu.physics.catenary.solve_inverse`). Continuing from the previous sample's tensions
     along a trajectory gives the tension path with the least change: an over-constrained
     robot keeps the internal tension it started with.
 

@@ -1,0 +1,486 @@
+"""Adds one lumped-mass cable to an Exudyn system, effect by effect (paper sec. 2.1).
+
+A cable of n elements has n + 1 mass points, node 0 at the winch end and node n at
+the platform anchor. Each element is an axial spring-damper (k_i, c_i); each interior
+node carries a rotational spring-damper (k_theta, c_theta) on the relative angle of
+its two elements. The axial items are Exudyn's built-in C++ spring-dampers; the
+bending of all cables is one ``ObjectGenericODE2`` whose force and analytic Jacobian
+are numba kernels (:mod:`cdpr_exu.physics.bending`): one Python call per Newton iteration for
+the whole robot. The same object carries the tension-only elements (``Effects.slack``,
+:mod:`cdpr_exu.physics.axial`) and the pulley contact on element segments
+(``Effects.pulley_contact_model = "segment"``, :mod:`cdpr_exu.physics.segment_contact`).
+
+Exudyn items live in its x-y plane: the paper's (x, z) maps to Exudyn's (x, y).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+
+from cdpr_exu.physics import axial
+from cdpr_exu.physics import bending
+from cdpr_exu.scenes.scene import CableSpec, Effects, PulleySpec
+from cdpr_exu.physics import node_contact as node_contact_module
+from cdpr_exu.physics.node_contact import NodePulleyContact
+from cdpr_exu.physics.segment_contact import SegmentPulleyContact
+
+
+@dataclass
+class CableItems:
+    """Exudyn indices of one cable's items.
+
+    Attributes
+    ----------
+    nodes : list of int
+        ``NodePoint2D`` indices, winch end first, length n + 1.
+    markers : list of int
+        ``MarkerNodePosition`` of each node.
+    reference : ndarray, shape (n + 1, 2) [m]
+        Reference (initial) node positions in the x-z plane.
+    springs : list of int
+        Axial ``ObjectConnectorSpringDamper`` indices, length n (empty if elasticity is off).
+    loads : list of int
+        Gravity ``LoadForceVector`` indices.
+    """
+
+    nodes: list[int]
+    markers: list[int]
+    reference: np.ndarray
+    springs: list[int] = field(default_factory=list)
+    loads: list[int] = field(default_factory=list)
+    masses: np.ndarray | None = None
+
+
+def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effects: Effects,
+              gravity: float) -> CableItems:
+    """Add the mass points, axial spring-dampers and gravity loads of one cable.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    cable : CableSpec
+    nodes_xz : ndarray, shape (n + 1, 2) [m]
+        Initial node positions (x, z), winch end first; each element should start at
+        its unstrained length.
+    effects : Effects
+        Which items to add (axial damping, gravity).
+    gravity : float [m/s^2]
+        Magnitude of gravity along -z.
+
+    Returns
+    -------
+    CableItems
+    """
+    nodes_xz = np.asarray(nodes_xz, dtype=float)
+    masses = cable.node_masses()
+    items = CableItems(nodes=[], markers=[], reference=nodes_xz.copy(), masses=masses)
+    for (x, z), mass in zip(nodes_xz, masses):
+        node = mbs.AddNode(eii.NodePoint2D(referenceCoordinates=[x, z]))
+        mbs.AddObject(eii.ObjectMassPoint2D(mass=float(mass), nodeNumber=node))
+        items.nodes.append(node)
+        items.markers.append(mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
+    damping = cable.axial_damping if effects.axial_damping else 0.0
+    if effects.slack:
+        return _add_gravity(mbs, items, masses, effects, gravity)  # axial forces: see add_cable_forces
+    if not effects.axial_elasticity:  # inextensible elements: distance constraints
+        for a, b in zip(items.markers[:-1], items.markers[1:]):
+            items.springs.append(mbs.AddObject(eii.ObjectConnectorDistance(
+                markerNumbers=[a, b], distance=cable.element_length)))
+        return _add_gravity(mbs, items, masses, effects, gravity)
+    for a, b in zip(items.markers[:-1], items.markers[1:]):
+        items.springs.append(mbs.AddObject(eii.ObjectConnectorSpringDamper(
+            markerNumbers=[a, b], referenceLength=cable.element_length,
+            stiffness=cable.axial_stiffness, damping=damping)))
+    return _add_gravity(mbs, items, masses, effects, gravity)
+
+
+def _add_gravity(mbs: exu.MainSystem, items: CableItems, masses: np.ndarray, effects: Effects,
+                 gravity: float) -> CableItems:
+    if effects.gravity and gravity > 0.0:
+        for marker, mass in zip(items.markers, masses):
+            items.loads.append(mbs.AddLoad(eii.LoadForceVector(
+                markerNumber=marker, loadVector=[0.0, -float(mass) * gravity, 0.0])))
+    return items
+
+
+@dataclass
+class CableForceItems:
+    """The one ``ObjectGenericODE2`` that carries the cables' numba-computed forces.
+
+    It holds the exact-angle bending springs (``Effects.bending``), with
+    ``Effects.slack`` the tension-only axial elements, and with segment pulley contact
+    the rim contacts of ``contact_segments`` (global node pairs, shape (S, 2), into the
+    object's node list; ``contact`` their :class:`SegmentPulleyContact`). ``user_functions``
+    keeps the Python callables alive as long as the model.
+    """
+
+    object: int
+    joints: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    slack_elements: np.ndarray
+    user_functions: tuple = ()
+    contact_segments: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    contact: SegmentPulleyContact | None = None
+    #: The tension-only elements' rest lengths, stiffnesses and dampings [m, N/m, N s/m], shape (E,):
+    #: the arrays the force kernels read (a winch's rope reservoir changes its first element's).
+    slack_arrays: tuple = ()
+    #: The smooth node rim contacts (``Effects.pulley_contact_model = "node_smooth"``), or None.
+    node_contact: NodePulleyContact | None = None
+
+
+def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
+                     effects: Effects, pulleys: list[PulleySpec] | None = None,
+                     contact_elements: list[np.ndarray] | None = None,
+                     sparse_jacobian: bool = True,
+                     contact_nodes: list[np.ndarray] | None = None) -> CableForceItems | None:
+    """Add the bending (with slack, the axial; with segment contact, the pulley) forces of all cables as one object.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    cables : list of CableSpec
+    items : list of CableItems
+        The cables' nodes, in the same order.
+    effects : Effects
+    pulleys : list of PulleySpec, optional
+        Pulley of each cable; needed with ``contact_elements``.
+    contact_elements : list of ndarray of int, optional
+        Cable-local indices of the elements (element j joins nodes j and j + 1) that get
+        a segment rim contact with their cable's pulley (``Effects.pulley_contact_model =
+        "segment"``); None or all empty: no segment contact and no cost for it.
+    sparse_jacobian : bool
+        Return the Jacobian as sparse triplets (36 per bending joint, 16 per tension-only
+        element, 4 per contact node: cost linear in the number of nodes) instead of a
+        dense (2N, 2N) matrix. With segment contact the dense form is kept.
+    contact_nodes : list of ndarray of int, optional
+        Cable-local indices of the nodes that get a rim contact with their cable's pulley
+        (``Effects.pulley_contact_model = "node_smooth"``, :mod:`cdpr_exu.physics.node_contact`); None or
+        all empty: no node contact and no cost for it.
+
+    Returns None when neither ``effects.bending`` nor ``effects.slack`` is on and there
+    is no segment contact (then no item and no cost). The force user function receives
+    Exudyn's displacement coordinates ``q``; the reference positions are added here. Its
+    Jacobian is analytic (numba kernels), ``fODE2 * K + fODE2_t * D`` with K = -df/dq,
+    D = -df/dq_t.
+    """
+    counts = [len(it.nodes) for it in items]
+    contact = _segment_contact(counts, pulleys, contact_elements)
+    node_contact = _node_contact(counts, pulleys, contact_nodes)
+    if not (effects.bending or effects.slack or contact is not None or node_contact is not None):
+        return None
+    reference = np.concatenate([it.reference for it in items]).ravel()
+    size = reference.size
+    if effects.bending:
+        joints = bending.cable_joints(counts)
+        stiffness = np.concatenate([np.full(n - 2, c.bending_stiffness) for c, n in zip(cables, counts)])
+        damping = np.concatenate([
+            np.full(n - 2, c.bending_damping if effects.bending_damping else 0.0) for c, n in zip(cables, counts)
+        ])
+    else:
+        joints, stiffness, damping = np.zeros((0, 3), np.int64), np.zeros(0), np.zeros(0)
+    linear = effects.bending and effects.bending_model == "linear"
+    matrices = _linear_bending_matrices(cables, counts, joints, stiffness, damping, reference) if linear else {}
+    if linear:  # K and D live in the object's constant matrices; no exact-angle joints
+        spring = bending.BendingSpringDamper(size // 2, np.zeros((0, 3), np.int64), np.zeros(0), np.zeros(0))
+    else:
+        spring = bending.BendingSpringDamper(size // 2, joints, stiffness, damping)
+    if effects.slack:
+        elements = axial.cable_elements(counts)
+        rest = np.concatenate([np.full(n - 1, c.element_length) for c, n in zip(cables, counts)])
+        axial_k = np.concatenate([np.full(n - 1, c.axial_stiffness) for c, n in zip(cables, counts)])
+        axial_c = np.concatenate([
+            np.full(n - 1, c.axial_damping if effects.axial_damping else 0.0) for c, n in zip(cables, counts)
+        ])
+    else:
+        elements = np.zeros((0, 2), np.int64)
+    positions = np.zeros(size)
+
+    def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
+        np.add(reference, q, out=positions)
+        velocities = np.asarray(q_t)
+        force = spring.force(positions, velocities)
+        if effects.slack:
+            axial.slack_axial_force(positions, velocities, elements, rest, axial_k, axial_c, force)
+        if contact is not None:
+            contact.add_force(positions, velocities, force)
+        if node_contact is not None:
+            node_contact.add_force(positions, velocities, force)
+        return force
+
+    def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
+        np.add(reference, q, out=positions)
+        velocities = np.asarray(q_t)
+        jacobian = spring.jacobian_weighted(positions, velocities, f_q, f_q_t)
+        if effects.slack:
+            axial.slack_axial_jacobian(positions, velocities, elements, rest, axial_k, axial_c,
+                                       float(f_q), float(f_q_t), jacobian)
+        if contact is not None:
+            contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
+        if node_contact is not None:
+            node_contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
+        return jacobian
+
+    nodes = [n for it in items for n in it.nodes]
+    functions = (force_function, jacobian_function)
+    mass = np.zeros((size, size))
+    if sparse_jacobian and contact is None and not linear:
+        blocks = [_bending_blocks(spring)]
+        if effects.slack and len(elements):
+            blocks.append(_slack_blocks(elements, rest, axial_k, axial_c))
+        if node_contact is not None:
+            blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
+        functions = (force_function, _sparse_jacobian_function(blocks, reference, positions))
+        mass = _sparse(np.zeros((size, size)))
+    if linear and not effects.slack and contact is None and node_contact is None:
+        # Nothing left for Python per Newton iteration: no force function, and a Jacobian
+        # function that returns an empty matrix, so that Exudyn adds the constant K and D
+        # itself (without any Jacobian function it would differentiate them numerically).
+        # Sparse triplets: dense (2N, 2N) matrices made a 2 x 61-node cable 8 times slower.
+        matrices = {key: _sparse(value) if key != "forceVector" else value for key, value in matrices.items()}
+        empty = _sparse(np.zeros((size, size)))
+        mass = _sparse(np.zeros((size, size)))
+
+        def zero_jacobian(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
+            return empty
+
+        functions = (0, zero_jacobian)
+    obj = mbs.AddObject(eii.ObjectGenericODE2(
+        nodeNumbers=nodes, massMatrix=mass,
+        forceUserFunction=functions[0], jacobianUserFunction=functions[1], **matrices))
+    segments = np.zeros((0, 2), np.int64) if contact is None else contact.segments
+    return CableForceItems(obj, joints, stiffness, damping, elements, (spring, *functions, matrices),
+                           segments, contact, (rest, axial_k, axial_c) if effects.slack else (), node_contact)
+
+
+def _bending_blocks(spring):
+    """Sparse pattern and value filler of the bending joints' 6 x 6 blocks."""
+    rows, columns = bending.bending_triplet_pattern(spring.joints)
+
+    def fill(positions, velocities, factor_position, factor_velocity, out_values):
+        bending.bending_triplet_values(positions, velocities, spring.joints, spring.stiffness, spring.damping,
+                                       factor_position, factor_velocity, out_values)
+    return rows, columns, fill
+
+
+def _slack_blocks(elements, rest, axial_k, axial_c):
+    """Sparse pattern and value filler of the tension-only elements' 4 x 4 blocks."""
+    rows, columns = axial.slack_triplet_pattern(elements)
+
+    def fill(positions, velocities, factor_position, factor_velocity, out_values):
+        axial.slack_triplet_values(positions, velocities, elements, rest, axial_k, axial_c,
+                                   factor_position, factor_velocity, out_values)
+    return rows, columns, fill
+
+
+def _sparse_jacobian_function(blocks, reference, positions):
+    """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets (an
+    ``exu.MatrixContainer``) in a fixed pattern.
+
+    ``blocks`` lists ``(rows, columns, fill)`` per force (bending joints, tension-only
+    elements, contact nodes): the places of its triplets and a numba-backed function
+    ``fill(positions, velocities, f_q, f_q_t, out_values)`` that writes their values.
+    """
+    size = reference.size
+    bounds = np.cumsum([0] + [rows.size for rows, _, _ in blocks])
+    triplets = np.zeros((int(bounds[-1]), 3))
+    triplets[:, 0] = np.concatenate([rows for rows, _, _ in blocks])
+    triplets[:, 1] = np.concatenate([columns for _, columns, _ in blocks])
+    values = [np.zeros(rows.size) for rows, _, _ in blocks]
+    container = exu.MatrixContainer()
+
+    def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001 - Exudyn's signature
+        np.add(reference, q, out=positions)
+        velocities = np.asarray(q_t)
+        for (_, _, fill), out_values, first, last in zip(blocks, values, bounds[:-1], bounds[1:]):
+            fill(positions, velocities, float(f_q), float(f_q_t), out_values)
+            triplets[first:last, 2] = out_values
+        container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
+        return container
+
+    return jacobian_function
+
+
+def _node_contact(counts: list[int], pulleys: list[PulleySpec] | None,
+                  contact_nodes: list[np.ndarray] | None) -> NodePulleyContact | None:
+    """The node rim contacts of the listed nodes with their cables' pulleys (None if none)."""
+    if contact_nodes is None or not any(len(n) for n in contact_nodes):
+        return None
+    if pulleys is None or len(pulleys) != len(counts) or len(contact_nodes) != len(counts):
+        raise ValueError("node contact needs one pulley and one list of contact nodes per cable")
+    first = np.cumsum([0] + list(counts[:-1]))
+    nodes = np.concatenate([start + np.asarray(n, dtype=np.int64) for start, n in zip(first, contact_nodes)])
+    per_node = [np.repeat(np.array([getattr(p, name) for p in pulleys], dtype=float),
+                          [len(n) for n in contact_nodes], axis=0)
+                for name in ("center", "radius", "contact_stiffness", "contact_damping")]
+    return NodePulleyContact(sum(counts), nodes, *per_node, band=node_contact_module.CONTACT_ONSET_DEPTH)
+
+
+def _segment_contact(counts: list[int], pulleys: list[PulleySpec] | None,
+                     contact_elements: list[np.ndarray] | None) -> SegmentPulleyContact | None:
+    """The segment rim contacts of the listed elements with their cables' pulleys (None if none)."""
+    if contact_elements is None or not any(len(e) for e in contact_elements):
+        return None
+    if pulleys is None or len(pulleys) != len(counts) or len(contact_elements) != len(counts):
+        raise ValueError("segment contact needs one pulley and one list of contact elements per cable")
+    segments, centers, radii, stiffness, damping = [], [], [], [], []
+    first = 0
+    for count, pulley, elements in zip(counts, pulleys, contact_elements):
+        elements = np.asarray(elements, dtype=np.int64)
+        segments.append(np.column_stack([first + elements, first + elements + 1]))
+        centers.append(np.tile(pulley.center, (len(elements), 1)))
+        radii.append(np.full(len(elements), pulley.radius))
+        stiffness.append(np.full(len(elements), pulley.contact_stiffness))
+        damping.append(np.full(len(elements), pulley.contact_damping))
+        first += count
+    return SegmentPulleyContact(first, np.concatenate(segments), np.concatenate(centers), np.concatenate(radii),
+                                np.concatenate(stiffness), np.concatenate(damping))
+
+
+def _sparse(matrix: np.ndarray) -> exu.MatrixContainer:
+    """Exudyn sparse-triplet container of a (square) NumPy matrix."""
+    rows, columns = np.nonzero(matrix)
+    container = exu.MatrixContainer()
+    container.SetWithSparseMatrix(np.column_stack([rows, columns, matrix[rows, columns]]).reshape(-1, 3),
+                                  numberOfRows=matrix.shape[0], numberOfColumns=matrix.shape[1],
+                                  useDenseMatrix=False)
+    return container
+
+
+def _linear_bending_matrices(cables: list[CableSpec], counts: list[int], joints: np.ndarray, stiffness: np.ndarray,
+                             damping: np.ndarray, reference: np.ndarray) -> dict[str, np.ndarray]:
+    """Constant matrices of the linear curvature-vector bending (``Effects.bending_model = "linear"``).
+
+    The spring ``(k_theta / l0i^2) |p_a - 2 p_b + p_c|^2 / 2`` acts on the absolute
+    positions p = q_ref + q, while Exudyn multiplies K by the displacement q; the force
+    vector ``-K q_ref`` supplies the rest, so any straight, evenly spaced cable is free of
+    bending, whatever the (wrapped) reference configuration. For equal element lengths
+    its moment is k_theta sin(theta) instead of k_theta theta: 17 % less at 60 degrees.
+
+    Returns
+    -------
+    dict
+        ``stiffnessMatrix``, ``dampingMatrix`` (2N, 2N) [N/m, N s/m] and ``forceVector`` (2N,) [N].
+    """
+    lengths = np.concatenate([np.full(n - 2, c.element_length) for c, n in zip(cables, counts)])
+    n_nodes = reference.size // 2
+    k_matrix = bending.curvature_stiffness_matrix(n_nodes, joints, stiffness, lengths)
+    d_matrix = bending.curvature_damping_matrix(n_nodes, joints, damping, lengths)
+    return {"stiffnessMatrix": k_matrix, "dampingMatrix": d_matrix, "forceVector": -k_matrix @ reference}
+
+
+def element_tensions(cable: CableSpec, positions: np.ndarray, velocities: np.ndarray,
+                     effects: Effects, rest_length: np.ndarray | None = None) -> np.ndarray:
+    """Axial force of each element, as the spring-dampers compute it (tension > 0).
+
+    Parameters
+    ----------
+    cable : CableSpec
+    positions, velocities : ndarray, shape (..., n + 1, 2) [m, m/s]
+    effects : Effects
+        With ``slack``, the tension-only law of :func:`cdpr_exu.physics.axial.tension_law`.
+    rest_length : ndarray, shape (..., n), optional [m]
+        Rest length of each element when it differs from the nominal one (the winch
+        element holding slack rope, :func:`cdpr_exu.builder.winch.reservoir_split`); stiffness
+        and damping scale as 1 / rest length.
+
+    Returns
+    -------
+    ndarray, shape (..., n) [N]
+    """
+    delta = np.diff(positions, axis=-2)
+    delta_rate = np.diff(velocities, axis=-2)
+    length = np.linalg.norm(delta, axis=-1)
+    length_rate = np.einsum("...i,...i->...", delta, delta_rate) / np.where(length > 0, length, 1.0)
+    rest = cable.element_length if rest_length is None else np.asarray(rest_length, dtype=float)
+    scale = cable.element_length / rest
+    extension = length - rest
+    force = cable.axial_stiffness * scale * extension
+    if effects.axial_damping:
+        force = force + cable.axial_damping * scale * length_rate
+    if effects.slack:  # axial.tension_law, vectorised: nothing below the rest length, a C1 switch above
+        x = np.clip(extension / (axial.TAUT_BAND * rest), 0.0, 1.0)
+        force = np.maximum(force, 0.0) * x * x * (3.0 - 2.0 * x)
+    return force
+
+
+#: Stiffness of an "inextensible" massless rope, as a multiple of its elastic EA:
+#: stiff enough that its stretch (about 1e-3 of the elastic one) is negligible, soft
+#: enough for the implicit solver's Newton iteration at the usual step sizes.
+INEXTENSIBLE_STIFFNESS_FACTOR = 1.0e3
+
+
+@dataclass
+class RopeItems:
+    """A massless cable: one Exudyn ``ObjectConnectorReevingSystemSprings``.
+
+    Attributes
+    ----------
+    rope : int
+        The reeving-system object (winch point, pulley sheave, platform anchor).
+    drum_node : int
+        A one-coordinate node whose prescribed value is the paid-out length change.
+    drum_marker : int
+        Its coordinate marker.
+    winch_point : ndarray, shape (2,) [m]
+        Fixed start of the rope below the pulley (x, z).
+    """
+
+    rope: int
+    drum_node: int
+    drum_marker: int
+    winch_point: np.ndarray
+
+
+def add_rope(mbs: exu.MainSystem, cable: CableSpec, pulley_center, pulley_radius: float, side: int,
+             anchor_marker: int, winch_point, ground_coordinate_marker: int, effects: Effects) -> RopeItems:
+    """Add a massless rope from a fixed winch point over the pulley to the platform anchor.
+
+    The rope force is uniform along it (frictionless sheave): EA / L times the stretch
+    over the current length L, plus the damping dn A / L times the stretch rate; with
+    ``effects.slack`` compression is cut off (Exudyn's regularisation force, 0.1 N).
+    Exudyn's sheave wraps the rope on the side given by the sign of its axis: +z for a
+    cable hanging on the pulley's right side, -z on its left (``side``). The paid-out
+    length change lambda - lambda(0) is a prescribed coordinate that Exudyn adds to the
+    rope's reference length.
+
+    Parameters
+    ----------
+    cable : CableSpec
+        Unstrained length, EA and dn A of the rope.
+    pulley_center : (x, z) [m]
+    pulley_radius : float [m]
+        0 for a point exit.
+    side : {-1, +1}
+    anchor_marker : int
+        ``MarkerBodyRigid`` of the platform anchor.
+    winch_point : (x, z) [m]
+        Fixed start of the rope, below the pulley on the winch side.
+    ground_coordinate_marker : int
+        A coordinate marker that is always 0 (closes the coordinate pair).
+    """
+    winch_point = np.asarray(winch_point, dtype=float)
+    winch_ground = mbs.AddObject(eii.ObjectGround(referencePosition=[winch_point[0], winch_point[1], 0.0]))
+    winch_marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=winch_ground))
+    pulley_ground = mbs.AddObject(eii.ObjectGround(referencePosition=[pulley_center[0], pulley_center[1], 0.0]))
+    pulley_marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=pulley_ground))
+    drum = mbs.AddNode(eii.NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.0],
+                                           initialCoordinates_t=[0.0], numberOfODE2Coordinates=1))
+    # The drum coordinate is prescribed (winch constraint); this small mass only keeps
+    # the mass matrix regular.
+    mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=[drum], massMatrix=np.eye(1) * 1.0e-3))
+    drum_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=drum, coordinate=0))
+    stiffness = cable.axial_rigidity * (1.0 if effects.axial_elasticity else INEXTENSIBLE_STIFFNESS_FACTOR)
+    damping = cable.damping_constant * cable.area if effects.axial_damping else 0.0
+    rope = mbs.AddObject(eii.ObjectConnectorReevingSystemSprings(
+        markerNumbers=[winch_marker, pulley_marker, anchor_marker, drum_marker, ground_coordinate_marker],
+        hasCoordinateMarkers=True, coordinateFactors=[1.0, 1.0],
+        stiffnessPerLength=stiffness, dampingPerLength=damping, referenceLength=cable.unstrained_length,
+        sheavesAxes=exu.Vector3DList([[0.0, 0.0, float(side)]] * 3),
+        sheavesRadii=[0.0, float(pulley_radius), 0.0],
+        regularizationForce=0.1 if effects.slack else -1.0))
+    return RopeItems(rope, drum, drum_marker, winch_point)

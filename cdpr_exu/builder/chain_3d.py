@@ -1,0 +1,211 @@
+"""A spatial cable in Exudyn: 3-D mass points, axial spring-dampers and exact-angle bending.
+
+:func:`add_spatial_chain` adds one chain of ``NodePoint`` + ``ObjectMassPoint`` items
+joined by Exudyn's ``ObjectConnectorSpringDamper`` (axial, k = E A / l0, c = d_n A / l0),
+with gravity along -z and the bending springs of :mod:`cdpr_exu.physics.bending_3d` in
+one ``ObjectGenericODE2`` whose Jacobian is sparse triplets. Its first node can be held
+(three coordinate constraints). Units SI; z up.
+
+With ``tension_only=True`` there are no Exudyn spring-dampers: the axial elements are
+the tension-only ones of :mod:`cdpr_exu.physics.axial_3d` (a cable cannot push; a slack
+element carries nothing, not even damping) and join the bending springs in the one
+``ObjectGenericODE2`` (one force function, one sparse Jacobian summing both), which then
+exists even without bending.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+
+from cdpr_exu.physics import axial_3d
+from cdpr_exu.physics import bending_3d
+from cdpr_exu.physics.axial import cable_elements
+
+
+@dataclass
+class SpatialChainItems:
+    """Item indices of a spatial chain.
+
+    Attributes
+    ----------
+    nodes, masses, markers, springs : list of int
+    bending : int or None
+        The ``ObjectGenericODE2`` of the bending springs (None without bending).
+    reference : ndarray, shape (3N,) [m]
+        Reference positions of the nodes (Exudyn's coordinates are displacements from them).
+    joints : ndarray of int, shape (J, 3)
+    user_functions : tuple
+        Keeps the Python callables alive as long as the model.
+    loads : list of int
+        The nodes' gravity ``LoadForceVector`` items (empty without gravity).
+    bending_stiffness : ndarray, shape (J,) [N m/rad] or None
+        The joints' stiffnesses, the very array the bending force reads (a winch that
+        changes the cable's length scales it in place).
+    generic : int or None
+        The chain's ``ObjectGenericODE2`` (bending and/or tension-only axial elements; the
+        same as ``bending`` when there is bending), None when there is none.
+    axial_elements : ndarray of int, shape (n, 2) or None
+        With ``tension_only``: the node pairs of the tension-only elements (None with
+        Exudyn's spring-dampers, which are in ``springs``).
+    axial_rest_length, axial_stiffness, axial_damping, axial_rest_rate : ndarray, shape (n,) or None
+        With ``tension_only``: the very arrays the force and Jacobian functions read
+        [m, N/m, N s/m, m/s]; change them in place between steps (a winch paying out cable
+        scales them, and sets the rest length's rate so that the damper acts on the
+        strain rate). None with Exudyn's spring-dampers.
+    """
+
+    nodes: list
+    masses: list
+    markers: list
+    springs: list
+    bending: int | None
+    reference: np.ndarray
+    joints: np.ndarray
+    user_functions: tuple = field(default_factory=tuple)
+    loads: list = field(default_factory=list)
+    bending_stiffness: np.ndarray | None = None
+    generic: int | None = None
+    axial_elements: np.ndarray | None = None
+    axial_rest_length: np.ndarray | None = None
+    axial_stiffness: np.ndarray | None = None
+    axial_damping: np.ndarray | None = None
+    axial_rest_rate: np.ndarray | None = None
+
+    @property
+    def tension_only(self) -> bool:
+        """The axial elements are tension-only (in ``generic``), not Exudyn spring-dampers."""
+        return self.axial_rest_length is not None
+
+
+def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: np.ndarray, axial_stiffness: float,
+                      axial_damping: float, bending_stiffness: float, gravity: float = 9.81,
+                      hold_first: bool = True, tension_only: bool = False) -> SpatialChainItems:
+    """Add a chain through ``positions`` (N, 3) [m] (unstrained, at rest) to ``mbs``.
+
+    Parameters
+    ----------
+    positions : ndarray, shape (N, 3) [m]
+    node_masses : ndarray, shape (N,) [kg]
+    axial_stiffness, axial_damping : float [N/m, N s/m]
+        Of each element (E A / l0 and d_n A / l0 of its unstrained length l0).
+    bending_stiffness : float [N m/rad]
+        Of each joint (0: no bending object at all).
+    gravity : float [m/s^2]
+        Along -z.
+    hold_first : bool
+        Hold the first node in place.
+    tension_only : bool
+        Tension-only axial elements (:mod:`cdpr_exu.physics.axial_3d`) in the chain's
+        ``ObjectGenericODE2`` instead of Exudyn's ``ObjectConnectorSpringDamper``
+        (``springs`` stays empty; the arrays the kernels read are in the returned
+        items' ``axial_rest_length``, ``axial_stiffness``, ``axial_damping``).
+    """
+    positions = np.asarray(positions, dtype=float)
+    nodes, masses, markers, springs, loads = [], [], [], [], []
+    for point, mass in zip(positions, node_masses):
+        node = mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point)))
+        masses.append(mbs.AddObject(eii.ObjectMassPoint(mass=float(mass), nodeNumber=node)))
+        marker = mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node))
+        if gravity:
+            loads.append(mbs.AddLoad(eii.LoadForceVector(markerNumber=marker,
+                                                         loadVector=[0.0, 0.0, -float(mass) * gravity])))
+        nodes.append(node)
+        markers.append(marker)
+    for i in range(0 if tension_only else len(nodes) - 1):
+        springs.append(mbs.AddObject(eii.ObjectConnectorSpringDamper(
+            markerNumbers=[markers[i], markers[i + 1]], stiffness=axial_stiffness, damping=axial_damping,
+            referenceLength=float(np.linalg.norm(positions[i + 1] - positions[i])))))
+    if hold_first:
+        ground = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
+        ground_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+        for coordinate in range(3):
+            held = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=nodes[0], coordinate=coordinate))
+            mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_marker, held]))
+    joints = bending_3d.chain_joints([len(nodes)])
+    reference = positions.ravel().copy()
+    bending = bending_stiffness > 0.0 and len(joints) > 0
+    if not bending and not tension_only:
+        return SpatialChainItems(nodes, masses, markers, springs, None, reference, joints, loads=loads)
+    bending_joints = joints if bending else np.zeros((0, 3), dtype=np.int64)
+    stiffness = np.full(len(bending_joints), float(bending_stiffness))
+    if tension_only:
+        elements = cable_elements([len(nodes)])
+        rest = np.linalg.norm(np.diff(positions, axis=0), axis=1)
+        axial_k = np.full(len(elements), float(axial_stiffness))
+        axial_c = np.full(len(elements), float(axial_damping))
+    else:
+        elements = np.zeros((0, 2), dtype=np.int64)
+        rest = axial_k = axial_c = np.zeros(0)
+    rest_rate = np.zeros(len(elements))
+    size = reference.size
+    bending_rows, bending_columns = bending_3d.spatial_bending_pattern(bending_joints)
+    axial_rows, axial_columns = axial_3d.tension_only_pattern(elements)
+    split = bending_rows.size
+    triplets = np.zeros((split + axial_rows.size, 3))
+    triplets[:, 0] = np.concatenate([bending_rows, axial_rows])
+    triplets[:, 1] = np.concatenate([bending_columns, axial_columns])
+    bending_values = np.zeros(split)
+    axial_values = np.zeros(axial_rows.size)
+    current = np.zeros(size)
+    force = np.zeros(size)
+    container = exu.MatrixContainer()
+
+    def force_function(mbs_, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
+        np.add(reference, q, out=current)
+        bending_3d.spatial_bending_force(current, bending_joints, stiffness, force)  # overwrites
+        if tension_only:
+            axial_3d.tension_only_force(current, np.asarray(q_t), elements, rest, axial_k, axial_c, rest_rate, force)
+        return force
+
+    def jacobian_function(mbs_, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
+        np.add(reference, q, out=current)
+        triplets[:split, 2] = bending_3d.spatial_bending_stiffness(current, bending_joints, stiffness,
+                                                                   float(f_q), bending_values)
+        if tension_only:
+            triplets[split:, 2] = axial_3d.tension_only_triplet_values(
+                current, np.asarray(q_t), elements, rest, axial_k, axial_c, rest_rate, float(f_q), float(f_q_t),
+                axial_values)
+        container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
+        return container
+
+    empty = exu.MatrixContainer()
+    empty.SetWithSparseMatrix(np.zeros((0, 3)), numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
+    generic = mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=nodes, massMatrix=empty,
+                                                   forceUserFunction=force_function,
+                                                   jacobianUserFunction=jacobian_function))
+    common = dict(user_functions=(force_function, jacobian_function, container), loads=loads,
+                  bending_stiffness=stiffness if bending else None, generic=generic)
+    if not tension_only:
+        return SpatialChainItems(nodes, masses, markers, springs, generic, reference, joints, **common)
+    return SpatialChainItems(nodes, masses, markers, springs, generic if bending else None, reference, joints,
+                             axial_elements=elements, axial_rest_length=rest, axial_stiffness=axial_k,
+                             axial_damping=axial_c, axial_rest_rate=rest_rate, **common)
+
+
+def chain_energy(items: SpatialChainItems, node_masses: np.ndarray, q: np.ndarray, v: np.ndarray,
+                 axial_stiffness: float, bending_stiffness: float, gravity: float = 9.81) -> float:
+    """Mechanical energy [J] of the chain at displacements ``q`` and velocities ``v`` (3N,):
+    kinetic, gravity (z up), axial springs and bending springs.
+
+    With tension-only elements the axial energy is that of their law
+    (:func:`cdpr_exu.physics.axial_3d.tension_only_energy`: zero below the rest length)
+    with the items' current ``axial_rest_length`` and ``axial_stiffness`` (``axial_stiffness``
+    here is then not used)."""
+    positions = items.reference + q
+    points = positions.reshape(-1, 3)
+    energy = 0.5 * float(np.sum(node_masses * np.sum(v.reshape(-1, 3) ** 2, axis=1)))
+    energy += gravity * float(np.sum(node_masses * points[:, 2]))
+    if items.tension_only:
+        energy += axial_3d.tension_only_energy(positions, items.axial_elements, items.axial_rest_length,
+                                               items.axial_stiffness)
+    else:
+        rest = np.linalg.norm(np.diff(items.reference.reshape(-1, 3), axis=0), axis=1)
+        stretch = np.linalg.norm(np.diff(points, axis=0), axis=1) - rest
+        energy += 0.5 * axial_stiffness * float(np.sum(stretch**2))
+    if items.bending is not None:
+        energy += bending_3d.spatial_bending_energy(positions, items.joints, np.full(len(items.joints), bending_stiffness))
+    return energy

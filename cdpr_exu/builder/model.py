@@ -1,0 +1,313 @@
+"""Scene -> Exudyn system: builds the lumped-mass CDPR and returns a :class:`Model`.
+
+Coordinates: the scene speaks the paper's x-z plane; Exudyn's planar items live in
+its x-y plane. The builder maps paper (x, z) onto Exudyn (x, y) one to one, so
+Exudyn's y *is* the paper's height z, and rotations about Exudyn's z axis are the
+paper's platform rotation (positive counter-clockwise, eq. 17).
+
+Only the items of the effects the scene switches on are added (see
+:class:`~cdpr_exu.scenes.scene.Effects`); :meth:`Model.item_counts` says which are there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+
+from cdpr_exu.builder.cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes, straight_cable_nodes
+from cdpr_exu.builder.platform import PlatformItems, add_platform, attach_cable
+from cdpr_exu.builder.pulley import add_pulley_contact, add_pulley_ground
+from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.physics.segment_contact import contact_segments
+from cdpr_exu.builder.winch import ServoItems, WinchItems, add_servo_drum, add_winch
+
+
+@dataclass
+class Model:
+    """An assembled Exudyn system of a scene, with the indices of its items.
+
+    Attributes
+    ----------
+    scene : Scene
+    system_container : exudyn.SystemContainer
+    mbs : exudyn.MainSystem
+    cables : list of CableItems
+    platform : PlatformItems
+    winches : list of WinchItems
+    cable_forces : CableForceItems or None
+        The generic object of bending and slack-axial forces.
+    contacts : list of list of int
+        Exudyn contact objects of each cable with its pulley
+        (``effects.pulley_contact_model = "node"`` only).
+    contact_nodes : list of ndarray of int
+        Cable-local indices of the nodes that carry a rim contact (node contact: in
+        Exudyn's items with "node", in ``cable_forces`` with "node_smooth").
+    contact_elements : list of ndarray of int
+        Cable-local indices of the elements (element j joins nodes j and j + 1) that
+        carry a segment contact (``effects.pulley_contact_model = "segment"``); their
+        forces live in ``cable_forces``.
+    initial_paid_out : ndarray, shape (m,) [m]
+        Paid-out length lambda_i(0) of the initial configuration: the unstrained cable
+        between the pulley's hang point and the anchor (over a pulley, the cable less
+        its straight hanging part; with a point exit, the whole cable).
+    ropes : list of RopeItems
+        The massless ropes (``effects.cable_mass`` off); then ``cables`` is empty.
+    servos : list of ServoItems
+        The winch drums of a servo winch (``winch.kind = "servo"``).
+    """
+
+    scene: Scene
+    system_container: exu.SystemContainer
+    mbs: exu.MainSystem
+    cables: list[CableItems]
+    platform: PlatformItems
+    winches: list[WinchItems]
+    cable_forces: CableForceItems | None
+    contacts: list[list[int]] = field(default_factory=list)
+    contact_nodes: list[np.ndarray] = field(default_factory=list)
+    initial_paid_out: np.ndarray | None = None
+    ropes: list[RopeItems] = field(default_factory=list)
+    servos: list[ServoItems] = field(default_factory=list)
+    contact_elements: list[np.ndarray] = field(default_factory=list)
+
+    def item_counts(self) -> dict[str, int]:
+        """How many Exudyn items each effect added."""
+        return {
+            "mass_points": sum(len(c.nodes) for c in self.cables),
+            "axial_spring_dampers": sum(len(c.springs) for c in self.cables),
+            "gravity_loads": sum(len(c.loads) for c in self.cables) + (self.platform.load is not None),
+            "cable_force_objects": int(self.cable_forces is not None),
+            "bending_joints": 0 if self.cable_forces is None else len(self.cable_forces.joints),
+            "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
+            "pulley_contacts": sum(len(n) for n in self.contact_nodes),
+            "contact_segments": sum(len(e) for e in self.contact_elements),
+            "massless_ropes": len(self.ropes),
+            "winch_constraints": sum((int(w.horizontal) >= 0) + (int(w.vertical) >= 0) for w in self.winches),
+            "servo_drums": len(self.servos),
+            "platform_joints": len(self.platform.joints),
+        }
+
+    def coordinate_indices(self) -> dict[str, np.ndarray]:
+        """Positions of the model's nodes in Exudyn's ODE2 coordinate vector.
+
+        Returns
+        -------
+        dict
+            ``"platform"``: shape (3,), (x, z, rotation); ``"cable_i"``: shape (n + 1, 2).
+        """
+        mbs = self.mbs
+        out = {"platform": mbs.GetNodeODE2Index(self.platform.node) + np.arange(3)}
+        for i, cable in enumerate(self.cables):
+            out[f"cable_{i}"] = np.array([mbs.GetNodeODE2Index(n) + np.arange(2) for n in cable.nodes])
+        return out
+
+
+def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
+    """Initial node positions (x, z) of a cable, winch end first, shape (n + 1, 2) [m].
+
+    Over a pulley: the paper's ideal configuration, straight from the anchor to the
+    pulley, wrapped over it and hanging to the winch, every element at its unstrained
+    length. With a point exit: straight from the pulley centre to the anchor.
+
+    With segment contact (``effects.pulley_contact_model = "segment"``) the nodes on the
+    rim of the pulley radius r would make every wrapped element a chord cutting
+    r - sqrt(r^2 - l0i^2 / 4) into the disc (30 mm for the paper's 0.25 m elements),
+    which the segment contact would fire out at the first step. The nodes are then
+    placed the same way on a circle of radius sqrt(r^2 + l0i^2 / 4): the wrap becomes
+    the polygon circumscribed about the pulley, every chord touching the rim, and the
+    winch line moves out by the difference (30 mm for the paper's cable).
+    """
+    cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
+    anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
+    if scene.exits[cable_index].is_point_exit:
+        return straight_cable_nodes(np.asarray(pulley.center), anchor, cable.n_elements)
+    contact = scene.contact_model
+    radius = pulley.radius if contact is None else contact.wrap_radius(pulley.radius, cable.element_length)
+    return initial_cable_nodes(np.asarray(pulley.center), radius, pulley.side, anchor,
+                               cable.element_length, cable.n_elements)
+
+
+def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 2.0) -> np.ndarray:
+    """Cable-local indices of the nodes that can reach their pulley during the run.
+
+    A node at unstrained distance s = j l0i from the winch end lies on the pulley
+    when s is between the hanging length l0 - lambda(t) and that plus the wrapped arc.
+    This range is taken over the reference trajectory sampled at 200 times, widened
+    by ``margin_elements`` elements and 5 % of the cable for sag, stretch and the
+    difference between controllers.
+
+    Returns
+    -------
+    ndarray of int
+    """
+    cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
+    times = np.linspace(0.0, scene.solver.end_time, 200)
+    anchors = anchor_points(scene.trajectory.pose(times), np.asarray(scene.platform.anchors))[:, cable_index]
+    exits = pulley.exit(anchors)  # all times at once
+    hang = cable.unstrained_length - exits.cable_length
+    arc_end = hang + pulley.radius * exits.wrap_angle
+    margin = margin_elements * cable.element_length + 0.05 * cable.unstrained_length
+    s = np.arange(cable.n_elements + 1) * cable.element_length
+    reach = (s >= hang.min() - margin) & (s <= arc_end.max() + margin)
+    reach[0] = False  # the winch node's motion is prescribed
+    return np.flatnonzero(reach)
+
+
+def check_trajectory_reachable(scene: Scene) -> None:
+    """Refuse a reference the cables cannot reach or hold, before any simulation.
+
+    See :func:`cdpr_exu.statics.workspace.check_reference` (one check for every controller).
+    """
+    from cdpr_exu.statics.workspace import check_reference
+
+    check_reference(scene)
+
+
+def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.ndarray) -> None:
+    """Refuse a cable whose straight elements cut deep into the pulley from the start.
+
+    With node contact an element much longer than the pulley radius spans the wrap as a
+    chord through the disc, and the cable then slips through the pulley. Segment contact
+    pushes the chords themselves out of the disc: no element length is refused then
+    (``effects.pulley_contact_model = "segment"``; the coarsest cables are limited by
+    :func:`check_trajectory_reachable` instead).
+    """
+    from cdpr_exu.core.geometry import segment_penetration
+
+    if scene.contact_model is not None and not scene.contact_model.limits_element_length:
+        return
+    pulley, cable = scene.pulleys[cable_index], scene.cables[cable_index]
+    depth = segment_penetration(pulley, nodes_xz).max()
+    if depth > 0.5 * pulley.radius:
+        raise SceneError(
+            f"cables[{cable_index}].n_elements = {cable.n_elements} is too coarse: its {cable.element_length:.3f} m "
+            f"elements cut {1000 * depth:.0f} mm into the {pulley.radius} m pulley as chords of the wrap; "
+            f"use elements no longer than about 1.4 pulley radii, or effects.pulley_contact_model = 'segment'")
+
+
+#: Above this many cable nodes (all cables) the cables' Jacobian is handed to Exudyn as
+#: sparse triplets; below, the dense matrix is cheaper (measured: 0.45x at 2 x 16 nodes,
+#: 1.06x at 2 x 31, 3.2x at 2 x 121, 5.5x at 2 x 241; see benchmarks/bench_sparse_jacobian.py).
+SPARSE_JACOBIAN_MIN_NODES = 50
+
+
+def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
+    """Build and assemble the Exudyn system of ``scene``.
+
+    ``sparse_jacobian`` hands Exudyn the Jacobian of the cables' Python-side forces
+    (exact bending, tension-only elements) as sparse triplets, whose cost grows with the
+    number of elements rather than its square; False keeps the dense (2N)^2 matrix (the
+    same numbers to round-off); None (default) chooses sparse above
+    :data:`SPARSE_JACOBIAN_MIN_NODES` nodes.
+
+    Raises
+    ------
+    UnreachableError
+        If the reference trajectory leaves the reachable workspace.
+    """
+    check_trajectory_reachable(scene)
+    system_container = exu.SystemContainer()
+    mbs = system_container.AddSystem()
+    ground_node = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
+    ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node, coordinate=0))
+
+    effects = scene.effects
+    platform = add_platform(mbs, scene.platform, effects, scene.gravity)
+    if not effects.cable_mass:
+        return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
+    contact = scene.contact_model
+    on_segments = contact is not None and contact.on_segments
+    cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
+    contact_elements = []  # cable-local element indices per cable (segment contact only)
+    for i, (cable, pulley, exit_) in enumerate(zip(scene.cables, scene.pulleys, scene.exits)):
+        nodes_xz = initial_nodes(scene, i)
+        if not exit_.is_point_exit:
+            _check_elements_fit_the_pulley(scene, i, nodes_xz)
+        items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
+        attach_cable(mbs, platform, i, items.markers[-1], cable, explicit=scene.solver.integrator != "generalized_alpha")
+        servo = scene.winch.kind == "servo"
+        winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1]), drive_height=not servo))
+        if servo:
+            servos.append(add_servo_drum(mbs, winches[-1], items.nodes[0], scene.winch))
+        if on_segments:  # forces in the cables' generic object (add_cable_forces): no Exudyn contact items
+            contacts.append([])
+            contact_nodes.append(np.zeros(0, dtype=int))
+            contact_elements.append(contact_segments(contact_candidates(scene, i), cable.n_elements))
+        elif contact is not None:
+            contact_elements.append(np.zeros(0, dtype=np.int64))
+            candidates = contact_candidates(scene, i)
+            if contact.exudyn_items:
+                pulley_marker = add_pulley_ground(mbs, pulley)
+                contacts.append(add_pulley_contact(mbs, pulley, pulley_marker,
+                                                   [items.markers[j] for j in candidates], nodes_xz[candidates]))
+            else:  # forces in the cables' generic object (add_cable_forces)
+                contacts.append([])
+            contact_nodes.append(candidates)
+        else:
+            contact_elements.append(np.zeros(0, dtype=np.int64))
+            contacts.append([])
+            contact_nodes.append(np.zeros(0, dtype=int))
+        paid_out.append(exit_.paid_out_length(cable.unstrained_length, nodes_xz[0]))
+        cables.append(items)
+    if sparse_jacobian is None:
+        sparse_jacobian = sum(c.n_elements + 1 for c in scene.cables) > SPARSE_JACOBIAN_MIN_NODES
+    on_nodes = contact is not None and contact.smooth_nodes
+    cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.pulleys),
+                                    contact_elements if on_segments else None, sparse_jacobian=sparse_jacobian,
+                                    contact_nodes=contact_nodes if on_nodes else None)
+    mbs.Assemble()
+    return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
+                 contacts, contact_nodes, np.asarray(paid_out), servos=servos, contact_elements=contact_elements)
+
+
+#: Shortest rope segment kept between the fixed winch point and the pulley [m]; a
+#: cable that starts fully paid out gets this much extra, unstrained rope there.
+MIN_WINCH_SEGMENT = 0.25
+
+
+def rope_geometry(scene: Scene, cable_index: int, anchor) -> tuple[np.ndarray, float, float]:
+    """Hang point, sheave radius and ideal paid-out length of a massless rope.
+
+    Returns
+    -------
+    hang : ndarray, shape (2,) [m]
+        Where the rope leaves its vertical winch line (the pulley centre for a point exit).
+    radius : float [m]
+        Sheave radius given to Exudyn (0 for a point exit).
+    paid_out : float [m]
+        Ideal length from the hang point to the anchor.
+    """
+    exit_ = scene.exits[cable_index]
+    return exit_.hang_point, exit_.radius, float(exit_.cable_length(np.asarray(anchor)))
+
+
+def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems, ground_coordinate: int) -> Model:
+    """Massless cables: one reeving-system rope per cable, winch point -> pulley -> anchor."""
+    from dataclasses import replace as _replace
+
+    import exudyn.itemInterface as _eii
+
+    anchors = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))
+    ropes, winches, paid_out = [], [], []
+    for i, cable in enumerate(scene.cables):
+        hang, radius, length = rope_geometry(scene, i, anchors[i])
+        hanging = cable.unstrained_length - length
+        segment = max(hanging, MIN_WINCH_SEGMENT)
+        rope_cable = _replace(cable, unstrained_length=cable.unstrained_length + segment - hanging)
+        bx, bz = scene.platform.anchors[i]
+        anchor_marker = mbs.AddMarker(_eii.MarkerBodyRigid(bodyNumber=platform.body, localPosition=[bx, bz, 0.0]))
+        rope = add_rope(mbs, rope_cable, scene.pulleys[i].center, radius, scene.pulleys[i].side, anchor_marker,
+                        hang - np.array([0.0, segment]), ground_coordinate, scene.effects)
+        drive = mbs.AddObject(_eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
+                                                            offset=0.0))
+        winches.append(WinchItems(-1, drive, float(hang[1] - hanging)))
+        ropes.append(rope)
+        paid_out.append(length)
+    mbs.Assemble()
+    return Model(scene, system_container, mbs, [], platform, winches, None, [[] for _ in ropes],
+                 [np.zeros(0, dtype=int) for _ in ropes], np.asarray(paid_out), ropes)

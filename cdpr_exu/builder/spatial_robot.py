@@ -1,0 +1,552 @@
+"""A spatial cable robot in Exudyn: lumped spatial chains from held exit points to a 6-DOF (or point-mass) platform.
+
+Each cable is a chain of :mod:`cdpr_exu.builder.chain_3d` (``NodePoint`` +
+``ObjectMassPoint`` nodes, Exudyn's ``ObjectConnectorSpringDamper`` between them,
+exact-angle bending in one ``ObjectGenericODE2``, gravity along -z), its first node
+held at the cable's exit point (a point exit, no pulley). Its last node is joined to
+the platform's anchor by an ``ObjectJointSpherical`` (the three translations; a
+spherical joint transmits no moment, like a cable end on a swivel eye), or, when
+``SpatialChainSpec.anchor_spring_factor`` is given, by a stiff
+``ObjectConnectorCartesianSpringDamper`` (a penalty spherical joint). With
+``SpatialChainSpec.tension_only`` the axial elements are tension-only
+(:mod:`cdpr_exu.physics.axial_3d`, in the chain's ``ObjectGenericODE2``) instead of
+Exudyn's spring-dampers, which push when compressed.
+
+Why the penalty joint exists (measured): Exudyn's static solver does not converge
+when an ``ObjectJointSpherical`` holds a rigid body's ``MarkerBodyPosition`` and the
+body must turn. From the catenary pose, 3e-4 rad from the answer (5 elements per
+cable), the first Newton step turned the platform by 1e-2 rad and the iteration
+diverged, with Exudyn's analytic and with its system-wide numerical Jacobian, for
+Euler-parameter, rotation-vector and Tait-Bryan nodes alike. A bare rigid body hung
+on four springs fixed straight to it converged in 3 steps; the same body with each
+spring joined to it through a mass point and a spherical joint diverged. It behaves
+as if the joint's geometric stiffness (the derivative of ``C_q^T lambda`` in the
+body's rotation, the pendulum stiffness of a hanging body) were missing from the
+static Jacobian. The dynamic solver, whose Jacobian the mass matrix dominates, runs
+with the exact joint; a point-mass platform solves statically with it.
+
+Platform
+--------
+* a **point mass** (every anchor at the centre): ``NodePoint`` + ``ObjectMassPoint``;
+* a **rigid body**: ``NodeRigidBodyEP`` + ``ObjectRigidBody`` (``mbs.CreateRigidBody``
+  with Euler parameters), anchors as ``MarkerBodyPosition``. Euler parameters are
+  free of singularities and work with both solvers this project uses, the implicit
+  generalised-alpha integrator and ``SolveStatic``; their unit-norm condition is one
+  algebraic equation Exudyn adds itself. The alternatives: ``NodeRigidBodyRotVecLG``
+  is meant for Exudyn's explicit Lie-group integrators (its documentation), and
+  Tait-Bryan angles (``NodeRigidBodyRxyz``) are singular at a pitch of 90 degrees.
+
+Units SI, z up, gravity along -z. The parameters are those of
+:mod:`cdpr_exu.physics.spatial_statics` (:class:`SpatialPlatform`, the unstrained
+lengths), plus the discretisation and the cable's damping and bending
+(:class:`SpatialChainSpec`); the chain's mass per length is ``weight_per_length /
+gravity``. The chains start on the catenary statics' solution (or any
+:class:`SpatialEquilibrium`, eg one under an extra load, to start the robot swinging):
+their reference configuration is straight and unstrained (element length ``L / n``),
+their initial displacements put the nodes on the catenary.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+from exudyn.rigidBodyUtilities import RigidBodyInertia
+
+from cdpr_exu.core.errors import SceneError, SolverFailure
+from cdpr_exu.core.validation import non_negative, positive
+
+from cdpr_exu.physics import axial_3d
+from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
+from cdpr_exu.core.geometry import rotation_vector
+from cdpr_exu.physics.spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, solve_spatial_statics
+
+
+@dataclass(frozen=True)
+class SpatialChainSpec:
+    """How the cables are discretised, damped and bent.
+
+    Parameters
+    ----------
+    n_elements : int
+        Elements per cable (at least 2), each of unstrained length ``L / n``.
+    axial_damping_constant : float [N s]
+        ``d_n A``: element damping ``c = d_n A / l_e`` (Kelvin-Voigt); 0 for none.
+    flexural_rigidity : float [N m^2]
+        ``E J``: joint bending stiffness ``k_theta = E J / l_e``; 0 for no bending
+        (the catenary's cable).
+    anchor_spring_factor : float or None
+        None: the cable ends are held at the anchors by ``ObjectJointSpherical``
+        (exact). A number ``f > 0``: by an ``ObjectConnectorCartesianSpringDamper`` of
+        stiffness ``f EA / l_e`` in x, y, z, in series with the last element, which
+        adds ``1 / (f n)`` of the cable's compliance (1000: a 20-element cable
+        stretches 5e-5 of its stretch more). Needed for Exudyn's static solver on a
+        rigid platform (see the module notes).
+    tension_only : bool
+        Tension-only axial elements (a cable cannot push; a slack element carries
+        nothing, :mod:`cdpr_exu.physics.axial_3d`) instead of Exudyn's
+        ``ObjectConnectorSpringDamper``; a taut element is the same spring-damper.
+    """
+
+    n_elements: int = 20
+    axial_damping_constant: float = 0.0
+    flexural_rigidity: float = 0.0
+    anchor_spring_factor: float | None = None
+    tension_only: bool = False
+
+    def __post_init__(self):
+        if not isinstance(self.tension_only, (bool, np.bool_)):
+            raise SceneError(f"tension_only must be True or False, got {self.tension_only!r}")
+        object.__setattr__(self, "tension_only", bool(self.tension_only))
+        if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
+            raise SceneError(f"n_elements must be a whole number, got {self.n_elements!r}")
+        if self.n_elements < 2:
+            raise SceneError(f"n_elements must be at least 2, got {self.n_elements!r}")
+        object.__setattr__(self, "n_elements", int(self.n_elements))
+        object.__setattr__(self, "axial_damping_constant",
+                           non_negative("axial_damping_constant", self.axial_damping_constant))
+        object.__setattr__(self, "flexural_rigidity", non_negative("flexural_rigidity", self.flexural_rigidity))
+        if self.anchor_spring_factor is not None:
+            factor = positive("anchor_spring_factor", self.anchor_spring_factor)
+            object.__setattr__(self, "anchor_spring_factor", factor)
+
+
+@dataclass
+class SpatialRobotItems:
+    """Item indices and data of a spatial robot in an Exudyn ``MainSystem``.
+
+    Attributes
+    ----------
+    platform : SpatialPlatform
+    unstrained_lengths : ndarray, shape (n_cables,) [m]
+    chain : SpatialChainSpec
+    chains : list of SpatialChainItems
+        One per cable, node 0 at the exit point.
+    node_masses : list of ndarray
+        Lumped masses of each chain's nodes [kg].
+    axial_stiffnesses, axial_dampings, bending_stiffnesses : ndarray, shape (n_cables,)
+        Per element [N/m], [N s/m] and per joint [N m/rad].
+    platform_node : int
+        ``NodePoint`` (point mass) or ``NodeRigidBodyEP`` (rigid body).
+    platform_body : int
+        ``ObjectMassPoint`` or ``ObjectRigidBody``.
+    anchor_markers, joints : list of int
+        Platform markers at the anchors and the spherical joints (or penalty
+        spring-dampers), one per cable.
+    initial : SpatialEquilibrium
+        The catenary equilibrium the robot was started on.
+    """
+
+    platform: SpatialPlatform
+    unstrained_lengths: np.ndarray
+    chain: SpatialChainSpec
+    chains: list
+    node_masses: list
+    axial_stiffnesses: np.ndarray
+    axial_dampings: np.ndarray
+    bending_stiffnesses: np.ndarray
+    platform_node: int
+    platform_body: int
+    anchor_markers: list
+    joints: list
+    initial: SpatialEquilibrium = field(repr=False)
+
+    @property
+    def is_point_mass(self):
+        return self.platform.is_point_mass
+
+
+def _chain_positions(equilibrium_cable, length, n_elements):
+    """Straight unstrained reference (exit first) and the catenary's node positions, shape (n + 1, 3) each."""
+    exit_point = equilibrium_cable.exit_point
+    towards = equilibrium_cable.anchor_point - exit_point
+    direction = towards / max(float(np.linalg.norm(towards)), 1e-300)
+    arc_from_exit = np.linspace(0.0, length, n_elements + 1)
+    reference = exit_point + np.outer(arc_from_exit, direction)
+    current = equilibrium_cable.points(length - arc_from_exit)
+    current[0] = exit_point  # the catenary ends there to round-off; the held node must sit exactly on it
+    return reference, current
+
+
+def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None):
+    """Add the robot to ``mbs``: chains, platform, spherical joints, gravity.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    platform : SpatialPlatform
+        Its ``inertia`` must be positive for a rigid body.
+    unstrained_lengths : array_like, shape (n_cables,) [m]
+    chain : SpatialChainSpec, optional
+        Default ``SpatialChainSpec()`` (20 elements, no damping, no bending).
+    initial : SpatialEquilibrium, optional
+        Start configuration: platform pose and cable shapes; default the catenary
+        statics of these lengths (:func:`solve_spatial_statics`).
+
+    Returns
+    -------
+    SpatialRobotItems
+
+    Raises
+    ------
+    SceneError
+        Naming the field, before anything is added to ``mbs``.
+    """
+    if not isinstance(platform, SpatialPlatform):
+        raise SceneError(f"platform must be a SpatialPlatform, got {platform!r}")
+    lengths = _lengths(platform, unstrained_lengths)
+    chain = SpatialChainSpec() if chain is None else chain
+    if not isinstance(chain, SpatialChainSpec):
+        raise SceneError(f"chain must be a SpatialChainSpec, got {chain!r}")
+    gravity = positive("gravity", platform.gravity)  # the chains' mass is weight_per_length / gravity
+    inertia = np.array(platform.inertia)
+    if not platform.is_point_mass and np.any(inertia <= 0.0):
+        raise SceneError(f"inertia must be positive for a rigid platform, got {platform.inertia!r}")
+    if not platform.is_point_mass and platform.mass <= 0.0:
+        raise SceneError(f"mass must be positive for a rigid platform, got {platform.mass!r}")
+    if initial is None:
+        initial = solve_spatial_statics(platform, lengths)
+    elif not isinstance(initial, SpatialEquilibrium) or len(initial.cables) != len(platform.cables):
+        raise SceneError(f"initial must be a SpatialEquilibrium of this platform's {len(platform.cables)} cables, "
+                         f"got {initial!r}")
+
+    n = chain.n_elements
+    element_lengths = lengths / n
+    axial_stiffnesses = np.array([c.axial_stiffness for c in platform.cables]) / element_lengths
+    axial_dampings = chain.axial_damping_constant / element_lengths
+    bending_stiffnesses = chain.flexural_rigidity / element_lengths
+
+    chains, node_masses = [], []
+    for cable, length, equilibrium_cable, k, c, k_theta in zip(
+            platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses):
+        element_mass = cable.weight_per_length / gravity * length / n
+        masses = np.full(n + 1, element_mass)
+        masses[[0, -1]] = 0.5 * element_mass
+        reference, current = _chain_positions(equilibrium_cable, length, n)
+        items = add_spatial_chain(mbs, reference, masses, float(k), float(c), float(k_theta), gravity=gravity,
+                                  hold_first=True, tension_only=chain.tension_only)
+        for node, displacement in zip(items.nodes, current - reference):
+            mbs.SetNodeParameter(node, "initialCoordinates", [float(x) for x in displacement])
+        chains.append(items)
+        node_masses.append(masses)
+
+    position = [float(x) for x in initial.position]
+    if platform.is_point_mass:
+        platform_node = mbs.AddNode(eii.NodePoint(referenceCoordinates=position))
+        platform_body = mbs.AddObject(eii.ObjectMassPoint(mass=platform.mass, nodeNumber=platform_node))
+        centre = mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=platform_node))
+        anchor_markers = [centre] * len(platform.cables)
+        if platform.mass > 0.0:
+            mbs.AddLoad(eii.LoadForceVector(markerNumber=centre, loadVector=[0.0, 0.0, -platform.mass * gravity]))
+    else:
+        body_inertia = RigidBodyInertia(mass=platform.mass, inertiaTensor=np.diag(inertia), inertiaTensorAtCOM=True)
+        created = mbs.CreateRigidBody(referencePosition=position, referenceRotationMatrix=initial.rotation,
+                                      inertia=body_inertia, gravity=[0.0, 0.0, -gravity],
+                                      nodeType=exu.NodeType.RotationEulerParameters, returnDict=True, show=False)
+        platform_node, platform_body = created["nodeNumber"], created["bodyNumber"]
+        anchor_markers = [mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=platform_body,
+                                                               localPosition=[float(x) for x in cable.anchor]))
+                          for cable in platform.cables]
+    joints = []
+    for items, marker, k in zip(chains, anchor_markers, axial_stiffnesses):
+        markers = [items.markers[-1], marker]
+        if chain.anchor_spring_factor is None:
+            joints.append(mbs.AddObject(eii.ObjectJointSpherical(markerNumbers=markers)))
+        else:
+            stiffness = float(chain.anchor_spring_factor * k)
+            joints.append(mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
+                markerNumbers=markers, stiffness=[stiffness] * 3, damping=[0.0] * 3)))
+    return SpatialRobotItems(platform, lengths, chain, chains, node_masses, axial_stiffnesses, axial_dampings,
+                             bending_stiffnesses, platform_node, platform_body, anchor_markers, joints, initial)
+
+
+# ---------------------------------------------------------------------------
+# reading the state
+# ---------------------------------------------------------------------------
+def _configuration(current):
+    return exu.ConfigurationType.Current if current else exu.ConfigurationType.Initial
+
+
+def platform_pose(mbs, items, current=True):
+    """Platform position [m] shape (3,) and rotation matrix shape (3, 3) (identity for a point mass)."""
+    configuration = _configuration(current)
+    position = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.Position,
+                                          configuration=configuration))
+    if items.is_point_mass:
+        return position, np.eye(3)
+    rotation = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.RotationMatrix,
+                                          configuration=configuration)).reshape(3, 3)
+    return position, rotation
+
+
+def chain_positions(mbs, items, cable, current=True):
+    """Node positions of one cable, exit first, shape (n + 1, 3) [m]."""
+    chain = items.chains[cable]
+    configuration = _configuration(current)
+    q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
+                        for node in chain.nodes])
+    return (chain.reference + q).reshape(-1, 3)
+
+
+def anchor_forces(mbs, items):
+    """Force each cable exerts on the platform at its anchor, shape (n_cables, 3) [N]: the joint reactions.
+
+    The reaction of each spherical joint (or penalty joint) on the platform: the last
+    element's axial force, the bending shear of the last joints and the anchor node's
+    weight and inertia together (with bending on, the shear is not small: 0.2 N of 9 N
+    on the paper's cable). Exudyn reports the spherical joint's force as the force on
+    the platform, and the penalty spring's with the opposite sign.
+    """
+    sign = 1.0 if items.chain.anchor_spring_factor is None else -1.0
+    return np.array([sign * np.asarray(mbs.GetObjectOutput(joint, exu.OutputVariableType.Force))
+                     for joint in items.joints])
+
+
+def element_forces(mbs, items, cable, current=True):
+    """Axial force of each element of one cable [N], shape (n,), exit first (tension > 0).
+
+    As the model computes it: Exudyn's spring-damper k (l - l0) + c dl/dt with the
+    parameters the connectors hold now (negative when compressed), or, with
+    ``tension_only``, the tension-only law with the arrays the chain's force reads
+    (never negative).
+    """
+    chain = items.chains[cable]
+    configuration = _configuration(current)
+    q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
+                        for node in chain.nodes])
+    v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
+                        for node in chain.nodes])
+    positions = chain.reference + q
+    if chain.tension_only:
+        return axial_3d.tension_only_tensions(positions, v, chain.axial_elements, chain.axial_rest_length,
+                                              chain.axial_stiffness, chain.axial_damping, chain.axial_rest_rate,
+                                              np.zeros(len(chain.axial_elements)))
+    points, velocities = positions.reshape(-1, 3), v.reshape(-1, 3)
+    delta, delta_rate = np.diff(points, axis=0), np.diff(velocities, axis=0)
+    length = np.linalg.norm(delta, axis=1)
+    rate = np.einsum("ij,ij->i", delta, delta_rate) / length
+    rest, stiffness, damping = (np.array([mbs.GetObjectParameter(spring, name) for spring in chain.springs])
+                                for name in ("referenceLength", "stiffness", "damping"))
+    return stiffness * (length - rest) + damping * rate
+
+
+def anchor_points(mbs, items):
+    """World positions of the anchors on the platform, shape (n_cables, 3) [m] (current state)."""
+    return np.array([mbs.GetMarkerOutput(marker, exu.OutputVariableType.Position) for marker in items.anchor_markers])
+
+
+def robot_energy(mbs, items, current=True):
+    """Mechanical energy [J] of cables and platform: kinetic, gravity (z up), axial and bending springs.
+
+    Tension-only elements store the potential of their undamped law
+    (:func:`cdpr_exu.physics.axial_3d.tension_only_energy`: 0 below the rest length)."""
+    configuration = _configuration(current)
+    gravity = items.platform.gravity
+    energy = 0.0
+    for chain, masses, k, k_theta in zip(items.chains, items.node_masses, items.axial_stiffnesses,
+                                         items.bending_stiffnesses):
+        q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
+                            for node in chain.nodes])
+        v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t,
+                                              configuration=configuration) for node in chain.nodes])
+        energy += chain_energy(chain, masses, q, v, float(k), float(k_theta), gravity)
+    if items.chain.anchor_spring_factor is not None:  # the penalty joints' springs
+        anchors = np.array([mbs.GetMarkerOutput(marker, exu.OutputVariableType.Position, configuration=configuration)
+                            for marker in items.anchor_markers])
+        for cable, (anchor, k) in enumerate(zip(anchors, items.axial_stiffnesses)):
+            gap = chain_positions(mbs, items, cable, current)[-1] - anchor
+            energy += 0.5 * items.chain.anchor_spring_factor * k * float(gap @ gap)
+    position, rotation = platform_pose(mbs, items, current)
+    velocity = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.Velocity,
+                                          configuration=configuration))
+    energy += items.platform.mass * (0.5 * float(velocity @ velocity) + gravity * position[2])
+    if not items.is_point_mass:
+        omega = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.AngularVelocityLocal,
+                                           configuration=configuration))
+        energy += 0.5 * float(omega @ (np.array(items.platform.inertia) * omega))
+    return energy
+
+
+# ---------------------------------------------------------------------------
+# solving
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SpatialStaticResult:
+    """Exudyn's static solution of the lumped robot.
+
+    Attributes
+    ----------
+    position : ndarray, shape (3,) [m]
+    rotation : ndarray, shape (3, 3)
+    rotation_vector : ndarray, shape (3,) [rad]
+    forces_on_platform : ndarray, shape (n_cables, 3) [N]
+        The joint reactions on the platform (:func:`anchor_forces`).
+    anchor_points : ndarray, shape (n_cables, 3) [m]
+    tensions_at_anchor : ndarray, shape (n_cables,) [N]
+        Norm of each cable's force on the platform (what a load cell at the anchor reads; the
+        catenary's ``tension_at_anchor``, to O(n^-2)).
+    wall_time : float [s]
+        Of ``SolveStatic``.
+    """
+
+    position: np.ndarray
+    rotation: np.ndarray
+    rotation_vector: np.ndarray
+    forces_on_platform: np.ndarray
+    anchor_points: np.ndarray
+    tensions_at_anchor: np.ndarray
+    wall_time: float
+
+
+def static_settings(tolerance=1e-9):
+    """Settings of Exudyn's static solver (one load step, Newton to ``tolerance``), planar or spatial."""
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False  # else Exudyn writes solution/ into the working folder
+    settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    static = settings.staticSolver
+    static.verboseMode = 0
+    static.numberOfLoadSteps = 1
+    static.newton.maxIterations = 50
+    static.newton.relativeTolerance = tolerance
+    static.newton.absoluteTolerance = tolerance
+    return settings
+
+
+def solve_static(mbs, items, settings=None):
+    """Exudyn's static equilibrium of the assembled robot, from its initial (catenary) configuration.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        Assembled (``mbs.Assemble()``).
+    items : SpatialRobotItems
+    settings : exudyn.SimulationSettings, optional
+        Default :func:`static_settings`.
+
+    Returns
+    -------
+    SpatialStaticResult
+
+    Raises
+    ------
+    SolverFailure
+        If Exudyn's static solver does not converge (on a rigid platform with exact
+        spherical joints it does not: use ``SpatialChainSpec.anchor_spring_factor``).
+    """
+    settings = static_settings() if settings is None else settings
+    hint = ("" if items.is_point_mass or items.chain.anchor_spring_factor is not None else
+            " (a rigid platform on exact spherical joints: set SpatialChainSpec.anchor_spring_factor)")
+    start = time.perf_counter()
+    printing = exu.config.printToConsole
+    exu.config.printToConsole = False  # a failed static solve prints a page of hints
+    try:
+        converged = bool(mbs.SolveStatic(settings, showHints=False, showCausingItems=False))
+    except (exu.SolverError, RuntimeError, SystemError) as error:
+        raise SolverFailure(f"Exudyn's static solver failed: {error}{hint}") from None
+    finally:
+        exu.config.printToConsole = printing
+    wall_time = time.perf_counter() - start
+    if not converged:
+        raise SolverFailure(f"Exudyn's static solver did not converge{hint}")
+    position, rotation = platform_pose(mbs, items)
+    forces = anchor_forces(mbs, items)
+    return SpatialStaticResult(position, rotation, rotation_vector(rotation), forces, anchor_points(mbs, items),
+                               np.linalg.norm(forces, axis=1), wall_time)
+
+
+@dataclass(frozen=True, eq=False)
+class SpatialRunResult:
+    """A dynamic run: platform trajectory and, when asked, the energy.
+
+    Attributes
+    ----------
+    time : ndarray, shape (k,) [s]
+        Start of each step, and the end time.
+    position : ndarray, shape (k, 3) [m]
+    rotation_vector : ndarray, shape (k, 3) [rad]
+    energy : ndarray, shape (k,) [J] or None
+    wall_time : float [s]
+        Of ``SolveDynamic`` (with the recording).
+    newton_iterations : int
+    """
+
+    time: np.ndarray
+    position: np.ndarray
+    rotation_vector: np.ndarray
+    energy: np.ndarray | None
+    wall_time: float
+    newton_iterations: int
+
+
+def dynamic_settings(end_time, step_size, spectral_radius=0.9, tolerance=1e-8):
+    """Settings of the implicit generalised-alpha integrator at a fixed step, full Newton."""
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False
+    settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    ti = settings.timeIntegration
+    ti.endTime = float(end_time)
+    ti.numberOfSteps = int(round(end_time / step_size))
+    ti.verboseMode = 0
+    ti.adaptiveStep = False
+    ti.generalizedAlpha.spectralRadius = float(spectral_radius)
+    ti.newton.useModifiedNewton = False
+    ti.newton.relativeTolerance = tolerance
+    ti.newton.absoluteTolerance = tolerance
+    ti.newton.maxIterations = 25
+    return settings
+
+
+def run_dynamic(mbs, items, end_time, step_size, spectral_radius=0.9, record_energy=False, settings=None):
+    """Integrate the assembled robot from its initial configuration (at rest) over ``end_time`` [s].
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        Assembled.
+    items : SpatialRobotItems
+    end_time, step_size : float [s]
+    spectral_radius : float, optional
+        Of the generalised-alpha integrator (1: no numerical damping).
+    record_energy : bool, optional
+        Record :func:`robot_energy` at every step (a Python call per step).
+    settings : exudyn.SimulationSettings, optional
+        Default :func:`dynamic_settings`.
+
+    Returns
+    -------
+    SpatialRunResult
+
+    Raises
+    ------
+    SolverFailure
+        If the integration fails.
+    """
+    end_time, step_size = positive("end_time", end_time), positive("step_size", step_size)
+    settings = dynamic_settings(end_time, step_size, spectral_radius) if settings is None else settings
+    times, positions, rotations, energies = [], [], [], []
+
+    def record(mbs_, t):
+        position, rotation = platform_pose(mbs_, items)
+        times.append(t)
+        positions.append(position)
+        rotations.append(rotation_vector(rotation))
+        if record_energy:
+            energies.append(robot_energy(mbs_, items))
+        return True
+
+    mbs.SetPreStepUserFunction(record)
+    start = time.perf_counter()
+    try:
+        mbs.SolveDynamic(settings)
+    except (exu.SolverError, RuntimeError, SystemError) as error:
+        raise SolverFailure(f"Exudyn's dynamic solver failed: {error}") from None
+    finally:
+        mbs.SetPreStepUserFunction(0)
+    wall_time = time.perf_counter() - start
+    record(mbs, float(mbs.systemData.GetTime()))
+    iterations = int(mbs.sys["dynamicSolver"].it.newtonStepsCount) if "dynamicSolver" in mbs.sys else -1
+    return SpatialRunResult(np.array(times), np.array(positions), np.array(rotations),
+                            np.array(energies) if record_energy else None, wall_time, iterations)

@@ -1,0 +1,226 @@
+"""The driven winch end of each cable (paper sec. 3: a flow source along -z).
+
+The winch end (node 0) hangs on the vertical line below the pulley. The winch
+command is the *paid-out length* lambda(t) [m]: the cable length between the hang
+point on the pulley and the platform anchor. Paying out moves node 0 up, hauling in
+moves it down: z_0(t) = z_0(0) + lambda(t) - lambda(0), x_0 fixed. Both coordinates
+of node 0 are prescribed by ``ObjectConnectorCoordinate`` constraints whose offsets
+are updated once per time step (a pre-step function), never per Newton iteration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+
+from cdpr_exu.scenes.scene import WinchSpec
+
+
+@dataclass
+class WinchItems:
+    """The two coordinate constraints on a cable's winch node.
+
+    Attributes
+    ----------
+    horizontal, vertical : int
+        ``ObjectConnectorCoordinate`` indices prescribing x and z of node 0.
+    initial_height : float [m]
+        z of node 0 at t = 0 (its Exudyn reference coordinate).
+    """
+
+    horizontal: int
+    vertical: int
+    initial_height: float
+
+
+def add_winch(mbs: exu.MainSystem, ground_coordinate_marker: int, node: int, initial_height: float,
+              drive_height: bool = True) -> WinchItems:
+    """Prescribe the winch node: x held, z driven by the offset set per step.
+
+    With ``drive_height`` False only x is held (a servo drum then drives z, see
+    :func:`add_servo_drum`) and ``vertical`` is -1 until the drum is added.
+
+    Parameters
+    ----------
+    ground_coordinate_marker : int
+        A ``MarkerNodeCoordinate`` on a ground node (its coordinate is always 0).
+    node : int
+        The cable's node 0 (``NodePoint2D``).
+    initial_height : float [m]
+        z of node 0 at t = 0.
+    """
+    constraints = []
+    for coordinate in ((0, 1) if drive_height else (0,)):
+        marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node, coordinate=coordinate))
+        constraints.append(mbs.AddObject(eii.ObjectConnectorCoordinate(
+            markerNumbers=[ground_coordinate_marker, marker], offset=0.0)))
+    return WinchItems(constraints[0], constraints[1] if drive_height else -1, initial_height)
+
+
+def set_paid_out_length(mbs: exu.MainSystem, winch: WinchItems, paid_out: float, initial_paid_out: float) -> None:
+    """Move the winch node to where the paid-out length ``paid_out`` [m] puts it.
+
+    The constraint acts on Exudyn's displacement coordinate of node 0, so the offset
+    is the displacement from the initial height: lambda - lambda(0).
+    """
+    mbs.SetObjectParameter(winch.vertical, "offset", float(paid_out - initial_paid_out))
+
+
+def servo_gains(spec: WinchSpec) -> np.ndarray:
+    """State-feedback gains of the winch servo, designed with python-control.
+
+    The drum seen along the cable is a mass m = J / r^2 driven by the motor force
+    u = torque / r: s'' = u / m (the cable tension is a disturbance, fed forward and
+    removed by the integral). With the state x = (integral of e, e, e'), e = s - s_cmd,
+    u = u_ff - K x.
+
+    Returns
+    -------
+    ndarray, shape (3,) [N/(m s), N/m, N s/m]
+    """
+    import control
+
+    a = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.0]])
+    b = np.array([[0.0], [0.0], [1.0 / spec.drum_mass]])
+    w = spec.servo_bandwidth
+    if spec.servo_design == "pole_placement":
+        gains = control.place(a, b, [-w, -1.1 * w, -1.2 * w])
+    else:
+        # Bryson's rule: 1 mm of error weighs as much as the force that accelerates the
+        # drum mass by w^2 * 1 mm; the integral and rate states scaled by w.
+        q = np.diag([(w / 1e-3) ** 2, 1.0 / 1e-3**2, (1.0 / (w * 1e-3)) ** 2])
+        r = np.array([[1.0 / (spec.drum_mass * w**2 * 1e-3) ** 2]])
+        gains, _, _ = control.lqr(a, b, q, r)
+    return np.asarray(gains, dtype=float).reshape(3)
+
+
+@dataclass
+class ServoItems:
+    """The drum of a servo winch: a one-coordinate node s (paid-out change) [m].
+
+    Attributes
+    ----------
+    drum_node : int
+    load : int
+        ``LoadCoordinate`` of the motor force on the drum coordinate [N].
+    gains : ndarray, shape (3,)
+    """
+
+    drum_node: int
+    load: int
+    gains: np.ndarray
+
+
+def add_servo_drum(mbs: exu.MainSystem, winch: WinchItems, node: int, spec: WinchSpec) -> ServoItems:
+    """Drive the height of the winch node by a drum under a motor force.
+
+    The drum coordinate s is the paid-out length change (rope taken off the drum); the
+    winch node's height follows it through the (now offset-free) vertical constraint.
+    """
+    drum = mbs.AddNode(eii.NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.0],
+                                           initialCoordinates_t=[0.0], numberOfODE2Coordinates=1))
+    mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=[drum], massMatrix=np.eye(1) * spec.drum_mass))
+    drum_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=drum, coordinate=0))
+    node_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node, coordinate=1))
+    winch.vertical = mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[drum_marker, node_marker], offset=0.0))
+    load = mbs.AddLoad(eii.LoadCoordinate(markerNumber=drum_marker, load=0.0))
+    return ServoItems(drum, load, servo_gains(spec))
+
+
+def servo_force(servo: ServoItems, error_integral: float, error: float, error_rate: float,
+                feed_forward: float) -> float:
+    """Motor force on the drum [N]: u = u_ff - K (integral e, e, e')."""
+    return float(feed_forward - servo.gains @ np.array([error_integral, error, error_rate]))
+
+
+# --------------------------------------------------------------------------- slack rope at the winch
+
+#: A tension-only winch element (element 0) may shorten to this fraction of its nominal
+#: length while slack; rope that would shorten it further goes into the reservoir.
+RESERVOIR_THRESHOLD = 0.75
+
+
+def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, element_length: float,
+                    rest_length: float, threshold: float = RESERVOIR_THRESHOLD) -> tuple[float, float]:
+    """Split a winch command between moving the winch node and the slack rope at the drum.
+
+    A slack cable cannot keep its rope off the winch: rope paid out while nothing pulls
+    it away, or falling faster than the winch hauls in, piles up at the drum. In the
+    lumped model the winch node would instead run into the next node, and the first
+    element would collapse (and Newton with it when the cable snaps taut). So the winch
+    node never moves where its element would be shorter than ``threshold`` of its
+    nominal length: the rope that does not go into the node's motion is kept as
+    *surplus* at the drum, added to the first element's rest length. Hauling in takes up
+    the surplus first. Rope is conserved: ``node_offset + surplus == paid_out_change``.
+
+    Parameters
+    ----------
+    paid_out_change : float [m]
+        The command: paid-out length minus its initial value (positive: paid out, the
+        node moves up the winch line towards the pulley).
+    node_offset : float [m]
+        The winch node's current offset up the winch line.
+    surplus : float [m]
+        The rope held at the drum so far (>= 0).
+    element_length : float [m]
+        The first element's current length |p_1 - p_0|.
+    rest_length : float [m]
+        Its nominal rest length (without the surplus).
+    threshold : float
+        Shortest length of the first element, as a fraction of ``rest_length``.
+
+    Returns
+    -------
+    (node_offset, surplus) : floats [m]
+        The new offset of the winch node and the new surplus (>= 0).
+    """
+    wanted = paid_out_change - surplus  # where the node goes if the surplus stays
+    node = wanted if wanted > node_offset else min(node_offset, paid_out_change)
+    highest = node_offset + element_length - threshold * rest_length  # the first element at its shortest
+    node = min(node, highest)
+    return node, paid_out_change - node
+
+
+@dataclass
+class RopeReservoir:
+    """The slack rope held at each winch drum, and the first elements it lengthens.
+
+    Attributes
+    ----------
+    first_elements : ndarray of int, shape (m,)
+        Index of each cable's winch element in the tension-only element arrays.
+    nominal_rest_length, axial_rigidity, damping_rigidity : ndarray, shape (m,) [m, N, N s]
+        The winch element's unstrained length, E A and d_n A: its stiffness and damping
+        are E A / l and d_n A / l for its current rest length l.
+    rest_length, stiffness, damping : ndarray
+        The arrays the force kernel reads (changed in place).
+    surplus, node_offset, max_surplus : ndarray, shape (m,) [m]
+    """
+
+    first_elements: np.ndarray
+    nominal_rest_length: np.ndarray
+    axial_rigidity: np.ndarray
+    damping_rigidity: np.ndarray
+    rest_length: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    surplus: np.ndarray
+    node_offset: np.ndarray
+    max_surplus: np.ndarray
+
+    def update(self, paid_out_change: np.ndarray, element_lengths: np.ndarray) -> np.ndarray:
+        """Split this step's commands (shape (m,) [m]); returns the winch nodes' offsets [m]."""
+        for i, e in enumerate(self.first_elements):
+            node, surplus = reservoir_split(float(paid_out_change[i]), float(self.node_offset[i]),
+                                            float(self.surplus[i]), float(element_lengths[i]),
+                                            float(self.nominal_rest_length[i]))
+            self.node_offset[i], self.surplus[i] = node, surplus
+            rest = self.nominal_rest_length[i] + surplus
+            self.rest_length[e] = rest
+            self.stiffness[e] = self.axial_rigidity[i] / rest
+            self.damping[e] = self.damping_rigidity[i] / rest
+            self.max_surplus[i] = max(self.max_surplus[i], surplus)
+        return self.node_offset.copy()

@@ -1,0 +1,587 @@
+"""Geometry of a cable robot: poses, rotations, anchor points, pulley exits.
+
+One home for each geometric concept, used by the builder, the statics, the chain
+statics, the controllers and the plots. Pure NumPy/SciPy; no Exudyn. Units SI.
+
+Spatial robots (z up, gravity along -z) turn their platform by a rotation vector
+``theta`` [rad], ``R = exp([theta]x)`` (:func:`rotation_from_vector`), the planar
+robot by the angle ``phi`` below (:func:`rotation_matrix`).
+
+Frame
+-----
+A planar robot lives in the paper's vertical x-z plane with gravity along -z (the
+builder maps it onto Exudyn's x-y plane: Exudyn's y is the paper's z). A platform
+pose is ``(x, z, phi)`` [m, m, rad], ``phi`` positive counter-clockwise, and a
+platform anchor is ``p_i = r + R(phi) b_i`` (paper eq. 16) with
+``R = [[cos, -sin], [sin, cos]]``.
+
+Pulley convention
+-----------------
+Each cable comes from its winch straight up the vertical line ``x = c_x + s r_p``
+(``s = -1``: the cable hangs on the left side of the pulley, ``s = +1``: on the right),
+leaves that line at the *hang point* ``h = (c_x + s r_p, c_z)``, wraps over the top of
+the pulley (centre ``c``, radius ``r_p``) by the *wrap angle*, leaves the rim at the
+tangent point ``t`` and runs straight to the platform anchor ``p``. In the paper,
+pulley 1 at (-1.75, 0) has ``s = -1`` and pulley 2 at (1.75, 0) has ``s = +1``: the
+cables hang on the outer sides. ``r_p = 0`` is a point exit at ``c`` (no wrap).
+
+The *ideal cable length* is the length of that path from the hang point to the anchor,
+``|p - t| + r_p * wrap``; the vertical part down to the winch is a constant offset. The
+*paid-out length* lambda of a winch is the cable beyond the hang point: a cable of
+unstrained length ``L0`` has its winch end at ``h - (0, L0 - lambda)``.
+
+:class:`Pulley` is the one description of where a cable leaves the frame; a point exit
+is a ``Pulley`` of radius 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.validation import real_array
+
+__all__ = [
+    "Pulley",
+    "PulleyExit",
+    "rotation_matrix",
+    "rotation_from_vector",
+    "rotation_vector",
+    "left_jacobian",
+    "skew",
+    "planar_cross",
+    "perpendicular",
+    "anchor_points",
+    "anchor_velocities",
+    "hang_point",
+    "pulley_exit",
+    "ideal_cable_length",
+    "ideal_cable_length_rate",
+    "penetration",
+    "segment_penetration",
+]
+
+# A wrap angle this far below zero is rounding, not geometry [rad].
+_WRAP_ROUNDING = 1e-9
+
+
+# ----------------------------------------------------------------------------------
+# argument checks
+# ----------------------------------------------------------------------------------
+def finite_array(name, value, last_dims=None):
+    """Return ``value`` as a finite float array, or raise SceneError naming it."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise SceneError(f"{name} must be numeric, got {value!r}") from exc
+    if last_dims is not None:
+        if array.ndim < len(last_dims) or array.shape[array.ndim - len(last_dims):] != tuple(last_dims):
+            raise SceneError(
+                f"{name} must have trailing shape {tuple(last_dims)}, got shape {array.shape}: {value!r}"
+            )
+    if not np.all(np.isfinite(array)):
+        raise SceneError(f"{name} must be finite, got {value!r}")
+    return array
+
+
+def check_radius(name, radius):
+    radius = finite_array(name, radius)
+    if radius.ndim != 0:
+        raise SceneError(f"{name} must be a scalar, got {radius!r}")
+    if radius < 0.0:
+        raise SceneError(f"{name} must be >= 0 [m], got {float(radius)!r}")
+    return float(radius)
+
+
+def check_side(name, side):
+    try:
+        side_float = float(side)
+    except (TypeError, ValueError) as exc:
+        raise SceneError(f"{name} must be -1 or +1, got {side!r}") from exc
+    if side_float not in (-1.0, 1.0):
+        raise SceneError(f"{name} must be -1 (cable on the left) or +1 (on the right), got {side!r}")
+    return int(side_float)
+
+
+# ----------------------------------------------------------------------------------
+# small helpers
+# ----------------------------------------------------------------------------------
+def rotation_matrix(phi):
+    """Planar rotation matrix ``R(phi) = [[cos, -sin], [sin, cos]]``.
+
+    Parameters
+    ----------
+    phi : float or ndarray, shape (...) [rad]
+        Rotation angle, positive counter-clockwise in the x-z plane.
+
+    Returns
+    -------
+    ndarray, shape (..., 2, 2)
+    """
+    if isinstance(phi, (float, int)) and not isinstance(phi, bool) and math.isfinite(phi):
+        c, s = math.cos(phi), math.sin(phi)  # one angle: the statics' Newton loops call this often
+        return np.array([[c, -s], [s, c]])
+    phi = real_array("phi", phi)
+    c, s = np.cos(phi), np.sin(phi)
+    return np.stack([np.stack([c, -s], axis=-1), np.stack([s, c], axis=-1)], axis=-2)
+
+
+def planar_cross(a, b):
+    """Scalar planar cross product ``a_x b_z - a_z b_x`` (moment about the out-of-plane axis).
+
+    Positive for a counter-clockwise moment, consistent with the platform angle ``phi``.
+
+    Parameters
+    ----------
+    a, b : ndarray, shape (..., 2)
+        Planar vectors, broadcast against each other.
+
+    Returns
+    -------
+    ndarray, shape (...)
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def perpendicular(v):
+    """Rotate planar vectors by +90 degrees: (x, z) -> (-z, x)."""
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def rotated_anchors(pose, anchors):
+    """``R(phi) b_i`` for pose (..., 3) and body anchors (m, 2) -> (..., m, 2)."""
+    phi = pose[..., 2][..., None]
+    c, s = np.cos(phi), np.sin(phi)
+    bx, bz = anchors[:, 0], anchors[:, 1]
+    return np.stack([c * bx - s * bz, s * bx + c * bz], axis=-1)
+
+
+def check_pose_and_anchors(pose, anchors, pose_name="pose"):
+    pose = finite_array(pose_name, pose, (3,))
+    if pose.ndim > 2:
+        raise SceneError(f"{pose_name} must have shape (3,) or (N, 3), got shape {pose.shape}")
+    anchors = finite_array("anchors", anchors, (2,))
+    if anchors.ndim != 2:
+        raise SceneError(f"anchors must have shape (m, 2), got shape {anchors.shape}")
+    return pose, anchors
+
+
+def anchor_points(pose, anchors):
+    """World positions of the platform anchors, ``p_i = r + R(phi) b_i`` (paper eq. 16).
+
+    Parameters
+    ----------
+    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
+        Platform pose(s) ``(x, z, phi)``.
+    anchors : array_like, shape (m, 2) [m]
+        Anchor points ``b_i`` in the platform frame.
+
+    Returns
+    -------
+    ndarray, shape (m, 2) or (N, m, 2) [m]
+
+    Raises
+    ------
+    SceneError
+        If a shape is wrong or a value is not finite.
+    """
+    pose, anchors = check_pose_and_anchors(pose, anchors)
+    return pose[..., None, :2] + rotated_anchors(pose, anchors)
+
+
+def anchor_velocities(pose, pose_rate, anchors):
+    """World velocities of the platform anchors, ``v_i = rdot + phidot * perp(R(phi) b_i)``.
+
+    Parameters
+    ----------
+    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
+        Platform pose(s) ``(x, z, phi)``.
+    pose_rate : array_like, same shape as ``pose`` [m/s, m/s, rad/s]
+        Pose rate(s) ``(xdot, zdot, phidot)``.
+    anchors : array_like, shape (m, 2) [m]
+        Anchor points ``b_i`` in the platform frame.
+
+    Returns
+    -------
+    ndarray, shape (m, 2) or (N, m, 2) [m/s]
+    """
+    pose, anchors = check_pose_and_anchors(pose, anchors)
+    pose_rate = finite_array("pose_rate", pose_rate, (3,))
+    if pose_rate.shape != pose.shape:
+        raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
+    arm = rotated_anchors(pose, anchors)
+    return pose_rate[..., None, :2] + pose_rate[..., 2][..., None, None] * perpendicular(arm)
+
+
+# ----------------------------------------------------------------------------------
+# one cable over one pulley
+# ----------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)  # array fields: compare them field by field
+class PulleyExit:
+    """Where and how an ideal (straight, massless) cable leaves a pulley towards its anchor.
+
+    Attributes
+    ----------
+    tangent_point : ndarray, shape (2,) or (N, 2) [m]
+        Point ``t`` where the cable leaves the rim (the centre for a point exit).
+    wrap_angle : float or ndarray, shape (N,) [rad]
+        Arc over the top of the pulley from the hang point to ``t``; in ``[0, 3 pi / 2)``.
+        Above ``pi`` when the anchor is below the pulley on its inner side; 0 for a
+        point exit.
+    free_length : float or ndarray, shape (N,) [m]
+        Straight length ``|p - t|``.
+    unit_vector : ndarray, shape (2,) or (N, 2)
+        Unit vector from ``t`` towards the anchor ``p`` (opposite to the pull on the platform).
+    arc_length : float or ndarray, shape (N,) [m]
+        Wrapped length ``r_p * wrap_angle``.
+    """
+
+    tangent_point: np.ndarray
+    wrap_angle: float | np.ndarray
+    free_length: float | np.ndarray
+    unit_vector: np.ndarray
+    arc_length: float | np.ndarray
+
+    @property
+    def cable_length(self):
+        """Ideal length from the hang point to the anchor, ``free_length + arc_length`` [m]."""
+        return self.free_length + self.arc_length
+
+
+def hang_point(center, radius, side):
+    """Point ``h = (c_x + s r_p, c_z)`` where the cable leaves its vertical winch line.
+
+    Parameters
+    ----------
+    center : array_like, shape (2,) [m]
+        Pulley centre ``c``.
+    radius : float [m]
+        Pulley radius ``r_p >= 0``.
+    side : {-1, +1}
+        Side of the pulley on which the cable hangs (-1 left, +1 right).
+
+    Returns
+    -------
+    ndarray, shape (2,) [m]
+    """
+    return Pulley(center, radius, side).hang_point
+
+
+def exit_arrays(center, radius, side, anchor):
+    """Vectorised core of :func:`pulley_exit` on checked arguments; anchor (..., 2)."""
+    delta = anchor - center
+    distance = np.hypot(delta[..., 0], delta[..., 1])
+    if radius > 0.0:
+        inside = distance <= radius
+        if np.any(inside):
+            bad = anchor[inside] if anchor.ndim > 1 else anchor
+            raise UnreachableError(
+                f"anchor {np.asarray(bad).tolist()} lies inside the pulley disc "
+                f"(centre {center.tolist()}, radius {radius} m)"
+            )
+    elif np.any(distance == 0.0):
+        raise UnreachableError(f"anchor coincides with the point exit {center.tolist()}")
+    # the anchor direction from the centre, and the half-angle between it and the tangent
+    beta = np.arctan2(delta[..., 1], delta[..., 0])
+    alpha = np.arccos(np.clip(radius / distance, -1.0, 1.0))
+    angle_t = beta - side * alpha  # rim angle of the tangent point
+    angle_h = np.pi if side < 0 else 0.0  # rim angle of the hang point
+    # the cable travels from h over the top: counter-clockwise for s = +1, clockwise for s = -1
+    wrap = np.mod(side * (angle_t - angle_h) + np.pi / 2.0, 2.0 * np.pi) - np.pi / 2.0
+    if radius > 0.0:
+        backwards = wrap < -_WRAP_ROUNDING
+        if np.any(backwards):
+            bad = anchor[backwards] if anchor.ndim > 1 else anchor
+            raise UnreachableError(
+                f"anchor {np.asarray(bad).tolist()} is above the pulley on the outer side of its "
+                f"vertical cable line (centre {center.tolist()}, radius {radius} m, side {side}): "
+                "the cable would reach it without touching the pulley"
+            )
+        wrap = np.maximum(wrap, 0.0)
+    else:
+        wrap = np.zeros_like(distance)  # a point exit does not wrap
+    normal = np.stack([np.cos(angle_t), np.sin(angle_t)], axis=-1)
+    tangent_point = center + radius * normal
+    unit_vector = side * perpendicular(normal)  # direction of travel at t, = (p - t) / |p - t|
+    free_length = np.sqrt(np.maximum(distance**2 - radius**2, 0.0))
+    return tangent_point, wrap, free_length, unit_vector
+
+
+def pulley_exit(center, radius, side, anchor):
+    """Tangent point, wrap angle and free length of a cable running over a pulley to an anchor.
+
+    Parameters
+    ----------
+    center : array_like, shape (2,) [m]
+        Pulley centre ``c``.
+    radius : float [m]
+        Pulley radius ``r_p >= 0``; 0 is a point exit at ``c``.
+    side : {-1, +1}
+        Side on which the cable hangs towards its winch (-1 left, +1 right).
+    anchor : array_like, shape (2,) or (N, 2) [m]
+        Platform anchor(s) ``p`` in the world frame.
+
+    Returns
+    -------
+    PulleyExit
+        Fields of shape (2,) and scalars, or (N, 2) and (N,) for N anchors.
+
+    Raises
+    ------
+    SceneError
+        If an argument is malformed or not finite, or ``side`` is not -1 or +1.
+    UnreachableError
+        If an anchor is inside the pulley disc (or on the point exit), or above the
+        pulley on the outer side of the vertical cable line (negative wrap).
+
+    Notes
+    -----
+    With ``beta`` the direction of ``p - c`` and ``alpha = arccos(r_p / |p - c|)``, the
+    tangent point is at rim angle ``beta - s alpha``; the wrap angle is measured from the
+    hang point over the top of the pulley. For the paper's cable 1 (``c = (-1.75, 0)``,
+    ``r_p = 0.25``, ``s = -1``, ``p = (-0.15, -1.9)``) the wrap is about 145.7 degrees and
+    the free length about 2.471 m.
+    """
+    return Pulley(center, radius, side).exit(anchor)
+
+
+def ideal_cable_length(center, radius, side, anchor):
+    """Ideal cable length from the hang point over the pulley to the anchor.
+
+    ``L = |p - t| + r_p * wrap``: straight, massless, inextensible cable.
+
+    Parameters
+    ----------
+    center : array_like, shape (2,) [m]
+        Pulley centre.
+    radius : float [m]
+        Pulley radius (0: point exit, ``L = |p - c|``).
+    side : {-1, +1}
+        Side on which the cable hangs.
+    anchor : array_like, shape (2,) or (N, 2) [m]
+        Platform anchor(s) in the world frame.
+
+    Returns
+    -------
+    float or ndarray, shape (N,) [m]
+
+    Raises
+    ------
+    SceneError, UnreachableError
+        As :func:`pulley_exit`.
+    """
+    return pulley_exit(center, radius, side, anchor).cable_length
+
+
+def ideal_cable_length_rate(center, radius, side, anchor, anchor_velocity):
+    """Rate of the ideal cable length for an anchor moving at ``anchor_velocity``.
+
+    ``dL/dt = u . v`` with ``u`` the unit vector from the tangent point to the anchor:
+    the change of wrap exactly cancels the tangential motion of the tangent point.
+
+    Parameters
+    ----------
+    center : array_like, shape (2,) [m]
+    radius : float [m]
+    side : {-1, +1}
+    anchor : array_like, shape (2,) or (N, 2) [m]
+    anchor_velocity : array_like, same shape as ``anchor`` [m/s]
+
+    Returns
+    -------
+    float or ndarray, shape (N,) [m/s]
+    """
+    exit_ = pulley_exit(center, radius, side, anchor)
+    velocity = finite_array("anchor_velocity", anchor_velocity, (2,))
+    if velocity.shape != exit_.unit_vector.shape:
+        raise SceneError(
+            f"anchor_velocity must have the shape of anchor {exit_.unit_vector.shape}, got {velocity.shape}"
+        )
+    rate = np.sum(exit_.unit_vector * velocity, axis=-1)
+    return float(rate) if rate.ndim == 0 else rate
+
+
+# ----------------------------------------------------------------------------------
+# spatial rotations (rotation vector, SO(3))
+# ----------------------------------------------------------------------------------
+def skew(vector_):
+    """``[v]x``, the matrix of ``v x ...``, shape (3, 3)."""
+    x, y, z = vector_
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def rotation_from_vector(rotation_vector):
+    """Spatial rotation matrix ``R = exp([theta]x)`` of a rotation vector ``theta`` [rad] (Rodrigues), shape (3, 3)."""
+    theta = np.asarray(rotation_vector, dtype=float)
+    angle = float(np.linalg.norm(theta))
+    k = skew(theta)
+    if angle < 1e-8:  # series: 1 - a^2/6 and 1/2 - a^2/24, exact to round-off here
+        return np.eye(3) + (1.0 - angle**2 / 6.0) * k + (0.5 - angle**2 / 24.0) * (k @ k)
+    return np.eye(3) + math.sin(angle) / angle * k + (1.0 - math.cos(angle)) / angle**2 * (k @ k)
+
+
+def rotation_vector(matrix):
+    """The rotation vector [rad] (angle in [0, pi]) of a rotation matrix, shape (3,)."""
+    matrix = np.asarray(matrix, dtype=float)
+    cosine = min(max(0.5 * (np.trace(matrix) - 1.0), -1.0), 1.0)
+    angle = math.acos(cosine)
+    axial = 0.5 * np.array([matrix[2, 1] - matrix[1, 2], matrix[0, 2] - matrix[2, 0], matrix[1, 0] - matrix[0, 1]])
+    if angle < 1e-8:
+        return axial  # sin(a) ~ a
+    if angle > math.pi - 1e-6:  # near a half turn: axis from the symmetric part
+        symmetric = 0.5 * (matrix + matrix.T) - cosine * np.eye(3)
+        column = int(np.argmax(np.diag(symmetric)))
+        axis = symmetric[:, column] / math.sqrt(max(symmetric[column, column], 1e-300))
+        if axis @ axial < 0.0:
+            axis = -axis
+        return angle * axis / np.linalg.norm(axis)
+    return angle / math.sin(angle) * axial
+
+
+def left_jacobian(rotation_vector_):
+    """``J_l(theta)``: ``exp([theta + d]x) = exp([J_l d]x) exp([theta]x)`` to first order in ``d``."""
+    theta = np.asarray(rotation_vector_, dtype=float)
+    angle = float(np.linalg.norm(theta))
+    k = skew(theta)
+    if angle < 1e-6:
+        return np.eye(3) + 0.5 * k + (k @ k) / 6.0
+    return (np.eye(3) + (1.0 - math.cos(angle)) / angle**2 * k
+            + (angle - math.sin(angle)) / angle**3 * (k @ k))
+
+
+# ----------------------------------------------------------------------------------
+# the one pulley description
+# ----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Pulley:
+    """Where a cable leaves the frame: a pulley it wraps over, or a point exit.
+
+    The one description of a cable's exit used by the builder, the statics, the chain
+    statics, the controllers and the plots (the scene's ``PulleySpec`` is a ``Pulley``
+    with contact parameters).
+
+    Parameters
+    ----------
+    center : (x, z) [m]
+        Pulley centre ``c`` (the exit point of a point exit).
+    radius : float [m]
+        Rim radius ``r_p >= 0``; 0 is a point exit at ``center`` (no wrap).
+    side : {-1, +1}
+        Side on which the cable hangs to its winch: -1 on the left (it wraps clockwise
+        over the top), +1 on the right (counter-clockwise).
+
+    Raises
+    ------
+    SceneError
+        If ``center`` is not two finite numbers, ``radius`` is negative or not finite,
+        or ``side`` is not -1 or +1; the message names the field.
+    """
+
+    center: tuple = (0.0, 0.0)
+    radius: float = 0.0
+    side: int = -1
+
+    def __post_init__(self):
+        center = finite_array("center", self.center, (2,))
+        if center.ndim != 1:
+            raise SceneError(f"center must have shape (2,), got shape {center.shape}")
+        object.__setattr__(self, "center", (float(center[0]), float(center[1])))
+        object.__setattr__(self, "radius", check_radius("radius", self.radius))
+        object.__setattr__(self, "side", check_side("side", self.side))
+
+    @property
+    def is_point_exit(self) -> bool:
+        """True for a point exit (radius 0)."""
+        return self.radius == 0.0
+
+    @property
+    def hang_point(self) -> np.ndarray:
+        """Where the cable leaves its vertical winch line, ``(c_x + s r_p, c_z)``, shape (2,) [m]."""
+        return np.array([self.center[0] + self.side * self.radius, self.center[1]])
+
+    def exit(self, anchor) -> PulleyExit:
+        """Tangent point, wrap and free length of the ideal cable to ``anchor`` (2,) or (N, 2) [m].
+
+        See :func:`pulley_exit`.
+        """
+        anchor = finite_array("anchor", anchor, (2,))
+        tangent_point, wrap, free_length, unit_vector = exit_arrays(
+            np.asarray(self.center), self.radius, self.side, anchor)
+        if anchor.ndim == 1:
+            wrap, free_length = float(wrap), float(free_length)
+        return PulleyExit(tangent_point=tangent_point, wrap_angle=wrap, free_length=free_length,
+                          unit_vector=unit_vector, arc_length=self.radius * wrap)
+
+    def cable_length(self, anchor):
+        """Ideal cable length [m] from the hang point to ``anchor`` (2,) or (N, 2) [m]."""
+        return self.exit(anchor).cable_length
+
+    def rim_point(self, angle: float) -> np.ndarray:
+        """Point of the rim at polar angle ``angle`` [rad], shape (2,) [m]."""
+        return np.array(self.center) + self.radius * np.array([math.cos(angle), math.sin(angle)])
+
+    def wrap_to(self, angle: float) -> float:
+        """Angle [rad] wrapped from the hang point over the top to the rim angle ``angle``, in [0, 2 pi)."""
+        if self.side < 0:
+            return (math.pi - angle) % (2.0 * math.pi)
+        return angle % (2.0 * math.pi)
+
+    def winch_end(self, unstrained_length: float, paid_out: float) -> np.ndarray:
+        """Winch end of a cable of unstrained length ``L0`` [m] with ``paid_out`` [m] beyond the hang point.
+
+        ``h - (0, L0 - lambda)``: the cable runs straight down the winch line. Shape (2,) [m].
+        """
+        hang = self.hang_point
+        return np.array([hang[0], hang[1] - (unstrained_length - paid_out)])
+
+    def paid_out_length(self, unstrained_length: float, winch_end) -> float:
+        """Paid-out length lambda [m] of a cable of unstrained length ``L0`` [m] whose winch end is at ``winch_end`` (2,) [m].
+
+        The inverse of :meth:`winch_end`: all of the cable but the part hanging below the hang point.
+        """
+        return float(unstrained_length - (self.center[1] - winch_end[1]))
+
+
+# ----------------------------------------------------------------------------------
+# how deep the lumped cable cuts into a pulley
+# ----------------------------------------------------------------------------------
+def penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
+    """Depth by which each node lies inside the pulley disc (0 outside) [m].
+
+    Parameters
+    ----------
+    positions : ndarray, shape (..., 2) [m]
+
+    Returns
+    -------
+    ndarray, shape (...) [m]
+    """
+    distance = np.linalg.norm(np.asarray(positions) - np.asarray(pulley.center), axis=-1)
+    return np.maximum(pulley.radius - distance, 0.0)
+
+
+def segment_penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
+    """Depth by which each element (the segment between two nodes) cuts into the pulley disc [m].
+
+    Parameters
+    ----------
+    positions : ndarray, shape (n + 1, 2) [m]
+        Node positions of one cable.
+
+    Returns
+    -------
+    ndarray, shape (n,) [m]
+        r_p minus the distance of the segment from the pulley centre, 0 if outside.
+    """
+    positions = np.asarray(positions, dtype=float)
+    center = np.asarray(pulley.center)
+    a, b = positions[:-1], positions[1:]
+    d = b - a
+    t = np.clip(np.einsum("ij,ij->i", center - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+    closest = a + t[:, None] * d
+    return np.maximum(pulley.radius - np.linalg.norm(closest - center, axis=1), 0.0)

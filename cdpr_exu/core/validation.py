@@ -1,0 +1,126 @@
+"""Argument checks shared by the scene, the catenary and the statics.
+
+Each returns the value as a float or raises :class:`~cdpr_exu.core.errors.SceneError`
+naming the parameter and the offending value. Booleans are refused: ``True`` is no
+length.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from cdpr_exu.core.errors import SceneError
+
+
+def finite(name: str, value: Any) -> float:
+    """``value`` as a finite float."""
+    if isinstance(value, bool):
+        raise SceneError(f"{name} must be a real number, got {value!r}")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise SceneError(f"{name} must be finite, got {value!r}")
+    return number
+
+
+def positive(name: str, value: Any) -> float:
+    """``value`` as a finite float > 0."""
+    number = finite(name, value)
+    if number <= 0.0:
+        raise SceneError(f"{name} must be positive, got {value!r}")
+    return number
+
+
+def non_negative(name: str, value: Any) -> float:
+    """``value`` as a finite float >= 0."""
+    number = finite(name, value)
+    if number < 0.0:
+        raise SceneError(f"{name} must be zero or positive, got {value!r}")
+    return number
+
+
+def real_array(name: str, value: Any, *, require_finite: bool = True):
+    """``value`` as a float ndarray (any shape); text, objects and NaN/inf are refused."""
+    import numpy as np
+
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be real numbers, got {value!r}") from None
+    if require_finite and not np.all(np.isfinite(array)):
+        raise SceneError(f"{name} must be finite, got {value!r}")
+    return array
+
+
+def whole_array(name: str, value: Any):
+    """``value`` as an int64 ndarray whose entries are whole numbers (2.5 is refused, not truncated)."""
+    import numpy as np
+
+    array = real_array(name, value)
+    if not np.all(array == np.round(array)):
+        raise SceneError(f"{name} must be whole numbers, got {value!r}")
+    return array.astype(np.int64)
+
+
+def flat_coordinates(name: str, value: Any, n_coordinates: int | None = None):
+    """``value`` as a C-contiguous float64 array of planar coordinates ``x0, y0, x1, y1, ...``.
+
+    Shape (2 n_nodes,); with ``n_coordinates`` given, exactly that many entries.
+    """
+    import numpy as np
+
+    array = np.ascontiguousarray(real_array(name, value), dtype=np.float64)
+    if array.ndim != 1 or array.shape[0] % 2 != 0:
+        raise SceneError(f"{name} must be a flat array (2 n_nodes,) x0, y0, x1, ...; got shape {array.shape}")
+    if n_coordinates is not None and array.shape[0] != n_coordinates:
+        raise SceneError(f"{name} has {array.shape[0]} coordinates, expected {n_coordinates}")
+    return array
+
+
+def vector(name: str, value: Any, length: int, meaning: str = ""):
+    """``value`` as a finite float ndarray of shape ``(length,)``.
+
+    ``meaning`` describes the entries in the message, e.g. ``" (x, z) [m]"``.
+    """
+    import numpy as np
+
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be a {length}-vector{meaning}, got {value!r}") from None
+    if array.shape != (length,) or not np.all(np.isfinite(array)):
+        raise SceneError(f"{name} must be a finite {length}-vector{meaning}, got {value!r}")
+    return array
+
+
+def per_item(name: str, values: Any, count: int, positive: bool = False):
+    """One finite, non-negative (or positive) value per item: a scalar is repeated.
+
+    Returns a contiguous float64 ndarray, shape (count,); raises SceneError naming ``name``.
+    """
+    import numpy as np
+
+    array = real_array(name, values)
+    if array.ndim == 0:
+        array = np.full(count, float(array))
+    elif array.shape != (count,):
+        raise SceneError(f"{name} must be a scalar or have shape ({count},); got shape {array.shape}")
+    array = np.ascontiguousarray(array, dtype=np.float64)
+    if not np.isfinite(array).all() or (array <= 0.0 if positive else array < 0.0).any():
+        raise SceneError(f"{name} must be finite and {'positive' if positive else 'zero or positive'}; got {values!r}")
+    return array
+
+
+def points_per_item(name: str, values: Any, count: int):
+    """One finite planar point per item, shape (count, 2) [m]: a single (2,) point is repeated."""
+    import numpy as np
+
+    array = np.asarray(real_array(name, values), dtype=np.float64)
+    if array.shape == (2,):
+        array = np.tile(array, (count, 1))
+    if array.shape != (count, 2) or not np.isfinite(array).all():
+        raise SceneError(f"{name} must be finite, shape (2,) or ({count}, 2); got shape {array.shape}")
+    return np.ascontiguousarray(array)

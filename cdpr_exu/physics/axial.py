@@ -1,0 +1,203 @@
+"""Tension-only (slack) axial spring-dampers of lumped-mass cables: numba kernels.
+
+A real cable cannot push, and a slack cable carries nothing at all. With
+``Effects.slack`` the axial force of element e between nodes a and b is
+
+    f = g(s) max(0, k s + c ds/dt),   s = l - l0,   l = |p_b - p_a|,
+
+pulling the nodes together along u = (p_b - p_a) / l (:func:`tension_law`). The switch
+g rises from 0 at the rest length to 1 at a strain of :data:`TAUT_BAND` as a C1
+smoothstep: below the rest length there is no force at all (not even damping: a slack
+element that is pulled straight again does not resist with its Kelvin-Voigt damper),
+and Newton sees a force that is continuous with a continuous slope in the length when
+a cable snaps taut. Exudyn's built-in spring-damper
+has no tension-only option, so these elements join the bending springs in the one
+``ObjectGenericODE2`` of the cables (:mod:`cdpr_exu.builder.cable`), with an analytic Jacobian.
+
+No Exudyn here: coordinates are flat arrays (x0, y0, x1, y1, ...) [m, m/s].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _element_state(positions, velocities, a, b):
+    dx = positions[2 * b] - positions[2 * a]
+    dy = positions[2 * b + 1] - positions[2 * a + 1]
+    dvx = velocities[2 * b] - velocities[2 * a]
+    dvy = velocities[2 * b + 1] - velocities[2 * a + 1]
+    length = np.sqrt(dx * dx + dy * dy)
+    ux, uy = dx / length, dy / length
+    rate = ux * dvx + uy * dvy
+    return length, ux, uy, rate, dvx, dvy
+
+
+#: Strain over which a tension-only element goes from slack (no force) to taut (the full
+#: Kelvin-Voigt law); 1e-5 is a hundredth of the strain the paper's cable carries under
+#: the platform's weight (about 1e-3), so it moves no taut force noticeably.
+TAUT_BAND = 1e-5
+
+
+@njit(cache=True)
+def tension_law(extension, rate, stiffness, damping, band):
+    """Tension of a tension-only element and its derivatives.
+
+    Parameters
+    ----------
+    extension : float [m]
+        s = l - l0 (negative: shorter than the rest length, slack).
+    rate : float [m/s]
+        ds/dt.
+    stiffness, damping : float [N/m, N s/m]
+    band : float [m]
+        Extension over which the element goes from slack to taut (C1 smoothstep).
+
+    Returns
+    -------
+    (tension, d tension / d extension, d tension / d rate) : floats [N, N/m, N s/m]
+        The tension is never negative; zero below the rest length.
+    """
+    if extension <= 0.0:
+        return 0.0, 0.0, 0.0
+    viscoelastic = stiffness * extension + damping * rate
+    if viscoelastic <= 0.0:
+        return 0.0, 0.0, 0.0
+    if extension >= band:
+        return viscoelastic, stiffness, damping
+    x = extension / band
+    switch = x * x * (3.0 - 2.0 * x)
+    switch_slope = 6.0 * x * (1.0 - x) / band
+    return switch * viscoelastic, switch_slope * viscoelastic + switch * stiffness, switch * damping
+
+
+@njit(cache=True)
+def slack_axial_force(positions, velocities, elements, rest_length, stiffness, damping, out):
+    """Add the tension-only axial forces to ``out`` (2N,) [N] and return it.
+
+    Parameters
+    ----------
+    positions, velocities : ndarray, shape (2N,) [m, m/s]
+    elements : ndarray of int, shape (E, 2)
+        Node pairs (a, b) of each element.
+    rest_length, stiffness, damping : ndarray, shape (E,) [m, N/m, N s/m]
+    out : ndarray, shape (2N,)
+        Accumulated into (not zeroed).
+    """
+    for e in range(elements.shape[0]):
+        a, b = elements[e, 0], elements[e, 1]
+        length, ux, uy, rate, _, _ = _element_state(positions, velocities, a, b)
+        force, _, _ = tension_law(length - rest_length[e], rate, stiffness[e], damping[e],
+                                  TAUT_BAND * rest_length[e])
+        if force <= 0.0:
+            continue
+        out[2 * a] += force * ux
+        out[2 * a + 1] += force * uy
+        out[2 * b] -= force * ux
+        out[2 * b + 1] -= force * uy
+    return out
+
+
+@njit(cache=True)
+def _element_block(positions, velocities, a, b, rest_length, stiffness, damping, factor_position,
+                   factor_velocity, block):
+    """The (b, b) block, shape (2, 2), of ``factor_position * K + factor_velocity * D`` of one
+    element into ``block``; the (a, a) block is the same, (a, b) and (b, a) its negative.
+    Returns False (block untouched) when the element carries no force (slack)."""
+    length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
+    force, k, c = tension_law(length - rest_length, rate, stiffness, damping, TAUT_BAND * rest_length)
+    if force <= 0.0:
+        return False
+    u = (ux, uy)
+    # d(rate)/d(p_b) = (dv - u rate) / l
+    w = ((dvx - ux * rate) / length, (dvy - uy * rate) / length)
+    for i in range(2):
+        for j in range(2):
+            projector = (1.0 if i == j else 0.0) - u[i] * u[j]
+            g = u[i] * (k * u[j] + c * w[j]) + force * projector / length
+            block[i, j] = factor_position * g + factor_velocity * c * u[i] * u[j]
+    return True
+
+
+@njit(cache=True)
+def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness, damping,
+                         factor_position, factor_velocity, out):
+    """Add ``factor_position * K + factor_velocity * D`` of the slack elements to ``out``.
+
+    K = -df/dq and D = -df/dv (the left-hand-side Jacobians Exudyn expects), shape
+    (2N, 2N); zero for an element whose force is not positive (slack). The element's
+    stiffness and damping are the slopes of :func:`tension_law` in the extension and its rate.
+    """
+    block = np.empty((2, 2))
+    for e in range(elements.shape[0]):
+        a, b = elements[e, 0], elements[e, 1]
+        if not _element_block(positions, velocities, a, b, rest_length[e], stiffness[e], damping[e],
+                              factor_position, factor_velocity, block):
+            continue
+        for i in range(2):
+            for j in range(2):
+                out[2 * b + i, 2 * b + j] += block[i, j]
+                out[2 * a + i, 2 * a + j] += block[i, j]
+                out[2 * a + i, 2 * b + j] -= block[i, j]
+                out[2 * b + i, 2 * a + j] -= block[i, j]
+    return out
+
+
+@njit(cache=True)
+def slack_triplet_pattern(elements):
+    """Rows and columns of the slack elements' sparse Jacobian triplets: 16 per element, shape (16 E,) each.
+
+    Per element the blocks (b, b), (a, a), (a, b) and (b, a), each 2 x 2, in that order.
+    """
+    n = elements.shape[0]
+    rows = np.empty(16 * n, dtype=np.int64)
+    columns = np.empty(16 * n, dtype=np.int64)
+    for e in range(n):
+        a, b = elements[e, 0], elements[e, 1]
+        pairs = ((b, b), (a, a), (a, b), (b, a))
+        for block in range(4):
+            r, c = pairs[block]
+            for i in range(2):
+                for j in range(2):
+                    rows[16 * e + 4 * block + 2 * i + j] = 2 * r + i
+                    columns[16 * e + 4 * block + 2 * i + j] = 2 * c + j
+    return rows, columns
+
+
+@njit(cache=True)
+def slack_triplet_values(positions, velocities, elements, rest_length, stiffness, damping,
+                         factor_position, factor_velocity, out_values):
+    """Values of ``factor_position * K + factor_velocity * D`` of the slack elements at
+    :func:`slack_triplet_pattern`'s places (overwrites ``out_values``, shape (16 E,))."""
+    out_values[:] = 0.0
+    block = np.empty((2, 2))
+    for e in range(elements.shape[0]):
+        if not _element_block(positions, velocities, elements[e, 0], elements[e, 1], rest_length[e], stiffness[e],
+                              damping[e], factor_position, factor_velocity, block):
+            continue
+        for i in range(2):
+            for j in range(2):
+                base = 16 * e + 2 * i + j
+                out_values[base] = out_values[base + 4] = block[i, j]
+                out_values[base + 8] = out_values[base + 12] = -block[i, j]
+    return out_values
+
+
+def cable_elements(nodes_per_cable) -> np.ndarray:
+    """Element node pairs (a, b) for cables whose nodes are numbered one after another.
+
+    Parameters
+    ----------
+    nodes_per_cable : sequence of int
+
+    Returns
+    -------
+    ndarray of int64, shape (E, 2)
+    """
+    pairs, start = [], 0
+    for count in nodes_per_cable:
+        pairs.extend((start + j, start + j + 1) for j in range(count - 1))
+        start += count
+    return np.asarray(pairs, dtype=np.int64).reshape(-1, 2)

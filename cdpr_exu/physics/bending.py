@@ -1,0 +1,611 @@
+"""Bending spring-damper of a lumped-mass cable, planar, with the exact relative angle.
+
+A *joint* is a triplet ``(a, b, c)`` of global node indices; for a cable these are
+consecutive nodes ``(b - 1, b, b + 1)``, but any triplets are accepted, so that all the
+cables of a scene can share one call over one global node list. For a joint,
+
+    e1 = p_b - p_a,    e2 = p_c - p_b,
+    dtheta = atan2(e1 x e2, e1 . e2)  in (-pi, pi]      (exact, valid for large angles)
+
+and the joint moment is ``M = k dtheta + c dtheta_dot`` with ``dtheta_dot = grad(dtheta) . v``.
+The potential is ``V = k dtheta^2 / 2`` and the generalized force on the nodes is
+``f = -M grad_p(dtheta)``. With ``g(e) = (-e_y, e_x) / |e|^2``, the gradient of
+``atan2(e_y, e_x)``:
+
+    d dtheta / d p_a = g(e1),   d dtheta / d p_b = -g(e1) - g(e2),   d dtheta / d p_c = g(e2).
+
+The tangent matrices are ``K = -df/dq = G (k G + c H v)^T + M H`` and ``D = -df/dv = c G G^T``
+per joint, with ``G`` the (6,) gradient and ``H`` the (6, 6) Hessian of ``dtheta`` in
+``(p_a, p_b, p_c)``; the Hessian of ``atan2(e_y, e_x)`` is
+``1/|e|^4 [[2 e_x e_y, e_y^2 - e_x^2], [e_y^2 - e_x^2, -2 e_x e_y]]``.
+``K`` is not symmetric when ``c != 0`` (the velocity-dependent term).
+
+Coordinates are flat, ``(2 n_nodes,)``, ordered ``x0, y0, x1, y1, ...`` as in an Exudyn
+``ObjectGenericODE2`` over ``NodePoint2D`` nodes. Note that Exudyn passes the
+*displacement* ``q`` to user functions: add the reference positions before calling.
+
+Also here: the linear curvature-vector spring ``(k / l^2) |p_a - 2 p_b + p_c|^2 / 2``, a
+cheaper small-angle alternative with constant matrices (see ``curvature_stiffness_matrix``).
+
+Three levels of API, from safest to fastest:
+- the functions ``bending_force``, ``bending_jacobian``, ... validate every argument on each
+  call (about 15-25 us for 2 x 16 nodes) and allocate unless given ``out=`` arrays;
+- ``BendingSpringDamper`` validates joints and parameters once, owns the output buffers and
+  only checks the coordinate arrays per call: the one to use in Exudyn user functions;
+- the numba kernels (``*_kernel``) do no checks at all.
+This module does not import Exudyn.
+"""
+
+import numpy as np
+from numba import njit
+
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.validation import flat_coordinates, real_array, whole_array
+
+__all__ = [
+    "BendingSpringDamper",
+    "cable_joints",
+    "bending_angles",
+    "bending_energy",
+    "bending_force",
+    "bending_jacobian",
+    "bending_force_and_jacobian",
+    "bending_jacobian_weighted",
+    "curvature_stiffness_matrix",
+    "curvature_damping_matrix",
+    "bending_force_kernel",
+    "bending_jacobian_kernel",
+]
+
+
+# --------------------------------------------------------------------------- kernels
+
+@njit(cache=True, fastmath=False)
+def _joint_geometry(positions, velocities, a, b, c, grad, hess):
+    """Angle, angular rate, gradient (6,) and Hessian (6, 6) of one joint (writes grad, hess).
+
+    Returns ``(dtheta, dtheta_dot)``. ``hess`` is only filled when its size is 36.
+    """
+    e1x = positions[2 * b] - positions[2 * a]
+    e1y = positions[2 * b + 1] - positions[2 * a + 1]
+    e2x = positions[2 * c] - positions[2 * b]
+    e2y = positions[2 * c + 1] - positions[2 * b + 1]
+    dtheta = np.arctan2(e1x * e2y - e1y * e2x, e1x * e2x + e1y * e2y)
+    r1 = 1.0 / (e1x * e1x + e1y * e1y)
+    r2 = 1.0 / (e2x * e2x + e2y * e2y)
+    g1x = -e1y * r1
+    g1y = e1x * r1
+    g2x = -e2y * r2
+    g2y = e2x * r2
+    grad[0] = g1x
+    grad[1] = g1y
+    grad[2] = -g1x - g2x
+    grad[3] = -g1y - g2y
+    grad[4] = g2x
+    grad[5] = g2y
+    dtheta_dot = (grad[0] * velocities[2 * a] + grad[1] * velocities[2 * a + 1]
+                  + grad[2] * velocities[2 * b] + grad[3] * velocities[2 * b + 1]
+                  + grad[4] * velocities[2 * c] + grad[5] * velocities[2 * c + 1])
+    if hess.shape[0] == 6:
+        # Hessian of atan2(e_y, e_x): 1/|e|^4 [[2 xy, y^2 - x^2], [y^2 - x^2, -2 xy]]
+        h1xx = 2.0 * e1x * e1y * r1 * r1
+        h1xy = (e1y * e1y - e1x * e1x) * r1 * r1
+        h2xx = 2.0 * e2x * e2y * r2 * r2
+        h2xy = (e2y * e2y - e2x * e2x) * r2 * r2
+        # dtheta = theta(e2) - theta(e1); blocks in (p_a, p_b, p_c):
+        # aa = -H1, ab = +H1, bb = -H1 + H2, bc = -H2, cc = +H2, ac = 0
+        for i in range(6):
+            for j in range(6):
+                hess[i, j] = 0.0
+        blocks_h1 = ((0, 0, -1.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, -1.0))
+        blocks_h2 = ((1, 1, 1.0), (1, 2, -1.0), (2, 1, -1.0), (2, 2, 1.0))
+        for blk in blocks_h1:
+            i0 = 2 * blk[0]
+            j0 = 2 * blk[1]
+            s = blk[2]
+            hess[i0, j0] += s * h1xx
+            hess[i0, j0 + 1] += s * h1xy
+            hess[i0 + 1, j0] += s * h1xy
+            hess[i0 + 1, j0 + 1] -= s * h1xx
+        for blk in blocks_h2:
+            i0 = 2 * blk[0]
+            j0 = 2 * blk[1]
+            s = blk[2]
+            hess[i0, j0] += s * h2xx
+            hess[i0, j0 + 1] += s * h2xy
+            hess[i0 + 1, j0] += s * h2xy
+            hess[i0 + 1, j0 + 1] -= s * h2xx
+    return dtheta, dtheta_dot
+
+
+@njit(cache=True)
+def bending_force_kernel(positions, velocities, joints, stiffness, damping, out):
+    """Unchecked kernel of ``bending_force``: overwrites ``out`` (2N,) with the force [N]."""
+    out[:] = 0.0
+    grad = np.empty(6)
+    no_hess = np.empty((0, 0))
+    for j in range(joints.shape[0]):
+        a = joints[j, 0]
+        b = joints[j, 1]
+        c = joints[j, 2]
+        dtheta, dtheta_dot = _joint_geometry(positions, velocities, a, b, c, grad, no_hess)
+        moment = stiffness[j] * dtheta + damping[j] * dtheta_dot
+        out[2 * a] -= moment * grad[0]
+        out[2 * a + 1] -= moment * grad[1]
+        out[2 * b] -= moment * grad[2]
+        out[2 * b + 1] -= moment * grad[3]
+        out[2 * c] -= moment * grad[4]
+        out[2 * c + 1] -= moment * grad[5]
+    return out
+
+
+@njit(cache=True)
+def _joint_terms(positions, velocities, joints, j, stiffness, damping, grad, hess, index, hess_v):
+    """Geometry of joint j for the tangent matrices: fills grad (6,), hess (6, 6), the
+    coordinate indices ``index`` (6,) and ``hess_v`` = H v (6,) = d(dtheta_dot)/dq; returns
+    the moment k dtheta + d dtheta_dot [N m]."""
+    dtheta, dtheta_dot = _joint_geometry(positions, velocities, joints[j, 0], joints[j, 1], joints[j, 2], grad, hess)
+    for node in range(3):
+        index[2 * node] = 2 * joints[j, node]
+        index[2 * node + 1] = 2 * joints[j, node] + 1
+    for i in range(6):
+        s = 0.0
+        for m in range(6):
+            s += hess[i, m] * velocities[index[m]]
+        hess_v[i] = s  # d(dtheta_dot)/dq_i (H symmetric)
+    return stiffness[j] * dtheta + damping[j] * dtheta_dot
+
+
+@njit(cache=True)
+def bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
+                            factor_position, factor_velocity, out_force, out_k, out_d):
+    """Unchecked kernel of the force and tangent matrices.
+
+    Overwrites ``out_force`` (2N,) with f; if ``out_d`` has size 0, overwrites ``out_k``
+    (2N, 2N) with ``factor_position * K + factor_velocity * D``, else ``out_k`` with K and
+    ``out_d`` with D (factors ignored). ``out_force`` may have size 0 to skip the force.
+    """
+    separate = out_d.shape[0] != 0
+    want_force = out_force.shape[0] != 0
+    if want_force:
+        out_force[:] = 0.0
+    out_k[:, :] = 0.0
+    if separate:
+        out_d[:, :] = 0.0
+    grad = np.empty(6)
+    hess = np.empty((6, 6))
+    index = np.empty(6, dtype=np.int64)
+    hess_v = np.empty(6)
+    for j in range(joints.shape[0]):
+        moment = _joint_terms(positions, velocities, joints, j, stiffness, damping, grad, hess, index, hess_v)
+        k = stiffness[j]
+        d = damping[j]
+        if want_force:
+            for i in range(6):
+                out_force[index[i]] -= moment * grad[i]
+        if separate:
+            for i in range(6):
+                gi = grad[i]
+                for m in range(6):
+                    out_k[index[i], index[m]] += gi * (k * grad[m] + d * hess_v[m]) + moment * hess[i, m]
+                    out_d[index[i], index[m]] += d * gi * grad[m]
+        else:
+            for i in range(6):
+                gi = grad[i]
+                for m in range(6):
+                    out_k[index[i], index[m]] += (
+                        factor_position * (gi * (k * grad[m] + d * hess_v[m]) + moment * hess[i, m])
+                        + factor_velocity * d * gi * grad[m])
+    return out_force
+
+
+@njit(cache=True)
+def bending_triplet_pattern(joints):
+    """Rows and columns of the sparse Jacobian triplets of the joints: 36 per joint, shape (36 J,) each."""
+    n = joints.shape[0]
+    rows = np.empty(36 * n, dtype=np.int64)
+    columns = np.empty(36 * n, dtype=np.int64)
+    index = np.empty(6, dtype=np.int64)
+    for j in range(n):
+        for node in range(3):
+            index[2 * node] = 2 * joints[j, node]
+            index[2 * node + 1] = 2 * joints[j, node] + 1
+        for i in range(6):
+            for m in range(6):
+                rows[36 * j + 6 * i + m] = index[i]
+                columns[36 * j + 6 * i + m] = index[m]
+    return rows, columns
+
+
+@njit(cache=True)
+def bending_triplet_values(positions, velocities, joints, stiffness, damping, factor_position, factor_velocity,
+                           out_values):
+    """Values of ``factor_position * K + factor_velocity * D`` at :func:`bending_triplet_pattern`'s
+    places (overwrites ``out_values``, shape (36 J,)): the same numbers the dense kernel adds, in
+    36-entry blocks per joint, so the Jacobian costs O(J) instead of O(N^2)."""
+    grad = np.empty(6)
+    hess = np.empty((6, 6))
+    index = np.empty(6, dtype=np.int64)
+    hess_v = np.empty(6)
+    for j in range(joints.shape[0]):
+        moment = _joint_terms(positions, velocities, joints, j, stiffness, damping, grad, hess, index, hess_v)
+        k = stiffness[j]
+        d = damping[j]
+        for i in range(6):
+            gi = grad[i]
+            for m in range(6):
+                out_values[36 * j + 6 * i + m] = (
+                    factor_position * (gi * (k * grad[m] + d * hess_v[m]) + moment * hess[i, m])
+                    + factor_velocity * d * gi * grad[m])
+    return out_values
+
+
+# --------------------------------------------------------------------------- validation
+
+def _as_joints(joints, n_nodes):
+    array = np.ascontiguousarray(whole_array("joints", joints))
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise SceneError(f"joints must be an integer array (n_joints, 3); got shape {array.shape}")
+    if array.size:
+        low, high = array.min(), array.max()
+        if low < 0 or high >= n_nodes:
+            raise SceneError(f"joints refer to nodes outside 0..{n_nodes - 1}: min {low}, max {high}")
+        if ((array[:, 0] == array[:, 1]) | (array[:, 1] == array[:, 2])).any():
+            raise SceneError("joints must not repeat a node in (a, b) or (b, c): the element would have zero length")
+    return array
+
+
+def _as_per_joint(name, values, n_joints):
+    array = real_array(name, values)
+    if np.any(array < 0):
+        raise SceneError(f"{name} must be zero or positive, got {values!r}")
+    if array.ndim == 0:
+        array = np.full(n_joints, float(array))
+    elif array.shape != (n_joints,):
+        raise SceneError(f"{name} must be a scalar or have shape ({n_joints},); got shape {array.shape}")
+    else:
+        array = np.ascontiguousarray(array)
+    if not np.isfinite(array).all():
+        raise SceneError(f"{name} must be finite; got {array}")
+    return array
+
+
+def _check_output(name, out, shape):
+    if out is None:
+        return np.empty(shape)
+    if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == shape
+            and out.flags.c_contiguous and out.flags.writeable):
+        raise SceneError(f"{name} must be a writeable C-contiguous float64 array of shape {shape}")
+    return out
+
+
+def _validate(positions, velocities, joints, stiffness, damping):
+    positions = flat_coordinates("positions", positions)
+    velocities = flat_coordinates("velocities", velocities, positions.shape[0])
+    joints = _as_joints(joints, positions.shape[0] // 2)
+    stiffness = _as_per_joint("stiffness", stiffness, joints.shape[0])
+    damping = _as_per_joint("damping", damping, joints.shape[0])
+    return positions, velocities, joints, stiffness, damping
+
+
+_EMPTY_VECTOR = np.empty(0)
+_EMPTY_MATRIX = np.empty((0, 0))
+
+
+# --------------------------------------------------------------------------- public API
+
+def cable_joints(nodes_per_cable):
+    """Joint triplets of cables whose nodes are numbered consecutively, cable after cable.
+
+    Parameters
+    ----------
+    nodes_per_cable : sequence of int
+        Number of nodes of each cable; cable ``i`` occupies the global nodes following
+        those of cable ``i - 1``.
+
+    Returns
+    -------
+    joints : ndarray of int64, shape (sum(n_i - 2), 3)
+        ``(b - 1, b, b + 1)`` for every interior node ``b`` of every cable.
+    """
+    rows = []
+    first = 0
+    for n in whole_array("nodes_per_cable", nodes_per_cable).reshape(-1):
+        n = int(n)
+        if n < 2:
+            raise SceneError(f"nodes_per_cable entries must be >= 2; got {n}")
+        middle = np.arange(first + 1, first + n - 1, dtype=np.int64)
+        rows.append(np.stack([middle - 1, middle, middle + 1], axis=1))
+        first += n
+    if not rows:
+        return np.empty((0, 3), dtype=np.int64)
+    return np.concatenate(rows, axis=0)
+
+
+def bending_angles(positions, joints):
+    """Relative angle of each joint, ``atan2(e1 x e2, e1 . e2)``.
+
+    Parameters
+    ----------
+    positions : array_like, shape (2 n_nodes,) [m]
+        Node positions x0, y0, x1, y1, ...
+    joints : array_like of int, shape (n_joints, 3)
+        Node triplets (a, b, c).
+
+    Returns
+    -------
+    dtheta : ndarray, shape (n_joints,) [rad], in (-pi, pi]
+        Positive when the cable turns counter-clockwise from a-b to b-c.
+    """
+    positions = flat_coordinates("positions", positions)
+    joints = _as_joints(joints, positions.shape[0] // 2)
+    p = positions.reshape(-1, 2)
+    e1 = p[joints[:, 1]] - p[joints[:, 0]]
+    e2 = p[joints[:, 2]] - p[joints[:, 1]]
+    cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    dot = np.einsum("ij,ij->i", e1, e2)
+    return np.arctan2(cross, dot)
+
+
+def bending_energy(positions, joints, stiffness):
+    """Elastic bending energy ``sum_j k_j dtheta_j^2 / 2``.
+
+    Parameters
+    ----------
+    positions : array_like, shape (2 n_nodes,) [m]
+    joints : array_like of int, shape (n_joints, 3)
+    stiffness : float or array_like, shape (n_joints,) [N m/rad]
+
+    Returns
+    -------
+    energy : float [J]
+    """
+    dtheta = bending_angles(positions, joints)
+    stiffness = _as_per_joint("stiffness", stiffness, dtheta.shape[0])
+    return 0.5 * float(np.dot(stiffness, dtheta * dtheta))
+
+
+def bending_force(positions, velocities, joints, stiffness, damping, out=None):
+    """Generalized bending force on the node coordinates (right-hand side).
+
+    ``f = -sum_j (k_j dtheta_j + c_j dtheta_dot_j) grad_q(dtheta_j)``.
+
+    Parameters
+    ----------
+    positions : array_like, shape (2 n_nodes,) [m]
+        Current node positions x0, y0, x1, y1, ... (not Exudyn displacements).
+    velocities : array_like, shape (2 n_nodes,) [m/s]
+    joints : array_like of int, shape (n_joints, 3)
+        Node triplets (a, b, c); may span several cables.
+    stiffness : float or array_like, shape (n_joints,) [N m/rad]
+    damping : float or array_like, shape (n_joints,) [N m s/rad]
+    out : ndarray, shape (2 n_nodes,), float64, C-contiguous, optional
+        Overwritten with the result and returned (no allocation).
+
+    Returns
+    -------
+    force : ndarray, shape (2 n_nodes,) [N]
+
+    Raises
+    ------
+    SceneError
+        On a bad shape, a node index out of range or a repeated node in an element.
+    """
+    positions, velocities, joints, stiffness, damping = _validate(
+        positions, velocities, joints, stiffness, damping)
+    out = _check_output("out", out, positions.shape)
+    return bending_force_kernel(positions, velocities, joints, stiffness, damping, out)
+
+
+def bending_jacobian(positions, velocities, joints, stiffness, damping, out_k=None, out_d=None):
+    """Tangent stiffness ``K = -df/dq`` and tangent damping ``D = -df/dv`` of the bending force.
+
+    Parameters are those of ``bending_force``; ``out_k`` and ``out_d`` are optional
+    (2 n_nodes, 2 n_nodes) float64 C-contiguous arrays, overwritten and returned.
+
+    Returns
+    -------
+    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m]
+        ``sum_j G (k G + c H v)^T + (k dtheta + c dtheta_dot) H``; not symmetric if c != 0.
+    D : ndarray, shape (2 n_nodes, 2 n_nodes) [N s/m]
+        ``sum_j c G G^T``.
+    """
+    _, out_k, out_d = bending_force_and_jacobian(
+        positions, velocities, joints, stiffness, damping, out_force=_EMPTY_VECTOR,
+        out_k=out_k, out_d=out_d)
+    return out_k, out_d
+
+
+def bending_force_and_jacobian(positions, velocities, joints, stiffness, damping,
+                               out_force=None, out_k=None, out_d=None):
+    """Force, K and D of ``bending_force`` and ``bending_jacobian`` in one pass.
+
+    Returns
+    -------
+    force : ndarray, shape (2 n_nodes,) [N]
+    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m]
+    D : ndarray, shape (2 n_nodes, 2 n_nodes) [N s/m]
+    """
+    positions, velocities, joints, stiffness, damping = _validate(
+        positions, velocities, joints, stiffness, damping)
+    n = positions.shape[0]
+    if out_force is not _EMPTY_VECTOR:
+        out_force = _check_output("out_force", out_force, (n,))
+    out_k = _check_output("out_k", out_k, (n, n))
+    out_d = _check_output("out_d", out_d, (n, n))
+    bending_jacobian_kernel(positions, velocities, joints, stiffness, damping, 1.0, 0.0,
+                            out_force, out_k, out_d)
+    return out_force, out_k, out_d
+
+
+def bending_jacobian_weighted(positions, velocities, joints, stiffness, damping,
+                              factor_position, factor_velocity, out=None):
+    """``factor_position * K + factor_velocity * D``: what an Exudyn jacobianUserFunction returns.
+
+    For ``ObjectGenericODE2`` the user Jacobian is the derivative of the left-hand side
+    (i.e. of ``-f``) w.r.t. q times ``fODE2`` plus w.r.t. q_t times ``fODE2_t``, which is
+    ``fODE2 * K + fODE2_t * D`` here.
+
+    Parameters
+    ----------
+    positions, velocities, joints, stiffness, damping
+        As in ``bending_force``.
+    factor_position : float
+        Weight of K (Exudyn's ``fODE2``).
+    factor_velocity : float [s]
+        Weight of D (Exudyn's ``fODE2_t``).
+    out : ndarray, shape (2 n_nodes, 2 n_nodes), optional
+        Overwritten and returned.
+
+    Returns
+    -------
+    jacobian : ndarray, shape (2 n_nodes, 2 n_nodes)
+    """
+    positions, velocities, joints, stiffness, damping = _validate(
+        positions, velocities, joints, stiffness, damping)
+    n = positions.shape[0]
+    out = _check_output("out", out, (n, n))
+    bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
+                            float(factor_position), float(factor_velocity),
+                            _EMPTY_VECTOR, out, _EMPTY_MATRIX)
+    return out
+
+
+def curvature_stiffness_matrix(n_nodes, joints, stiffness, element_length):
+    """Constant matrix of the linear curvature-vector spring ``(k / l^2) |p_a - 2 p_b + p_c|^2 / 2``.
+
+    For equal element lengths ``l`` and small angles ``|p_a - 2 p_b + p_c| ~ l dtheta``, so
+    the energy tends to ``k dtheta^2 / 2``; at large angles (wrapped joints) it differs.
+    The force is ``-K q``: zero for any straight, evenly spaced cable.
+
+    Parameters
+    ----------
+    n_nodes : int
+        Total number of nodes (all cables).
+    joints : array_like of int, shape (n_joints, 3)
+    stiffness : float or array_like, shape (n_joints,) [N m/rad]
+        Bending stiffness k of each joint.
+    element_length : float or array_like, shape (n_joints,) [m]
+        Reference element length l of each joint.
+
+    Returns
+    -------
+    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m], symmetric positive semi-definite
+    """
+    n_nodes = int(n_nodes)
+    if n_nodes < 0:
+        raise SceneError(f"n_nodes must be >= 0; got {n_nodes}")
+    joints = _as_joints(joints, n_nodes)
+    stiffness = _as_per_joint("stiffness", stiffness, joints.shape[0])
+    element_length = _as_per_joint("element_length", element_length, joints.shape[0])
+    if np.any(element_length <= 0.0):
+        raise SceneError(f"element_length must be > 0; got {element_length}")
+    coefficient = stiffness / element_length**2
+    matrix = np.zeros((2 * n_nodes, 2 * n_nodes))
+    weights = np.array([1.0, -2.0, 1.0])
+    outer = np.outer(weights, weights)  # B^T B per coordinate direction
+    for j in range(joints.shape[0]):
+        for r in range(3):
+            for s in range(3):
+                value = coefficient[j] * outer[r, s]
+                for axis in range(2):
+                    matrix[2 * joints[j, r] + axis, 2 * joints[j, s] + axis] += value
+    return matrix
+
+
+def curvature_damping_matrix(n_nodes, joints, damping, element_length):
+    """Constant damping matrix of the curvature-vector spring: ``curvature_stiffness_matrix`` with c.
+
+    Parameters
+    ----------
+    n_nodes : int
+    joints : array_like of int, shape (n_joints, 3)
+    damping : float or array_like, shape (n_joints,) [N m s/rad]
+    element_length : float or array_like, shape (n_joints,) [m]
+
+    Returns
+    -------
+    D : ndarray, shape (2 n_nodes, 2 n_nodes) [N s/m]; the damping force is ``-D v``.
+    """
+    return curvature_stiffness_matrix(n_nodes, joints, damping, element_length)
+
+
+class BendingSpringDamper:
+    """Exact-angle bending spring-dampers of a set of joints, validated once, for the hot path.
+
+    Joints, stiffness and damping are checked and stored when made; each call only checks
+    the coordinate arrays and runs the numba kernel into buffers owned by the object.
+
+    Parameters
+    ----------
+    n_nodes : int
+        Total number of nodes (all cables), so coordinates have shape (2 n_nodes,).
+    joints : array_like of int, shape (n_joints, 3)
+        Node triplets (a, b, c), e.g. from ``cable_joints``.
+    stiffness : float or array_like, shape (n_joints,) [N m/rad]
+    damping : float or array_like, shape (n_joints,) [N m s/rad]
+
+    Notes
+    -----
+    The returned arrays are the object's buffers, overwritten by the next call of the
+    same method: copy them if they must be kept (Exudyn copies what a user function returns).
+    """
+
+    def __init__(self, n_nodes, joints, stiffness, damping):
+        n_nodes = int(n_nodes)
+        if n_nodes < 1:
+            raise SceneError(f"n_nodes must be >= 1; got {n_nodes}")
+        self.n_nodes = n_nodes
+        self.n_coordinates = 2 * n_nodes
+        self.joints = _as_joints(joints, n_nodes)
+        self.stiffness = _as_per_joint("stiffness", stiffness, self.joints.shape[0])
+        self.damping = _as_per_joint("damping", damping, self.joints.shape[0])
+        n = self.n_coordinates
+        self._force = np.empty(n)
+        self._force_with_jacobian = np.empty(n)
+        self._stiffness_matrix = np.empty((n, n))
+        self._damping_matrix = np.empty((n, n))
+        self._weighted = np.empty((n, n))
+
+    def _coordinates(self, name, values):
+        if not (type(values) is np.ndarray and values.dtype == np.float64 and values.flags.c_contiguous):
+            values = np.ascontiguousarray(values, dtype=np.float64)
+        if values.shape != (self.n_coordinates,):
+            raise SceneError(f"{name} must have shape ({self.n_coordinates},); got {values.shape}")
+        return values
+
+    def force(self, positions, velocities):
+        """Generalized bending force (2 n_nodes,) [N]; see ``bending_force``."""
+        return bending_force_kernel(self._coordinates("positions", positions),
+                                    self._coordinates("velocities", velocities),
+                                    self.joints, self.stiffness, self.damping, self._force)
+
+    def jacobian(self, positions, velocities):
+        """``(K, D)``, each (2 n_nodes, 2 n_nodes): K = -df/dq [N/m], D = -df/dv [N s/m]."""
+        bending_jacobian_kernel(self._coordinates("positions", positions),
+                                self._coordinates("velocities", velocities),
+                                self.joints, self.stiffness, self.damping, 1.0, 0.0,
+                                _EMPTY_VECTOR, self._stiffness_matrix, self._damping_matrix)
+        return self._stiffness_matrix, self._damping_matrix
+
+    def force_and_jacobian(self, positions, velocities):
+        """``(f, K, D)`` in one pass; see ``bending_force_and_jacobian``."""
+        bending_jacobian_kernel(self._coordinates("positions", positions),
+                                self._coordinates("velocities", velocities),
+                                self.joints, self.stiffness, self.damping, 1.0, 0.0,
+                                self._force_with_jacobian, self._stiffness_matrix, self._damping_matrix)
+        return self._force_with_jacobian, self._stiffness_matrix, self._damping_matrix
+
+    def jacobian_weighted(self, positions, velocities, factor_position, factor_velocity):
+        """``factor_position * K + factor_velocity * D`` (2 n_nodes, 2 n_nodes): Exudyn's
+        ``jacobianUserFunction`` result with ``fODE2``, ``fODE2_t``."""
+        bending_jacobian_kernel(self._coordinates("positions", positions),
+                                self._coordinates("velocities", velocities),
+                                self.joints, self.stiffness, self.damping,
+                                float(factor_position), float(factor_velocity),
+                                _EMPTY_VECTOR, self._weighted, _EMPTY_MATRIX)
+        return self._weighted
+
+    def energy(self, positions):
+        """Elastic bending energy [J]; see ``bending_energy``."""
+        return bending_energy(positions, self.joints, self.stiffness)

@@ -1,0 +1,214 @@
+"""Pulley rim contact on cable nodes, with a smooth onset: numba kernels.
+
+A node at p within the disc of a pulley (centre c, radius r) is pushed out along the
+outward normal n = (p - c) / d, d = |p - c|, with the normal force
+
+    F = S(delta / b) * max(0, k_p delta + c_p delta_t),   delta = r - d,  delta_t = -n . v,
+
+where S(x) = x^2 (3 - 2 x) on [0, 1] (1 beyond) switches the contact on over a
+penetration band b (:data:`CONTACT_ONSET_DEPTH`). This is the law of the tension-only
+elements (:func:`cdpr_exu.physics.axial.tension_law`, with the penetration as the extension),
+and, for b -> 0, the law of Exudyn's ``ObjectContactSphereSphere`` (contact model "node"):
+spring and damper in compression, never pulling the node into the pulley.
+
+It was built to answer one question of the speed work (issue 14): does contact that
+Newton sees as a smooth force beat Exudyn's contact items, which switch contact on and
+off in *discontinuous iterations* after Newton has converged (1.5 per step on the paper
+circle at 60 elements and a 1e-2 s step)? Measured there
+(``benchmarks/bench_contact_models.py``, docs/accuracy.md): it does not. The contact is
+stiff (k_p = 1e7 N/m against 22 g nodes: omega h = 200 at that step), and a Newton
+iteration that starts outside the disc overshoots deep into it; with the contact status
+frozen, as Exudyn's items do it, Newton solves a fixed problem instead. So
+``Effects.pulley_contact_model = "node_smooth"`` is an option, not the default.
+
+The force is C1 in the coordinates, with an analytic Jacobian (2 x 2 per node, handed
+to Exudyn as sparse triplets).
+
+Coordinates are flat arrays ``x0, y0, x1, y1, ...`` [m, m/s] over a global node list,
+as in :mod:`cdpr_exu.physics.segment_contact`; each contact node carries its own pulley.
+This module does not import Exudyn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from cdpr_exu.physics.axial import tension_law
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.validation import per_item, points_per_item, whole_array
+
+__all__ = ["CONTACT_ONSET_DEPTH", "NodePulleyContact", "node_contact_force_kernel",
+           "node_contact_triplet_pattern", "node_contact_triplet_values"]
+
+#: Penetration [m] over which the contact force switches on (C1 smoothstep): a hundredth
+#: of the 1 mm accuracy the accuracy study aims at.
+CONTACT_ONSET_DEPTH = 1.0e-5
+
+#: Below this distance from the centre [m] the normal is undefined (a node at the centre).
+_MIN_DISTANCE = 1.0e-12
+
+
+@njit(cache=True)
+def _node_state(positions, velocities, node, cx, cy):
+    """(d, nx, ny, vx, vy): distance from the centre, outward normal, node velocity."""
+    rx = positions[2 * node] - cx
+    ry = positions[2 * node + 1] - cy
+    d = np.sqrt(rx * rx + ry * ry)
+    if d <= _MIN_DISTANCE:
+        return d, 0.0, 0.0, 0.0, 0.0
+    return d, rx / d, ry / d, velocities[2 * node], velocities[2 * node + 1]
+
+
+@njit(cache=True)
+def node_contact_force_kernel(positions, velocities, nodes, centers, radii, stiffness, damping, band, out):
+    """Add the rim-contact forces of ``nodes`` to ``out`` (2N,) [N] and return it (unchecked).
+
+    Parameters
+    ----------
+    positions, velocities : ndarray, shape (2N,) [m, m/s]
+    nodes : ndarray of int64, shape (C,)
+        Global indices of the contact nodes.
+    centers : ndarray, shape (C, 2) [m]
+    radii, stiffness, damping : ndarray, shape (C,) [m, N/m, N s/m]
+    band : float [m]
+        Onset band b.
+    out : ndarray, shape (2N,)
+        Accumulated into (not zeroed).
+    """
+    for k in range(nodes.shape[0]):
+        node = nodes[k]
+        d, nx, ny, vx, vy = _node_state(positions, velocities, node, centers[k, 0], centers[k, 1])
+        if d >= radii[k] or d <= _MIN_DISTANCE:
+            continue
+        force = tension_law(radii[k] - d, -(nx * vx + ny * vy), stiffness[k], damping[k], band)[0]
+        out[2 * node] += force * nx
+        out[2 * node + 1] += force * ny
+    return out
+
+
+@njit(cache=True)
+def _node_block(positions, velocities, node, cx, cy, radius, stiffness, damping, band,
+                factor_position, factor_velocity, block):
+    """``factor_position * K + factor_velocity * D`` of one node (2 x 2) into ``block``; False if no force.
+
+    With F_e = dF/d delta and F_r = dF/d delta_t, P = I - n n^T:
+    K = -df/dp = n (F_e n + F_r P v / d)^T - F P / d,   D = -df/dv = F_r n n^T.
+    """
+    d, nx, ny, vx, vy = _node_state(positions, velocities, node, cx, cy)
+    if d >= radius or d <= _MIN_DISTANCE:
+        return False
+    force, slope, viscous = tension_law(radius - d, -(nx * vx + ny * vy), stiffness, damping, band)
+    if force == 0.0 and slope == 0.0 and viscous == 0.0:
+        return False
+    n = (nx, ny)
+    projected = (vx - (nx * vx + ny * vy) * nx, vy - (nx * vx + ny * vy) * ny)  # P v
+    for i in range(2):
+        for j in range(2):
+            p_ij = (1.0 if i == j else 0.0) - n[i] * n[j]
+            stiff = n[i] * (slope * n[j] + viscous * projected[j] / d) - force * p_ij / d
+            block[i, j] = factor_position * stiff + factor_velocity * viscous * n[i] * n[j]
+    return True
+
+
+@njit(cache=True)
+def node_contact_triplet_pattern(nodes):
+    """Rows and columns of the contact nodes' sparse Jacobian triplets: 4 per node, shape (4 C,) each."""
+    rows = np.empty(4 * nodes.shape[0], dtype=np.int64)
+    columns = np.empty(4 * nodes.shape[0], dtype=np.int64)
+    for k in range(nodes.shape[0]):
+        for i in range(2):
+            for j in range(2):
+                rows[4 * k + 2 * i + j] = 2 * nodes[k] + i
+                columns[4 * k + 2 * i + j] = 2 * nodes[k] + j
+    return rows, columns
+
+
+@njit(cache=True)
+def node_contact_triplet_values(positions, velocities, nodes, centers, radii, stiffness, damping, band,
+                                factor_position, factor_velocity, out_values):
+    """Values of ``factor_position * K + factor_velocity * D`` at :func:`node_contact_triplet_pattern`'s
+    places (overwrites ``out_values``, shape (4 C,))."""
+    out_values[:] = 0.0
+    block = np.empty((2, 2))
+    for k in range(nodes.shape[0]):
+        if _node_block(positions, velocities, nodes[k], centers[k, 0], centers[k, 1], radii[k], stiffness[k],
+                       damping[k], band, factor_position, factor_velocity, block):
+            for i in range(2):
+                for j in range(2):
+                    out_values[4 * k + 2 * i + j] = block[i, j]
+    return out_values
+
+
+@njit(cache=True)
+def node_contact_jacobian_kernel(positions, velocities, nodes, centers, radii, stiffness, damping, band,
+                                 factor_position, factor_velocity, out):
+    """Add ``factor_position * K + factor_velocity * D`` (2N, 2N) of the contacts to the dense ``out`` (unchecked)."""
+    block = np.empty((2, 2))
+    for k in range(nodes.shape[0]):
+        node = nodes[k]
+        if _node_block(positions, velocities, node, centers[k, 0], centers[k, 1], radii[k], stiffness[k],
+                       damping[k], band, factor_position, factor_velocity, block):
+            for i in range(2):
+                for j in range(2):
+                    out[2 * node + i, 2 * node + j] += block[i, j]
+    return out
+
+
+class NodePulleyContact:
+    """Rim contacts of a set of nodes with their pulleys, validated once, for the hot path.
+
+    Parameters
+    ----------
+    n_nodes : int
+        Total number of nodes, so coordinates have shape (2 n_nodes,).
+    nodes : array_like of int, shape (C,)
+        Global indices of the contact nodes.
+    centers : array_like, shape (2,) or (C, 2) [m]
+        Pulley centre of each contact.
+    radii, stiffness, damping : float or array_like, shape (C,) [m, N/m, N s/m]
+        Pulley radius r_p, penalty stiffness k_p and normal damping c_p.
+    band : float [m]
+        Onset band b (default :data:`CONTACT_ONSET_DEPTH`; 0 gives the sharp law).
+    """
+
+    def __init__(self, n_nodes, nodes, centers, radii, stiffness, damping, band=CONTACT_ONSET_DEPTH):
+        self.n_coordinates = 2 * int(n_nodes)
+        self.nodes = np.ascontiguousarray(whole_array("nodes", nodes), dtype=np.int64).reshape(-1)
+        count = self.nodes.size
+        if count and (self.nodes.min() < 0 or self.nodes.max() >= int(n_nodes)):
+            raise SceneError(f"nodes must lie in 0..{int(n_nodes) - 1}; got {self.nodes.min()}..{self.nodes.max()}")
+        self.centers = points_per_item("centers", centers, count)
+        self.radii = per_item("radii", radii, count, positive=True)
+        self.stiffness = per_item("stiffness", stiffness, count)
+        self.damping = per_item("damping", damping, count)
+        band = float(band)
+        if not np.isfinite(band) or band < 0.0:
+            raise SceneError(f"band must be a finite length >= 0 [m]; got {band!r}")
+        self.band = band
+
+    def add_force(self, positions, velocities, out):
+        """Add the contact forces (2 n_nodes,) [N] to ``out`` and return it."""
+        return node_contact_force_kernel(positions, velocities, self.nodes, self.centers, self.radii,
+                                         self.stiffness, self.damping, self.band, out)
+
+    def add_jacobian(self, positions, velocities, factor_position, factor_velocity, out):
+        """Add ``factor_position * K + factor_velocity * D`` (2 n_nodes, 2 n_nodes) to ``out``."""
+        return node_contact_jacobian_kernel(positions, velocities, self.nodes, self.centers, self.radii,
+                                            self.stiffness, self.damping, self.band, float(factor_position),
+                                            float(factor_velocity), out)
+
+    def triplet_pattern(self):
+        """Rows and columns of the sparse Jacobian, shape (4 C,) each."""
+        return node_contact_triplet_pattern(self.nodes)
+
+    def triplet_values(self, positions, velocities, factor_position, factor_velocity, out_values):
+        """Values at :meth:`triplet_pattern`'s places (overwrites ``out_values``)."""
+        return node_contact_triplet_values(positions, velocities, self.nodes, self.centers, self.radii,
+                                           self.stiffness, self.damping, self.band, float(factor_position),
+                                           float(factor_velocity), out_values)
+
+    def force(self, positions, velocities):
+        """Contact forces alone, (2 n_nodes,) [N] (a new array)."""
+        return self.add_force(np.ascontiguousarray(positions, dtype=np.float64),
+                              np.ascontiguousarray(velocities, dtype=np.float64), np.zeros(self.n_coordinates))

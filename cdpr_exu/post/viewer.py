@@ -1,0 +1,825 @@
+"""Replay a finished run: Exudyn's SolutionViewer, or a headless GIF/MP4 animation.
+
+A run folder written by ``cdpr run SCENE --out DIR`` holds ``scene.toml`` and
+``solution.sol`` (Exudyn's binary solution file). The scene rebuilds the identical
+Exudyn system (:func:`cdpr_exu.builder.model.build_model`); each row of the solution file
+is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
+
+- :func:`view_solution` (``cdpr view DIR``) replays the run in Exudyn's interactive
+  ``SolutionViewer``: it needs a display. Without one it raises
+  :class:`NoDisplayError` before touching Exudyn's windows (Exudyn would end the
+  whole process there).
+- :func:`render_animation` (``cdpr animate DIR``) draws each chosen row with Exudyn's
+  software raytracer (no window, no OpenGL) and writes a GIF (Pillow) or an MP4
+  (the optional package ``imageio-ffmpeg``), and optionally the PNG frames.
+
+Both add drawing-only items before replaying (:func:`decorate_model`): the pulleys
+as discs, the platform as its rectangle (``platform.size``) and the reference path
+of the platform as a polyline. They are ground graphics and body graphics only, so
+the coordinates of the system, and thus the columns of the solution file, are
+unchanged (checked on every load). Exudyn's x-y plane is the paper's x-z plane.
+
+Examples::
+
+    cdpr view results/paper_circle
+    cdpr animate results/paper_circle --out results/paper_circle/animation.gif
+    cdpr animate results/paper_circle --out circle.mp4 --fps 30 --size 960x720
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time as _time
+from dataclasses import dataclass
+from pathlib import Path
+
+import exudyn as exu
+import exudyn.graphics as graphics
+import numpy as np
+
+from cdpr_exu.core.errors import EXIT_CODES, CdprError
+from cdpr_exu.builder.model import Model, build_model
+from cdpr_exu.scenes.scene import Scene, load_scene
+
+#: File names inside a run folder (written by ``cdpr run --out``).
+SCENE_FILE = "scene.toml"
+SOLUTION_FILE = "solution.sol"
+
+#: Default image size of ``cdpr animate`` [pixels] (width, height).
+DEFAULT_SIZE = (640, 480)
+#: Default frame rate of ``cdpr animate`` [frames per second].
+DEFAULT_FPS = 25.0
+#: Share of the scene's extent left free around it in an animation frame.
+FRAME_MARGIN = 0.06
+#: Height of the caption band at the top of an animation frame, as a share of its height.
+CAPTION_BAND = 0.07
+
+# Colours, RGBA in [0, 1].
+PULLEY_COLOR = [0.72, 0.72, 0.75, 1.0]
+PULLEY_RIM_COLOR = [0.35, 0.35, 0.38, 1.0]
+REFERENCE_COLOR = [0.85, 0.12, 0.12, 1.0]
+PLATFORM_COLOR = [0.55, 0.70, 0.95, 1.0]
+CABLE_COLOR = [0.10, 0.10, 0.25, 1.0]
+NODE_COLOR = [0.10, 0.15, 0.55, 1.0]
+#: Colour of the platform's travelled path in animation frames (RGB, 0-255).
+TRAIL_RGB = (40, 110, 210)
+
+#: Exudyn items that only clutter a replay (constraint symbols, contact helpers).
+_HIDDEN_OBJECT_TYPES = ("ConnectorCoordinate", "JointRevolute2D", "ContactSphereSphere", "GenericODE2")
+_HIDDEN_NODE_TYPES = ("PointGround", "RigidBody2D")
+
+
+class RunFolderError(CdprError, FileNotFoundError):
+    """A run folder or one of its files is missing or unreadable; the message names it."""
+
+
+class SolutionMismatchError(CdprError, ValueError):
+    """The solution file does not fit the model rebuilt from the folder's scene."""
+
+
+class NoDisplayError(CdprError, RuntimeError):
+    """No window can be opened here (no display, or Exudyn's windows are switched off)."""
+
+
+# --------------------------------------------------------------------------- loading
+
+
+@dataclass
+class Replay:
+    """A run folder loaded for replay: its scene, the rebuilt model and the solution.
+
+    Attributes
+    ----------
+    run_dir : Path
+    scene : Scene
+    model : Model
+        Rebuilt from ``scene.toml`` and decorated (:func:`decorate_model`).
+    solution : dict
+        As returned by :func:`exudyn.utilities.LoadSolutionFile`; ``solution["data"]``
+        has shape (n_rows, n_columns + 1), time first.
+    """
+
+    run_dir: Path
+    scene: Scene
+    model: Model
+    solution: dict
+
+    @property
+    def n_rows(self) -> int:
+        """Number of stored time instants."""
+        return int(self.solution["nRows"])
+
+    @property
+    def times(self) -> np.ndarray:
+        """Time of each row, shape (n_rows,) [s]."""
+        return np.asarray(self.solution["data"][:, 0], dtype=float)
+
+    def positions(self) -> dict[str, np.ndarray]:
+        """Positions of the platform and of every cable node in each row.
+
+        Returns
+        -------
+        dict
+            ``"platform"``: shape (n_rows, 3) (x, z, rotation) [m, m, rad];
+            ``"cable_i"``: shape (n_rows, n_i + 1, 2) [m], winch end first.
+        """
+        mbs = self.model.mbs
+        reference = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
+        n_ode2 = int(self.solution["columnsExported"][0])
+        q = reference + self.solution["data"][:, 1:1 + n_ode2]
+        return {name: q[:, index] for name, index in self.model.coordinate_indices().items()}
+
+
+def _require_file(path: Path, what: str) -> Path:
+    if not path.is_file():
+        raise RunFolderError(f"{what} {str(path)!r} not found; a run folder is written by "
+                             f"`cdpr run SCENE --out DIR` and holds {SCENE_FILE} and {SOLUTION_FILE}")
+    return path
+
+
+def run_files(run_dir: str | Path) -> tuple[Path, Path]:
+    """Paths of the scene and solution files of a run folder, checked to exist.
+
+    Raises
+    ------
+    RunFolderError
+        If the folder or one of the two files is missing.
+    """
+    run_dir = Path(run_dir)
+    if not run_dir.is_dir():
+        raise RunFolderError(f"run folder {str(run_dir)!r} does not exist; write one with "
+                             f"`cdpr run SCENE --out {run_dir}`")
+    return (_require_file(run_dir / SCENE_FILE, "scene file"),
+            _require_file(run_dir / SOLUTION_FILE, "solution file"))
+
+
+def load_solution(path: str | Path) -> dict:
+    """Read an Exudyn solution file (text or binary) into Exudyn's solution dictionary.
+
+    Raises
+    ------
+    RunFolderError
+        If the file is missing, unreadable or holds no row.
+    """
+    from exudyn.utilities import LoadSolutionFile
+
+    path = Path(path)
+    _require_file(path, "solution file")
+    try:
+        solution = LoadSolutionFile(str(path), verbose=False)
+    except Exception as err:  # Exudyn raises plain exceptions of several kinds here
+        raise RunFolderError(f"solution file {str(path)!r} cannot be read: {err}") from None
+    if int(solution["nRows"]) == 0:
+        raise RunFolderError(f"solution file {str(path)!r} holds no time step (did the run fail at once?)")
+    return solution
+
+
+def check_solution_fits(model: Model, solution: dict, source: str = "the solution") -> None:
+    """Refuse a solution whose coordinate layout differs from the model's.
+
+    Compares the exported sizes (positions, velocities, accelerations, ODE1,
+    algebraic and data coordinates) with the model's system sizes.
+
+    Raises
+    ------
+    SolutionMismatchError
+    """
+    data = model.mbs.systemData
+    n_ode2, n_vel2, n_acc2, n_ode1, n_vel1, n_algebraic, n_data = (int(n) for n in solution["columnsExported"])
+    expected = {"ODE2 coordinates": (n_ode2, data.ODE2Size()), "ODE1 coordinates": (n_ode1, data.ODE1Size()),
+                "algebraic coordinates": (n_algebraic, data.AEsize()), "data coordinates": (n_data, data.DataSize())}
+    for name, count in (("velocities", n_vel2), ("accelerations", n_acc2)):
+        if count not in (0, data.ODE2Size()):
+            expected[f"ODE2 {name}"] = (count, data.ODE2Size())
+    if n_vel1 not in (0, data.ODE1Size()):
+        expected["ODE1 velocities"] = (n_vel1, data.ODE1Size())
+    wrong = [f"{name}: file {found}, model {want}" for name, (found, want) in expected.items() if found != want]
+    if wrong:
+        raise SolutionMismatchError(
+            f"{source} does not fit the model rebuilt from the scene ({'; '.join(wrong)}); was scene.toml "
+            "edited, or the package changed, after the run? Run the scene again with `cdpr run`")
+
+
+def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
+    """Load a run folder: scene, rebuilt (and decorated) model, solution file.
+
+    Parameters
+    ----------
+    run_dir : path
+        Folder written by ``cdpr run SCENE --out DIR``.
+    decorate : bool
+        Add pulleys, platform rectangle and reference path (:func:`decorate_model`).
+
+    Raises
+    ------
+    RunFolderError, SolutionMismatchError, SceneError
+    """
+    scene_file, solution_file = run_files(run_dir)
+    scene = load_scene(scene_file)
+    solution = load_solution(solution_file)
+    model = build_model(scene)
+    check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
+    if decorate:
+        times = np.asarray(solution["data"][:, 0], dtype=float)
+        decorate_model(model, reference_path(scene, times))
+        check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
+    return Replay(Path(run_dir), scene, model, solution)
+
+
+# --------------------------------------------------------------------------- drawing
+
+
+def reference_path(scene: Scene, times: np.ndarray) -> np.ndarray:
+    """Reference position of the platform at the given times, shape (N, 2) [m].
+
+    Empty, shape (0, 2), when the scene has no trajectory.
+    """
+    if scene.trajectory is None or len(times) == 0:
+        return np.zeros((0, 2))
+    return np.atleast_2d(scene.trajectory.pose(np.asarray(times, dtype=float)))[:, :2]
+
+
+def thin_polyline(points: np.ndarray, min_segment: float) -> np.ndarray:
+    """Drop points of a polyline closer than ``min_segment`` to the last kept one.
+
+    Exudyn's raytracer leaves out segments shorter than about a pixel, so a finely
+    sampled path must be thinned to be drawn at all. The last point is always kept.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 2) [m]
+    min_segment : float [m]
+
+    Returns
+    -------
+    ndarray, shape (K, 2) [m], K <= N
+    """
+    points = np.asarray(points, dtype=float)
+    points = points[np.all(np.isfinite(points), axis=1)]
+    if len(points) < 2:
+        return points
+    kept = [points[0]]
+    for point in points[1:]:
+        if np.linalg.norm(point - kept[-1]) >= min_segment:
+            kept.append(point)
+    if np.linalg.norm(points[-1] - kept[-1]) > 0.0:
+        if len(kept) > 1 and np.linalg.norm(points[-1] - kept[-1]) < min_segment:
+            kept[-1] = points[-1]
+        else:
+            kept.append(points[-1])
+    return np.array(kept)
+
+
+def scene_extent(scene: Scene) -> float:
+    """Size of the robot: the larger side of the box around pulleys and start pose [m]."""
+    centers = np.array([p.center for p in scene.pulleys] + [scene.platform.initial_pose[:2]], dtype=float)
+    radius = max(p.radius for p in scene.pulleys)
+    return float(np.max(np.ptp(centers, axis=0)) + 2.0 * radius) or 1.0
+
+
+def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
+    """Add drawing-only items to an assembled model and assemble it again.
+
+    Adds a ground object with the pulleys (discs with rim and axle) and the
+    reference path (a polyline, or a small circle for a fixed reference), gives the
+    platform body its rectangle and anchor points, draws cables as plain lines and
+    hides the constraint and contact symbols. No node and no coordinate is added.
+
+    Parameters
+    ----------
+    model : Model
+    reference_xz : ndarray, shape (N, 2) [m], optional
+        Reference path of the platform.
+
+    Returns
+    -------
+    int
+        Index of the added ground object.
+    """
+    scene, mbs = model.scene, model.mbs
+    extent = scene_extent(scene)
+    items = []
+    for pulley in scene.pulleys:
+        x, z = pulley.center
+        if pulley.radius > 0.0:
+            items.append(graphics.Cylinder(pAxis=[x, z, -0.02], vAxis=[0.0, 0.0, 0.01], radius=pulley.radius,
+                                           color=PULLEY_COLOR, nTiles=64))
+            items.append(graphics.Circle([x, z, 0.0], pulley.radius, color=PULLEY_RIM_COLOR))
+        items.append(graphics.Circle([x, z, 0.0], 0.008 * extent, color=PULLEY_RIM_COLOR))
+    if reference_xz is not None and len(reference_xz):
+        path = thin_polyline(reference_xz, extent / 300.0)
+        if len(path) >= 2:
+            items.append(graphics.Lines([[x, z, -0.005] for x, z in path], color=REFERENCE_COLOR))
+        elif len(path) == 1:  # a fixed reference: mark the point
+            items.append(graphics.Circle([path[0, 0], path[0, 1], 0.0], 0.015 * extent, color=REFERENCE_COLOR))
+    ground = mbs.CreateGround(graphicsDataList=items)
+
+    width, height = scene.platform.size
+    body = []
+    if width > 0.0 and height > 0.0:
+        body.append(graphics.Brick(size=[width, height, 0.004], color=PLATFORM_COLOR, addEdges=True))
+    else:
+        body.append(graphics.Circle([0.0, 0.0, 0.0], 0.02 * extent, color=CABLE_COLOR))
+    for bx, bz in scene.platform.anchors:
+        body.append(graphics.Circle([bx, bz, 0.003], 0.004 * extent, color=CABLE_COLOR))
+    mbs.SetObjectParameter(model.platform.body, "VgraphicsData", body)
+
+    for index in range(mbs.systemData.NumberOfObjects()):
+        kind = mbs.GetObject(index)["objectType"]
+        if kind in _HIDDEN_OBJECT_TYPES:
+            mbs.SetObjectParameter(index, "Vshow", False)
+        elif kind == "ConnectorSpringDamper":  # a cable element: a straight line, not a coil
+            mbs.SetObjectParameter(index, "VdrawSize", 1e-6)
+            mbs.SetObjectParameter(index, "Vcolor", CABLE_COLOR)
+    for index in range(mbs.systemData.NumberOfNodes()):
+        if mbs.GetNode(index)["nodeType"] in _HIDDEN_NODE_TYPES:
+            mbs.SetNodeParameter(index, "Vshow", False)
+    mbs.Assemble()
+    return ground
+
+
+def _style(model: Model) -> None:
+    """Visualization settings shared by the viewer and the animation."""
+    settings = model.system_container.visualizationSettings
+    extent = scene_extent(model.scene)
+    settings.loads.show = False
+    settings.markers.show = False
+    settings.connectors.springNumberOfWindings = 1
+    settings.nodes.drawNodesAsPoint = False
+    settings.nodes.defaultSize = 0.006 * extent
+    settings.nodes.defaultColor = NODE_COLOR
+    settings.nodes.tiling = 8
+    settings.view0.scene.drawCoordinateSystem = 0
+    settings.general.autoFitScene = False
+
+
+# --------------------------------------------------------------------------- camera
+
+
+@dataclass(frozen=True)
+class Camera:
+    """An orthographic view of the x-z plane (Exudyn x-y), as the raytracer draws it.
+
+    Attributes
+    ----------
+    center : (x, z) [m]
+        World point at the image centre.
+    zoom : float [m]
+        Half the visible height (Exudyn's render-state ``zoom``).
+    size : (width, height) [pixels]
+    """
+
+    center: tuple[float, float]
+    zoom: float
+    size: tuple[int, int]
+
+    @property
+    def scale(self) -> float:
+        """Pixels per metre."""
+        return self.size[1] / (2.0 * self.zoom)
+
+    def to_pixels(self, points: np.ndarray) -> np.ndarray:
+        """Image coordinates (column, row) of world points, shape (..., 2) [pixels]."""
+        points = np.asarray(points, dtype=float)
+        column = self.size[0] / 2.0 + (points[..., 0] - self.center[0]) * self.scale
+        row = self.size[1] / 2.0 - (points[..., 1] - self.center[1]) * self.scale
+        return np.stack([column, row], axis=-1)
+
+    def apply(self, model: Model) -> None:
+        """Make this the initial view of the model's renderer."""
+        settings = model.system_container.visualizationSettings
+        settings.view0.window.renderWindowSize = [int(self.size[0]), int(self.size[1])]
+        advanced = settings.openGL.advanced
+        advanced.initialCenterPoint = [float(self.center[0]), float(self.center[1]), 0.0]
+        advanced.initialZoom = float(self.zoom)
+        advanced.initialMaxSceneSize = float(4.0 * self.zoom)
+        advanced.initialModelRotation = np.eye(3).tolist()
+
+
+def fit_camera(points: np.ndarray, size: tuple[int, int], margin: float = FRAME_MARGIN,
+               caption_band: float = CAPTION_BAND) -> Camera:
+    """The view that shows all ``points`` below a caption band, with a margin.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 2) [m]
+        Non-finite points are ignored.
+    size : (width, height) [pixels]
+    margin : float
+        Free share of the points' extent on each side.
+    caption_band : float
+        Share of the image height kept free at the top for the caption.
+    """
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    points = points[np.all(np.isfinite(points), axis=1)]
+    if len(points) == 0:
+        points = np.zeros((1, 2))
+    low, high = points.min(axis=0), points.max(axis=0)
+    span = np.maximum(high - low, 1e-3)
+    pad = margin * max(span)
+    low, high = low - pad, high + pad
+    width, height = size
+    band = caption_band * height
+    scale = min(width / (high[0] - low[0]), (height - band) / (high[1] - low[1]))
+    middle = (low + high) / 2.0
+    center = (float(middle[0]), float(middle[1] + band / (2.0 * scale)))
+    return Camera(center, float(height / (2.0 * scale)), (int(width), int(height)))
+
+
+def _view_points(replay: Replay) -> np.ndarray:
+    """Every point an animation must show: pulleys, nodes, platform, reference."""
+    scene = replay.scene
+    positions = replay.positions()
+    parts = [np.array([[p.center[0] + dx * p.radius, p.center[1] + dz * p.radius]
+                       for p in scene.pulleys for dx, dz in ((-1, -1), (1, 1))])]
+    parts += [value.reshape(-1, 2) for name, value in positions.items() if name != "platform"]
+    platform = positions["platform"][:, :2]
+    half_diagonal = 0.5 * float(np.hypot(*scene.platform.size))
+    parts += [platform + [dx * half_diagonal, dz * half_diagonal] for dx, dz in ((-1, -1), (1, 1))]
+    parts.append(reference_path(scene, replay.times))
+    return np.concatenate(parts)
+
+
+# --------------------------------------------------------------------------- viewer
+
+
+def display_problem() -> str | None:
+    """Why no window can be opened here, or None if one can.
+
+    Checks, in this order: Exudyn's own switch (``EXUDYN_SUPPRESS_UI_WINDOW_OPEN``);
+    on Linux and other X11/Wayland systems, that ``DISPLAY`` or ``WAYLAND_DISPLAY``
+    is set; that tkinter (the viewer's dialog) is installed; and on X11 that the
+    display accepts a connection.
+    """
+    if getattr(exu.special.userInterface, "suppressSolutionViewer", False):
+        return ("Exudyn's windows are switched off in this process (the environment variable "
+                "EXUDYN_SUPPRESS_UI_WINDOW_OPEN is set, or exudyn.special.userInterface.suppressSolutionViewer)")
+    uses_x11 = sys.platform not in ("win32", "cygwin", "darwin")
+    if uses_x11 and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        return "there is no display (neither DISPLAY nor WAYLAND_DISPLAY is set)"
+    try:
+        import tkinter
+    except ImportError:
+        return "tkinter is not installed (Exudyn's SolutionViewer dialog needs it)"
+    if uses_x11 and os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        try:  # a stale DISPLAY (e.g. a closed ssh -X session) would end the process inside Exudyn
+            root = tkinter.Tk()
+            root.destroy()
+        except tkinter.TclError as err:
+            return f"the display {os.environ['DISPLAY']!r} cannot be opened ({err})"
+    return None
+
+
+def _rows_per_frame(times: np.ndarray, fps: float) -> int:
+    """Row step that plays the stored rows in real time at ``fps`` frames per second."""
+    if len(times) < 2:
+        return 1
+    period = float(np.median(np.diff(times)))
+    return max(1, int(round(1.0 / (fps * period)))) if period > 0 else 1
+
+
+def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
+    """Replay a run folder in Exudyn's interactive SolutionViewer (needs a display).
+
+    Parameters
+    ----------
+    run_dir : path
+        Folder written by ``cdpr run SCENE --out DIR``.
+    every : int, optional
+        Show every ``every``-th stored row; default: about real time at 25 frames/s.
+
+    Raises
+    ------
+    RunFolderError, SolutionMismatchError
+        Missing or unfitting files.
+    NoDisplayError
+        When no window can be opened here (checked before any window is tried, since
+        Exudyn ends the whole process when it fails to open one). Exudyn's windows
+        are then switched off for the rest of the process as a second guard.
+    """
+    run_files(run_dir)
+    problem = display_problem()
+    if problem is not None:
+        exu.special.userInterface.SuppressAll(True)
+        raise NoDisplayError(
+            f"cannot open Exudyn's SolutionViewer: {problem}. Render the run to a file instead with "
+            f"`cdpr animate {run_dir}` (GIF or MP4, no display needed), or run `cdpr view {run_dir}` "
+            "on a machine with a display")
+    from exudyn.interactive import SolutionViewer
+
+    replay = load_replay(run_dir)
+    _style(replay.model)
+    camera = fit_camera(_view_points(replay), (1024, 768), caption_band=0.12)
+    camera.apply(replay.model)
+    if every is None:
+        every = _rows_per_frame(replay.times, DEFAULT_FPS)
+    SolutionViewer(replay.model.mbs, replay.solution, rowIncrement=min(int(every), replay.n_rows),
+                   timeout=1.0 / DEFAULT_FPS, runOnStart=True, runMode=0,
+                   title=f"cdpr view: {replay.scene.name} ({replay.run_dir})")
+
+
+# --------------------------------------------------------------------------- animation
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """Parse an image size ``"WIDTHxHEIGHT"`` [pixels], each 32 to 8192.
+
+    Raises
+    ------
+    ValueError
+        With the bad text in the message.
+    """
+    try:
+        width, height = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise ValueError(f"size must look like 640x480, got {text!r}") from None
+    if not (32 <= width <= 8192 and 32 <= height <= 8192):
+        raise ValueError(f"size must be between 32x32 and 8192x8192 pixels, got {text!r}")
+    return width, height
+
+
+class _Caption:
+    """Draws the caption, the legend and the platform's travelled path onto a frame."""
+
+    def __init__(self, title: str, camera: Camera, trail: np.ndarray, has_reference: bool):
+        from PIL import ImageFont
+
+        self.title, self.camera, self.has_reference = title, camera, has_reference
+        self.trail = camera.to_pixels(trail)
+        height = camera.size[1]
+        try:
+            self.font = ImageFont.load_default(size=max(10, round(0.035 * height)))
+        except TypeError:  # Pillow without FreeType: the fixed bitmap font
+            self.font = ImageFont.load_default()
+        self.line = max(1, round(height / 480))
+        self.text_height = self.font.getbbox("Ag")[3]
+
+    def draw(self, image, row: int, time: float):
+        """Draw onto ``image`` (a PIL image) for stored row ``row`` at ``time`` [s]."""
+        from PIL import ImageDraw
+
+        draw = ImageDraw.Draw(image)
+        width, height = self.camera.size
+        pad = round(0.015 * height)
+        trail = self.trail[:row + 1]
+        trail = trail[np.all(np.isfinite(trail), axis=1)]
+        if len(trail) > 1:
+            draw.line([tuple(p) for p in trail], fill=TRAIL_RGB, width=self.line)
+        draw.text((pad, pad), f"{self.title}    t = {time:6.2f} s", fill=(0, 0, 0), font=self.font)
+        legend = [(TRAIL_RGB, "platform path")]
+        if self.has_reference:
+            legend.insert(0, (tuple(round(255 * c) for c in REFERENCE_COLOR[:3]), "reference"))
+        x, y = pad, height - pad - self.text_height
+        middle = y + self.text_height // 2 + 1
+        for color, label in legend:
+            length = round(0.04 * width)
+            draw.line([(x, middle), (x + length, middle)], fill=color, width=2 * self.line)
+            x += length + pad // 2
+            draw.text((x, y), label, fill=(60, 60, 60), font=self.font)
+            x += round(draw.textlength(label, font=self.font)) + 2 * pad
+        return image
+
+
+class _Writer:
+    """Collects frames into a GIF (Pillow) or streams them into an MP4 (imageio-ffmpeg)."""
+
+    @staticmethod
+    def check(path: Path, size: tuple[int, int]) -> None:
+        """Refuse an animation file this writer cannot make, before any rendering."""
+        suffix = path.suffix.lower()
+        if suffix not in (".gif", ".mp4"):
+            raise CdprError(f"animation file {str(path)!r} must end in .gif or .mp4")
+        if suffix == ".mp4":
+            try:
+                import imageio_ffmpeg  # noqa: F401
+            except ImportError:
+                raise CdprError(f"writing {str(path)!r} needs the optional package imageio-ffmpeg "
+                                "(pip install 'cdpr-exu[video]', or pip install imageio-ffmpeg); "
+                                "or write a GIF: --out animation.gif") from None
+            if size[0] % 2 or size[1] % 2:
+                raise CdprError(f"an MP4 needs an even width and height, got --size {size[0]}x{size[1]}")
+        if path.parent.exists() and not path.parent.is_dir():
+            raise CdprError(f"--out {str(path)!r}: {str(path.parent)!r} is a file, not a folder")
+        if not path.parent.is_dir():
+            raise CdprError(f"the folder of the animation file {str(path)!r} does not exist")
+
+    def __init__(self, path: Path, fps: float, size: tuple[int, int]):
+        self.check(path, size)
+        self.path, self.fps, self.frames, self.mp4 = path, fps, [], None
+        if path.suffix.lower() == ".mp4":
+            import imageio_ffmpeg
+
+            self.mp4 = imageio_ffmpeg.write_frames(str(path), size, fps=fps, codec="libx264",
+                                                   pix_fmt_out="yuv420p", quality=7, macro_block_size=1,
+                                                   ffmpeg_log_level="error")
+            self.mp4.send(None)
+
+    def add(self, image) -> None:
+        """Append a frame (a PIL RGB image of the writer's size)."""
+        if self.mp4 is not None:
+            self.mp4.send(np.ascontiguousarray(np.asarray(image)))
+        else:  # palette images: a third of the memory of RGB frames
+            self.frames.append(image.quantize(colors=96))
+
+    def close(self) -> None:
+        """Finish the file."""
+        if self.mp4 is not None:
+            self.mp4.close()
+        elif self.frames:
+            self.frames[0].save(self.path, save_all=True, append_images=self.frames[1:],
+                                duration=round(1000.0 / self.fps), loop=0)
+
+    def abort(self) -> None:
+        """Stop without leaving a partial file."""
+        if self.mp4 is not None:
+            self.mp4.close()
+            self.path.unlink(missing_ok=True)
+        self.frames = []
+
+
+def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
+                     every: int | None = None, size: tuple[int, int] = DEFAULT_SIZE,
+                     frames_dir: str | Path | None = None, progress: bool = False,
+                     multi_sampling: int = 2) -> Path:
+    """Render a run folder to a GIF or MP4 with Exudyn's raytracer (no display needed).
+
+    Each chosen row of the solution file is loaded into the rebuilt model and drawn;
+    a caption gives scene name and time, and the platform's travelled path is drawn
+    over the frame next to the reference path.
+
+    Parameters
+    ----------
+    run_dir : path
+        Folder written by ``cdpr run SCENE --out DIR``.
+    out_file : path, optional
+        ``.gif`` or ``.mp4`` (MP4 needs the package imageio-ffmpeg); default
+        ``run_dir/animation.gif``.
+    fps : float [1/s]
+        Frame rate of the animation (GIF stores it in steps of 10 ms).
+    every : int, optional
+        Use every ``every``-th stored row; default: the step that plays the run in
+        real time at ``fps``.
+    size : (width, height) [pixels]
+    frames_dir : path, optional
+        Also write each frame there as ``frame_00000.png``, ...
+    progress : bool
+        Show a progress bar (only on a terminal).
+    multi_sampling : int
+        Raytracer samples per pixel (1, 2 or 4); 1 leaves thin lines broken.
+
+    Returns
+    -------
+    Path
+        The animation file.
+
+    Raises
+    ------
+    RunFolderError, SolutionMismatchError
+        Missing or unfitting files.
+    CdprError
+        Unknown file type, bad arguments, or MP4 without imageio-ffmpeg.
+    """
+    path, _, _ = _render_animation(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir,
+                                   progress=progress, multi_sampling=multi_sampling)
+    return path
+
+
+def _render_animation(run_dir, out_file, *, fps, every, size, frames_dir, progress,
+                      multi_sampling) -> tuple[Path, int, float]:
+    """:func:`render_animation`, also returning the frame count and seconds per frame."""
+    from PIL import Image
+    from tqdm import tqdm
+
+    if not (np.isfinite(fps) and fps > 0):
+        raise CdprError(f"fps must be a positive number, got {fps!r}")
+    if every is not None and (isinstance(every, bool) or int(every) < 1):
+        raise CdprError(f"every must be a whole number >= 1, got {every!r}")
+    size = (int(size[0]), int(size[1]))
+    out_file = Path(out_file) if out_file is not None else Path(run_dir) / "animation.gif"
+    run_files(run_dir)
+    _Writer.check(out_file, size)  # before the slow part
+    replay = load_replay(run_dir)
+    model, mbs = replay.model, replay.model.mbs
+    _style(model)
+    settings = model.system_container.visualizationSettings
+    settings.raytracer.multiSampling = int(multi_sampling)
+    settings.raytracer.numberOfThreads = max(1, os.cpu_count() or 1)
+    settings.raytracer.advanced.showText = False  # the caption replaces Exudyn's text
+    camera = fit_camera(_view_points(replay), size)
+    camera.apply(model)
+
+    times = replay.times
+    step = int(every) if every is not None else _rows_per_frame(times, fps)
+    rows = range(0, replay.n_rows, step)
+    trail = replay.positions()["platform"][:, :2]
+    caption = _Caption(replay.scene.name, camera, trail, replay.scene.trajectory is not None)
+    if frames_dir is not None:
+        frames_dir = Path(frames_dir)
+        frames_dir.mkdir(parents=True, exist_ok=True)
+    from exudyn.utilities import SetSolutionState
+
+    start = _time.perf_counter()
+    writer = _Writer(out_file, fps, size)
+    try:
+        for frame, row in enumerate(tqdm(rows, unit="frame", desc=f"{replay.scene.name} ",
+                                         disable=None if progress else True)):
+            SetSolutionState(mbs, replay.solution, row, exu.ConfigurationType.Current)
+            SetSolutionState(mbs, replay.solution, row, exu.ConfigurationType.Visualization)
+            pixels = model.system_container.renderer.RedrawAndGetImage(useRaytracer=True)
+            image = Image.fromarray(np.asarray(pixels, dtype=np.uint8)[:, :, :3])
+            image = caption.draw(image, row, float(times[row]))
+            if frames_dir is not None:
+                image.save(frames_dir / f"frame_{frame:05d}.png")
+            writer.add(image)
+    except BaseException:
+        writer.abort()
+        raise
+    writer.close()
+    return out_file, len(rows), (_time.perf_counter() - start) / max(1, len(rows))
+
+
+# --------------------------------------------------------------------------- CLI
+
+EPILOG_VIEW = """examples:
+  cdpr run paper-circle --out results/paper_circle
+  cdpr view results/paper_circle
+  cdpr view results/paper_circle --every 10
+Needs a display; without one, use `cdpr animate`.
+"""
+
+EPILOG_ANIMATE = """examples:
+  cdpr animate results/paper_circle                    # results/paper_circle/animation.gif
+  cdpr animate results/paper_circle --out circle.mp4   # needs: pip install imageio-ffmpeg
+  cdpr animate results/paper_circle --fps 20 --every 10 --size 480x360 --frames-dir frames/
+"""
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
+    return value
+
+
+def _size_argument(text: str) -> tuple[int, int]:
+    try:
+        return parse_size(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    try:
+        view_solution(args.run_dir, every=args.every)
+    except NoDisplayError as err:
+        print(f"cdpr view: {err}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _cmd_animate(args: argparse.Namespace) -> int:
+    from cdpr_exu.post.spatial_animation import is_spatial_run, render_spatial_animation
+
+    if is_spatial_run(args.run_dir):  # matplotlib's 3-D axes, not Exudyn's renderer
+        out, frames = render_spatial_animation(args.run_dir, args.out, fps=args.fps, every=args.every, size=args.size)
+        if not args.quiet:
+            print(f"wrote {out}: {frames} frames of {args.size[0]}x{args.size[1]} at {args.fps:g} frames/s")
+        return 0
+    out, frames, seconds = _render_animation(args.run_dir, args.out, fps=args.fps, every=args.every,
+                                             size=args.size, frames_dir=args.frames_dir,
+                                             progress=not args.quiet, multi_sampling=2)
+    if not args.quiet:
+        print(f"wrote {out}: {frames} frames of {args.size[0]}x{args.size[1]} at {args.fps:g} frames/s "
+              f"({seconds:.3f} s per frame)")
+    return 0
+
+
+def add_commands(subparsers) -> None:
+    """Add ``view`` and ``animate`` to the ``cdpr`` command."""
+    view = subparsers.add_parser(
+        "view", help="replay a run in Exudyn's interactive SolutionViewer (needs a display)",
+        description="Replay a run folder (written by `cdpr run SCENE --out DIR`) in Exudyn's interactive "
+        "SolutionViewer, with pulleys, platform and reference path drawn. Exits with code 1 when no "
+        "window can be opened here.", epilog=EPILOG_VIEW + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    view.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
+    view.add_argument("--every", type=_positive_int, help="show every K-th stored row (default: about real time)")
+    view.set_defaults(func=_cmd_view)
+
+    animate = subparsers.add_parser(
+        "animate", help="render a run to a GIF or MP4 without a display",
+        description="Render a run folder (written by `cdpr run SCENE --out DIR`) with Exudyn's software "
+        "raytracer, no display needed, into a GIF (or an MP4 with imageio-ffmpeg installed); a spatial run "
+        "folder is drawn with matplotlib's 3-D axes into a GIF.",
+        epilog=EPILOG_ANIMATE + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    animate.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
+    animate.add_argument("--out", help="animation file, .gif or .mp4 (default: RUN_DIR/animation.gif)")
+    animate.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per second (default: 25)")
+    animate.add_argument("--every", type=_positive_int,
+                         help="use every K-th stored row (default: real-time playback at --fps)")
+    animate.add_argument("--size", type=_size_argument, default=DEFAULT_SIZE, metavar="WxH",
+                         help="image size in pixels (default: 640x480)")
+    animate.add_argument("--frames-dir", help="also write each frame as a PNG into this folder")
+    animate.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no message")
+    animate.set_defaults(func=_cmd_animate)

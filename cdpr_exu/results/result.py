@@ -1,0 +1,259 @@
+"""The result of a run: time series in the paper's x-z plane, and their files.
+
+A :class:`Result` is plain NumPy data (no Exudyn): the platform pose, every cable
+node's position, every element's tension, the winch lengths and the reference, at
+the output times. It saves to ``result.npz`` + ``pose.csv`` + ``summary.json`` and
+loads back from the ``.npz``.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import platform as _platform
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cdpr_exu.core.output import json_text, write_npz, write_summary
+
+
+@dataclass
+class Result:
+    """Time series of one run. Units SI; positions (x, z) in the paper's plane.
+
+    Attributes
+    ----------
+    scene_name : str
+    controller : str
+    time : ndarray, shape (N,) [s]
+    platform_pose : ndarray, shape (N, 3) [m, m, rad]
+        (x, z, rotation), rotation positive counter-clockwise.
+    platform_velocity : ndarray, shape (N, 3) [m/s, m/s, rad/s]
+    reference_pose : ndarray, shape (N, 3)
+    nodes : list of ndarray, each shape (N, n_i + 1, 2) [m]
+        Node positions of cable i, winch end first.
+    node_velocities : list of ndarray, each shape (N, n_i + 1, 2) [m/s]
+    tensions : list of ndarray, each shape (N, n_i) [N]
+        Axial force of each element (tension positive).
+    paid_out : ndarray, shape (N, m) [m]
+        Commanded paid-out length of each winch.
+    pulley_penetration : ndarray, shape (N, m) [m]
+        Deepest node penetration into each cable's pulley (0 if none).
+    wall_time : float [s]
+    steps : int
+        Time steps completed.
+    newton_iterations : int
+    status : str
+        "completed" or "failed: <cause>".
+    failure_time : float or None [s]
+    winch_reservoir : ndarray, shape (N, m), or None [m]
+        Slack rope held at each winch drum (tension-only cables under kinematic winches,
+        see :func:`cdpr_exu.builder.winch.reservoir_split`); it lengthens each cable's winch
+        element (element 0). None where there is no reservoir.
+    metadata : dict
+    """
+
+    scene_name: str
+    controller: str
+    time: np.ndarray
+    platform_pose: np.ndarray
+    platform_velocity: np.ndarray
+    reference_pose: np.ndarray
+    nodes: list[np.ndarray]
+    node_velocities: list[np.ndarray]
+    tensions: list[np.ndarray]
+    paid_out: np.ndarray
+    pulley_penetration: np.ndarray
+    wall_time: float = 0.0
+    steps: int = 0
+    newton_iterations: int = 0
+    status: str = "completed"
+    failure_time: float | None = None
+    winch_reservoir: np.ndarray | None = None
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    # ----------------------------------------------------------------- derived
+    @property
+    def error(self) -> np.ndarray:
+        """Pose error actual - reference, shape (N, 3) [m, m, rad]."""
+        return self.platform_pose - self.reference_pose
+
+    @property
+    def simulated_time(self) -> float:
+        return float(self.time[-1]) if len(self.time) else 0.0
+
+    def summary(self, after: float = 0.0) -> dict[str, Any]:
+        """Scalar figures of the run (errors measured from time ``after`` on) [SI, degrees].
+
+        A figure that does not exist (no sample at or after ``after``: a run shorter than
+        the error window, or one that failed before it) is None, and ``notes`` says why.
+        """
+        mask = self.time >= after
+        err = self.error[mask]
+        position_error = np.linalg.norm(err[:, :2], axis=1) if len(err) else np.zeros(0)
+        taut = np.concatenate([t[mask].ravel() for t in self.tensions]) if self.tensions else np.zeros(0)
+
+        def _max(a):
+            a = np.asarray(a, dtype=float)
+            return float(np.nanmax(a)) if a.size and np.isfinite(a).any() else None
+
+        def _min(a):
+            a = np.asarray(a, dtype=float)
+            return float(np.nanmin(a)) if a.size and np.isfinite(a).any() else None
+
+        notes = []
+        pushing = bool(taut.size) and float(np.nanmin(taut)) < 0.0
+        if pushing:
+            notes.append(f"elements pushed (lowest tension {float(np.nanmin(taut)):.3g} N): this model lets cables "
+                         "carry compression, which a real cable cannot; effects.slack = true makes them tension-only")
+        if not len(err):
+            notes.append(f"no sample at or after t = {after:g} s (the run reached {self.simulated_time:g} s): "
+                         "its error, rotation and tension figures do not exist and are null")
+        return {
+            "scene": self.scene_name,
+            "controller": self.controller,
+            "status": self.status,
+            "errors_measured_after_s": after,
+            "max_abs_error_x_m": _max(np.abs(err[:, 0])),
+            "max_abs_error_z_m": _max(np.abs(err[:, 1])),
+            "min_error_z_m": _min(err[:, 1]),
+            "max_error_z_m": _max(err[:, 1]),
+            "max_position_error_m": _max(position_error),
+            "rms_position_error_m": float(np.sqrt(np.mean(position_error**2))) if len(err) else None,
+            "max_abs_rotation_deg": _max(np.degrees(np.abs(self.platform_pose[mask, 2]))),
+            "min_element_tension_N": _min(taut),
+            "max_element_tension_N": _max(taut),
+            "min_tension_per_cable_N": [_min(t[mask]) for t in self.tensions],
+            "slack_time_per_cable_s": [self._slack_time(t, mask) for t in self.tensions],
+            "elements_pushed": pushing,
+            "max_pulley_penetration_m": _max(self.pulley_penetration),
+            "wall_time_s": self.wall_time,
+            "simulated_time_s": self.simulated_time,
+            "real_time_factor": self.simulated_time / self.wall_time if self.wall_time > 0 else None,
+            "steps": int(self.steps),
+            "newton_iterations": int(self.newton_iterations),
+            "failure_time_s": self.failure_time,
+            "max_winch_reservoir_m": (None if self.winch_reservoir is None or not len(self.winch_reservoir)
+                                      else self.winch_reservoir.max(axis=0).tolist()),
+            "notes": notes,
+            **self._violations(mask),
+        }
+
+    def _violations(self, mask: np.ndarray) -> dict[str, Any]:
+        """``tension_limit_violations``: each cable's element tensions outside its (t_min, t_max), if any are set.
+
+        One entry per cable and limit crossed: the limit, when it was first crossed, the
+        most extreme tension and for how long some element was beyond it. Absent from the
+        summary of a scene without tension limits.
+        """
+        limits = self.metadata.get("tension_limits_N")
+        if limits is None:
+            return {}
+        times = self.time[mask]
+        widths = np.diff(times, append=times[-1]) if len(times) else np.zeros(0)
+        violations = []
+        for i, (tensions, (low, high)) in enumerate(zip(self.tensions, limits)):
+            series = np.asarray(tensions[mask], dtype=float)
+            if not series.size:
+                continue
+            for name, limit, extreme, beyond in (
+                    ("min_tension", low, np.nanmin(series, axis=1), lambda x, v: x < v),
+                    ("max_tension", high, np.nanmax(series, axis=1), lambda x, v: x > v)):
+                if limit is None:
+                    continue
+                crossed = beyond(extreme, limit)
+                if np.any(crossed):
+                    worst = extreme[crossed].min() if name == "min_tension" else extreme[crossed].max()
+                    violations.append({"cable": i + 1, "limit": name, "limit_N": float(limit),
+                                       "first_time_s": float(times[np.argmax(crossed)]), "extreme_N": float(worst),
+                                       "duration_s": float(np.sum(widths[crossed]))})
+        return {"tension_limits_N": limits, "tension_limit_violations": violations}
+
+    def _slack_time(self, tensions: np.ndarray, mask: np.ndarray) -> float | None:
+        """Time [s] during which some element of a cable carries no tension (slack, or pushing)."""
+        times = self.time[mask]
+        if len(times) < 2:
+            return None
+        slack = np.any(tensions[mask] <= 0.0, axis=1)
+        widths = np.diff(times, append=times[-1])  # each sample stands for the interval after it
+        return float(np.sum(widths[slack]))
+
+    # ----------------------------------------------------------------- files
+    def save(self, folder: str | Path, summary_after: float = 0.0) -> dict[str, Path]:
+        """Write ``result.npz``, ``pose.csv`` and ``summary.json`` into ``folder``.
+
+        Returns the paths written, by kind.
+        """
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        arrays = {
+            "time": self.time, "platform_pose": self.platform_pose,
+            "platform_velocity": self.platform_velocity, "reference_pose": self.reference_pose,
+            "paid_out": self.paid_out, "pulley_penetration": self.pulley_penetration,
+        }
+        if self.winch_reservoir is not None:
+            arrays["winch_reservoir"] = self.winch_reservoir
+        for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
+            arrays[f"nodes_{i}"] = nodes
+            arrays[f"node_velocities_{i}"] = self.node_velocities[i]
+            arrays[f"tensions_{i}"] = tensions
+        info = {
+            "scene_name": self.scene_name, "controller": self.controller, "wall_time": self.wall_time,
+            "steps": self.steps, "newton_iterations": self.newton_iterations, "status": self.status,
+            "failure_time": self.failure_time, "metadata": self.metadata,
+        }
+        # The wall time lives in timing.json, so that result.npz is the same from run to run.
+        info.pop("wall_time")
+        write_npz(folder / "result.npz", info=np.array(json_text(info)), **arrays)
+        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
+        table = np.column_stack([self.time, self.platform_pose, self.reference_pose])
+        np.savetxt(folder / "pose.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+        summary = {**self.summary(after=summary_after), **provenance()}
+        summary.update({k: v for k, v in self.metadata.items() if k not in summary})
+        write_summary(folder, summary)
+        return {"npz": folder / "result.npz", "csv": folder / "pose.csv", "summary": folder / "summary.json"}
+
+    @classmethod
+    def load(cls, path: str | Path) -> "Result":
+        """Read a ``result.npz`` written by :meth:`save` (a folder is accepted too)."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / "result.npz"
+        with np.load(path, allow_pickle=False) as data:
+            info = json.loads(str(data["info"]))
+            timing = path.parent / "timing.json"
+            if "wall_time" not in info and timing.is_file():
+                info["wall_time"] = json.loads(timing.read_text()).get("wall_time_s") or 0.0
+            m = sum(1 for k in data.files if k.startswith("nodes_"))
+            return cls(
+                scene_name=info["scene_name"], controller=info["controller"], time=data["time"],
+                platform_pose=data["platform_pose"], platform_velocity=data["platform_velocity"],
+                reference_pose=data["reference_pose"],
+                nodes=[data[f"nodes_{i}"] for i in range(m)],
+                node_velocities=[data[f"node_velocities_{i}"] for i in range(m)],
+                tensions=[data[f"tensions_{i}"] for i in range(m)],
+                paid_out=data["paid_out"], pulley_penetration=data["pulley_penetration"],
+                wall_time=info.get("wall_time", 0.0), steps=info["steps"],
+                newton_iterations=info["newton_iterations"], status=info["status"],
+                failure_time=info["failure_time"], metadata=info.get("metadata", {}),
+                winch_reservoir=data["winch_reservoir"] if "winch_reservoir" in data.files else None,
+            )
+
+
+def provenance() -> dict[str, Any]:
+    """Package versions, Python and the date, for every file a run writes."""
+    versions = {}
+    for package in ("cdpr-exu", "exudyn", "numpy", "scipy", "numba"):
+        try:
+            versions[package] = metadata.version(package)
+        except metadata.PackageNotFoundError:
+            versions[package] = None
+    return {
+        "versions": versions,
+        "python": _platform.python_version(),
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    }

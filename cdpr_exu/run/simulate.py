@@ -1,0 +1,716 @@
+"""Runs a scene through Exudyn's implicit generalized-alpha solver.
+
+:func:`simulate` builds the model, asks the controller for winch commands once per
+time step (a pre-step function), records the state at the output times (a post-step
+function), and returns a :class:`~cdpr_exu.results.result.Result`. If the solver fails
+mid-run, :class:`~cdpr_exu.core.errors.SolverFailure` says at what time and why, and
+carries the result up to that time.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import signal
+import threading
+import time as _time
+from pathlib import Path
+from typing import Callable
+
+import exudyn as exu
+import numpy as np
+
+from controllers.base import Controller, Measurement
+from controllers.ideal_ik import IdealIKController
+
+from cdpr_exu.builder.cable import element_tensions
+from cdpr_exu.core.errors import RunInterrupted, SolverFailure
+from cdpr_exu.builder.model import Model, build_model
+from cdpr_exu.core.geometry import penetration, segment_penetration
+from cdpr_exu.results.result import Result
+from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.builder.winch import RopeReservoir, servo_force, set_paid_out_length
+
+
+@contextlib.contextmanager
+def quiet_exudyn():
+    """Keep Exudyn's own console messages (failure banners, allocation warnings) to itself.
+
+    The project reports failures in its own words; Exudyn's banner ("DYNAMIC SOLVER
+    FAILED ... use showHints=True") and its memory-allocation warning would only
+    confuse. Both go through ``exudyn.Print``, which ``exu.config.printToConsole``
+    switches off; the setting is restored afterwards.
+    """
+    before = exu.config.printToConsole
+    exu.config.printToConsole = False
+    try:
+        yield
+    finally:
+        exu.config.printToConsole = before
+
+
+@contextlib.contextmanager
+def interrupt_flag():
+    """While active, Ctrl-C (SIGINT) sets ``flag["interrupted"]`` instead of raising.
+
+    The solver's post-step function checks the flag and ends the time integration
+    cleanly, so the samples computed so far are kept. Outside the main thread (where
+    signal handlers cannot be installed) Ctrl-C behaves as usual.
+    """
+    flag = {"interrupted": False}
+    if threading.current_thread() is not threading.main_thread():
+        yield flag
+        return
+    previous = signal.getsignal(signal.SIGINT)
+
+    def handler(signum, frame):  # noqa: ARG001
+        if flag["interrupted"]:  # a second Ctrl-C: the user insists
+            raise KeyboardInterrupt
+        flag["interrupted"] = True
+
+    signal.signal(signal.SIGINT, handler)
+    try:
+        yield flag
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
+    """Exudyn settings of the implicit run of ``scene``.
+
+    Generalized-alpha with the scene's spectral radius, the sparse LU solver, and
+    (modified) Newton whose Jacobian is updated every step. The contact's own
+    step-size recommendation is switched off (it shrinks steps to about 1e-6 s).
+    """
+    solver = scene.solver
+    settings = exu.SimulationSettings()
+    ti = settings.timeIntegration
+    ti.numberOfSteps = solver.n_steps
+    ti.endTime = solver.end_time
+    ti.verboseMode = 0
+    ti.generalizedAlpha.spectralRadius = solver.spectral_radius
+    # By default start from zero accelerations. The consistent initial acceleration of a
+    # straight cable's free nodes is -g, but the Kelvin-Voigt damping (c_i / m_i ~ 4e6
+    # 1/s) cuts it off within microseconds; carried into the first step it injects a
+    # start-up energy jolt (13 J on the paper scene at 1.7e-2 s steps). Without it the
+    # paper circle's path moves by 0.7 mm and its step-size error halves; a drop from
+    # rest, though, then converges at first order (SolverSpec.initial_accelerations).
+    ti.generalizedAlpha.computeInitialAccelerations = bool(solver.initial_accelerations)
+    ti.newton.useModifiedNewton = solver.newton == "modified"
+    ti.newton.modifiedNewtonJacUpdatePerStep = True
+    ti.newton.maxIterations = solver.max_newton_iterations
+    # 1e-6 by default (SolverSpec.newton_tolerance): Exudyn's 1e-8 buys nothing at the
+    # millimetres asked here, and on stiff massless ropes it sits at the residual's
+    # round-off, so Newton stalls and the adaptive step shrinks up to 350-fold.
+    ti.newton.relativeTolerance = solver.newton_tolerance
+    ti.discontinuous.useRecommendedStepSize = False
+    ti.adaptiveStep = True
+    ti.minimumStepSize = solver.step_size * 1e-4
+    settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    if solver.integrator == "rk44":
+        # Explicit classical Runge-Kutta at the fixed step (comparison runs only).
+        # SolveDynamic takes the solver type from these settings when called without
+        # solverType; ``timeIntegration.explicitIntegration`` is the deprecated name of
+        # ``timeIntegration.explicit``. The winch's ground-coordinate constraints are
+        # eliminated (``explicit.eliminateConstraints``, Exudyn's default); the
+        # platform joints must be spring-dampers (see cdpr_exu.builder.platform).
+        ti.solverType = exu.DynamicSolverType.RK44
+        ti.adaptiveStep = False
+        ti.explicit.eliminateConstraints = True
+    settings.solution.file.write = solution_file is not None
+    if solution_file is not None:
+        settings.solution.file.name = str(solution_file)
+        settings.solution.file.writePeriod = solver.output_period
+        settings.solution.file.binary = True
+    return settings
+
+
+#: A run stops when an element's strain exceeds this: the lumped model has left the
+#: range where it describes a steel cable (real cables break near 1-2 % strain).
+MAX_STRAIN = 0.05
+#: A run stops when a node lies deeper than this fraction of the pulley radius inside
+#: a pulley: the cable is slipping through it, which penalty contact on nodes allows
+#: when an element is long compared with the contact's reach.
+MAX_PENETRATION_FRACTION = 0.5
+
+
+class _Monitor:
+    """Checks each recorded sample for states the model cannot describe."""
+
+    def __init__(self, scene: Scene, indices: dict[str, np.ndarray], reference: np.ndarray):
+        self.scene = scene
+        self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
+                       for i, cable in enumerate(scene.cables) if f"cable_{i}" in indices]
+        self.check_pulleys = scene.pulley_contact
+        self.on_segments = scene.contact_model is not None and scene.contact_model.on_segments
+        self.platform_index = indices["platform"]
+        self.reference_pose = reference[self.platform_index]
+        # No pose of a platform hung on these cables lies farther from every pulley
+        # than the longest cable; the box of those reaches bounds every sane state.
+        centers = np.array([p.center for p in scene.pulleys])
+        reach = max(c.unstrained_length for c in scene.cables) * (1.0 + MAX_STRAIN) + max(
+            np.abs(np.asarray(scene.platform.anchors)).max(), 0.0)
+        self.box = (centers.min(axis=0) - reach, centers.max(axis=0) + reach)
+        # A suspended platform (starting below every pulley) that rises above the
+        # highest pulley rim is held there only by cables that push.
+        tops = centers[:, 1] + np.array([p.radius for p in scene.pulleys])
+        suspended = scene.platform.initial_pose[1] < centers[:, 1].min()
+        self.ceiling = tops.max() if suspended else np.inf
+
+    def problem(self, t: float, q: np.ndarray, surplus: np.ndarray | None = None) -> str | None:
+        """A description of what is wrong at time ``t``, or None.
+
+        ``surplus`` [m], shape (m,): slack rope held at each drum, which lengthens the
+        winch element (:func:`cdpr_exu.builder.winch.reservoir_split`).
+        """
+        if not np.all(np.isfinite(q)):
+            return f"the coordinates are no longer finite at t = {t:.4f} s"
+        for i, (cable, reference, idx) in enumerate(self.cables):
+            positions = reference + q[idx]
+            rest = np.full(cable.n_elements, cable.element_length)
+            if surplus is not None:
+                rest[0] += surplus[i]
+            strain = np.linalg.norm(np.diff(positions, axis=0), axis=1) / rest - 1.0
+            if self.scene.effects.slack:
+                strain = np.maximum(strain, 0.0)  # a tension-only element may go slack: shortening is no fault
+            worst = int(np.argmax(np.abs(strain)))
+            if abs(strain[worst]) > MAX_STRAIN:
+                return (f"element {worst} of cable {i + 1} is strained by {100 * strain[worst]:+.4g} % at t = {t:.4f} s "
+                        f"(limit {100 * MAX_STRAIN:.0f} %): the run has left the model's valid range")
+            if self.check_pulleys:
+                pulley = self.scene.pulleys[i]
+                depth = segment_penetration(pulley, positions)
+                element = int(np.argmax(depth))
+                if depth[element] > MAX_PENETRATION_FRACTION * pulley.radius:
+                    advice = ("segment contact: the rim contact is too soft for the cable tension; raise "
+                              f"pulleys[{i}].contact_stiffness" if self.on_segments else
+                              "contact acts on nodes only; use more elements, or "
+                              "effects.pulley_contact_model = 'segment'")
+                    return (f"element {element} of cable {i + 1} cuts {1000 * depth[element]:.0f} mm deep into pulley {i + 1} "
+                            f"at t = {t:.4f} s: the cable is slipping through the pulley ({advice})")
+        pose = self.reference_pose + q[self.platform_index]
+        if np.any(pose[:2] < self.box[0]) or np.any(pose[:2] > self.box[1]):
+            return (f"the platform left the reachable region at t = {t:.4f} s (it is at x = {pose[0]:.3f} m, "
+                    f"z = {pose[1]:.3f} m): the integration has diverged")
+        if pose[1] > self.ceiling:
+            return (f"the platform rose above the pulleys at t = {t:.4f} s (z = {pose[1]:.3f} m): only pushing "
+                    f"cables can hold it there; the run has diverged (try a smaller step, or effects.slack = true)")
+        return None
+
+
+class _Recorder:
+    """Stores Exudyn's coordinates at the output times (called once per step)."""
+
+    def __init__(self, model: Model, output_period: float, end_time: float):
+        self.model = model
+        self.indices = model.coordinate_indices()
+        count = int(math.floor(end_time / output_period + 1e-9)) + 1
+        self.output_times = np.arange(count) * output_period
+        size = model.mbs.systemData.GetODE2Coordinates().size
+        self.q = np.full((count, size), np.nan)
+        self.v = np.full((count, size), np.nan)
+        self.times = np.full(count, np.nan)
+        self.paid_out = np.full((count, len(model.winches)), np.nan)
+        self.rope_forces = np.full((count, len(model.ropes)), np.nan)
+        self.surplus = np.zeros((count, len(model.winches)))  # slack rope at each drum [m]
+        self.count = 0
+
+    def record_if_due(self, t: float, paid_out: np.ndarray, surplus: np.ndarray | None = None) -> bool:
+        """Store the state if an output time is due; True if it was stored."""
+        if self.count < len(self.output_times) and t >= self.output_times[self.count] - 1e-9:
+            data = self.model.mbs.systemData
+            self.q[self.count] = data.GetODE2Coordinates()
+            self.v[self.count] = data.GetODE2Coordinates_t()
+            self.times[self.count] = t
+            self.paid_out[self.count] = paid_out
+            if surplus is not None:
+                self.surplus[self.count] = surplus
+            for i, rope in enumerate(self.model.ropes):
+                self.rope_forces[self.count, i] = self.model.mbs.GetObjectOutput(rope.rope, exu.OutputVariableType.ForceLocal)
+            self.count += 1
+            return True
+        return False
+
+    def result(self, scene: Scene, controller_name: str) -> Result:
+        """Convert the recorded coordinates to a Result in the x-z plane."""
+        k = self.count
+        q, v = self.q[:k], self.v[:k]
+        times = self.times[:k]
+        ref_q = self.model.mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
+        platform_idx = self.indices["platform"]
+        pose = ref_q[platform_idx] + q[:, platform_idx]
+        velocity = v[:, platform_idx]
+        nodes, node_velocities, tensions, depth = [], [], [], []
+        if self.model.ropes:
+            nodes, node_velocities, tensions = _rope_series(scene, self.model, pose, self.paid_out[:k],
+                                                            self.rope_forces[:k], times)
+            depth = [np.zeros(k) for _ in self.model.ropes]
+        for i, cable in enumerate(scene.cables if not self.model.ropes else ()):
+            idx = self.indices[f"cable_{i}"]
+            positions = ref_q[idx] + q[:, idx]
+            velocities = v[:, idx]
+            nodes.append(positions)
+            node_velocities.append(velocities)
+            rest = np.full((k, cable.n_elements), cable.element_length)
+            rest[:, 0] += self.surplus[:k, i]  # the winch element holds the slack rope at the drum
+            tensions.append(element_tensions(cable, positions, velocities, scene.effects, rest))
+            if not scene.exits[i].is_point_exit:
+                depth.append(penetration(scene.pulleys[i], positions).max(axis=1))
+            else:
+                depth.append(np.zeros(k))
+        reference = scene.trajectory.pose(times) if k else np.zeros((0, 3))
+        return Result(
+            scene_name=scene.name, controller=controller_name, time=times, platform_pose=pose,
+            platform_velocity=velocity, reference_pose=np.atleast_2d(reference).reshape(-1, 3),
+            nodes=nodes, node_velocities=node_velocities, tensions=tensions, paid_out=self.paid_out[:k],
+            pulley_penetration=np.column_stack(depth) if depth else np.zeros((k, 0)),
+        )
+
+
+def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndarray, forces: np.ndarray,
+                 times: np.ndarray):
+    """Polylines (winch end, hang point, tangent point, anchor) and tensions of massless ropes.
+
+    The ropes have no nodes: their points follow from the platform pose and the
+    paid-out length; their velocities are time derivatives of those points.
+    """
+    from cdpr_exu.statics.kinematics import anchor_points
+
+    k = len(times)
+    anchors = anchor_points(pose, np.asarray(scene.platform.anchors)) if k else np.zeros((0, len(model.ropes), 2))
+    nodes, velocities, tensions = [], [], []
+    for i, cable in enumerate(scene.cables):
+        points = np.zeros((k, 4, 2))
+        exit_ = scene.exits[i]
+        hang = exit_.hang_point
+        for row in range(k):
+            tangent = exit_.exit(anchors[row, i]).tangent_point
+            points[row] = [exit_.winch_end(cable.unstrained_length, paid_out[row, i]), hang, tangent, anchors[row, i]]
+        nodes.append(points)
+        velocities.append(np.gradient(points, times, axis=0) if k > 1 else np.zeros_like(points))
+        tensions.append(forces[:, i:i + 1])
+    return nodes, velocities, tensions
+
+
+class _Stepper:
+    """The per-step state of one run and Exudyn's pre- and post-step functions.
+
+    Before each step it asks the controller for the winch commands (from a
+    :class:`Measurement`) and drives the winches (kinematic lengths, servo motor forces,
+    the slack-rope reservoir); after each step it records the outputs that are due,
+    checks them (:class:`_Monitor`), reports progress and ends the integration on a
+    problem or a Ctrl-C, keeping what was computed.
+
+    Attributes
+    ----------
+    paid_out, rate : ndarray, shape (m,) [m, m/s]
+        The last commanded (or, for servos, measured) paid-out lengths and rates.
+    stop_reason : str or None
+        Why the run was stopped early (a monitor problem or a controller error).
+    stop_exception : Exception or None
+        The controller's exception, when it raised.
+    interrupted : dict
+        ``{"interrupted": bool}``, set by :func:`interrupt_flag` during the solve.
+    """
+
+    def __init__(self, scene: Scene, model: Model, controller: Controller, recorder: "_Recorder",
+                 monitor: "_Monitor", report, ref_q: np.ndarray):
+        self.scene, self.model, self.controller = scene, model, controller
+        self.recorder, self.monitor, self.report = recorder, monitor, report
+        self.ref_q = ref_q
+        self.indices = recorder.indices
+        self.paid_out = model.initial_paid_out.copy()
+        self.rate = np.zeros(len(scene.cables))
+        self.stop_reason: str | None = None
+        self.stop_exception: Exception | None = None
+        self.interrupted = {"interrupted": False}
+        self.reservoir = _rope_reservoir(scene, model)
+        self.first_nodes = ([self.indices[f"cable_{i}"][:2] for i in range(len(scene.cables))]
+                            if self.reservoir else [])
+        self.drum_index = [model.mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
+        self.servo_integral = np.zeros(len(model.servos))
+        self.servo_time = 0.0
+        self.start = _time.perf_counter()
+
+    def _cable_tensions(self, q: np.ndarray, v: np.ndarray, i: int, which: slice) -> np.ndarray:
+        """Tensions [N] of the elements of cable i between the nodes ``which`` (a slice of its nodes)."""
+        idx = self.indices[f"cable_{i}"][which]
+        return element_tensions(self.scene.cables[i], self.ref_q[idx] + q[idx], v[idx], self.scene.effects)
+
+    def measurement(self, t: float) -> Measurement:
+        """What the controller may see at time ``t`` [s]."""
+        controller, model = self.controller, self.model
+        pose = velocity = tensions = None
+        if controller.uses_pose or controller.uses_tension:
+            q = model.mbs.systemData.GetODE2Coordinates()
+            v = model.mbs.systemData.GetODE2Coordinates_t()
+            platform = self.indices["platform"]
+            pose = self.ref_q[platform] + q[platform]
+            velocity = v[platform]
+            if controller.uses_tension and model.ropes:
+                tensions = np.array([model.mbs.GetObjectOutput(r.rope, exu.OutputVariableType.ForceLocal)
+                                     for r in model.ropes])
+            elif controller.uses_tension:
+                tensions = np.array([self._cable_tensions(q, v, i, slice(-2, None))[-1]
+                                     for i in range(len(self.scene.cables))])
+        return Measurement(t, self.paid_out.copy(), self.rate.copy(), pose, velocity, tensions)
+
+    def drive_servos(self, mbs_, t: float, command, q: np.ndarray, v: np.ndarray) -> None:
+        """Motor force of each servo drum from the command (once per step)."""
+        dt = t - self.servo_time
+        self.servo_time = t
+        for i, (servo, index) in enumerate(zip(self.model.servos, self.drum_index)):
+            error = q[index] - (command.paid_out[i] - self.model.initial_paid_out[i])
+            error_rate = v[index] - command.paid_out_rate[i]
+            self.servo_integral[i] += error * dt
+            tension = self._cable_tensions(q, v, i, slice(0, 2))[0]
+            # The cable pulls rope off the drum with its winch-end tension: feed it forward.
+            force = servo_force(servo, self.servo_integral[i], error, error_rate, -tension)
+            mbs_.SetLoadParameter(servo.load, "load", force)
+
+    def pre_step(self, mbs_, t: float) -> bool:
+        """Exudyn's pre-step function: command and drive the winches; False stops the run."""
+        model = self.model
+        if self.scene.winch.kind == "fixed":
+            return True
+        try:
+            if model.servos:
+                q = mbs_.systemData.GetODE2Coordinates()
+                v = mbs_.systemData.GetODE2Coordinates_t()
+                self.paid_out = model.initial_paid_out + q[self.drum_index]
+                self.rate = v[self.drum_index]
+            command = self.controller.command(self.measurement(t))
+            paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
+            if paid_out.shape != self.paid_out.shape or not np.all(np.isfinite(paid_out)):
+                raise ValueError(f"the command must be {self.paid_out.size} finite lengths, got {command.paid_out!r}")
+            if model.servos:
+                self.drive_servos(mbs_, t, command, q, v)
+                return True
+        except Exception as err:  # noqa: BLE001 - reported as the cause of the stop
+            self.stop_reason = (f"controller {self.controller.name!r} raised at t = {t:.4f} s: "
+                                f"{type(err).__name__}: {err}")
+            self.stop_exception = err
+            return False
+        self.paid_out = paid_out
+        self.rate = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
+        targets = self.paid_out
+        if self.reservoir is not None:  # slack rope paid out piles up at the drum (winch.reservoir_split)
+            q = mbs_.systemData.GetODE2Coordinates()
+            lengths = np.array([np.linalg.norm(np.diff(self.ref_q[idx] + q[idx], axis=0)) for idx in self.first_nodes])
+            targets = model.initial_paid_out + self.reservoir.update(targets - model.initial_paid_out, lengths)
+        for winch, length, initial in zip(model.winches, targets, model.initial_paid_out):
+            set_paid_out_length(mbs_, winch, length, initial)
+        return True
+
+    def post_step(self, mbs_, t: float) -> bool:  # noqa: ARG002 - Exudyn's signature
+        """Exudyn's post-step function: record, check, report; False ends the integration."""
+        if self.interrupted["interrupted"]:
+            return False  # Ctrl-C: end the integration, keep what was computed
+        surplus = None if self.reservoir is None else self.reservoir.surplus
+        recorder = self.recorder
+        if recorder.record_if_due(t, self.paid_out, surplus):
+            self.stop_reason = self.monitor.problem(t, recorder.q[recorder.count - 1], surplus)
+            if self.stop_reason is not None:
+                return False  # ends the time integration; the samples so far are kept
+        if self.report is not None:
+            self.report(t, _time.perf_counter() - self.start)
+        return True
+
+
+def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
+             progress: bool | Callable[[float, float], None] = False,
+             sparse_jacobian: bool | None = None) -> Result:
+    """Simulate ``scene`` under ``controller`` (default: ideal inverse kinematics).
+
+    Parameters
+    ----------
+    scene : Scene
+    controller : Controller, optional
+        Gives the winch commands once per step; default :class:`IdealIKController`.
+    solution_file : path, optional
+        Also write Exudyn's solution file there, for ``SolutionViewer``.
+    progress : bool or callable
+        True shows a progress bar (simulated time, ratio to real time); a callable
+        is called as ``progress(t, wall_time)`` about 100 times per run.
+    sparse_jacobian : bool, optional
+        Hand Exudyn the cables' Jacobian as sparse triplets (True) or a dense matrix
+        (False); default: sparse for fine cables (see :func:`cdpr_exu.builder.model.build_model`).
+
+    Returns
+    -------
+    Result
+
+    Raises
+    ------
+    UnreachableError
+        Before the run, if the reference leaves the workspace.
+    SolverFailure
+        If the solver fails; ``.time`` and ``.partial_result`` say when and what was
+        computed up to then.
+    """
+    controller = controller or IdealIKController()
+    model = build_model(scene, sparse_jacobian=sparse_jacobian)
+
+    controller.reset(scene, model.initial_paid_out.copy())
+    mbs = model.mbs
+    solver = scene.solver
+    recorder = _Recorder(model, solver.output_period, solver.end_time)
+    ref_q = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
+    report = _progress_reporter(progress, scene)
+    stepper = _Stepper(scene, model, controller, recorder, _Monitor(scene, recorder.indices, ref_q), report, ref_q)
+    start = stepper.start
+    mbs.SetPreStepUserFunction(stepper.pre_step)
+    mbs.SetPostStepUserFunction(stepper.post_step)
+    recorder.record_if_due(0.0, stepper.paid_out)
+    settings = solver_settings(scene, solution_file)
+    failure = None
+    with interrupt_flag() as interrupted, quiet_exudyn():
+        stepper.interrupted = interrupted
+        try:
+            mbs.SolveDynamic(settings)
+        except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
+            failure = _solver_report(mbs, " ".join(str(err).split()))
+    if interrupted["interrupted"]:
+        wall = _time.perf_counter() - start
+        if report is not None:
+            report(None, wall)
+        result = recorder.result(scene, controller.name)
+        result.wall_time = wall
+        reached = float(result.time[-1]) if len(result.time) else 0.0
+        result.status = f"interrupted at t = {reached:.4f} s"
+        result.failure_time = reached
+        raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
+                             time=reached, partial_result=result)
+    if stepper.stop_reason is not None:
+        failure = stepper.stop_reason
+    if failure is not None:  # the partial result ends at its last finite sample
+        recorded = slice(0, recorder.count)
+        finite_rows = np.all(np.isfinite(recorder.q[recorded]) & np.isfinite(recorder.v[recorded]), axis=1)
+        if not finite_rows.all():
+            recorder.count = int(np.argmin(finite_rows))
+    wall = _time.perf_counter() - start
+    if report is not None:
+        report(None, wall)
+    result = recorder.result(scene, controller.name)
+    iterations = mbs.sys["dynamicSolver"].it
+    result.wall_time = wall
+    result.steps = int(iterations.currentStepIndex)
+    result.newton_iterations = int(iterations.newtonStepsCount)
+    if stepper.reservoir is not None:
+        result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
+    result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
+                       "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts()}
+    if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
+        result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
+    last_time = float(result.time[-1]) if len(result.time) else 0.0
+    if failure is None and (not np.all(np.isfinite(result.platform_pose)) or len(result.time) < len(recorder.output_times)):
+        failure = "the solution contains NaN or stopped before the end time"
+    if failure is not None:
+        finite = np.all(np.isfinite(result.platform_pose), axis=1) if len(result.time) else np.zeros(0, bool)
+        last_time = float(result.time[finite][-1]) if finite.any() else 0.0
+        result.status = f"failed: {failure}"
+        result.failure_time = last_time
+        raise SolverFailure(
+            f"the run failed at t = {last_time:.4f} s of {solver.end_time} s "
+            f"(step size {solver.step_size} s): {failure}. {likely_cause(scene, failure, last_time)}",
+            time=last_time, partial_result=result)
+    return result
+
+
+def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
+    """The slack-rope reservoir of kinematic winches on tension-only lumped cables (else None)."""
+    forces = model.cable_forces
+    if not (scene.effects.slack and scene.winch.kind == "kinematic" and forces is not None and forces.slack_arrays):
+        return None
+    rest, stiffness, damping = forces.slack_arrays
+    counts = [cable.n_elements for cable in scene.cables]
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int)
+    m = len(scene.cables)
+    return RopeReservoir(
+        first_elements=first, nominal_rest_length=rest[first].copy(),
+        axial_rigidity=stiffness[first] * rest[first], damping_rigidity=damping[first] * rest[first],
+        rest_length=rest, stiffness=stiffness, damping=damping,
+        surplus=np.zeros(m), node_offset=np.zeros(m), max_surplus=np.zeros(m))
+
+
+def _solver_report(mbs: exu.MainSystem, message: str) -> str:
+    """What Exudyn's solver said when it stopped: its error string, time, step and residual.
+
+    Exudyn's exception text is only "SolveDynamic terminated"; the stored solver
+    (``mbs.sys["dynamicSolver"]``) knows why.
+    """
+    solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
+    if solver is None:
+        return f"Exudyn's solver stopped: {message}"
+    try:
+        reason = solver.GetErrorString().strip() or message
+        it, conv = solver.it, solver.conv
+        details = [f"at t = {it.currentTime:.6g} s", f"step size then {it.currentStepSize:.3g} s"]
+        if not conv.newtonConverged:
+            details.append(f"Newton residual {conv.residual:.3g}")
+        if conv.linearSolverFailed:
+            details.append(f"the linear solver failed (singular Jacobian, row {conv.linearSolverCausingRow})")
+        if conv.massMatrixNotInvertible:
+            details.append("the mass matrix is not invertible")
+    except Exception:  # noqa: BLE001 - the report must never hide the failure itself
+        return f"Exudyn's solver stopped: {message}"
+    return f"Exudyn's solver stopped ({message}): {reason} ({', '.join(details)})"
+
+
+#: Largest step of Exudyn's explicit RK44 on a real negative eigenvalue, times -lambda
+#: (the classical Runge-Kutta stability interval is [-2.785, 0]).
+RK44_STABILITY_LIMIT = 2.785
+
+
+def explicit_step_limit(scene: Scene) -> float:
+    """Estimated largest stable step of explicit RK44 on ``scene``'s cables [s].
+
+    The fastest mode of a chain of over-damped Kelvin-Voigt elements is the zig-zag,
+    eigenvalue about -4 c_i / m_i; undamped, its frequency is 2 sqrt(k_i / m_i), and a
+    pulley contact adds sqrt(k_p / m_i). RK44 needs h |lambda| below about 2.8.
+    """
+    limits = []
+    for cable, pulley in zip(scene.cables, scene.pulleys):
+        mass = float(cable.node_masses()[1:-1].min()) if cable.n_elements > 1 else cable.element_mass
+        damping = cable.axial_damping if scene.effects.axial_damping else 0.0
+        stiffness = cable.axial_stiffness if scene.effects.axial_elasticity else 0.0
+        rate = 4.0 * damping / mass
+        frequency = 2.0 * math.sqrt(stiffness / mass)
+        if scene.pulley_contact:
+            frequency = math.hypot(frequency, math.sqrt(pulley.contact_stiffness / mass))
+        limits.append(RK44_STABILITY_LIMIT / max(rate, frequency, 1e-300))
+    return min(limits)
+
+
+def _cause_hints(scene: Scene, failure: str) -> list[str]:
+    """Hints that follow the cause the monitor (or Exudyn) named in ``failure``."""
+    hints = []
+    if "is strained by +" in failure:
+        hints.append("an element stretched beyond the strain limit: the cable is too soft for its load "
+                     "(cables[i].youngs_modulus, platform.mass), or the winch command pulls against the platform")
+    elif "is strained by -" in failure:
+        hints.append("a slack (tension-only) element shortened beyond the monitor's strain limit: the cable "
+                     "went slack and bunched up, which the monitor counts as leaving the model's range "
+                     "(simulate.MAX_STRAIN)" if scene.effects.slack else
+                     "an element was compressed beyond the strain limit: the cable pushes, which a real cable "
+                     "cannot (effects.slack = true makes elements tension-only)")
+    if "deep into pulley" in failure:
+        hints.append("a node or element slipped into the pulley: elements too long for the pulley radius "
+                     "(cables[i].n_elements) or a contact too soft for the tension (pulleys[i].contact_stiffness)")
+    if "rose above the pulleys" in failure:
+        hints.append("the platform was thrown upwards: only pushing cables can hold it above the pulleys; "
+                     "a start-up jolt at a large solver.step_size or a reference that accelerates downwards "
+                     "faster than gravity does this (effects.slack = true lets the cables go slack instead)")
+    if "left the reachable region" in failure or "no longer finite" in failure:
+        hints.append("the integration diverged: solver.step_size is too large for the stiffest mode "
+                     "(axial stiffness or pulley contact), or solver.spectral_radius near 1 leaves it undamped")
+    if "minimum step size" in failure or "Newton" in failure:
+        hints.append("Newton's iteration found no solution even for tiny steps: a force jumps within a step "
+                     "(a winch command that jumps, a slack cable snapping taut, a node striking the rim)")
+    return hints
+
+
+def first_step_hints(scene: Scene) -> list[str]:
+    """What in ``scene`` can make the very first step fail (a run that stops at t = 0)."""
+    hints = []
+    solver = scene.solver
+    cable = scene.cables[0]
+    mass = cable.element_mass if scene.effects.cable_mass else scene.platform.mass
+    if scene.pulley_contact:
+        worst = max(scene.pulleys, key=lambda p: p.contact_stiffness)
+        # The paper's pulley (1e7 N/m on 0.0875 kg nodes) runs at 2e-3 s: k h^2 / m = 457.
+        ratio = worst.contact_stiffness * solver.step_size**2 / mass
+        if ratio > 1e4:
+            hints.append(f"pulleys[i].contact_stiffness = {worst.contact_stiffness:g} N/m is stiff for "
+                         f"solver.step_size = {solver.step_size} s (k h^2 / m = {ratio:.3g}; the paper scene runs "
+                         "at 457): the nodes resting on the rim cannot be balanced in one step")
+    if scene.effects.axial_elasticity and scene.effects.cable_mass:
+        ratio = cable.axial_stiffness * solver.step_size**2 / cable.element_mass
+        if ratio > 1e5:
+            hints.append(f"cables[i] axial stiffness ({cable.axial_stiffness:.3g} N/m per element) is stiff for "
+                         f"solver.step_size = {solver.step_size} s (k h^2 / m = {ratio:.3g})")
+    if solver.max_newton_iterations < 4:
+        hints.append(f"solver.max_newton_iterations = {solver.max_newton_iterations} is too few for Newton to "
+                     "converge from the initial state")
+    if not hints:
+        hints.append("the initial state is far from balanced (platform.initial_pose against the cables' "
+                     "lengths) or solver.step_size is too large; try a smaller step")
+    return hints
+
+
+def likely_cause(scene: Scene, failure: str = "", failure_time: float | None = None) -> str:
+    """A hint at what most likely made the integration fail.
+
+    Parameters
+    ----------
+    scene : Scene
+    failure : str
+        What stopped the run (the monitor's or the solver's words): the hint follows
+        the cause named there.
+    failure_time : float, optional [s]
+        When the run stopped; a stop within the first step gets hints about what in
+        the scene makes the first step fail.
+    """
+    hints = []
+    if scene.solver.integrator == "rk44":
+        limit = explicit_step_limit(scene)
+        if scene.solver.step_size > limit:
+            hints.append(f"explicit RK44 is unstable above a step of about {limit:.2g} s on these cables "
+                         f"(axial damping c_i / m_i and stiffness); use a smaller step or the implicit solver")
+    if failure_time is not None and failure_time < scene.solver.step_size:
+        hints += ["at t = 0 the first step failed: " + hint for hint in first_step_hints(scene)]
+    hints += _cause_hints(scene, failure)
+    downward = -_steepest_downward_acceleration(scene)
+    if scene.winch.kind == "kinematic" and downward > scene.gravity > 0.0:
+        hints.append(f"the reference accelerates the platform downwards at up to {downward:.3g} m/s^2, more than "
+                     f"gravity ({scene.gravity} m/s^2): cables can only pull, so they go slack"
+                     + ("" if scene.effects.slack else " (with effects.slack off they push instead)"))
+    if not hints and not scene.effects.bending:
+        hints.append("bending is off: the paper scene relies on bending stiffness to stay well-behaved")
+    if not hints and scene.solver.integrator == "generalized_alpha" and scene.solver.spectral_radius > 0.9:
+        hints.append("spectral radius near 1 leaves the stiff axial modes undamped; try 0")
+    if not hints:
+        hints.append("a sudden jump of the winch command or the step size; try a smaller solver.step_size")
+    return "Likely cause: " + "; ".join(dict.fromkeys(hints)) + "."
+
+
+def _steepest_downward_acceleration(scene: Scene) -> float:
+    """Most negative vertical acceleration of the reference over the run [m/s^2] (0 if none)."""
+    try:
+        times = np.linspace(0.0, scene.solver.end_time, 2001)
+        acceleration = np.asarray(scene.trajectory.acceleration(times), dtype=float)[:, 1]
+        return float(min(acceleration.min(), 0.0))
+    except Exception:  # noqa: BLE001 - a hint must never raise
+        return 0.0
+
+
+def _progress_reporter(progress, scene: Scene):
+    """A per-step callback that updates a tqdm bar or a user callable ~100 times."""
+    if not progress:
+        return None
+    end = scene.solver.end_time
+    every = end / 100.0
+    last = {"t": -1.0}
+    if callable(progress):
+        def report(t, wall):
+            if t is None or t - last["t"] >= every:
+                last["t"] = end if t is None else t
+                progress(end if t is None else t, wall)
+        return report
+    from tqdm import tqdm
+
+    # disable=None: no bar when the output is not a terminal (logs, CI), so it never floods them.
+    bar = tqdm(total=end, unit="s", disable=None, mininterval=0.25,
+               bar_format="{desc}{percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}{postfix}]",
+               desc=scene.name + " ")
+
+    def report(t, wall):
+        if t is None:
+            bar.close()
+            return
+        if t - last["t"] >= every or t >= end - 1e-9:
+            last["t"] = t
+            bar.n = min(t, end)
+            bar.set_postfix_str(f"{t / wall:.1f}x real time" if wall > 0 else "", refresh=False)
+            bar.refresh()
+    return report

@@ -1,0 +1,229 @@
+"""The static mode of a spatial scene: the lumped robot at rest, beside its elastic catenaries.
+
+:func:`solve_spatial_rest` solves the scene twice, by two independent methods:
+
+* the **catenary statics** (:func:`cdpr_exu.physics.spatial_statics.solve_spatial_statics`):
+  each cable a continuous elastic catenary in its own vertical plane, the platform's
+  pose from the cables' unstrained lengths (no bending);
+* the **lumped robot in Exudyn** (:mod:`cdpr_exu.builder.spatial_robot`): the scene's
+  chains with its effects (bending included), started on the catenary solution and
+  brought to equilibrium by Exudyn's static solver (``mbs.SolveStatic``).
+
+and reports the lumped robot's pose (position, rotation vector and the rotation as
+angles), its tensions and end forces, and how far the catenary answer lies from it
+(the discretisation error, about n^-2, plus the effect of bending). A rigid platform's
+cable ends are held by stiff penalty joints in the static solve (Exudyn's static
+solver diverges on ``ObjectJointSpherical`` when the body must turn, see
+:mod:`cdpr_exu.builder.spatial_robot`); they add 1 / (:data:`PENALTY` n) of a cable's
+compliance. The static solve uses spring elements also where the scene's cables are
+tension-only (``effects.slack``): a slack element has no stiffness, and Exudyn's static
+solver fails from such a start; while every element is taut the two give the same
+equilibrium, and a compressed element is reported. Units SI; z up, gravity along -z.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass
+from pathlib import Path
+
+import exudyn as exu
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from cdpr_exu.core.output import write_summary
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static
+from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.results.result import provenance
+from cdpr_exu.scenes.spatial_scene import SpatialScene
+
+__all__ = ["SpatialRest", "solve_spatial_rest", "PENALTY"]
+
+#: Stiffness of the penalty spherical joints of a rigid platform, in element axial
+#: stiffnesses: they add 1 / (100 n) of a cable's compliance (3e-7 m at n = 40 on the
+#: four-cable robot, measured in tests/test_spatial_robot.py).
+PENALTY = 100.0
+
+#: Points per catenary curve in the figure.
+CURVE_SAMPLES = 60
+
+
+def rotation_angles_deg(rotation: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw [deg] of a rotation matrix, R = Rz(yaw) Ry(pitch) Rx(roll) (for reading only)."""
+    pitch = np.arcsin(np.clip(-rotation[2, 0], -1.0, 1.0))
+    roll = np.arctan2(rotation[2, 1], rotation[2, 2])
+    yaw = np.arctan2(rotation[1, 0], rotation[0, 0])
+    return np.degrees([roll, pitch, yaw])
+
+
+@dataclass(frozen=True, eq=False)
+class SpatialRest:
+    """A spatial scene at rest: the lumped robot (Exudyn) and the catenary statics.
+
+    Attributes
+    ----------
+    scene : SpatialScene
+    position : ndarray, shape (3,) [m]
+        Platform centre of mass (lumped robot).
+    rotation : ndarray, shape (3, 3)
+        Platform frame to world frame.
+    rotation_vector : ndarray, shape (3,) [rad]
+    tensions_at_anchor : ndarray, shape (m,) [N]
+    forces_on_platform : ndarray, shape (m, 3) [N]
+        Force each cable exerts on the platform at its anchor.
+    nodes : tuple of ndarray, each shape (n + 1, 3) [m]
+        Node positions of each cable, exit first.
+    catenary : SpatialEquilibrium
+        The catenary statics of the same scene.
+    element_tensions : tuple of ndarray, each shape (n,) [N]
+        Axial force of each element, exit first (negative: compressed, which a real cable
+        cannot be; the static solve uses spring elements, see the module notes).
+    anchor_joint : str
+        How the cable ends are held in the static solve.
+    wall_time : float [s]
+        Both solves together.
+    """
+
+    scene: SpatialScene
+    position: np.ndarray
+    rotation: np.ndarray
+    rotation_vector: np.ndarray
+    tensions_at_anchor: np.ndarray
+    forces_on_platform: np.ndarray
+    nodes: tuple
+    element_tensions: tuple
+    catenary: object
+    anchor_joint: str
+    wall_time: float
+
+    def summary(self) -> dict:
+        """Plain data for summary.json (SI units in the key names)."""
+        catenary = self.catenary
+        return {
+            "scene": self.scene.name,
+            "dimension": 3,
+            "method": f"Exudyn static solver on the lumped robot ({self.scene.cables[0].n_elements} elements per "
+                      f"cable, {self.anchor_joint}), started on the elastic-catenary statics",
+            "platform_position_m": self.position.tolist(),
+            "platform_rotation_vector_rad": self.rotation_vector.tolist(),
+            "platform_roll_pitch_yaw_deg": rotation_angles_deg(self.rotation).tolist(),
+            "platform_rotation_matrix": self.rotation.tolist(),
+            "tension_at_anchor_N": self.tensions_at_anchor.tolist(),
+            "force_on_platform_N": self.forces_on_platform.tolist(),
+            "catenary_platform_position_m": catenary.position.tolist(),
+            "catenary_platform_rotation_vector_rad": catenary.rotation_vector.tolist(),
+            "catenary_tension_at_anchor_N": catenary.tensions_at_anchor.tolist(),
+            "min_element_tension_N": float(min(t.min() for t in self.element_tensions)),
+            "elements_pushed": bool(min(t.min() for t in self.element_tensions) < 0.0),
+            "lumped_minus_catenary_position_m": float(np.linalg.norm(self.position - catenary.position)),
+            "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(self.rotation_vector - catenary.rotation_vector)),
+            "wall_time_s": self.wall_time,
+            **provenance(),
+        }
+
+    def save(self, out: str | Path) -> list[Path]:
+        """Write summary.json and rest_profile.png to the folder ``out``; returns the paths."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        return [write_summary(out, self.summary()), plot_spatial_rest(self, out / "rest_profile.png")]
+
+
+def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
+    """Bring a spatial scene to rest: catenary statics, then Exudyn's static solve of the lumped robot.
+
+    Raises
+    ------
+    UnreachableError
+        If the catenary statics find no equilibrium (cables that cannot hold the platform).
+    SolverFailure
+        If Exudyn's static solver does not converge.
+    """
+    start = _time.perf_counter()
+    platform = scene.catenary_platform()
+    lengths = scene.unstrained_lengths
+    catenary = solve_spatial_statics(platform, lengths)
+    rigid = not platform.is_point_mass
+    chain = scene.chain_spec(anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
+    mbs = exu.SystemContainer().AddSystem()
+    items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary)
+    mbs.Assemble()
+    static = solve_static(mbs, items)
+    nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
+    tensions = tuple(element_forces(mbs, items, i) for i in range(scene.n_cables))
+    joint = f"penalty spherical joints of {PENALTY:g} element stiffnesses" if rigid else "exact spherical joints"
+    return SpatialRest(scene, static.position, static.rotation, static.rotation_vector, static.tensions_at_anchor,
+                       static.forces_on_platform, nodes, tensions, catenary, joint, _time.perf_counter() - start)
+
+
+def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
+    """Figure of the robot at rest, in 3-D and from above: lumped cables (dots), catenaries (dashed), platform."""
+    figure = Figure(figsize=(11.0, 5.2))
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot(1, 2, 1, projection="3d")
+    top = figure.add_subplot(1, 2, 2)
+    figure.subplots_adjust(wspace=0.35)
+    colors = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive")
+    anchors = rest.position + np.asarray(rest.scene.platform.anchors) @ rest.rotation.T
+    outline = np.vstack([anchors, anchors[:1]])
+    exits = np.asarray(rest.scene.exits)
+    for i, (nodes, cable) in enumerate(zip(rest.nodes, rest.catenary.cables)):
+        color = colors[i % len(colors)]
+        curve = cable.points(np.linspace(0.0, cable.unstrained_length, CURVE_SAMPLES))
+        label = f"cable {i + 1}: {rest.tensions_at_anchor[i]:.1f} N at the anchor"
+        ax.plot(nodes[:, 0], nodes[:, 1], nodes[:, 2], "o-", color=color, markersize=2, linewidth=1.0, label=label)
+        ax.plot(curve[:, 0], curve[:, 1], curve[:, 2], "--", color="0.3", linewidth=0.7)
+        top.plot(nodes[:, 0], nodes[:, 1], "o-", color=color, markersize=2, linewidth=1.0)
+        top.annotate(f"{i + 1}", exits[i, :2], textcoords="offset points", xytext=(4, 4), fontsize=8, color=color)
+    for axes, coordinates in ((ax, (outline[:, 0], outline[:, 1], outline[:, 2])), (top, (outline[:, 0], outline[:, 1]))):
+        axes.plot(*coordinates, "k-", linewidth=1.5)
+    ax.plot(*rest.position, "ks", markersize=4)
+    ax.plot(exits[:, 0], exits[:, 1], exits[:, 2], "k^", markersize=5)
+    top.plot(exits[:, 0], exits[:, 1], "k^", markersize=5)
+    top.plot(*rest.position[:2], "ks", markersize=4)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    top.set_xlabel("x [m]")
+    top.set_ylabel("y [m]")
+    top.set_aspect("equal")
+    top.grid(True, linewidth=0.3)
+    top.set_title("from above (exits: triangles)", fontsize=9)
+    x, y, z = rest.position
+    roll, pitch, yaw = rotation_angles_deg(rest.rotation)
+    figure.suptitle(f"{rest.scene.name} at rest: platform at ({x:.4f}, {y:.4f}, {z:.4f}) m, roll {roll:.2f}, "
+                    f"pitch {pitch:.2f}, yaw {yaw:.2f} deg\nlumped cables (dots) and elastic catenaries (dashed)",
+                    fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    span = np.vstack([exits, *rest.nodes])
+    centre, half = span.mean(axis=0), 0.55 * np.ptp(span, axis=0).max()
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    path = Path(path)
+    figure.savefig(path, dpi=110, format="png")
+    return path
+
+
+def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
+    """The static mode's summary on the terminal."""
+    x, y, z = rest.position
+    roll, pitch, yaw = rotation_angles_deg(rest.rotation)
+    catenary = rest.catenary
+    print(f"{rest.scene.name} at rest (Exudyn's static solver, {rest.scene.cables[0].n_elements} elements per cable, "
+          f"{rest.anchor_joint}; {rest.wall_time:.2f} s)")
+    print(f"  platform at x = {x:.6f} m, y = {y:.6f} m, z = {z:.6f} m; rotation vector "
+          f"{np.round(rest.rotation_vector, 6).tolist()} rad (roll {roll:.4f}, pitch {pitch:.4f}, yaw {yaw:.4f} deg)")
+    for i, (tension, force) in enumerate(zip(rest.tensions_at_anchor, rest.forces_on_platform)):
+        print(f"  cable {i + 1}: {tension:.4f} N at the anchor (catenary {catenary.tensions_at_anchor[i]:.4f} N), "
+              f"force on platform {np.round(force, 4).tolist()} N")
+    print(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
+          f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
+          f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation_vector)):.4f} deg from the lumped robot")
+    lowest = min(t.min() for t in rest.element_tensions)
+    if lowest < 0.0:
+        print(f"  note: an element is compressed ({lowest:.3g} N), which a real cable cannot be: that cable is "
+              "slack at rest, and its length is longer than the catenary the lumped model can hang")
+    if out is not None:
+        print(f"  written to {out}/")
+

@@ -1,0 +1,516 @@
+"""Dynamic runs of spatial scenes: the lumped robot following a 6-DOF reference (issue 15).
+
+:func:`simulate_spatial` builds the scene's robot (:mod:`cdpr_exu.builder.spatial_robot`:
+chains held at their exit points, a point-mass or rigid platform on spherical joints),
+starts it at rest on its elastic-catenary equilibrium, and integrates it with Exudyn's
+implicit solver (the scene's ``[solver]``) while the winches follow the ideal inverse
+kinematics of the reference: each cable's paid-out length is its initial length plus
+the change of the straight distance from its exit point to its anchor along the
+reference (:mod:`cdpr_exu.physics.spatial_kinematics`), the spatial counterpart of the
+planar ``ideal_ik`` controller.
+
+**The winch at a point exit.** A spatial scene's cable leaves the frame at a fixed
+point (swivel pulleys come later), where the winch pays it out. The lumped cable keeps
+its n elements and changes with its paid-out (unstrained) length L(t): every element's
+unstrained length L / n, its axial stiffness E A n / L and damping d_n A n / L, the node
+masses rho L / n (half at the ends) and their weights, and the bending stiffness
+E J n / L, set before every step. This is a *variable-length* lumped cable: its
+statics are those of the elastic catenary of length L (which depends on L only, not on
+where along the cable the change happens), and its mass is the mass of the cable paid
+out. What it leaves out is the flow of material through the exit: the nodes slide
+along the cable by up to (L(t) - L(0)) (s / L) instead of the cable running in at the
+exit, an axial motion whose inertia is small beside the platform's.
+
+Units SI; z up, gravity along -z; poses ``(x, y, z, theta)`` with ``theta`` the platform's
+rotation vector.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import exudyn as exu
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
+from cdpr_exu.core.output import write_npz, write_summary
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose
+from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from controllers.base import Controller, Measurement
+from controllers.ideal_ik import IdealIKController, ideal_paid_out
+
+from cdpr_exu.results.result import provenance
+from cdpr_exu.run.simulate import interrupt_flag, quiet_exudyn, solver_settings
+from cdpr_exu.scenes.scene import tension_limits
+from cdpr_exu.scenes.spatial_scene import SpatialScene
+from cdpr_exu.statics.workspace import first_unheld, limits_text
+
+__all__ = ["SpatialResult", "simulate_spatial", "check_spatial_reference", "run_spatial_scene"]
+
+
+#: Samples of the reference checked before a run.
+REFERENCE_SAMPLES = 401
+
+
+def check_spatial_reference(scene: SpatialScene) -> None:
+    """Refuse a reference the cables cannot follow, before the run.
+
+    At 401 samples of the reference: every commanded paid-out length stays positive, and
+    straight cables from the exits to the anchors can give the platform its weight and
+    the reference's acceleration, ``M (a + g e_z)``, with non-negative tensions (within
+    the cables' ``min_tension`` / ``max_tension`` where given). Like the planar check,
+    this is the force part of the wrench-feasible workspace: the platform's rotation is
+    free to balance the moment.
+
+    Raises
+    ------
+    UnreachableError
+        Naming the time, the pose and what fails.
+    """
+    times = np.linspace(0.0, scene.solver.end_time, REFERENCE_SAMPLES)
+    poses = np.atleast_2d(scene.trajectory.pose(times))
+    ideal, _ = ideal_paid_out(scene, poses)
+    lengths = scene.unstrained_lengths + ideal - ideal[0]
+    short = np.argwhere(lengths <= 0.0)
+    if short.size:
+        k, i = short[0]
+        raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
+                               f"cable {i + 1} paid out to {lengths[k, i]:.4f} m: it would be reeled in completely")
+    rotations = [rotation_from_vector(theta) for theta in poses[:, 3:]]
+    anchors = poses[:, None, :3] + np.einsum("nij,mj->nmi", np.asarray(rotations), np.asarray(scene.platform.anchors))
+    pulls = np.asarray(scene.exits)[None] - anchors  # (N, m, 3)
+    directions = np.swapaxes(pulls / np.linalg.norm(pulls, axis=2, keepdims=True), 1, 2)  # (N, 3, m)
+    gravity = scene.gravity if scene.effects.gravity else 0.0
+    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
+    needed = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
+    limits = tension_limits(scene.cables)
+    unheld = first_unheld(directions, needed, limits)
+    if unheld is not None:
+        k, residual, free = unheld
+        why = ("with non-negative tensions" if limits is None
+               else f"within the cables' tension limits ({limits_text(free, limits)})")
+        raise UnreachableError(
+            f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) at "
+            f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight and "
+            f"the reference's acceleration ({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
+            "remain unbalanced")
+
+
+def rotation_error_deg(pose: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Angle [deg] of the rotation from the reference orientation to the actual one, shape (N,)."""
+    angles = []
+    for theta, theta_ref in zip(pose[:, 3:], reference[:, 3:]):
+        relative = rotation_from_vector(theta_ref).T @ rotation_from_vector(theta)
+        angles.append(np.linalg.norm(rotation_vector(relative)))
+    return np.degrees(np.asarray(angles))
+
+
+@dataclass
+class SpatialResult:
+    """A spatial run: platform pose, reference, paid-out lengths, cable nodes and tensions.
+
+    Attributes
+    ----------
+    scene_name, controller : str
+    time : ndarray, shape (N,) [s]
+    pose, reference : ndarray, shape (N, 6) [m, rad]
+        Actual and reference pose: centre of mass and rotation vector.
+    paid_out : ndarray, shape (N, m) [m]
+        Each winch's paid-out (unstrained) cable length.
+    nodes : list of ndarray, each (N, n + 1, 3) [m]
+        Node positions of each cable, exit first.
+    tensions : list of ndarray, each (N, n) [N]
+        Axial force of each element (spring part; positive in tension).
+    wall_time : float [s]
+    steps, newton_iterations : int
+    status : str
+        "completed", "failed: <cause>" or "interrupted ...".
+    failure_time : float or None [s]
+    """
+
+    scene_name: str
+    controller: str
+    time: np.ndarray
+    pose: np.ndarray
+    reference: np.ndarray
+    paid_out: np.ndarray
+    nodes: list
+    tensions: list
+    wall_time: float = 0.0
+    steps: int = 0
+    newton_iterations: int = 0
+    status: str = "completed"
+    failure_time: float | None = None
+    metadata: dict = field(default_factory=dict)
+
+    @property
+    def position_error(self) -> np.ndarray:
+        """Actual minus reference position, shape (N, 3) [m]."""
+        return self.pose[:, :3] - self.reference[:, :3]
+
+    def summary(self, after: float = 1.0) -> dict[str, Any]:
+        """Error and tension figures from ``after`` [s] on (strict JSON: null where there is no sample)."""
+        mask = self.time >= after
+        error = np.linalg.norm(self.position_error[mask], axis=1)
+        rotation = rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
+        tensions = np.concatenate([t[mask].ravel() for t in self.tensions]) if self.tensions else np.zeros(0)
+
+        def extreme(values, pick):
+            return float(pick(values)) if values.size else None
+
+        pushed = bool(tensions.size) and float(tensions.min()) < 0.0
+        notes = []
+        if pushed:
+            notes.append(f"elements pushed (lowest tension {tensions.min():.3g} N): the lumped cable carries "
+                         "compression, which a real cable cannot")
+        if not mask.any():
+            notes.append(f"no sample at or after t = {after:g} s: its error and tension figures are null")
+        simulated = float(self.time[-1]) if len(self.time) else 0.0
+        return {
+            "scene": self.scene_name, "controller": self.controller, "dimension": 3, "status": self.status,
+            "errors_measured_after_s": after,
+            "max_position_error_m": extreme(error, np.max),
+            "rms_position_error_m": float(np.sqrt(np.mean(error**2))) if error.size else None,
+            "max_abs_error_m": [extreme(np.abs(self.position_error[mask, k]), np.max) for k in range(3)],
+            "max_rotation_error_deg": extreme(rotation, np.max),
+            "min_element_tension_N": extreme(tensions, np.min),
+            "max_element_tension_N": extreme(tensions, np.max),
+            "min_tension_per_cable_N": [extreme(t[mask].ravel(), np.min) for t in self.tensions],
+            "elements_pushed": pushed,
+            "wall_time_s": self.wall_time, "simulated_time_s": simulated,
+            "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
+            "steps": int(self.steps), "newton_iterations": int(self.newton_iterations),
+            "failure_time_s": self.failure_time, "notes": notes,
+        }
+
+    def save(self, folder: str | Path, after: float = 1.0, figures: bool = True) -> list[Path]:
+        """Write result.npz, summary.json and (``figures``) overview.png into ``folder``; returns the paths."""
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
+        for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
+            arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = nodes, tensions
+        written = [write_npz(folder / "result.npz", **arrays),
+                   write_summary(folder, {**self.summary(after), **provenance()})]
+        if figures:
+            written.append(plot_spatial_run(self, folder / "overview.png", after))
+        return written
+
+
+class _SpatialWinches:
+    """The variable-length cables: before each step, every cable's elements follow its paid-out length."""
+
+    def __init__(self, mbs, scene: SpatialScene, items, lengths: np.ndarray):
+        self.mbs, self.scene, self.items = mbs, scene, items
+        self.n = scene.cables[0].n_elements
+        self.gravity = scene.gravity if (scene.effects.gravity and scene.effects.cable_mass) else 0.0
+        self.lengths = np.array(lengths, dtype=float)
+        weights = np.ones(self.n + 1)
+        weights[[0, -1]] = 0.5
+        self.mass_shares = weights  # node mass = rho l_e times this
+        self.applied = self.lengths.copy()
+
+    def set_lengths(self, lengths: np.ndarray, rates: np.ndarray) -> None:
+        """Give every cable the paid-out length ``lengths`` (m,) [m], changing at ``rates`` (m,) [m/s].
+
+        The rate goes to each element's damper as Exudyn's ``velocityOffset``: the
+        Kelvin-Voigt damper acts on the strain rate d(l - l0)/dt, so a cable that is paid
+        out without stretching is not damped (without the offset the paper's damping
+        constant on a CoGiRo cable paid out at 0.25 m/s pulls with 740 N).
+        """
+        mbs, items = self.mbs, self.items
+        for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
+            if chain.tension_only:  # the arrays the cable's numba kernels read
+                chain.axial_rest_rate[:] = float(rate) / self.n
+            for spring in chain.springs:
+                mbs.SetObjectParameter(spring, "velocityOffset", float(rate) / self.n)
+            if length == self.applied[i]:
+                continue
+            element = float(length) / self.n
+            stiffness = cable.axial_rigidity / element
+            damping = items.axial_dampings[i] * items.unstrained_lengths[i] / self.n / element
+            if chain.tension_only:
+                chain.axial_rest_length[:] = element
+                chain.axial_stiffness[:] = stiffness
+                chain.axial_damping[:] = damping
+            for spring in chain.springs:
+                mbs.SetObjectParameter(spring, "referenceLength", element)
+                mbs.SetObjectParameter(spring, "stiffness", stiffness)
+                mbs.SetObjectParameter(spring, "damping", damping)
+            masses = cable.linear_density * element * self.mass_shares
+            for body, load, mass in zip(chain.masses, chain.loads or [None] * len(masses), masses):
+                mbs.SetObjectParameter(body, "mass", float(mass))
+                if load is not None:
+                    mbs.SetLoadParameter(load, "loadVector", [0.0, 0.0, -float(mass) * self.gravity])
+            if chain.bending_stiffness is not None:
+                chain.bending_stiffness[:] = items.bending_stiffnesses[i] * items.unstrained_lengths[i] / self.n / element
+            self.applied[i] = length
+
+
+def _element_tensions(nodes: np.ndarray, length: float, axial_rigidity: float, n: int,
+                      tension_only: bool) -> np.ndarray:
+    """Spring force of each element [N], shape (n,), for node positions (n + 1, 3) and paid-out length L
+    (tension-only elements: nothing below the rest length)."""
+    element = length / n
+    force = axial_rigidity / element * (np.linalg.norm(np.diff(nodes, axis=0), axis=1) - element)
+    return np.maximum(force, 0.0) if tension_only else force
+
+
+def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False) -> SpatialResult:
+    """Run ``scene``'s reference under ``controller`` (default: ideal inverse kinematics).
+
+    The controller is any :class:`controllers.base.Controller` that works on spatial
+    scenes (:class:`controllers.ideal_ik.IdealIKController`,
+    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController`); it is asked
+    for the winch commands before every step. Open loop so far: it reads no pose.
+
+    Raises
+    ------
+    SceneError
+        If the scene has no ``[trajectory]``.
+    UnreachableError
+        If no static equilibrium of the scene's lengths exists to start from.
+    SolverFailure
+        If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed.
+    """
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
+    check_spatial_reference(scene)
+    platform = scene.catenary_platform()
+    lengths = scene.unstrained_lengths
+    start = solve_spatial_statics(platform, lengths)
+    mbs = exu.SystemContainer().AddSystem()
+    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start)
+    mbs.Assemble()
+    winches = _SpatialWinches(mbs, scene, items, lengths)
+    solver = scene.solver
+    outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
+    m, n = scene.n_cables, scene.cables[0].n_elements
+    times, poses, paid, node_series = [], [], [], [[] for _ in range(m)]
+    kinematic = scene.winch.kind == "kinematic"
+    controller = controller or IdealIKController()
+    if controller.uses_pose or controller.uses_tension:
+        raise SceneError(f"controller {controller.name!r} reads the pose or the tensions: spatial runs give "
+                         "open-loop controllers only so far")
+    controller.reset(scene, lengths.copy())
+    state = {"next": 0, "failure": None}
+
+    def record(t: float) -> None:
+        position, rotation = platform_pose(mbs, items)
+        times.append(t)
+        poses.append(np.concatenate([position, rotation_vector(rotation)]))
+        paid.append(winches.applied.copy())
+        for i in range(m):
+            node_series[i].append(chain_positions(mbs, items, i))
+
+    def pre_step(mbs_, t):  # noqa: ARG001
+        if not kinematic:
+            return True
+        try:
+            command = controller.command(Measurement(t, winches.applied.copy(), np.zeros(len(lengths))))
+            paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
+            rates = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
+            if paid_out.shape != lengths.shape or not (np.all(np.isfinite(paid_out)) and np.all(paid_out > 0.0)):
+                raise ValueError(f"the command must be {lengths.size} finite positive lengths, got {command.paid_out!r}")
+            winches.set_lengths(paid_out, rates)
+        except Exception as err:  # noqa: BLE001 - reported as the cause of the stop, with the partial result
+            state["failure"] = (f"controller {controller.name!r} raised at t = {t:.4f} s: "
+                                f"{type(err).__name__}: {err}")
+            return False
+        return True
+
+    def post_step(mbs_, t):  # noqa: ARG001
+        if interrupted["interrupted"]:
+            return False
+        while state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
+            record(float(outputs[state["next"]]))
+            state["next"] += 1
+        if report is not None:
+            report(t, _time.perf_counter() - wall_start)
+        return True
+
+    report = _progress(progress, scene)
+    record(0.0)
+    state["next"] = 1
+    mbs.SetPreStepUserFunction(pre_step)
+    mbs.SetPostStepUserFunction(post_step)
+    wall_start = _time.perf_counter()
+    with interrupt_flag() as interrupted, quiet_exudyn():
+        try:
+            mbs.SolveDynamic(solver_settings(scene))
+        except (exu.SolverError, RuntimeError, SystemError) as err:
+            state["failure"] = " ".join(str(err).split())
+    wall = _time.perf_counter() - wall_start
+    if report is not None:
+        report(None, wall)
+    time_array = np.asarray(times)
+    pose = np.asarray(poses)
+    paid_out = np.asarray(paid)
+    nodes = [np.asarray(series) for series in node_series]
+    tensions = [np.array([_element_tensions(frame, length, cable.axial_rigidity, n, scene.effects.slack)
+                          for frame, length in zip(nodes[i], paid_out[:, i])])
+                for i, cable in enumerate(scene.cables)]
+    iterations = mbs.sys["dynamicSolver"].it
+    result = SpatialResult(scene.name, controller.name if kinematic else "fixed winches", time_array, pose,
+                           np.atleast_2d(scene.trajectory.pose(time_array)), paid_out, nodes, tensions, wall,
+                           int(iterations.currentStepIndex), int(iterations.newtonStepsCount))
+    reached = float(time_array[-1])
+    if interrupted["interrupted"]:
+        result.status, result.failure_time = f"interrupted at t = {reached:.4f} s", reached
+        raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
+                             time=reached, partial_result=result)
+    elif state["failure"] is not None or reached < solver.end_time - 1e-9 or not np.all(np.isfinite(pose)):
+        cause = state["failure"] or "the solution stopped before the end time or contains NaN"
+        result.status, result.failure_time = f"failed: {cause}", reached
+        raise SolverFailure(f"the spatial run failed at t = {reached:.4f} s of {solver.end_time} s: {cause}",
+                            time=reached, partial_result=result)
+    return result
+
+
+def _progress(progress, scene):
+    """The planar runs' progress reporter (a bar or a callable), for a spatial scene."""
+    from cdpr_exu.run.simulate import _progress_reporter
+
+    return _progress_reporter(progress, scene)
+
+
+def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0) -> Path:
+    """Overview figure: the path from above and from the side, against the reference; the position
+    error over time; the lowest element tension of each cable over time."""
+    figure = Figure(figsize=(11.0, 8.0))
+    FigureCanvasAgg(figure)
+    axes = figure.subplots(2, 2)
+    top, side, error, tension = axes[0, 0], axes[0, 1], axes[1, 0], axes[1, 1]
+    for ax, (a, b), names in ((top, (0, 1), ("x [m]", "y [m]")), (side, (0, 2), ("x [m]", "z [m]"))):
+        ax.plot(result.reference[:, a], result.reference[:, b], "k--", linewidth=1.0, label="reference")
+        ax.plot(result.pose[:, a], result.pose[:, b], "tab:blue", linewidth=1.2, label="platform")
+        ax.set_xlabel(names[0])
+        ax.set_ylabel(names[1])
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, linewidth=0.3)
+        ax.legend(fontsize=8)
+    top.set_title("path from above", fontsize=9)
+    side.set_title("path from the side", fontsize=9)
+    for k, name in enumerate("xyz"):
+        error.plot(result.time, 1000.0 * result.position_error[:, k], label=f"error {name}")
+    error.axvline(after, color="0.6", linewidth=0.8, linestyle=":")
+    error.set_xlabel("t [s]")
+    error.set_ylabel("actual - reference [mm]")
+    error.grid(True, linewidth=0.3)
+    error.legend(fontsize=8)
+    for i, series in enumerate(result.tensions):
+        tension.plot(result.time, series.min(axis=1), label=f"cable {i + 1}")
+    tension.axhline(0.0, color="k", linewidth=0.8)
+    tension.set_xlabel("t [s]")
+    tension.set_ylabel("lowest element tension [N]")
+    tension.grid(True, linewidth=0.3)
+    tension.legend(fontsize=7, ncol=2)
+    summary = result.summary(after)
+    worst = summary["max_position_error_m"]
+    figure.suptitle(f"{result.scene_name} under {result.controller}: max position error after {after:g} s "
+                    f"{'n/a' if worst is None else f'{1000 * worst:.2f} mm'} ({result.status})", fontsize=10)
+    figure.tight_layout()
+    path = Path(path)
+    figure.savefig(path, dpi=100, format="png")
+    return path
+
+
+def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
+                      after: float = 1.0) -> SpatialResult:
+    """``cdpr run`` on a spatial scene: run, write (``out``: scene.toml-free result folder), print a summary.
+
+    On a solver failure the partial result is written before the error propagates.
+    """
+    def write(result: SpatialResult) -> None:
+        if out is not None:
+            result.save(out, after, figures)
+
+    try:
+        result = simulate_spatial(scene, progress=not quiet)
+    except (SolverFailure, RunInterrupted) as err:  # keep what was computed
+        if err.partial_result is not None:
+            write(err.partial_result)
+        raise
+    write(result)
+    if not quiet:
+        s = result.summary(after)
+
+        def mm(value):
+            return "n/a" if value is None else f"{1000 * value:.2f} mm"
+        print(f"{scene.name} under {result.controller} (spatial; error = actual - reference, after {after:g} s)")
+        print(f"  status                     {s['status']}")
+        print(f"  max / RMS position error   {mm(s['max_position_error_m'])} / {mm(s['rms_position_error_m'])}")
+        rotation = s["max_rotation_error_deg"]
+        print(f"  max rotation error         {'n/a' if rotation is None else f'{rotation:.4f} deg'}")
+        print("  min tension per cable      " + " / ".join("n/a" if v is None else f"{v:.1f} N"
+                                                          for v in s["min_tension_per_cable_N"]))
+        print(f"  simulated / wall time      {s['simulated_time_s']:.2f} s / {s['wall_time_s']:.2f} s "
+              f"({s['real_time_factor']:.1f}x real time), {s['steps']} steps, {s['newton_iterations']} Newton iterations")
+        for note in s["notes"]:
+            print(f"  note: {note}")
+        if out is not None:
+            print(f"  written to {out}/")
+    return result
+
+
+#: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
+SPATIAL_CONTROLLERS = {
+    "ideal_ik": IdealIKController,
+    "tension_aware": lambda: __import__("controllers.spatial_tension_aware",
+                                        fromlist=["SpatialTensionAwareController"]).SpatialTensionAwareController(),
+}
+
+_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
+            ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
+            ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
+
+
+def spatial_comparison_table(summaries: dict) -> str:
+    """The spatial comparison as a Markdown table (errors after the summaries' ``after``)."""
+    lines = ["| controller | " + " | ".join(title for _, title, _ in _COLUMNS) + " | vs ideal IK | status |",
+             "|" + "---|" * (len(_COLUMNS) + 3)]
+    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
+    for name, s in summaries.items():
+        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in _COLUMNS]
+        worst = s.get("max_position_error_m")
+        ratio = f"{base / worst:.1f}x" if base and worst else ""
+        pushed = "; cables pushed" if s.get("elements_pushed") else ""
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{pushed} |")
+    return "\n".join(lines) + "\n"
+
+
+def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
+                    after: float = 1.0, quiet: bool = True) -> dict[str, dict]:
+    """Run a spatial scene under each named controller; write summary.json, comparison.md and each
+    controller's overview figure to ``out``. Returns the summaries by name."""
+    from cdpr_exu.core.output import write_summary as _write
+
+    names = list(names or SPATIAL_CONTROLLERS)
+    unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
+    if unknown:
+        raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
+    summaries = {}
+    for name in names:
+        try:
+            result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
+        except SolverFailure as err:
+            result = err.partial_result
+        summaries[name] = result.summary(after)
+        if out is not None:
+            Path(out).mkdir(parents=True, exist_ok=True)
+            plot_spatial_run(result, Path(out) / f"overview_{name}.png", after)
+        if not quiet:
+            worst = summaries[name]["max_position_error_m"]
+            print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   {summaries[name]['status']}")
+    if out is not None:
+        _write(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
+                     "error_convention": "actual - reference", "controllers": summaries, **provenance()})
+        (Path(out) / "comparison.md").write_text(spatial_comparison_table(summaries))
+    return summaries
+

@@ -1,0 +1,293 @@
+"""Spatial scenes: a 3-D cable robot declared in TOML, validated once (issue 15).
+
+A spatial scene says ``dimension = 3`` at its top. Its cables use the planar scenes'
+``[cable]`` / ``[[cables]]`` tables (material, unstrained length, elements: they do not
+depend on the dimension); each cable leaves the frame at a fixed exit point (a point
+exit; swivel pulleys come later) given in ``[[exits]]``; the platform is a point mass
+(every anchor at its centre of mass) or a rigid 6-DOF body. Frame: z up, gravity along
+-z, SI units. Example (the shipped ``spatial-four-cable``)::
+
+    name = "spatial-four-cable"
+    dimension = 3
+    [cable]
+    radius = 0.005
+    ...
+    [[cables]]
+    unstrained_length = 2.40
+    [[exits]]
+    point = [1.5, 1.5, 0.0]
+    [platform]
+    mass = 5.0
+    inertia = [0.05, 0.05, 0.08]       # principal moments about the centre of mass
+    anchors = [[0.1, 0.1, 0.05], ...]  # platform frame
+
+``cdpr static`` brings a spatial scene to rest (:mod:`cdpr_exu.run.spatial_rest`); ``cdpr run``
+follows its ``[trajectory]`` (a 6-DOF reference, :mod:`cdpr_exu.scenes.spatial_trajectories`) with
+``[winch] kind = "kinematic"`` winches under ideal inverse kinematics, with its ``[solver]``
+settings (:mod:`cdpr_exu.run.spatial_run`). The other commands refuse spatial scenes with a
+message that says so.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, ClassVar, Mapping
+
+import numpy as np
+
+from cdpr_exu.physics.catenary import STANDARD_GRAVITY
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
+from cdpr_exu.scenes.scene import CableSpec, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec, _build, _per_cable, load_scene
+from cdpr_exu.core.validation import non_negative, vector
+
+__all__ = ["SpatialPlatformSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
+           "shipped_spatial_scenes", "is_spatial", "load_any_scene"]
+
+#: Where the shipped spatial scenes live, inside the package's ``scenes`` folder.
+SPATIAL_FOLDER = "spatial"
+
+
+@dataclass(frozen=True)
+class SpatialPlatformSpec:
+    """The platform of a spatial robot: a point mass, or a rigid body when an anchor is off its centre.
+
+    Parameters
+    ----------
+    mass : float [kg]
+    inertia : (float, float, float) [kg m^2]
+        Principal moments of inertia about the centre of mass, along the platform axes
+        (positive for a rigid platform).
+    anchors : sequence of (x, y, z) [m]
+        Cable anchor points in the platform frame (centre of mass at 0), one per cable.
+    """
+
+    mass: float = 1.0
+    inertia: tuple = (0.0, 0.0, 0.0)
+    anchors: tuple = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mass", non_negative("platform.mass", self.mass))
+        inertia = vector("platform.inertia", self.inertia, 3, " (principal moments) [kg m^2]")
+        if np.any(inertia < 0.0):
+            raise SceneError(f"platform.inertia must be zero or positive, got {self.inertia!r}")
+        object.__setattr__(self, "inertia", tuple(float(v) for v in inertia))
+        if isinstance(self.anchors, (str, bytes, Mapping)):
+            raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {self.anchors!r}")
+        anchors = tuple(tuple(float(v) for v in vector(f"platform.anchors[{i}]", a, 3, " (x, y, z) [m]"))
+                        for i, a in enumerate(self.anchors))
+        object.__setattr__(self, "anchors", anchors)
+        if not self.is_point_mass and (self.mass <= 0.0 or min(self.inertia) <= 0.0):
+            raise SceneError(f"a rigid platform (an anchor off its centre of mass) needs platform.mass > 0 and "
+                             f"every platform.inertia > 0, got mass {self.mass!r}, inertia {self.inertia!r}")
+
+    @property
+    def is_point_mass(self) -> bool:
+        """True when every anchor is at the centre of mass."""
+        return all(a == (0.0, 0.0, 0.0) for a in self.anchors)
+
+
+@dataclass(frozen=True)
+class SpatialScene:
+    """A spatial cable robot: cables from fixed exit points to a platform, z up, SI units.
+
+    Parameters
+    ----------
+    name, description : str
+    cables : tuple of CableSpec
+        Material, unstrained length [m] and elements of each cable (as in planar scenes).
+    exits : tuple of (x, y, z) [m]
+        Where each cable leaves the frame (a point exit), world frame.
+    platform : SpatialPlatformSpec
+    gravity : float [m/s^2]
+        Along -z.
+    effects : Effects
+        Which physics the lumped model includes: cable mass and gravity, axial elasticity
+        and damping, bending, tension-only elements (``slack``: the cables cannot push,
+        :mod:`cdpr_exu.physics.axial_3d`); point exits have no pulley contact.
+    trajectory : spatial trajectory or None
+        The reference of ``cdpr run`` (:mod:`cdpr_exu.scenes.spatial_trajectories`); None: the
+        scene has a static mode only.
+    solver : SolverSpec
+        The implicit integration of ``cdpr run`` (as in planar scenes).
+    winch : WinchSpec
+        ``kind = "kinematic"`` (the winches pay out what the controller commands) or
+        ``"fixed"``; servo drums are planar only so far.
+
+    Raises
+    ------
+    SceneError
+        Naming the field: counts that do not match, two cables on one exit point,
+        effects the spatial model does not have, cables that differ in elements,
+        damping or bending (one chain description serves all cables so far).
+    """
+
+    name: str = "spatial-scene"
+    description: str = ""
+    cables: tuple = ()
+    exits: tuple = ()
+    platform: SpatialPlatformSpec = field(default_factory=SpatialPlatformSpec)
+    gravity: float = STANDARD_GRAVITY
+    effects: Effects = field(default_factory=lambda: Effects.from_preset("full"))
+    trajectory: Any = None
+    solver: SolverSpec = field(default_factory=SolverSpec)
+    winch: WinchSpec = field(default_factory=WinchSpec)
+
+    #: Spatial scenes are 3-D; planar :class:`~cdpr_exu.scenes.scene.Scene` objects have no such attribute.
+    dimension: ClassVar[int] = 3
+
+    def __post_init__(self) -> None:
+        if not self.cables or not all(isinstance(c, CableSpec) for c in self.cables):
+            raise SceneError(f"cables must be a non-empty list of cable tables, got {self.cables!r}")
+        object.__setattr__(self, "cables", tuple(self.cables))
+        exits = tuple(tuple(float(v) for v in vector(f"exits[{i}].point", e, 3, " (x, y, z) [m]"))
+                      for i, e in enumerate(self.exits))
+        object.__setattr__(self, "exits", exits)
+        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
+        m = len(self.cables)
+        if len(exits) != m:
+            raise SceneError(f"exits must give one exit point per cable ({m}), got {len(exits)}")
+        if len(self.platform.anchors) != m:
+            raise SceneError(f"platform.anchors must give one anchor per cable ({m}), got {len(self.platform.anchors)}")
+        if not isinstance(self.effects, Effects):
+            raise SceneError(f"effects must be an effects table, got {self.effects!r}")
+        if not (self.effects.cable_mass and self.effects.axial_elasticity):
+            raise SceneError(f"effects.preset = {self.effects.preset!r}: a spatial scene needs lumped, elastic cables "
+                             "(effects.cable_mass and effects.axial_elasticity); use the 'full' or 'catenary' preset")
+        first = self.cables[0]
+        for i, cable in enumerate(self.cables[1:], start=1):
+            for name in ("n_elements", "radius", "youngs_modulus", "damping_constant"):
+                if getattr(cable, name) != getattr(first, name):
+                    raise SceneError(f"cables[{i}].{name} = {getattr(cable, name)!r} differs from cables[0].{name} = "
+                                     f"{getattr(first, name)!r}: the cables of a spatial scene share one "
+                                     "discretisation, damping and bending so far")
+        self.catenary_platform()  # refuses coincident exits, too few cables, anchors on one line
+        if self.winch.kind == "servo":
+            raise SceneError("winch.kind = 'servo': servo drums are planar only so far; use 'kinematic' or 'fixed'")
+        if not isinstance(self.solver, SolverSpec) or self.solver.integrator != "generalized_alpha":
+            raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
+
+    @property
+    def n_cables(self) -> int:
+        return len(self.cables)
+
+    @property
+    def unstrained_lengths(self) -> np.ndarray:
+        """Unstrained length of each cable, shape (m,) [m]."""
+        return np.array([c.unstrained_length for c in self.cables])
+
+    def catenary_platform(self) -> SpatialPlatform:
+        """The scene as elastic catenaries (:mod:`cdpr_exu.physics.spatial_statics`)."""
+        gravity = self.gravity if self.effects.gravity else 0.0
+        weighs = self.effects.cable_mass and self.effects.gravity
+        cables = [SpatialCable(e, c.linear_density * gravity if weighs else 0.0, c.axial_rigidity, anchor=a)
+                  for c, e, a in zip(self.cables, self.exits, self.platform.anchors)]
+        return SpatialPlatform(cables, self.platform.mass, gravity, self.platform.inertia)
+
+    def chain_spec(self, anchor_spring_factor: float | None = None, tension_only: bool | None = None):
+        """The lumped cables (:mod:`cdpr_exu.builder.spatial_robot`), with the scene's effects.
+
+        ``tension_only`` defaults to ``effects.slack``; the static mode asks for False (Exudyn's
+        static solver needs every element's stiffness, which a slack element has not).
+        """
+        from cdpr_exu.builder.spatial_robot import SpatialChainSpec  # the builder's: Exudyn loads with it
+
+        cable = self.cables[0]
+        return SpatialChainSpec(
+            tension_only=self.effects.slack if tension_only is None else bool(tension_only),
+            n_elements=cable.n_elements,
+            axial_damping_constant=cable.damping_constant * cable.area if self.effects.axial_damping else 0.0,
+            flexural_rigidity=cable.youngs_modulus * cable.second_moment if self.effects.bending else 0.0,
+            anchor_spring_factor=anchor_spring_factor)
+
+
+def is_spatial(scene: Any) -> bool:
+    """True for a spatial scene (``dimension = 3``)."""
+    return getattr(scene, "dimension", 2) == 3
+
+
+def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
+    """Make a validated SpatialScene from plain data (as read from TOML).
+
+    ``[cable]`` holds values shared by every cable; ``[[cables]]`` entries override them
+    one by one (at least one entry per cable). ``[[exits]]`` give each cable's exit
+    ``point``; ``[effects]`` may name a ``preset`` and override single effects.
+    """
+    if not isinstance(data, Mapping):
+        raise SceneError(f"a scene must be a table (mapping), got {data!r}")
+    known = {"name", "description", "dimension", "gravity", "cable", "cables", "exits", "platform", "effects",
+             "trajectory", "solver", "winch"}
+    unknown = set(data) - known
+    if unknown:
+        raise SceneError(f"spatial scene has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
+    if data.get("dimension") != 3:
+        raise SceneError(f"a spatial scene says dimension = 3, got {data.get('dimension')!r}")
+    for table in ("cables", "exits", "platform"):
+        if table not in data:
+            raise SceneError(f"spatial scene lacks {table}: give [[cables]] (one per cable, at least its "
+                             "unstrained_length), [[exits]] (each with a point) and [platform] (mass, anchors)")
+    exits = data["exits"]
+    if not isinstance(exits, list) or not all(isinstance(e, Mapping) and set(e) == {"point"} for e in exits):
+        raise SceneError(f"exits must be an array of tables, each with one field 'point' = [x, y, z], got {exits!r}")
+    cables = tuple(_build(CableSpec, c, f"cables[{i}]")
+                   for i, c in enumerate(_per_cable(data, "cable", "cables", [])))
+    effects_data = data.get("effects", {})
+    if not isinstance(effects_data, Mapping):
+        raise SceneError(f"effects must be a table, got {effects_data!r}")
+    effects_data = dict(effects_data)
+    effects = Effects.from_preset(effects_data.pop("preset", "full"), **effects_data)
+    kwargs: dict[str, Any] = dict(cables=cables, exits=tuple(e["point"] for e in exits),
+                                  platform=_build(SpatialPlatformSpec, data["platform"], "platform"), effects=effects,
+                                  solver=_build(SolverSpec, data.get("solver", {}), "solver"),
+                                  winch=_build(WinchSpec, data.get("winch", {}), "winch"))
+    if "trajectory" in data:
+        from cdpr_exu.scenes.spatial_trajectories import spatial_trajectory_from_dict
+
+        kwargs["trajectory"] = spatial_trajectory_from_dict(data["trajectory"])
+    for key in ("name", "description", "gravity"):
+        if key in data:
+            kwargs[key] = data[key]
+    return SpatialScene(**kwargs)
+
+
+def shipped_spatial_scenes() -> list[str]:
+    """Names of the spatial scenes shipped with the package."""
+    folder = resources.files("cdpr_exu.scenes").joinpath(SPATIAL_FOLDER)
+    return sorted(p.name[:-5].replace("_", "-") for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def shipped_spatial_text(name: str) -> str | None:
+    """The TOML text of the shipped spatial scene ``name``, or None."""
+    resource = resources.files("cdpr_exu.scenes").joinpath(SPATIAL_FOLDER, str(name).replace("-", "_") + ".toml")
+    return resource.read_text() if resource.is_file() else None
+
+
+def load_spatial_scene(source: str | Path) -> SpatialScene:
+    """Load a spatial scene by shipped name (e.g. ``"spatial-four-cable"``) or from a TOML file path."""
+    path = Path(source)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise SceneError(f"scene file {str(path)!r} does not exist")
+        text = path.read_text()
+    else:
+        text = shipped_spatial_text(str(source))
+        if text is None:
+            raise SceneError(f"no spatial scene named {str(source)!r}; shipped spatial scenes: "
+                             f"{', '.join(shipped_spatial_scenes())}")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
+    return spatial_scene_from_dict(data)
+
+
+def load_any_scene(source: str | Path) -> Scene | SpatialScene:
+    """Load a planar or a spatial scene, by shipped name or TOML file path."""
+    try:
+        return load_scene(source)
+    except SpatialSceneError:
+        return load_spatial_scene(source)
+

@@ -1,0 +1,865 @@
+"""Accuracy against cost: the model ladder over element counts and step sizes.
+
+One scene is run on every model of the ladder (the :data:`~cdpr_exu.scenes.scene.PRESETS`
+``ideal``, ``elastic``, ``catenary``, ``full``, and ``full`` with the linear
+curvature-vector bending), over the number of elements per cable and the time step,
+and every run is compared with a *reference*: the richest model (``full``) at the
+finest discretisation and step that still finish in reasonable time. Each run gives
+one row: its configuration, its status (a run the builder refuses or the monitor
+stops is a result too), its cost, and its errors against the reference:
+
+- ``path`` comparison (moving scenes): the platform position error
+  ``|p(t) - p_ref(t)|`` on the reference's output times from ``after`` seconds on
+  (the run interpolated onto them), its maximum and RMS; the largest rotation error;
+  the error of the cable tensions at the platform end (the last element's axial
+  force, or the massless rope's force), maximum and RMS over cables and times;
+- ``final`` comparison (static scenes: a held pose and fixed winches): the same
+  errors of the final state only, and the platform's final speed, which says whether
+  the run had come to rest.
+
+From the rows: the Pareto front of error against cost, the cheapest
+configuration meeting each tolerance, and what each effect changes and costs
+(each model and effect variant against ``full`` at the same discretisation).
+
+Cost: every run records its wall time (``wall_time_s``, the time integration as
+:func:`~cdpr_exu.run.simulate.simulate` measures it) and the CPU time of its
+single-threaded worker process over the whole run, model building included
+(``cpu_time_s``). The front, the tables and the figure use the CPU time (:data:`COST`):
+on an idle core the two agree, but on a shared machine the wall time of the same run
+varied by a factor of two with the load of other processes, the CPU time by a few
+per cent.
+
+Command line: ``cdpr study accuracy SCENE --out DIR [--quick]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import os
+import sys
+import time
+from concurrent.futures import Executor, Future, as_completed
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from cdpr_exu.core.errors import EXIT_CODES, SceneError
+from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, apply_parameters, study_subparsers
+
+# --------------------------------------------------------------------------- configurations
+
+#: Position tolerances of the tolerance table [m].
+TOLERANCES = (1.0e-3, 1.0e-2, 5.0e-2)
+
+#: The cost a run is judged by: the CPU time of its single-threaded process [s].
+COST = "cpu_time_s"
+
+#: Presets whose cables are massless ropes: the number of elements does not apply.
+MASSLESS_PRESETS = ("ideal", "elastic")
+
+#: Files the study writes into its output folder.
+ACCURACY_FILES = {
+    "csv": "accuracy.csv",
+    "json": "accuracy.json",
+    "pareto": "pareto.png",
+    "tables": "tables.md",
+    "reference": "reference.npz",
+    "scene": "base_scene.toml",
+}
+
+
+@dataclass(frozen=True)
+class Configuration:
+    """One run of the study: a model of the ladder and its discretisation.
+
+    Parameters
+    ----------
+    preset : str
+        Effects preset (see :data:`~cdpr_exu.scenes.scene.PRESETS`).
+    n_elements : int or None
+        Elements per cable; None for the massless presets (one rope per cable).
+    step_size : float [s]
+    overrides : tuple of (path, value)
+        Further parameter paths of :mod:`cdpr_exu.studies.study`, e.g.
+        ``(("effects.bending_model", "linear"),)`` or ``(("cables.mass_lumping", "paper"),)``.
+    """
+
+    preset: str
+    n_elements: int | None
+    step_size: float
+    overrides: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def model(self) -> str:
+        """The model's name: the preset and its overrides, e.g. ``full, linear bending``."""
+        return model_name(self.preset, self.overrides)
+
+    @property
+    def label(self) -> str:
+        """Short description, e.g. ``full n=15 h=2e-03``."""
+        n = "" if self.n_elements is None else f" n={self.n_elements}"
+        return f"{self.model}{n} h={self.step_size:.0e}"
+
+    def scene_data(self, base_data: Mapping[str, Any]) -> dict[str, Any]:
+        """Plain scene data of this configuration made from the base scene's (not validated).
+
+        The effects are the preset's with the ``effects.*`` overrides (the base scene's
+        own effects are replaced); other overrides are parameter paths of
+        :func:`~cdpr_exu.studies.study.apply_parameters`.
+        """
+        assignments: list[tuple[str, Any]] = [("solver.step_size", self.step_size)]
+        if self.n_elements is not None:
+            assignments.append(("cables.n_elements", self.n_elements))
+        effects: dict[str, Any] = {"preset": self.preset}
+        for path, value in self.overrides:
+            if path.startswith("effects."):
+                effects[path[len("effects."):]] = value
+            else:
+                assignments.append((path, value))
+        data = apply_parameters(base_data, assignments)
+        data["effects"] = effects
+        return data
+
+
+def model_name(preset: str, overrides: Sequence[tuple[str, Any]] = ()) -> str:
+    """Readable name of a preset with overrides (``full, linear bending``, ``full, segment contact``,
+    ``full, slack=true``)."""
+    parts = [preset]
+    for path, value in overrides:
+        key = path.split(".")[-1]
+        if key == "bending_model":
+            parts.append(f"{value} bending")
+        elif key == "pulley_contact_model":
+            parts.append(f"{value} contact")
+        else:
+            parts.append(f"{key}={json.dumps(value) if isinstance(value, bool) else value}")
+    return ", ".join(parts)
+
+
+LINEAR_BENDING = (("effects.bending_model", "linear"),)
+
+
+@dataclass(frozen=True)
+class AccuracyGrid:
+    """Which configurations an accuracy study runs.
+
+    Parameters
+    ----------
+    models : tuple of (preset, overrides)
+        The model ladder; massless presets are run once per step size.
+    n_elements : tuple of int
+        Elements per cable of the lumped models.
+    step_sizes : tuple of float [s]
+    reference : Configuration
+        The configuration every run is compared with.
+    variants : tuple of overrides
+        Single-effect variants of ``full``, run at ``variant_resolution`` only.
+    variant_resolution : (n_elements, step_size)
+        Where the effects are compared with each other (every model is run there too).
+    end_time : float or None [s]
+        Overrides the scene's end time.
+    after : float [s]
+        Path errors are measured from this time on (from 0 if the run is not longer).
+    """
+
+    models: tuple[tuple[str, tuple], ...]
+    n_elements: tuple[int, ...]
+    step_sizes: tuple[float, ...]
+    reference: Configuration
+    variants: tuple[tuple[tuple[str, Any], ...], ...] = ()
+    variant_resolution: tuple[int, float] | None = None
+    end_time: float | None = None
+    after: float = 1.0
+
+    def configurations(self) -> list[Configuration]:
+        """Every configuration, the reference first, without duplicates."""
+        out = [self.reference]
+        for preset, overrides in self.models:
+            counts = (None,) if preset in MASSLESS_PRESETS else self.n_elements
+            out.extend(Configuration(preset, n, h, tuple(overrides)) for n in counts for h in self.step_sizes)
+        if self.variant_resolution is not None:
+            n, h = self.variant_resolution
+            for preset, overrides in self.models:
+                out.append(Configuration(preset, None if preset in MASSLESS_PRESETS else n, h, tuple(overrides)))
+            out.extend(Configuration("full", n, h, tuple(v)) for v in self.variants)
+        unique: list[Configuration] = []
+        for configuration in out:
+            if configuration not in unique:
+                unique.append(configuration)
+        return unique
+
+
+#: The ladder: every preset, and the full model with the linear bending.
+LADDER = (("ideal", ()), ("elastic", ()), ("catenary", ()), ("full", ()), ("full", LINEAR_BENDING))
+
+#: Single-effect variants of the full model compared at the variant resolution.
+EFFECT_VARIANTS = (
+    (("effects.bending_damping", False),),
+    (("effects.bending_model", "linear"), ("effects.bending_damping", False)),
+    (("effects.slack", True),),
+    (("cables.mass_lumping", "paper"),),
+    (("effects.pulley_contact_model", "segment"),),
+)
+
+#: The grid of ``examples/accuracy_vs_time.py`` (about 6 minutes per scene on 2 cores).
+FULL_GRID = AccuracyGrid(
+    models=LADDER,
+    n_elements=(8, 10, 15, 20, 30, 45, 60),
+    step_sizes=(5.0e-4, 1.0e-3, 2.0e-3, 5.0e-3, 1.0e-2),
+    reference=Configuration("full", 90, 5.0e-4),
+    variants=EFFECT_VARIANTS,
+    variant_resolution=(30, 1.0e-3),
+)
+
+#: A small grid for tests and a first look: 1.5 s of the scene, reference = finest run.
+QUICK_GRID = AccuracyGrid(
+    models=(("ideal", ()), ("full", ()), ("full", LINEAR_BENDING)),
+    n_elements=(12, 20),
+    step_sizes=(2.0e-3, 5.0e-3),
+    reference=Configuration("full", 20, 2.0e-3),
+    end_time=1.5,
+    after=1.0,
+)
+
+
+# --------------------------------------------------------------------------- one run
+
+
+def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
+    """Simulate one configuration given as plain scene data; never raises.
+
+    The worker function of the study (top-level, plain data in and out).
+
+    Returns
+    -------
+    dict
+        ``status`` (``completed``, ``failed: ...``, ``refused: ...``), ``wall_time_s``,
+        ``cpu_time_s`` (of the whole run, model building included), ``simulated_time_s``, ``steps``, ``newton_iterations``, ``failure_time_s``, and
+        for runs that produced samples: ``time`` (N,) [s], ``pose`` (N, 3) [m, m, rad],
+        ``end_tensions`` (N, m) [N] at the platform end of each cable, ``speed`` (N,)
+        [m/s] of the platform.
+    """
+    for name, value in SINGLE_THREAD_ENVIRONMENT.items():
+        os.environ.setdefault(name, value)
+    from cdpr_exu.core.errors import SolverFailure, UnreachableError
+    from cdpr_exu.scenes.scene import scene_from_dict
+    from cdpr_exu.run.simulate import simulate
+    from cdpr_exu.studies.study import _warm_up
+
+    empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
+             "newton_iterations": 0, "failure_time_s": math.nan}
+    try:
+        scene = scene_from_dict(scene_data)
+        _warm_up(scene)
+        cpu = time.process_time()
+        try:
+            result = simulate(scene, progress=False)
+            status = "completed"
+        except SolverFailure as err:
+            result = err.partial_result
+            status = "failed: " + " ".join(str(err).split())
+            if result is None:
+                return {"status": status, **empty}
+        finally:
+            cpu = time.process_time() - cpu
+    except (SceneError, UnreachableError) as err:
+        return {"status": "refused: " + " ".join(str(err).split()), **empty}
+    except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
+        return {"status": f"failed: {type(err).__name__}: " + " ".join(str(err).split()), **empty}
+    finite = np.all(np.isfinite(result.platform_pose), axis=1)
+    tensions = np.column_stack([t[:, -1] for t in result.tensions]) if result.tensions else np.zeros((len(finite), 0))
+    return {
+        "status": status,
+        "wall_time_s": float(result.wall_time),
+        "cpu_time_s": float(cpu),
+        "simulated_time_s": float(result.time[finite][-1]) if finite.any() else 0.0,
+        "steps": int(result.steps),
+        "newton_iterations": int(result.newton_iterations),
+        "failure_time_s": math.nan if result.failure_time is None else float(result.failure_time),
+        "time": result.time[finite],
+        "pose": result.platform_pose[finite],
+        "end_tensions": tensions[finite],
+        "speed": np.linalg.norm(result.platform_velocity[finite, :2], axis=1),
+    }
+
+
+# --------------------------------------------------------------------------- errors
+
+
+#: Error figures of every compared run, in column order.
+ERROR_FIGURES = ("position_error_max_m", "position_error_rms_m", "rotation_error_max_deg",
+                 "tension_error_max_N", "tension_error_rms_N", "final_speed_m_s")
+
+
+def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: str = "path",
+            after: float = 1.0) -> dict[str, float]:
+    """Errors of one run against the reference.
+
+    Parameters
+    ----------
+    run, reference : dict
+        Outcomes of :func:`run_configuration` with ``time``, ``pose``, ``end_tensions``.
+    comparison : {"path", "final"}
+        ``"path"``: on the reference's times from ``after`` on (the run interpolated
+        linearly onto them); ``"final"``: the last samples only.
+    after : float [s]
+
+    Returns
+    -------
+    dict
+        The :data:`ERROR_FIGURES` [m, deg, N, m/s]; NaN if the run does not cover the
+        compared times.
+    """
+    nan = {name: math.nan for name in ERROR_FIGURES}
+    if "time" not in run or len(run["time"]) == 0:
+        return nan
+    t_ref = np.asarray(reference["time"])
+    t_run = np.asarray(run["time"])
+    speed = float(np.asarray(run["speed"])[-1])
+    if comparison == "final":
+        if t_run[-1] < t_ref[-1] - 1e-9:
+            return {**nan, "final_speed_m_s": speed}
+        pose_error = np.asarray(run["pose"])[-1:] - np.asarray(reference["pose"])[-1:]
+        tension_error = np.asarray(run["end_tensions"])[-1:] - np.asarray(reference["end_tensions"])[-1:]
+    elif comparison == "path":
+        mask = t_ref >= min(after, t_ref[-1]) - 1e-9
+        times = t_ref[mask]
+        if t_run[-1] < times[-1] - 1e-9:
+            return {**nan, "final_speed_m_s": speed}
+        pose = np.column_stack([np.interp(times, t_run, column) for column in np.asarray(run["pose"]).T])
+        tensions = np.column_stack([np.interp(times, t_run, column) for column in np.asarray(run["end_tensions"]).T])
+        pose_error = pose - np.asarray(reference["pose"])[mask]
+        tension_error = tensions - np.asarray(reference["end_tensions"])[mask]
+    else:
+        raise SceneError(f"comparison must be 'path' or 'final', got {comparison!r}")
+    position = np.linalg.norm(pose_error[:, :2], axis=1)
+    return {
+        "position_error_max_m": float(position.max()),
+        "position_error_rms_m": float(np.sqrt(np.mean(position**2))),
+        "rotation_error_max_deg": float(np.degrees(np.abs(pose_error[:, 2]).max())),
+        "tension_error_max_N": float(np.abs(tension_error).max()),
+        "tension_error_rms_N": float(np.sqrt(np.mean(tension_error**2))),
+        "final_speed_m_s": speed,
+    }
+
+
+def comparison_for(scene) -> str:
+    """``"final"`` for a static scene (held pose, fixed winches), else ``"path"``."""
+    from cdpr_exu.scenes.trajectories import HoldTrajectory
+
+    static = isinstance(scene.trajectory, HoldTrajectory) and scene.winch.kind == "fixed"
+    return "final" if static else "path"
+
+
+def pareto_front(rows: Sequence[Mapping[str, Any]], error: str = "position_error_max_m") -> list[Mapping[str, Any]]:
+    """Completed runs no other run beats in both cost (:data:`COST`) and ``error``, cheapest first."""
+    candidates = sorted((r for r in rows if _usable(r, error)), key=lambda r: (r[COST], r[error]))
+    front, best = [], math.inf
+    for row in candidates:
+        if row[error] < best:
+            front.append(row)
+            best = row[error]
+    return front
+
+
+def cheapest_meeting(rows: Sequence[Mapping[str, Any]], tolerance: float, error: str = "position_error_max_m",
+                     model: str | None = None) -> Mapping[str, Any] | None:
+    """The completed run of least cost (:data:`COST`) whose ``error`` is within ``tolerance``."""
+    meeting = [r for r in rows if _usable(r, error) and r[error] <= tolerance and (model is None or r["model"] == model)]
+    return min(meeting, key=lambda r: r[COST]) if meeting else None
+
+
+def _usable(row: Mapping[str, Any], error: str) -> bool:
+    """A completed, compared run other than the reference."""
+    return (row.get("status") == "completed" and not row.get("is_reference")
+            and _finite(row.get(error)) and _finite(row.get(COST)))
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+# --------------------------------------------------------------------------- the study
+
+
+@dataclass
+class AccuracyStudy:
+    """The outcome of :func:`run_accuracy_study`.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One per configuration (the reference first): configuration, status, cost,
+        errors against the reference, and for the effects table the errors against
+        ``full`` at the variant resolution (``moved_*``).
+    reference : Configuration
+    comparison : {"path", "final"}
+    scene_name : str
+    end_time : float [s]
+    after : float [s]
+    series : dict
+        Time series of every run that produced samples, by run index (not written).
+    """
+
+    rows: list[dict[str, Any]]
+    reference: Configuration
+    comparison: str
+    scene_name: str
+    end_time: float
+    after: float
+    grid: AccuracyGrid
+    series: dict[int, dict[str, Any]] = field(default_factory=dict, repr=False)
+
+    @property
+    def reference_row(self) -> dict[str, Any]:
+        return next(r for r in self.rows if r["is_reference"])
+
+
+def _estimated_cost(configuration: Configuration) -> float:
+    """Rough relative cost, to start the longest runs first."""
+    n = configuration.n_elements or 4
+    return n ** 1.5 / configuration.step_size
+
+
+def run_accuracy_study(scene, grid: AccuracyGrid = FULL_GRID, *, out: str | Path | None = None,
+                       workers: int | None = None, executor: Executor | None = None, progress: bool = True,
+                       comparison: str | None = None) -> AccuracyStudy:
+    """Run ``scene`` on every configuration of ``grid`` and compare each with the reference.
+
+    Parameters
+    ----------
+    scene : Scene, or a shipped scene name or TOML path
+    grid : AccuracyGrid
+    out : path, optional
+        Folder for the CSV, JSON, tables, Pareto plot and the reference's series.
+    workers : int, optional
+        Single-threaded worker processes (default: one per core).
+    executor : concurrent.futures.Executor, optional
+        Where the runs go instead (not shut down here).
+    progress : bool
+        Progress bar on terminals.
+    comparison : {"path", "final"}, optional
+        Default: ``"final"`` for a static scene, else ``"path"``.
+
+    Returns
+    -------
+    AccuracyStudy
+
+    Raises
+    ------
+    SceneError
+        If the reference run does not complete: nothing can be compared then.
+    """
+    from cdpr_exu.scenes.scene import Scene, load_scene, scene_from_dict
+    from cdpr_exu.studies.study import _executor_for, _progress_bar
+
+    base = scene if isinstance(scene, Scene) else load_scene(scene)
+    if grid.end_time is not None:
+        base = base.with_changes(solver=replace(base.solver, end_time=grid.end_time))
+    comparison = comparison or comparison_for(base)
+    after = grid.after if grid.after < base.solver.end_time else 0.0
+    base_data = base.to_dict()
+    configurations = grid.configurations()
+    rows: list[dict[str, Any]] = []
+    pending: list[tuple[int, dict[str, Any]]] = []
+    for index, configuration in enumerate(configurations):
+        row = {"run": index, "model": configuration.model, "preset": configuration.preset,
+               "n_elements": configuration.n_elements, "step_size_s": configuration.step_size,
+               "overrides": "; ".join(f"{p}={v}" for p, v in configuration.overrides),
+               "is_reference": configuration == grid.reference}
+        rows.append(row)
+        try:
+            data = scene_from_dict(configuration.scene_data(base_data)).to_dict()
+        except SceneError as err:
+            row["status"] = "refused: " + " ".join(str(err).split())
+        else:
+            pending.append((index, data))
+    pending.sort(key=lambda item: -_estimated_cost(configurations[item[0]]))
+
+    series: dict[int, dict[str, Any]] = {}
+    bar = _progress_bar(len(rows), progress)
+    bar.update(len(rows) - len(pending))
+    try:
+        with _executor_for(executor, min(workers or os.cpu_count() or 1, max(len(pending), 1)), None) as pool:
+            futures: dict[Future, int] = {pool.submit(run_configuration, data): index for index, data in pending}
+            for future in as_completed(futures):
+                index = futures[future]
+                try:
+                    outcome = future.result()
+                except Exception as err:  # noqa: BLE001 - a lost worker fails one run, not the study
+                    outcome = {"status": f"failed: worker error: {type(err).__name__}: {err}"}
+                if "time" in outcome:
+                    series[index] = {k: outcome.pop(k) for k in ("time", "pose", "end_tensions", "speed")}
+                rows[index].update(outcome)
+                bar.update(1)
+    finally:
+        bar.close()
+
+    reference_index = next(r["run"] for r in rows if r["is_reference"])
+    if rows[reference_index]["status"] != "completed":
+        raise SceneError(f"the reference run ({grid.reference.label}) did not complete: "
+                         f"{rows[reference_index]['status']}")
+    reference = series[reference_index]
+    for row in rows:
+        row.setdefault("wall_time_s", math.nan)
+        row.setdefault(COST, math.nan)
+        simulated = row.get("simulated_time_s", math.nan)
+        row["real_time_factor"] = (simulated / row[COST]
+                                   if _finite(simulated) and _finite(row[COST]) and row[COST] > 0 else math.nan)
+        figures = compare(series[row["run"]], reference, comparison, after) if row["run"] in series else {}
+        for name in ERROR_FIGURES:
+            row[name] = figures.get(name, math.nan)
+        if row["status"] != "completed":  # errors of a partial run are not comparable
+            for name in ERROR_FIGURES[:-1]:
+                row[name] = math.nan
+    _effects_columns(rows, series, grid, comparison, after)
+    study = AccuracyStudy(rows, grid.reference, comparison, base.name, base.solver.end_time, after, grid, series)
+    if out is not None:
+        write_accuracy_study(study, base, out)
+    return study
+
+
+def _effects_columns(rows: list[dict[str, Any]], series: Mapping[int, Mapping[str, Any]], grid: AccuracyGrid,
+                     comparison: str, after: float) -> None:
+    """``moved_*`` columns: each run at the variant resolution against ``full`` there."""
+    for row in rows:
+        row["moved_position_max_m"] = row["moved_position_rms_m"] = row["moved_rotation_max_deg"] = math.nan
+        row["moved_tension_rms_N"] = row["cost_relative_to_full"] = math.nan
+        row["at_variant_resolution"] = False
+    if grid.variant_resolution is None:
+        return
+    n, h = grid.variant_resolution
+    full = next((r for r in rows if r["model"] == "full" and r["n_elements"] == n and r["step_size_s"] == h), None)
+    if full is None or full.get("status") != "completed":
+        return
+    for row in rows:
+        if row["step_size_s"] != h or row["n_elements"] not in (n, None):
+            continue
+        row["at_variant_resolution"] = True
+        if row.get("status") != "completed" or row["run"] not in series:
+            continue
+        moved = compare(series[row["run"]], series[full["run"]], comparison, after)
+        row["moved_position_max_m"] = moved["position_error_max_m"]
+        row["moved_position_rms_m"] = moved["position_error_rms_m"]
+        row["moved_rotation_max_deg"] = moved["rotation_error_max_deg"]
+        row["moved_tension_rms_N"] = moved["tension_error_rms_N"]
+        row["cost_relative_to_full"] = row[COST] / full[COST]
+
+
+# --------------------------------------------------------------------------- files
+
+COLUMNS = ("run", "model", "preset", "overrides", "n_elements", "step_size_s", "is_reference", "status",
+           "cpu_time_s", "wall_time_s", "real_time_factor", "simulated_time_s", "steps", "newton_iterations",
+           "failure_time_s", *ERROR_FIGURES, "at_variant_resolution", "moved_position_max_m", "moved_position_rms_m",
+           "moved_rotation_max_deg", "moved_tension_rms_N", "cost_relative_to_full")
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return "" if math.isnan(value) else f"{value:.6g}"
+    return str(value)
+
+
+def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> dict[str, Path]:
+    """Write the CSV, JSON, tables, Pareto plot and the reference's series into ``out``."""
+    from cdpr_exu.core.output import write_npz, write_summary
+    from cdpr_exu.results.result import provenance
+    from cdpr_exu.scenes.scene import save_scene
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {"scene": save_scene(base_scene, out / ACCURACY_FILES["scene"])}
+    with open(out / ACCURACY_FILES["csv"], "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(COLUMNS)
+        for row in study.rows:
+            writer.writerow([_cell(row.get(c)) for c in COLUMNS])
+    paths["csv"] = out / ACCURACY_FILES["csv"]
+    reference_row = study.reference_row
+    info = {
+        "scene": study.scene_name,
+        "end_time_s": study.end_time,
+        "comparison": study.comparison,
+        "errors_measured_after_s": study.after if study.comparison == "path" else None,
+        "reference": {"configuration": study.reference.label, "preset": study.reference.preset,
+                      "n_elements": study.reference.n_elements, "step_size_s": study.reference.step_size,
+                      "cpu_time_s": reference_row[COST], "wall_time_s": reference_row["wall_time_s"]},
+        "cost": "cpu_time_s: CPU time of the single-threaded run, model building included",
+        "tolerances_m": list(TOLERANCES),
+        "grid": {"models": [model_name(p, o) for p, o in study.grid.models],
+                 "n_elements": list(study.grid.n_elements), "step_sizes_s": list(study.grid.step_sizes),
+                 "variants": [model_name("full", v) for v in study.grid.variants],
+                 "variant_resolution": study.grid.variant_resolution},
+        "rows": [{c: (None if isinstance(row.get(c), float) and math.isnan(row[c]) else row.get(c)) for c in COLUMNS}
+                 for row in study.rows],
+        **provenance(),
+    }
+    write_summary(out, info, name=ACCURACY_FILES["json"])  # the date goes to timing.json
+    paths["json"] = out / ACCURACY_FILES["json"]
+    reference = study.series[reference_row["run"]]
+    write_npz(out / ACCURACY_FILES["reference"], **reference)
+    paths["reference"] = out / ACCURACY_FILES["reference"]
+    (out / ACCURACY_FILES["tables"]).write_text(format_tables(study) + "\n")
+    paths["tables"] = out / ACCURACY_FILES["tables"]
+    paths["pareto"] = plot_pareto(study, out / ACCURACY_FILES["pareto"])
+    return paths
+
+
+def load_accuracy_study(out: str | Path) -> dict[str, Any]:
+    """Read ``accuracy.json`` back (rows, reference, grid, provenance)."""
+    return json.loads((Path(out) / ACCURACY_FILES["json"]).read_text())
+
+
+# --------------------------------------------------------------------------- tables
+
+
+def _mm(value: Any) -> str:
+    return f"{1000 * value:.3g}" if _finite(value) else "-"
+
+
+def _seconds(value: Any) -> str:
+    return f"{value:.2f}" if _finite(value) else "-"
+
+
+def _markdown(head: Sequence[str], lines: Sequence[Sequence[str]]) -> str:
+    out = ["| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
+    out.extend("| " + " | ".join(line) + " |" for line in lines)
+    return "\n".join(out)
+
+
+def _configuration_cell(row: Mapping[str, Any]) -> str:
+    n = "-" if row.get("n_elements") is None else str(row["n_elements"])
+    return f"{row['model']} | {n} | {row['step_size_s']:.0e}"
+
+
+def format_tables(study: AccuracyStudy) -> str:
+    """Markdown tables: tolerances, per-model best, effects, and the runs that did not complete."""
+    rows = study.rows
+    ref = study.reference_row
+    what = ("platform position error after " f"{study.after:g} s (max over time)" if study.comparison == "path"
+            else "final platform position error")
+    parts = [f"# Accuracy against cost: {study.scene_name}, {study.end_time:g} s",
+             "",
+             f"Reference: {study.reference.label} ({ref[COST]:.1f} s CPU time). "
+             f"Error: {what}, against the reference. Cost: the CPU time of the single-threaded "
+             "run (model building included; about its wall time on an idle core); x real time = "
+             "simulated time / CPU time.",
+             "",
+             "## Cheapest configuration meeting each tolerance",
+             ""]
+    lines = []
+    for tolerance in TOLERANCES:
+        best = cheapest_meeting(rows, tolerance)
+        if best is None:
+            lines.append([f"{1000 * tolerance:g} mm", "none", "-", "-", "-", "-", "-", "-"])
+            continue
+        lines.append([f"{1000 * tolerance:g} mm", _configuration_cell(best), _seconds(best[COST]),
+                      f"{best['real_time_factor']:.1f}", _mm(best["position_error_max_m"]),
+                      _mm(best["position_error_rms_m"]), f"{best['tension_error_rms_N']:.3g}"])
+    parts.append(_markdown(["tolerance", "model", "n", "step [s]", "CPU [s]", "x real time", "max err [mm]",
+                            "rms err [mm]", "tension rms err [N]"], lines))
+    parts += ["", "## Each model: cheapest run per tolerance (CPU time [s]) and its best run", ""]
+    lines = []
+    for model in dict.fromkeys(r["model"] for r in rows):
+        members = [r for r in rows if r["model"] == model]
+        done = [r for r in members if _usable(r, "position_error_max_m")]
+        cells = [model]
+        for tolerance in TOLERANCES:
+            best = cheapest_meeting(rows, tolerance, model=model)
+            cells.append("-" if best is None else f"{best[COST]:.2f} (n={best['n_elements'] or '-'}, "
+                         f"h={best['step_size_s']:.0e})")
+        if done:
+            best = min(done, key=lambda r: r["position_error_max_m"])
+            cells += [_mm(best["position_error_max_m"]), f"n={best['n_elements'] or '-'}, h={best['step_size_s']:.0e}",
+                      _seconds(best[COST])]
+        else:
+            cells += ["-", "-", "-"]
+        status = {}
+        for r in members:
+            kind = r["status"].split(":")[0]
+            status[kind] = status.get(kind, 0) + 1
+        cells.append(", ".join(f"{v} {k}" for k, v in status.items()))
+        lines.append(cells)
+    parts.append(_markdown(["model", *[f"<= {1000 * t:g} mm" for t in TOLERANCES], "best err [mm]", "at",
+                            "its CPU [s]", "runs"], lines))
+    effects = [r for r in rows if r.get("at_variant_resolution")]
+    if effects:
+        n, h = study.grid.variant_resolution
+        parts += ["", f"## What each model and effect changes, against `full` at n = {n}, h = {h:g} s", "",
+                  "(massless presets at the same step; moved = difference of the platform "
+                  + ("path after " + f"{study.after:g} s" if study.comparison == "path" else "final position")
+                  + "; cost = CPU time / that of full)", ""]
+        lines = []
+        for r in effects:
+            lines.append([r["model"], "-" if r["n_elements"] is None else str(r["n_elements"]),
+                          r["status"].split(":")[0], _mm(r["moved_position_max_m"]), _mm(r["moved_position_rms_m"]),
+                          f"{r['moved_rotation_max_deg']:.3g}" if _finite(r["moved_rotation_max_deg"]) else "-",
+                          f"{r['moved_tension_rms_N']:.3g}" if _finite(r["moved_tension_rms_N"]) else "-",
+                          _seconds(r[COST]),
+                          f"{r['cost_relative_to_full']:.2f}" if _finite(r["cost_relative_to_full"]) else "-"])
+        parts.append(_markdown(["model", "n", "status", "moved max [mm]", "moved rms [mm]", "rotation [deg]",
+                                "tension rms [N]", "CPU [s]", "cost"], lines))
+    if study.comparison == "final":
+        moving = [r for r in rows if r["status"] == "completed" and _finite(r.get("final_speed_m_s"))
+                  and r["final_speed_m_s"] > 1e-3]
+        if moving:
+            parts += ["", "## Runs not at rest at the end (platform speed above 1 mm/s)", ""]
+            parts.append(_markdown(["model", "n", "step [s]", "final speed [m/s]"],
+                                   [[*_configuration_cell(r).split(" | "), f"{r['final_speed_m_s']:.3g}"] for r in moving]))
+    bad = [r for r in rows if r["status"] != "completed"]
+    if bad:
+        parts += ["", "## Runs that did not complete", ""]
+        lines = []
+        for r in bad:
+            kind, _, cause = r["status"].partition(": ")
+            cause = cause.split(". Likely cause")[0]
+            if len(cause) > 160:
+                cause = cause[:157] + "..."
+            when = f"{r['failure_time_s']:.2f}" if _finite(r.get("failure_time_s")) else "-"
+            lines.append([*_configuration_cell(r).split(" | "), kind, when, cause.replace("|", "/")])
+        parts.append(_markdown(["model", "n", "step [s]", "status", "stopped at [s]", "cause"], lines))
+    return "\n".join(parts)
+
+
+# --------------------------------------------------------------------------- figure
+
+#: Colours of the ladder's models; other models take the spare colours in turn.
+_MODEL_COLORS = {"ideal": "tab:gray", "elastic": "tab:green", "catenary": "tab:orange", "full": "tab:blue",
+                 model_name("full", LINEAR_BENDING): "tab:purple"}
+_SPARE_COLORS = ("tab:red", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
+_STEP_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+
+
+def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
+    """Error against cost (CPU time), log-log: one marker per run, coloured by model, Pareto front drawn.
+
+    Left: the platform position error; right: the RMS error of the platform-end
+    tensions. Marker shapes give the step size; tolerance lines at 1 mm, 1 cm, 5 cm.
+    """
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import NullFormatter
+
+    from cdpr_exu.post.plots import _figure, _save
+
+    rows = study.rows
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    spare = [m for m in models if m not in _MODEL_COLORS]
+    colors = {m: _MODEL_COLORS.get(m) or _SPARE_COLORS[spare.index(m) % len(_SPARE_COLORS)] for m in models}
+    steps = sorted({r["step_size_s"] for r in rows})
+    markers = {h: _STEP_MARKERS[i % len(_STEP_MARKERS)] for i, h in enumerate(steps)}
+    figure = _figure(12.0, 5.2, left=0.8, right=0.2, bottom=1.3, top=0.55, wspace=0.85, columns=2)
+    axes = figure.subplots(1, 2)
+    quantities = (("position_error_max_m", 1000.0, "max platform position error [mm]" if study.comparison == "path"
+                   else "final platform position error [mm]"),
+                  ("tension_error_rms_N", 1.0, "RMS error of platform-end tensions [N]" if study.comparison == "path"
+                   else "final platform-end tension error [N]"))
+    for axis, (quantity, scale, label) in zip(axes, quantities):
+        for r in rows:
+            if not _usable(r, quantity) or r[quantity] <= 0:
+                continue
+            axis.plot(r[COST], scale * r[quantity], linestyle="none", marker=markers[r["step_size_s"]],
+                      color=colors[r["model"]], markersize=6, alpha=0.8, markeredgecolor="black", markeredgewidth=0.4)
+        front = [r for r in pareto_front(rows, quantity) if r[quantity] > 0]
+        if front:
+            x = [r[COST] for r in front]
+            y = [scale * r[quantity] for r in front]
+            axis.step(x, y, where="post", color="black", linewidth=1.0, alpha=0.7, zorder=0)
+            for r, xi, yi in zip(front, x, y):
+                axis.annotate(_short_label(r), (xi, yi), fontsize=6, xytext=(3, 3), textcoords="offset points",
+                              color="0.25")
+        if quantity == "position_error_max_m":
+            for tolerance in TOLERANCES:
+                axis.axhline(1000 * tolerance, color="0.5", linestyle=":", linewidth=0.8)
+                axis.annotate(f"{1000 * tolerance:g} mm", (1.0, 1000 * tolerance), xycoords=("axes fraction", "data"),
+                              fontsize=7, color="0.4", ha="right", va="bottom")
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        axis.xaxis.set_minor_formatter(NullFormatter())
+        axis.yaxis.set_minor_formatter(NullFormatter())
+        axis.set_xlabel("CPU time of the run [s] (one core)")
+        axis.set_ylabel(label)
+        axis.grid(True, which="both", alpha=0.25)
+    done = sum(r["status"] == "completed" for r in rows) - 1
+    failed = sum(r["status"].startswith("failed") for r in rows)
+    refused = sum(r["status"].startswith("refused") for r in rows)
+    ref = study.reference_row
+    figure.suptitle(f"{study.scene_name}, {study.end_time:g} s: error against the reference ({study.reference.label}, "
+                    f"{ref[COST]:.0f} s) vs CPU time; {done} runs compared, {failed} failed, "
+                    f"{refused} refused (see accuracy.csv); black: Pareto front", fontsize=9)
+    handles = [Line2D([], [], linestyle="none", marker="o", color=colors[m], label=m) for m in models]
+    handles += [Line2D([], [], linestyle="none", marker=markers[h], color="black", markerfacecolor="none",
+                       label=f"h = {h:g} s") for h in steps]
+    figure.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
+    return _save(figure, path)
+
+
+def _short_label(row: Mapping[str, Any]) -> str:
+    """``full 20, 5e-03`` (model, elements, step) for annotations."""
+    n = "" if row.get("n_elements") is None else f" {row['n_elements']}"
+    return f"{row['model']}{n}, {row['step_size_s']:.0e}"
+
+
+# --------------------------------------------------------------------------- command line
+
+EPILOG_ACCURACY = """examples:
+  cdpr study accuracy paper-circle --out results/accuracy/paper_circle
+  cdpr study accuracy paper-catenary --out results/accuracy/paper_catenary
+  cdpr study accuracy paper-circle --out /tmp/quick --quick
+
+runs the scene on every preset (ideal, elastic, catenary, full) and the full model
+with linear bending, over elements per cable (8..60) and step sizes (5e-4..1e-2 s),
+against a reference (full, 90 elements, 5e-4 s); --quick: a small grid, 1.5 s.
+A static scene (held pose, fixed winches) compares final states, others the path.
+writes accuracy.csv, accuracy.json, tables.md (tolerance table, effects table),
+pareto.png and reference.npz into --out.
+"""
+
+
+def _cmd_accuracy(args: argparse.Namespace) -> int:
+    grid = QUICK_GRID if args.quick else FULL_GRID
+    if args.end_time is not None:
+        grid = replace(grid, end_time=args.end_time)
+    from cdpr_exu.core.output import check_output_folder
+
+    out = check_output_folder(args.out)
+    start = time.perf_counter()
+    study = run_accuracy_study(args.scene, grid, out=out, workers=args.workers, progress=not args.quiet,
+                               comparison=args.compare)
+    if not args.quiet:
+        print(format_tables(study))
+        print(f"\n{len(study.rows)} runs in {time.perf_counter() - start:.0f} s; written to {out}/")
+    return 0
+
+
+def add_commands(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``cdpr study accuracy`` to the ``cdpr`` command."""
+    accuracy = study_subparsers(subparsers).add_parser(
+        "accuracy", help="error against run time over the model ladder, elements and step sizes",
+        description="Run a scene on every model of the ladder over elements per cable and step sizes, "
+        "compare each run with a reference (the full model, finest discretisation), and write the "
+        "Pareto front of error against run time (CPU time) and the cheapest configuration per tolerance.",
+        epilog=EPILOG_ACCURACY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    accuracy.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
+    accuracy.add_argument("--out", required=True, help="output folder (created)")
+    accuracy.add_argument("--quick", action="store_true", help="a small grid over 1.5 s (a minute or less)")
+    accuracy.add_argument("--workers", type=int, help="worker processes (default: one per core)")
+    accuracy.add_argument("--end-time", type=float, help="override the end time of every run [s]")
+    accuracy.add_argument("--compare", choices=("path", "final"),
+                          help="compare the path after 1 s or the final state (default: final for static scenes)")
+    accuracy.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no tables")
+    accuracy.set_defaults(func=_cmd_accuracy)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    from cdpr_exu.cli import main
+
+    sys.exit(main(["study", "accuracy", *sys.argv[1:]]))

@@ -1,0 +1,219 @@
+"""Controller comparison: the same scene under every controller, tabulated and plotted.
+
+``cdpr compare paper-circle --out results/controllers`` runs the scene under each
+controller of :data:`CONTROLLERS`, writes ``summary.json`` (keyed by controller name),
+``comparison.md`` (a Markdown table), a ``pose.csv`` per controller and the figures
+``comparison_paths.png`` and ``comparison_errors.png``. Errors are actual - reference,
+measured after the start-up (``--after``, default 1 s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from controllers.ideal_ik import IdealIKController
+from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
+
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SceneError, SolverFailure
+from cdpr_exu.core.output import fixed
+from cdpr_exu.results.result import Result, provenance
+from cdpr_exu.scenes.scene import Scene, load_scene
+
+#: The controllers compared by default, by name, each a factory.
+CONTROLLERS: dict[str, Callable[[], object]] = {
+    "ideal_ik": IdealIKController,
+    "tension_aware": TensionAwareController,
+    "tension_aware_chordal": lambda: TensionAwareController(chordal_correction=True),
+    "tension_aware_dynamic_chordal": lambda: TensionAwareController(dynamic=True, chordal_correction=True),
+    "tension_aware_chain": lambda: TensionAwareController(statics="chain"),
+    "closed_loop_tension_aware": lambda: ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True),
+}
+
+_COLUMNS = (
+    ("max_position_error_m", "max pos. error [mm]", 1000.0),
+    ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
+    ("max_abs_error_x_m", "max \\|err x\\| [mm]", 1000.0),
+    ("max_abs_error_z_m", "max \\|err z\\| [mm]", 1000.0),
+    ("max_abs_rotation_deg", "max \\|rotation\\| [deg]", 1.0),
+    ("min_element_tension_N", "min tension [N]", 1.0),
+    ("slack_time_s", "slack time [s]", 1.0),
+    ("wall_time_s", "wall time [s]", 1.0),
+)
+
+
+def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: str | Path | None = None,
+                        after: float = 1.0, progress: bool = False, quiet: bool = True) -> dict[str, dict]:
+    """Run ``scene`` under each named controller; returns their summaries by name.
+
+    A controller that refuses the reference (e.g. a pose that needs a pushing cable)
+    or whose run fails is recorded with its status; the others still run.
+    """
+    from cdpr_exu.run.simulate import simulate
+
+    names = list(names or CONTROLLERS)
+    unknown = [n for n in names if n not in CONTROLLERS]
+    if unknown:
+        from cdpr_exu.core.errors import SceneError
+
+        raise SceneError(f"unknown controller(s) {unknown}; known: {list(CONTROLLERS)}")
+    summaries: dict[str, dict] = {}
+    results: dict[str, Result] = {}
+    try:
+        for name in names:
+            controller = CONTROLLERS[name]()
+            try:
+                result = simulate(scene, controller, progress=progress)
+            except SolverFailure as err:
+                result = err.partial_result
+            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
+                results[name] = err.partial_result
+                summaries[name] = {**err.partial_result.summary(after=after), "controller": name}
+                raise
+            except CdprError as err:  # a refused reference is a result of the comparison too
+                summaries[name] = {"controller": name, "status": f"refused: {err}"}
+                continue
+            results[name] = result
+            summary = result.summary(after=after)
+            summary["controller"] = name
+            slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
+            summary["slack_time_s"] = max(slack) if slack else None
+            if "tension_limit_violations" in summary:
+                summary["tension_limit_violation_count"] = len(summary["tension_limit_violations"])
+            summaries[name] = summary
+            if not quiet:
+                def mm(value):
+                    return "     n/a" if value is None else f"{1000 * value:8.2f}"
+                print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
+                      f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+    except KeyboardInterrupt:  # Ctrl-C, inside a run or between two: keep the controllers done so far
+        if out is not None and summaries:
+            _write(scene, summaries, {k: r for k, r in results.items() if k in summaries}, Path(out), after)
+        raise
+    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
+    if base is not None:
+        for summary in summaries.values():
+            if (summary.get("max_position_error_m") or 0.0) > 0:
+                summary["error_reduction_vs_ideal_ik"] = base / summary["max_position_error_m"]
+    if out is not None:
+        _write(scene, summaries, results, Path(out), after)
+    return summaries
+
+
+def markdown_table(summaries: dict[str, dict]) -> str:
+    """The comparison as a Markdown table."""
+    columns = _COLUMNS
+    if any("tension_limit_violation_count" in s for s in summaries.values()):  # a scene with tension limits
+        columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
+    header = "| controller | " + " | ".join(title for _, title, _ in columns) + " | vs ideal IK | status |"
+    lines = [header, "|" + "---|" * (len(columns) + 3)]
+    for name, summary in summaries.items():
+        cells = []
+        for key, _, scale in columns:
+            value = summary.get(key)
+            cells.append("" if value is None else (str(value) if isinstance(value, int) else fixed(scale * value, 2)))
+        ratio = summary.get("error_reduction_vs_ideal_ik")
+        flag = "; cables pushed" if summary.get("elements_pushed") else ""  # a real cable cannot
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {'' if ratio is None else f'{ratio:.1f}x'} | "
+                     f"{summary.get('status', '')}{flag} |")
+    return "\n".join(lines) + "\n"
+
+
+def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
+    from cdpr_exu.core.output import write_summary
+    from cdpr_exu.post.plots import plot_comparison
+    from cdpr_exu.scenes.scene import save_scene
+
+    out.mkdir(parents=True, exist_ok=True)
+    save_scene(scene, out / "scene.toml")
+    document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
+                "controllers": summaries, **provenance()}
+    write_summary(out, document)
+    (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
+                                       + markdown_table(summaries))
+    for name, result in results.items():
+        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
+        table = np.column_stack([result.time, result.platform_pose, result.reference_pose])
+        np.savetxt(out / f"pose_{name}.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+    if results:
+        plot_comparison(scene, results, out)
+
+
+def _compare_spatial(scene, args: argparse.Namespace) -> int:
+    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.run.spatial_run.compare_spatial`)."""
+    from dataclasses import replace
+
+    from cdpr_exu.run.spatial_run import check_spatial_reference, compare_spatial, spatial_comparison_table
+
+    if args.end_time is not None:
+        scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr compare` needs one")
+    check_spatial_reference(scene)
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
+    summaries = compare_spatial(scene, names, args.out, args.after, quiet=args.quiet)
+    if not args.quiet:
+        print()
+        print(spatial_comparison_table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    return EXIT_RUN_FAILED if failed else EXIT_OK
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from cdpr_exu.core.output import check_output_folder
+    from cdpr_exu.statics.workspace import check_reference
+
+    check_output_folder(args.out)
+    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+
+    spatial = load_any_scene(args.scene)
+    if is_spatial(spatial):
+        return _compare_spatial(spatial, args)
+    scene = load_scene(args.scene)
+    if args.end_time is not None:
+        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
+    # A reference no controller can follow is bad input (exit 2), not six failed runs.
+    check_reference(scene)
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
+    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet)
+    if not args.quiet:
+        print()
+        print(markdown_table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    if failed:
+        print(f"cdpr compare: {len(failed)} of {len(summaries)} controllers did not complete: {', '.join(failed)}",
+              file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return EXIT_OK
+
+
+def add_commands(subparsers) -> None:
+    """Register ``cdpr compare``."""
+    parser = subparsers.add_parser(
+        "compare", help="run a scene under every controller and compare their errors",
+        description="Run a scene under each controller (ideal inverse kinematics, tension-aware variants, "
+        "closed loop) and write a table and figures of their errors.",
+        epilog="examples:\n  cdpr compare paper-circle --out results/controllers\n"
+               "  cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal\n\n" + EXIT_CODES,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scene", help="shipped scene name or path to a .toml file")
+    parser.add_argument("--out", help="output folder (summary.json, comparison.md, figures)")
+    parser.add_argument("--controllers", help=f"comma-separated subset of: {', '.join(CONTROLLERS)}")
+    parser.add_argument("--after", type=float, default=1.0, help="measure errors after this time [s] (default 1)")
+    parser.add_argument("--end-time", type=float, help="override solver.end_time [s]")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+    parser.set_defaults(func=_cmd_compare)

@@ -1,0 +1,881 @@
+"""Parameter studies: run one scene over a grid of parameter values, in parallel.
+
+A study varies fields of a base scene, named by *parameter paths* into its plain-data
+form (:meth:`~cdpr_exu.scenes.scene.Scene.to_dict`):
+
+- ``"platform.mass=1,2.5,5"``: one field;
+- ``"cables.n_elements=5,10,15"``: a list field without an index applies to every
+  entry (every cable); ``"cables[1].radius=0.004,0.006"`` to one entry;
+- ``"platform.initial_pose[1]=-2,-1.9"``: one entry of a vector field;
+- ``"solver.step_size=1e-3,2e-3"``, ``"effects.bending=true,false"``,
+  ``"effects.preset=full,catenary"``, ``"trajectory.angular_rate=1,1.5"``.
+
+Values are TOML scalars (numbers, ``true``/``false``, strings; a bare word is taken as
+a string). By default the study runs the cartesian product of all values (a grid);
+``mode="zip"`` runs the i-th values of every parameter together.
+
+Every variation becomes one row: its parameters, its status (``"completed"``,
+``"failed: ..."`` when the solver failed, ``"refused: ..."`` when the scene is invalid
+or the reference unreachable), and the summary figures of
+:meth:`~cdpr_exu.results.result.Result.summary`. A failed or refused run is recorded, never
+fatal. Runs go to any :class:`concurrent.futures.Executor`: by default a process pool
+with one single-threaded process per core; a Dask cluster through
+``scheduler="tcp://host:8786"`` (or ``"local"``).
+
+Adding a ``cdpr study`` sub-command from another module::
+
+    from cdpr_exu.studies.study import study_subparsers
+
+    def add_commands(subparsers):
+        accuracy = study_subparsers(subparsers).add_parser("accuracy", ...)
+        accuracy.set_defaults(func=...)
+
+This module imports only the standard library at its top, so that a spawned worker
+process can set its thread limits before NumPy, Numba or Exudyn load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import copy
+import csv
+import difflib
+import itertools
+import json
+import math
+import multiprocessing
+import os
+import re
+import sys
+import time
+import tomllib
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
+
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, SceneError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from cdpr_exu.scenes.scene import Scene
+
+#: Environment that keeps every worker process on one thread (one run per core).
+SINGLE_THREAD_ENVIRONMENT = {
+    "OMP_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+    "NUMBA_NUM_THREADS": "1",
+}
+
+#: Summary figures of :meth:`Result.summary` recorded for every run, in column order.
+FIGURES = (
+    "max_abs_error_x_m",
+    "max_abs_error_z_m",
+    "max_position_error_m",
+    "rms_position_error_m",
+    "max_abs_rotation_deg",
+    "min_element_tension_N",
+    "max_element_tension_N",
+    "max_pulley_penetration_m",
+    "simulated_time_s",
+    "wall_time_s",
+    "real_time_factor",
+    "steps",
+    "newton_iterations",
+    "failure_time_s",
+    "errors_measured_after_s",
+)
+
+#: Files a study writes into its output folder.
+STUDY_FILES = {"csv": "study.csv", "json": "study.json", "scene": "base_scene.toml"}
+
+#: Effects that need another effect on: ``{dependent: needed}``.
+DEPENDENT_EFFECTS = {"bending_damping": "bending"}
+
+_SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
+
+_MODES = ("grid", "zip")
+
+
+# --------------------------------------------------------------------------- parameters
+
+
+@dataclass(frozen=True)
+class Variation:
+    """One varied parameter: a path into the scene's plain data and its values.
+
+    Parameters
+    ----------
+    path : str
+        E.g. ``"cables.n_elements"``, ``"cables[1].radius"``, ``"effects.preset"``.
+    values : tuple
+        The values it takes (numbers, booleans or strings).
+    """
+
+    path: str
+    values: tuple
+
+    def __post_init__(self) -> None:
+        _split_path(self.path)
+        object.__setattr__(self, "values", tuple(self.values))
+        if not self.values:
+            raise SceneError(f"parameter {self.path!r} needs at least one value")
+        for value in self.values:
+            if isinstance(value, (dict, list, tuple)) or value is None:
+                raise SceneError(f"parameter {self.path!r}: values must be numbers, booleans or strings, got {value!r}")
+
+    def to_text(self) -> str:
+        """The ``PATH=V1,V2`` form that :func:`parse_parameter` reads back."""
+        return f"{self.path}=" + ",".join(_toml_scalar(v) for v in self.values)
+
+
+def _toml_scalar(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    return repr(value)
+
+
+def _parse_value(text: str, path: str) -> Any:
+    """One TOML scalar; a bare word (``full``) is taken as a string."""
+    text = text.strip()
+    if not text:
+        raise SceneError(f"parameter {path!r} has an empty value")
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_\-]*", text):
+            return text
+        raise SceneError(f"parameter {path!r}: {text!r} is not a number, true/false or a string") from None
+    if isinstance(value, (dict, list)) or not isinstance(value, (int, float, bool, str)):
+        raise SceneError(f"parameter {path!r}: values must be numbers, booleans or strings, got {text!r}")
+    return value
+
+
+def parse_parameter(text: str) -> Variation:
+    """Read ``"PATH=V1,V2,..."`` into a :class:`Variation`.
+
+    Values are TOML scalars: ``5``, ``2.5``, ``1e-3``, ``true``, ``"full"`` or a bare
+    word ``full``. Quoted strings may contain commas.
+
+    Raises
+    ------
+    SceneError
+        If the text has no ``=``, the path is malformed or a value is not a scalar.
+    """
+    if not isinstance(text, str) or "=" not in text:
+        raise SceneError(f"parameter {text!r} must read PATH=V1,V2,... (e.g. platform.mass=1,2.5,5)")
+    path, _, values_text = text.partition("=")
+    path = path.strip()
+    _split_path(path)
+    try:  # the whole list at once: quoted strings may hold commas
+        values = tomllib.loads(f"v = [{values_text}]")["v"]
+        if any(isinstance(v, (dict, list)) for v in values):
+            raise SceneError(f"parameter {path!r}: values must be numbers, booleans or strings, got {values_text!r}")
+    except tomllib.TOMLDecodeError:
+        values = [_parse_value(part, path) for part in values_text.split(",")]
+    if not values:
+        raise SceneError(f"parameter {path!r} has no values (write {path}=V1,V2,...)")
+    return Variation(path, tuple(values))
+
+
+def _split_path(path: str) -> list[str | int]:
+    """``"cables[1].radius"`` -> ``["cables", 1, "radius"]``."""
+    if not isinstance(path, str) or not path:
+        raise SceneError(f"parameter path must be a non-empty string, got {path!r}")
+    parts: list[str | int] = []
+    for segment in path.split("."):
+        match = _SEGMENT.match(segment)
+        if match is None:
+            raise SceneError(f"parameter path {path!r} is malformed at {segment!r} "
+                             "(write e.g. cables.n_elements or cables[1].radius)")
+        parts.append(match.group(1))
+        parts.extend(int(i) for i in re.findall(r"\[(\d+)\]", match.group(2)))
+    return parts
+
+
+def _assign(node: Any, parts: list[str | int], value: Any, path: str, done: str, write: bool) -> None:
+    """Walk ``parts`` from ``node`` and set the leaf (every entry of an unindexed list)."""
+    head, rest = parts[0], parts[1:]
+    if isinstance(head, int):
+        if not isinstance(node, list):
+            raise SceneError(f"unknown parameter path {path!r}: {done} is not a list")
+        if head >= len(node):
+            raise SceneError(f"unknown parameter path {path!r}: {done} has {len(node)} entries, no [{head}]")
+        key, where = head, f"{done}[{head}]"
+    elif isinstance(node, list):  # a name after a list: every entry
+        if not node:
+            raise SceneError(f"unknown parameter path {path!r}: {done} is empty")
+        for i, entry in enumerate(node):
+            _assign(entry, parts, value, path, f"{done}[{i}]", write)
+        return
+    elif isinstance(node, dict):
+        if head not in node:
+            close = difflib.get_close_matches(head, list(node), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise SceneError(f"unknown parameter path {path!r}: {done or 'the scene'} has no field {head!r}"
+                             f"{hint}; known: {', '.join(sorted(node))}")
+        key, where = head, f"{done}.{head}" if done else head
+    else:
+        raise SceneError(f"unknown parameter path {path!r}: {done} is a value, it has no field {head!r}")
+    if rest:
+        _assign(node[key], rest, value, path, where, write)
+        return
+    if isinstance(node[key], dict):
+        raise SceneError(f"parameter path {path!r} names a table; name one of its fields: "
+                         f"{', '.join(sorted(node[key]))}")
+    if isinstance(node[key], list):
+        raise SceneError(f"parameter path {path!r} names a list; name one of its entries, e.g. {where}[0]")
+    if write:
+        node[key] = value
+
+
+def check_parameter_path(scene_data: Mapping[str, Any], path: str) -> None:
+    """Raise SceneError naming ``path`` unless it names scalar fields of ``scene_data``."""
+    _assign(dict(scene_data), _split_path(path), None, path, "", write=False)
+
+
+def apply_parameters(scene_data: Mapping[str, Any], assignments: Iterable[tuple[str, Any]]) -> dict[str, Any]:
+    """A copy of the plain scene data with each ``(path, value)`` set.
+
+    ``effects.preset`` is set first and resets the effect flags to the new preset's,
+    keeping the base scene's own deviations from its preset (and any effect varied
+    explicitly). Switching an effect off by a parameter also switches off the effects
+    that need it (:data:`DEPENDENT_EFFECTS`, e.g. ``effects.bending=false`` turns
+    ``bending_damping`` off) unless those are varied too. The result is not
+    validated: pass it to :func:`~cdpr_exu.scenes.scene.scene_from_dict`.
+    """
+    data = copy.deepcopy(dict(scene_data))
+    assignments = sorted(assignments, key=lambda a: a[0] != "effects.preset")
+    for path, value in assignments:
+        if path == "effects.preset":
+            data["effects"] = _effects_for_preset(data.get("effects", {}), value)
+            continue
+        _assign(data, _split_path(path), value, path, "", write=True)
+    effects = data.get("effects")
+    varied = {path for path, _ in assignments}
+    if isinstance(effects, dict):
+        for dependent, needed in DEPENDENT_EFFECTS.items():
+            if effects.get(needed) is False and f"effects.{dependent}" not in varied \
+                    and f"effects.{needed}" in varied | {"effects.preset"}:
+                effects[dependent] = False
+    return data
+
+
+def _effects_for_preset(effects: Mapping[str, Any], preset: Any) -> dict[str, Any]:
+    from cdpr_exu.scenes.scene import PRESETS
+
+    base_preset = effects.get("preset", "full")
+    flags = PRESETS.get(base_preset, {})
+    kept = {k: v for k, v in effects.items() if k != "preset" and (k not in flags or flags[k] != v)}
+    return {"preset": preset, **kept}
+
+
+def combinations(variations: Sequence[Variation], mode: str = "grid") -> list[tuple[tuple[str, Any], ...]]:
+    """The parameter assignments of every run, in order.
+
+    ``"grid"``: the cartesian product, the last parameter varying fastest.
+    ``"zip"``: the i-th values of every parameter together (equal lengths required).
+    """
+    if mode not in _MODES:
+        raise SceneError(f"mode must be 'grid' or 'zip', got {mode!r}")
+    if not variations:
+        return [()]
+    paths = [v.path for v in variations]
+    if mode == "zip":
+        lengths = {v.path: len(v.values) for v in variations}
+        if len(set(lengths.values())) != 1:
+            raise SceneError(f"zipped parameters need equal numbers of values, got {lengths}")
+        return [tuple(zip(paths, values)) for values in zip(*(v.values for v in variations))]
+    return [tuple(zip(paths, values)) for values in itertools.product(*(v.values for v in variations))]
+
+
+def _as_variations(variations: Any) -> list[Variation]:
+    """Variations from strings ``"PATH=V1,V2"``, ``(path, values)`` pairs, a dict or Variations."""
+    if isinstance(variations, (str, Variation)):
+        variations = [variations]
+    if isinstance(variations, Mapping):
+        variations = list(variations.items())
+    out = []
+    for item in variations:
+        if isinstance(item, Variation):
+            out.append(item)
+        elif isinstance(item, str):
+            out.append(parse_parameter(item))
+        else:
+            path, values = item
+            if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+                values = [values]
+            out.append(Variation(path, tuple(values)))
+    seen = set()
+    for v in out:
+        if v.path in seen:
+            raise SceneError(f"parameter {v.path!r} is given twice; list all its values in one PATH=V1,V2,...")
+        seen.add(v.path)
+    return out
+
+
+# --------------------------------------------------------------------------- one run
+
+
+def _nan_figures() -> dict[str, Any]:
+    return {name: float("nan") for name in FIGURES}
+
+
+#: Model configurations already run once in this process (see :func:`_warm_up`).
+_WARMED: set[str] = set()
+
+
+def _warm_up(scene: "Scene") -> None:
+    """Run two steps of ``scene`` once per process and model configuration, untimed.
+
+    The first run in a process loads Numba's compiled kernels and Exudyn's code
+    paths (0.2 to 1 s); without this, whichever run a worker takes first would report
+    that in its wall time.
+    """
+    key = json.dumps([scene.to_dict()["effects"], scene.cable_exit, scene.winch.kind], sort_keys=True)
+    if key in _WARMED:
+        return
+    _WARMED.add(key)
+    from dataclasses import replace
+
+    from cdpr_exu.run.simulate import simulate
+
+    solver = scene.solver
+    short = replace(solver, end_time=2 * solver.step_size, output_period=solver.step_size)
+    try:
+        simulate(scene.with_changes(solver=short), progress=False)
+    except Exception:  # noqa: BLE001 - only a warm-up; the real run reports any problem
+        pass
+
+
+def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, Any]:
+    """Simulate one scene given as plain data; return its status and summary figures.
+
+    The worker function of a study: top-level and picklable, it takes and returns
+    plain data only. Never raises for a bad scene or a failed run.
+
+    Parameters
+    ----------
+    scene_data : dict
+        Plain scene data (as :meth:`Scene.to_dict` gives).
+    after : float [s]
+        Errors are measured from this time on; from 0 if the run is not longer.
+
+    Returns
+    -------
+    dict
+        ``status`` (``"completed"``, ``"failed: ..."``, ``"refused: ..."``) and
+        the figures of :data:`FIGURES` (NaN for a refused run).
+    """
+    for name, value in SINGLE_THREAD_ENVIRONMENT.items():
+        os.environ.setdefault(name, value)  # effective if the libraries are not loaded yet
+    from cdpr_exu.core.errors import SolverFailure, UnreachableError
+    from cdpr_exu.scenes.scene import scene_from_dict
+
+    try:
+        scene = scene_from_dict(scene_data)
+        from cdpr_exu.run.simulate import simulate
+
+        after = after if after < scene.solver.end_time else 0.0
+        _warm_up(scene)
+        try:
+            result = simulate(scene, progress=False)
+            status = "completed"
+        except SolverFailure as err:
+            result = err.partial_result
+            status = "failed: " + " ".join(str(err).split())
+            if result is None:
+                return {"status": status, **_nan_figures()}
+    except (SceneError, UnreachableError) as err:
+        return {"status": "refused: " + " ".join(str(err).split()), **_nan_figures()}
+    except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
+        return {"status": f"failed: {type(err).__name__}: " + " ".join(str(err).split()), **_nan_figures()}
+    summary = result.summary(after=after)
+    row = {"status": status}
+    for name in FIGURES:
+        value = summary.get(name)
+        row[name] = float("nan") if value is None else value
+    return row
+
+
+# --------------------------------------------------------------------------- the study
+
+
+@contextlib.contextmanager
+def _environment(values: Mapping[str, str]):
+    """Set environment variables for the block (spawned processes inherit them)."""
+    saved = {name: os.environ.get(name) for name in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+
+
+def local_dask_cluster(n_workers: int | None = None):
+    """A Dask ``LocalCluster`` of single-threaded worker processes (one per core)."""
+    import dask
+    from dask.distributed import LocalCluster
+
+    environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ", {}))
+    environ.update(SINGLE_THREAD_ENVIRONMENT)
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+        return LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1,
+                            processes=True, dashboard_address=None)
+
+
+@contextlib.contextmanager
+def _executor_for(executor: Executor | None, workers: int | None, scheduler: str | None):
+    """The executor to use; the ones made here are shut down afterwards."""
+    if executor is not None:
+        yield executor
+        return
+    if scheduler:
+        try:
+            from dask.distributed import Client
+        except ImportError:
+            raise CdprError("a Dask scheduler needs dask.distributed: pip install 'cdpr-exu[cluster]'") from None
+        if scheduler == "local":
+            with local_dask_cluster(workers) as cluster, Client(cluster) as client:
+                yield client.get_executor()
+        else:
+            try:
+                client = Client(scheduler, timeout=30)
+            except OSError as err:
+                raise CdprError(f"cannot reach the Dask scheduler {scheduler!r}: {err}") from None
+            with client:
+                yield client.get_executor()
+        return
+    workers = workers or os.cpu_count() or 1
+    # Spawned (not forked) processes start from a fresh interpreter with this
+    # environment, so BLAS, OpenMP and Numba load with one thread each.
+    with _environment(SINGLE_THREAD_ENVIRONMENT):
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        try:
+            yield pool
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _progress_bar(total: int, enabled: bool):
+    from tqdm import tqdm
+
+    # disable=None: no bar when the output is not a terminal (logs, CI).
+    return tqdm(total=total, unit="run", desc="study", disable=None if enabled else True, mininterval=0.25)
+
+
+def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Executor | None = None,
+              out: str | Path | None = None, progress: bool = True, after: float = 1.0, *,
+              mode: str = "grid", workers: int | None = None, scheduler: str | None = None,
+              plots: bool = True) -> list[dict[str, Any]]:
+    """Run ``base_scene`` once per combination of parameter values; one row per run.
+
+    Parameters
+    ----------
+    base_scene : Scene, or a shipped scene name or TOML path
+    variations : sequence
+        ``"PATH=V1,V2"`` strings, :class:`Variation` objects, ``(path, values)``
+        pairs, or a dict ``{path: values}``.
+    executor : concurrent.futures.Executor, optional
+        Where the runs go (not shut down here). Default: a process pool of
+        ``workers`` single-threaded processes, or the Dask cluster of ``scheduler``.
+    out : path, optional
+        Folder to write ``study.csv``, ``study.json``, ``base_scene.toml`` and plots.
+    progress : bool
+        Show a progress bar (runs done / total, simulated seconds per wall second)
+        when the output is a terminal.
+    after : float [s]
+        Errors are measured from this time on (from 0 for runs not longer than it).
+    mode : {"grid", "zip"}
+        Cartesian product of the values, or the i-th values together.
+    workers : int, optional
+        Processes of the default pool (or of ``scheduler="local"``); default: cores.
+    scheduler : str, optional
+        ``"tcp://host:8786"``: run on that Dask scheduler's workers (the project must
+        be installed on them); ``"local"``: start a local Dask cluster.
+    plots : bool
+        Write the summary figures into ``out``.
+
+    Returns
+    -------
+    list of dict
+        In the order of :func:`combinations`: the parameters (by path), ``run``,
+        ``status`` and the figures of :data:`FIGURES`.
+
+    Raises
+    ------
+    SceneError
+        Before any run, for an unknown parameter path, a malformed value or unequal
+        zipped lengths. Invalid values of a known path are recorded as refused runs.
+    """
+    from cdpr_exu.scenes.scene import Scene, load_scene, scene_from_dict
+
+    if workers is not None and (isinstance(workers, bool) or int(workers) != workers or workers < 1):
+        raise SceneError(f"workers must be a whole number of at least 1, got {workers!r}")
+    scene = base_scene if isinstance(base_scene, Scene) else load_scene(base_scene)
+    after = float(after)
+    variations = _as_variations(variations)
+    base_data = scene.to_dict()
+    for variation in variations:
+        check_parameter_path(base_data, variation.path)
+    runs = combinations(variations, mode)
+
+    rows: list[dict[str, Any]] = []
+    pending: list[tuple[int, dict[str, Any]]] = []
+    for index, assignments in enumerate(runs):
+        row = {path: value for path, value in assignments}
+        row["run"] = index
+        data = apply_parameters(base_data, assignments)
+        try:
+            data = scene_from_dict(data).to_dict()
+        except SceneError as err:
+            row.update({"status": "refused: " + " ".join(str(err).split()), **_nan_figures()})
+        else:
+            pending.append((index, data))
+        rows.append(row)
+
+    bar = _progress_bar(len(rows), progress)
+    bar.update(len(rows) - len(pending))
+    start = time.perf_counter()
+    simulated = 0.0
+    try:
+        if pending:
+            if executor is None and scheduler is None:
+                workers = min(workers or os.cpu_count() or 1, len(pending))
+            with _executor_for(executor, workers, scheduler) as pool:
+                futures: dict[Future, int] = {pool.submit(run_variation, data, after): index
+                                              for index, data in pending}
+                for future in as_completed(futures):
+                    index = futures[future]
+                    try:
+                        outcome = future.result()
+                    except Exception as err:  # noqa: BLE001 - a lost worker fails one run, not the study
+                        outcome = {"status": f"failed: worker error: {type(err).__name__}: "
+                                   + " ".join(str(err).split()), **_nan_figures()}
+                    rows[index].update(outcome)
+                    if math.isfinite(outcome.get("simulated_time_s", float("nan"))):
+                        simulated += outcome["simulated_time_s"]
+                    elapsed = time.perf_counter() - start
+                    bar.set_postfix_str(f"{simulated / elapsed:.1f} simulated s per wall s", refresh=False)
+                    bar.update(1)
+    finally:
+        bar.close()
+
+    if out is not None:
+        write_study(out, rows, scene, variations, mode=mode, after=after, plots=plots)
+    return rows
+
+
+# --------------------------------------------------------------------------- files
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ""  # empty: "not applicable", never "nan"
+    return "" if value is None else str(value)
+
+
+def _json_value(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def study_columns(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation]) -> list[str]:
+    """CSV columns: the parameters first, then run, status and the figures."""
+    columns = [v.path for v in variations] + ["run", "status", *FIGURES]
+    for row in rows:
+        columns.extend(k for k in row if k not in columns)
+    return columns
+
+
+def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: "Scene",
+                variations: Sequence[Variation], *, mode: str = "grid", after: float = 1.0,
+                plots: bool = True) -> dict[str, Path]:
+    """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
+    from cdpr_exu.core.output import write_summary
+    from cdpr_exu.results.result import provenance
+    from cdpr_exu.scenes.scene import save_scene
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {"scene": save_scene(base_scene, out / STUDY_FILES["scene"])}
+    columns = study_columns(rows, variations)
+    with open(out / STUDY_FILES["csv"], "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(columns)
+        for row in rows:
+            writer.writerow([_cell(row.get(c)) for c in columns])
+    paths["csv"] = out / STUDY_FILES["csv"]
+    data = {
+        "variations": [{"path": v.path, "values": list(v.values)} for v in variations],
+        "mode": mode,
+        "errors_measured_after_s": after,
+        "columns": columns,
+        "rows": [{k: _json_value(v) for k, v in row.items()} for row in rows],
+        "base_scene": base_scene.to_dict(),
+        **provenance(),
+    }
+    write_summary(out, data, name=STUDY_FILES["json"])  # the date goes to timing.json
+    paths["json"] = out / STUDY_FILES["json"]
+    if plots and variations:
+        paths.update(plot_study(rows, variations, out, mode=mode))
+    return paths
+
+
+def load_study(out: str | Path) -> dict[str, Any]:
+    """Read a study's ``study.json`` back (rows, variations, base scene, provenance)."""
+    return json.loads((Path(out) / STUDY_FILES["json"]).read_text())
+
+
+# --------------------------------------------------------------------------- figures
+
+
+def _file_stem(path: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_]+", "_", path).strip("_")
+
+
+def _is_numeric(values: Sequence[Any]) -> bool:
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and math.isfinite(value)
+
+
+def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation], out: str | Path,
+               mode: str = "grid") -> dict[str, Path]:
+    """Summary figures of a study; returns their paths by name.
+
+    For each varied parameter, ``vs_<path>.png``: the maximum position error and the
+    wall time against that parameter (one line per value of the other parameter in a
+    2-parameter grid, per combination of the others beyond). A 2-parameter grid also
+    gets ``heatmap.png``. Failed and refused runs are marked with red crosses at the
+    bottom of the axes.
+    """
+    from cdpr_exu.post.plots import DPI, _figure
+
+    out = Path(out)
+    written: dict[str, Path] = {}
+    for variation in variations:
+        others = [v for v in variations if v.path != variation.path] if mode == "grid" else []
+        figure = _figure(10.0, 4.0, left=0.9, right=0.25, bottom=0.8, top=0.5, wspace=0.9, columns=2)
+        axes = figure.subplots(1, 2)
+        numeric = _is_numeric(variation.values)
+        position = {v: (v if numeric else i) for i, v in enumerate(variation.values)}
+        groups: dict[tuple, list[Mapping[str, Any]]] = {}
+        for row in rows:
+            groups.setdefault(tuple(row[o.path] for o in others), []).append(row)
+        for quantity, axis, scale, label in (("max_position_error_m", axes[0], 1000.0, "max position error [mm]"),
+                                             ("wall_time_s", axes[1], 1.0, "wall time [s]")):
+            failed_label = "failed / refused"
+            for key, members in groups.items():
+                members = sorted(members, key=lambda r: position[r[variation.path]])
+                name = ", ".join(f"{o.path} = {_cell(v)}" for o, v in zip(others, key)) or None
+                ok = [r for r in members if r["status"] == "completed" and _finite(r.get(quantity))]
+                bad = [r for r in members if r["status"] != "completed"]
+                if ok:
+                    axis.plot([position[r[variation.path]] for r in ok], [scale * r[quantity] for r in ok],
+                              marker="o", label=name)
+                elif name:
+                    failed_label = None
+                if bad:  # at the foot of the axes: their figures are partial or missing
+                    label_bad = failed_label if ok or not name else f"{name}: failed / refused"
+                    axis.plot([position[r[variation.path]] for r in bad], [0.03] * len(bad), linestyle="none",
+                              marker="x", color="tab:red", markersize=9, markeredgewidth=2,
+                              transform=axis.get_xaxis_transform(), label=label_bad, clip_on=False)
+                    if ok or not name:
+                        failed_label = None
+            axis.set_xlabel(variation.path)
+            axis.set_ylabel(label)
+            axis.grid(True, alpha=0.3)
+            if not numeric:
+                axis.set_xticks(range(len(variation.values)), [_cell(v) for v in variation.values])
+            if others or failed_label is None:
+                axis.legend(fontsize=7)
+        after = next((r["errors_measured_after_s"] for r in rows if _finite(r.get("errors_measured_after_s"))), None)
+        figure.suptitle(f"study over {variation.path}" + (f" (errors after {after:g} s)" if _finite(after) else ""),
+                        fontsize=10)
+        path = out / f"vs_{_file_stem(variation.path)}.png"
+        figure.savefig(path, dpi=DPI, format="png")
+        written[f"vs_{variation.path}"] = path
+    if mode == "grid" and len(variations) == 2:
+        written["heatmap"] = _plot_heatmap(rows, variations, out / "heatmap.png")
+    return written
+
+
+def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation], path: Path) -> Path:
+    """Maximum position error and wall time over a 2-parameter grid, failed cells marked."""
+    import matplotlib
+    import numpy as np
+
+    from cdpr_exu.post.plots import DPI, _figure
+
+    first, second = variations
+    figure = _figure(11.0, 4.5, left=1.0, right=0.3, bottom=0.8, top=0.5, wspace=1.6, columns=2)
+    axes = figure.subplots(1, 2)
+    index = {(row[first.path], row[second.path]): row for row in rows}
+    for axis, quantity, scale, label in ((axes[0], "max_position_error_m", 1000.0, "max position error [mm]"),
+                                         (axes[1], "wall_time_s", 1.0, "wall time [s]")):
+        grid = np.full((len(first.values), len(second.values)), np.nan)
+        for i, a in enumerate(first.values):
+            for j, b in enumerate(second.values):
+                row = index.get((a, b))
+                if row is not None and row["status"] == "completed" and _finite(row.get(quantity)):
+                    grid[i, j] = scale * row[quantity]
+        colormap = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
+        image = axis.imshow(grid, origin="lower", aspect="auto", cmap=colormap)
+        figure.colorbar(image, ax=axis, label=label)
+        finite = grid[np.isfinite(grid)]
+        middle = 0.5 * (finite.min() + finite.max()) if finite.size else 0.0
+        for i, a in enumerate(first.values):
+            for j, b in enumerate(second.values):
+                row = index.get((a, b))
+                if row is None:
+                    continue
+                if row["status"] != "completed":
+                    text, color = row["status"].split(":")[0], "tab:red"
+                else:
+                    text, color = f"{grid[i, j]:.3g}", ("black" if grid[i, j] > middle else "white")
+                axis.text(j, i, text, ha="center", va="center", fontsize=8, color=color)
+        axis.set_xticks(range(len(second.values)), [_cell(v) for v in second.values])
+        axis.set_yticks(range(len(first.values)), [_cell(v) for v in first.values])
+        axis.set_xlabel(second.path)
+        axis.set_ylabel(first.path)
+    figure.suptitle("study grid (grey, red text: failed or refused run)", fontsize=10)
+    figure.savefig(path, dpi=DPI, format="png")
+    return path
+
+
+# --------------------------------------------------------------------------- table
+
+
+def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation]) -> str:
+    """A plain-text table of a study: parameters, status, errors [mm], wall time [s].
+
+    The causes of failed and refused runs follow the table, once each.
+    """
+    head = [v.path for v in variations] + ["run", "status", "max err [mm]", "rms err [mm]", "wall [s]",
+                                           "x real time"]
+    lines, causes = [], {}
+    for row in rows:
+        status = str(row.get("status", ""))
+        kind, _, cause = status.partition(": ")
+        if cause:
+            causes.setdefault(cause, []).append(str(row.get("run", "")))
+        cells = [_cell(row.get(v.path)) for v in variations] + [_cell(row.get("run")), kind]
+        for name, scale, fmt in (("max_position_error_m", 1000.0, "{:.2f}"), ("rms_position_error_m", 1000.0, "{:.2f}"),
+                                 ("wall_time_s", 1.0, "{:.2f}"), ("real_time_factor", 1.0, "{:.2f}")):
+            value = row.get(name)
+            cells.append(fmt.format(scale * value) if _finite(value) else "-")
+        lines.append(cells)
+    widths = [max(len(str(c)) for c in column) for column in zip(head, *lines)]
+    out = ["  ".join(str(c).ljust(w) for c, w in zip(head, widths)).rstrip()]
+    out.extend("  ".join(str(c).ljust(w) for c, w in zip(cells, widths)).rstrip() for cells in lines)
+    for cause, runs in causes.items():
+        out.append(f"run{'s' if len(runs) > 1 else ''} {', '.join(runs)}: {cause}")
+    return "\n".join(out)
+
+
+# --------------------------------------------------------------------------- command line
+
+EPILOG_STUDY = """examples:
+  cdpr study sweep paper-circle --param cables.n_elements=10,15 --param platform.mass=1,2.5 --out results/study
+  cdpr study sweep --help
+"""
+
+EPILOG_SWEEP = """examples:
+  cdpr study sweep paper-circle --param cables.n_elements=8,10,15 --param platform.mass=1,2.5,5 --out out/grid
+  cdpr study sweep paper-circle --param effects.preset=full,catenary --end-time 2 --out out/presets
+  cdpr study sweep scene.toml --param 'cables[1].radius=0.004,0.006' --param solver.step_size=1e-3,2e-3 \\
+      --zip --out out/zipped --workers 2
+  cdpr study sweep paper-circle --param platform.mass=1,2.5,5 --out out/local-dask --scheduler local
+  cdpr study sweep paper-circle --param platform.mass=1,2.5,5 --out out/cluster --scheduler tcp://10.0.0.1:8786
+
+parameter paths name fields of the scene's TOML form: cables.n_elements (every cable),
+cables[1].radius (one cable), platform.mass, solver.step_size, effects.bending,
+effects.preset, trajectory.angular_rate, platform.initial_pose[1], ...
+values are TOML scalars: 5, 2.5, 1e-3, true, false, "full" (or a bare word: full).
+
+writes study.csv, study.json, base_scene.toml and vs_<parameter>.png (+ heatmap.png
+for a 2-parameter grid) into --out. Failed and refused runs are recorded as rows.
+"""
+
+
+def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubParsersAction:
+    """The sub-parsers of ``cdpr study`` (made on first call; the same object after).
+
+    Other modules add ``cdpr study <name>`` commands with
+    ``study_subparsers(subparsers).add_parser(name, ...)`` in their ``add_commands``.
+    """
+    existing = getattr(subparsers, "_cdpr_study_subparsers", None)
+    if existing is not None:
+        return existing
+    study = subparsers.add_parser("study", help="parameter studies over a scene, in parallel",
+                                  description="Parameter studies: run a scene over many parameter values "
+                                  "on all cores or on a Dask cluster, and tabulate and plot the results.",
+                                  epilog=EPILOG_STUDY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    study_sub = study.add_subparsers(dest="study_command", required=True, metavar="COMMAND")
+    subparsers._cdpr_study_subparsers = study_sub
+    return study_sub
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from cdpr_exu.core.output import check_output_folder
+    from cdpr_exu.scenes.scene import load_scene
+
+    scene = load_scene(args.scene)
+    if args.end_time is not None:
+        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
+    if args.scheduler and args.scheduler != "local" and args.workers and not args.quiet:
+        print("cdpr study: --workers is ignored with a remote --scheduler (its workers run the study)",
+              file=sys.stderr)
+    variations = _as_variations(args.param)
+    out = check_output_folder(args.out)
+    rows = run_study(scene, variations, out=out, progress=not args.quiet, after=args.after,
+                     mode="zip" if args.zip else "grid", workers=args.workers, scheduler=args.scheduler)
+    if not args.quiet:
+        print(format_table(rows, variations))
+        done = sum(row["status"] == "completed" for row in rows)
+        print(f"{done} of {len(rows)} runs completed; written to {out}/")
+    failed = sum(row["status"] != "completed" for row in rows)
+    if failed:
+        print(f"cdpr study sweep: {failed} of {len(rows)} runs did not complete (see the status column)",
+              file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return EXIT_OK
+
+
+def add_commands(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``cdpr study sweep`` (and the ``study`` group) to the ``cdpr`` command."""
+    sweep = study_subparsers(subparsers).add_parser(
+        "sweep", help="run a scene over a grid of parameter values",
+        description="Run a scene once per combination of parameter values (a grid, or --zip), in "
+        "parallel, and write a CSV/JSON table and summary plots. Failed and refused runs are recorded, "
+        "not fatal.", epilog=EPILOG_SWEEP + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sweep.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
+    sweep.add_argument("--param", action="append", required=True, metavar="PATH=V1,V2,...",
+                       help="a parameter and its values; repeat for more parameters")
+    sweep.add_argument("--zip", action="store_true",
+                       help="run the i-th values of all parameters together instead of the grid")
+    sweep.add_argument("--out", required=True, help="output folder (created)")
+    sweep.add_argument("--workers", type=int, help="worker processes (default: one per core)")
+    sweep.add_argument("--scheduler", metavar="ADDRESS|local",
+                       help="run on a Dask cluster: its scheduler's address (tcp://host:8786), or 'local' "
+                       "to start one on this machine")
+    sweep.add_argument("--end-time", type=float, help="override solver.end_time of every run [s]")
+    sweep.add_argument("--after", type=float, default=1.0,
+                       help="measure errors from this time on [s] (default 1; 0 for runs not longer)")
+    sweep.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table")
+    sweep.set_defaults(func=_cmd_sweep)
