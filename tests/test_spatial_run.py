@@ -147,3 +147,15 @@ def test_cdpr_animate_renders_a_spatial_run_headless(tmp_path):
     with Image.open(run / "animation.gif") as gif:
         # 1 s stored every 0.02 s (51 rows), played in real time at 10 frames/s: every 5th row
         assert gif.n_frames == 11 and gif.size == (640, 480)
+
+
+def test_a_study_sweeps_a_spatial_scene_and_keeps_its_base_scene(tmp_path):
+    from cdpr_exu.scenes.spatial_scene import load_any_scene
+    from cdpr_exu.studies.study import run_study
+
+    scene = load_spatial_scene("spatial-ipanema")
+    scene = replace(scene, solver=replace(scene.solver, end_time=1.5))
+    rows = run_study(scene, ["cables.n_elements=5,10"], out=tmp_path, progress=False, workers=1, plots=False)
+    assert [row["status"] for row in rows] == ["completed", "completed"]
+    assert all(0.0 < row["max_position_error_m"] < 5e-3 for row in rows)  # ideal IK on IPAnema: about 0.1 mm
+    assert load_any_scene(tmp_path / "base_scene.toml") == scene  # the spatial scene round-trips through TOML

@@ -817,8 +817,8 @@ class SpatialSceneError(SceneError):
 
 def _refuse_spatial(source: str | Path) -> None:
     raise SpatialSceneError(
-        f"scene {str(source)!r} is spatial (dimension = 3): so far `cdpr static`, `run`, `compare` and `animate` "
-        "take spatial scenes; study and view take planar scenes only (see docs/spatial.md)")
+        f"scene {str(source)!r} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep` and "
+        "`animate` take spatial scenes; `study accuracy` and `view` take planar scenes only (see docs/spatial.md)")
 
 
 def load_scene(source: str | Path) -> Scene:

@@ -31,7 +31,7 @@ message that says so.
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any, ClassVar, Mapping
@@ -45,7 +45,7 @@ from cdpr_exu.scenes.scene import CableSpec, Effects, Scene, SolverSpec, Spatial
 from cdpr_exu.core.validation import non_negative, vector
 
 __all__ = ["SpatialPlatformSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
-           "shipped_spatial_scenes", "is_spatial", "load_any_scene"]
+           "shipped_spatial_scenes", "is_spatial", "load_any_scene", "any_scene_from_dict", "save_any_scene"]
 
 #: Where the shipped spatial scenes live, inside the package's ``scenes`` folder.
 SPATIAL_FOLDER = "spatial"
@@ -174,6 +174,28 @@ class SpatialScene:
     def n_cables(self) -> int:
         return len(self.cables)
 
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (TOML-ready) of the scene; :func:`spatial_scene_from_dict` reads it back."""
+        import dataclasses
+
+        data: dict[str, Any] = {
+            "name": self.name, "description": self.description, "dimension": 3, "gravity": self.gravity,
+            "cables": [{k: v for k, v in dataclasses.asdict(c).items() if v is not None} for c in self.cables],
+            "exits": [{"point": list(e)} for e in self.exits],
+            "platform": {"mass": self.platform.mass, "inertia": list(self.platform.inertia),
+                         "anchors": [list(a) for a in self.platform.anchors]},
+            "effects": dataclasses.asdict(self.effects),
+            "solver": dataclasses.asdict(self.solver),
+            "winch": dataclasses.asdict(self.winch),
+        }
+        if self.trajectory is not None:
+            data["trajectory"] = self.trajectory.to_dict()
+        return data
+
+    def with_changes(self, **changes: Any) -> "SpatialScene":
+        """A copy with fields replaced (validated again)."""
+        return replace(self, **changes)
+
     @property
     def unstrained_lengths(self) -> np.ndarray:
         """Unstrained length of each cable, shape (m,) [m]."""
@@ -290,4 +312,23 @@ def load_any_scene(source: str | Path) -> Scene | SpatialScene:
         return load_scene(source)
     except SpatialSceneError:
         return load_spatial_scene(source)
+
+
+def any_scene_from_dict(data: Mapping[str, Any]) -> Scene | SpatialScene:
+    """A planar or a spatial scene from plain data, by its ``dimension`` (2 when absent)."""
+    from .scene import scene_from_dict
+
+    if isinstance(data, Mapping) and data.get("dimension") == 3:
+        return spatial_scene_from_dict(data)
+    return scene_from_dict(data)
+
+
+def save_any_scene(scene: Scene | SpatialScene, path: str | Path) -> Path:
+    """Write a planar or spatial scene as TOML; :func:`load_any_scene` reads it back to an equal scene."""
+    import tomli_w
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(tomli_w.dumps(scene.to_dict()))
+    return path
 

@@ -373,14 +373,17 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)  # effective if the libraries are not loaded yet
     from cdpr_exu.core.errors import SolverFailure, UnreachableError
-    from cdpr_exu.scenes.scene import scene_from_dict
+    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial
 
     try:
-        scene = scene_from_dict(scene_data)
-        from cdpr_exu.run.simulate import simulate
+        scene = any_scene_from_dict(scene_data)
+        if is_spatial(scene):
+            from cdpr_exu.run.spatial_run import simulate_spatial as simulate
+        else:
+            from cdpr_exu.run.simulate import simulate
 
+            _warm_up(scene)
         after = after if after < scene.solver.end_time else 0.0
-        _warm_up(scene)
         try:
             result = simulate(scene, progress=False)
             status = "completed"
@@ -515,11 +518,12 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         Before any run, for an unknown parameter path, a malformed value or unequal
         zipped lengths. Invalid values of a known path are recorded as refused runs.
     """
-    from cdpr_exu.scenes.scene import Scene, load_scene, scene_from_dict
+    from cdpr_exu.scenes.scene import Scene
+    from cdpr_exu.scenes.spatial_scene import SpatialScene, any_scene_from_dict, load_any_scene
 
     if workers is not None and (isinstance(workers, bool) or int(workers) != workers or workers < 1):
         raise SceneError(f"workers must be a whole number of at least 1, got {workers!r}")
-    scene = base_scene if isinstance(base_scene, Scene) else load_scene(base_scene)
+    scene = base_scene if isinstance(base_scene, (Scene, SpatialScene)) else load_any_scene(base_scene)
     after = float(after)
     variations = _as_variations(variations)
     base_data = scene.to_dict()
@@ -534,7 +538,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         row["run"] = index
         data = apply_parameters(base_data, assignments)
         try:
-            data = scene_from_dict(data).to_dict()
+            data = any_scene_from_dict(data).to_dict()
         except SceneError as err:
             row.update({"status": "refused: " + " ".join(str(err).split()), **_nan_figures()})
         else:
@@ -604,7 +608,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
     """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
     from cdpr_exu.core.output import write_summary
     from cdpr_exu.results.result import provenance
-    from cdpr_exu.scenes.scene import save_scene
+    from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -833,9 +837,9 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from cdpr_exu.core.output import check_output_folder
-    from cdpr_exu.scenes.scene import load_scene
+    from cdpr_exu.scenes.spatial_scene import load_any_scene
 
-    scene = load_scene(args.scene)
+    scene = load_any_scene(args.scene)  # planar or spatial
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
     if args.scheduler and args.scheduler != "local" and args.workers and not args.quiet:
