@@ -146,11 +146,15 @@ class SwivelRun:
         Azimuth of the end mass seen from the axis (where ideal kinematics puts psi).
     in_contact : ndarray (S,) of int
         Nodes touching the pulley.
-    positions : ndarray (S, N, 3) [m]
+    positions : ndarray (S', N, 3) [m]
+        Node positions every ``record_every`` rows (the first row included).
+    final_positions : ndarray (N, 3) [m]
+        Node positions at the last step.
     newton_iterations, steps : int
     wall_time : float [s]
     failed : str
-        Empty, or the solver's error if the run stopped early.
+        Empty, or why the run stopped early (the solver's error, or the energy rose by more
+        than ``abort_rise``).
     """
 
     time: np.ndarray
@@ -160,6 +164,7 @@ class SwivelRun:
     mass_azimuth: np.ndarray
     in_contact: np.ndarray
     positions: np.ndarray
+    final_positions: np.ndarray
     newton_iterations: int
     steps: int
     wall_time: float
@@ -184,19 +189,23 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
                         cone_angle: float = math.radians(30.0), free_length: float = 1.0,
                         winch_length: float = 0.3, element_length: float = 0.05, cable_radius: float = 0.002,
                         youngs_modulus: float = 1.0e9, linear_density: float = 0.05, axial_damping: float = 0.0,
-                        psi: float = 0.0, psi_offset: float = 0.0, swing: bool = True,
-                        spectral_radius: float = 1.0, gravity: float = 9.81, record_every: int = 1,
-                        newton_tolerance: float = 1e-8, verbose: int = 0, initial_accelerations: bool = True,
-                        adaptive: bool = True) -> SwivelRun:
+                        psi: float = 0.0, psi_offset: float = 0.0, swing: bool = True, rate_factor: float = 1.0,
+                        spectral_radius: float = 0.5, gravity: float = 9.81, record_every: int = 1,
+                        newton_tolerance: float = 1e-10, verbose: int = 0, initial_accelerations: bool = True,
+                        adaptive: bool = True, abort_rise: float = math.inf,
+                        settle_statically: bool = False) -> SwivelRun:
     """Run a mass on a cable over a swivel pulley: a conical pendulum (``swing``) or a hang.
 
     The cable (held at ``winch_length`` [m] below the inlet on the axis) comes up the axis,
     wraps the disc at azimuth ``psi`` and leaves at ``cone_angle`` [rad] from the vertical
     for ``free_length`` [m] to the ``end_mass`` [kg]. With ``swing`` the whole cable and the
     swivel start turning rigidly about the axis at the conical pendulum's rate
-    omega = sqrt(g tan(angle) / R), R the mass's distance from the axis; the swivel starts at
+    omega = rate_factor sqrt(g tan(angle) / R), R the mass's distance from the axis (1: a circle;
+    less: the mass swings in and out, its azimuth rate varies); the swivel starts at
     ``psi + psi_offset``. Fixed step ``step`` [s], generalized-alpha with ``spectral_radius``,
     full Newton; no damping but the bearing's (and ``axial_damping`` [N s/m] per element).
+    With ``settle_statically``, Exudyn's static solver then starts from the final state, and
+    ``final_positions`` and the last ``psi`` are its rest state.
     """
     path = sp.cable_path_over_swivel(pulley, psi, winch_length, free_length, cone_angle, element_length)
     spacing = np.linalg.norm(np.diff(path, axis=0), axis=1)
@@ -215,6 +224,7 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     inlet = pulley.inlet_array
     reach = math.hypot(path[-1, 0] - inlet[0], path[-1, 1] - inlet[1])
     omega = math.sqrt(gravity * math.tan(cone_angle) / reach) if swing and cone_angle > 0.0 else 0.0
+    omega *= rate_factor
     swivel = add_swivel_pulley(mbs, chain, pulley, psi + psi_offset, omega)
     mbs.Assemble()
     n3 = 3 * len(path)
@@ -269,8 +279,14 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
         rows["contact"].append(int(np.count_nonzero(np.any(force[:n3].reshape(-1, 3) != 0.0, axis=1))))
         if len(rows["time"]) % record_every == 1 or record_every == 1:
             rows["positions"].append(points.copy())
+        last[:] = points
+        if energy - rows["energy"][0] > abort_rise:
+            aborted.append(t)
+            return False  # stops the run
         return True
 
+    aborted = []
+    last = np.zeros((len(path), 3))
     record(mbs, 0.0, exu.ConfigurationType.Initial)
     mbs.SetPostStepUserFunction(record)
     failed = ""
@@ -280,6 +296,22 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     except Exception as error:  # noqa: BLE001 - exu.SolverError and friends: report, keep what ran
         failed = f"{type(error).__name__}: {error}"[:300]
     wall = time.perf_counter() - started
+    if settle_statically and not failed and not aborted:
+        # Exudyn's static solver from where the run ended: the rest state without a swing left
+        mbs.SetPostStepUserFunction(0)
+        mbs.systemData.SetODE2Coordinates(mbs.systemData.GetODE2Coordinates(), exu.ConfigurationType.Initial)
+        static = exu.SimulationSettings()
+        static.staticSolver.newton.relativeTolerance = 1e-10
+        static.staticSolver.newton.absoluteTolerance = 1e-12
+        static.staticSolver.newton.maxIterations = 50
+        static.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+        static.solution.file.write = False
+        mbs.SolveStatic(static)
+        q_all = np.asarray(mbs.systemData.GetODE2Coordinates())
+        last[:] = (chain.reference + q_all[chain_index]).reshape(-1, 3)
+        rows["psi"][-1] = swivel.psi_reference + float(q_all[psi_index])
+    if aborted and not failed:
+        failed = f"aborted at t = {aborted[0]:.4g} s: energy rose by more than {abort_rise:g} J"
     iterations = mbs.sys["dynamicSolver"].it.newtonStepsCount if "dynamicSolver" in mbs.sys else -1
     steps = mbs.sys["dynamicSolver"].it.currentStepIndex if "dynamicSolver" in mbs.sys else len(rows["time"]) - 1
     t = np.array(rows["time"])
@@ -287,5 +319,5 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     power = pulley.bearing_damping * rate**2
     dissipated = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
     return SwivelRun(t, np.array(rows["energy"]), dissipated, np.unwrap(np.array(rows["psi"])),
-                     np.unwrap(np.array(rows["azimuth"])), np.array(rows["contact"]), np.array(rows["positions"]),
+                     np.unwrap(np.array(rows["azimuth"])), np.array(rows["contact"]), np.array(rows["positions"]), last.copy(),
                      int(iterations), int(steps), wall, failed)
