@@ -10,14 +10,16 @@ conical pendulum's rate, so the mass swings in and out and its azimuth rate vari
 swivel has to speed up and slow down to follow it. 10 s, generalized-alpha, full Newton,
 adaptive step (Exudyn halves the step where Newton fails).
 
-For each (J_s, d_s), step and Newton relative tolerance it writes the largest rise of
+For each (J_s, d_s), step, Newton relative tolerance and energy guard (a step whose
+Newton solution gains more than the guard over the last accepted step is repeated at a
+quarter of its size) it writes the largest rise of
 the mechanical energy above its start (nothing dissipates but the bearing and the
 integrator), the largest |E + bearing dissipation - E0|, the largest lag of psi behind
 the mass's azimuth after the first second, Newton iterations per step and the steps
 taken. A run whose energy rises by more than 10 J is stopped there ("gained").
 
 Run: ``python benchmarks/bench_swivel_pulley.py [--end-time 10]``; writes
-``benchmarks/results/swivel_pulley.md``. About 10 minutes on one core.
+``benchmarks/results/swivel_pulley.md``. About 15 minutes on one core.
 """
 
 from __future__ import annotations
@@ -35,22 +37,24 @@ from cdpr_exu.physics.swivel_pulley import SwivelPulley
 INERTIAS = (1e-6, 1e-4, 1e-2, 1.0)  # kg m^2
 DAMPINGS = (0.0, 1e-3, 1e-1)  # N m s
 STEPS = (5e-3, 2e-3)  # s
-TOLERANCES = (1e-8, 1e-10)
+CONFIGURATIONS = ((1e-8, None), (1e-10, None), (1e-8, 1e-3))  # Newton relative tolerance, energy guard [J]
 ABORT_RISE = 10.0  # J: several times the pendulum's kinetic energy (about 2 J)
 HOLDS_BELOW = 0.1  # J: a run "holds" if its energy never rises more than this
 
 
 def _measure(inertia, damping, step, tolerance, end_time, rate_factor=0.7, spectral_radius=0.5,
-             element_length=0.05):
+             element_length=0.05, guard=None):
     pulley = SwivelPulley(swivel_inertia=inertia, bearing_damping=damping)
     run = run_swivel_pendulum(pulley, step, end_time, rate_factor=rate_factor, spectral_radius=spectral_radius,
                               newton_tolerance=tolerance, abort_rise=ABORT_RISE, record_every=10**9,
-                              element_length=element_length)
+                              element_length=element_length, energy_guard=guard)
     lag = np.degrees(np.abs(run.psi - run.mass_azimuth))
     late = lag[run.time > 1.0]
     verdict = "holds" if not run.failed and run.energy_rise < HOLDS_BELOW else (
         "gained" if run.energy_rise >= HOLDS_BELOW else "failed")
     return {"J_s": inertia, "d_s": damping, "step": step, "tol": tolerance, "rho": spectral_radius,
+            "guard": "-" if guard is None else f"{guard:g}", "rejections": run.guard_rejections,
+            "rate_factor": rate_factor,
             "element": element_length, "verdict": verdict, "t_end": run.time[-1], "rise": run.energy_rise,
             "balance": run.balance_error, "lag": float(late.max()) if late.size else float("nan"),
             "its": run.iterations_per_step, "steps": run.steps, "wall": run.wall_time,
@@ -59,13 +63,15 @@ def _measure(inertia, damping, step, tolerance, end_time, rate_factor=0.7, spect
 
 def _row(r):
     rise = f"{r['rise']:.3g}" if r["verdict"] != "gained" or r["rise"] < ABORT_RISE else f"> {ABORT_RISE:g}"
-    return (f"| {r['J_s']:g} | {r['d_s']:g} | {r['step']:g} | {r['tol']:g} | {r['verdict']} | {r['t_end']:.2f} | "
-            f"{rise} | {r['balance']:.3g} | {r['lag']:.2f} | {r['its']:.2f} | {r['steps']} | {r['contact']} |")
+    return (f"| {r['J_s']:g} | {r['d_s']:g} | {r['step']:g} | {r['tol']:g} | {r['guard']} | {r['verdict']} | "
+            f"{r['t_end']:.2f} | {rise} | {r['balance']:.3g} | {r['lag']:.2f} | {r['its']:.2f} | {r['steps']} | "
+            f"{r['rejections']} | {r['contact']} | {r['wall']:.1f} |")
 
 
-HEADER = ("| J_s [kg m^2] | d_s [N m s] | step [s] | Newton rel. tol. | verdict | reached [s] | energy rise [J] | "
-          "balance error [J] | psi lag after 1 s [deg] | Newton it. / step | steps taken | fewest nodes in contact |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|---|")
+HEADER = ("| J_s [kg m^2] | d_s [N m s] | step [s] | Newton rel. tol. | energy guard [J] | verdict | reached [s] | "
+          "energy rise [J] | balance error [J] | psi lag after 1 s [deg] | Newton it. / step | steps taken | "
+          "steps repeated by the guard | fewest nodes in contact after 0.1 s | wall [s] |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 
 
 def main() -> None:
@@ -75,21 +81,26 @@ def main() -> None:
     args = parser.parse_args()
     started = time.perf_counter()
     grid = []
-    for tolerance in TOLERANCES:
+    for tolerance, guard in CONFIGURATIONS:
         for step in STEPS:
             for inertia in INERTIAS:
                 for damping in DAMPINGS:
-                    grid.append(_measure(inertia, damping, step, tolerance, args.end_time))
+                    grid.append(_measure(inertia, damping, step, tolerance, args.end_time, guard=guard))
                     print(_row(grid[-1]), flush=True)
     extra = []
-    for rho in (0.0, 1.0):
+    for rho, guard in ((0.0, None), (1.0, None), (1.0, 1e-3)):
         for step in STEPS:
-            extra.append(_measure(1e-2, 1e-3, step, 1e-10, args.end_time, spectral_radius=rho))
+            extra.append(_measure(1e-2, 1e-3, step, 1e-10, args.end_time, spectral_radius=rho, guard=guard))
             print(rho, _row(extra[-1]), flush=True)
     coarse = []
+    for guard in (None, 1e-3):
+        for step in STEPS:
+            coarse.append(_measure(1e-2, 1e-3, step, 1e-10, args.end_time, element_length=0.1, guard=guard))
+            print("coarse", _row(coarse[-1]), flush=True)
+    circle = []
     for step in STEPS:
-        coarse.append(_measure(1e-2, 1e-3, step, 1e-10, args.end_time, element_length=0.1))
-        print("coarse", _row(coarse[-1]), flush=True)
+        circle.append(_measure(1e-2, 1e-3, step, 1e-10, args.end_time, rate_factor=1.0))
+        print("circle", _row(circle[-1]), flush=True)
 
     lines = [f"# Swivel pulley stability map (pendulum around the axis, {args.end_time:g} s per run)", "",
              __doc__.split("\n\n")[1].replace("\n", " "), "",
@@ -98,16 +109,24 @@ def main() -> None:
              "at the smallest step. Spectral radius 0.5, elements 0.05 m, unless said.", "",
              "## J_s x d_s x step x Newton tolerance", "", HEADER]
     lines += [_row(r) for r in grid]
-    lines += ["", "## Spectral radius (J_s = 1e-2 kg m^2, d_s = 1e-3 N m s, tolerance 1e-10)", "",
+    lines += ["", "## Spectral radius (J_s = 1e-2 kg m^2, d_s = 1e-3 N m s, tolerance 1e-10; at 1.0 even the planar "
+              "hang, psi still, gains energy)", "",
               HEADER.replace("| J_s", "| spectral radius | J_s").replace("|---|", "|---|---|", 1)]
     lines += [f"| {r['rho']:g} " + _row(r) for r in extra]
     lines += ["", "## Elements as long as the pulley radius (0.1 m; J_s = 1e-2, d_s = 1e-3, tolerance 1e-10)", "",
               HEADER]
     lines += [_row(r) for r in coarse]
+    lines += ["", "## The conical pendulum proper (started at the conical rate: the mass circles; J_s = 1e-2, "
+              "d_s = 1e-3, tolerance 1e-10)", "", HEADER]
+    lines += [_row(r) for r in circle]
     held = [r for r in grid if r["verdict"] == "holds"]
-    lines += ["", f"Runs that hold: {len(held)} of {len(grid)} in the grid "
-              f"({sum(r['tol'] == 1e-10 for r in held)} of {sum(r['tol'] == 1e-10 for r in grid)} at tolerance 1e-10, "
-              f"{sum(r['tol'] == 1e-8 for r in held)} of {sum(r['tol'] == 1e-8 for r in grid)} at 1e-8). "
+    counts = []
+    for tolerance, guard in CONFIGURATIONS:
+        label = "-" if guard is None else f"{guard:g}"
+        mine = [r for r in grid if r["tol"] == tolerance and r["guard"] == label]
+        counts.append(f"{sum(r['verdict'] == 'holds' for r in mine)} of {len(mine)} at tolerance {tolerance:g}"
+                      + ("" if guard is None else f" with the {guard:g} J energy guard"))
+    lines += ["", f"Runs that hold in the grid: {len(held)} of {len(grid)} (" + "; ".join(counts) + "). "
               f"Total wall time {time.perf_counter() - started:.0f} s on a shared 2-core machine.", ""]
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text("\n".join(lines))

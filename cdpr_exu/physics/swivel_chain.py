@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import exudyn as exu
@@ -155,6 +156,8 @@ class SwivelRun:
     failed : str
         Empty, or why the run stopped early (the solver's error, or the energy rose by more
         than ``abort_rise``).
+    guard_rejections : int
+        Steps repeated smaller by the energy guard (``energy_guard``).
     """
 
     time: np.ndarray
@@ -169,6 +172,7 @@ class SwivelRun:
     steps: int
     wall_time: float
     failed: str = ""
+    guard_rejections: int = 0
 
     @property
     def energy_rise(self) -> float:
@@ -193,7 +197,8 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
                         spectral_radius: float = 0.5, gravity: float = 9.81, record_every: int = 1,
                         newton_tolerance: float = 1e-10, verbose: int = 0, initial_accelerations: bool = True,
                         adaptive: bool = True, abort_rise: float = math.inf,
-                        settle_statically: bool = False) -> SwivelRun:
+                        settle_statically: bool = False, max_newton_iterations: int = 25,
+                        energy_guard: float | None = None) -> SwivelRun:
     """Run a mass on a cable over a swivel pulley: a conical pendulum (``swing``) or a hang.
 
     The cable (held at ``winch_length`` [m] below the inlet on the axis) comes up the axis,
@@ -205,8 +210,19 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     ``psi + psi_offset``. Fixed step ``step`` [s], generalized-alpha with ``spectral_radius``,
     full Newton; no damping but the bearing's (and ``axial_damping`` [N s/m] per element).
     With ``settle_statically``, Exudyn's static solver then starts from the final state, and
-    ``final_positions`` and the last ``psi`` are its rest state.
+    ``final_positions`` and the last ``psi`` are its rest state. With ``energy_guard`` [J],
+    a step whose Newton solution gains more than that over the last accepted step is
+    repeated at a quarter of its size (down to step / 1000).
     """
+    if energy_guard is None:
+        if newton_tolerance > sp.SAFE_NEWTON_TOLERANCE:
+            warnings.warn(f"newton_tolerance = {newton_tolerance:g} is looser than {sp.SAFE_NEWTON_TOLERANCE:g}, "
+                          "where runs over a swivel pulley were measured to gain energy; set energy_guard",
+                          sp.SwivelStabilityWarning, stacklevel=2)
+        if element_length > sp.SAFE_ELEMENT_FRACTION * pulley.radius:
+            warnings.warn(f"element_length = {element_length:g} m is longer than {sp.SAFE_ELEMENT_FRACTION:g} "
+                          f"of the pulley radius ({pulley.radius:g} m), where runs were measured to lose the wrap "
+                          "and gain energy; set energy_guard", sp.SwivelStabilityWarning, stacklevel=2)
     path = sp.cable_path_over_swivel(pulley, psi, winch_length, free_length, cone_angle, element_length)
     spacing = np.linalg.norm(np.diff(path, axis=0), axis=1)
     masses = np.zeros(len(path))
@@ -246,7 +262,7 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     ti.generalizedAlpha.computeInitialAccelerations = initial_accelerations
     ti.newton.useModifiedNewton = False
     ti.newton.relativeTolerance = newton_tolerance
-    ti.newton.maxIterations = 25
+    ti.newton.maxIterations = max_newton_iterations
     # Exudyn halves the step where Newton fails (a node entering the stiff contact) and
     # grows it back; the steps taken are reported (SwivelRun.steps).
     ti.adaptiveStep = adaptive
@@ -259,13 +275,18 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     rows = {key: [] for key in ("time", "energy", "psi", "azimuth", "contact", "positions", "rate")}
     bending = 0.0 if chain.bending is None else bending_stiffness
 
-    def record(mbs_, t, configuration=exu.ConfigurationType.Current):
+    def state(mbs_, configuration):
         q_all = np.asarray(mbs_.systemData.GetODE2Coordinates(configuration))
         v_all = np.asarray(mbs_.systemData.GetODE2Coordinates_t(configuration))
         q, v = q_all[chain_index], v_all[chain_index]
         dpsi, rate = float(q_all[psi_index]), float(v_all[psi_index])
         energy = chain_energy(chain, masses, q, v, axial_stiffness, bending, gravity)
         energy += swivel_energy(swivel, chain, pulley, q, dpsi, rate)
+        return q, dpsi, rate, energy
+
+    def record(mbs_, t, configuration=exu.ConfigurationType.Current):
+        q, dpsi, rate, energy = state(mbs_, configuration)
+        accepted[0] = energy
         points = (chain.reference + q).reshape(-1, 3)
         force = sp.swivel_contact_force(points.ravel().copy(), np.zeros(n3), swivel.psi_reference + dpsi, 0.0,
                                         *(swivel.contact_nodes, inlet, pulley.radius, pulley.groove_radius,
@@ -286,9 +307,24 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
         return True
 
     aborted = []
+    accepted = [0.0]  # energy after the last accepted step [J]
+    rejected = [0]
     last = np.zeros((len(path), 3))
     record(mbs, 0.0, exu.ConfigurationType.Initial)
     mbs.SetPostStepUserFunction(record)
+    if energy_guard is not None:
+        minimum = step * 1e-3
+
+        def guard(mbs_, t):
+            """Repeat a step at a quarter of its size if its converged state gained more than
+            ``energy_guard`` [J]: nothing in this scene can supply energy (no moving winch)."""
+            size = mbs_.sys["dynamicSolver"].it.currentStepSize
+            if state(mbs_, exu.ConfigurationType.Current)[3] - accepted[0] > energy_guard and size > minimum:
+                rejected[0] += 1
+                return [1e3, max(minimum, 0.25 * size)]  # an error above the goal: repeat the step
+            return [0.0, -1.0]
+
+        mbs.SetPostNewtonUserFunction(guard)
     failed = ""
     started = time.perf_counter()
     try:
@@ -319,5 +355,6 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     power = pulley.bearing_damping * rate**2
     dissipated = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
     return SwivelRun(t, np.array(rows["energy"]), dissipated, np.unwrap(np.array(rows["psi"])),
-                     np.unwrap(np.array(rows["azimuth"])), np.array(rows["contact"]), np.array(rows["positions"]), last.copy(),
-                     int(iterations), int(steps), wall, failed)
+                     np.unwrap(np.array(rows["azimuth"])), np.array(rows["contact"]),
+                     np.array(rows["positions"]), last.copy(),
+                     int(iterations), int(steps), wall, failed, rejected[0])

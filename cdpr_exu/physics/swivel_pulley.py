@@ -44,7 +44,6 @@ Flat arrays (x0, y0, z0, x1, ...) [m, m/s]; no Exudyn here (the builder is
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,7 +53,8 @@ from cdpr_exu.axial import tension_law
 from cdpr_exu.errors import CdprWarning, SceneError
 from cdpr_exu.validation import non_negative, positive, vector
 
-__all__ = ["SwivelPulley", "SwivelStabilityWarning", "swivel_contact_force", "swivel_contact_energy",
+__all__ = ["SAFE_ELEMENT_FRACTION", "SAFE_NEWTON_TOLERANCE", "SwivelPulley", "SwivelStabilityWarning",
+           "swivel_contact_force", "swivel_contact_energy",
            "swivel_contact_pattern", "swivel_contact_values", "swivel_penetration", "exit_azimuth"]
 
 #: Below this in-plane distance from the disc centre [m] the normal is undefined: no force.
@@ -220,8 +220,18 @@ def exit_azimuth(point, inlet) -> float:
     return math.atan2(point[1] - inlet[1], point[0] - inlet[0])
 
 
+#: Newton relative tolerance at which every measured (J_s, d_s) held without the energy guard
+#: (benchmarks/results/swivel_pulley.md); Exudyn's default 1e-8 let some runs gain energy.
+SAFE_NEWTON_TOLERANCE = 1e-10
+
+#: Longest element, as a fraction of the pulley radius, measured to keep the wrap without
+#: the energy guard (0.5 held; 1.0 lost the wrap and gained 710 J at 5e-3 s steps).
+SAFE_ELEMENT_FRACTION = 0.5
+
+
 class SwivelStabilityWarning(CdprWarning):
-    """The swivel's inertia and bearing damping lie outside the region measured to be stable."""
+    """A run over a swivel pulley is set up outside what was measured to hold without the
+    energy guard (Newton tolerance, element length); the message names the setting."""
 
 
 @dataclass(frozen=True)
