@@ -22,9 +22,9 @@ and rises to flanks of height h:
 g(s) ~ s^2 / (2 r_g) near the groove's middle, so the sideways force comes from the
 contact force itself (a sideways spring switched on and off with contact is not
 conservative, docs/spatial.md). The unbounded parabola s^2 / (2 r_g) of the prototype
-reaches out of the pulley: with r_g = 1 cm a node 1 m down a cable that leaves the disc
-plane by 10 degrees has s^2 / (2 r_g) = 1.5 m > d - r_p = 1 m and would be "in contact";
-the flanks of height h bound it: only nodes within h of the rim can touch.
+reaches out of the pulley: with r_g = 1 cm, a node 1 m below the rim on a cable that leaves
+the disc plane by 10 degrees has s^2 / (2 r_g) = 1.5 m against d - r_p = 0.9 m, and would be
+"in contact"; the flanks of height h bound it: only nodes within h of the rim can touch.
 
 The normal force is the planar node contact's law (:mod:`cdpr_exu.node_contact`,
 :func:`cdpr_exu.axial.tension_law`): F = S(delta / b) max(0, k_p delta + c_p d(delta)/dt),
