@@ -233,13 +233,13 @@ def test_a_pendulum_around_the_swivel_axis_gains_no_energy_for_10_s_and_the_swiv
     # Bound 1e-3 J on the rise: the prototype's best was 0.17 J, its failures 287-731 J.
     assert run.energy_rise < 1e-3
     assert run.balance_error < 0.1
-    # psi follows the mass's azimuth within 3.1-3.3 degrees after the first second (measured);
+    # psi follows the mass's azimuth within 3.1 degrees after the first second (measured 3.06, 3.10);
     # bound 5 degrees. The mass goes round about 4 times.
     after_first_second = run.time > 1.0
     assert np.degrees(np.abs(run.psi - run.mass_azimuth)[after_first_second]).max() < 5.0
     assert run.mass_azimuth[-1] - run.mass_azimuth[0] > 6 * math.pi
     assert run.in_contact[after_first_second].min() >= 5  # the wrap never lifts off
-    # Newton iterations per step, measured 6.0 (5e-3 s) and 3.1 (2e-3 s), with Exudyn's step
+    # Newton iterations per step, measured 6.0 (5e-3 s) and 3.5 (2e-3 s), with Exudyn's step
     # halving where Newton fails: 2657 and 5024 steps taken for 2000 and 5000 nominal.
     assert run.iterations_per_step < iterations_bound
 
