@@ -11,7 +11,7 @@ from cdpr_exu.errors import SceneError
 from cdpr_exu.node_contact import node_contact_force_kernel
 from cdpr_exu.physics.swivel_chain import run_swivel_pendulum
 from cdpr_exu.physics.swivel_pulley import (SwivelPulley, SwivelStabilityWarning, cable_path_over_swivel,
-                                            swivel_contact_energy,
+                                            stability_concerns, swivel_contact_energy,
                                             swivel_contact_force, swivel_contact_pattern, swivel_contact_values,
                                             swivel_penetration)
 
@@ -275,3 +275,17 @@ def test_the_energy_guard_holds_the_runs_that_gain_energy_without_it(newton_tole
     assert not run.failed and run.time[-1] == pytest.approx(10.0)
     assert run.energy_rise < 1e-3  # the guard's own threshold (per step), measured 0
     assert 0 < run.guard_rejections < 100
+
+
+def test_settings_outside_the_measured_region_are_named_and_the_measured_ones_pass():
+    """Without the energy guard: full Newton at 1e-10 and spectral radius 0.5 with 0.05 m elements,
+    and the planar runs' defaults (modified Newton, 0, 1e-6) with 0.1 m elements held every
+    measured run (benchmarks/results/swivel_pulley.md); the settings measured to gain energy are
+    named in the message."""
+    assert stability_concerns(False, 0.5, 1e-10, 0.05, 0.1) == []
+    assert stability_concerns(True, 0.0, 1e-6, 0.1, 0.1) == []
+    for arguments, name in (((False, 0.5, 1e-8, 0.05, 0.1), "newton_tolerance"),
+                            ((False, 0.5, 1e-10, 0.1, 0.1), "element_length"),
+                            ((True, 1.0, 1e-6, 0.05, 0.1), "spectral_radius")):
+        concerns = stability_concerns(*arguments)
+        assert concerns and name in concerns[0]

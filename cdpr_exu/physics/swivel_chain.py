@@ -186,6 +186,7 @@ class SwivelRun:
 
     @property
     def iterations_per_step(self) -> float:
+        """Newton iterations per step taken (those of repeated or halved steps included)."""
         return self.newton_iterations / max(1, self.steps)
 
 
@@ -198,7 +199,7 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
                         newton_tolerance: float = 1e-10, verbose: int = 0, initial_accelerations: bool = True,
                         adaptive: bool = True, abort_rise: float = math.inf,
                         settle_statically: bool = False, max_newton_iterations: int = 25,
-                        energy_guard: float | None = None) -> SwivelRun:
+                        energy_guard: float | None = None, modified_newton: bool = False) -> SwivelRun:
     """Run a mass on a cable over a swivel pulley: a conical pendulum (``swing``) or a hang.
 
     The cable (held at ``winch_length`` [m] below the inlet on the axis) comes up the axis,
@@ -207,22 +208,18 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     swivel start turning rigidly about the axis at the conical pendulum's rate
     omega = rate_factor sqrt(g tan(angle) / R), R the mass's distance from the axis (1: a circle;
     less: the mass swings in and out, its azimuth rate varies); the swivel starts at
-    ``psi + psi_offset``. Fixed step ``step`` [s], generalized-alpha with ``spectral_radius``,
-    full Newton; no damping but the bearing's (and ``axial_damping`` [N s/m] per element).
+    ``psi + psi_offset``. Step ``step`` [s], generalized-alpha with ``spectral_radius``,
+    full Newton (or modified, Jacobian each step, with ``modified_newton``); no damping but
+    the bearing's (and ``axial_damping`` [N s/m] per element).
     With ``settle_statically``, Exudyn's static solver then starts from the final state, and
     ``final_positions`` and the last ``psi`` are its rest state. With ``energy_guard`` [J],
     a step whose Newton solution gains more than that over the last accepted step is
     repeated at a quarter of its size (down to step / 1000).
     """
     if energy_guard is None:
-        if newton_tolerance > sp.SAFE_NEWTON_TOLERANCE:
-            warnings.warn(f"newton_tolerance = {newton_tolerance:g} is looser than {sp.SAFE_NEWTON_TOLERANCE:g}, "
-                          "where runs over a swivel pulley were measured to gain energy; set energy_guard",
-                          sp.SwivelStabilityWarning, stacklevel=2)
-        if element_length > sp.SAFE_ELEMENT_FRACTION * pulley.radius:
-            warnings.warn(f"element_length = {element_length:g} m is longer than {sp.SAFE_ELEMENT_FRACTION:g} "
-                          f"of the pulley radius ({pulley.radius:g} m), where runs were measured to lose the wrap "
-                          "and gain energy; set energy_guard", sp.SwivelStabilityWarning, stacklevel=2)
+        for concern in sp.stability_concerns(modified_newton, spectral_radius, newton_tolerance, element_length,
+                                             pulley.radius):
+            warnings.warn(concern + "; set energy_guard", sp.SwivelStabilityWarning, stacklevel=2)
     path = sp.cable_path_over_swivel(pulley, psi, winch_length, free_length, cone_angle, element_length)
     spacing = np.linalg.norm(np.diff(path, axis=0), axis=1)
     masses = np.zeros(len(path))
@@ -260,7 +257,8 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     ti.verboseMode = verbose
     ti.generalizedAlpha.spectralRadius = spectral_radius
     ti.generalizedAlpha.computeInitialAccelerations = initial_accelerations
-    ti.newton.useModifiedNewton = False
+    ti.newton.useModifiedNewton = modified_newton
+    ti.newton.modifiedNewtonJacUpdatePerStep = True  # as the planar runs (cdpr_exu.simulate)
     ti.newton.relativeTolerance = newton_tolerance
     ti.newton.maxIterations = max_newton_iterations
     # Exudyn halves the step where Newton fails (a node entering the stiff contact) and

@@ -54,6 +54,7 @@ from cdpr_exu.errors import CdprWarning, SceneError
 from cdpr_exu.validation import non_negative, positive, vector
 
 __all__ = ["SAFE_ELEMENT_FRACTION", "SAFE_NEWTON_TOLERANCE", "SwivelPulley", "SwivelStabilityWarning",
+           "stability_concerns",
            "swivel_contact_force", "swivel_contact_energy",
            "swivel_contact_pattern", "swivel_contact_values", "swivel_penetration", "exit_azimuth"]
 
@@ -220,18 +221,61 @@ def exit_azimuth(point, inlet) -> float:
     return math.atan2(point[1] - inlet[1], point[0] - inlet[0])
 
 
-#: Newton relative tolerance at which every measured (J_s, d_s) held without the energy guard
-#: (benchmarks/results/swivel_pulley.md); Exudyn's default 1e-8 let some runs gain energy.
+#: Full Newton held every measured run without the energy guard at this relative tolerance
+#: or tighter (benchmarks/results/swivel_pulley.md); at 1e-8 and 1e-6, 4 of 24 runs gained.
 SAFE_NEWTON_TOLERANCE = 1e-10
 
-#: Longest element, as a fraction of the pulley radius, measured to keep the wrap without
-#: the energy guard (0.5 held; 1.0 lost the wrap and gained 710 J at 5e-3 s steps).
+#: Longest element, as a fraction of the pulley radius, that full Newton was measured to
+#: hold without the guard (0.5 held; 1.0 lost the wrap and gained 710 J at 5e-3 s steps).
 SAFE_ELEMENT_FRACTION = 0.5
 
 
 class SwivelStabilityWarning(CdprWarning):
     """A run over a swivel pulley is set up outside what was measured to hold without the
-    energy guard (Newton tolerance, element length); the message names the setting."""
+    energy guard; the message names the setting."""
+
+
+def stability_concerns(modified_newton: bool, spectral_radius: float, newton_tolerance: float,
+                       element_length: float, radius: float) -> list[str]:
+    """Why a run without the energy guard lies outside the measured region, one message per setting.
+
+    Measured to hold (benchmarks/results/swivel_pulley.md, J_s 1e-6 to 1 kg m^2, d_s 0 to
+    0.1 N m s, steps 5e-3 and 2e-3 s): full Newton at spectral radius <= 0.5, relative
+    tolerance <= :data:`SAFE_NEWTON_TOLERANCE` and elements up to :data:`SAFE_ELEMENT_FRACTION`
+    of the radius; and the planar runs' defaults, modified Newton at spectral radius 0 and
+    tolerance 1e-6, with elements up to the radius. Measured to gain energy: spectral
+    radius 1 (even in a planar hang), full Newton at 1e-8 or 1e-6, and full Newton with
+    elements as long as the radius.
+
+    Parameters
+    ----------
+    modified_newton : bool
+    spectral_radius, newton_tolerance : float
+    element_length, radius : float [m]
+
+    Returns
+    -------
+    list of str
+        Empty inside the measured region.
+    """
+    concerns = []
+    if spectral_radius > 0.5:
+        concerns.append(f"spectral_radius = {spectral_radius:g} is above 0.5; at 1 even a planar hang over the "
+                        "swivel pulley was measured to gain energy")
+    if modified_newton:
+        if spectral_radius > 0.0 or newton_tolerance > 1e-6 or element_length > radius:
+            concerns.append("modified Newton was measured to hold at spectral_radius = 0, newton_tolerance <= 1e-6 "
+                            f"and elements up to the pulley radius only; got {spectral_radius:g}, "
+                            f"{newton_tolerance:g} and {element_length:g} m")
+        return concerns
+    if newton_tolerance > SAFE_NEWTON_TOLERANCE:
+        concerns.append(f"newton_tolerance = {newton_tolerance:g} is looser than {SAFE_NEWTON_TOLERANCE:g}; with "
+                        "full Newton, 4 of 24 runs over a swivel pulley were measured to gain energy at 1e-8 "
+                        "and at 1e-6")
+    if element_length > SAFE_ELEMENT_FRACTION * radius:
+        concerns.append(f"element_length = {element_length:g} m is longer than {SAFE_ELEMENT_FRACTION:g} of the pulley "
+                        f"radius ({radius:g} m); with full Newton such a run lost the wrap and gained energy")
+    return concerns
 
 
 @dataclass(frozen=True)
