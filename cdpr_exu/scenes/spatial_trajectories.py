@@ -40,7 +40,8 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.scenes.trajectories import _finite_float, _finite_tuple, _quintic, _quintic_integral, _times
+from cdpr_exu.scenes.trajectories import (PointToPointMotion, _finite_float, _finite_tuple, _quintic_integral, _quintic,
+                                          _times)
 
 __all__ = [
     "SpatialTrajectory",
@@ -234,7 +235,7 @@ class SpatialHoldTrajectory(SpatialTrajectory):
 
 
 @dataclass(frozen=True)
-class SpatialPointToPointTrajectory(SpatialTrajectory):
+class SpatialPointToPointTrajectory(PointToPointMotion, SpatialTrajectory):
     """Rest-to-rest quintic motion from ``start`` to ``end``; holds outside the motion.
 
     ``pose(t) = start + (end - start) s((t - start_time) / duration)``, with
@@ -267,33 +268,6 @@ class SpatialPointToPointTrajectory(SpatialTrajectory):
             raise SceneError(f"trajectory.duration must be > 0 [s], got {self.duration!r}")
         object.__setattr__(self, "duration", duration)
         object.__setattr__(self, "start_time", _finite_float("trajectory.start_time", self.start_time))
-
-    def turning_times(self, end_time: float) -> np.ndarray:
-        """The start and the end of the motion [s] (the pose is monotone in between)."""
-        return np.array([self.start_time, self.start_time + self.duration])
-
-    def _blend(self, t):
-        # the planar PointToPointTrajectory._blend is a method of that class, not a
-        # helper to import; this is the same few lines over the shared _quintic
-        t = np.asarray(t, dtype=float)
-        tau = (t - self.start_time) / self.duration
-        inside = (tau > 0.0) & (tau < 1.0)
-        value, first, second = _quintic(tau)
-        # derivatives vanish outside the motion (they are also 0 at the clamped ends)
-        return value, np.where(inside, first, 0.0) / self.duration, np.where(inside, second, 0.0) / self.duration**2
-
-    def pose(self, t):
-        value, _, _ = self._blend(t)
-        start, end = np.asarray(self.start), np.asarray(self.end)
-        return start + value[..., None] * (end - start)
-
-    def velocity(self, t):
-        _, first, _ = self._blend(t)
-        return first[..., None] * (np.asarray(self.end) - np.asarray(self.start))
-
-    def acceleration(self, t):
-        _, _, second = self._blend(t)
-        return second[..., None] * (np.asarray(self.end) - np.asarray(self.start))
 
 
 #: Fields a spatial trajectory table must give, by kind (no default would be what the user meant).

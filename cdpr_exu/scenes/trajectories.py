@@ -237,8 +237,41 @@ class HoldTrajectory(Trajectory):
         return {"kind": self.kind, "pose": list(self.held_pose)}
 
 
+class PointToPointMotion:
+    """The rest-to-rest quintic motion from ``start`` to ``end`` over ``duration`` from ``start_time``.
+
+    Shared by the planar and the spatial point-to-point trajectories (any pose size):
+    ``pose(t) = start + (end - start) s((t - start_time) / duration)``, holding outside the motion.
+    """
+
+    def turning_times(self, end_time: float) -> np.ndarray:
+        """The start and the end of the motion [s] (the pose is monotone in between)."""
+        return np.array([self.start_time, self.start_time + self.duration])
+
+    def _blend(self, t):
+        t = np.asarray(t, dtype=float)
+        tau = (t - self.start_time) / self.duration
+        inside = (tau > 0.0) & (tau < 1.0)
+        value, first, second = _quintic(tau)
+        # derivatives vanish outside the motion (they are also 0 at the clamped ends)
+        return value, np.where(inside, first, 0.0) / self.duration, np.where(inside, second, 0.0) / self.duration**2
+
+    def pose(self, t):
+        value, _, _ = self._blend(t)
+        start, end = np.asarray(self.start), np.asarray(self.end)
+        return start + value[..., None] * (end - start)
+
+    def velocity(self, t):
+        _, first, _ = self._blend(t)
+        return first[..., None] * (np.asarray(self.end) - np.asarray(self.start))
+
+    def acceleration(self, t):
+        _, _, second = self._blend(t)
+        return second[..., None] * (np.asarray(self.end) - np.asarray(self.start))
+
+
 @dataclass(frozen=True)
-class PointToPointTrajectory(Trajectory):
+class PointToPointTrajectory(PointToPointMotion, Trajectory):
     """Rest-to-rest quintic motion from ``start`` to ``end``; holds outside the motion.
 
     ``pose(t) = start + (end - start) s((t - start_time) / duration)``, with
@@ -268,31 +301,6 @@ class PointToPointTrajectory(Trajectory):
             raise SceneError(f"trajectory.duration must be > 0 [s], got {self.duration!r}")
         object.__setattr__(self, "duration", duration)
         object.__setattr__(self, "start_time", _finite_float("trajectory.start_time", self.start_time))
-
-    def turning_times(self, end_time: float) -> np.ndarray:
-        """The start and the end of the motion [s] (the pose is monotone in between)."""
-        return np.array([self.start_time, self.start_time + self.duration])
-
-    def _blend(self, t):
-        t = np.asarray(t, dtype=float)
-        tau = (t - self.start_time) / self.duration
-        inside = (tau > 0.0) & (tau < 1.0)
-        value, first, second = _quintic(tau)
-        # derivatives vanish outside the motion (they are also 0 at the clamped ends)
-        return value, np.where(inside, first, 0.0) / self.duration, np.where(inside, second, 0.0) / self.duration**2
-
-    def pose(self, t):
-        value, _, _ = self._blend(t)
-        start, end = np.asarray(self.start), np.asarray(self.end)
-        return start + value[..., None] * (end - start)
-
-    def velocity(self, t):
-        _, first, _ = self._blend(t)
-        return first[..., None] * (np.asarray(self.end) - np.asarray(self.start))
-
-    def acceleration(self, t):
-        _, _, second = self._blend(t)
-        return second[..., None] * (np.asarray(self.end) - np.asarray(self.start))
 
 
 #: Fields a trajectory table must give, by kind (no default would be what the user meant).
