@@ -12,6 +12,8 @@ import math
 
 import pytest
 
+from cdpr_exu.physics.catenary import CatenaryCable
+from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, WinchSpec
 
 #: Gravity used by the small scenes [m/s^2].
@@ -104,6 +106,28 @@ def v_shaped_scene(effects: Effects | None = None, n_elements: int = 6, platform
         gravity=GRAVITY,
         cable_exit="point",
     )
+
+
+# --------------------------------------------------------------------------- spatial
+
+#: The paper's cable (radius 5 mm, E = 1e9 Pa, 0.35 kg/m) as a catenary: w = 3.43 N/m, EA = 7.85e4 N.
+PAPER_CATENARY_CABLE = CatenaryCable.from_material(1.0, 0.005, 1e9, 0.35)
+#: Corner signs of the square frame, cable 1 to 4.
+CORNERS = ((1, 1), (-1, 1), (-1, -1), (1, -1))
+#: Unequal lengths [m] that make the four-cable robot hang off-centre and tilt.
+ASYMMETRIC_LENGTHS = [2.4, 2.5, 2.6, 2.55]
+#: Stiffness of the penalty spherical joints, in element axial stiffnesses: it adds 1/(100 n)
+#: of a cable's compliance, a 3e-7 m shift at n = 40, below every discretisation error here.
+PENALTY = 100.0
+
+
+def four_cable_robot(rigid: bool, mass: float = 5.0) -> SpatialPlatform:
+    """The paper's cable from the corners of a 3 m x 3 m frame (exits at z = 0) to a point mass, or to
+    a rigid 0.2 m square platform whose anchors sit 5 cm above its centre of mass."""
+    w, ea = PAPER_CATENARY_CABLE.weight_per_length, PAPER_CATENARY_CABLE.axial_stiffness
+    cables = [SpatialCable((1.5 * sx, 1.5 * sy, 0.0), w, ea,
+                           anchor=(0.1 * sx, 0.1 * sy, 0.05) if rigid else (0.0, 0.0, 0.0)) for sx, sy in CORNERS]
+    return SpatialPlatform(cables, mass=mass, inertia=(0.05, 0.05, 0.08))
 
 
 @pytest.fixture

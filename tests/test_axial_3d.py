@@ -10,26 +10,15 @@ import numpy as np
 import pytest
 
 from cdpr_exu.physics.axial import TAUT_BAND, cable_elements, slack_axial_force
-from cdpr_exu.physics.catenary import CatenaryCable
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import add_spatial_chain
 from cdpr_exu.builder.spatial_robot import (SpatialChainSpec, anchor_forces, build_spatial_robot, dynamic_settings,
                                             element_forces, robot_energy, solve_static)
-from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
+from conftest import ASYMMETRIC_LENGTHS, PAPER_CATENARY_CABLE, PENALTY, four_cable_robot
 
-# The four-cable robot of tests/test_spatial_robot.py: the paper's cable on a 3 m x 3 m frame, 5 kg.
-CABLE = CatenaryCable.from_material(1.0, 0.005, 1e9, 0.35)
-W, EA = CABLE.weight_per_length, CABLE.axial_stiffness
-CORNERS = ((1, 1), (-1, 1), (-1, -1), (1, -1))
-ASYMMETRIC_LENGTHS = [2.4, 2.5, 2.6, 2.55]
-PENALTY = 100.0
-
-
-def four_cable_robot(rigid):
-    cables = [SpatialCable((1.5 * sx, 1.5 * sy, 0.0), W, EA,
-                           anchor=(0.1 * sx, 0.1 * sy, 0.05) if rigid else (0.0, 0.0, 0.0)) for sx, sy in CORNERS]
-    return SpatialPlatform(cables, mass=5.0, inertia=(0.05, 0.05, 0.08))
+# The paper's cable, and the four-cable robot of tests/conftest.py.
+EA = PAPER_CATENARY_CABLE.axial_stiffness
 
 
 # ---------------------------------------------------------------------------

@@ -4,26 +4,10 @@ import exudyn as exu
 import numpy as np
 import pytest
 
-from cdpr_exu.physics.catenary import CatenaryCable
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.builder.spatial_robot import SpatialChainSpec, build_spatial_robot, run_dynamic, solve_static
-from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform, solve_spatial_statics
-
-# The paper's cable (radius 5 mm, E = 1e9 Pa, 0.35 kg/m) on a 3 m x 3 m frame, a 5 kg platform.
-CABLE = CatenaryCable.from_material(1.0, 0.005, 1e9, 0.35)
-W, EA = CABLE.weight_per_length, CABLE.axial_stiffness
-CORNERS = ((1, 1), (-1, 1), (-1, -1), (1, -1))
-ASYMMETRIC_LENGTHS = [2.4, 2.5, 2.6, 2.55]
-#: Stiffness of the penalty spherical joints, in element axial stiffnesses: it adds 1/(100 n)
-#: of a cable's compliance, a 3e-7 m shift at n = 40, below every discretisation error here.
-PENALTY = 100.0
-
-
-def four_cable_robot(rigid):
-    cables = [SpatialCable((1.5 * sx, 1.5 * sy, 0.0), W, EA,
-                           anchor=(0.1 * sx, 0.1 * sy, 0.05) if rigid else (0.0, 0.0, 0.0)) for sx, sy in CORNERS]
-    return SpatialPlatform(cables, mass=5.0, inertia=(0.05, 0.05, 0.08))
-
+from cdpr_exu.physics.spatial_statics import SpatialPlatform, solve_spatial_statics
+from conftest import ASYMMETRIC_LENGTHS, PENALTY, four_cable_robot
 
 def build(platform, lengths, chain, initial=None):
     mbs = exu.SystemContainer().AddSystem()

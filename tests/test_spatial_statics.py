@@ -6,26 +6,16 @@ import numpy as np
 import pytest
 
 import cdpr_exu.physics.spatial_statics as spatial_statics
-from cdpr_exu.physics.catenary import CatenaryCable
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform, solve_cable, solve_spatial_statics
 from cdpr_exu.statics.statics import SuspendedCable, SuspendedPlatform, solve_forward_statics
+from conftest import ASYMMETRIC_LENGTHS, PAPER_CATENARY_CABLE, four_cable_robot
 
-# The paper's cable (radius 5 mm, E = 1e9 Pa, 0.35 kg/m): w = 3.43 N/m, EA = 7.85e4 N.
-CABLE = CatenaryCable.from_material(1.0, 0.005, 1e9, 0.35)
-W, EA = CABLE.weight_per_length, CABLE.axial_stiffness
-HALF_SPAN = 1.5  # square frame 3 m x 3 m, exits at z = 0
-CORNERS = ((1, 1), (-1, 1), (-1, -1), (1, -1))
-PLATFORM_HALF = 0.1  # square platform 0.2 m x 0.2 m, anchors 5 cm above its centre of mass
-ASYMMETRIC_LENGTHS = [2.4, 2.5, 2.6, 2.55]
-
-
-def four_cable_robot(rigid, mass=5.0):
-    cables = [SpatialCable((sx * HALF_SPAN, sy * HALF_SPAN, 0.0), W, EA,
-                           anchor=(sx * PLATFORM_HALF, sy * PLATFORM_HALF, 0.05) if rigid else (0.0, 0.0, 0.0))
-              for sx, sy in CORNERS]
-    return SpatialPlatform(cables, mass=mass, inertia=(0.05, 0.05, 0.08))
+# The paper's cable, w = 3.43 N/m and EA = 7.85e4 N, and the four-cable robot of tests/conftest.py
+# (3 m x 3 m frame, exits at z = 0; 0.2 m square platform, anchors 5 cm above its centre of mass).
+W, EA = PAPER_CATENARY_CABLE.weight_per_length, PAPER_CATENARY_CABLE.axial_stiffness
+PLATFORM_HALF = 0.1
 
 
 def net_wrench(platform, equilibrium):
