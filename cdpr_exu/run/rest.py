@@ -78,7 +78,7 @@ from cdpr_exu.core.geometry import penetration
 from cdpr_exu.core.output import write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import static_settings
 from cdpr_exu.results.result import provenance
-from cdpr_exu.scenes.scene import Scene, load_scene
+from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
 #: Default tolerance on the largest node speed at rest [m/s].

@@ -97,6 +97,11 @@ class SpatialRest:
     anchor_joint: str
     wall_time: float
 
+    @property
+    def lowest_element_tension(self) -> float:
+        """The lowest axial force of all elements [N] (negative: compressed)."""
+        return float(min(t.min() for t in self.element_tensions))
+
     def summary(self) -> dict:
         """Plain data for summary.json (SI units in the key names)."""
         catenary = self.catenary
@@ -114,8 +119,8 @@ class SpatialRest:
             "catenary_platform_position_m": catenary.position.tolist(),
             "catenary_platform_rotation_vector_rad": catenary.rotation_vector.tolist(),
             "catenary_tension_at_anchor_N": catenary.tensions_at_anchor.tolist(),
-            "min_element_tension_N": float(min(t.min() for t in self.element_tensions)),
-            "elements_pushed": bool(min(t.min() for t in self.element_tensions) < 0.0),
+            "min_element_tension_N": self.lowest_element_tension,
+            "elements_pushed": self.lowest_element_tension < 0.0,
             "lumped_minus_catenary_position_m": float(np.linalg.norm(self.position - catenary.position)),
             "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(self.rotation_vector - catenary.rotation_vector)),
             "wall_time_s": self.wall_time,
@@ -220,7 +225,7 @@ def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
     print(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
           f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
           f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation_vector)):.4f} deg from the lumped robot")
-    lowest = min(t.min() for t in rest.element_tensions)
+    lowest = rest.lowest_element_tension
     if lowest < 0.0:
         print(f"  note: an element is compressed ({lowest:.3g} N), which a real cable cannot be: that cable is "
               "slack at rest, and its length is longer than the catenary the lumped model can hang")

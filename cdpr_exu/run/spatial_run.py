@@ -44,9 +44,10 @@ from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions,
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from controllers.base import Controller, Measurement
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
+from controllers.spatial_tension_aware import SpatialTensionAwareController
 
 from cdpr_exu.results.result import provenance
-from cdpr_exu.run.simulate import interrupt_flag, quiet_exudyn, solver_settings
+from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, quiet_exudyn, solver_settings
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
@@ -210,11 +211,7 @@ class _SpatialWinches:
         self.mbs, self.scene, self.items = mbs, scene, items
         self.n = scene.cables[0].n_elements
         self.gravity = scene.gravity if (scene.effects.gravity and scene.effects.cable_mass) else 0.0
-        self.lengths = np.array(lengths, dtype=float)
-        weights = np.ones(self.n + 1)
-        weights[[0, -1]] = 0.5
-        self.mass_shares = weights  # node mass = rho l_e times this
-        self.applied = self.lengths.copy()
+        self.applied = np.array(lengths, dtype=float)
 
     def set_lengths(self, lengths: np.ndarray, rates: np.ndarray) -> None:
         """Give every cable the paid-out length ``lengths`` (m,) [m], changing at ``rates`` (m,) [m/s].
@@ -243,7 +240,7 @@ class _SpatialWinches:
                 mbs.SetObjectParameter(spring, "referenceLength", element)
                 mbs.SetObjectParameter(spring, "stiffness", stiffness)
                 mbs.SetObjectParameter(spring, "damping", damping)
-            masses = cable.linear_density * element * self.mass_shares
+            masses = items.node_masses[i] * (float(length) / items.unstrained_lengths[i])  # rho l_e per node
             for body, load, mass in zip(chain.masses, chain.loads or [None] * len(masses), masses):
                 mbs.SetObjectParameter(body, "mass", float(mass))
                 if load is not None:
@@ -335,7 +332,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
             report(t, _time.perf_counter() - wall_start)
         return True
 
-    report = _progress(progress, scene)
+    report = _progress_reporter(progress, scene)
     record(0.0)
     state["next"] = 1
     mbs.SetPreStepUserFunction(pre_step)
@@ -371,13 +368,6 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         raise SolverFailure(f"the spatial run failed at t = {reached:.4f} s of {solver.end_time} s: {cause}",
                             time=reached, partial_result=result)
     return result
-
-
-def _progress(progress, scene):
-    """The planar runs' progress reporter (a bar or a callable), for a spatial scene."""
-    from cdpr_exu.run.simulate import _progress_reporter
-
-    return _progress_reporter(progress, scene)
 
 
 def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0) -> Path:
@@ -462,8 +452,7 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
 #: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
 SPATIAL_CONTROLLERS = {
     "ideal_ik": IdealIKController,
-    "tension_aware": lambda: __import__("controllers.spatial_tension_aware",
-                                        fromlist=["SpatialTensionAwareController"]).SpatialTensionAwareController(),
+    "tension_aware": SpatialTensionAwareController,
 }
 
 _COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),

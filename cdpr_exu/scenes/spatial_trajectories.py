@@ -33,15 +33,15 @@ not the same motion.
 
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
+from abc import abstractmethod
 from dataclasses import dataclass
 from dataclasses import fields as dataclass_fields
 
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.scenes.trajectories import (PointToPointMotion, _finite_float, _finite_tuple, _quintic_integral, _quintic,
-                                          _times)
+from cdpr_exu.scenes.trajectories import (PointToPointMotion, ReferenceTrajectory, _finite_float, _finite_tuple,
+                                          _quintic, _quintic_integral, _times)
 
 __all__ = [
     "SpatialTrajectory",
@@ -63,10 +63,8 @@ def _stack(components, scalar):
 # ----------------------------------------------------------------------------------
 # trajectories
 # ----------------------------------------------------------------------------------
-class SpatialTrajectory(ABC):
+class SpatialTrajectory(ReferenceTrajectory):
     """A reference spatial platform pose as a function of time [s]."""
-
-    kind: str = ""
 
     @abstractmethod
     def pose(self, t):
@@ -82,21 +80,6 @@ class SpatialTrajectory(ABC):
     @abstractmethod
     def acceleration(self, t):
         """Second derivative of the pose [m/s^2, rad/s^2] (not the angular acceleration): (6,) or (N, 6)."""
-
-    def turning_times(self, end_time: float) -> np.ndarray:
-        """Times in [0, end_time] [s] where a pose coordinate may be extreme (for exact workspace checks).
-
-        The default is none: a uniform sampling of the run is used alone.
-        """
-        return np.zeros(0)
-
-    def to_dict(self):
-        """Plain dict with a ``kind`` key and the fields (tuples as lists), for TOML."""
-        data = {"kind": self.kind}
-        for field in dataclass_fields(self):
-            value = getattr(self, field.name)
-            data[field.name] = list(value) if isinstance(value, tuple) else value
-        return data
 
 
 @dataclass(frozen=True)

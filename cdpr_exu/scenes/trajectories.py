@@ -86,22 +86,12 @@ def _quintic_integral(tau):
 # ----------------------------------------------------------------------------------
 # trajectories
 # ----------------------------------------------------------------------------------
-class Trajectory(ABC):
-    """A reference platform pose as a function of time [s]."""
+class ReferenceTrajectory(ABC):
+    """What every reference trajectory has, planar (:class:`Trajectory`) or spatial
+    (:class:`~cdpr_exu.scenes.spatial_trajectories.SpatialTrajectory`): its turning times
+    and its plain-dict form."""
 
     kind: str = ""
-
-    @abstractmethod
-    def pose(self, t):
-        """Pose ``(x, z, phi)`` [m, m, rad]: shape (3,) for scalar t, (N, 3) for t of shape (N,)."""
-
-    @abstractmethod
-    def velocity(self, t):
-        """Pose rate [m/s, m/s, rad/s]: shape (3,) or (N, 3)."""
-
-    @abstractmethod
-    def acceleration(self, t):
-        """Second derivative of the pose [m/s^2, m/s^2, rad/s^2]: shape (3,) or (N, 3)."""
 
     def turning_times(self, end_time: float) -> np.ndarray:
         """Times in [0, end_time] [s] where a pose coordinate may be extreme (for exact workspace checks).
@@ -117,6 +107,22 @@ class Trajectory(ABC):
             value = getattr(self, field.name)
             data[field.name] = list(value) if isinstance(value, tuple) else value
         return data
+
+
+class Trajectory(ReferenceTrajectory):
+    """A reference planar platform pose as a function of time [s]."""
+
+    @abstractmethod
+    def pose(self, t):
+        """Pose ``(x, z, phi)`` [m, m, rad]: shape (3,) for scalar t, (N, 3) for t of shape (N,)."""
+
+    @abstractmethod
+    def velocity(self, t):
+        """Pose rate [m/s, m/s, rad/s]: shape (3,) or (N, 3)."""
+
+    @abstractmethod
+    def acceleration(self, t):
+        """Second derivative of the pose [m/s^2, m/s^2, rad/s^2]: shape (3,) or (N, 3)."""
 
 
 @dataclass(frozen=True)

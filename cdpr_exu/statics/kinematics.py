@@ -8,8 +8,6 @@ for code that imports them from ``cdpr_exu.statics.kinematics``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.optimize import brentq
 
