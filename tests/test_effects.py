@@ -38,21 +38,31 @@ def counts(scene, preset="full", **overrides):
 # ============================================================================ items
 
 
-def test_full_preset_adds_every_item_of_the_paper_model(paper_scene):
-    full = counts(paper_scene)
-    assert full["mass_points"] == NODES
-    assert full["axial_spring_dampers"] == ELEMENTS
-    assert full["bending_joints"] == JOINTS
-    assert full["pulley_contacts"] > 0
-    assert full["gravity_loads"] == NODES + 1  # every node and the platform
-    assert full["slack_elements"] == 0 and full["massless_ropes"] == 0
+def test_paper_preset_adds_every_item_of_the_paper_model(paper_scene):
+    paper = counts(paper_scene, "paper")
+    assert paper["mass_points"] == NODES
+    assert paper["axial_spring_dampers"] == ELEMENTS  # Exudyn's spring-dampers, which push as well
+    assert paper["bending_joints"] == JOINTS
+    assert paper["pulley_contacts"] > 0
+    assert paper["gravity_loads"] == NODES + 1  # every node and the platform
+    assert paper["slack_elements"] == 0 and paper["massless_ropes"] == 0
+
+
+def test_full_preset_is_the_paper_model_with_tension_only_elements(paper_scene):
+    full, paper = counts(paper_scene), counts(paper_scene, "paper")
+    assert full["axial_spring_dampers"] == 0 and full["slack_elements"] == ELEMENTS
+    assert full["cable_force_objects"] == 1  # the tension-only elements ride in the bending object
+    for item in ("mass_points", "bending_joints", "pulley_contacts", "gravity_loads", "massless_ropes"):
+        assert full[item] == paper[item], item
 
 
 def test_bending_off_removes_the_bending_joints_and_their_object(paper_scene):
-    off = counts(paper_scene, bending=False, bending_damping=False)
+    off = counts(paper_scene, "paper", bending=False, bending_damping=False)
     assert off["bending_joints"] == 0
     assert off["cable_force_objects"] == 0  # nothing left for the generic object to carry
     assert off["axial_spring_dampers"] == ELEMENTS and off["mass_points"] == NODES
+    tension_only = counts(paper_scene, bending=False, bending_damping=False)
+    assert tension_only["bending_joints"] == 0 and tension_only["cable_force_objects"] == 1  # the slack elements
 
 
 def test_contact_off_removes_the_pulley_contacts(paper_scene):
@@ -92,7 +102,7 @@ def test_each_preset_adds_only_the_items_of_its_effects(paper_scene, preset):
 
 
 def test_linear_bending_has_the_same_joints_in_constant_matrices_without_a_force_function(paper_scene):
-    model = build_model(paper_scene.with_changes(effects=Effects.from_preset("full", bending_model="linear")))
+    model = build_model(paper_scene.with_changes(effects=Effects.from_preset("paper", bending_model="linear")))
     assert model.item_counts()["bending_joints"] == JOINTS
     item = model.mbs.GetObject(model.cable_forces.object)
     assert item["forceUserFunction"] == 0  # no Python call per Newton iteration

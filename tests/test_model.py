@@ -87,7 +87,8 @@ def end_forces_on_cable(model, i):
 
 @pytest.fixture(scope="module")
 def paper_model():
-    return build_model(load_scene("paper-circle"))
+    """The paper scene built as the paper published it (spring-dampers that can push)."""
+    return build_model(load_scene("paper-circle").with_changes(effects=Effects.from_preset("paper")))
 
 
 def test_paper_scene_has_a_mass_point_per_node_and_a_spring_damper_per_element(paper_model):
@@ -123,8 +124,12 @@ def test_pulley_contacts_only_on_nodes_that_can_reach_the_pulley(paper_model):
 def test_catenary_preset_adds_no_bending_object():
     scene = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary"))
     counts = build_model(scene).item_counts()
-    assert counts["cable_force_objects"] == 0
     assert counts["bending_joints"] == 0
+    assert counts["slack_elements"] == 2 * 15  # tension-only, in the one cable-force object
+    assert counts["cable_force_objects"] == 1
+    pushing = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary", slack=False))
+    counts = build_model(pushing).item_counts()
+    assert counts["cable_force_objects"] == 0  # no bending, no slack: nothing for the object to carry
     assert counts["axial_spring_dampers"] == 2 * 15
 
 

@@ -221,7 +221,7 @@ def test_node_contact_is_unchanged():
 
 
 def test_segment_contact_without_bending_or_slack_still_gets_its_generic_object():
-    model = build_model(segment_scene(bending=False, bending_damping=False))
+    model = build_model(segment_scene(bending=False, bending_damping=False, slack=False))
     counts = model.item_counts()
     assert counts["bending_joints"] == 0 and counts["slack_elements"] == 0
     assert counts["cable_force_objects"] == 1 and counts["contact_segments"] > 0

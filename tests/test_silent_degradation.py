@@ -73,15 +73,15 @@ def test_a_result_that_needs_cables_to_push_is_flagged_and_tension_only_cables_a
     """The paper's spring elements push at the start-up (lowest tension -6.5 N measured);
     tension-only elements never do. Every summary gives each cable's lowest tension and
     the time any of its elements carried no tension."""
+    from cdpr_exu.scenes.scene import Effects
+
     short = PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.5))
-    spring = simulate(short).summary()
+    spring = simulate(short.with_changes(effects=Effects.from_preset("paper"))).summary()
     assert spring["elements_pushed"] and spring["min_element_tension_N"] < 0
     assert any("pushed" in note for note in spring["notes"])
     assert min(spring["min_tension_per_cable_N"]) == spring["min_element_tension_N"]
     assert all(0.0 < t <= 0.5 for t in spring["slack_time_per_cable_s"])
-    from cdpr_exu.scenes.scene import Effects
-
-    tension_only = simulate(short.with_changes(effects=Effects.from_preset("full", slack=True))).summary()
+    tension_only = simulate(short).summary()  # the default "full" preset: tension-only elements
     assert not tension_only["elements_pushed"] and tension_only["min_element_tension_N"] >= 0.0
 
 
@@ -91,7 +91,7 @@ def test_a_real_run_thrown_above_the_pulleys_gets_the_hint_for_that_cause():
     above the pulleys, and the hint speaks of that, not of the generic winch jump."""
     from cdpr_exu.scenes.scene import Effects
 
-    scene = PAPER.with_changes(effects=Effects.from_preset("catenary"),
+    scene = PAPER.with_changes(effects=Effects.from_preset("catenary", slack=False),
                                solver=replace(PAPER.solver, spectral_radius=0.5, end_time=1.5))
     with pytest.raises(SolverFailure, match="rose above the pulleys") as failure:
         simulate(scene)

@@ -42,6 +42,12 @@ from controllers.base import WinchCommand
 from controllers.ideal_ik import IdealIKController
 
 PAPER = load_scene("paper-circle")
+#: The paper's model as published: spring elements that push as well as pull. The cases
+#: below that are about those springs (a viscous rod pushing the platform up, failures
+#: of a winch that pays out by kilometres, Exudyn's start-up jolt, RK44's step limit)
+#: use it; with tension-only elements (the default) a cable paid out that far simply
+#: goes slack.
+PAPER_SPRINGS = PAPER.with_changes(effects=Effects.from_preset("paper"))
 
 # ============================================================================ helpers
 
@@ -213,7 +219,7 @@ def test_damping_scaled_by_1e3_gives_a_step_converged_answer():
     the model's answer for this absurd material, not numerical trouble: it does not
     change with the step size. Measured difference between steps of 2e-3 and 5e-4 s:
     0.6 mm and 4e-3 rad; bounds 5 mm and 0.02 rad."""
-    scene = with_cables(shortened(PAPER), damping_constant=PAPER.cables[0].damping_constant * 1e3)
+    scene = with_cables(shortened(PAPER_SPRINGS), damping_constant=PAPER.cables[0].damping_constant * 1e3)
     coarse, failure = run(scene)
     assert failure is None, str(failure)
     fine, failure = run(shortened(scene, step_size=5e-4))
@@ -248,9 +254,9 @@ ENERGY_CASES = {
 }
 
 
-def held_scene(name: str, **solver) -> Scene:
-    """Case ``name`` held still for 0.5 s (output every 0.01 s, or every step if coarser)."""
-    scene = ENERGY_CASES[name](holding_still(PAPER))
+def held_scene(name: str, base: Scene = PAPER, **solver) -> Scene:
+    """Case ``name`` of ``base`` held still for 0.5 s (output every 0.01 s, or every step if coarser)."""
+    scene = ENERGY_CASES[name](holding_still(base))
     step = scene.solver.step_size
     return shortened(scene, end_time=0.5, output_period=max(0.01, step), **solver)
 
@@ -295,7 +301,7 @@ def test_start_up_energy_jolt_comes_from_initial_accelerations(name, monkeypatch
     it, 0. The bound 1e-2 J is far below both and far above round-off.
     """
     with_initial_accelerations(monkeypatch)
-    scene = held_scene(name)
+    scene = held_scene(name, PAPER_SPRINGS)
     result, failure = run(scene)
     assert failure is None, str(failure)
     assert energy_rise(mechanical_energy(scene, result)) > 1e-2
@@ -386,20 +392,24 @@ def crossed_the_pulley(scene: Scene, result: Result, cable_index: int) -> np.nda
     return np.flatnonzero(on_winch_line & past_the_top)
 
 
-def test_winch_paying_out_fast_carries_several_nodes_over_the_pulley():
+@pytest.mark.parametrize("preset, max_error", [("paper", 0.35), ("full", 0.6)])
+def test_winch_paying_out_fast_carries_several_nodes_over_the_pulley(preset, max_error):
     """Lower the platform 1.5 m in 1 s (peak winch speed 2.8 m/s, almost 5 times the
     paper's; peak acceleration 8.7 m/s^2, just below g): each winch pays out 1.1 m,
     4.4 elements; three nodes of the winch's vertical line run over the top of the
-    pulley without cutting into it (assert_plausible's depth bound)."""
+    pulley without cutting into it (assert_plausible's depth bound).
+
+    Position error: the sag of the longer cables and the stop at 1 s. The paper's
+    springs: measured 0.27 m in z, bound 0.35 m. Tension-only elements cannot push the
+    platform down after the winches: measured 0.52 m, bound 0.6 m. A lost run falls
+    metres away or is stopped."""
     start, end = (0.0, -0.8, 0.0), (0.0, -2.3, 0.0)
-    scene = shortened(PAPER, end_time=1.2).with_changes(
+    scene = shortened(PAPER.with_changes(effects=Effects.from_preset(preset)), end_time=1.2).with_changes(
         platform=dataclasses.replace(PAPER.platform, initial_pose=start),
         trajectory=PointToPointTrajectory(start=start, end=end, duration=1.0))
     result, failure = run(scene)
     assert failure is None, str(failure)
-    # Position error: the sag of the longer cables and the stop at 1 s; measured
-    # 0.27 m in z. Bound 0.35 m: a lost run falls metres away or is stopped.
-    assert_plausible(scene, result, max_position_error=0.35)
+    assert_plausible(scene, result, max_position_error=max_error)
     for i in range(scene.n_cables):
         assert len(crossed_the_pulley(scene, result, i)) >= 3
 
@@ -463,7 +473,7 @@ def test_newton_failure_mid_run_says_when_what_and_why_and_keeps_a_savable_resul
     lets Newton converge (residual ~1e23 N); the solver cuts the step to its minimum
     and gives up. The failure names the time, Exudyn's own report and a likely cause,
     and the partial result up to the last good sample saves and loads back."""
-    scene = shortened(PAPER, end_time=0.5, output_period=0.01)
+    scene = shortened(PAPER_SPRINGS, end_time=0.5, output_period=0.01)
     jump_time = 0.3
     with pytest.raises(SolverFailure) as caught:
         simulate(scene, _JumpingWinch(jump_time, 1e12))
@@ -499,7 +509,7 @@ def test_newton_failure_mid_run_says_when_what_and_why_and_keeps_a_savable_resul
 def test_monitor_stop_mid_run_names_the_element_and_keeps_the_result():
     """A 1 m jump of the winch command strains the winch element by -85 % at once:
     the monitor stops the run with the element, the strain and the time."""
-    scene = shortened(PAPER, end_time=0.5, output_period=0.01)
+    scene = shortened(PAPER_SPRINGS, end_time=0.5, output_period=0.01)
     with pytest.raises(SolverFailure) as caught:
         simulate(scene, _JumpingWinch(0.3, 1.0))
     failure = caught.value
@@ -530,7 +540,7 @@ def test_explicit_rk44_runs_below_its_step_limit_and_matches_the_implicit_solver
 
 
 def test_explicit_rk44_above_its_step_limit_stops_clearly():
-    scene = shortened(holding_still(PAPER), end_time=1e-3, output_period=1e-4, step_size=1e-6,
+    scene = shortened(holding_still(PAPER_SPRINGS), end_time=1e-3, output_period=1e-4, step_size=1e-6,
                       integrator="rk44")
     result, failure = run(scene)
     assert failure is not None

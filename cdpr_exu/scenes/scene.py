@@ -350,7 +350,11 @@ class WinchSpec:
         return self.drum_inertia / self.drum_radius**2
 
 
-#: The model ladder: which effects each preset switches on.
+#: The model ladder: which effects each preset switches on. A cable cannot push, so the
+#: lumped-mass presets ("full", the default, and "catenary") have tension-only elements;
+#: "paper" is the paper's model as published, whose axial spring-dampers also push when
+#: compressed (kept to reproduce it). "ideal" and "elastic" are the massless references
+#: of inverse kinematics (ropes that may push; a run reports it when they do).
 PRESETS: dict[str, dict[str, bool]] = {
     "ideal": dict(
         cable_mass=False, axial_elasticity=False, axial_damping=False, bending=False,
@@ -362,11 +366,15 @@ PRESETS: dict[str, dict[str, bool]] = {
     ),
     "full": dict(
         cable_mass=True, axial_elasticity=True, axial_damping=True, bending=True,
+        bending_damping=True, pulley_contact=True, slack=True, gravity=True,
+    ),
+    "paper": dict(
+        cable_mass=True, axial_elasticity=True, axial_damping=True, bending=True,
         bending_damping=True, pulley_contact=True, slack=False, gravity=True,
     ),
     "catenary": dict(
         cable_mass=True, axial_elasticity=True, axial_damping=True, bending=False,
-        bending_damping=False, pulley_contact=True, slack=False, gravity=True,
+        bending_damping=False, pulley_contact=True, slack=True, gravity=True,
     ),
 }
 
@@ -386,13 +394,16 @@ class Effects:
     preset : str
         Name of the preset the flags started from (see :data:`PRESETS`), for reports:
         "ideal" (massless inextensible ropes), "elastic" (massless elastic ropes),
-        "catenary" (lumped mass and elasticity, no bending), "full" (the paper's model).
+        "catenary" (lumped mass and elasticity, no bending), "full" (the paper's model with
+        tension-only elements, the default), "paper" (the paper's model as published: its
+        spring-dampers push when compressed, which a real cable cannot).
     cable_mass, axial_elasticity, axial_damping, bending, bending_damping,
     pulley_contact, slack, gravity : bool
         Switches of the individual effects. Without ``cable_mass`` each cable is one
         massless rope over its pulley (Exudyn's reeving system); without
         ``axial_elasticity`` the elements (or the rope) are inextensible. ``slack``
-        makes the elements (or the rope) tension-only.
+        (on in every preset but "paper") makes the elements (or the rope) tension-only:
+        a cable cannot push.
     bending_model : {"exact", "linear"}
         Formulation of the bending spring: "exact" is the paper's relative joint angle;
         "linear" the curvature-vector spring (k_theta / l0i^2) |p_a - 2 p_b + p_c|^2 / 2
@@ -418,7 +429,7 @@ class Effects:
     bending: bool = True
     bending_damping: bool = True
     pulley_contact: bool = True
-    slack: bool = False
+    slack: bool = True
     gravity: bool = True
     bending_model: str = "exact"
     pulley_contact_model: str = "node"
@@ -445,12 +456,20 @@ class Effects:
 
     @classmethod
     def from_preset(cls, preset: str = "full", **overrides: Any) -> "Effects":
-        """Effects of a named preset, with single effects overridden."""
+        """Effects of a named preset, with single effects overridden.
+
+        Inextensible lumped cables (``axial_elasticity = False`` with ``cable_mass``) have
+        no springs to make tension-only, so a preset's ``slack`` is dropped for them unless
+        it is asked for explicitly (which is refused).
+        """
         _choice("effects.preset", preset, tuple(PRESETS))
         unknown = set(overrides) - {f.name for f in fields(cls)}
         if unknown:
             raise SceneError(f"effects has no field(s) {sorted(unknown)}")
-        return cls(preset=preset, **{**PRESETS[preset], **overrides})
+        flags = {**PRESETS[preset], **overrides}
+        if flags["cable_mass"] and flags["axial_elasticity"] is False and "slack" not in overrides:
+            flags["slack"] = False
+        return cls(preset=preset, **flags)
 
 
 @dataclass(frozen=True)

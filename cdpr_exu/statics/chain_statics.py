@@ -33,7 +33,7 @@ rad). Plain NumPy plus the numba bending kernels; no Exudyn.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numba import njit
@@ -598,6 +598,12 @@ def solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rotat
                         tension_guess=None, tolerance: float = 1e-7, max_iterations: int = 50) -> ChainEquilibrium:
     """Paid-out lengths, node positions and rotation that hold the platform at ``position``.
 
+    Tension-only (slack) elements have no stiffness in compression, so Newton started
+    from a guess with compressed elements can stall on them. Their equilibrium is first
+    sought with springs that also push: where no element of that equilibrium is
+    compressed it is the tension-only one as well (the two potentials agree wherever
+    every element is stretched); otherwise it is the start of the tension-only solve.
+
     Two nested Newton iterations. Inner: with the platform held at ``position`` and the
     paid-out lengths given, the nodes (and the free rotation) minimise the potential
     (:func:`_minimise`). Outer: the paid-out lengths are corrected until the cables
@@ -639,6 +645,24 @@ def solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rotat
     SceneError
         On malformed input or a problem that is not square.
     """
+    kwargs = dict(free_rotation=free_rotation, external_wrench=external_wrench, tolerance=tolerance,
+                  max_iterations=max_iterations)
+    if not any(c.slack for c in robot.cables):
+        return _solve_chain_statics(robot, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
+    springs = ChainRobot(tuple(replace(c, slack=False) for c in robot.cables), robot.mass, robot.gravity)
+    try:
+        spring = _solve_chain_statics(springs, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
+    except UnreachableError:
+        return _solve_chain_statics(robot, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
+    if all(np.all(t >= 0.0) for t in spring.tensions):
+        return spring
+    return _solve_chain_statics(robot, position, rotation, guess=spring, **kwargs)
+
+
+def _solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None,
+                         external_wrench=None, guess: ChainEquilibrium | None = None,
+                         tension_guess=None, tolerance: float = 1e-7, max_iterations: int = 50) -> ChainEquilibrium:
+    """:func:`solve_chain_statics` for one element law (the robot's own)."""
     position = vector("position", position, 2)
     rotation = finite("rotation", rotation)
     m = len(robot.cables)
