@@ -451,7 +451,10 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     controller = controller or IdealIKController()
     model = build_model(scene, sparse_jacobian=sparse_jacobian)
 
-    controller.reset(scene, model.initial_paid_out.copy())
+    # The controller plans on its own model of the robot (the scene's controller model,
+    # if it has one), never on the plant's parameters; what the winches paid out at t = 0
+    # is the plant's.
+    controller.reset(scene.controller_scene(), model.initial_paid_out.copy())
     mbs = model.mbs
     solver = scene.solver
     recorder = _Recorder(model, solver.output_period, solver.end_time)
