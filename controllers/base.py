@@ -9,6 +9,11 @@ The winch variable is the *paid-out length* lambda_i [m]: the unstrained cable l
 between the point where cable i leaves its winch-side vertical line on the pulley
 (the hang point) and the platform anchor. Hauling in decreases it. The simulation
 tells each controller what was paid out at t = 0 (``reset``).
+
+Every controller starts the same way (:class:`SmoothStart`, applied by the run): its
+commands begin at what the winches paid out at t = 0 and take up the controller's own
+commands over :data:`START_BLEND_TIME`. A reference that starts from rest (a circle
+with ``ramp_time`` > 0) then gives commands that start with zero rate and acceleration.
 """
 
 from __future__ import annotations
@@ -17,6 +22,9 @@ from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
+
+#: Duration of the blend from the paid-out lengths at t = 0 into a controller's commands [s].
+START_BLEND_TIME = 0.5
 
 
 @dataclass(frozen=True)
@@ -85,3 +93,71 @@ class Controller(Protocol):
 
     def command(self, measurement: Measurement) -> WinchCommand:
         """The winch command for ``measurement.time``."""
+
+
+def quintic_blend(tau):
+    """The rest-to-rest quintic s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 and its first derivative.
+
+    Clamped to 0 before tau = 0 and 1 after tau = 1; s' and s'' vanish at both ends.
+    """
+    tau = np.clip(np.asarray(tau, dtype=float), 0.0, 1.0)
+    return tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2), 30.0 * tau**2 * (1.0 - tau) ** 2
+
+
+class SmoothStart:
+    """A controller whose commands start at what the winches paid out at t = 0.
+
+    The run wraps every controller in it. With c(t) the controller's command and p0 the
+    paid-out lengths at t = 0, the command is
+
+        c(t) + (1 - s(t / T)) (p0 - c(0)),
+
+    s the quintic blend over T = ``duration``: the offset between where the cables start
+    (straight, as built) and where the controller wants them at t = 0 (e.g. the
+    tension-aware lengths, with sag and stretch) is taken up with zero rate and
+    acceleration at both ends. A controller whose command starts at p0 (ideal inverse
+    kinematics) is unchanged, so the paper's abrupt start stays the paper's. The rate
+    and acceleration of the command at t = 0 are those of c: zero for a reference that
+    starts from rest.
+
+    Parameters
+    ----------
+    controller : Controller
+    duration : float [s]
+        The blend time T (> 0).
+    """
+
+    def __init__(self, controller: Controller, duration: float = START_BLEND_TIME) -> None:
+        if not np.isfinite(duration) or duration <= 0:
+            raise ValueError(f"duration must be positive [s], got {duration!r}")
+        self.controller = controller
+        self.duration = float(duration)
+        self.name = controller.name
+        self.uses_pose = controller.uses_pose
+        self.uses_tension = controller.uses_tension
+        self._offset = None
+
+    def reset(self, scene, initial_paid_out) -> None:
+        """Reset the controller and measure its command at t = 0 against ``initial_paid_out``.
+
+        The command at t = 0 is asked with the platform at rest at ``scene.platform.initial_pose``.
+        """
+        initial = np.asarray(initial_paid_out, dtype=float)
+        self.controller.reset(scene, initial.copy())
+        m = initial.size
+        pose = np.asarray(scene.platform.initial_pose, dtype=float) if self.uses_pose else None
+        velocity = np.zeros(3) if self.uses_pose else None
+        first = self.controller.command(Measurement(0.0, initial.copy(), np.zeros(m), pose, velocity, None))
+        offset = initial - np.asarray(first.paid_out, dtype=float)
+        # Below 1e-12 m the offset is the round-off of a controller's own "initial + change"
+        # (ideal IK): dropped, so that a controller that starts where the winches are keeps
+        # its commands bit for bit.
+        self._offset = np.where(np.abs(offset) < 1e-12, 0.0, offset)
+
+    def command(self, measurement: Measurement) -> WinchCommand:
+        if self._offset is None:
+            raise RuntimeError("SmoothStart.reset(scene, initial_paid_out) must be called before command()")
+        command = self.controller.command(measurement)
+        blend, rate = quintic_blend(measurement.time / self.duration)
+        return WinchCommand(np.asarray(command.paid_out, dtype=float) + (1.0 - blend) * self._offset,
+                            np.asarray(command.paid_out_rate, dtype=float) - rate / self.duration * self._offset)

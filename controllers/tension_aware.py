@@ -31,8 +31,8 @@ Options:
 The commands are tabulated once per run on a coarse time grid and interpolated with a
 cubic spline, so they and their rates are continuous. The cables start straight (the
 paper's initial state), with a paid-out length that differs from the compensated one:
-the command blends from the initial length into the compensated one over
-``start_time`` with a smooth (quintic) ramp instead of jumping.
+the run blends every controller's command from the initial length into its own
+(:class:`controllers.base.SmoothStart`) instead of jumping.
 
 Plain NumPy/SciPy; no Exudyn.
 """
@@ -106,9 +106,8 @@ class TensionAwareController:
     dynamic : bool
         Add the inertial load -M a of the reference acceleration (dynamic feed-forward).
     table_period : float [s]
-        Time grid of the equilibrium table (interpolated by a cubic spline).
-    start_time : float [s]
-        Duration of the blend from the initial (straight-cable) lengths.
+        Time grid of the equilibrium table (interpolated by a cubic spline; where the
+        reference starts from rest, the spline starts with zero rate).
     chordal_correction : bool
         Correct for the lumped model's polygon over the pulley (see the module notes).
     statics : {"catenary", "chain"}
@@ -121,14 +120,12 @@ class TensionAwareController:
     uses_pose = False
     uses_tension = False
 
-    def __init__(self, dynamic: bool = False, table_period: float = 0.02, start_time: float = 0.5,
+    def __init__(self, dynamic: bool = False, table_period: float = 0.02,
                  chordal_correction: bool = False, statics: str = "catenary", table_spacing: float = 2e-3):
         if not np.isfinite(table_period) or table_period <= 0:
             raise SceneError(f"table_period must be positive, got {table_period!r}")
         if not np.isfinite(table_spacing) or table_spacing < 0:
             raise SceneError(f"table_spacing must be zero or positive, got {table_spacing!r}")
-        if not np.isfinite(start_time) or start_time < 0:
-            raise SceneError(f"start_time must be zero or positive, got {start_time!r}")
         if statics not in STATICS_MODELS:
             raise SceneError(f"statics must be one of {STATICS_MODELS}, got {statics!r}")
         if statics == "chain" and chordal_correction:
@@ -138,7 +135,6 @@ class TensionAwareController:
         self.statics = statics
         self.table_period = float(table_period)
         self.table_spacing = float(table_spacing)
-        self.start_time = float(start_time)
         self.name = ("tension_aware" + ("_chain" if statics == "chain" else "") + ("_dynamic" if self.dynamic else "")
                      + ("_chordal" if self.chordal_correction else ""))
         self._spline = None
@@ -208,10 +204,12 @@ class TensionAwareController:
         count = max(int(np.ceil(end / self._period(scene))), 3) + 1
         times = np.linspace(0.0, end, count)
         lengths = self.compensated_lengths(scene, times)
-        ramp = _smoothstep(times / self.start_time) if self.start_time > 0 else np.ones_like(times)
-        initial = np.asarray(initial_paid_out, dtype=float)
-        commands = ramp[:, None] * lengths + (1.0 - ramp[:, None]) * initial
-        self._spline = CubicSpline(times, commands, axis=0)
+        # The command is the compensated length itself; the run takes up its offset from
+        # the initial (straight-cable) paid-out length (controllers.base.SmoothStart).
+        commands = lengths
+        at_rest = not (np.any(scene.trajectory.velocity(0.0)) or np.any(scene.trajectory.acceleration(0.0)))
+        start = (1, np.zeros(scene.n_cables)) if at_rest else "not-a-knot"  # from rest: zero rate at t = 0
+        self._spline = CubicSpline(times, commands, axis=0, bc_type=(start, "not-a-knot"))
         self._rate = self._spline.derivative()
 
     def feed_forward(self, t: float) -> tuple[np.ndarray, np.ndarray]:
@@ -239,14 +237,20 @@ class ClosedLoopTensionAwareController(TensionAwareController):
     ----------
     proportional_gain : float [-]
     integral_gain : float [1/s]
-    dynamic, table_period, start_time
+    start_time : float [s]
+        The feedback (and its integral) fades in over this time from t = 0.
+    dynamic, table_period, ...
         As :class:`TensionAwareController`.
     """
 
     uses_pose = True
 
-    def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, **kwargs):
+    def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, start_time: float = 0.5,
+                 **kwargs):
         super().__init__(**kwargs)
+        if not np.isfinite(start_time) or start_time < 0:
+            raise SceneError(f"start_time must be zero or positive, got {start_time!r}")
+        self.start_time = float(start_time)
         for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
             if not np.isfinite(value) or value < 0:
                 raise SceneError(f"{name} must be zero or positive, got {value!r}")

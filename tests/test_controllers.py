@@ -8,7 +8,7 @@ import pytest
 from cdpr_exu.core.errors import UnreachableError
 from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, load_scene
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory
-from controllers import IdealIKController, Measurement
+from controllers import IdealIKController, Measurement, SmoothStart
 from controllers.ideal_ik import ideal_paid_out
 from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
 
@@ -66,7 +66,7 @@ def test_tension_aware_commands_are_continuous_in_time(controller):
     dt = 1e-3
     times = np.arange(0.0, 3.0, dt)
     initial = np.array([3.08, 3.08])
-    lengths, rates = _commands(controller, scene, times, initial)
+    lengths, rates = _commands(SmoothStart(controller), scene, times, initial)  # as the run starts them
     assert np.allclose(lengths[0], initial, atol=1e-12)  # starts where the winches are
     # Continuity: no step changes a command by more than its largest rate allows
     # (with 50 % margin for the rate's own change within a step).
@@ -182,3 +182,64 @@ def test_the_closed_loop_switches_on_without_pushing_its_cables():
     result = simulate(scene, ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True))
     near = (result.time > 0.45) & (result.time < 0.6)
     assert min(t[near].min() for t in result.tensions) > 0.0
+
+
+# ----------------------------------------------------------------------------- smooth start
+
+SMOOTH = load_scene("paper-circle-mismatch")  # its circle starts from rest (trajectory.ramp_time = 1 s)
+
+
+@pytest.mark.parametrize("controller", [
+    IdealIKController(), TensionAwareController(), TensionAwareController(dynamic=True, chordal_correction=True),
+    TensionAwareController(statics="chain"), ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True)],
+    ids=lambda c: c.name)
+def test_with_the_smooth_start_every_controller_starts_at_rest_and_commands_are_c1(controller):
+    scene = SMOOTH.with_changes(solver=replace(SMOOTH.solver, end_time=2.0))
+    initial = ideal_paid_out(scene, scene.trajectory.pose(np.zeros(1)))[0][0]  # straight cables, as built
+    started = SmoothStart(controller)  # as the run wraps every controller
+    started.reset(scene.controller_scene(), initial)
+    dt = 1e-3
+    times = np.arange(0.0, 2.0, dt)
+    # The closed loop measures the platform on its reference: its feedback is then zero.
+    out = [started.command(Measurement(t, initial, np.zeros(2), scene.trajectory.pose(t), np.zeros(3))) for t in times]
+    lengths = np.array([c.paid_out for c in out])
+    rates = np.array([c.paid_out_rate for c in out])
+    np.testing.assert_array_equal(lengths[0], initial)  # starts where the winches are
+    np.testing.assert_array_equal(rates[0], 0.0)  # and at rest
+    # C1: the rate is the derivative of the lengths (central differences; measured at most
+    # 9e-5 m/s, the chain statics' spline) and has no jump (measured at most 8.7e-3 m/s
+    # per millisecond, i.e. 8.7 m/s^2, against 0.6 m/s of circle speed).
+    np.testing.assert_allclose(np.gradient(lengths, dt, axis=0)[1:-1], rates[1:-1], atol=5e-4)
+    assert np.abs(np.diff(rates, axis=0)).max() < 0.02
+    assert np.abs(rates).max() < 1.0
+
+
+def test_the_smooth_start_leaves_ideal_ik_on_the_paper_start_unchanged():
+    """The paper's circle starts at full speed; ideal IK commands that start (its command
+    at t = 0 is what the winches paid out), so the paper reproduction keeps it."""
+    scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=1.0))
+    times = np.linspace(0.0, 1.0, 101)
+    plain, plain_rates = _commands(IdealIKController(), scene, times)
+    started, started_rates = _commands(SmoothStart(IdealIKController()), scene, times)
+    np.testing.assert_array_equal(started, plain)
+    np.testing.assert_array_equal(started_rates, plain_rates)
+    assert np.abs(plain_rates[0]).max() > 0.3  # m/s: the paper's winches jump from rest
+
+
+@pytest.mark.parametrize("controller", [IdealIKController(), TensionAwareController()], ids=lambda c: c.name)
+def test_with_the_smooth_start_no_tension_only_element_goes_slack_in_the_first_second(controller):
+    """On paper-circle-mismatch (tension-only cables, circle from rest over 1 s) every element
+    stays taut after t = 0; the paper's start at full speed throws the cables slack."""
+    from cdpr_exu.run.simulate import simulate
+
+    scene = SMOOTH.with_changes(solver=replace(SMOOTH.solver, end_time=1.0))
+    assert scene.effects.slack
+    smooth = simulate(scene, controller)
+    after = smooth.time > 0.0  # at t = 0 the straight cables, as built, carry nothing yet
+    lowest = min(t[after].min() for t in smooth.tensions)
+    # Measured 13.1 N (ideal IK) and 11.5 N (tension-aware), at 0.57-0.64 s; 5 N is the margin.
+    assert lowest > 5.0
+    assert max(smooth._slack_time(t, after) for t in smooth.tensions) == 0.0
+    abrupt = simulate(scene.with_changes(trajectory=replace(scene.trajectory, ramp_time=0.0)), controller)
+    # Measured 0.12 s and 0.16 s of slack in the first second.
+    assert max(abrupt._slack_time(t, abrupt.time > 0.0) for t in abrupt.tensions) > 0.05

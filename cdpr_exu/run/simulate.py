@@ -20,7 +20,7 @@ from typing import Callable
 import exudyn as exu
 import numpy as np
 
-from controllers.base import Controller, Measurement
+from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController
 
 from cdpr_exu.builder.cable import element_tensions
@@ -483,7 +483,12 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     controller = controller or IdealIKController()
     model = build_model(scene, sparse_jacobian=sparse_jacobian)
 
-    controller.reset(scene, model.initial_paid_out.copy())
+    # The controller plans on its own model of the robot (the scene's controller model,
+    # if it has one), never on the plant's parameters; what the winches paid out at t = 0
+    # is the plant's.
+    # Every controller starts from what the winches paid out at t = 0 (SmoothStart).
+    controller = SmoothStart(controller)
+    controller.reset(scene.controller_scene(), model.initial_paid_out.copy())
     mbs = model.mbs
     solver = scene.solver
     recorder = _Recorder(model, solver.output_period, solver.end_time)

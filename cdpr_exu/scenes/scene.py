@@ -565,6 +565,163 @@ class SolverSpec:
         return int(round(self.end_time / self.step_size))
 
 
+# --------------------------------------------------------------------------- controller model
+
+#: Fields the controllers' model may override, by part. Left out: where the platform
+#: starts and its drawing size (the run starts from the plant's state, which the
+#: controllers are told: the paid-out lengths at t = 0) and the tension limits (the
+#: robot's requirements, one set for plant and controllers).
+MODEL_FIELDS: dict[str, tuple[str, ...]] = {
+    "cable": ("unstrained_length", "radius", "linear_density", "youngs_modulus", "damping_constant",
+              "n_elements", "mass_lumping"),
+    "pulley": ("center", "radius", "side", "contact_stiffness", "contact_damping"),
+    "platform": ("mass", "inertia", "anchors"),
+}
+
+
+def _overrides(path: str, data: Any, part: str) -> dict[str, Any]:
+    """A copy of one override table, refusing keys the controllers' model cannot override."""
+    if not isinstance(data, Mapping):
+        raise SceneError(f"{path} must be a table, got {data!r}")
+    known = MODEL_FIELDS[part]
+    unknown = sorted(set(data) - set(known))
+    if unknown:
+        raise SceneError(f"{path} has unknown or non-model field(s) {unknown}; the controllers' model may "
+                         f"override: {list(known)}")
+    return {key: _tupled(value) for key, value in data.items()}
+
+
+def _tupled(value: Any) -> Any:
+    """Lists to tuples, recursively (so that overrides compare equal after a TOML round trip)."""
+    if isinstance(value, (list, tuple)):
+        return tuple(_tupled(v) for v in value)
+    return value
+
+
+@dataclass(frozen=True)
+class ControllerModel:
+    """What the controllers believe of the robot, where it differs from the simulated plant.
+
+    Overrides of the plant's parameters; everything not named is the plant's. A scene
+    with a controller model simulates its own parts (the plant) and hands the controllers
+    :meth:`Scene.controller_scene`, the plant with these overrides applied. In TOML::
+
+        [controller_model.platform]   # the paper's platform, while the plant's is heavier
+        mass = 2.5
+        inertia = 0.0271
+        [controller_model.cable]      # shared by every cable
+        linear_density = 0.35
+        [[controller_model.cables]]   # optional, one per cable, over [controller_model.cable]
+        youngs_modulus = 0.9e9
+
+    Parameters
+    ----------
+    cable : mapping
+        Overrides of every cable's :class:`CableSpec` fields (see :data:`MODEL_FIELDS`).
+    cables : sequence of mappings
+        Per-cable overrides (none, or one per cable), applied after ``cable``.
+    pulley, pulleys : mapping, sequence of mappings
+        The same for the :class:`PulleySpec` fields.
+    platform : mapping
+        Overrides of :class:`PlatformSpec` fields: mass [kg], inertia [kg m^2], anchors [m].
+    gravity : float or None [m/s^2]
+        The gravitational acceleration the controllers assume (None: the plant's).
+    """
+
+    cable: Mapping[str, Any] = field(default_factory=dict)
+    cables: tuple[Mapping[str, Any], ...] = ()
+    pulley: Mapping[str, Any] = field(default_factory=dict)
+    pulleys: tuple[Mapping[str, Any], ...] = ()
+    platform: Mapping[str, Any] = field(default_factory=dict)
+    gravity: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("cable", "pulley", "platform"):
+            _set(self, name, _overrides(f"controller_model.{name}", getattr(self, name), name))
+        for name, part in (("cables", "cable"), ("pulleys", "pulley")):
+            entries = getattr(self, name)
+            if isinstance(entries, (str, bytes, Mapping)) or not hasattr(entries, "__iter__"):
+                raise SceneError(f"controller_model.{name} must be an array of tables, got {entries!r}")
+            _set(self, name, tuple(_overrides(f"controller_model.{name}[{i}]", e, part)
+                                   for i, e in enumerate(entries)))
+        if self.gravity is not None:
+            _set(self, "gravity", non_negative("controller_model.gravity", self.gravity))
+
+    def is_empty(self) -> bool:
+        """True when it overrides nothing (the controllers know the plant)."""
+        return not (self.cable or self.cables or self.pulley or self.pulleys or self.platform
+                    or self.gravity is not None)
+
+    def apply(self, scene: "Scene") -> "Scene":
+        """``scene`` with these overrides applied (and no controller model of its own).
+
+        Raises
+        ------
+        SceneError
+            If an override is invalid or the per-cable lists do not match the cables;
+            the message names the ``controller_model`` field.
+        """
+        m = scene.n_cables
+        for name in ("cables", "pulleys"):
+            if getattr(self, name) and len(getattr(self, name)) != m:
+                raise SceneError(f"controller_model.{name} must list one table per cable ({m}), "
+                                 f"got {len(getattr(self, name))}")
+        cables = tuple(_override(c, {**self.cable, **(self.cables[i] if self.cables else {})}, f"cables[{i}]", "cable")
+                       for i, c in enumerate(scene.cables))
+        pulleys = tuple(_override(p, {**self.pulley, **(self.pulleys[i] if self.pulleys else {})}, f"pulleys[{i}]",
+                                  "pulley") for i, p in enumerate(scene.pulleys))
+        platform = _override(scene.platform, self.platform, "platform", "platform")
+        gravity = scene.gravity if self.gravity is None else self.gravity
+        try:
+            return replace(scene, cables=cables, pulleys=pulleys, platform=platform, gravity=gravity,
+                           controller_model=None)
+        except SceneError as err:
+            raise SceneError(f"controller_model: the controllers' model is not a valid robot: {err}") from None
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (TOML-ready): only the overrides given."""
+        data: dict[str, Any] = {}
+        for name in ("cable", "pulley", "platform"):
+            if getattr(self, name):
+                data[name] = _listify(dict(getattr(self, name)))
+        for name in ("cables", "pulleys"):
+            if getattr(self, name):
+                data[name] = [_listify(dict(e)) for e in getattr(self, name)]
+        if self.gravity is not None:
+            data["gravity"] = self.gravity
+        return data
+
+
+def _override(part: Any, changes: Mapping[str, Any], path: str, head: str) -> Any:
+    """``part`` (a frozen spec) with ``changes``; an invalid value is named under controller_model."""
+    if not changes:
+        return part
+    try:
+        return replace(part, **changes)
+    except SceneError as err:
+        message = str(err)
+        if message.startswith(head + "."):
+            message = path + message[len(head):]
+        raise SceneError(f"controller_model.{message}") from None
+    except TypeError as err:
+        raise SceneError(f"controller_model.{path}: {err}") from None
+
+
+def controller_model_from_dict(data: Any) -> ControllerModel:
+    """A :class:`ControllerModel` from its TOML table, refusing unknown keys (named)."""
+    if not isinstance(data, Mapping):
+        raise SceneError(f"controller_model must be a table, got {data!r}")
+    known = {f.name for f in fields(ControllerModel)}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise SceneError(f"controller_model has unknown field(s) {unknown}; known: {sorted(known)}")
+    values = dict(data)
+    for name in ("cables", "pulleys"):
+        if name in values and not (isinstance(values[name], list) and all(isinstance(e, Mapping) for e in values[name])):
+            raise SceneError(f"controller_model.{name} must be an array of tables, got {values[name]!r}")
+    return ControllerModel(**values)
+
+
 # --------------------------------------------------------------------------- scene
 
 
@@ -591,6 +748,9 @@ class Scene:
         "pulley": each cable wraps over its pulley and hangs to its winch (paper).
         "point": the cable's winch end is fixed at the pulley centre and there is no
         pulley contact (used to compare with the catenary's fixed end points).
+    controller_model : ControllerModel or None
+        What the controllers believe where it differs from this (simulated) robot;
+        :meth:`controller_scene` applies it. None: the controllers know the plant.
     """
 
     name: str = "scene"
@@ -607,6 +767,7 @@ class Scene:
     trajectory: Trajectory | None = None
     gravity: float = 9.81
     cable_exit: str = "pulley"
+    controller_model: ControllerModel | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -653,6 +814,23 @@ class Scene:
 
             _set(self, "trajectory", HoldTrajectory(tuple(self.platform.initial_pose)))
         self._check_reachable()
+        if self.controller_model is not None:
+            if not isinstance(self.controller_model, ControllerModel):
+                raise SceneError(f"controller_model must be a ControllerModel, got {self.controller_model!r}")
+            if self.controller_model.is_empty():
+                _set(self, "controller_model", None)
+            else:
+                self.controller_model.apply(self)  # refuse a model that is no valid robot now, not at the run
+
+    def controller_scene(self) -> "Scene":
+        """The robot the controllers believe in: this scene with its controller model applied.
+
+        Without a controller model, the scene itself. The trajectory, solver settings,
+        effects and the initial pose are the plant's.
+        """
+        if self.controller_model is None:
+            return self
+        return self.controller_model.apply(self)
 
     def _check_reachable(self) -> None:
         """Refuse an initial pose the cables cannot reach (before any simulation)."""
@@ -724,6 +902,8 @@ class Scene:
             "solver": dataclasses.asdict(self.solver),
             "trajectory": self.trajectory.to_dict(),
         }
+        if self.controller_model is not None:
+            data["controller_model"] = self.controller_model.to_dict()
         return data
 
 
@@ -787,7 +967,7 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     data.pop("dimension", None)
     top_known = {
         "name", "description", "gravity", "cable_exit", "cable", "cables", "pulley", "pulleys",
-        "platform", "winch", "effects", "solver", "trajectory",
+        "platform", "winch", "effects", "solver", "trajectory", "controller_model",
     }
     unknown = set(data) - top_known
     if unknown:
@@ -816,6 +996,7 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
         effects=effects,
         solver=_build(SolverSpec, data.get("solver", {}), "solver"),
         trajectory=trajectory,
+        controller_model=controller_model_from_dict(data["controller_model"]) if "controller_model" in data else None,
     )
     for key in ("name", "description", "gravity", "cable_exit"):
         if key in data:
