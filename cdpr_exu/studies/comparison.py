@@ -30,6 +30,7 @@ from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError
 from cdpr_exu.core.output import fixed
 from cdpr_exu.results.result import Result, provenance
 from cdpr_exu.scenes.scene import Scene, load_scene
+from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule, ilc_controller, model_feed_forward_controller
 
 #: The controllers compared by default, by name, each a factory.
 CONTROLLERS: dict[str, Callable[[], object]] = {
@@ -39,6 +40,14 @@ CONTROLLERS: dict[str, Callable[[], object]] = {
     "tension_aware_dynamic_chordal": lambda: TensionAwareController(dynamic=True, chordal_correction=True),
     "tension_aware_chain": lambda: TensionAwareController(statics="chain"),
     "closed_loop_tension_aware": lambda: ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True),
+    "model_feed_forward": model_feed_forward_controller,
+    "ilc": ilc_controller,
+}
+#: Controllers that learn over trials before their run (cdpr_exu.studies.learning), made with the
+#: comparison's stopping rule and progress setting.
+LEARNING_CONTROLLERS: dict[str, Callable[..., object]] = {
+    "model_feed_forward": model_feed_forward_controller,
+    "ilc": ilc_controller,
 }
 
 #: Ramp time [s] of the smooth start `cdpr compare` gives a circle that starts at full speed.
@@ -77,11 +86,14 @@ _COLUMNS = (
 
 
 def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: str | Path | None = None,
-                        after: float = 1.0, progress: bool = False, quiet: bool = True) -> dict[str, dict]:
+                        after: float = 1.0, progress: bool = False, quiet: bool = True,
+                        learning_rule: StoppingRule = DEFAULT_RULE) -> dict[str, dict]:
     """Run ``scene`` under each named controller; returns their summaries by name.
 
     A controller that refuses the reference (e.g. a pose that needs a pushing cable)
-    or whose run fails is recorded with its status; the others still run.
+    or whose run fails is recorded with its status; the others still run. The
+    learning controllers (:data:`LEARNING_CONTROLLERS`) run their trials first, as
+    ``learning_rule`` says (their per-trial errors go into the summary as ``trials``).
     """
     from cdpr_exu.run.simulate import simulate
 
@@ -95,7 +107,10 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
     results: dict[str, Result] = {}
     try:
         for name in names:
-            controller = CONTROLLERS[name]()
+            if name in LEARNING_CONTROLLERS:
+                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, progress=not quiet)
+            else:
+                controller = CONTROLLERS[name]()
             try:
                 result = simulate(scene, controller, progress=progress)
             except SolverFailure as err:
@@ -110,6 +125,9 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
             results[name] = result
             summary = result.summary(after=after)
             summary["controller"] = name
+            learning = getattr(getattr(controller, "learner", None), "learning", None)
+            if learning is not None:
+                summary["learning"] = learning.to_dict()
             slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
             summary["slack_time_s"] = max(slack) if slack else None
             if "tension_limit_violations" in summary:
@@ -219,10 +237,15 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     scene = started
     # A reference no controller can follow is bad input (exit 2), not six failed runs.
     check_reference(scene)
+    try:
+        rule = StoppingRule(max_trials=args.trials, min_improvement=args.min_improvement)
+    except SceneError as err:
+        raise SceneError(f"--trials / --min-improvement: {err}") from None
     names = args.controllers.split(",") if args.controllers else None
     if not args.quiet:
         print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
-    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet)
+    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet,
+                                    learning_rule=rule)
     if not args.quiet:
         print()
         print(markdown_table(summaries))
@@ -253,5 +276,10 @@ def add_commands(subparsers) -> None:
     parser.add_argument("--ramp-time", type=float, default=COMPARISON_RAMP_TIME,
                         help="start a circle that starts at full speed smoothly from rest over this time [s] "
                              f"(default {COMPARISON_RAMP_TIME}; 0 keeps the scene's own start)")
+    parser.add_argument("--trials", type=int, default=DEFAULT_RULE.max_trials,
+                        help=f"most learning trials of ilc and model_feed_forward (default {DEFAULT_RULE.max_trials})")
+    parser.add_argument("--min-improvement", type=float, default=DEFAULT_RULE.min_improvement,
+                        help="stop learning when a trial's max error falls by less than this fraction "
+                             f"(default {DEFAULT_RULE.min_improvement})")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     parser.set_defaults(func=_cmd_compare)
