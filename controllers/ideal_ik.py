@@ -17,7 +17,9 @@ from .base import Measurement, WinchCommand
 
 def _spatial_ideal_lengths(scene, poses, pose_rates=None):
     """:func:`ideal_paid_out` of a spatial scene: straight distances from the exit points to the
-    anchors, poses (N, 6) (x, y, z, rotation vector); a point-mass platform's rotation is ignored."""
+    anchors, over the swivel pulleys where there are (wrap plus tangent length from the inlet,
+    :mod:`cdpr_exu.physics.spatial_kinematics`), poses (N, 6) (x, y, z, rotation vector); a
+    point-mass platform's rotation is ignored."""
     from cdpr_exu.physics.spatial_kinematics import inverse_kinematics, inverse_kinematics_rates
 
     poses = np.atleast_2d(poses)
@@ -28,10 +30,11 @@ def _spatial_ideal_lengths(scene, poses, pose_rates=None):
     else:
         points, anchors = poses, np.asarray(scene.platform.anchors)
         rates = None if pose_rates is None else np.atleast_2d(pose_rates)
-    lengths = inverse_kinematics(points, anchors, exits, 0.0)
+    radii = np.asarray(getattr(scene, "pulley_radii", 0.0))  # swivel pulleys (0: a point exit)
+    lengths = inverse_kinematics(points, anchors, exits, radii)
     if rates is None:
         return lengths, None
-    return lengths, inverse_kinematics_rates(points, rates, anchors, exits, 0.0)
+    return lengths, inverse_kinematics_rates(points, rates, anchors, exits, radii)
 
 
 def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = None):

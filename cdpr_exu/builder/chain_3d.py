@@ -42,6 +42,9 @@ class SpatialChainItems:
         Keeps the Python callables alive as long as the model.
     loads : list of int
         The nodes' gravity ``LoadForceVector`` items (empty without gravity).
+    holds : list of int
+        The three ``ObjectConnectorCoordinate`` items that hold the first node (x, y, z;
+        empty if it is free); their ``offset`` moves it (a winch on a swivel axis).
     bending_stiffness : ndarray, shape (J,) [N m/rad] or None
         The joints' stiffnesses, the very array the bending force reads (a winch that
         changes the cable's length scales it in place).
@@ -74,6 +77,7 @@ class SpatialChainItems:
     axial_stiffness: np.ndarray | None = None
     axial_damping: np.ndarray | None = None
     axial_rest_rate: np.ndarray | None = None
+    holds: list = field(default_factory=list)
 
     @property
     def tension_only(self) -> bool:
@@ -105,7 +109,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         items' ``axial_rest_length``, ``axial_stiffness``, ``axial_damping``).
     """
     positions = np.asarray(positions, dtype=float)
-    nodes, masses, markers, springs, loads = [], [], [], [], []
+    nodes, masses, markers, springs, loads, holds = [], [], [], [], [], []
     for point, mass in zip(positions, node_masses):
         node = mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point)))
         masses.append(mbs.AddObject(eii.ObjectMassPoint(mass=float(mass), nodeNumber=node)))
@@ -124,12 +128,12 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         ground_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
         for coordinate in range(3):
             held = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=nodes[0], coordinate=coordinate))
-            mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_marker, held]))
+            holds.append(mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_marker, held])))
     joints = bending_3d.chain_joints([len(nodes)])
     reference = positions.ravel().copy()
     bending = bending_stiffness > 0.0 and len(joints) > 0
     if not bending and not tension_only:
-        return SpatialChainItems(nodes, masses, markers, springs, None, reference, joints, loads=loads)
+        return SpatialChainItems(nodes, masses, markers, springs, None, reference, joints, loads=loads, holds=holds)
     bending_joints = joints if bending else np.zeros((0, 3), dtype=np.int64)
     stiffness = np.full(len(bending_joints), float(bending_stiffness))
     if tension_only:
@@ -177,7 +181,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     generic = mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=nodes, massMatrix=empty,
                                                    forceUserFunction=force_function,
                                                    jacobianUserFunction=jacobian_function))
-    common = dict(user_functions=(force_function, jacobian_function, container), loads=loads,
+    common = dict(user_functions=(force_function, jacobian_function, container), loads=loads, holds=holds,
                   bending_stiffness=stiffness if bending else None, generic=generic)
     if not tension_only:
         return SpatialChainItems(nodes, masses, markers, springs, generic, reference, joints, **common)

@@ -36,6 +36,22 @@ Platform
   is meant for Exudyn's explicit Lie-group integrators (its documentation), and
   Tait-Bryan angles (``NodeRigidBodyRxyz``) are singular at a pitch of 90 degrees.
 
+Swivel pulleys
+--------------
+A cable whose exit is a swivel pulley (``swivels[i]``, a
+:class:`cdpr_exu.scenes.spatial_scene.SwivelSpec`) is a fixed-length chain that starts at
+its winch end, held on the pulley's vertical axis ``winch_line`` below the inlet, runs
+up the axis, wraps over the disc and hangs to the anchor: its elements keep their
+length ``L / n`` (``L`` the unstrained length from the inlet, the catenary statics'),
+the winch line getting ``round(winch_line n / L)`` more of them. The disc and its swivel
+angle psi are :func:`cdpr_exu.builder.swivel_chain.add_swivel_pulley`'s (every node of
+the chain may touch it: the cable runs over the disc as the winch moves). The winch
+moves the held end along the axis (``SpatialChainItems.holds``), as the planar winch
+moves its node along the winch line, so cable flows over the pulley. The chain starts
+on the catenary statics' shape: the winch line stretched under the tension at the
+tangent point less its own weight, the wrap on the groove bottom, psi at the anchor's
+azimuth.
+
 Units SI, z up, gravity along -z. The parameters are those of
 :mod:`cdpr_exu.physics.spatial_statics` (:class:`SpatialPlatform`, the unstrained
 lengths), plus the discretisation and the cable's damping and bending
@@ -48,6 +64,7 @@ their initial displacements put the nodes on the catenary.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -89,6 +106,10 @@ class SpatialChainSpec:
         Tension-only axial elements (a cable cannot push; a slack element carries
         nothing, :mod:`cdpr_exu.physics.axial_3d`) instead of Exudyn's
         ``ObjectConnectorSpringDamper``; a taut element is the same spring-damper.
+    mass_lumping : {"consistent", "paper"}
+        As the planar cable's (:class:`cdpr_exu.scenes.scene.CableSpec`): "consistent" puts
+        half of each element's mass on each of its nodes; "paper" puts it on its far
+        (platform-side) node, the held exit node getting half an element.
     """
 
     n_elements: int = 20
@@ -96,8 +117,11 @@ class SpatialChainSpec:
     flexural_rigidity: float = 0.0
     anchor_spring_factor: float | None = None
     tension_only: bool = False
+    mass_lumping: str = "consistent"
 
     def __post_init__(self):
+        if self.mass_lumping not in ("consistent", "paper"):
+            raise SceneError(f"mass_lumping must be 'consistent' or 'paper', got {self.mass_lumping!r}")
         if not isinstance(self.tension_only, (bool, np.bool_)):
             raise SceneError(f"tension_only must be True or False, got {self.tension_only!r}")
         object.__setattr__(self, "tension_only", bool(self.tension_only))
@@ -138,6 +162,13 @@ class SpatialRobotItems:
         spring-dampers), one per cable.
     initial : SpatialEquilibrium
         The catenary equilibrium the robot was started on.
+    swivels : list of (SwivelItems or None)
+        Each cable's swivel pulley in Exudyn (None: a point exit).
+    swivel_pulleys : list of (SwivelPulley or None)
+        Their physics (:class:`cdpr_exu.physics.swivel_pulley.SwivelPulley`).
+    winch_elements : ndarray of int, shape (n_cables,)
+        Elements of each chain below the inlet (0 for a point exit): node
+        ``winch_elements[i]`` started at the inlet.
     """
 
     platform: SpatialPlatform
@@ -153,10 +184,27 @@ class SpatialRobotItems:
     anchor_markers: list
     joints: list
     initial: SpatialEquilibrium = field(repr=False)
+    swivels: list = field(default_factory=list)
+    swivel_pulleys: list = field(default_factory=list)
+    winch_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    def has_swivel(self, cable):
+        """True when ``cable`` leaves over a swivel pulley."""
+        return bool(self.swivels) and self.swivels[cable] is not None
 
     @property
     def is_point_mass(self):
         return self.platform.is_point_mass
+
+
+def node_masses_along(n_elements, element_mass, mass_lumping="consistent"):
+    """Lumped masses of the n + 1 nodes of a cable of equal elements, exit first, shape (n + 1,) [kg]
+    (``mass_lumping`` as :class:`SpatialChainSpec`'s)."""
+    masses = np.full(n_elements + 1, float(element_mass))
+    masses[0] = 0.5 * element_mass
+    if mass_lumping == "consistent":
+        masses[-1] = 0.5 * element_mass
+    return masses
 
 
 def _chain_positions(equilibrium_cable, length, n_elements):
@@ -171,7 +219,51 @@ def _chain_positions(equilibrium_cable, length, n_elements):
     return reference, current
 
 
-def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None):
+def _swivel_chain_positions(equilibrium_cable, length, n_elements, winch_elements, contact_stiffness):
+    """Straight unstrained reference (winch end first) and the catenary statics' node positions of a
+    cable over a swivel pulley, shape (k + n + 1, 3) each, k = ``winch_elements``.
+
+    From the anchor: the catenary up to the tangent point; then the wrap as the lumped
+    cable lies on it, a polygon of chords of the stretched element length (on the arc
+    instead, each chord is short by r_p theta^3 / 24 and pushes with up to 3 kN at
+    l_e = r_p: Newton then diverged), each node inside the groove by the depth that carries
+    its share of the pressure, ``T l_e / (r_p k_p)`` (on the rim itself psi has no stiffness:
+    Exudyn's static solver met a singular matrix); then down the axis to the winch end.
+    The tension is the catenary's at the tangent point (frictionless wrap, its weight
+    left out, as in the statics).
+    """
+    element = length / n_elements
+    inlet = equilibrium_cable.inlet
+    axial = equilibrium_cable.cable.axial_stiffness
+    tension = equilibrium_cable.tension_at_exit
+    radius = equilibrium_cable.pulley_radius
+    direction = equilibrium_cable.horizontal_direction
+    suspended = equilibrium_cable.suspended_length
+    arcs = length - element * np.arange(-winch_elements, n_elements + 1)  # unstrained, from the anchor
+    hanging = arcs <= suspended
+    current = np.empty((len(arcs), 3))
+    current[hanging] = equilibrium_cable.points(arcs[hanging])
+    stretched = element * (1.0 + tension / axial)
+    chord_angle = 2.0 * math.asin(min(1.0, stretched / (2.0 * radius)))  # rim angle per element
+    angle = math.pi - equilibrium_cable.wrap_angle + (arcs[~hanging] - suspended) / element * chord_angle
+    depth = tension * stretched / (radius * contact_stiffness)
+    centre = inlet + radius * direction
+    rim = centre + np.outer((radius - depth) * np.cos(angle), direction) + np.outer((radius - depth) * np.sin(angle), _E_Z)
+    axis = inlet - np.outer((angle - math.pi) / chord_angle * stretched, _E_Z)
+    current[~hanging] = np.where((angle <= math.pi)[:, None], rim, axis)
+    # the winch end on the axis, below the inlet by the winch line stretched under the tension at
+    # the inlet less its own weight: where the paid-out length puts it, whatever the polygon
+    weight = equilibrium_cable.cable.weight_per_length
+    below = element * winch_elements
+    current[0] = inlet - (below * (1.0 + tension / axial) - weight * below**2 / (2.0 * axial)) * _E_Z
+    reference = current[0] + np.outer(element * np.arange(len(current)), _E_Z)
+    return reference, current
+
+
+_E_Z = np.array([0.0, 0.0, 1.0])
+
+
+def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None, swivels=None):
     """Add the robot to ``mbs``: chains, platform, spherical joints, gravity.
 
     Parameters
@@ -185,6 +277,10 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     initial : SpatialEquilibrium, optional
         Start configuration: platform pose and cable shapes; default the catenary
         statics of these lengths (:func:`solve_spatial_statics`).
+    swivels : sequence of (SwivelSpec or None), optional
+        Each cable's swivel pulley (its contact, swivel inertia and bearing, winch line;
+        see the module notes), None for a point exit; the platform's cable must then
+        have the same ``pulley_radius`` and its ``exit_point`` at the inlet.
 
     Returns
     -------
@@ -213,25 +309,50 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         raise SceneError(f"initial must be a SpatialEquilibrium of this platform's {len(platform.cables)} cables, "
                          f"got {initial!r}")
 
+    swivels = [None] * len(platform.cables) if swivels is None else list(swivels)
+    if len(swivels) != len(platform.cables):
+        raise SceneError(f"swivels must give one entry (or None) per cable ({len(platform.cables)}), got {len(swivels)}")
+    for i, (cable, swivel) in enumerate(zip(platform.cables, swivels)):
+        radius = 0.0 if swivel is None else swivel.radius
+        if cable.pulley_radius != radius or (swivel is not None and tuple(swivel.inlet) != cable.exit_point):
+            raise SceneError(f"swivels[{i}] does not match cables[{i}] of the platform (pulley_radius "
+                             f"{cable.pulley_radius!r} m, exit_point {cable.exit_point})")
+
     n = chain.n_elements
     element_lengths = lengths / n
     axial_stiffnesses = np.array([c.axial_stiffness for c in platform.cables]) / element_lengths
     axial_dampings = chain.axial_damping_constant / element_lengths
     bending_stiffnesses = chain.flexural_rigidity / element_lengths
 
-    chains, node_masses = [], []
-    for cable, length, equilibrium_cable, k, c, k_theta in zip(
-            platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses):
+    from cdpr_exu.builder.swivel_chain import add_swivel_pulley  # Exudyn items of the disc and psi
+
+    chains, node_masses, swivel_items, swivel_pulleys, winch_elements = [], [], [], [], []
+    for cable, length, equilibrium_cable, k, c, k_theta, swivel in zip(
+            platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses,
+            swivels):
         element_mass = cable.weight_per_length / gravity * length / n
-        masses = np.full(n + 1, element_mass)
-        masses[[0, -1]] = 0.5 * element_mass
-        reference, current = _chain_positions(equilibrium_cable, length, n)
+        below = 0 if swivel is None else max(2, int(round(swivel.winch_line / (length / n))))
+        masses = node_masses_along(n + below, element_mass, chain.mass_lumping)
+        if swivel is None:
+            reference, current = _chain_positions(equilibrium_cable, length, n)
+        else:
+            reference, current = _swivel_chain_positions(equilibrium_cable, length, n, below,
+                                                         swivel.contact_stiffness)
         items = add_spatial_chain(mbs, reference, masses, float(k), float(c), float(k_theta), gravity=gravity,
                                   hold_first=True, tension_only=chain.tension_only)
         for node, displacement in zip(items.nodes, current - reference):
             mbs.SetNodeParameter(node, "initialCoordinates", [float(x) for x in displacement])
+        if swivel is None:
+            swivel_items.append(None)
+            swivel_pulleys.append(None)
+        else:
+            pulley = swivel.pulley()
+            anchor = equilibrium_cable.anchor_point - np.asarray(swivel.inlet)
+            swivel_items.append(add_swivel_pulley(mbs, items, pulley, psi=float(np.arctan2(anchor[1], anchor[0]))))
+            swivel_pulleys.append(pulley)
         chains.append(items)
         node_masses.append(masses)
+        winch_elements.append(below)
 
     position = [float(x) for x in initial.position]
     if platform.is_point_mass:
@@ -260,7 +381,8 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
             joints.append(mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
                 markerNumbers=markers, stiffness=[stiffness] * 3, damping=[0.0] * 3)))
     return SpatialRobotItems(platform, lengths, chain, chains, node_masses, axial_stiffnesses, axial_dampings,
-                             bending_stiffnesses, platform_node, platform_body, anchor_markers, joints, initial)
+                             bending_stiffnesses, platform_node, platform_body, anchor_markers, joints, initial,
+                             swivel_items, swivel_pulleys, np.array(winch_elements, dtype=int))
 
 
 # ---------------------------------------------------------------------------
@@ -353,6 +475,9 @@ def robot_energy(mbs, items, current=True):
         v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t,
                                               configuration=configuration) for node in chain.nodes])
         energy += chain_energy(chain, masses, q, v, float(k), float(k_theta), gravity)
+    for swivel, pulley in zip(items.swivels, items.swivel_pulleys):
+        if swivel is not None:
+            energy += _swivel_energy(mbs, items, swivel, pulley, configuration)
     if items.chain.anchor_spring_factor is not None:  # the penalty joints' springs
         anchors = np.array([mbs.GetMarkerOutput(marker, exu.OutputVariableType.Position, configuration=configuration)
                             for marker in items.anchor_markers])
@@ -368,6 +493,27 @@ def robot_energy(mbs, items, current=True):
                                            configuration=configuration))
         energy += 0.5 * float(omega @ (np.array(items.platform.inertia) * omega))
     return energy
+
+
+def _swivel_energy(mbs, items, swivel, pulley, configuration):
+    """Contact potential and J_s psi_dot^2 / 2 of one swivel pulley [J]."""
+    from cdpr_exu.builder.swivel_chain import swivel_energy
+
+    cable = items.swivels.index(swivel)
+    chain = items.chains[cable]
+    q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
+                        for node in chain.nodes])
+    psi = mbs.GetNodeOutput(swivel.node, exu.OutputVariableType.Coordinates, configuration=configuration)
+    rate = mbs.GetNodeOutput(swivel.node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
+    return swivel_energy(swivel, chain, pulley, q, float(np.ravel(psi)[0]), float(np.ravel(rate)[0]))
+
+
+def swivel_angles(mbs, items, current=True):
+    """Swivel angle psi [rad] of each cable's pulley, shape (n_cables,) (NaN for a point exit)."""
+    configuration = _configuration(current)
+    return np.array([np.nan if swivel is None else swivel.psi_reference + float(np.ravel(
+        mbs.GetNodeOutput(swivel.node, exu.OutputVariableType.Coordinates, configuration=configuration))[0])
+        for swivel in (items.swivels or [None] * len(items.chains))])
 
 
 # ---------------------------------------------------------------------------
@@ -413,6 +559,45 @@ def static_settings(tolerance=1e-9):
     static.newton.relativeTolerance = tolerance
     static.newton.absoluteTolerance = tolerance
     return settings
+
+
+#: How long :func:`settle` integrates a robot over swivel pulleys [s], and at what step.
+SETTLE_TIME, SETTLE_STEP = 0.5, 5.0e-3
+
+
+def settle(mbs, items, duration=SETTLE_TIME, step_size=SETTLE_STEP):
+    """Let the assembled robot come to rest from its initial configuration, then make that its start (at rest).
+
+    Exudyn's static solver does not converge from the catenary start of a cable over a
+    swivel pulley (measured on spatial-four-cable-swivel at 24 and 48 elements: the
+    first Newton step raised the residual 300-fold, psi held or not); after this settle
+    it converges in 3 to 6 iterations, as the planar static mode polishes a settled
+    state (:mod:`cdpr_exu.run.rest`). Generalised-alpha at spectral radius 0, modified
+    Newton, adaptive steps, zero initial accelerations (the consistent ones, of a start
+    a few newtons out of balance on stiff elements, put tens of joules into the first
+    step), the cables' own damping.
+    """
+    settings = dynamic_settings(duration, step_size, spectral_radius=0.0, tolerance=1e-6)
+    ti = settings.timeIntegration
+    ti.newton.useModifiedNewton = True
+    ti.newton.modifiedNewtonJacUpdatePerStep = True
+    ti.adaptiveStep = True
+    ti.minimumStepSize = step_size * 1e-4
+    ti.generalizedAlpha.computeInitialAccelerations = False
+    printing = exu.config.printToConsole
+    exu.config.printToConsole = False
+    try:
+        mbs.SolveDynamic(settings)
+    except (exu.SolverError, RuntimeError, SystemError) as error:
+        raise SolverFailure(f"settling the robot over its swivel pulleys failed: {error}") from None
+    finally:
+        exu.config.printToConsole = printing
+    state = np.asarray(mbs.systemData.GetODE2Coordinates())
+    mbs.systemData.SetODE2Coordinates(state, exu.ConfigurationType.Initial)
+    mbs.systemData.SetODE2Coordinates_t(np.zeros_like(state), exu.ConfigurationType.Initial)
+    mbs.systemData.SetODE2Coordinates(state, exu.ConfigurationType.Current)
+    mbs.systemData.SetODE2Coordinates_t(np.zeros_like(state), exu.ConfigurationType.Current)
+    mbs.systemData.SetTime(0.0, exu.ConfigurationType.Initial)
 
 
 def solve_static(mbs, items, settings=None):

@@ -18,6 +18,22 @@ and the turning of ``u``::
 (a sideways step of the anchor turns the horizontal pull). For a vertical cable
 (``h -> 0``) the sideways stiffness ``H / h`` tends to the in-plane one, ``-K2[0, 0]``.
 
+Swivel pulleys
+--------------
+A cable whose exit is a swivel pulley (``SpatialCable.pulley_radius > 0``; the exit
+point is then the pulley's inlet, :mod:`cdpr_exu.physics.spatial_kinematics`) comes up
+the vertical axis through the inlet, wraps over the disc and hangs to the anchor. The
+suspended part hangs in a vertical plane, and the disc, free to turn about the axis,
+has no torque on it only when that plane contains the axis: the pulley's azimuth is
+the anchor's, ``e_rho`` the horizontal unit vector from the axis to the anchor. In the
+plane ``(rho, z)`` from the inlet the cable is the planar pulley cable of
+:mod:`cdpr_exu.statics.statics` (pulley centre ``(r_p, 0)``, side -1, hang point at the
+inlet; frictionless, the wrap's weight carried by the disc, the unstrained length
+counted from the inlet, wrap included). Its force on the platform is
+``f_rho e_rho + f_z e_z`` and, the plane turning about the axis when the anchor moves
+sideways, its 3-D end stiffness is ``Q K2 Q^T + (f_rho / rho) (P_h - e_rho e_rho^T)``,
+``Q = [e_rho, e_z]``, ``rho`` the anchor's distance from the axis.
+
 Platform
 --------
 * a **point mass** (every anchor at the centre of mass): unknowns the position
@@ -84,6 +100,9 @@ class SpatialCable:
         ``EA > 0``.
     anchor : (float, float, float) [m], optional
         Anchor on the platform, platform frame (centre of mass at 0); default the centre.
+    pulley_radius : float [m], optional
+        0 (default): ``exit_point`` is a point exit. Positive: the cable leaves over a
+        swivel pulley of this radius whose inlet is ``exit_point`` (module notes).
 
     Raises
     ------
@@ -95,8 +114,10 @@ class SpatialCable:
     weight_per_length: float
     axial_stiffness: float
     anchor: tuple = (0.0, 0.0, 0.0)
+    pulley_radius: float = 0.0
 
     def __post_init__(self):
+        object.__setattr__(self, "pulley_radius", non_negative("pulley_radius", self.pulley_radius))
         object.__setattr__(self, "exit_point", tuple(_point3("exit_point", self.exit_point)))
         object.__setattr__(self, "weight_per_length", non_negative("weight_per_length", self.weight_per_length))
         object.__setattr__(self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness))
@@ -214,13 +235,23 @@ class SpatialCableEquilibrium:
         World positions of the two ends.
     horizontal_direction : ndarray, shape (3,)
         ``u``: unit horizontal vector from the anchor towards the exit (the plane's x
-        axis); any horizontal unit vector for a vertical cable.
+        axis); any horizontal unit vector for a vertical cable. Over a swivel pulley,
+        ``e_rho``, from the axis towards the anchor (the catenary's horizontal sign then
+        says which way the exit lies).
     force_on_platform : ndarray, shape (3,) [N]
         Force the cable exerts on the platform at its anchor.
     force_on_exit : ndarray, shape (3,) [N]
-        Force the cable exerts on its exit point.
+        Force the cable exerts on its exit point (on a swivel pulley: at the tangent point).
     cable : CatenaryCable
-        The cable's 2-D catenary parameters (its unstrained length, weight, ``EA``).
+        The 2-D catenary parameters of the suspended part (its unstrained length, weight, ``EA``).
+    guess : tuple
+        Warm start of the next solve of this cable.
+    pulley_radius : float [m]
+        0 for a point exit; else the swivel pulley's: ``exit_point`` is then the tangent
+        point where the cable leaves the disc, ``inlet`` the pulley's inlet.
+    wrap_angle : float [rad]
+        Angle the cable wraps on the swivel pulley (0 for a point exit).
+    inlet : ndarray, shape (3,) [m] or None
     """
 
     catenary: CatenaryState
@@ -231,6 +262,15 @@ class SpatialCableEquilibrium:
     force_on_platform: np.ndarray
     force_on_exit: np.ndarray
     cable: CatenaryCable = field(repr=False)
+    guess: tuple = field(default=None, repr=False)
+    pulley_radius: float = 0.0
+    wrap_angle: float = 0.0
+    inlet: np.ndarray | None = None
+
+    @property
+    def suspended_length(self):
+        """Unstrained length of the suspended part, anchor to exit or tangent point [m]."""
+        return self.cable.unstrained_length
 
     @property
     def tension_at_anchor(self):
@@ -243,9 +283,26 @@ class SpatialCableEquilibrium:
         return self.catenary.tension_b
 
     def points(self, s):
-        """Points of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor, shape (n, 3) [m]."""
-        planar = profile(self.cable, self.catenary, s)
-        return self.anchor_point + np.outer(planar[:, 0], self.horizontal_direction) + np.outer(planar[:, 1], _E_Z)
+        """Points of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor, shape (n, 3) [m].
+
+        On a swivel pulley, arc lengths beyond the suspended part lie on the wrap (stretched
+        by the tension at the tangent point), up to ``unstrained_length`` at the inlet."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        suspended = self.suspended_length
+        hanging = s <= suspended if self.pulley_radius > 0.0 else np.ones(s.shape, bool)
+        points = np.empty((s.size, 3))
+        if hanging.any():
+            planar = profile(self.cable, self.catenary, s[hanging])
+            points[hanging] = (self.anchor_point + np.outer(planar[:, 0], self.horizontal_direction)
+                               + np.outer(planar[:, 1], _E_Z))
+        if not hanging.all():
+            radius = self.pulley_radius
+            stretch = 1.0 + self.tension_at_exit / self.cable.axial_stiffness
+            # rim angle in the plane (rho, z) about the centre (r_p, 0): the inlet is at pi
+            angle = np.minimum(math.pi - self.wrap_angle + (s[~hanging] - suspended) * stretch / radius, math.pi)
+            points[~hanging] = (self.inlet + np.outer(radius * (1.0 + np.cos(angle)), self.horizontal_direction)
+                                + np.outer(radius * np.sin(angle), _E_Z))
+        return points
 
 
 @dataclass(frozen=True, eq=False)
@@ -316,6 +373,9 @@ def solve_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=D
     UnreachableError
         If the span is beyond the cable's reach at its tension limit.
     """
+    if cable.pulley_radius > 0.0:
+        return _solve_swivel_cable(cable, unstrained_length, np.asarray(anchor_point, dtype=float), guess, max_strain,
+                                   max_tension)
     catenary_cable = cable.catenary(unstrained_length)
     exit_point = np.array(cable.exit_point)
     span = exit_point - anchor_point
@@ -338,6 +398,46 @@ def solve_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=D
         force_on_platform=state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
         force_on_exit=state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
         cable=catenary_cable,
+        guess=(state.horizontal_tension, state.vertical_tension_b),
+    )
+    return equilibrium, stiffness
+
+
+def _solve_swivel_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
+    """:func:`solve_cable` over a swivel pulley: the planar pulley cable in the plane through the axis and the anchor."""
+    from cdpr_exu.core.geometry import Pulley
+    from cdpr_exu.statics.statics import SuspendedCable, _forward_cable
+
+    inlet = np.array(cable.exit_point)
+    offset = anchor_point - inlet
+    rho = float(math.hypot(offset[0], offset[1]))
+    if rho <= 1e-12 * (float(np.linalg.norm(offset)) + cable.pulley_radius):
+        raise UnreachableError(f"anchor {anchor_point.tolist()} lies on the axis of the swivel pulley at "
+                               f"{inlet.tolist()}: its azimuth is undefined")
+    e_rho = np.array([offset[0], offset[1], 0.0]) / rho
+    radius = cable.pulley_radius
+    planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
+                                  pulley=Pulley((radius, 0.0), radius, -1))
+    planar, planar_stiffness, new_guess = _forward_cable(planar_cable, float(unstrained_length),
+                                                         np.array([rho, offset[2]]), guess, max_strain, max_tension)
+    basis = np.column_stack([e_rho, _E_Z])
+    force = planar.force_on_platform
+    stiffness = basis @ planar_stiffness @ basis.T + force[0] / rho * (_HORIZONTAL - np.outer(e_rho, e_rho))
+    tangent = inlet + planar.upper_point[0] * e_rho + planar.upper_point[1] * _E_Z
+    state = planar.catenary
+    equilibrium = SpatialCableEquilibrium(
+        catenary=state,
+        unstrained_length=float(unstrained_length),
+        anchor_point=np.array(anchor_point, dtype=float),
+        exit_point=tangent,
+        horizontal_direction=e_rho,
+        force_on_platform=force[0] * e_rho + force[1] * _E_Z,
+        force_on_exit=state.force_on_b[0] * e_rho + state.force_on_b[1] * _E_Z,
+        cable=cable.catenary(planar.suspended_length),
+        guess=tuple(new_guess),
+        pulley_radius=radius,
+        wrap_angle=float(planar.wrap_angle),
+        inlet=inlet,
     )
     return equilibrium, stiffness
 
@@ -518,7 +618,7 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
         equilibria = []
         for i, (cable, length, arm_) in enumerate(zip(platform.cables, lengths, arms)):
             equilibrium, stiffness = solve_cable(cable, length, position + arm_, guesses[i], max_strain, max_tension)
-            guesses[i] = (equilibrium.catenary.horizontal_tension, equilibrium.catenary.vertical_tension_b)
+            guesses[i] = equilibrium.guess
             equilibria.append(equilibrium)
             force = equilibrium.force_on_platform
             wrench_total[:3] += force
@@ -584,6 +684,9 @@ class SpatialInverse:
 
 def _inverse_cable(cable, anchor_point, horizontal_tension):
     """Unstrained length [m] and force on the platform (3,) [N] of one cable at horizontal tension H."""
+    if cable.pulley_radius > 0.0:
+        raise SceneError("the inverse spatial statics covers point exits only so far, not swivel pulleys "
+                         f"(pulley_radius = {cable.pulley_radius!r} m)")
     exit_point = np.array(cable.exit_point)
     span = exit_point - anchor_point
     horizontal = float(math.hypot(span[0], span[1]))

@@ -144,34 +144,9 @@ class Result:
         }
 
     def _violations(self, mask: np.ndarray) -> dict[str, Any]:
-        """``tension_limit_violations``: each cable's element tensions outside its (t_min, t_max), if any are set.
-
-        One entry per cable and limit crossed: the limit, when it was first crossed, the
-        most extreme tension and for how long some element was beyond it. Absent from the
-        summary of a scene without tension limits.
-        """
-        limits = self.metadata.get("tension_limits_N")
-        if limits is None:
-            return {}
-        times = self.time[mask]
-        widths = np.diff(times, append=times[-1]) if len(times) else np.zeros(0)
-        violations = []
-        for i, (tensions, (low, high)) in enumerate(zip(self.tensions, limits)):
-            series = np.asarray(tensions[mask], dtype=float)
-            if not series.size:
-                continue
-            for name, limit, extreme, beyond in (
-                    ("min_tension", low, np.nanmin(series, axis=1), lambda x, v: x < v),
-                    ("max_tension", high, np.nanmax(series, axis=1), lambda x, v: x > v)):
-                if limit is None:
-                    continue
-                crossed = beyond(extreme, limit)
-                if np.any(crossed):
-                    worst = extreme[crossed].min() if name == "min_tension" else extreme[crossed].max()
-                    violations.append({"cable": i + 1, "limit": name, "limit_N": float(limit),
-                                       "first_time_s": float(times[np.argmax(crossed)]), "extreme_N": float(worst),
-                                       "duration_s": float(np.sum(widths[crossed]))})
-        return {"tension_limits_N": limits, "tension_limit_violations": violations}
+        """``tension_limit_violations`` of the samples in ``mask`` (:func:`tension_limit_report`)."""
+        return tension_limit_report(self.time[mask], [t[mask] for t in self.tensions],
+                                    self.metadata.get("tension_limits_N"))
 
     def _slack_time(self, tensions: np.ndarray, mask: np.ndarray) -> float | None:
         """Time [s] during which some element of a cable carries no tension (slack, or pushing)."""
@@ -257,3 +232,41 @@ def provenance() -> dict[str, Any]:
         "python": _platform.python_version(),
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
     }
+
+
+def tension_limit_report(times: np.ndarray, tensions, limits) -> dict[str, Any]:
+    """``tension_limit_violations``: each cable's element tensions outside its (t_min, t_max), if any are set.
+
+    One entry per cable and limit crossed: the limit, when it was first crossed, the
+    most extreme tension and for how long some element was beyond it. Empty (``{}``:
+    absent from the summary) for a scene without tension limits. Planar and spatial
+    runs report the same way.
+
+    Parameters
+    ----------
+    times : ndarray, shape (N,) [s]
+    tensions : sequence of ndarray, each shape (N, n) [N]
+        Element tensions of each cable at those times.
+    limits : list of [t_min or None, t_max or None] [N], one per cable, or None
+    """
+    if limits is None:
+        return {}
+    times = np.asarray(times, dtype=float)
+    widths = np.diff(times, append=times[-1]) if len(times) else np.zeros(0)
+    violations = []
+    for i, (series, (low, high)) in enumerate(zip(tensions, limits)):
+        series = np.asarray(series, dtype=float)
+        if not series.size:
+            continue
+        for name, limit, extreme, beyond in (
+                ("min_tension", low, np.nanmin(series, axis=1), lambda x, v: x < v),
+                ("max_tension", high, np.nanmax(series, axis=1), lambda x, v: x > v)):
+            if limit is None:
+                continue
+            crossed = beyond(extreme, limit)
+            if np.any(crossed):
+                worst = extreme[crossed].min() if name == "min_tension" else extreme[crossed].max()
+                violations.append({"cable": i + 1, "limit": name, "limit_N": float(limit),
+                                   "first_time_s": float(times[np.argmax(crossed)]), "extreme_N": float(worst),
+                                   "duration_s": float(np.sum(widths[crossed]))})
+    return {"tension_limits_N": limits, "tension_limit_violations": violations}

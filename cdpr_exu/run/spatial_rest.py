@@ -33,7 +33,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from cdpr_exu.core.output import write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, settle, solve_static, \
+    swivel_angles
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.spatial_scene import SpatialScene
@@ -96,6 +97,7 @@ class SpatialRest:
     catenary: object
     anchor_joint: str
     wall_time: float
+    swivel_angles: np.ndarray | None = None
 
     @property
     def lowest_element_tension(self) -> float:
@@ -124,6 +126,9 @@ class SpatialRest:
             "lumped_minus_catenary_position_m": float(np.linalg.norm(self.position - catenary.position)),
             "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(self.rotation_vector - catenary.rotation_vector)),
             "wall_time_s": self.wall_time,
+            **({} if self.swivel_angles is None else {
+                "swivel_angle_rad": [None if np.isnan(a) else float(a) for a in self.swivel_angles],
+                "catenary_wrap_angle_rad": [float(c.wrap_angle) for c in catenary.cables]}),
             **provenance(),
         }
 
@@ -151,14 +156,17 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     rigid = not platform.is_point_mass
     chain = scene.chain_spec(anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary)
+    items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary, swivels=scene.swivel_exits)
     mbs.Assemble()
+    if scene.swivels:
+        settle(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley
     static = solve_static(mbs, items)
     nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
     tensions = tuple(element_forces(mbs, items, i) for i in range(scene.n_cables))
     joint = f"penalty spherical joints of {PENALTY:g} element stiffnesses" if rigid else "exact spherical joints"
     return SpatialRest(scene, static.position, static.rotation, static.rotation_vector, static.tensions_at_anchor,
-                       static.forces_on_platform, nodes, tensions, catenary, joint, _time.perf_counter() - start)
+                       static.forces_on_platform, nodes, tensions, catenary, joint, _time.perf_counter() - start,
+                       swivel_angles(mbs, items) if scene.swivels else None)
 
 
 def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
@@ -225,6 +233,13 @@ def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
     print(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
           f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
           f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation_vector)):.4f} deg from the lumped robot")
+    if rest.swivel_angles is not None:
+        azimuths = [np.degrees(np.arctan2(*(c.anchor_point - c.inlet)[1::-1])) if c.inlet is not None else None
+                    for c in catenary.cables]
+        for i, (psi, azimuth) in enumerate(zip(rest.swivel_angles, azimuths)):
+            if azimuth is not None:
+                print(f"  swivel pulley {i + 1}: psi = {np.degrees(psi):.4f} deg (anchor azimuth {azimuth:.4f} deg), "
+                      f"wrap {np.degrees(catenary.cables[i].wrap_angle):.2f} deg")
     lowest = rest.lowest_element_tension
     if lowest < 0.0:
         print(f"  note: an element is compressed ({lowest:.3g} N), which a real cable cannot be: that cable is "

@@ -10,7 +10,8 @@ reference (:mod:`cdpr_exu.physics.spatial_kinematics`), the spatial counterpart 
 planar ``ideal_ik`` controller.
 
 **The winch at a point exit.** A spatial scene's cable leaves the frame at a fixed
-point (swivel pulleys come later), where the winch pays it out. The lumped cable keeps
+point, where the winch pays it out (over a swivel pulley the winch end moves along
+the pulley's axis instead, :mod:`cdpr_exu.builder.spatial_robot`). The lumped cable keeps
 its n elements and changes with its paid-out (unstrained) length L(t): every element's
 unstrained length L / n, its axial stiffness E A n / L and damping d_n A n / L, the node
 masses rho L / n (half at the ends) and their weights, and the bending stiffness
@@ -40,13 +41,13 @@ from matplotlib.figure import Figure
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import write_npz, write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose, settle
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from controllers.base import Controller, Measurement
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.results.result import provenance
+from cdpr_exu.results.result import provenance, tension_limit_report
 from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, quiet_exudyn, solver_settings
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
@@ -83,10 +84,21 @@ def check_spatial_reference(scene: SpatialScene) -> None:
         k, i = short[0]
         raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
                                f"cable {i + 1} paid out to {lengths[k, i]:.4f} m: it would be reeled in completely")
-    rotations = [rotation_from_vector(theta) for theta in poses[:, 3:]]
-    anchors = poses[:, None, :3] + np.einsum("nij,mj->nmi", np.asarray(rotations), np.asarray(scene.platform.anchors))
-    pulls = np.asarray(scene.exits)[None] - anchors  # (N, m, 3)
-    directions = np.swapaxes(pulls / np.linalg.norm(pulls, axis=2, keepdims=True), 1, 2)  # (N, 3, m)
+    for i, swivel in enumerate(scene.swivel_exits):
+        if swivel is None:
+            continue
+        room = swivel.winch_line - 2.0 * scene.cables[i].element_length  # the winch end stays two elements below
+        gain = lengths[:, i] - lengths[0, i]
+        if gain.max() > room:
+            k = int(np.argmax(gain))
+            raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
+                                   f"cable {i + 1} paid out by {gain[k]:.4f} m over its swivel pulley: more than "
+                                   f"exits[{i}].winch_line = {swivel.winch_line:g} m less two elements holds")
+    from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors
+
+    anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
+    points = poses[:, :3] if anchors is None else poses
+    directions = np.swapaxes(cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii), 1, 2)
     gravity = scene.gravity if scene.effects.gravity else 0.0
     acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
     needed = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
@@ -188,6 +200,8 @@ class SpatialResult:
             "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
             "steps": int(self.steps), "newton_iterations": int(self.newton_iterations),
             "failure_time_s": self.failure_time, "notes": notes,
+            **tension_limit_report(self.time[mask], [t[mask] for t in self.tensions],
+                                   self.metadata.get("tension_limits_N")),
         }
 
     def save(self, folder: str | Path, after: float = 1.0, figures: bool = True) -> list[Path]:
@@ -216,6 +230,9 @@ class _SpatialWinches:
     def set_lengths(self, lengths: np.ndarray, rates: np.ndarray) -> None:
         """Give every cable the paid-out length ``lengths`` (m,) [m], changing at ``rates`` (m,) [m/s].
 
+        Over a swivel pulley the cable keeps its elements: its held winch end moves along
+        the swivel axis by the change of the paid-out length (cable runs over the disc).
+
         The rate goes to each element's damper as Exudyn's ``velocityOffset``: the
         Kelvin-Voigt damper acts on the strain rate d(l - l0)/dt, so a cable that is paid
         out without stretching is not damped (without the offset the paper's damping
@@ -223,6 +240,11 @@ class _SpatialWinches:
         """
         mbs, items = self.mbs, self.items
         for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
+            if items.has_swivel(i):  # the winch end moves along the swivel axis: up when paying out
+                if length != self.applied[i]:
+                    mbs.SetObjectParameter(chain.holds[2], "offset", float(length - items.unstrained_lengths[i]))
+                    self.applied[i] = length
+                continue
             if chain.tension_only:  # the arrays the cable's numba kernels read
                 chain.axial_rest_rate[:] = float(rate) / self.n
             for spring in chain.springs:
@@ -251,12 +273,29 @@ class _SpatialWinches:
 
 
 def _element_tensions(nodes: np.ndarray, length: float, axial_rigidity: float, n: int,
-                      tension_only: bool) -> np.ndarray:
-    """Spring force of each element [N], shape (n,), for node positions (n + 1, 3) and paid-out length L
-    (tension-only elements: nothing below the rest length)."""
+                      tension_only: bool, elements: int | None = None) -> np.ndarray:
+    """Spring force of each element [N], shape (elements,), for node positions (elements + 1, 3), elements of
+    unstrained length L / n (tension-only elements: nothing below the rest length)."""
     element = length / n
     force = axial_rigidity / element * (np.linalg.norm(np.diff(nodes, axis=0), axis=1) - element)
     return np.maximum(force, 0.0) if tension_only else force
+
+
+def _warn_outside_measured_region(scene: SpatialScene) -> None:
+    """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
+    outside the region where runs over a swivel pulley were measured to keep their energy."""
+    import warnings
+
+    from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
+
+    solver = scene.solver
+    for swivel, cable in zip(scene.swivel_exits, scene.cables):
+        if swivel is None:
+            continue
+        for concern in stability_concerns(solver.newton == "modified", solver.spectral_radius, solver.newton_tolerance,
+                                          cable.element_length, swivel.radius):
+            warnings.warn(concern, SwivelStabilityWarning, stacklevel=3)
+        return
 
 
 def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False) -> SpatialResult:
@@ -283,8 +322,11 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     lengths = scene.unstrained_lengths
     start = solve_spatial_statics(platform, lengths)
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start)
+    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start, swivels=scene.swivel_exits)
     mbs.Assemble()
+    if scene.swivels:
+        _warn_outside_measured_region(scene)
+        settle(mbs, items)  # from the catenary shape, the wrap's chords first find their rest (spatial_robot.settle)
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
@@ -350,13 +392,16 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     pose = np.asarray(poses)
     paid_out = np.asarray(paid)
     nodes = [np.asarray(series) for series in node_series]
-    tensions = [np.array([_element_tensions(frame, length, cable.axial_rigidity, n, scene.effects.slack)
+    tensions = [np.array([_element_tensions(frame, lengths[i] if items.has_swivel(i) else length, cable.axial_rigidity,
+                                            n, scene.effects.slack, len(frame) - 1)
                           for frame, length in zip(nodes[i], paid_out[:, i])])
                 for i, cable in enumerate(scene.cables)]
     iterations = mbs.sys["dynamicSolver"].it
     result = SpatialResult(scene.name, controller.name if kinematic else "fixed winches", time_array, pose,
                            np.atleast_2d(scene.trajectory.pose(time_array)), paid_out, nodes, tensions, wall,
                            int(iterations.currentStepIndex), int(iterations.newtonStepsCount))
+    if tension_limits(scene.cables) is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
+        result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     reached = float(time_array[-1])
     if interrupted["interrupted"]:
         result.status, result.failure_time = f"interrupted at t = {reached:.4f} s", reached
@@ -442,6 +487,12 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
                                                           for v in s["min_tension_per_cable_N"]))
         print(f"  simulated / wall time      {s['simulated_time_s']:.2f} s / {s['wall_time_s']:.2f} s "
               f"({s['real_time_factor']:.1f}x real time), {s['steps']} steps, {s['newton_iterations']} Newton iterations")
+        if "tension_limit_violations" in s:
+            count = len(s["tension_limit_violations"])
+            print(f"  tension limits             {f'{count} violation(s)' if count else 'none'}")
+        for v in s.get("tension_limit_violations", []):
+            print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
+                  f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
         for note in s["notes"]:
             print(f"  note: {note}")
         if out is not None:
@@ -461,12 +512,18 @@ _COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_posit
 
 
 def spatial_comparison_table(summaries: dict) -> str:
-    """The spatial comparison as a Markdown table (errors after the summaries' ``after``)."""
-    lines = ["| controller | " + " | ".join(title for _, title, _ in _COLUMNS) + " | vs ideal IK | status |",
-             "|" + "---|" * (len(_COLUMNS) + 3)]
+    """The spatial comparison as a Markdown table (errors after the summaries' ``after``); a scene
+    with tension limits gets a column counting the violations, as the planar table does."""
+    columns = _COLUMNS
+    if any("tension_limit_violations" in s for s in summaries.values()):
+        columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
+        summaries = {name: {**s, "tension_limit_violation_count": len(s.get("tension_limit_violations", []))}
+                     for name, s in summaries.items()}
+    lines = ["| controller | " + " | ".join(title for _, title, _ in columns) + " | vs ideal IK | status |",
+             "|" + "---|" * (len(columns) + 3)]
     base = summaries.get("ideal_ik", {}).get("max_position_error_m")
     for name, s in summaries.items():
-        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in _COLUMNS]
+        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in columns]
         worst = s.get("max_position_error_m")
         ratio = f"{base / worst:.1f}x" if base and worst else ""
         pushed = "; cables pushed" if s.get("elements_pushed") else ""

@@ -2,8 +2,10 @@
 
 A spatial scene says ``dimension = 3`` at its top. Its cables use the planar scenes'
 ``[cable]`` / ``[[cables]]`` tables (material, unstrained length, elements: they do not
-depend on the dimension); each cable leaves the frame at a fixed exit point (a point
-exit; swivel pulleys come later) given in ``[[exits]]``; the platform is a point mass
+depend on the dimension); each cable leaves the frame at an exit given in ``[[exits]]``:
+a fixed exit point (``point = [x, y, z]``, the default ``kind = "point"``) or a swivel
+pulley (``kind = "swivel"``, :class:`SwivelSpec`: its inlet, radius, contact and swivel
+bearing; the winch side runs down its vertical axis); the platform is a point mass
 (every anchor at its centre of mass) or a rigid 6-DOF body. Frame: z up, gravity along
 -z, SI units. Example (the shipped ``spatial-four-cable``)::
 
@@ -30,6 +32,7 @@ message that says so.
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import dataclass, field, replace
 from importlib import resources
@@ -42,9 +45,9 @@ from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.scene import CableSpec, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec, _build, _per_cable, load_scene
-from cdpr_exu.core.validation import non_negative, vector
+from cdpr_exu.core.validation import non_negative, positive, vector
 
-__all__ = ["SpatialPlatformSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
+__all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
            "shipped_spatial_scenes", "is_spatial", "load_any_scene", "any_scene_from_dict", "save_any_scene"]
 
 #: Where the shipped spatial scenes live, inside the package's ``scenes`` folder.
@@ -91,6 +94,91 @@ class SpatialPlatformSpec:
 
 
 @dataclass(frozen=True)
+class SwivelSpec:
+    """A swivel-pulley exit of a spatial scene (``[[exits]]`` with ``kind = "swivel"``).
+
+    The pulley turns about the vertical axis through its inlet; the cable comes up that
+    axis from its winch, wraps over the disc and leaves it towards the anchor
+    (:mod:`cdpr_exu.physics.swivel_pulley`, :mod:`cdpr_exu.physics.spatial_kinematics`).
+    The cable's ``unstrained_length`` counts from the inlet to the anchor, the wrap
+    included: the paid-out length of the ideal kinematics.
+
+    Parameters
+    ----------
+    inlet : (x, y, z) [m]
+        Where the cable leaves the swivel axis onto the disc (the disc's centre is
+        ``radius`` from the axis, at the inlet's height).
+    radius : float [m]
+        Groove-bottom radius r_p of the disc.
+    contact_stiffness : float [N/m]
+        Penalty stiffness k_p of the node-on-disc contact.
+    contact_damping : float [N s/m]
+        Damping on the penetration rate (0: none).
+    swivel_inertia : float [kg m^2]
+        J_s of the turning part about the axis.
+    bearing_damping : float [N m s]
+        Viscous torque d_s psi_dot of the swivel bearing.
+    groove_radius, flange_height : float [m]
+        The groove's sideways curvature radius and the height of its flanks.
+    winch_line : float [m]
+        Unstrained cable between the winch end (held on the axis below the inlet) and
+        the inlet at the start; the winch can pay out at most this much less a
+        margin of two elements during a run.
+    """
+
+    inlet: tuple = (0.0, 0.0, 0.0)
+    radius: float = 0.1
+    contact_stiffness: float = 1.0e6
+    contact_damping: float = 0.0
+    swivel_inertia: float = 1.0e-2
+    bearing_damping: float = 1.0e-3
+    groove_radius: float = 0.01
+    flange_height: float = 0.01
+    winch_line: float = 0.3
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "winch_line", positive("swivel.winch_line", self.winch_line))
+        pulley = self.pulley()  # refuses bad fields, naming them swivel.<field>
+        for name in ("inlet", "radius", "contact_stiffness", "contact_damping", "swivel_inertia", "bearing_damping",
+                     "groove_radius", "flange_height"):
+            object.__setattr__(self, name, getattr(pulley, name))
+
+    def pulley(self):
+        """The physics' :class:`cdpr_exu.physics.swivel_pulley.SwivelPulley` of this exit."""
+        from cdpr_exu.physics.swivel_pulley import SwivelPulley
+
+        return SwivelPulley(inlet=self.inlet, radius=self.radius, groove_radius=self.groove_radius,
+                            flange_height=self.flange_height, contact_stiffness=self.contact_stiffness,
+                            contact_damping=self.contact_damping, swivel_inertia=self.swivel_inertia,
+                            bearing_damping=self.bearing_damping)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``[[exits]]`` table of this exit."""
+        import dataclasses
+
+        data = {"kind": "swivel", **dataclasses.asdict(self)}
+        data["inlet"] = list(self.inlet)
+        return data
+
+
+def _exit_from_dict(entry: Any, index: int):
+    """One ``[[exits]]`` table: a point (3-tuple) or a :class:`SwivelSpec`."""
+    path = f"exits[{index}]"
+    if not isinstance(entry, Mapping):
+        raise SceneError(f"{path} must be a table, got {entry!r}")
+    entry = dict(entry)
+    kind = entry.pop("kind", "point")
+    if kind == "point":
+        if set(entry) != {"point"}:
+            raise SceneError(f"{path}: a point exit has one field 'point' = [x, y, z] (and kind = 'point'), "
+                             f"got {sorted(entry)}")
+        return entry["point"]
+    if kind == "swivel":
+        return _build(SwivelSpec, entry, path)
+    raise SceneError(f"{path}.kind must be 'point' or 'swivel', got {kind!r}")
+
+
+@dataclass(frozen=True)
 class SpatialScene:
     """A spatial cable robot: cables from fixed exit points to a platform, z up, SI units.
 
@@ -100,7 +188,11 @@ class SpatialScene:
     cables : tuple of CableSpec
         Material, unstrained length [m] and elements of each cable (as in planar scenes).
     exits : tuple of (x, y, z) [m]
-        Where each cable leaves the frame (a point exit), world frame.
+        Where each cable leaves the frame, world frame: the exit point of a point exit,
+        the inlet of a swivel pulley.
+    swivels : tuple of (SwivelSpec or None)
+        Each cable's swivel pulley (None: a point exit); empty: point exits only. A
+        swivel's inlet is its cable's exit (give either, or both equal).
     platform : SpatialPlatformSpec
     gravity : float [m/s^2]
         Along -z.
@@ -129,6 +221,7 @@ class SpatialScene:
     description: str = ""
     cables: tuple = ()
     exits: tuple = ()
+    swivels: tuple = ()
     platform: SpatialPlatformSpec = field(default_factory=SpatialPlatformSpec)
     gravity: float = STANDARD_GRAVITY
     effects: Effects = field(default_factory=lambda: Effects.from_preset("full"))
@@ -143,6 +236,7 @@ class SpatialScene:
         if not self.cables or not all(isinstance(c, CableSpec) for c in self.cables):
             raise SceneError(f"cables must be a non-empty list of cable tables, got {self.cables!r}")
         object.__setattr__(self, "cables", tuple(self.cables))
+        self._set_swivels()
         exits = tuple(tuple(float(v) for v in vector(f"exits[{i}].point", e, 3, " (x, y, z) [m]"))
                       for i, e in enumerate(self.exits))
         object.__setattr__(self, "exits", exits)
@@ -159,7 +253,7 @@ class SpatialScene:
                              "(effects.cable_mass and effects.axial_elasticity); use the 'full' or 'catenary' preset")
         first = self.cables[0]
         for i, cable in enumerate(self.cables[1:], start=1):
-            for name in ("n_elements", "radius", "youngs_modulus", "damping_constant"):
+            for name in ("n_elements", "radius", "youngs_modulus", "damping_constant", "mass_lumping"):
                 if getattr(cable, name) != getattr(first, name):
                     raise SceneError(f"cables[{i}].{name} = {getattr(cable, name)!r} differs from cables[0].{name} = "
                                      f"{getattr(first, name)!r}: the cables of a spatial scene share one "
@@ -170,9 +264,49 @@ class SpatialScene:
         if not isinstance(self.solver, SolverSpec) or self.solver.integrator != "generalized_alpha":
             raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
 
+    def _set_swivels(self) -> None:
+        """Normalise ``swivels`` to one entry per cable; a swivel's inlet is its cable's exit."""
+        m = len(self.cables)
+        swivels = tuple(self.swivels) if self.swivels else (None,) * len(self.exits)
+        if len(swivels) != len(self.exits) or not all(s is None or isinstance(s, SwivelSpec) for s in swivels):
+            raise SceneError(f"swivels must give a SwivelSpec or None per exit ({len(self.exits)}), got {self.swivels!r}")
+        exits = list(self.exits)
+        for i, swivel in enumerate(swivels):
+            if swivel is None:
+                continue
+            if exits[i] is None or isinstance(exits[i], SwivelSpec):
+                exits[i] = swivel.inlet
+            elif np.any(np.asarray(exits[i], dtype=float) != np.asarray(swivel.inlet)):
+                raise SceneError(f"exits[{i}].inlet = {list(swivel.inlet)} differs from exits[{i}] = {exits[i]!r}: "
+                                 "a swivel pulley's cable leaves the frame at its inlet")
+            if swivel.radius >= self.cables[min(i, m - 1)].unstrained_length:
+                raise SceneError(f"exits[{i}].radius = {swivel.radius!r} m: the cable (cables[{i}].unstrained_length = "
+                                 f"{self.cables[min(i, m - 1)].unstrained_length!r} m) would not reach past the disc")
+            from cdpr_exu.physics.swivel_pulley import SAFE_ELEMENT_FRACTION
+
+            cable = self.cables[min(i, m - 1)]
+            if cable.element_length > SAFE_ELEMENT_FRACTION * swivel.radius * (1.0 + 1e-9):
+                raise SceneError(
+                    f"cables[{i}].n_elements = {cable.n_elements}: its elements ({cable.element_length:.4g} m) are longer "
+                    f"than {SAFE_ELEMENT_FRACTION:g} of the swivel pulley's radius (exits[{i}].radius = {swivel.radius!r} "
+                    f"m); give at least {math.ceil(cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius))} "
+                    "(measured: coarser chains lose the wrap and gain energy, and Exudyn's static solver fails)")
+        object.__setattr__(self, "exits", tuple(exits))
+        object.__setattr__(self, "swivels", swivels if any(s is not None for s in swivels) else ())
+
     @property
     def n_cables(self) -> int:
         return len(self.cables)
+
+    @property
+    def swivel_exits(self) -> tuple:
+        """Each cable's :class:`SwivelSpec` or None (a point exit), shape (m,)."""
+        return self.swivels if self.swivels else (None,) * len(self.cables)
+
+    @property
+    def pulley_radii(self) -> np.ndarray:
+        """Each exit's pulley radius [m], 0 for a point exit, shape (m,) (the ideal kinematics' ``pulley_radii``)."""
+        return np.array([0.0 if s is None else s.radius for s in self.swivel_exits])
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (TOML-ready) of the scene; :func:`spatial_scene_from_dict` reads it back."""
@@ -181,7 +315,7 @@ class SpatialScene:
         data: dict[str, Any] = {
             "name": self.name, "description": self.description, "dimension": 3, "gravity": self.gravity,
             "cables": [{k: v for k, v in dataclasses.asdict(c).items() if v is not None} for c in self.cables],
-            "exits": [{"point": list(e)} for e in self.exits],
+            "exits": [{"point": list(e)} if s is None else s.to_dict() for e, s in zip(self.exits, self.swivel_exits)],
             "platform": {"mass": self.platform.mass, "inertia": list(self.platform.inertia),
                          "anchors": [list(a) for a in self.platform.anchors]},
             "effects": dataclasses.asdict(self.effects),
@@ -205,8 +339,9 @@ class SpatialScene:
         """The scene as elastic catenaries (:mod:`cdpr_exu.physics.spatial_statics`)."""
         gravity = self.gravity if self.effects.gravity else 0.0
         weighs = self.effects.cable_mass and self.effects.gravity
-        cables = [SpatialCable(e, c.linear_density * gravity if weighs else 0.0, c.axial_rigidity, anchor=a)
-                  for c, e, a in zip(self.cables, self.exits, self.platform.anchors)]
+        cables = [SpatialCable(e, c.linear_density * gravity if weighs else 0.0, c.axial_rigidity, anchor=a,
+                               pulley_radius=r)
+                  for c, e, a, r in zip(self.cables, self.exits, self.platform.anchors, self.pulley_radii)]
         return SpatialPlatform(cables, self.platform.mass, gravity, self.platform.inertia)
 
     def chain_spec(self, anchor_spring_factor: float | None = None, tension_only: bool | None = None):
@@ -223,7 +358,7 @@ class SpatialScene:
             n_elements=cable.n_elements,
             axial_damping_constant=cable.damping_constant * cable.area if self.effects.axial_damping else 0.0,
             flexural_rigidity=cable.youngs_modulus * cable.second_moment if self.effects.bending else 0.0,
-            anchor_spring_factor=anchor_spring_factor)
+            anchor_spring_factor=anchor_spring_factor, mass_lumping=cable.mass_lumping)
 
 
 def is_spatial(scene: Any) -> bool:
@@ -252,8 +387,11 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
             raise SceneError(f"spatial scene lacks {table}: give [[cables]] (one per cable, at least its "
                              "unstrained_length), [[exits]] (each with a point) and [platform] (mass, anchors)")
     exits = data["exits"]
-    if not isinstance(exits, list) or not all(isinstance(e, Mapping) and set(e) == {"point"} for e in exits):
-        raise SceneError(f"exits must be an array of tables, each with one field 'point' = [x, y, z], got {exits!r}")
+    if not isinstance(exits, list):
+        raise SceneError(f"exits must be an array of tables, each a point exit (point = [x, y, z]) or a swivel "
+                         f"pulley (kind = 'swivel', inlet = [x, y, z], radius, ...), got {exits!r}")
+    exits = [_exit_from_dict(e, i) for i, e in enumerate(exits)]
+    swivels = tuple(e if isinstance(e, SwivelSpec) else None for e in exits)
     cables = tuple(_build(CableSpec, c, f"cables[{i}]")
                    for i, c in enumerate(_per_cable(data, "cable", "cables", [])))
     effects_data = data.get("effects", {})
@@ -261,7 +399,8 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
         raise SceneError(f"effects must be a table, got {effects_data!r}")
     effects_data = dict(effects_data)
     effects = Effects.from_preset(effects_data.pop("preset", "full"), **effects_data)
-    kwargs: dict[str, Any] = dict(cables=cables, exits=tuple(e["point"] for e in exits),
+    kwargs: dict[str, Any] = dict(cables=cables, exits=tuple(None if isinstance(e, SwivelSpec) else e for e in exits),
+                                  swivels=swivels if any(swivels) else (),
                                   platform=_build(SpatialPlatformSpec, data["platform"], "platform"), effects=effects,
                                   solver=_build(SolverSpec, data.get("solver", {}), "solver"),
                                   winch=_build(WinchSpec, data.get("winch", {}), "winch"))

@@ -1,0 +1,114 @@
+"""Spatial scenes with swivel-pulley exits (issue 15): scene, catenary statics, Exudyn's static solution, runs."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.run.spatial_rest import solve_spatial_rest
+from cdpr_exu.scenes.spatial_scene import load_any_scene, load_spatial_scene, save_any_scene, spatial_scene_from_dict
+
+NAME = "spatial-four-cable-swivel"
+
+
+def without_bending(scene, n_elements=None):
+    """The scene without bending (the catenary's cable), optionally with another element count."""
+    scene = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False))
+    if n_elements is not None:
+        scene = replace(scene, cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables))
+    return scene
+
+
+def test_the_swivel_scene_loads_and_round_trips_through_toml(tmp_path):
+    scene = load_spatial_scene(NAME)
+    assert len(scene.swivels) == 4 and all(s.radius == 0.1 for s in scene.swivels)
+    assert scene.exits[0] == scene.swivels[0].inlet and scene.pulley_radii.tolist() == [0.1] * 4
+    again = load_any_scene(save_any_scene(scene, tmp_path / "scene.toml"))
+    assert again == scene
+    # a point-exit scene keeps its form: no swivels written or read
+    plain = load_spatial_scene("spatial-four-cable")
+    assert plain.swivels == () and all("kind" not in e for e in plain.to_dict()["exits"])
+
+
+def _with_exit(change):
+    data = load_spatial_scene(NAME).to_dict()
+    change(data["exits"][0])
+    return data
+
+
+@pytest.mark.parametrize("change, field", [
+    (lambda e: e.update(radius=-0.1), r"exits\[0\]\.radius"),
+    (lambda e: e.update(groove_radius=0.2), r"exits\[0\]\.groove_radius"),
+    (lambda e: e.update(contact_stiffness=0.0), r"exits\[0\]\.contact_stiffness"),
+    (lambda e: e.update(swivel_inertia=float("nan")), r"exits\[0\]\.swivel_inertia"),
+    (lambda e: e.update(bearing_damping=-1.0), r"exits\[0\]\.bearing_damping"),
+    (lambda e: e.update(winch_line=0.0), r"exits\[0\]\.winch_line"),
+    (lambda e: e.update(inlet=[1.0, 2.0]), r"exits\[0\]\.inlet"),
+    (lambda e: e.update(kind="capstan"), r"exits\[0\]\.kind"),
+    (lambda e: e.update(sheave=1.0), r"exits\[0\]"),
+    (lambda e: e.update(radius=0.04), r"cables\[0\]\.n_elements"),  # elements longer than half the radius
+])
+def test_bad_swivel_fields_are_refused_naming_the_field(change, field):
+    with pytest.raises(SceneError, match=field):
+        spatial_scene_from_dict(_with_exit(change))
+
+
+def test_the_catenary_statics_over_swivel_pulleys_balance_and_point_each_pulley_at_its_anchor():
+    scene = load_spatial_scene(NAME)
+    equilibrium = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    weight = scene.platform.mass * scene.gravity
+    assert np.abs(equilibrium.net_wrench[:3]).max() < 1e-9 * weight
+    for cable, swivel in zip(equilibrium.cables, scene.swivels):
+        ideal = swivel_pulley_exit(swivel.inlet, swivel.radius, cable.anchor_point)
+        # the suspended part sags (its end at the disc is 5.1 degrees steeper than the chord,
+        # measured), so it leaves the disc further round than a straight cable
+        assert ideal.wrap_angle < cable.wrap_angle < ideal.wrap_angle + 0.1
+        # the tangent point lies on the disc in the vertical plane through the axis and the anchor
+        centre = np.asarray(swivel.inlet) + swivel.radius * cable.horizontal_direction
+        assert np.linalg.norm(cable.exit_point - centre) == pytest.approx(swivel.radius, abs=1e-12)
+        assert np.cross(cable.exit_point - swivel.inlet, cable.anchor_point - swivel.inlet)[2] == pytest.approx(
+            0.0, abs=1e-12)
+
+
+def test_exudyn_s_static_hang_converges_to_the_catenary_statics_as_the_elements_shrink():
+    rests = [solve_spatial_rest(without_bending(load_spatial_scene(NAME), n)) for n in (48, 96)]
+    errors = [np.linalg.norm(r.position - r.catenary.position) for r in rests]
+    # Measured 4.90 / 1.17 / 0.34 mm at 48 / 96 / 192 elements (the chords of the wrap are
+    # shorter than its arc, r_p theta^3 / 24 each, and the nodes sink T l_e / (r_p k_p) into
+    # the groove): about n^-2. The bounds sit 20 % above those numbers.
+    assert errors[0] < 5.9e-3 and errors[1] < 1.4e-3
+    assert errors[0] / errors[1] > 3.0  # second order (4.2 measured)
+    for rest in rests:  # tensions at the anchor: the same order
+        assert rest.tensions_at_anchor == pytest.approx(rest.catenary.tensions_at_anchor, abs=0.5)
+
+
+def test_a_symmetric_robot_over_swivel_pulleys_hangs_symmetric():
+    scene = without_bending(load_spatial_scene(NAME))
+    rest = solve_spatial_rest(scene)
+    # four equal cables from the corners of a square: on the axis, equal tensions, each
+    # pulley turned to its anchor (-135, -45, 45, 135 degrees)
+    assert np.abs(rest.position[:2]).max() < 1e-9
+    assert np.ptp(rest.tensions_at_anchor) < 1e-6 * rest.tensions_at_anchor.max()
+    assert rest.swivel_angles == pytest.approx(np.radians([-135.0, -45.0, 45.0, 135.0]), abs=1e-9)
+    weight = scene.platform.mass * scene.gravity
+    assert rest.forces_on_platform.sum(axis=0) == pytest.approx([0.0, 0.0, weight], abs=1e-8 * weight)
+
+
+def test_spatial_scenes_honour_the_paper_mass_lumping():
+    import exudyn as exu
+
+    from cdpr_exu.builder.spatial_robot import build_spatial_robot
+
+    scene = load_spatial_scene("spatial-four-cable")
+    paper = replace(scene, cables=tuple(replace(c, mass_lumping="paper") for c in scene.cables))
+    for chosen in (scene, paper):
+        mbs = exu.SystemContainer().AddSystem()
+        items = build_spatial_robot(mbs, chosen.catenary_platform(), chosen.unstrained_lengths, chosen.chain_spec())
+        cable = chosen.cables[0]
+        # the planar cable's own lumping (CableSpec.node_masses), exit node first
+        assert items.node_masses[0] == pytest.approx(cable.node_masses(), rel=1e-12)
+    with pytest.raises(SceneError, match=r"cables\[1\]\.mass_lumping"):
+        replace(scene, cables=(scene.cables[0], replace(scene.cables[1], mass_lumping="paper"), *scene.cables[2:]))
