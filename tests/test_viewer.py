@@ -36,10 +36,10 @@ pytestmark = pytest.mark.slow
 def run_dir(tmp_path_factory) -> Path:
     """A run folder of the paper's circle over 0.3 s, written as `cdpr run --out` writes it.
 
-    The paper's spring elements: Exudyn writes the solution file at the ends of its
-    steps, and with tension-only elements the start-up's snap-taut steps are shrunk, so
-    its rows then fall between the output times (the result itself is interpolated onto
-    them, see cdpr_exu.run.simulate._Recorder). Row-for-row equality needs unshrunk steps.
+    The paper's spring elements: with tension-only elements the start-up's snap-taut
+    steps are shrunk, and the solution file's rows and the result's samples then lie up
+    to a step after the output times (each the end of a real step, see
+    cdpr_exu.run.simulate._Recorder). The row-for-row checks here need unshrunk steps.
     """
     from cdpr_exu.scenes.scene import Effects
 

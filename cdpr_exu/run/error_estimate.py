@@ -141,9 +141,13 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     except (SolverFailure, CdprError) as err:
         return _not_applicable(f"the companion run at {n_companion} elements did not complete: {str(err)[:200]}")
     wall = time.perf_counter() - start
-    if companion.time.shape != result.time.shape:
-        return _not_applicable("the companion run was sampled at other times")
-    difference = np.linalg.norm(result.platform_pose[mask, :2] - companion.platform_pose[mask, :2], axis=1).max()
+    # Both runs sample at the output times, or up to a step after them where a step was
+    # shrunk: the companion's path is interpolated onto this run's sample times.
+    times = result.time[mask]
+    if companion.time[-1] < times[-1] - 1e-9:
+        return _not_applicable("the companion run ended before this run")
+    companion_path = np.column_stack([np.interp(times, companion.time, companion.platform_pose[:, k]) for k in (0, 1)])
+    difference = np.linalg.norm(result.platform_pose[mask, :2] - companion_path, axis=1).max()
     ratio = n_companion / n
     estimate = float(difference * richardson_factor(ratio))
     note = (f"Richardson from a companion run at {n_companion} elements per cable (this run: {n}), the error "

@@ -128,7 +128,7 @@ class Configuration:
 
 def model_name(preset: str, overrides: Sequence[tuple[str, Any]] = ()) -> str:
     """Readable name of a preset with overrides (``full, linear bending``, ``full, segment contact``,
-    ``full, slack=true``)."""
+    ``full, slack=false``)."""
     parts = [preset]
     for path, value in overrides:
         key = path.split(".")[-1]
@@ -201,7 +201,7 @@ LADDER = (("ideal", ()), ("elastic", ()), ("catenary", ()), ("full", ()), ("full
 EFFECT_VARIANTS = (
     (("effects.bending_damping", False),),
     (("effects.bending_model", "linear"), ("effects.bending_damping", False)),
-    (("effects.slack", True),),
+    (("effects.slack", False),),  # the paper's spring elements, which push
     (("cables.mass_lumping", "paper"),),
     (("effects.pulley_contact_model", "segment"),),
 )
