@@ -37,6 +37,41 @@ def test_a_robot_told_to_hold_its_equilibrium_stays_there():
     # error (6.6e-5 m measured for this robot, tests/test_spatial_robot.py); it settles there.
     assert np.abs(result.position_error).max() < 1.5e-4
     assert np.ptp(result.paid_out, axis=0).max() < 1e-12  # the winches did not move (round-off of the IK)
+    # every cable taut after the first sample (at t = 0 two elements of the catenary start
+    # sit at their rest length to round-off): lowest tension positive, no time slack
+    summary = result.summary(after=result.time[1])
+    assert min(summary["min_tension_per_cable_N"]) > 0.0
+    assert summary["slack_time_per_cable_s"] == [0.0] * 4
+
+
+def test_a_spatial_run_reports_how_long_each_cable_was_slack():
+    """Pay one cable out by 10 % in 0.2 s and hold: that cable goes slack, and the summary's
+    slack time is the recorded time during which one of its elements carried nothing."""
+    scene = four_cable(end_time=0.6)
+    pose = start_pose(scene)
+    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(pose)))
+    from controllers.base import WinchCommand
+
+    class PayOut:
+        name, uses_pose, uses_tension = "pay_out", False, False
+
+        def reset(self, scene_, initial):
+            self.initial = np.asarray(initial, dtype=float)
+
+        def command(self, measurement):
+            s = min(measurement.time / 0.2, 1.0)
+            lengths = self.initial.copy()
+            lengths[0] *= 1.0 + 0.1 * s
+            rates = np.zeros_like(lengths)
+            rates[0] = 0.1 * self.initial[0] / 0.2 if s < 1.0 else 0.0
+            return WinchCommand(lengths, rates)
+
+    result = simulate_spatial(scene, PayOut())
+    summary = result.summary(after=0.0)
+    slack = summary["slack_time_per_cable_s"]
+    widths = np.diff(result.time, append=result.time[-1])
+    assert slack[0] == pytest.approx(widths[np.any(result.tensions[0] <= 0.0, axis=1)].sum(), rel=1e-12)
+    assert slack[0] > 0.1  # 10 % more cable than the pose needs hangs slack for most of the run
 
 
 def ipanema(n_elements=10, **solver):

@@ -149,13 +149,8 @@ class Result:
                                     self.metadata.get("tension_limits_N"))
 
     def _slack_time(self, tensions: np.ndarray, mask: np.ndarray) -> float | None:
-        """Time [s] during which some element of a cable carries no tension (slack, or pushing)."""
-        times = self.time[mask]
-        if len(times) < 2:
-            return None
-        slack = np.any(tensions[mask] <= 0.0, axis=1)
-        widths = np.diff(times, append=times[-1])  # each sample stands for the interval after it
-        return float(np.sum(widths[slack]))
+        """Time [s] during which some element of a cable carries no tension (:func:`slack_time`)."""
+        return slack_time(self.time[mask], tensions[mask])
 
     # ----------------------------------------------------------------- files
     def save(self, folder: str | Path, summary_after: float = 0.0) -> dict[str, Path]:
@@ -232,6 +227,20 @@ def provenance() -> dict[str, Any]:
         "python": _platform.python_version(),
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
     }
+
+
+def slack_time(times: np.ndarray, tensions: np.ndarray) -> float | None:
+    """Time [s] during which some element of a cable carries no tension (slack, or pushing).
+
+    ``times`` shape (N,) [s]; ``tensions`` shape (N, n) [N], the cable's element tensions
+    at those times. Each sample stands for the interval after it. None with fewer than
+    two samples.
+    """
+    if len(times) < 2:
+        return None
+    slack = np.any(np.asarray(tensions).reshape(len(times), -1) <= 0.0, axis=1)
+    widths = np.diff(times, append=times[-1])
+    return float(np.sum(widths[slack]))
 
 
 def tension_limit_report(times: np.ndarray, tensions, limits) -> dict[str, Any]:

@@ -47,7 +47,7 @@ from controllers.base import Controller, Measurement
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.results.result import provenance, tension_limit_report
+from cdpr_exu.results.result import provenance, slack_time, tension_limit_report
 from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, quiet_exudyn, solver_settings
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
@@ -195,6 +195,7 @@ class SpatialResult:
             "min_element_tension_N": extreme(tensions, np.min),
             "max_element_tension_N": extreme(tensions, np.max),
             "min_tension_per_cable_N": [extreme(t[mask].ravel(), np.min) for t in self.tensions],
+            "slack_time_per_cable_s": [slack_time(self.time[mask], t[mask]) for t in self.tensions],
             "elements_pushed": pushed,
             "wall_time_s": self.wall_time, "simulated_time_s": simulated,
             "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
