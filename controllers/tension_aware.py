@@ -224,19 +224,34 @@ class TensionAwareController:
 
 
 class ClosedLoopTensionAwareController(TensionAwareController):
-    """Tension-aware feed-forward plus PI feedback on the measured platform position.
+    """Tension-aware feed-forward plus PI feedback on the low-pass filtered platform position error.
 
-    The position error e = r_ref - r (x, z) is turned into length corrections with the
+    The position error e = r_ref - r (x, z) passes a second-order low-pass filter
+    (Butterworth, cut-off ``cutoff`` [Hz]) and is turned into length corrections with the
     ideal inverse-kinematics Jacobian U (rows: unit vectors from each pulley's tangent
     point to its anchor): a length change U d moves the platform by about d. The
-    correction is dlambda = U (k_p e + k_i integral(e) dt), with the integral
-    running from the end of the start-up blend. (Velocity feedback was tried and
-    dropped: it feeds the start-up jolt into the winch command and the run diverges.)
+    correction is dlambda = U (k_p e_f + k_i integral(e_f) dt), e_f the filtered error,
+    with the integral and the feedback fading in over ``start_time``.
+
+    Why the filter: with tension-only cables, the unfiltered loop (k_p = 2) passed the
+    platform's jolts straight into the winch command (command accelerations up to
+    1300 m/s^2 measured, against 5 m/s^2 open loop); a winch element that then went
+    slack snapped taut and the run diverged (0.9 s into paper-circle-mismatch). The filter
+    keeps the command smooth above a few hertz, where the measured position response
+    has no usable phase. (Velocity feedback was tried and dropped: it feeds the
+    start-up jolt into the winch command and the run diverges.)
+
+    The filter and the integral are integrated from one call to the next; a call at or
+    before an earlier one (the solver retrying a step with a smaller size) restarts from
+    the state the controller had at the last earlier time, so a retried step is not
+    counted twice.
 
     Parameters
     ----------
     proportional_gain : float [-]
     integral_gain : float [1/s]
+    cutoff : float [Hz]
+        Cut-off frequency of the error filter (> 0).
     start_time : float [s]
         The feedback (and its integral) fades in over this time from t = 0.
     dynamic, table_period, ...
@@ -245,12 +260,18 @@ class ClosedLoopTensionAwareController(TensionAwareController):
 
     uses_pose = True
 
+    #: Damping ratio of the second-order error filter (Butterworth).
+    FILTER_DAMPING = np.sqrt(0.5)
+
     def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, start_time: float = 0.5,
-                 **kwargs):
+                 cutoff: float = 5.0, **kwargs):
         super().__init__(**kwargs)
         if not np.isfinite(start_time) or start_time < 0:
             raise SceneError(f"start_time must be zero or positive, got {start_time!r}")
+        if not np.isfinite(cutoff) or cutoff <= 0:
+            raise SceneError(f"cutoff must be positive [Hz], got {cutoff!r}")
         self.start_time = float(start_time)
+        self.cutoff = float(cutoff)
         for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
             if not np.isfinite(value) or value < 0:
                 raise SceneError(f"{name} must be zero or positive, got {value!r}")
@@ -261,8 +282,13 @@ class ClosedLoopTensionAwareController(TensionAwareController):
     def reset(self, scene, initial_paid_out) -> None:
         super().reset(scene, initial_paid_out)
         self._scene = scene
-        self._integral = np.zeros(2)
-        self._last_time = 0.0
+        # (time, filtered error, its rate, integral of the filtered error): one entry per call.
+        self._history = [(0.0, np.zeros(2), np.zeros(2), np.zeros(2))]
+
+    @property
+    def _integral(self) -> np.ndarray:
+        """Integral of the filtered position error at the last call [m s], shape (2,)."""
+        return self._history[-1][3]
 
     def _jacobian(self, pose: np.ndarray) -> np.ndarray:
         """d(lambda)/d(position) of the ideal cables at ``pose``, shape (m, 2).
@@ -274,23 +300,40 @@ class ClosedLoopTensionAwareController(TensionAwareController):
         anchors = np.asarray(scene.platform.anchors)
         return -cable_unit_vectors(pose, anchors, *pulley_arrays(scene.exits))
 
+    def _advance(self, time: float, error: np.ndarray, weight: float):
+        """The filter and integral state at ``time`` [s] from the last earlier call, and stored."""
+        history = self._history
+        while len(history) > 1 and history[-1][0] >= time:
+            history.pop()  # a retried step: start again from the last earlier state
+        last, filtered, rate, integral = history[-1]
+        dt = time - last
+        if dt <= 0:
+            return filtered, integral
+        omega = 2.0 * np.pi * self.cutoff
+        # Semi-implicit Euler on e_f'' = omega^2 (e - e_f) - 2 zeta omega e_f', substeps of 0.2 / omega.
+        substeps = max(1, int(np.ceil(dt * omega / 0.2)))
+        h = dt / substeps
+        filtered, rate = filtered.copy(), rate.copy()
+        for _ in range(substeps):
+            rate += h * (omega**2 * (error - filtered) - 2.0 * self.FILTER_DAMPING * omega * rate)
+            filtered += h * rate
+        integral = integral + filtered * dt * weight
+        history.append((time, filtered, rate, integral))
+        if len(history) > 64:  # retries reach back one step: a short history is enough
+            del history[:-16]
+        return filtered, integral
+
     def command(self, measurement: Measurement) -> WinchCommand:
         if measurement.platform_pose is None:
             raise SceneError(f"{self.name} needs the measured platform pose")
         lengths, rates = self.feed_forward(measurement.time)
         reference = self._scene.trajectory.pose(measurement.time)
         error = reference[:2] - measurement.platform_pose[:2]
-        dt = max(measurement.time - self._last_time, 0.0)
-        self._last_time = measurement.time
-        # The integral fades in with the start-up blend (weight 0 at t = 0, 1 from start_time on):
-        # switched on at once, its rate k_i e jumps the winch speed by metres per second and the
-        # axially over-damped winch element pushes (-62 N measured at the switch).
-        weight = _smoothstep(np.array(measurement.time / self.start_time)) if self.start_time > 0 else 1.0
-        self._integral += error * dt * weight
-        feedback = self.proportional_gain * error + self.integral_gain * self._integral
-        # Fade the feedback in with the start-up blend: a jump of the command in one
-        # step would jolt the axially over-damped cables.
-        if self.start_time > 0:
-            feedback = feedback * _smoothstep(np.array(measurement.time / self.start_time))
+        # The integral and the feedback fade in with the start-up blend (weight 0 at t = 0,
+        # 1 from start_time on): switched on at once, the winch speed jumps and the axially
+        # over-damped winch element pushes (-62 N measured at the switch with spring cables).
+        weight = float(_smoothstep(np.array(measurement.time / self.start_time))) if self.start_time > 0 else 1.0
+        filtered, integral = self._advance(measurement.time, error, weight)
+        feedback = weight * (self.proportional_gain * filtered + self.integral_gain * integral)
         correction = self._jacobian(reference) @ feedback
         return WinchCommand(lengths + correction, rates)

@@ -119,15 +119,19 @@ def test_a_reference_the_cables_cannot_reach_is_refused_before_the_run():
 
 
 @pytest.mark.slow
-def test_closed_loop_tension_aware_control_cuts_the_paper_circle_error_more_than_fivefold():
-    from cdpr_exu.studies.comparison import compare_controllers
+def test_closed_loop_tension_aware_control_cuts_the_paper_circle_error_more_than_fourfold():
+    from cdpr_exu.studies.comparison import compare_controllers, smooth_start
 
-    summaries = compare_controllers(PAPER, ["ideal_ik", "closed_loop_tension_aware"])
+    # As cdpr compare runs it: tension-only cables, the circle started over 1 s.
+    summaries = compare_controllers(smooth_start(PAPER), ["ideal_ik", "closed_loop_tension_aware"])
     ideal = summaries["ideal_ik"]["max_position_error_m"]
     closed = summaries["closed_loop_tension_aware"]["max_position_error_m"]
-    assert 0.05 < ideal < 0.10  # the open-loop drift this model shows (72 mm)
-    # Measured 9.3x; asserting 6x leaves margin for step-size and platform changes.
-    assert ideal / closed > 6.0
+    assert summaries["closed_loop_tension_aware"]["status"] == "completed"
+    assert 0.05 < ideal < 0.10  # the open-loop drift this model shows (71.9 mm)
+    # Measured 14.1 mm, 5.1x (the unfiltered loop diverged here at 1.1 s); 4x leaves
+    # margin for step-size and platform changes. What is left is where a winch element
+    # goes slack while it pays out (see ClosedLoopTensionAwareController).
+    assert ideal / closed > 4.0
 
 
 @pytest.mark.slow
@@ -171,17 +175,60 @@ def test_comparison_writes_its_table_and_summary(tmp_path):
     assert (tmp_path / "comparison_paths.png").stat().st_size > 0
 
 
-def test_the_closed_loop_switches_on_without_pushing_its_cables():
-    """The integral fades in with the start-up blend: at the switch-on (0.5 s) the winch
-    element no longer pushes (-62 N before; +14 N measured as the lowest tension of any
-    element from 0.45 to 0.6 s)."""
+def test_the_closed_loop_switches_on_without_slackening_its_cables():
+    """The feedback fades in with the start-up blend: around the switch-on (0.5 s) every
+    element of both tension-only cables keeps pulling (9.8 N measured as the lowest
+    tension from 0.45 to 0.6 s; -62 N, pushing, with the spring cables and the jump)."""
     from cdpr_exu.run.simulate import simulate
+    from cdpr_exu.studies.comparison import smooth_start
 
-    paper = load_scene("paper-circle")
+    paper = smooth_start(load_scene("paper-circle"))
     scene = paper.with_changes(solver=replace(paper.solver, end_time=0.7))
     result = simulate(scene, ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True))
     near = (result.time > 0.45) & (result.time < 0.6)
-    assert min(t[near].min() for t in result.tensions) > 0.0
+    assert min(t[near].min() for t in result.tensions) > 5.0
+
+
+def test_the_closed_loop_keeps_the_winch_commands_smooth_where_the_unfiltered_loop_diverged():
+    """On the mismatch plant the unfiltered PI loop (k_p = 2, k_i = 40 / s) passed the
+    platform's jolts into the winches (commanded accelerations up to 2100 m/s^2) until a
+    slack winch element snapped taut and the solver failed at 1.21 s. The filtered loop
+    runs through, with commands as smooth as the reference's (3.2 and 6.7 m/s^2 measured
+    on the 10 ms output grid; the circle itself needs about 1 m/s^2)."""
+    from cdpr_exu.run.simulate import simulate
+
+    scene = SMOOTH.with_changes(solver=replace(SMOOTH.solver, end_time=1.6))
+    result = simulate(scene, ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True))
+    assert result.status == "completed"
+    acceleration = np.diff(result.paid_out, 2, axis=0) / np.diff(result.time)[1:, None] ** 2
+    assert np.abs(acceleration).max() < 20.0  # m/s^2: a hundred times below the unfiltered loop's
+    assert np.abs(result.error[:, :2]).max() < 0.01  # tracking within 1 cm (4.1 mm measured)
+
+
+def test_the_closed_loop_filter_does_not_pass_a_jolt_straight_to_the_winches():
+    """A 1 cm jump of the measured position moves the command, one 2 ms step later, by
+    the filter's response only: (omega h)^2 ~ 0.4 % of what the proportional gain alone
+    would give; and a retried step (a call at an earlier time) restarts from the state at
+    that time, so it gives the same command as the first try."""
+    scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=2.0))
+    controller = ClosedLoopTensionAwareController(start_time=0.0)
+    controller.reset(scene, np.array([3.08, 3.08]))
+    m = scene.n_cables
+
+    def command(t, offset):
+        pose = scene.trajectory.pose(t) + np.array([offset, 0.0, 0.0])
+        return controller.command(Measurement(t, np.zeros(m), np.zeros(m), pose, np.zeros(3))).paid_out
+
+    times = np.arange(0.0, 1.0, 2e-3)
+    for t in times:
+        on_track = command(t, 0.0)
+    jolted = command(1.0, 0.01)
+    again = command(1.0, 0.01)  # the same step, retried
+    feed_forward = controller.feed_forward(1.0)[0]
+    unfiltered = np.abs(controller._jacobian(scene.trajectory.pose(1.0)) @ np.array([0.02, 0.0])).max()
+    assert np.abs(jolted - feed_forward).max() < 0.01 * unfiltered
+    np.testing.assert_array_equal(jolted, again)
+    np.testing.assert_allclose(on_track, controller.feed_forward(times[-1])[0], atol=1e-12)
 
 
 # ----------------------------------------------------------------------------- smooth start
