@@ -108,7 +108,7 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
     try:
         for name in names:
             if name in LEARNING_CONTROLLERS:
-                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, progress=not quiet)
+                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, progress=not quiet, plant=scene)
             else:
                 controller = CONTROLLERS[name]()
             try:

@@ -340,16 +340,27 @@ class Learner:
     """
 
     def __init__(self, on_model: bool, law: LearningLaw = DEFAULT_LAW, rule: StoppingRule = DEFAULT_RULE, *,
-                 after: float = 1.0, progress: bool = False):
+                 after: float = 1.0, progress: bool = False, plant: Scene | None = None):
         if not isinstance(law, LearningLaw):
             raise SceneError(f"law must be a LearningLaw, got {law!r}")
         if not isinstance(rule, StoppingRule):
             raise SceneError(f"rule must be a StoppingRule, got {rule!r}")
         self.on_model, self.law, self.rule, self.after, self.progress = bool(on_model), law, rule, after, progress
+        self.plant = plant
         self.learning: LearningRun | None = None
 
     def __call__(self, scene: Scene, initial_paid_out: np.ndarray) -> CommandTable:  # noqa: ARG002 - same start
-        target = controller_model(scene) if self.on_model else scene
+        """Learn the commands; ``scene`` is what the run hands its controllers (the controllers'
+        model, :meth:`Scene.controller_scene`), so learning on the robot itself needs ``plant``."""
+        if self.on_model:
+            target = controller_model(self.plant if self.plant is not None else scene)
+        elif self.plant is not None:
+            target = self.plant
+        elif scene.controller_model is None:
+            target = scene
+        else:
+            raise SceneError("iterative learning on the robot needs the plant (Learner(plant=...)): "
+                             "the run hands the controller only the controllers' model")
         if self.progress:
             where = "the controller's model of " if self.on_model else ""
             print(f"  learning on {where}{scene.name} (at most {self.rule.max_trials} trials)", flush=True)
@@ -360,14 +371,16 @@ class Learner:
 
 
 def ilc_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *, after: float = 1.0,
-                   progress: bool = False) -> LearnedController:
-    """``ilc`` for ``cdpr compare``: trials on the compared scene (the plant), then a run that replays
-    the best trial's commands."""
-    return LearnedController("ilc", Learner(False, law, rule, after=after, progress=progress))
+                   progress: bool = False, plant: Scene | None = None) -> LearnedController:
+    """``ilc`` for ``cdpr compare``: trials on ``plant`` (the compared scene), then a run that
+    replays the best trial's commands."""
+    return LearnedController("ilc", Learner(False, law, rule, after=after, progress=progress, plant=plant))
 
 
 def model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
-                                  after: float = 1.0, progress: bool = False) -> LearnedController:
+                                  after: float = 1.0, progress: bool = False,
+                                  plant: Scene | None = None) -> LearnedController:
     """``model_feed_forward`` for ``cdpr compare``: trials on :func:`controller_model` of the compared
     scene, then the plant runs open loop with the best trial's commands."""
-    return LearnedController("model_feed_forward", Learner(True, law, rule, after=after, progress=progress))
+    return LearnedController("model_feed_forward", Learner(True, law, rule, after=after, progress=progress,
+                                                           plant=plant))
