@@ -43,6 +43,9 @@ class Measurement:
     platform_velocity : ndarray, shape (3,) or None [m/s, m/s, rad/s]
     cable_tensions : ndarray, shape (m,) or None [N]
         Tension at the platform end of each cable, only for ``uses_tension``.
+    state_time : float or None [s]
+        The time the pose, velocity and tensions were measured at: the start of the step
+        being solved (the state the solver has), one step before ``time``. None: ``time``.
     """
 
     time: float
@@ -51,6 +54,7 @@ class Measurement:
     platform_pose: np.ndarray | None = None
     platform_velocity: np.ndarray | None = None
     cable_tensions: np.ndarray | None = None
+    state_time: float | None = None
 
 
 @dataclass(frozen=True)

@@ -104,10 +104,15 @@ class CommandTable:
         Increasing, from 0.
     changes : ndarray, shape (N, m) [m]
         Paid-out length of each winch minus what it paid out at t = 0 (zero in the first row).
+    expected_positions : ndarray, shape (N, 2), or None [m]
+        The platform position (x, z) these commands gave where they were learned (the
+        controller's model, for model-based feed-forward), if known: what a feedback
+        around them should expect of a plant that matches the model.
     """
 
     times: np.ndarray
     changes: np.ndarray
+    expected_positions: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         times = np.asarray(self.times, dtype=float)
@@ -118,10 +123,19 @@ class CommandTable:
             raise SceneError(f"changes must be finite, shape ({len(times)}, m), got shape {changes.shape}")
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "changes", changes)
+        if self.expected_positions is not None:
+            expected = np.asarray(self.expected_positions, dtype=float)
+            if expected.shape != (len(times), 2) or not np.all(np.isfinite(expected)):
+                raise SceneError(f"expected_positions must be finite, shape ({len(times)}, 2), "
+                                 f"got shape {expected.shape}")
+            object.__setattr__(self, "expected_positions", expected)
 
     def to_dict(self) -> dict:
         """Plain-data form (JSON-ready)."""
-        return {"times_s": self.times.tolist(), "changes_m": self.changes.tolist()}
+        data = {"times_s": self.times.tolist(), "changes_m": self.changes.tolist()}
+        if self.expected_positions is not None:
+            data["expected_positions_m"] = self.expected_positions.tolist()
+        return data
 
 
 class ReplayController:
@@ -154,6 +168,15 @@ class ReplayController:
                              f"{scene.solver.end_time:g} s")
         self._spline = CubicSpline(self.table.times, initial + self.table.changes, axis=0)
         self._rate = self._spline.derivative()
+        expected = self.table.expected_positions
+        self._expected = None if expected is None else CubicSpline(self.table.times, expected, axis=0)
+
+    def expected_position(self, time: float) -> np.ndarray | None:
+        """The platform position (x, z) [m] the table's commands gave where they were learned, at
+        ``time`` [s]; None if the table does not say."""
+        if self._spline is None:
+            raise RuntimeError(f"{type(self).__name__}.reset(scene, initial_paid_out) must be called first")
+        return None if self._expected is None else np.asarray(self._expected(time))
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if self._spline is None:

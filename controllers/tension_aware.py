@@ -26,7 +26,8 @@ Options:
   As for ``chordal_correction``, what it adds over the catenary is the simulator's
   discretisation;
 * :class:`ClosedLoopTensionAwareController` adds a PI correction from the measured
-  platform position, mapped onto the cables by the ideal inverse-kinematics Jacobian.
+  platform position, mapped onto the cables by the ideal inverse-kinematics Jacobian
+  (:class:`controllers.feedback.FilteredPositionPI`).
 
 The commands are tabulated once per run on a coarse time grid and interpolated with a
 cubic spline, so they and their rates are continuous. The cables start straight (the
@@ -45,9 +46,10 @@ from scipy.interpolate import CubicSpline
 from cdpr_exu.statics import chain_statics
 from cdpr_exu.statics import statics
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.statics.kinematics import anchor_points, cable_unit_vectors, initial_cable_nodes, pulley_arrays
+from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes
 
 from .base import Measurement, WinchCommand
+from .feedback import FilteredPositionPI
 from .ideal_ik import ideal_paid_out
 
 
@@ -90,12 +92,6 @@ def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
 #: catenaries, :mod:`cdpr_exu.statics.statics`) or "chain" (the simulator's own lumped chains,
 #: :mod:`cdpr_exu.statics.chain_statics`).
 STATICS_MODELS = ("catenary", "chain")
-
-
-def _smoothstep(s: np.ndarray) -> np.ndarray:
-    """Quintic ramp from 0 to 1 on s in [0, 1] with zero first and second derivatives."""
-    s = np.clip(s, 0.0, 1.0)
-    return s**3 * (10.0 - 15.0 * s + 6.0 * s**2)
 
 
 class TensionAwareController:
@@ -226,25 +222,11 @@ class TensionAwareController:
 class ClosedLoopTensionAwareController(TensionAwareController):
     """Tension-aware feed-forward plus PI feedback on the low-pass filtered platform position error.
 
-    The position error e = r_ref - r (x, z) passes a second-order low-pass filter
-    (Butterworth, cut-off ``cutoff`` [Hz]) and is turned into length corrections with the
-    ideal inverse-kinematics Jacobian U (rows: unit vectors from each pulley's tangent
-    point to its anchor): a length change U d moves the platform by about d. The
-    correction is dlambda = U (k_p e_f + k_i integral(e_f) dt), e_f the filtered error,
-    with the integral and the feedback fading in over ``start_time``.
-
-    Why the filter: with tension-only cables, the unfiltered loop (k_p = 2) passed the
-    platform's jolts straight into the winch command (command accelerations up to
-    1300 m/s^2 measured, against 5 m/s^2 open loop); a winch element that then went
-    slack snapped taut and the run diverged (0.9 s into paper-circle-mismatch). The filter
-    keeps the command smooth above a few hertz, where the measured position response
-    has no usable phase. (Velocity feedback was tried and dropped: it feeds the
-    start-up jolt into the winch command and the run diverges.)
-
-    The filter and the integral are integrated from one call to the next; a call at or
-    before an earlier one (the solver retrying a step with a smaller size) restarts from
-    the state the controller had at the last earlier time, so a retried step is not
-    counted twice.
+    The feedback is :class:`controllers.feedback.FilteredPositionPI` (see there why the
+    error is filtered and how a retried step is handled): the position error e = r_ref - r
+    (x, z), filtered by a second-order Butterworth low-pass (cut-off ``cutoff`` [Hz]),
+    turned into length corrections dlambda = U (k_p e_f + k_i integral(e_f) dt) with the
+    ideal inverse-kinematics Jacobian U, fading in over ``start_time``.
 
     Parameters
     ----------
@@ -261,79 +243,34 @@ class ClosedLoopTensionAwareController(TensionAwareController):
     uses_pose = True
 
     #: Damping ratio of the second-order error filter (Butterworth).
-    FILTER_DAMPING = np.sqrt(0.5)
+    FILTER_DAMPING = FilteredPositionPI.FILTER_DAMPING
 
     def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, start_time: float = 0.5,
                  cutoff: float = 5.0, **kwargs):
         super().__init__(**kwargs)
-        if not np.isfinite(start_time) or start_time < 0:
-            raise SceneError(f"start_time must be zero or positive, got {start_time!r}")
-        if not np.isfinite(cutoff) or cutoff <= 0:
-            raise SceneError(f"cutoff must be positive [Hz], got {cutoff!r}")
-        self.start_time = float(start_time)
-        self.cutoff = float(cutoff)
-        for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
-            if not np.isfinite(value) or value < 0:
-                raise SceneError(f"{name} must be zero or positive, got {value!r}")
-        self.proportional_gain = float(proportional_gain)
-        self.integral_gain = float(integral_gain)
+        self.feedback = FilteredPositionPI(proportional_gain, integral_gain, cutoff, start_time)
+        self.start_time = self.feedback.start_time
+        self.cutoff = self.feedback.cutoff
+        self.proportional_gain = self.feedback.proportional_gain
+        self.integral_gain = self.feedback.integral_gain
         self.name = ("closed_loop_" + self.name)
 
     def reset(self, scene, initial_paid_out) -> None:
         super().reset(scene, initial_paid_out)
         self._scene = scene
-        # (time, filtered error, its rate, integral of the filtered error): one entry per call.
-        self._history = [(0.0, np.zeros(2), np.zeros(2), np.zeros(2))]
+        self.feedback.reset(scene)
 
     @property
     def _integral(self) -> np.ndarray:
         """Integral of the filtered position error at the last call [m s], shape (2,)."""
-        return self._history[-1][3]
+        return self.feedback.integral
 
     def _jacobian(self, pose: np.ndarray) -> np.ndarray:
-        """d(lambda)/d(position) of the ideal cables at ``pose``, shape (m, 2).
-
-        Moving an anchor by d changes the ideal length by u . d, u the unit vector
-        from the cable's exit point to the anchor (with the rotation held).
-        """
-        scene = self._scene
-        anchors = np.asarray(scene.platform.anchors)
-        return -cable_unit_vectors(pose, anchors, *pulley_arrays(scene.exits))
-
-    def _advance(self, time: float, error: np.ndarray, weight: float):
-        """The filter and integral state at ``time`` [s] from the last earlier call, and stored."""
-        history = self._history
-        while len(history) > 1 and history[-1][0] >= time:
-            history.pop()  # a retried step: start again from the last earlier state
-        last, filtered, rate, integral = history[-1]
-        dt = time - last
-        if dt <= 0:
-            return filtered, integral
-        omega = 2.0 * np.pi * self.cutoff
-        # Semi-implicit Euler on e_f'' = omega^2 (e - e_f) - 2 zeta omega e_f', substeps of 0.2 / omega.
-        substeps = max(1, int(np.ceil(dt * omega / 0.2)))
-        h = dt / substeps
-        filtered, rate = filtered.copy(), rate.copy()
-        for _ in range(substeps):
-            rate += h * (omega**2 * (error - filtered) - 2.0 * self.FILTER_DAMPING * omega * rate)
-            filtered += h * rate
-        integral = integral + filtered * dt * weight
-        history.append((time, filtered, rate, integral))
-        if len(history) > 64:  # retries reach back one step: a short history is enough
-            del history[:-16]
-        return filtered, integral
+        """d(lambda)/d(position) of the ideal cables at ``pose``, shape (m, 2) (:meth:`FilteredPositionPI.jacobian`)."""
+        return self.feedback.jacobian(pose)
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if measurement.platform_pose is None:
             raise SceneError(f"{self.name} needs the measured platform pose")
         lengths, rates = self.feed_forward(measurement.time)
-        reference = self._scene.trajectory.pose(measurement.time)
-        error = reference[:2] - measurement.platform_pose[:2]
-        # The integral and the feedback fade in with the start-up blend (weight 0 at t = 0,
-        # 1 from start_time on): switched on at once, the winch speed jumps and the axially
-        # over-damped winch element pushes (-62 N measured at the switch with spring cables).
-        weight = float(_smoothstep(np.array(measurement.time / self.start_time))) if self.start_time > 0 else 1.0
-        filtered, integral = self._advance(measurement.time, error, weight)
-        feedback = weight * (self.proportional_gain * filtered + self.integral_gain * integral)
-        correction = self._jacobian(reference) @ feedback
-        return WinchCommand(lengths + correction, rates)
+        return WinchCommand(lengths + self.feedback.correction(measurement), rates)

@@ -257,3 +257,31 @@ def test_newton_tolerance_reaches_exudyn_and_moves_the_paper_path_by_less_than_a
                                       for k in (0, 1)])
         assert np.abs(default.platform_pose[:, :2] - tight_path).max() < bound, preset
         assert default.newton_iterations < reference.newton_iterations
+
+
+def test_a_controller_is_told_the_time_of_the_pose_it_measures():
+    """The solver asks for the command at the end of the step it is about to solve, with its
+    state still at the step's start: ``state_time`` is that start, and the pose handed over
+    is exactly the pose recorded there (the platform moves about 1 mm per 2 ms step here)."""
+    scene = load_scene("paper-circle-mismatch")
+    scene = scene.with_changes(solver=dataclasses.replace(scene.solver, end_time=0.3))
+    seen = []
+
+    class Watcher(IdealIKController):
+        uses_pose = True
+
+        def command(self, measurement):
+            if measurement.state_time is not None:
+                seen.append((measurement.time, measurement.state_time, *measurement.platform_pose))
+            return super().command(measurement)
+
+    result = simulate(scene, Watcher())
+    seen = np.array(seen)
+    assert np.all(seen[:, 1] < seen[:, 0])  # measured before the command's time
+    checked = 0
+    for k, t in enumerate(result.time[1:], start=1):
+        rows = np.flatnonzero(np.abs(seen[:, 1] - t) < 1e-9)
+        if rows.size:
+            np.testing.assert_array_equal(seen[rows[-1], 2:], result.platform_pose[k])
+            checked += 1
+    assert checked > 20  # every output time after the start-up steps (30 outputs in 0.3 s)

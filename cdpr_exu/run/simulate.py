@@ -340,6 +340,7 @@ class _Stepper:
         self.drum_index = [model.mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
         self.servo_integral = np.zeros(len(model.servos))
         self.servo_time = 0.0
+        self.step_start = 0.0  # end of the last accepted step: the time of the state the solver has [s]
         self.start = _time.perf_counter()
 
     def _cable_tensions(self, q: np.ndarray, v: np.ndarray, i: int, which: slice) -> np.ndarray:
@@ -363,7 +364,8 @@ class _Stepper:
             elif controller.uses_tension:
                 tensions = np.array([self._cable_tensions(q, v, i, slice(-2, None))[-1]
                                      for i in range(len(self.scene.cables))])
-        return Measurement(t, self.paid_out.copy(), self.rate.copy(), pose, velocity, tensions)
+        return Measurement(t, self.paid_out.copy(), self.rate.copy(), pose, velocity, tensions,
+                           state_time=self.step_start)
 
     def drive_servos(self, mbs_, t: float, command, q: np.ndarray, v: np.ndarray) -> None:
         """Motor force of each servo drum from the command (once per step)."""
@@ -414,6 +416,7 @@ class _Stepper:
 
     def post_step(self, mbs_, t: float) -> bool:  # noqa: ARG002 - Exudyn's signature
         """Exudyn's post-step function: record, check, report; False ends the integration."""
+        self.step_start = t
         if self.interrupted["interrupted"]:
             return False  # Ctrl-C: end the integration, keep what was computed
         surplus = None if self.reservoir is None else self.reservoir.surplus

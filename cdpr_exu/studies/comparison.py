@@ -30,7 +30,8 @@ from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError
 from cdpr_exu.core.output import fixed
 from cdpr_exu.results.result import Result, provenance
 from cdpr_exu.scenes.scene import Scene, load_scene
-from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule, ilc_controller, model_feed_forward_controller
+from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
+                                      ilc_controller, model_feed_forward_controller)
 
 #: The controllers compared by default, by name, each a factory.
 CONTROLLERS: dict[str, Callable[[], object]] = {
@@ -41,12 +42,14 @@ CONTROLLERS: dict[str, Callable[[], object]] = {
     "tension_aware_chain": lambda: TensionAwareController(statics="chain"),
     "closed_loop_tension_aware": lambda: ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True),
     "model_feed_forward": model_feed_forward_controller,
+    "closed_loop_model_feed_forward": closed_loop_model_feed_forward_controller,
     "ilc": ilc_controller,
 }
 #: Controllers that learn over trials before their run (cdpr_exu.studies.learning), made with the
 #: comparison's stopping rule and progress setting.
 LEARNING_CONTROLLERS: dict[str, Callable[..., object]] = {
     "model_feed_forward": model_feed_forward_controller,
+    "closed_loop_model_feed_forward": closed_loop_model_feed_forward_controller,
     "ilc": ilc_controller,
 }
 

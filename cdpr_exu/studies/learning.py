@@ -46,13 +46,15 @@ Plain NumPy plus runs of :func:`cdpr_exu.run.simulate.simulate`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
 
 from controllers.ilc import (CommandTable, LearnedController, LearningLaw, ReplayController, StoppingRule, fade_in,
                              ideal_changes, position_jacobian)
+
+from controllers.feedback import ClosedLoopController, FilteredPositionPI
 
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.results.result import Result
@@ -102,7 +104,8 @@ class LearningRun:
     ----------
     trials : list of Trial
     table : CommandTable
-        The commands of the best trial (lowest max error).
+        The commands of the best trial (lowest max error), with the platform positions
+        they gave on the learning's scene (``expected_positions``).
     best_trial : int
     stop_reason : str
     result : Result
@@ -210,7 +213,8 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
         if report:
             report(trial)
         if best is None or trial.max_position_error_m < best[0].max_position_error_m:
-            best = (trial, table, result)
+            expected = np.column_stack([np.interp(times, result.time, column) for column in result.platform_pose[:, :2].T])
+            best = (trial, replace(table, expected_positions=expected), result)
         stop_reason = rule.reason_to_stop([t.max_position_error_m for t in trials])
         if stop_reason is not None:
             break
@@ -384,3 +388,25 @@ def model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: Learni
     scene, then the plant runs open loop with the best trial's commands."""
     return LearnedController("model_feed_forward", Learner(True, law, rule, after=after, progress=progress,
                                                            plant=plant))
+
+
+def closed_loop_model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
+                                              after: float = 1.0, progress: bool = False,
+                                              feedback: FilteredPositionPI | None = None,
+                                              follow: str = "expected",
+                                              plant: Scene | None = None) -> ClosedLoopController:
+    """``closed_loop_model_feed_forward`` for ``cdpr compare``: the lengths learned on
+    :func:`controller_model` of the compared scene (as ``model_feed_forward``), with the
+    filtered PI position loop (:class:`~controllers.feedback.FilteredPositionPI`, the
+    gains of ``closed_loop_tension_aware`` by default) around them on the plant.
+
+    The learned lengths already carry the cables' dynamics as the model has them (their
+    sag, inertia and drag over the pulleys). The loop holds the platform to the path they
+    gave on the model (``follow = "expected"``, :class:`~controllers.feedback.ClosedLoopController`),
+    so that it is left with what the model gets wrong; ``follow = "reference"`` holds it
+    to the reference instead."""
+    if feedback is None:
+        feedback = FilteredPositionPI()
+    feed_forward = LearnedController("model_feed_forward", Learner(True, law, rule, after=after, progress=progress,
+                                                                   plant=plant))
+    return ClosedLoopController("closed_loop_model_feed_forward", feed_forward, feedback, follow)
