@@ -183,3 +183,22 @@ def test_without_damping_the_energy_over_swivel_pulleys_is_bounded_and_its_first
         first.append(abs(energy[1] - energy[0]))
     assert max(errors) < 3e-3  # bounded: 1.8 mJ measured
     assert first[0] < 3e-6 and first[0] / first[1] > 5.0  # local error O(h^3): 7.3 measured
+
+
+def test_the_inverse_statics_over_swivel_pulleys_give_lengths_whose_catenaries_hold_the_pose():
+    from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics
+
+    scene = load_spatial_scene(NAME)
+    platform, lengths = scene.catenary_platform(), scene.unstrained_lengths
+    rest = solve_spatial_statics(platform, lengths)
+    tensions = np.array([c.catenary.horizontal_tension for c in rest.cables])
+    # at the rest pose with the rest tensions: the scene's lengths (8.9e-16 m measured)
+    back = solve_inverse_spatial_statics(platform, rest.position, tensions)
+    assert back.unstrained_lengths == pytest.approx(lengths, abs=1e-12)
+    # off the rest pose (an indeterminate robot: tensions nearest the rest ones); the forward statics of
+    # the inverse lengths put the platform back there (2e-14 m measured), the wraps included
+    pose = rest.position + [0.1, -0.05, 0.08]
+    inverse = solve_inverse_spatial_statics(platform, pose, tensions)
+    forward = solve_spatial_statics(platform, inverse.unstrained_lengths)
+    assert forward.position == pytest.approx(pose, abs=1e-10)
+    assert np.abs(inverse.forces_on_platform.sum(axis=0) - [0.0, 0.0, scene.platform.mass * scene.gravity]).max() < 1e-8
