@@ -685,8 +685,7 @@ class SpatialInverse:
 def _inverse_cable(cable, anchor_point, horizontal_tension):
     """Unstrained length [m] and force on the platform (3,) [N] of one cable at horizontal tension H."""
     if cable.pulley_radius > 0.0:
-        raise SceneError("the inverse spatial statics covers point exits only so far, not swivel pulleys "
-                         f"(pulley_radius = {cable.pulley_radius!r} m)")
+        return _inverse_swivel_cable(cable, anchor_point, horizontal_tension)
     exit_point = np.array(cable.exit_point)
     span = exit_point - anchor_point
     horizontal = float(math.hypot(span[0], span[1]))
@@ -697,6 +696,29 @@ def _inverse_cable(cable, anchor_point, horizontal_tension):
     length, state = solve_inverse((horizontal, span[2]), cable.weight_per_length, cable.axial_stiffness,
                                   horizontal_tension)
     return length, state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z
+
+
+def _inverse_swivel_cable(cable, anchor_point, horizontal_tension):
+    """:func:`_inverse_cable` over a swivel pulley: the planar pulley cable's inverse (``statics._inverse_cable``)
+    in the vertical plane through the axis and the anchor, as :func:`_solve_swivel_cable` solves it forward.
+    The length counts from the inlet, the wrap included."""
+    from cdpr_exu.core.geometry import Pulley
+    from cdpr_exu.statics.statics import SuspendedCable, _inverse_cable as _planar_inverse_cable
+
+    inlet = np.array(cable.exit_point)
+    offset = np.asarray(anchor_point, dtype=float) - inlet
+    rho = float(math.hypot(offset[0], offset[1]))
+    if rho <= 1e-12 * (float(np.linalg.norm(offset)) + cable.pulley_radius):
+        raise UnreachableError(f"anchor {np.asarray(anchor_point).tolist()} lies on the axis of the swivel pulley at "
+                               f"{inlet.tolist()}: its azimuth is undefined")
+    e_rho = np.array([offset[0], offset[1], 0.0]) / rho
+    radius = cable.pulley_radius
+    planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
+                                  pulley=Pulley((radius, 0.0), radius, -1))
+    planar, _, _, _ = _planar_inverse_cable(planar_cable, float(horizontal_tension), np.array([rho, offset[2]]),
+                                            None, DEFAULT_MAX_STRAIN, None)
+    force = planar.force_on_platform
+    return planar.unstrained_length, force[0] * e_rho + force[1] * _E_Z
 
 
 def solve_inverse_spatial_statics(platform, pose, horizontal_guess, external_wrench=None, tolerance=1e-9,
