@@ -80,7 +80,8 @@ from cdpr_exu.core.validation import non_negative, positive
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
 from cdpr_exu.core.geometry import rotation_vector
-from cdpr_exu.physics.spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, solve_spatial_statics
+from cdpr_exu.physics.spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, chain_element_mass, \
+    node_masses_along, solve_spatial_statics
 
 
 @dataclass(frozen=True)
@@ -196,16 +197,6 @@ class SpatialRobotItems:
     @property
     def is_point_mass(self):
         return self.platform.is_point_mass
-
-
-def node_masses_along(n_elements, element_mass, mass_lumping="consistent"):
-    """Lumped masses of the n + 1 nodes of a cable of equal elements, exit first, shape (n + 1,) [kg]
-    (``mass_lumping`` as :class:`SpatialChainSpec`'s)."""
-    masses = np.full(n_elements + 1, float(element_mass))
-    masses[0] = 0.5 * element_mass
-    if mass_lumping == "consistent":
-        masses[-1] = 0.5 * element_mass
-    return masses
 
 
 def _chain_positions(equilibrium_cable, length, n_elements):
@@ -331,7 +322,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     for cable, length, equilibrium_cable, k, c, k_theta, swivel in zip(
             platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses,
             swivels):
-        element_mass = cable.weight_per_length / gravity * length / n
+        element_mass = chain_element_mass(cable, length, n, gravity)
         below = 0 if swivel is None else max(2, int(round(swivel.winch_line / (length / n))))
         masses = node_masses_along(n + below, element_mass, chain.mass_lumping)
         if swivel is None:

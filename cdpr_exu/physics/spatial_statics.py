@@ -345,6 +345,26 @@ class SpatialEquilibrium(PlatformEquilibriumViews):
 
 
 # ---------------------------------------------------------------------------
+# the lumped cable's masses (the spatial builder's and the spatial chain statics')
+# ---------------------------------------------------------------------------
+def chain_element_mass(cable, length, n_elements, gravity):
+    """Mass of one of the ``n_elements`` equal elements of ``cable`` (a :class:`SpatialCable`) of unstrained
+    ``length`` [m] [kg]: its weight per length over ``gravity`` [m/s^2] (> 0)."""
+    return cable.weight_per_length / gravity * length / n_elements
+
+
+def node_masses_along(n_elements, element_mass, mass_lumping="consistent"):
+    """Lumped masses of the n + 1 nodes of a cable of equal elements, exit first, shape (n + 1,) [kg]:
+    "consistent" puts half of each element on each of its nodes; "paper" puts it on its far node,
+    the held exit node getting half an element."""
+    masses = np.full(n_elements + 1, float(element_mass))
+    masses[0] = 0.5 * element_mass
+    if mass_lumping == "consistent":
+        masses[-1] = 0.5 * element_mass
+    return masses
+
+
+# ---------------------------------------------------------------------------
 # one cable
 # ---------------------------------------------------------------------------
 def solve_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
