@@ -146,9 +146,9 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         result.save(out)
         data = {**summary, **provenance()}
         if estimate is not None:
-            data["error_estimate"] = {k: v for k, v in estimate.to_dict().items() if k != "companion_wall_time_s"}
-            if estimate.companion_n_elements is not None:  # a companion run was made
-                data["companion_wall_time_s"] = estimate.companion_wall_time_s
+            from cdpr_exu.run.error_estimate import summary_entry
+
+            data.update(summary_entry(estimate))
         data.update({k: v for k, v in result.metadata.items() if k not in data})
         data["after_start_up"] = {k: settled[k] for k in (
             "errors_measured_after_s", "max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m",
@@ -165,9 +165,9 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     if not quiet:
         _print_summary(summary, settled, out)
         if estimate is not None:
-            value = estimate.max_position_error_m
-            print(f"  estimated discretisation error after {SETTLED_AFTER} s: "
-                  + ("n/a" if value is None else f"{1000 * value:.2f} mm") + f" ({estimate.note})")
+            from cdpr_exu.run.error_estimate import estimate_line
+
+            print(estimate_line(estimate))
     if failure is not None:
         raise failure
     return summary
@@ -188,13 +188,12 @@ def undate_solution_file(path: Path) -> None:
     path.write_bytes(bytes(data))
 
 
-def _elements_for(scene: Scene, tolerance: float, quiet: bool) -> Scene:
-    """The scene with the fewest elements per cable that the error model says meet ``tolerance`` [m]."""
-    from cdpr_exu.run.error_estimate import elements_for_tolerance, estimate_error
-    from cdpr_exu.run.simulate import simulate
+def _elements_for(scene, tolerance: float, quiet: bool):
+    """The scene (planar or spatial) with the fewest elements per cable that the error model says meet ``tolerance`` [m]."""
+    from cdpr_exu.run.error_estimate import elements_for_tolerance, estimate_error, simulate_any
 
     n = max(c.n_elements for c in scene.cables)
-    pilot = estimate_error(scene, simulate(scene), after=SETTLED_AFTER)
+    pilot = estimate_error(scene, simulate_any(scene), after=SETTLED_AFTER)
     if pilot.max_position_error_m is None:
         raise CdprError(f"--tolerance: no error estimate for this scene ({pilot.note})")
     needed = elements_for_tolerance(n, pilot.max_position_error_m, tolerance)
@@ -217,10 +216,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from cdpr_exu.run.spatial_run import run_spatial_scene
 
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
+        spatial = replace(spatial, solver=replace(spatial.solver, **changes))
         if tolerance is not None:
-            raise SceneError("--tolerance: the error model is planar only so far; give a spatial scene's n_elements")
-        run_spatial_scene(replace(spatial, solver=replace(spatial.solver, **changes)), out, quiet=args.quiet,
-                          figures=not args.no_figures)
+            spatial = _elements_for(spatial, tolerance, args.quiet)
+        run_spatial_scene(spatial, out, quiet=args.quiet, figures=not args.no_figures,
+                          error_estimate=not args.no_error_estimate)
         return EXIT_OK
     scene = _scene_with_overrides(args)
     if tolerance is not None:

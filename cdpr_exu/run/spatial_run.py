@@ -205,15 +205,17 @@ class SpatialResult:
                                    self.metadata.get("tension_limits_N")),
         }
 
-    def save(self, folder: str | Path, after: float = 1.0, figures: bool = True) -> list[Path]:
-        """Write result.npz, summary.json and (``figures``) overview.png into ``folder``; returns the paths."""
+    def save(self, folder: str | Path, after: float = 1.0, figures: bool = True,
+             extra: dict | None = None) -> list[Path]:
+        """Write result.npz, summary.json (with ``extra``'s entries) and (``figures``) overview.png into
+        ``folder``; returns the paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = nodes, tensions
         written = [write_npz(folder / "result.npz", **arrays),
-                   write_summary(folder, {**self.summary(after), **provenance()})]
+                   write_summary(folder, {**self.summary(after), **provenance(), **(extra or {})})]
         if figures:
             written.append(plot_spatial_run(self, folder / "overview.png", after))
         return written
@@ -458,14 +460,18 @@ def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0
 
 
 def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
-                      after: float = 1.0) -> SpatialResult:
+                      after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
     """``cdpr run`` on a spatial scene: run, write (``out``: scene.toml-free result folder), print a summary.
 
-    On a solver failure the partial result is written before the error propagates.
+    On a solver failure the partial result is written before the error propagates. With
+    ``error_estimate`` a companion run estimates the discretisation error
+    (:mod:`cdpr_exu.run.error_estimate`): ``error_estimate`` in summary.json and a printed line.
     """
-    def write(result: SpatialResult) -> None:
+    from cdpr_exu.run.error_estimate import estimate_error, estimate_line, summary_entry
+
+    def write(result: SpatialResult, extra: dict | None = None) -> None:
         if out is not None:
-            result.save(out, after, figures)
+            result.save(out, after, figures, extra)
 
     try:
         result = simulate_spatial(scene, progress=not quiet)
@@ -473,7 +479,15 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
         if err.partial_result is not None:
             write(err.partial_result)
         raise
-    write(result)
+    estimate, interrupt = None, None
+    if error_estimate:
+        if not quiet:
+            print("estimating the discretisation error (a companion run) ...", flush=True)
+        try:
+            estimate = estimate_error(scene, result, after=after)
+        except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
+            interrupt = err
+    write(result, None if estimate is None else summary_entry(estimate))
     if not quiet:
         s = result.summary(after)
 
@@ -498,6 +512,10 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
             print(f"  note: {note}")
         if out is not None:
             print(f"  written to {out}/")
+        if estimate is not None:
+            print(estimate_line(estimate))
+    if interrupt is not None:
+        raise interrupt
     return result
 
 
