@@ -355,7 +355,10 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
                          "the platform's pose only so far")
     # Every controller starts from what the winches paid out at t = 0 (SmoothStart), as on planar scenes.
     controller = SmoothStart(controller)
-    controller.reset(scene, lengths.copy(), initial_pose=measured_state()[0] if controller.uses_pose else None)
+    # It plans on its own model of the robot (the scene's [controller_model], if any); what the
+    # winches paid out at t = 0 and the pose it starts from are the plant's.
+    controller.reset(scene.controller_scene(), lengths.copy(),
+                     initial_pose=measured_state()[0] if controller.uses_pose else None)
     state = {"next": 0, "failure": None, "step_start": 0.0}
 
     def measurement(t: float) -> Measurement:
