@@ -38,9 +38,13 @@ class Measurement:
     paid_out : ndarray, shape (m,) [m]
         Current paid-out length of each winch.
     paid_out_rate : ndarray, shape (m,) [m/s]
-    platform_pose : ndarray, shape (3,) or None [m, m, rad]
-        Measured (x, z, rotation), only for controllers with ``uses_pose``.
-    platform_velocity : ndarray, shape (3,) or None [m/s, m/s, rad/s]
+    platform_pose : ndarray, shape (3,) or (6,), or None [m, rad]
+        Measured pose, only for controllers with ``uses_pose``: (x, z, rotation) on a
+        planar robot; (x, y, z, rotation vector) on a spatial one (the rotation vector
+        of the platform's rotation matrix, zero for a point mass).
+    platform_velocity : ndarray, shape (3,) or (6,), or None [m/s, rad/s]
+        Its velocity: (vx, vz, angular rate) planar; (vx, vy, vz, angular velocity in
+        the global frame) spatial (the angular velocity, not the rotation vector's rate).
     cable_tensions : ndarray, shape (m,) or None [N]
         Tension at the platform end of each cable, only for ``uses_tension``.
     state_time : float or None [s]
@@ -141,16 +145,19 @@ class SmoothStart:
         self.uses_tension = controller.uses_tension
         self._offset = None
 
-    def reset(self, scene, initial_paid_out) -> None:
+    def reset(self, scene, initial_paid_out, initial_pose=None) -> None:
         """Reset the controller and measure its command at t = 0 against ``initial_paid_out``.
 
-        The command at t = 0 is asked with the platform at rest at ``scene.platform.initial_pose``.
+        The command at t = 0 is asked with the platform at rest at ``initial_pose`` (shape (3,)
+        planar or (6,) spatial [m, rad]; by default ``scene.platform.initial_pose``).
         """
         initial = np.asarray(initial_paid_out, dtype=float)
         self.controller.reset(scene, initial.copy())
         m = initial.size
-        pose = np.asarray(scene.platform.initial_pose, dtype=float) if self.uses_pose else None
-        velocity = np.zeros(3) if self.uses_pose else None
+        pose = velocity = None
+        if self.uses_pose:
+            pose = np.asarray(scene.platform.initial_pose if initial_pose is None else initial_pose, dtype=float)
+            velocity = np.zeros_like(pose)
         first = self.controller.command(Measurement(0.0, initial.copy(), np.zeros(m), pose, velocity, None))
         offset = initial - np.asarray(first.paid_out, dtype=float)
         # Below 1e-12 m the offset is the round-off of a controller's own "initial + change"

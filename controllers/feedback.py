@@ -82,13 +82,26 @@ class FilteredPositionPI:
     def reset(self, scene) -> None:
         """Start a run of ``scene`` with the filter and the integral at zero."""
         self._scene = scene
+        size = self.error_size(scene)
         # (time, filtered error, its rate, integral of the filtered error): one entry per call.
-        self._history = [(0.0, np.zeros(2), np.zeros(2), np.zeros(2))]
+        self._history = [(0.0, np.zeros(size), np.zeros(size), np.zeros(size))]
 
     @property
     def integral(self) -> np.ndarray:
         """Integral of the filtered position error at the last call [m s], shape (2,)."""
         return self._history[-1][3]
+
+    def error_size(self, scene) -> int:
+        """Length of the error vector the loop filters: 2, the position (x, z)."""
+        return 2
+
+    def target(self, time: float) -> np.ndarray:
+        """The scene's reference at ``time`` [s] as the loop compares it: (x, z) [m]."""
+        return self._scene.trajectory.pose(time)[:2]
+
+    def error(self, goal: np.ndarray, pose: np.ndarray) -> np.ndarray:
+        """The error e = goal - measured position, shape (2,) [m], for the target ``goal`` and the measured ``pose``."""
+        return goal - pose[:2]
 
     def jacobian(self, pose: np.ndarray) -> np.ndarray:
         """d(lambda)/d(position) of the ideal cables at ``pose`` (x, z, rotation), shape (m, 2) [m/m].
@@ -151,10 +164,10 @@ class FilteredPositionPI:
             raise SceneError("the position feedback needs the measured platform pose")
         measured_at = measurement.time if measurement.state_time is None else measurement.state_time
         if target is None:
-            goal = self._scene.trajectory.pose(measured_at)[:2]
+            goal = self.target(measured_at)
         else:
             goal = np.asarray(target(measured_at), dtype=float)
-        error = goal - measurement.platform_pose[:2]
+        error = self.error(goal, np.asarray(measurement.platform_pose, dtype=float))
         reference = self._scene.trajectory.pose(measurement.time)
         # The integral and the feedback fade in with the start-up blend (weight 0 at t = 0,
         # 1 from start_time on): switched on at once, the winch speed jumps and the axially

@@ -164,7 +164,8 @@ def test_cdpr_compare_on_a_spatial_scene_writes_the_table_and_each_controller(tm
                            "--out", str(out), "-q"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
-    assert set(summary["controllers"]) == {"ideal_ik", "tension_aware"}
+    assert set(summary["controllers"]) == {"ideal_ik", "tension_aware", "closed_loop_tension_aware"}
+    assert summary["controllers"]["closed_loop_tension_aware"]["status"] == "completed"
     assert "| tension_aware |" in (out / "comparison.md").read_text()
     assert (out / "overview_tension_aware.png").exists()
 

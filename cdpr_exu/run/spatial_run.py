@@ -43,8 +43,9 @@ from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose, settle
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
-from controllers.base import Controller, Measurement
+from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
+from controllers.spatial_feedback import spatial_closed_loop_tension_aware
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
 from cdpr_exu.results.result import provenance, slack_time, tension_limit_report
@@ -306,13 +307,18 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
 
     The controller is any :class:`controllers.base.Controller` that works on spatial
     scenes (:class:`controllers.ideal_ik.IdealIKController`,
-    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController`); it is asked
-    for the winch commands before every step. Open loop so far: it reads no pose.
+    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController`,
+    :func:`controllers.spatial_feedback.spatial_closed_loop_tension_aware`); it is asked
+    for the winch commands before every step, wrapped in
+    :class:`controllers.base.SmoothStart` as on planar scenes (its commands start at the
+    paid-out lengths). A controller with ``uses_pose`` reads the platform's pose
+    (x, y, z, rotation vector) and velocity (linear, global angular) at the start of the
+    step (``Measurement.state_time``); one with ``uses_tension`` is refused so far.
 
     Raises
     ------
     SceneError
-        If the scene has no ``[trajectory]``.
+        If the scene has no ``[trajectory]``, or the controller reads the cable tensions.
     UnreachableError
         If no static equilibrium of the scene's lengths exists to start from.
     SolverFailure
@@ -336,12 +342,34 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     m, n = scene.n_cables, scene.cables[0].n_elements
     times, poses, paid, node_series = [], [], [], [[] for _ in range(m)]
     kinematic = scene.winch.kind == "kinematic"
+
+    def measured_state() -> tuple[np.ndarray, np.ndarray]:
+        """The platform's pose (x, y, z, rotation vector) [m, rad] and velocity (linear, global angular)
+        [m/s, rad/s] now, each shape (6,)."""
+        position, rotation = platform_pose(mbs, items)
+        velocity = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.Velocity))
+        angular = (np.zeros(3) if items.is_point_mass else
+                   np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.AngularVelocity)))
+        return np.concatenate([position, rotation_vector(rotation)]), np.concatenate([velocity, angular])
     controller = controller or IdealIKController()
-    if controller.uses_pose or controller.uses_tension:
-        raise SceneError(f"controller {controller.name!r} reads the pose or the tensions: spatial runs give "
-                         "open-loop controllers only so far")
-    controller.reset(scene, lengths.copy())
-    state = {"next": 0, "failure": None}
+    if controller.uses_tension:
+        raise SceneError(f"controller {controller.name!r} reads the cable tensions: spatial runs give "
+                         "the platform's pose only so far")
+    # Every controller starts from what the winches paid out at t = 0 (SmoothStart), as on planar scenes.
+    controller = SmoothStart(controller)
+    # It plans on its own model of the robot (the scene's [controller_model], if any); what the
+    # winches paid out at t = 0 and the pose it starts from are the plant's.
+    controller.reset(scene.controller_scene(), lengths.copy(),
+                     initial_pose=measured_state()[0] if controller.uses_pose else None)
+    state = {"next": 0, "failure": None, "step_start": 0.0}
+
+    def measurement(t: float) -> Measurement:
+        """What the controller may see when asked for the command at ``t`` [s]."""
+        if not controller.uses_pose:
+            return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)))
+        pose, velocity = measured_state()
+        return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)), pose, velocity,
+                           state_time=state["step_start"])
 
     def record(t: float) -> None:
         position, rotation = platform_pose(mbs, items)
@@ -355,7 +383,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         if not kinematic:
             return True
         try:
-            command = controller.command(Measurement(t, winches.applied.copy(), np.zeros(len(lengths))))
+            command = controller.command(measurement(t))
             paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
             rates = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
             if paid_out.shape != lengths.shape or not (np.all(np.isfinite(paid_out)) and np.all(paid_out > 0.0)):
@@ -368,6 +396,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         return True
 
     def post_step(mbs_, t):  # noqa: ARG001
+        state["step_start"] = t  # the state the solver has for the next step's command
         if interrupted["interrupted"]:
             return False
         while state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
@@ -523,6 +552,7 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
 SPATIAL_CONTROLLERS = {
     "ideal_ik": IdealIKController,
     "tension_aware": SpatialTensionAwareController,
+    "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
 }
 
 _COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),

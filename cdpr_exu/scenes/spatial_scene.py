@@ -44,7 +44,8 @@ import numpy as np
 from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
-from cdpr_exu.scenes.scene import CableSpec, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec, _build, _per_cable, load_scene
+from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
+                                  _build, _override, _per_cable, controller_model_from_dict, load_scene)
 from cdpr_exu.core.validation import non_negative, positive, vector
 
 __all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
@@ -208,6 +209,11 @@ class SpatialScene:
     winch : WinchSpec
         ``kind = "kinematic"`` (the winches pay out what the controller commands) or
         ``"fixed"``; servo drums are planar only so far.
+    controller_model : ControllerModel or None
+        What the controllers believe of the robot where it differs from the plant
+        (``[controller_model]``, as in planar scenes: overrides of ``cable``, ``cables``,
+        ``platform`` (mass, inertia, anchors) and ``gravity``; a spatial scene has exits,
+        not pulleys). The controllers get :meth:`controller_scene`.
 
     Raises
     ------
@@ -228,6 +234,7 @@ class SpatialScene:
     trajectory: Any = None
     solver: SolverSpec = field(default_factory=SolverSpec)
     winch: WinchSpec = field(default_factory=WinchSpec)
+    controller_model: ControllerModel | None = None
 
     #: Spatial scenes are 3-D; planar :class:`~cdpr_exu.scenes.scene.Scene` objects have no such attribute.
     dimension: ClassVar[int] = 3
@@ -263,6 +270,42 @@ class SpatialScene:
             raise SceneError("winch.kind = 'servo': servo drums are planar only so far; use 'kinematic' or 'fixed'")
         if not isinstance(self.solver, SolverSpec) or self.solver.integrator != "generalized_alpha":
             raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
+        if self.controller_model is not None:
+            if not isinstance(self.controller_model, ControllerModel):
+                raise SceneError(f"controller_model must be a controller-model table, got {self.controller_model!r}")
+            if self.controller_model.pulley or self.controller_model.pulleys:
+                raise SceneError("controller_model.pulley / controller_model.pulleys: a spatial scene has exits, "
+                                 "not pulleys; its controller model overrides cable, cables, platform and gravity")
+            if self.controller_model.is_empty():
+                object.__setattr__(self, "controller_model", None)
+            else:
+                self.controller_scene()  # refuses a model that is not a valid robot, naming the field
+
+    def controller_scene(self) -> "SpatialScene":
+        """The robot the controllers believe in: this scene with its controller model applied.
+
+        Without a controller model, the scene itself. The trajectory, solver settings,
+        effects and exits are the plant's.
+
+        Raises
+        ------
+        SceneError
+            If an override is invalid or the per-cable list does not match the cables.
+        """
+        model = self.controller_model
+        if model is None:
+            return self
+        m = self.n_cables
+        if model.cables and len(model.cables) != m:
+            raise SceneError(f"controller_model.cables must list one table per cable ({m}), got {len(model.cables)}")
+        cables = tuple(_override(c, {**model.cable, **(model.cables[i] if model.cables else {})}, f"cables[{i}]",
+                                 "cable") for i, c in enumerate(self.cables))
+        platform = _override(self.platform, model.platform, "platform", "platform")
+        gravity = self.gravity if model.gravity is None else model.gravity
+        try:
+            return replace(self, cables=cables, platform=platform, gravity=gravity, controller_model=None)
+        except SceneError as err:
+            raise SceneError(f"controller_model: the controllers' model is not a valid robot: {err}") from None
 
     def _set_swivels(self) -> None:
         """Normalise ``swivels`` to one entry per cable; a swivel's inlet is its cable's exit."""
@@ -324,6 +367,8 @@ class SpatialScene:
         }
         if self.trajectory is not None:
             data["trajectory"] = self.trajectory.to_dict()
+        if self.controller_model is not None:
+            data["controller_model"] = self.controller_model.to_dict()
         return data
 
     def with_changes(self, **changes: Any) -> "SpatialScene":
@@ -376,7 +421,7 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {data!r}")
     known = {"name", "description", "dimension", "gravity", "cable", "cables", "exits", "platform", "effects",
-             "trajectory", "solver", "winch"}
+             "trajectory", "solver", "winch", "controller_model"}
     unknown = set(data) - known
     if unknown:
         raise SceneError(f"spatial scene has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
@@ -408,6 +453,8 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
         from cdpr_exu.scenes.spatial_trajectories import spatial_trajectory_from_dict
 
         kwargs["trajectory"] = spatial_trajectory_from_dict(data["trajectory"])
+    if "controller_model" in data:
+        kwargs["controller_model"] = controller_model_from_dict(data["controller_model"])
     for key in ("name", "description", "gravity"):
         if key in data:
             kwargs[key] = data[key]

@@ -1,0 +1,223 @@
+"""Spatial runs hand controllers the pose and start them smoothly; the spatial closed loop (real solver)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cdpr_exu.physics.spatial_kinematics import inverse_kinematics
+from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialPointToPointTrajectory
+from controllers.base import START_BLEND_TIME, WinchCommand, quintic_blend
+from controllers.feedback import ClosedLoopController
+from controllers.ideal_ik import IdealIKController
+from controllers.spatial_feedback import SpatialPositionPI
+from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+
+def four_cable(n_elements=10, **solver):
+    """The shipped four-cable robot, coarser, without bending, at a 10 ms step."""
+    scene = load_spatial_scene("spatial-four-cable")
+    effects = replace(scene.effects, bending=False, bending_damping=False)
+    cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
+    return replace(scene, cables=cables, effects=effects,
+                   solver=replace(scene.solver, step_size=1e-2, output_period=0.05, **solver))
+
+
+def ipanema(n_elements=10, **solver):
+    """The shipped IPAnema robot (8 taut cables from above and below), coarser, without bending."""
+    scene = load_spatial_scene("spatial-ipanema")
+    effects = replace(scene.effects, bending=False, bending_damping=False)
+    cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
+    return replace(scene, cables=cables, effects=effects, solver=replace(scene.solver, **solver))
+
+
+def start_pose(scene):
+    """The catenary equilibrium of the scene's lengths (x, y, z, rotation vector) [m, rad]."""
+    start = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    return np.concatenate([start.position, start.rotation_vector])
+
+
+#: What the spy controller pays out beyond the initial lengths from t = 0 on [m].
+OFFSET = 0.005
+
+
+class _Spy:
+    """Reads the pose; commands the initial lengths plus OFFSET at once (SmoothStart must blend it in)."""
+
+    name, uses_pose, uses_tension = "spy", True, False
+
+    def reset(self, scene, initial):
+        self.initial = np.asarray(initial, dtype=float)
+        self.seen = []
+
+    def command(self, measurement):
+        self.seen.append(measurement)
+        return WinchCommand(self.initial + OFFSET, np.zeros_like(self.initial))
+
+
+@pytest.fixture(scope="module")
+def spied():
+    scene = four_cable(end_time=1.0)
+    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    spy = _Spy()
+    return scene, spy, simulate_spatial(scene, spy)
+
+
+def test_a_controller_that_uses_the_pose_gets_the_pose_recorded_at_its_state_time(spied):
+    scene, spy, result = spied
+    during = [m for m in spy.seen if m.state_time is not None]
+    assert all(m.platform_pose.shape == (6,) and m.platform_velocity.shape == (6,) for m in during)
+    # the state is that of the last accepted step: before the command's time, never going back,
+    # and each one a time an earlier command was asked for (the solver shortens its first steps here)
+    states = np.array([m.state_time for m in during])
+    assert np.all(states < np.array([m.time for m in during])) and np.all(np.diff(states) >= 0.0)
+    asked = {round(m.time, 12) for m in spy.seen}
+    assert all(round(t, 12) in asked for t in states if t > 0.0)
+    compared = set()
+    for m in during:
+        k = np.flatnonzero(np.abs(result.time - m.state_time) < 1e-9)
+        if k.size:
+            assert np.abs(m.platform_pose - result.pose[k[0]]).max() < 1e-14
+            compared.add(int(k[0]))
+    # The output samples a step ended on exactly (the first 0.15 s here: after its shortened
+    # first steps the solver's 10 ms steps end at 0.155, 0.165, ... and a sample is the state
+    # of the first step end at or after its time, as before this test)
+    assert {0, 1, 2, 3} <= compared
+    # the velocity is the pose's rate: central differences of the measured positions
+    times, first = np.unique(states, return_index=True)
+    positions = np.array([during[k].platform_pose[:3] for k in first])
+    velocity = np.array([during[k].platform_velocity[:3] for k in first])
+    rates = np.gradient(positions, times, axis=0)
+    assert np.abs(rates[5:-5] - velocity[5:-5]).max() < 0.05 * np.abs(velocity).max() + 1e-6
+
+
+def test_every_spatial_command_starts_at_the_paid_out_lengths_with_zero_rate(spied):
+    scene, spy, result = spied
+    # paid out = initial + OFFSET s(t / T), s the quintic blend: zero rate and acceleration at t = 0.
+    # Each measurement carries the lengths the previous command set; where that step was kept
+    # (its state is the previous command's time) they are the blend at that time.
+    initial = scene.unstrained_lengths
+    assert np.array_equal(result.paid_out[0], initial)
+    checked = 0
+    for before, now in zip(spy.seen[1:], spy.seen[2:]):
+        if now.state_time is not None and abs(now.state_time - before.time) < 1e-12:
+            blend = quintic_blend(before.time / START_BLEND_TIME)[0]
+            assert np.abs(now.paid_out - (initial + OFFSET * blend)).max() < 1e-12
+            checked += 1
+    assert checked > 90
+    # from the end of the blend on, the controller's own command
+    assert np.abs(result.paid_out[result.time >= START_BLEND_TIME + 0.01] - (initial + OFFSET)).max() < 1e-12
+
+
+def test_ideal_ik_under_the_smooth_start_is_unchanged_bit_for_bit():
+    """SmoothStart drops the round-off offset of ideal IK's "initial + change": the winches get
+    ideal IK's own commands, bit for bit."""
+    scene = four_cable(end_time=0.5)
+    start = start_pose(scene)
+    end = start + np.array([0.02, 0.0, 0.0, 0.0, 0.0, 0.0])
+    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=0.5))
+
+    class Recorded(IdealIKController):
+        def reset(self, scene_, initial):
+            super().reset(scene_, initial)
+            self.pairs, self.last = [], None
+
+        def command(self, measurement):
+            if self.last is not None:
+                self.pairs.append((measurement.paid_out, self.last))  # what the winches got, what it gave
+            self.last = super().command(measurement).paid_out
+            return WinchCommand(self.last, super().command(measurement).paid_out_rate)
+
+    controller = Recorded()
+    result = simulate_spatial(scene, controller)
+    # the first pair is SmoothStart's own call at t = 0 (4e-16 m off the initial lengths, dropped)
+    assert np.array_equal(result.paid_out[0], scene.unstrained_lengths)
+    assert np.abs(controller.pairs[0][1] - scene.unstrained_lengths).max() < 1e-12
+    assert len(controller.pairs) > 40
+    bad = [(k, np.abs(a - g).max()) for k, (a, g) in enumerate(controller.pairs[1:]) if not np.array_equal(a, g)]
+    assert not bad, bad[:5]
+    assert max(np.abs(given - scene.unstrained_lengths).max() for _, given in controller.pairs) > 5e-3  # they moved
+
+
+def test_the_spatial_loop_removes_most_of_what_ideal_ik_misses():
+    """Ideal IK is a model that misses sag and stretch: around it, the filtered PI on the
+    position and rotation error brings the platform back to the reference."""
+    scene = ipanema(end_time=3.0)
+    start = start_pose(scene)
+    end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
+    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.5))
+    open_loop = simulate_spatial(scene, IdealIKController()).summary(2.25)
+    closed = simulate_spatial(scene, ClosedLoopController("closed", IdealIKController(), SpatialPositionPI(),
+                                                          follow="reference")).summary(2.25)
+    # measured 0.75 s after the move: 0.231 mm and 0.021 deg open loop, 1.7e-3 mm and 5.6e-4 deg
+    # closed (during the move the loop lags: 0.098 mm against 0.234 mm)
+    message = f"open {open_loop['max_position_error_m']:.3e} m, closed {closed['max_position_error_m']:.3e} m"
+    assert closed["max_position_error_m"] < open_loop["max_position_error_m"] / 20.0, message
+    assert closed["max_rotation_error_deg"] < open_loop["max_rotation_error_deg"] / 5.0, message
+    assert closed["min_element_tension_N"] > 0.0 and closed["status"] == "completed"
+
+
+def test_the_spatial_jacobian_is_the_change_of_the_straight_lengths():
+    scene = load_spatial_scene("spatial-cogiro")
+    feedback = SpatialPositionPI()
+    feedback.reset(scene)
+    pose = np.array([0.1, -0.05, 2.3, 0.02, -0.01, 0.03])
+    anchors, exits = np.asarray(scene.platform.anchors), np.asarray(scene.exits)
+    jacobian = feedback.jacobian(pose)
+    from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
+
+    h = 1e-6
+    for k in range(6):  # a small global move: translation, or rotation phi applied before R
+        step = np.zeros(6)
+        step[k] = h
+        moved = pose.copy()
+        moved[:3] += step[:3]
+        moved[3:] = rotation_vector(rotation_from_vector(step[3:]) @ rotation_from_vector(pose[3:]))
+        back = pose.copy()
+        back[:3] -= step[:3]
+        back[3:] = rotation_vector(rotation_from_vector(-step[3:]) @ rotation_from_vector(pose[3:]))
+        numeric = (inverse_kinematics(moved, anchors, exits, scene.pulley_radii)
+                   - inverse_kinematics(back, anchors, exits, scene.pulley_radii)) / (2 * h)
+        assert np.abs(jacobian[:, k] - numeric).max() < 1e-7
+
+
+def test_a_spatial_controller_model_round_trips_and_bad_overrides_are_named():
+    from cdpr_exu.core.errors import SceneError
+    from cdpr_exu.scenes.scene import ControllerModel
+    from cdpr_exu.scenes.spatial_scene import spatial_scene_from_dict
+
+    scene = replace(load_spatial_scene("spatial-ipanema"),
+                    controller_model=ControllerModel(platform={"mass": 20.0}, cable={"youngs_modulus": 1.5e11}))
+    again = spatial_scene_from_dict(scene.to_dict())
+    assert again.controller_model == scene.controller_model
+    model = again.controller_scene()
+    assert model.platform.mass == 20.0 and all(c.youngs_modulus == 1.5e11 for c in model.cables)
+    assert again.platform.mass == 25.0 and model.controller_model is None and model.exits == again.exits
+    with pytest.raises(SceneError, match=r"controller_model\.pulley.*exits, not pulleys"):
+        replace(scene, controller_model=ControllerModel(pulley={"radius": 0.1}))
+    with pytest.raises(SceneError, match=r"controller_model\.platform\.inertia"):
+        replace(scene, controller_model=ControllerModel(platform={"inertia": (1.0, 1.0, -1.0)}))
+
+
+def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_controllers_believe():
+    """The controllers' [controller_model] says 20 kg and cables 30 % stiffer; the plant's
+    platform weighs 25 kg (IPAnema): the tension-aware lengths leave the platform off the
+    reference, the loop around them brings it back."""
+    from cdpr_exu.scenes.scene import ControllerModel
+    from controllers.spatial_feedback import spatial_closed_loop_tension_aware
+    from controllers.spatial_tension_aware import SpatialTensionAwareController
+
+    scene = ipanema(end_time=3.0)
+    YOUNG = 1.3 * scene.cables[0].youngs_modulus
+    start = start_pose(scene)
+    end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
+    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.5),
+                    controller_model=ControllerModel(platform={"mass": 20.0}, cable={"youngs_modulus": YOUNG}))
+    open_loop = simulate_spatial(scene, SpatialTensionAwareController()).summary(2.25)
+    closed = simulate_spatial(scene, spatial_closed_loop_tension_aware()).summary(2.25)
+    # measured 0.75 s after the move: 6.6 um and 1.3e-3 deg open loop, 0.75 um and 4.4e-5 deg closed
+    message = f"open {open_loop['max_position_error_m']:.3e} m, closed {closed['max_position_error_m']:.3e} m"
+    assert closed["max_position_error_m"] < open_loop["max_position_error_m"] / 4.0, message
+    assert closed["max_rotation_error_deg"] < open_loop["max_rotation_error_deg"] / 10.0, message
+    assert closed["min_element_tension_N"] > 0.0 and closed["status"] == "completed"
