@@ -399,9 +399,13 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         state["step_start"] = t  # the state the solver has for the next step's command
         if interrupted["interrupted"]:
             return False
-        while state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
-            record(float(outputs[state["next"]]))
-            state["next"] += 1
+        # One sample per step that reaches an output time, with the step's own time, as the
+        # planar run records: a real state, labelled when it was. After a shrunk step the
+        # steps end up to one step after the output times; the time says so.
+        if state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
+            record(float(t))
+            while state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
+                state["next"] += 1
         if report is not None:
             report(t, _time.perf_counter() - wall_start)
         return True
