@@ -97,24 +97,19 @@ def _joint_geometry(positions, velocities, a, b, c, grad, hess):
         for i in range(6):
             for j in range(6):
                 hess[i, j] = 0.0
-        blocks_h1 = ((0, 0, -1.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, -1.0))
-        blocks_h2 = ((1, 1, 1.0), (1, 2, -1.0), (2, 1, -1.0), (2, 2, 1.0))
-        for blk in blocks_h1:
+        # the first four blocks carry H1 (segment 1), the last four H2 (segment 2)
+        blocks = ((0, 0, -1.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, -1.0),
+                  (1, 1, 1.0), (1, 2, -1.0), (2, 1, -1.0), (2, 2, 1.0))
+        for k in range(8):
+            blk = blocks[k]
+            hxx, hxy = (h1xx, h1xy) if k < 4 else (h2xx, h2xy)
             i0 = 2 * blk[0]
             j0 = 2 * blk[1]
             s = blk[2]
-            hess[i0, j0] += s * h1xx
-            hess[i0, j0 + 1] += s * h1xy
-            hess[i0 + 1, j0] += s * h1xy
-            hess[i0 + 1, j0 + 1] -= s * h1xx
-        for blk in blocks_h2:
-            i0 = 2 * blk[0]
-            j0 = 2 * blk[1]
-            s = blk[2]
-            hess[i0, j0] += s * h2xx
-            hess[i0, j0 + 1] += s * h2xy
-            hess[i0 + 1, j0] += s * h2xy
-            hess[i0 + 1, j0 + 1] -= s * h2xx
+            hess[i0, j0] += s * hxx
+            hess[i0, j0 + 1] += s * hxy
+            hess[i0 + 1, j0] += s * hxy
+            hess[i0 + 1, j0 + 1] -= s * hxx
     return dtheta, dtheta_dot
 
 

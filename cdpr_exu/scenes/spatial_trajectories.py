@@ -41,7 +41,7 @@ import numpy as np
 
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.scenes.trajectories import (PointToPointMotion, ReferenceTrajectory, _finite_float, _finite_tuple,
-                                          _quintic, _quintic_integral, _times)
+                                          _times, circle_phase, quarter_turn_times)
 
 __all__ = [
     "SpatialTrajectory",
@@ -140,22 +140,12 @@ class SpatialCircleTrajectory(SpatialTrajectory):
 
         The phase at a multiple of pi/2; none with a ramp (no closed form).
         """
-        still = self.radius == 0.0 and not any(self.tilt)
-        if self.ramp_time > 0.0 or self.angular_rate == 0.0 or still:
-            return np.zeros(0)
-        quarter = 0.5 * np.pi / abs(self.angular_rate)
-        return np.arange(0.0, end_time + 1e-12, quarter)
+        moves = self.radius != 0.0 or any(self.tilt)
+        return quarter_turn_times(end_time, self.angular_rate, self.ramp_time, moves)
 
     def phase(self, t):
         """Phase ``p`` [rad] and its first two time derivatives, each of t's shape (as the planar circle)."""
-        t = np.asarray(t, dtype=float)
-        rate = self.angular_rate
-        if self.ramp_time == 0.0:
-            return rate * t, np.full_like(t, rate), np.zeros_like(t)
-        ramp = self.ramp_time
-        tau = t / ramp
-        blend, blend_rate, _ = _quintic(tau)
-        return rate * ramp * _quintic_integral(np.maximum(tau, 0.0)), rate * blend, rate * blend_rate / ramp
+        return circle_phase(t, self.angular_rate, self.ramp_time)
 
     def pose(self, t):
         t, scalar = _times(t)

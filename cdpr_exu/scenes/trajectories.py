@@ -125,6 +125,29 @@ class Trajectory(ReferenceTrajectory):
         """Second derivative of the pose [m/s^2, m/s^2, rad/s^2]: shape (3,) or (N, 3)."""
 
 
+def circle_phase(t, angular_rate: float, ramp_time: float):
+    """Phase [rad] of a circle run at ``angular_rate`` [rad/s], and its first two time derivatives.
+
+    With ``ramp_time`` [s] > 0 the rate rises from 0 along the quintic blend (C2 from
+    rest); each output has t's shape.
+    """
+    t = np.asarray(t, dtype=float)
+    if ramp_time == 0.0:
+        return angular_rate * t, np.full_like(t, angular_rate), np.zeros_like(t)
+    tau = t / ramp_time
+    blend, blend_rate, _ = _quintic(tau)
+    return (angular_rate * ramp_time * _quintic_integral(np.maximum(tau, 0.0)), angular_rate * blend,
+            angular_rate * blend_rate / ramp_time)
+
+
+def quarter_turn_times(end_time: float, angular_rate: float, ramp_time: float, moves: bool) -> np.ndarray:
+    """Times [s] where a circle's phase is a multiple of pi/2, up to ``end_time``; none for a
+    ramped (no closed form), standing or motionless (``moves`` false) circle."""
+    if ramp_time > 0.0 or angular_rate == 0.0 or not moves:
+        return np.zeros(0)
+    return np.arange(0.0, end_time + 1e-12, 0.5 * np.pi / abs(angular_rate))
+
+
 @dataclass(frozen=True)
 class CircleTrajectory(Trajectory):
     """Circle ``x = c_x + R sin(theta)``, ``z = c_z - R cos(theta)`` at constant orientation.
@@ -171,21 +194,11 @@ class CircleTrajectory(Trajectory):
 
     def turning_times(self, end_time: float) -> np.ndarray:
         """Times where x or z is extreme: the phase at a multiple of pi/2 (no ramp), [s]."""
-        if self.ramp_time > 0.0 or self.angular_rate == 0.0 or self.radius == 0.0:
-            return np.zeros(0)
-        quarter = 0.5 * np.pi / abs(self.angular_rate)
-        return np.arange(0.0, end_time + 1e-12, quarter)
+        return quarter_turn_times(end_time, self.angular_rate, self.ramp_time, self.radius != 0.0)
 
     def phase(self, t):
         """Phase ``theta`` [rad] and its first two time derivatives, each of t's shape."""
-        t = np.asarray(t, dtype=float)
-        rate = self.angular_rate
-        if self.ramp_time == 0.0:
-            return rate * t, np.full_like(t, rate), np.zeros_like(t)
-        ramp = self.ramp_time
-        tau = t / ramp
-        blend, blend_rate, _ = _quintic(tau)
-        return rate * ramp * _quintic_integral(np.maximum(tau, 0.0)), rate * blend, rate * blend_rate / ramp
+        return circle_phase(t, self.angular_rate, self.ramp_time)
 
     def pose(self, t):
         t, scalar = _times(t)
