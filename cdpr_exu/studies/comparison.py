@@ -29,7 +29,7 @@ from controllers.tension_aware import ClosedLoopTensionAwareController, TensionA
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import fixed
 from cdpr_exu.results.result import Result, provenance
-from cdpr_exu.scenes.scene import Scene, load_scene
+from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
                                       ilc_controller, model_feed_forward_controller)
 
@@ -227,10 +227,9 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     check_output_folder(args.out)
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
-    spatial = load_any_scene(args.scene)
-    if is_spatial(spatial):
-        return _compare_spatial(spatial, args)
-    scene = load_scene(args.scene)
+    scene = load_any_scene(args.scene)
+    if is_spatial(scene):
+        return _compare_spatial(scene, args)
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
     started = smooth_start(scene, args.ramp_time)

@@ -315,13 +315,6 @@ def model_feed_forward(model: Scene, plant: Scene, law: LearningLaw = DEFAULT_LA
     return learning, simulate(plant, ReplayController(learning.table, name="model_feed_forward"))
 
 
-def controller_model(scene: Scene) -> Scene:
-    """The scene the controllers believe in for ``scene``: its ``[controller_model]``
-    applied (:meth:`Scene.controller_scene`), or ``scene`` itself without one.
-    ``model_feed_forward`` learns on it, then runs the plant open loop."""
-    return scene.controller_scene()
-
-
 class Learner:
     """Learns a :class:`~controllers.ilc.CommandTable` for a scene, for :class:`~controllers.ilc.LearnedController`.
 
@@ -329,7 +322,7 @@ class Learner:
     ----------
     on_model : bool
         False: the trials run on the compared scene itself (ILC on the plant). True:
-        on :func:`controller_model` of it (model-based feed-forward).
+        on :meth:`Scene.controller_scene` of it (model-based feed-forward).
     law : LearningLaw
     rule : StoppingRule
     after : float [s]
@@ -357,7 +350,7 @@ class Learner:
         """Learn the commands; ``scene`` is what the run hands its controllers (the controllers'
         model, :meth:`Scene.controller_scene`), so learning on the robot itself needs ``plant``."""
         if self.on_model:
-            target = controller_model(self.plant if self.plant is not None else scene)
+            target = (self.plant if self.plant is not None else scene).controller_scene()
         elif self.plant is not None:
             target = self.plant
         elif scene.controller_model is None:
@@ -384,7 +377,7 @@ def ilc_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT
 def model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
                                   after: float = 1.0, progress: bool = False,
                                   plant: Scene | None = None) -> LearnedController:
-    """``model_feed_forward`` for ``cdpr compare``: trials on :func:`controller_model` of the compared
+    """``model_feed_forward`` for ``cdpr compare``: trials on :meth:`Scene.controller_scene` of the compared
     scene, then the plant runs open loop with the best trial's commands."""
     return LearnedController("model_feed_forward", Learner(True, law, rule, after=after, progress=progress,
                                                            plant=plant))
@@ -396,7 +389,7 @@ def closed_loop_model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE,
                                               follow: str = "expected",
                                               plant: Scene | None = None) -> ClosedLoopController:
     """``closed_loop_model_feed_forward`` for ``cdpr compare``: the lengths learned on
-    :func:`controller_model` of the compared scene (as ``model_feed_forward``), with the
+    :meth:`Scene.controller_scene` of the compared scene (as ``model_feed_forward``), with the
     filtered PI position loop (:class:`~controllers.feedback.FilteredPositionPI`, the
     gains of ``closed_loop_tension_aware`` by default) around them on the plant.
 
