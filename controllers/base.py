@@ -169,6 +169,9 @@ class SmoothStart:
         if self._offset is None:
             raise RuntimeError("SmoothStart.reset(scene, initial_paid_out) must be called before command()")
         command = self.controller.command(measurement)
+        if measurement.time >= self.duration or not self._offset.any():
+            # the blend is over (s = 1, s' = 0) or there is nothing to blend: c(t) itself
+            return WinchCommand(np.asarray(command.paid_out, dtype=float), np.asarray(command.paid_out_rate, dtype=float))
         blend, rate = quintic_blend(measurement.time / self.duration)
         return WinchCommand(np.asarray(command.paid_out, dtype=float) + (1.0 - blend) * self._offset,
                             np.asarray(command.paid_out_rate, dtype=float) - rate / self.duration * self._offset)

@@ -290,3 +290,16 @@ def test_with_the_smooth_start_no_tension_only_element_goes_slack_in_the_first_s
     abrupt = simulate(scene.with_changes(trajectory=replace(scene.trajectory, ramp_time=0.0)), controller)
     # Measured 0.12 s and 0.16 s of slack in the first second.
     assert max(abrupt._slack_time(t, abrupt.time > 0.0) for t in abrupt.tensions) > 0.05
+
+
+def test_the_ideal_ik_table_lookup_is_np_interp_on_every_column():
+    # The controller reads its table once per step for all winches at once; it must give
+    # np.interp's numbers bit for bit (inside, on the samples, and past both ends).
+    from controllers.ideal_ik import table_lookup
+
+    rng = np.random.default_rng(3)
+    times = np.linspace(0.0, 10.0, 501)
+    table = rng.normal(size=(501, 3))
+    for t in np.concatenate([rng.uniform(-1.0, 11.0, 2000), times[::17], [0.0, 10.0]]):
+        expected = np.array([np.interp(t, times, column) for column in table.T])
+        assert np.array_equal(table_lookup(t, times, table), expected)

@@ -76,3 +76,34 @@ def test_fine_cables_get_the_sparse_jacobian_by_default():
     fine = paper.with_changes(cables=tuple(replace(c, n_elements=60) for c in paper.cables))
     functions = build_model(fine).cable_forces.user_functions
     assert functions[2].__name__ == "jacobian_function" and "_sparse_jacobian_function" in functions[2].__qualname__
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_fused_force_and_jacobian_are_the_separate_kernels_bit_for_bit(seed):
+    # One compiled call does the bending and the tension-only kernels in the same order:
+    # the same floating-point operations, so exactly the same numbers.
+    from cdpr_exu.physics import cable_forces
+
+    positions, velocities = _chain(seed)
+    joints = bending.cable_joints([6, 6])
+    stiffness, damping = np.full(len(joints), 1.96), np.full(len(joints), 0.4)
+    elements = axial.cable_elements([6, 6])
+    rest = np.full(len(elements), 0.24)  # some elements slack, some taut
+    k, c = np.full(len(elements), 4e5), np.full(len(elements), 3e2)
+    reference = positions - 0.01
+    q = positions - reference
+    size = positions.size
+    separate = bending.bending_force_kernel(reference + q, velocities, joints, stiffness, damping, np.zeros(size))
+    axial.slack_axial_force(reference + q, velocities, elements, rest, k, c, separate)
+    fused = cable_forces.cable_force(reference, q, velocities, np.zeros(size), joints, stiffness, damping,
+                                     elements, rest, k, c, np.zeros(size))
+    assert np.array_equal(fused, separate)
+    dense = np.zeros((size, size))
+    bending.bending_jacobian_kernel(reference + q, velocities, joints, stiffness, damping, 0.7, 0.003,
+                                    np.empty(0), dense, np.empty((0, 0)))
+    axial.slack_axial_jacobian(reference + q, velocities, elements, rest, k, c, 0.7, 0.003, dense)
+    fused_jacobian = cable_forces.cable_jacobian(reference, q, velocities, np.zeros(size), joints, stiffness,
+                                                 damping, elements, rest, k, c, 0.7, 0.003, np.empty(0),
+                                                 np.empty((0, 0)), np.zeros((size, size)))
+    assert np.array_equal(fused_jacobian, dense)
+    assert np.any(fused != 0.0) and np.any(fused_jacobian != 0.0)

@@ -23,6 +23,7 @@ import numpy as np
 
 from cdpr_exu.physics import axial
 from cdpr_exu.physics import bending
+from cdpr_exu.physics import cable_forces
 from cdpr_exu.scenes.scene import CableSpec, Effects, PulleySpec
 from cdpr_exu.physics import node_contact as node_contact_module
 from cdpr_exu.physics.node_contact import NodePulleyContact
@@ -198,7 +199,22 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         ])
     else:
         elements = np.zeros((0, 2), np.int64)
+        rest, axial_k, axial_c = np.zeros(0), np.zeros(0), np.zeros(0)
     positions = np.zeros(size)
+    fused = contact is None and node_contact is None
+    force_buffer = np.zeros(size)
+    jacobian_buffer = np.zeros((size, size))
+    no_force, no_matrix = np.zeros(0), np.zeros((0, 0))
+    joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
+
+    def fused_force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
+        # One compiled call (cable_forces): the same arithmetic as force_function below.
+        return cable_forces.cable_force(reference, np.asarray(q), np.asarray(q_t), positions, *joint_args,
+                                        force_buffer)
+
+    def fused_jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
+        return cable_forces.cable_jacobian(reference, np.asarray(q), np.asarray(q_t), positions, *joint_args,
+                                           float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer)
 
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         np.add(reference, q, out=positions)
@@ -226,7 +242,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         return jacobian
 
     nodes = [n for it in items for n in it.nodes]
-    functions = (force_function, jacobian_function)
+    functions = (fused_force_function, fused_jacobian_function) if fused else (force_function, jacobian_function)
     mass = np.zeros((size, size))
     if sparse_jacobian and contact is None and not linear:
         blocks = [_bending_blocks(spring)]
@@ -234,7 +250,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
             blocks.append(_slack_blocks(elements, rest, axial_k, axial_c))
         if node_contact is not None:
             blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
-        functions = (force_function, _sparse_jacobian_function(blocks, reference, positions))
+        functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions))
         mass = _sparse(np.zeros((size, size)))
     if linear and not effects.slack and contact is None and node_contact is None:
         # Nothing left for Python per Newton iteration: no force function, and a Jacobian

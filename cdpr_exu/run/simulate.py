@@ -26,7 +26,7 @@ from controllers.ideal_ik import IdealIKController
 from cdpr_exu.builder.cable import element_tensions
 from cdpr_exu.core.errors import RunInterrupted, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
-from cdpr_exu.core.geometry import penetration, segment_penetration
+from cdpr_exu.core.geometry import penetration
 from cdpr_exu.results.result import Result
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.builder.winch import RopeReservoir, servo_force, set_paid_out_length
@@ -135,14 +135,36 @@ MAX_PENETRATION_FRACTION = 0.5
 
 
 class _Monitor:
-    """Checks each recorded sample for states the model cannot describe."""
+    """Checks each recorded sample for states the model cannot describe.
+
+    All cables' elements are checked at once (one strain and one depth per element,
+    over flat arrays built here); the cable reported is the first that fails.
+    """
 
     def __init__(self, scene: Scene, indices: dict[str, np.ndarray], reference: np.ndarray):
         self.scene = scene
-        self.cables = [(cable, reference[indices[f"cable_{i}"]], indices[f"cable_{i}"])
-                       for i, cable in enumerate(scene.cables) if f"cable_{i}" in indices]
+        lumped = [i for i in range(len(scene.cables)) if f"cable_{i}" in indices]
+        self.cable_numbers = np.array(lumped, dtype=int)
         self.check_pulleys = scene.pulley_contact
         self.on_segments = scene.contact_model is not None and scene.contact_model.on_segments
+        # flat arrays over the lumped cables: node coordinates (N, 2), element ends (E,), per element
+        # its cable (position in ``lumped``), rest length [m], pulley centre [m] and radius [m]
+        self.node_index = (np.concatenate([indices[f"cable_{i}"] for i in lumped]) if lumped
+                           else np.zeros((0, 2), dtype=int))
+        self.reference_nodes = reference[self.node_index]
+        counts = [len(indices[f"cable_{i}"]) for i in lumped]
+        first_node = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int) if lumped else np.zeros(0, int)
+        self.start = np.concatenate([f + np.arange(n - 1) for f, n in zip(first_node, counts)]).astype(int) \
+            if lumped else np.zeros(0, int)
+        self.element_cable = np.concatenate([np.full(n - 1, k) for k, n in enumerate(counts)]).astype(int) \
+            if lumped else np.zeros(0, int)
+        self.first_element = np.concatenate([[0], np.cumsum([n - 1 for n in counts])[:-1]]).astype(int) \
+            if lumped else np.zeros(0, int)
+        self.rest = np.concatenate([np.full(scene.cables[i].n_elements, scene.cables[i].element_length)
+                                    for i in lumped]) if lumped else np.zeros(0)
+        if self.check_pulleys and lumped:
+            self.centers = np.array([scene.pulleys[i].center for i in lumped], dtype=float)[self.element_cable]
+            self.radii = np.array([scene.pulleys[i].radius for i in lumped], dtype=float)[self.element_cable]
         self.platform_index = indices["platform"]
         self.reference_pose = reference[self.platform_index]
         # No pose of a platform hung on these cables lies farther from every pulley
@@ -165,29 +187,41 @@ class _Monitor:
         """
         if not np.all(np.isfinite(q)):
             return f"the coordinates are no longer finite at t = {t:.4f} s"
-        for i, (cable, reference, idx) in enumerate(self.cables):
-            positions = reference + q[idx]
-            rest = np.full(cable.n_elements, cable.element_length)
+        if self.rest.size:
+            positions = self.reference_nodes + q[self.node_index]
+            a, b = positions[self.start], positions[self.start + 1]
+            chord = b - a
+            rest = self.rest
             if surplus is not None:
-                rest[0] += surplus[i]
-            strain = np.linalg.norm(np.diff(positions, axis=0), axis=1) / rest - 1.0
+                rest = rest.copy()
+                rest[self.first_element] += np.asarray(surplus)[self.cable_numbers]
+            strain = np.linalg.norm(chord, axis=1) / rest - 1.0
             if self.scene.effects.slack:
                 strain = np.maximum(strain, 0.0)  # a tension-only element may go slack: shortening is no fault
-            worst = int(np.argmax(np.abs(strain)))
-            if abs(strain[worst]) > MAX_STRAIN:
-                return (f"element {worst} of cable {i + 1} is strained by {100 * strain[worst]:+.4g} % at t = {t:.4f} s "
-                        f"(limit {100 * MAX_STRAIN:.0f} %): the run has left the model's valid range")
-            if self.check_pulleys:
-                pulley = self.scene.pulleys[i]
-                depth = segment_penetration(pulley, positions)
-                element = int(np.argmax(depth))
-                if depth[element] > MAX_PENETRATION_FRACTION * pulley.radius:
-                    advice = ("segment contact: the rim contact is too soft for the cable tension; raise "
-                              f"pulleys[{i}].contact_stiffness" if self.on_segments else
-                              "contact acts on nodes only; use more elements, or "
-                              "effects.pulley_contact_model = 'segment'")
-                    return (f"element {element} of cable {i + 1} cuts {1000 * depth[element]:.0f} mm deep into pulley {i + 1} "
-                            f"at t = {t:.4f} s: the cable is slipping through the pulley ({advice})")
+            strained = np.abs(strain) > MAX_STRAIN
+            cut = np.zeros_like(strained)
+            if self.check_pulleys:  # closest point of each element to its pulley centre
+                t_closest = np.clip(np.einsum("ij,ij->i", self.centers - a, chord)
+                                    / np.maximum(np.einsum("ij,ij->i", chord, chord), 1e-300), 0.0, 1.0)
+                distance = np.linalg.norm(a + t_closest[:, None] * chord - self.centers, axis=1)
+                depth = np.maximum(self.radii - distance, 0.0)
+                cut = depth > MAX_PENETRATION_FRACTION * self.radii
+            if strained.any() or cut.any():
+                k = int(self.element_cable[np.flatnonzero(strained | cut)[0]])  # the first cable that fails
+                i = int(self.cable_numbers[k])
+                mine = self.element_cable == k
+                if strained[mine].any():
+                    worst = int(np.argmax(np.abs(strain[mine])))
+                    value = strain[mine][worst]
+                    return (f"element {worst} of cable {i + 1} is strained by {100 * value:+.4g} % at t = {t:.4f} s "
+                            f"(limit {100 * MAX_STRAIN:.0f} %): the run has left the model's valid range")
+                element = int(np.argmax(depth[mine]))
+                advice = ("segment contact: the rim contact is too soft for the cable tension; raise "
+                          f"pulleys[{i}].contact_stiffness" if self.on_segments else
+                          "contact acts on nodes only; use more elements, or "
+                          "effects.pulley_contact_model = 'segment'")
+                return (f"element {element} of cable {i + 1} cuts {1000 * depth[mine][element]:.0f} mm deep into "
+                        f"pulley {i + 1} at t = {t:.4f} s: the cable is slipping through the pulley ({advice})")
         pose = self.reference_pose + q[self.platform_index]
         if np.any(pose[:2] < self.box[0]) or np.any(pose[:2] > self.box[1]):
             return (f"the platform left the reachable region at t = {t:.4f} s (it is at x = {pose[0]:.3f} m, "
@@ -335,8 +369,9 @@ class _Stepper:
         self.stop_exception: Exception | None = None
         self.interrupted = {"interrupted": False}
         self.reservoir = _rope_reservoir(scene, model)
-        self.first_nodes = ([self.indices[f"cable_{i}"][:2] for i in range(len(scene.cables))]
-                            if self.reservoir else [])
+        # coordinates of each cable's first two nodes, shape (m, 2, 2): its winch element
+        self.first_nodes = (np.array([self.indices[f"cable_{i}"][:2] for i in range(len(scene.cables))])
+                            if self.reservoir else np.zeros((0, 2, 2), dtype=int))
         self.drum_index = [model.mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
         self.servo_integral = np.zeros(len(model.servos))
         self.servo_time = 0.0
@@ -408,7 +443,10 @@ class _Stepper:
         targets = self.paid_out
         if self.reservoir is not None:  # slack rope paid out piles up at the drum (winch.reservoir_split)
             q = mbs_.systemData.GetODE2Coordinates()
-            lengths = np.array([np.linalg.norm(np.diff(self.ref_q[idx] + q[idx], axis=0)) for idx in self.first_nodes])
+            first = self.ref_q[self.first_nodes] + q[self.first_nodes]
+            chord = first[:, 1] - first[:, 0]
+            # |chord| as np.linalg.norm computes it (a dot product), for every cable at once
+            lengths = np.sqrt((chord[:, None, :] @ chord[:, :, None]).ravel())
             targets = model.initial_paid_out + self.reservoir.update(targets - model.initial_paid_out, lengths)
         for winch, length, initial in zip(model.winches, targets, model.initial_paid_out):
             set_paid_out_length(mbs_, winch, length, initial)
