@@ -153,8 +153,14 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
     element would collapse (and Newton with it when the cable snaps taut). So the winch
     node never moves where its element would be shorter than ``threshold`` of its
     nominal length: the rope that does not go into the node's motion is kept as
-    *surplus* at the drum, added to the first element's rest length. Hauling in takes up
-    the surplus first. Rope is conserved: ``node_offset + surplus == paid_out_change``.
+    *surplus* at the drum, added to the first element's rest length. Hauling in a slack
+    cable takes up the surplus first; once the cable is taut again (the first element at
+    or beyond its rest length, surplus included), the surplus is rope of that taut element
+    and hauling in moves the node. (Taking it up by shrinking the rest length of a taut
+    element instead strains that one element at the haul-in rate over its length; with
+    the paper's Kelvin-Voigt time constant d_n / E = 1 s the element then lags the
+    command by 1 s times the haul-in speed, 5 % of a 240th of the paper's cable, which
+    the run monitor refused.) Rope is conserved: ``node_offset + surplus == paid_out_change``.
 
     Parameters
     ----------
@@ -178,7 +184,8 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
         The new offset of the winch node and the new surplus (>= 0).
     """
     wanted = paid_out_change - surplus  # where the node goes if the surplus stays
-    node = wanted if wanted > node_offset else min(node_offset, paid_out_change)
+    taut = element_length >= rest_length + surplus
+    node = wanted if (wanted > node_offset or taut) else min(node_offset, paid_out_change)
     highest = node_offset + element_length - threshold * rest_length  # the first element at its shortest
     node = min(node, highest)
     return node, paid_out_change - node
