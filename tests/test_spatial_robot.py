@@ -112,6 +112,8 @@ def test_energy_without_damping_is_conserved_to_second_order_in_the_step(rigid):
     (dict(axial_damping_constant=-1.0), "axial_damping_constant"),
     (dict(flexural_rigidity=float("nan")), "flexural_rigidity"),
     (dict(anchor_spring_factor=0.0), "anchor_spring_factor"),
+    (dict(bending_damping_constant=-1.0), "bending_damping_constant"),
+    (dict(bending_damping_constant=0.5), "bending_damping_constant"),  # without bending
 ])
 def test_a_bad_chain_spec_is_refused_naming_the_field(fields, name):
     with pytest.raises(SceneError, match=name):

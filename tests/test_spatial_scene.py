@@ -152,3 +152,23 @@ def test_the_static_mode_reports_every_element_taut_on_the_shipped_robots():
         # the lowest of all elements (4 x 20 or 8 x 20): the four-cable robot's slackest cable
         # still carries about 10 N; nothing is compressed
         assert summary["min_element_tension_N"] > 5.0 and not summary["elements_pushed"], name
+
+
+def test_a_spatial_scene_gets_the_planar_bending_damping_constant_only_with_effects_bending_damping():
+    """c_theta = d_n J / l_e on every joint (the planar CableSpec.bending_damping); without
+    effects.bending_damping the chains have no dampers (and no cost for them)."""
+    import exudyn as exu
+
+    from cdpr_exu.builder.spatial_robot import build_spatial_robot
+
+    scene = load_spatial_scene("spatial-four-cable")
+    for damped in (True, False):
+        changed = replace(scene, effects=replace(scene.effects, bending_damping=damped))
+        mbs = exu.SystemContainer().AddSystem()
+        items = build_spatial_robot(mbs, changed.catenary_platform(), changed.unstrained_lengths, changed.chain_spec())
+        for cable, chain in zip(changed.cables, items.chains):
+            if damped:
+                assert chain.bending_damping == pytest.approx(np.full(len(chain.joints), cable.bending_damping),
+                                                              rel=1e-12)
+            else:
+                assert chain.bending_damping is None and chain.bending_stiffness is not None

@@ -6,6 +6,11 @@ with gravity along -z and the bending springs of :mod:`cdpr_exu.physics.bending_
 one ``ObjectGenericODE2`` whose Jacobian is sparse triplets. Its first node can be held
 (three coordinate constraints). Units SI; z up.
 
+With ``bending_damping > 0`` the joints also get the bending dampers of
+:mod:`cdpr_exu.physics.bending_3d` (on the neighbouring segments' relative angular
+velocity), in the same force function and the same 81 triplets per joint (their
+Jacobian has a velocity part, Exudyn's ``factorODE2_t``); without it they cost nothing.
+
 With ``tension_only=True`` there are no Exudyn spring-dampers: the axial elements are
 the tension-only ones of :mod:`cdpr_exu.physics.axial_3d` (a cable cannot push; a slack
 element carries nothing, not even damping) and join the bending springs in the one
@@ -48,6 +53,8 @@ class SpatialChainItems:
     bending_stiffness : ndarray, shape (J,) [N m/rad] or None
         The joints' stiffnesses, the very array the bending force reads (a winch that
         changes the cable's length scales it in place).
+    bending_damping : ndarray, shape (J,) [N m s/rad] or None
+        The joints' bending dampers, read the same way (None: no damper, no cost).
     generic : int or None
         The chain's ``ObjectGenericODE2`` (bending and/or tension-only axial elements; the
         same as ``bending`` when there is bending), None when there is none.
@@ -78,6 +85,7 @@ class SpatialChainItems:
     axial_damping: np.ndarray | None = None
     axial_rest_rate: np.ndarray | None = None
     holds: list = field(default_factory=list)
+    bending_damping: np.ndarray | None = None
 
     @property
     def tension_only(self) -> bool:
@@ -87,7 +95,8 @@ class SpatialChainItems:
 
 def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: np.ndarray, axial_stiffness: float,
                       axial_damping: float, bending_stiffness: float, gravity: float = 9.81,
-                      hold_first: bool = True, tension_only: bool = False) -> SpatialChainItems:
+                      hold_first: bool = True, tension_only: bool = False, bending_damping: float = 0.0,
+                      isotropic_bend: float | None = None) -> SpatialChainItems:
     """Add a chain through ``positions`` (N, 3) [m] (unstrained, at rest) to ``mbs``.
 
     Parameters
@@ -107,6 +116,11 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         ``ObjectGenericODE2`` instead of Exudyn's ``ObjectConnectorSpringDamper``
         (``springs`` stays empty; the arrays the kernels read are in the returned
         items' ``axial_rest_length``, ``axial_stiffness``, ``axial_damping``).
+    bending_damping : float [N m s/rad]
+        Of each joint (d_n J / l0, the planar model's c_theta); 0: no dampers. Needs bending.
+    isotropic_bend : float or None
+        The dampers' ``isotropic_bend`` (:func:`cdpr_exu.physics.bending_3d.add_spatial_bending_damping_force`);
+        None: :data:`cdpr_exu.physics.bending_3d.ISOTROPIC_BEND`.
     """
     positions = np.asarray(positions, dtype=float)
     nodes, masses, markers, springs, loads, holds = [], [], [], [], [], []
@@ -136,6 +150,9 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         return SpatialChainItems(nodes, masses, markers, springs, None, reference, joints, loads=loads, holds=holds)
     bending_joints = joints if bending else np.zeros((0, 3), dtype=np.int64)
     stiffness = np.full(len(bending_joints), float(bending_stiffness))
+    damped = bending and bending_damping > 0.0
+    damping = np.full(len(bending_joints), float(bending_damping)) if damped else None
+    bend = float(bending_3d.ISOTROPIC_BEND if isotropic_bend is None else isotropic_bend)
     if tension_only:
         elements = cable_elements([len(nodes)])
         rest = np.linalg.norm(np.diff(positions, axis=0), axis=1)
@@ -161,14 +178,19 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     def force_function(mbs_, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         np.add(reference, q, out=current)
         bending_3d.spatial_bending_force(current, bending_joints, stiffness, force)  # overwrites
+        if damped:
+            bending_3d.add_spatial_bending_damping_force(current, np.asarray(q_t), bending_joints, damping, bend, force)
         if tension_only:
             axial_3d.tension_only_force(current, np.asarray(q_t), elements, rest, axial_k, axial_c, rest_rate, force)
         return force
 
     def jacobian_function(mbs_, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
         np.add(reference, q, out=current)
-        triplets[:split, 2] = bending_3d.spatial_bending_stiffness(current, bending_joints, stiffness,
-                                                                   float(f_q), bending_values)
+        bending_3d.spatial_bending_stiffness(current, bending_joints, stiffness, float(f_q), bending_values)
+        if damped:
+            bending_3d.add_spatial_bending_damping_jacobian(current, np.asarray(q_t), bending_joints, damping, bend,
+                                                            float(f_q), float(f_q_t), bending_values)
+        triplets[:split, 2] = bending_values
         if tension_only:
             triplets[split:, 2] = axial_3d.tension_only_triplet_values(
                 current, np.asarray(q_t), elements, rest, axial_k, axial_c, rest_rate, float(f_q), float(f_q_t),
@@ -182,7 +204,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
                                                    forceUserFunction=force_function,
                                                    jacobianUserFunction=jacobian_function))
     common = dict(user_functions=(force_function, jacobian_function, container), loads=loads, holds=holds,
-                  bending_stiffness=stiffness if bending else None, generic=generic)
+                  bending_stiffness=stiffness if bending else None, generic=generic, bending_damping=damping)
     if not tension_only:
         return SpatialChainItems(nodes, masses, markers, springs, generic, reference, joints, **common)
     return SpatialChainItems(nodes, masses, markers, springs, generic if bending else None, reference, joints,

@@ -97,6 +97,10 @@ class SpatialChainSpec:
     flexural_rigidity : float [N m^2]
         ``E J``: joint bending stiffness ``k_theta = E J / l_e``; 0 for no bending
         (the catenary's cable).
+    bending_damping_constant : float [N m^2 s]
+        ``d_n J``: joint bending damping ``c_theta = d_n J / l_e`` (the planar model's), on
+        the segments' relative angular velocity (:mod:`cdpr_exu.physics.bending_3d`); 0 for
+        none. Needs ``flexural_rigidity > 0``.
     anchor_spring_factor : float or None
         None: the cable ends are held at the anchors by ``ObjectJointSpherical``
         (exact). A number ``f > 0``: by an ``ObjectConnectorCartesianSpringDamper`` of
@@ -117,6 +121,7 @@ class SpatialChainSpec:
     n_elements: int = 20
     axial_damping_constant: float = 0.0
     flexural_rigidity: float = 0.0
+    bending_damping_constant: float = 0.0
     anchor_spring_factor: float | None = None
     tension_only: bool = False
     mass_lumping: str = "consistent"
@@ -135,6 +140,10 @@ class SpatialChainSpec:
         object.__setattr__(self, "axial_damping_constant",
                            non_negative("axial_damping_constant", self.axial_damping_constant))
         object.__setattr__(self, "flexural_rigidity", non_negative("flexural_rigidity", self.flexural_rigidity))
+        object.__setattr__(self, "bending_damping_constant",
+                           non_negative("bending_damping_constant", self.bending_damping_constant))
+        if self.bending_damping_constant > 0.0 and self.flexural_rigidity == 0.0:
+            raise SceneError("bending_damping_constant needs bending: flexural_rigidity must be positive, got 0")
         if self.anchor_spring_factor is not None:
             factor = positive("anchor_spring_factor", self.anchor_spring_factor)
             object.__setattr__(self, "anchor_spring_factor", factor)
@@ -155,6 +164,8 @@ class SpatialRobotItems:
         Lumped masses of each chain's nodes [kg].
     axial_stiffnesses, axial_dampings, bending_stiffnesses : ndarray, shape (n_cables,)
         Per element [N/m], [N s/m] and per joint [N m/rad].
+    bending_dampings : ndarray, shape (n_cables,)
+        Per joint [N m s/rad] (zeros without bending damping).
     platform_node : int
         ``NodePoint`` (point mass) or ``NodeRigidBodyEP`` (rigid body).
     platform_body : int
@@ -189,6 +200,7 @@ class SpatialRobotItems:
     swivels: list = field(default_factory=list)
     swivel_pulleys: list = field(default_factory=list)
     winch_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    bending_dampings: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def has_swivel(self, cable):
         """True when ``cable`` leaves over a swivel pulley."""
@@ -315,13 +327,14 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     axial_stiffnesses = np.array([c.axial_stiffness for c in platform.cables]) / element_lengths
     axial_dampings = chain.axial_damping_constant / element_lengths
     bending_stiffnesses = chain.flexural_rigidity / element_lengths
+    bending_dampings = chain.bending_damping_constant / element_lengths
 
     from cdpr_exu.builder.swivel_chain import add_swivel_pulley  # Exudyn items of the disc and psi
 
     chains, node_masses, swivel_items, swivel_pulleys, winch_elements = [], [], [], [], []
-    for cable, length, equilibrium_cable, k, c, k_theta, swivel in zip(
+    for cable, length, equilibrium_cable, k, c, k_theta, c_theta, swivel in zip(
             platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses,
-            swivels):
+            bending_dampings, swivels):
         element_mass = chain_element_mass(cable, length, n, gravity)
         below = 0 if swivel is None else max(2, int(round(swivel.winch_line / (length / n))))
         masses = node_masses_along(n + below, element_mass, chain.mass_lumping)
@@ -331,7 +344,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
             reference, current = _swivel_chain_positions(equilibrium_cable, length, n, below,
                                                          swivel.contact_stiffness)
         items = add_spatial_chain(mbs, reference, masses, float(k), float(c), float(k_theta), gravity=gravity,
-                                  hold_first=True, tension_only=chain.tension_only)
+                                  hold_first=True, tension_only=chain.tension_only, bending_damping=float(c_theta))
         for node, displacement in zip(items.nodes, current - reference):
             mbs.SetNodeParameter(node, "initialCoordinates", [float(x) for x in displacement])
         if swivel is None:
@@ -374,7 +387,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
                 markerNumbers=markers, stiffness=[stiffness] * 3, damping=[0.0] * 3)))
     return SpatialRobotItems(platform, lengths, chain, chains, node_masses, axial_stiffnesses, axial_dampings,
                              bending_stiffnesses, platform_node, platform_body, anchor_markers, joints, initial,
-                             swivel_items, swivel_pulleys, np.array(winch_elements, dtype=int))
+                             swivel_items, swivel_pulleys, np.array(winch_elements, dtype=int), bending_dampings)
 
 
 # ---------------------------------------------------------------------------

@@ -15,7 +15,7 @@ the pulley's axis instead, :mod:`cdpr_exu.builder.spatial_robot`). The lumped ca
 its n elements and changes with its paid-out (unstrained) length L(t): every element's
 unstrained length L / n, its axial stiffness E A n / L and damping d_n A n / L, the node
 masses rho L / n (half at the ends) and their weights, and the bending stiffness
-E J n / L, set before every step. This is a *variable-length* lumped cable: its
+E J n / L and damping d_n J n / L, set before every step. This is a *variable-length* lumped cable: its
 statics are those of the elastic catenary of length L (which depends on L only, not on
 where along the cable the change happens), and its mass is the mass of the cable paid
 out. What it leaves out is the flow of material through the exit: the nodes slide
@@ -273,6 +273,8 @@ class _SpatialWinches:
                     mbs.SetLoadParameter(load, "loadVector", [0.0, 0.0, -float(mass) * self.gravity])
             if chain.bending_stiffness is not None:
                 chain.bending_stiffness[:] = items.bending_stiffnesses[i] * items.unstrained_lengths[i] / self.n / element
+            if chain.bending_damping is not None:
+                chain.bending_damping[:] = items.bending_dampings[i] * items.unstrained_lengths[i] / self.n / element
             self.applied[i] = length
 
 

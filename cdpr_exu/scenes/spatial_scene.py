@@ -403,6 +403,8 @@ class SpatialScene:
             n_elements=cable.n_elements,
             axial_damping_constant=cable.damping_constant * cable.area if self.effects.axial_damping else 0.0,
             flexural_rigidity=cable.youngs_modulus * cable.second_moment if self.effects.bending else 0.0,
+            bending_damping_constant=(cable.damping_constant * cable.second_moment
+                                      if self.effects.bending and self.effects.bending_damping else 0.0),
             anchor_spring_factor=anchor_spring_factor, mass_lumping=cable.mass_lumping)
 
 
