@@ -33,8 +33,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from cdpr_exu.core.output import write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, settle, solve_static, \
-    swivel_angles
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static, \
+    start_at_rest, swivel_angles
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.spatial_scene import SpatialScene
@@ -159,7 +159,7 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary, swivels=scene.swivel_exits)
     mbs.Assemble()
     if scene.swivels:
-        settle(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley
+        start_at_rest(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley
     static = solve_static(mbs, items)
     nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
     tensions = tuple(element_forces(mbs, items, i) for i in range(scene.n_cables))

@@ -41,7 +41,7 @@ from matplotlib.figure import Figure
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import write_npz, write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose, settle
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose, start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
@@ -335,7 +335,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     mbs.Assemble()
     if scene.swivels:
         _warn_outside_measured_region(scene)
-        settle(mbs, items)  # from the catenary shape, the wrap's chords first find their rest (spatial_robot.settle)
+        start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
