@@ -50,7 +50,9 @@ moves the held end along the axis (``SpatialChainItems.holds``), as the planar w
 moves its node along the winch line, so cable flows over the pulley. The chain starts
 on the catenary statics' shape: the winch line stretched under the tension at the
 tangent point less its own weight, the wrap on the groove bottom, psi at the anchor's
-azimuth.
+azimuth. From there :func:`start_at_rest` brings the robot to its static equilibrium by the
+chain statics (:mod:`cdpr_exu.statics.spatial_chain_statics`, on the same discrete model,
+:func:`chain_statics_robot`): Exudyn's static solver does not converge from that start.
 
 Units SI, z up, gravity along -z. The parameters are those of
 :mod:`cdpr_exu.physics.spatial_statics` (:class:`SpatialPlatform`, the unstrained
@@ -517,6 +519,11 @@ SETTLE_TIME, SETTLE_STEP = 0.5, 5.0e-3
 
 def settle(mbs, items, duration=SETTLE_TIME, step_size=SETTLE_STEP):
     """Let the assembled robot come to rest from its initial configuration, then make that its start (at rest).
+
+    The fallback of :func:`start_at_rest`, which finds the same equilibrium by the chain
+    statics in a fraction of the time (spatial-four-cable-swivel with bending and
+    tension-only elements: 0.07 s of CPU time against this settle's 15 s, the two states
+    3e-10 apart; benchmarks/results/swivel_start.md).
 
     Exudyn's static solver does not converge from the catenary start of a cable over a
     swivel pulley (measured on spatial-four-cable-swivel at 24 and 48 elements: the

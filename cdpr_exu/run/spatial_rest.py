@@ -7,7 +7,11 @@
   pose from the cables' unstrained lengths (no bending);
 * the **lumped robot in Exudyn** (:mod:`cdpr_exu.builder.spatial_robot`): the scene's
   chains with its effects (bending included), started on the catenary solution and
-  brought to equilibrium by Exudyn's static solver (``mbs.SolveStatic``).
+  brought to equilibrium by Exudyn's static solver (``mbs.SolveStatic``). Over swivel
+  pulleys, where Exudyn's static solver does not converge from the catenary start, the
+  chain statics (:mod:`cdpr_exu.statics.spatial_chain_statics`, the same discrete model)
+  first take it to equilibrium (:func:`cdpr_exu.builder.spatial_robot.start_at_rest`),
+  and Exudyn's static solver confirms it.
 
 and reports the lumped robot's pose (position, rotation vector and the rotation as
 angles), its tensions and end forces, and how far the catenary answer lies from it
@@ -111,7 +115,9 @@ class SpatialRest:
             "scene": self.scene.name,
             "dimension": 3,
             "method": f"Exudyn static solver on the lumped robot ({self.scene.cables[0].n_elements} elements per "
-                      f"cable, {self.anchor_joint}), started on the elastic-catenary statics",
+                      f"cable, {self.anchor_joint}), started on the elastic-catenary statics"
+                      + (" and, over swivel pulleys, on the chain statics' equilibrium from there"
+                         if self.scene.swivels else ""),
             "platform_position_m": self.position.tolist(),
             "platform_rotation_vector_rad": self.rotation_vector.tolist(),
             "platform_roll_pitch_yaw_deg": rotation_angles_deg(self.rotation).tolist(),

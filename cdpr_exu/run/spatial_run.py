@@ -2,7 +2,9 @@
 
 :func:`simulate_spatial` builds the scene's robot (:mod:`cdpr_exu.builder.spatial_robot`:
 chains held at their exit points, a point-mass or rigid platform on spherical joints),
-starts it at rest on its elastic-catenary equilibrium, and integrates it with Exudyn's
+starts it at rest on its elastic-catenary equilibrium (over swivel pulleys on the lumped
+robot's own equilibrium, found by the chain statics:
+:func:`cdpr_exu.builder.spatial_robot.start_at_rest`), and integrates it with Exudyn's
 implicit solver (the scene's ``[solver]``) while the winches follow the ideal inverse
 kinematics of the reference: each cable's paid-out length is its initial length plus
 the change of the straight distance from its exit point to its anchor along the
