@@ -50,7 +50,9 @@ moves the held end along the axis (``SpatialChainItems.holds``), as the planar w
 moves its node along the winch line, so cable flows over the pulley. The chain starts
 on the catenary statics' shape: the winch line stretched under the tension at the
 tangent point less its own weight, the wrap on the groove bottom, psi at the anchor's
-azimuth.
+azimuth. From there :func:`start_at_rest` brings the robot to its static equilibrium by the
+chain statics (:mod:`cdpr_exu.statics.spatial_chain_statics`, on the same discrete model,
+:func:`chain_statics_robot`): Exudyn's static solver does not converge from that start.
 
 Units SI, z up, gravity along -z. The parameters are those of
 :mod:`cdpr_exu.physics.spatial_statics` (:class:`SpatialPlatform`, the unstrained
@@ -64,7 +66,6 @@ their initial displacements put the nodes on the catenary.
 
 from __future__ import annotations
 
-import math
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -72,9 +73,9 @@ from dataclasses import dataclass, field
 import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
-from exudyn.rigidBodyUtilities import RigidBodyInertia
+from exudyn.rigidBodyUtilities import RigidBodyInertia, RotationMatrix2EulerParameters
 
-from cdpr_exu.core.errors import SceneError, SolverFailure
+from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.validation import non_negative, positive
 
 from cdpr_exu.physics import axial_3d
@@ -82,6 +83,8 @@ from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chai
 from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.physics.spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, chain_element_mass, \
     node_masses_along, solve_spatial_statics
+from cdpr_exu.statics.spatial_chain_statics import SpatialChainCable, SpatialChainRobot, solve_spatial_chain_statics, \
+    swivel_chain_start, winch_line_elements
 
 
 @dataclass(frozen=True)
@@ -223,48 +226,6 @@ def _chain_positions(equilibrium_cable, length, n_elements):
     return reference, current
 
 
-def _swivel_chain_positions(equilibrium_cable, length, n_elements, winch_elements, contact_stiffness):
-    """Straight unstrained reference (winch end first) and the catenary statics' node positions of a
-    cable over a swivel pulley, shape (k + n + 1, 3) each, k = ``winch_elements``.
-
-    From the anchor: the catenary up to the tangent point; then the wrap as the lumped
-    cable lies on it, a polygon of chords of the stretched element length (on the arc
-    instead, each chord is short by r_p theta^3 / 24 and pushes with up to 3 kN at
-    l_e = r_p: Newton then diverged), each node inside the groove by the depth that carries
-    its share of the pressure, ``T l_e / (r_p k_p)`` (on the rim itself psi has no stiffness:
-    Exudyn's static solver met a singular matrix); then down the axis to the winch end.
-    The tension is the catenary's at the tangent point (frictionless wrap, its weight
-    left out, as in the statics).
-    """
-    element = length / n_elements
-    inlet = equilibrium_cable.inlet
-    axial = equilibrium_cable.cable.axial_stiffness
-    tension = equilibrium_cable.tension_at_exit
-    radius = equilibrium_cable.pulley_radius
-    direction = equilibrium_cable.horizontal_direction
-    suspended = equilibrium_cable.suspended_length
-    arcs = length - element * np.arange(-winch_elements, n_elements + 1)  # unstrained, from the anchor
-    hanging = arcs <= suspended
-    current = np.empty((len(arcs), 3))
-    current[hanging] = equilibrium_cable.points(arcs[hanging])
-    stretched = element * (1.0 + tension / axial)
-    chord_angle = 2.0 * math.asin(min(1.0, stretched / (2.0 * radius)))  # rim angle per element
-    angle = math.pi - equilibrium_cable.wrap_angle + (arcs[~hanging] - suspended) / element * chord_angle
-    depth = tension * stretched / (radius * contact_stiffness)
-    centre = inlet + radius * direction
-    rim = centre + np.outer((radius - depth) * np.cos(angle), direction) + np.outer((radius - depth) * np.sin(angle), _E_Z)
-    axis = inlet - np.outer((angle - math.pi) / chord_angle * stretched, _E_Z)
-    current[~hanging] = np.where((angle <= math.pi)[:, None], rim, axis)
-    # the winch end on the axis, below the inlet by the winch line stretched under the tension at
-    # the inlet less its own weight: where the paid-out length puts it, whatever the polygon
-    weight = equilibrium_cable.cable.weight_per_length
-    below = element * winch_elements
-    current[0] = inlet - (below * (1.0 + tension / axial) - weight * below**2 / (2.0 * axial)) * _E_Z
-    reference = current[0] + np.outer(element * np.arange(len(current)), _E_Z)
-    return reference, current
-
-
-_E_Z = np.array([0.0, 0.0, 1.0])
 
 
 def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None, swivels=None):
@@ -336,13 +297,12 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
             platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses,
             bending_dampings, swivels):
         element_mass = chain_element_mass(cable, length, n, gravity)
-        below = 0 if swivel is None else max(2, int(round(swivel.winch_line / (length / n))))
+        below = 0 if swivel is None else winch_line_elements(swivel.winch_line, length / n)
         masses = node_masses_along(n + below, element_mass, chain.mass_lumping)
         if swivel is None:
             reference, current = _chain_positions(equilibrium_cable, length, n)
         else:
-            reference, current = _swivel_chain_positions(equilibrium_cable, length, n, below,
-                                                         swivel.contact_stiffness)
+            reference, current = swivel_chain_start(equilibrium_cable, length, n, below, swivel.contact_stiffness)
         items = add_spatial_chain(mbs, reference, masses, float(k), float(c), float(k_theta), gravity=gravity,
                                   hold_first=True, tension_only=chain.tension_only, bending_damping=float(c_theta))
         for node, displacement in zip(items.nodes, current - reference):
@@ -573,6 +533,11 @@ SETTLE_TIME, SETTLE_STEP = 0.5, 5.0e-3
 def settle(mbs, items, duration=SETTLE_TIME, step_size=SETTLE_STEP):
     """Let the assembled robot come to rest from its initial configuration, then make that its start (at rest).
 
+    The fallback of :func:`start_at_rest`, which finds the same equilibrium by the chain
+    statics in a fraction of the time (spatial-four-cable-swivel with bending and
+    tension-only elements: 0.07 s of CPU time against this settle's 15 s, the two states
+    3e-10 apart; benchmarks/results/swivel_start.md).
+
     Exudyn's static solver does not converge from the catenary start of a cable over a
     swivel pulley (measured on spatial-four-cable-swivel at 24 and 48 elements: the
     first Newton step raised the residual 300-fold, psi held or not); after this settle
@@ -627,6 +592,135 @@ def _start_at_rest(mbs):
     mbs.systemData.SetODE2Coordinates_t(np.zeros_like(state), exu.ConfigurationType.Current)
     mbs.systemData.SetTime(0.0, exu.ConfigurationType.Initial)
     return state
+
+
+def chain_statics_robot(mbs, items) -> SpatialChainRobot:
+    """The chain statics' model (:mod:`cdpr_exu.statics.spatial_chain_statics`) of a built robot, read from its items:
+    the same node masses, element stiffnesses, bending, tension-only law, held first nodes (a swivel
+    cable's winch end where the builder holds it), swivel pulleys and anchor joints.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        Assembled; the first nodes are held where its initial configuration has them.
+    items : SpatialRobotItems
+    """
+    platform, chain = items.platform, items.chain
+    cables = []
+    for i, cable in enumerate(platform.cables):
+        held = chain_positions(mbs, items, i, current=False)[0]
+        cables.append(SpatialChainCable(
+            exit_point=held, node_masses=tuple(float(m) for m in items.node_masses[i]),
+            element_length=float(items.unstrained_lengths[i]) / chain.n_elements,
+            axial_stiffness=float(items.axial_stiffnesses[i]), bending_stiffness=float(items.bending_stiffnesses[i]),
+            slack=chain.tension_only, anchor=cable.anchor,
+            swivel=items.swivel_pulleys[i] if items.has_swivel(i) else None,
+            winch_elements=int(items.winch_elements[i]) if items.has_swivel(i) else 0))
+    return SpatialChainRobot(tuple(cables), platform.mass, platform.gravity, chain.anchor_spring_factor)
+
+
+def set_configuration(mbs, items, equilibrium):
+    """Put the assembled robot at rest in a chain-statics equilibrium, as its initial and current configuration.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        Assembled.
+    items : SpatialRobotItems
+    equilibrium : SpatialChainEquilibrium
+        Of :func:`chain_statics_robot` (the nodes, the platform's pose and the swivel angles).
+    """
+    q = np.array(mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Initial))
+    for spec, nodes in zip(items.chains, equilibrium.nodes):
+        displacement = np.asarray(nodes, float).ravel() - spec.reference
+        for k, node in enumerate(spec.nodes):
+            index = mbs.GetNodeODE2Index(node)
+            q[index:index + 3] = displacement[3 * k:3 * k + 3]
+    for swivel, psi in zip(items.swivels or [], equilibrium.swivel_angles):
+        if swivel is not None:
+            q[mbs.GetNodeODE2Index(swivel.node)] = float(psi) - swivel.psi_reference
+    index = mbs.GetNodeODE2Index(items.platform_node)
+    reference = np.asarray(mbs.GetNodeParameter(items.platform_node, "referenceCoordinates"), float)
+    q[index:index + 3] = np.asarray(equilibrium.position, float) - reference[:3]
+    if not items.is_point_mass:
+        parameters = np.asarray(RotationMatrix2EulerParameters(np.asarray(equilibrium.rotation, float)), float)
+        if float(parameters @ reference[3:7]) < 0.0:
+            parameters = -parameters  # the same rotation, nearest the reference
+        q[index + 3:index + 7] = parameters - reference[3:7]
+    mbs.systemData.SetODE2Coordinates(q, exu.ConfigurationType.Current)
+    _start_at_rest(mbs)
+
+
+@dataclass(frozen=True, eq=False)
+class RestStart:
+    """How :func:`start_at_rest` brought the robot to rest.
+
+    Attributes
+    ----------
+    method : str
+        "chain statics" (the chain statics' equilibrium, polished by Exudyn's static solver
+        where it applies) or "dynamic settle" (the fallback, :func:`settle`).
+    statics : SpatialChainEquilibrium or None
+        The chain statics' answer (None after the fallback).
+    polish_shift : float or None [m, rad]
+        Largest change of any coordinate by Exudyn's static solver from the chain statics'
+        equilibrium (None: not polished).
+    """
+
+    method: str
+    statics: object
+    polish_shift: float | None
+
+
+def start_at_rest(mbs, items, max_iterations: int = 100) -> RestStart:
+    """Bring the assembled robot to its static equilibrium by the chain statics and make that its start (at rest).
+
+    The chain statics (:func:`cdpr_exu.statics.spatial_chain_statics.solve_spatial_chain_statics`
+    on :func:`chain_statics_robot`, the same discrete model, started where the builder
+    started Exudyn's) solve the robot over swivel pulleys, where Exudyn's static solver
+    does not converge from the catenary start; then Exudyn's static solver polishes that
+    state (on spatial-four-cable-swivel it converges at once and moves no coordinate by
+    more than 1e-15, measured), except on a rigid platform held by exact spherical joints,
+    where it is known to diverge (the module notes) and the chain statics' answer is the
+    start. If the chain statics fail, the dynamic :func:`settle` is the fallback, with a
+    ``RuntimeWarning`` that says so; if the polish fails, the chain statics' state stays the
+    start, with a ``RuntimeWarning``.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        Assembled, in its initial (catenary) configuration.
+    items : SpatialRobotItems
+    max_iterations : int
+        Of the chain statics' Newton iteration (the shipped swivel scene takes 12 to 15).
+
+    Returns
+    -------
+    RestStart
+    """
+    robot = chain_statics_robot(mbs, items)
+    start = ([chain_positions(mbs, items, i, current=False) for i in range(len(items.chains))],
+             *platform_pose(mbs, items, current=False), swivel_angles(mbs, items, current=False))
+    try:
+        statics = solve_spatial_chain_statics(robot, *start, max_iterations=max_iterations)
+    except UnreachableError as failure:
+        warnings.warn(f"the chain statics found no equilibrium ({failure}); the robot is brought to rest by the "
+                      "dynamic settle instead (slower)", RuntimeWarning, stacklevel=2)
+        settle(mbs, items)
+        return RestStart("dynamic settle", None, None)
+    set_configuration(mbs, items, statics)
+    if not items.is_point_mass and items.chain.anchor_spring_factor is None:
+        return RestStart("chain statics", statics, None)  # Exudyn's static solver diverges on these joints
+    before = np.asarray(mbs.systemData.GetODE2Coordinates())
+    try:
+        solve_static(mbs, items)
+    except SolverFailure as failure:
+        set_configuration(mbs, items, statics)
+        warnings.warn(f"Exudyn's static solver did not confirm the chain statics' equilibrium ({failure}); the robot "
+                      "starts from the chain statics' state", RuntimeWarning, stacklevel=2)
+        return RestStart("chain statics", statics, None)
+    after = _start_at_rest(mbs)
+    return RestStart("chain statics", statics, float(np.abs(after - before).max()))
 
 
 def solve_static(mbs, items, settings=None):

@@ -7,7 +7,11 @@
   pose from the cables' unstrained lengths (no bending);
 * the **lumped robot in Exudyn** (:mod:`cdpr_exu.builder.spatial_robot`): the scene's
   chains with its effects (bending included), started on the catenary solution and
-  brought to equilibrium by Exudyn's static solver (``mbs.SolveStatic``).
+  brought to equilibrium by Exudyn's static solver (``mbs.SolveStatic``). Over swivel
+  pulleys, where Exudyn's static solver does not converge from the catenary start, the
+  chain statics (:mod:`cdpr_exu.statics.spatial_chain_statics`, the same discrete model)
+  first take it to equilibrium (:func:`cdpr_exu.builder.spatial_robot.start_at_rest`),
+  and Exudyn's static solver confirms it.
 
 and reports the lumped robot's pose (position, rotation vector and the rotation as
 angles), its tensions and end forces, and how far the catenary answer lies from it
@@ -33,8 +37,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from cdpr_exu.core.output import write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, settle, solve_static, \
-    swivel_angles
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static, \
+    start_at_rest, swivel_angles
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.spatial_scene import SpatialScene
@@ -111,7 +115,9 @@ class SpatialRest:
             "scene": self.scene.name,
             "dimension": 3,
             "method": f"Exudyn static solver on the lumped robot ({self.scene.cables[0].n_elements} elements per "
-                      f"cable, {self.anchor_joint}), started on the elastic-catenary statics",
+                      f"cable, {self.anchor_joint}), started on the elastic-catenary statics"
+                      + (" and, over swivel pulleys, on the chain statics' equilibrium from there"
+                         if self.scene.swivels else ""),
             "platform_position_m": self.position.tolist(),
             "platform_rotation_vector_rad": self.rotation_vector.tolist(),
             "platform_roll_pitch_yaw_deg": rotation_angles_deg(self.rotation).tolist(),
@@ -159,7 +165,7 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary, swivels=scene.swivel_exits)
     mbs.Assemble()
     if scene.swivels:
-        settle(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley
+        start_at_rest(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley
     static = solve_static(mbs, items)
     nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
     tensions = tuple(element_forces(mbs, items, i) for i in range(scene.n_cables))

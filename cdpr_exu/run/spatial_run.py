@@ -2,7 +2,9 @@
 
 :func:`simulate_spatial` builds the scene's robot (:mod:`cdpr_exu.builder.spatial_robot`:
 chains held at their exit points, a point-mass or rigid platform on spherical joints),
-starts it at rest on its elastic-catenary equilibrium, and integrates it with Exudyn's
+starts it at rest on its elastic-catenary equilibrium (over swivel pulleys on the lumped
+robot's own equilibrium, found by the chain statics:
+:func:`cdpr_exu.builder.spatial_robot.start_at_rest`), and integrates it with Exudyn's
 implicit solver (the scene's ``[solver]``) while the winches follow the ideal inverse
 kinematics of the reference: each cable's paid-out length is its initial length plus
 the change of the straight distance from its exit point to its anchor along the
@@ -41,7 +43,7 @@ from matplotlib.figure import Figure
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import write_npz, write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose, settle
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose, start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
@@ -337,7 +339,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     mbs.Assemble()
     if scene.swivels:
         _warn_outside_measured_region(scene)
-        settle(mbs, items)  # from the catenary shape, the wrap's chords first find their rest (spatial_robot.settle)
+        start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)

@@ -9,34 +9,54 @@ This module solves that discrete model at rest, without Exudyn, as the spatial a
 of :mod:`cdpr_exu.statics.chain_statics` (forward problem: the unstrained lengths given,
 the pose found):
 
-* each cable's first node is held at its exit point (point exits only; swivel pulleys
-  are refused), its last node sits at the platform anchor (an exact spherical joint) or
-  is tied to it by a stiff isotropic penalty spring (``anchor_spring_factor``, what the
-  static mode of :mod:`cdpr_exu.run.spatial_rest` uses on a rigid platform);
+* each cable's first node is held at its exit point, or, over a swivel pulley, at its
+  winch end on the pulley's vertical axis below the inlet (the cable then runs up the
+  axis, over the disc and down to the anchor, as the builder makes it); its last node
+  sits at the platform anchor (an exact spherical joint) or is tied to it by a stiff
+  isotropic penalty spring (``anchor_spring_factor``, what the static mode of
+  :mod:`cdpr_exu.run.spatial_rest` uses on a rigid platform);
 * unknowns: the free node positions, the platform position and, for a rigid platform,
-  its rotation (updated multiplicatively, ``R <- exp([d]x) R``);
-* the total potential: axial springs ``k (|d| - l0)^2 / 2`` (zero in compression when
-  the elements are tension-only), bending ``k_theta theta^2 / 2``, node and platform
-  weights along -z, and the penalty springs, is minimised by Newton's method with its
-  analytic Hessian and a backtracking line search on the energy.
+  its rotation (updated multiplicatively, ``R <- exp([d]x) R``), and each swivel
+  pulley's angle psi (its turn about the vertical axis);
+* the total potential: axial springs ``k (|d| - l0)^2 / 2`` (tension-only elements: the
+  dynamic model's law, :func:`cdpr_exu.physics.axial_3d.tension_only_energy`, zero below
+  the rest length and a C1 smoothstep over a strain of 1e-5), bending
+  ``k_theta theta^2 / 2``, node and platform weights along -z, the penalty springs, and
+  the swivel pulleys' contact potential (:func:`cdpr_exu.physics.swivel_pulley.swivel_contact_energy`,
+  every node of a swivel cable may touch its disc, as in the builder), is minimised by
+  Newton's method with its analytic (sparse) Hessian and a backtracking line search on
+  the energy. The contact's and the tension-only elements' gradients and Hessians are the
+  dynamic model's own kernels at zero velocity (their force and ``-df/dq``), not copies.
+
+Why it exists for swivel pulleys: Exudyn's static solver does not converge from the
+catenary start over a swivel pulley (:func:`cdpr_exu.builder.spatial_robot.settle`);
+Newton on the energy with a line search does, and its answer is the start of runs and of
+the static mode on swivel scenes (:func:`cdpr_exu.builder.spatial_robot.start_at_rest_on`).
 
 The equilibrium at rest needs no damping. Units SI (m, N, kg, rad); z up, gravity -z.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sparse
+import scipy.sparse.linalg as sparse_linalg
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector, skew
 from cdpr_exu.core.validation import finite, vector
-from cdpr_exu.physics import bending_3d
+from cdpr_exu.physics import axial_3d, bending_3d
+from cdpr_exu.physics import swivel_pulley as sp
 from cdpr_exu.physics.spatial_statics import chain_element_mass, node_masses_along, solve_spatial_statics
 
 __all__ = ["SpatialChainCable", "SpatialChainRobot", "SpatialChainEquilibrium", "spatial_chain_robot",
-           "solve_spatial_chain_statics", "catenary_start", "spatial_chain_statics"]
+           "solve_spatial_chain_statics", "catenary_start", "spatial_chain_statics", "swivel_chain_start",
+           "winch_line_elements"]
+
+_E_Z = np.array([0.0, 0.0, 1.0])
 
 
 @dataclass(frozen=True)
@@ -46,7 +66,8 @@ class SpatialChainCable:
     Parameters
     ----------
     exit_point : (x, y, z) [m]
-        Where node 0 is held (a point exit), world frame.
+        Where node 0 is held, world frame: the exit point, or over a swivel pulley the
+        winch end on the pulley's vertical axis below its inlet.
     node_masses : tuple of float, length n + 1 [kg]
         Exit node first (its weight is carried by the frame).
     element_length : float [m]
@@ -59,6 +80,11 @@ class SpatialChainCable:
         Tension-only elements.
     anchor : (x, y, z) [m]
         Anchor in the platform frame (centre of mass at 0).
+    swivel : SwivelPulley or None
+        The swivel pulley the cable runs over (:class:`cdpr_exu.physics.swivel_pulley.SwivelPulley`);
+        None for a point exit. Every node may touch it.
+    winch_elements : int
+        Over a swivel pulley: the elements of the winch line, below the inlet (0 for a point exit).
     """
 
     exit_point: tuple
@@ -68,6 +94,8 @@ class SpatialChainCable:
     bending_stiffness: float
     slack: bool
     anchor: tuple
+    swivel: sp.SwivelPulley | None = None
+    winch_elements: int = 0
 
     def __post_init__(self):
         object.__setattr__(self, "exit_point", tuple(vector("exit_point", self.exit_point, 3)))
@@ -82,6 +110,12 @@ class SpatialChainCable:
             raise SceneError(f"bending_stiffness must be zero or positive, got {self.bending_stiffness!r}")
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
             raise SceneError(f"node_masses must be finite and non-negative, got {self.node_masses!r}")
+        if self.swivel is not None and not isinstance(self.swivel, sp.SwivelPulley):
+            raise SceneError(f"swivel must be a SwivelPulley or None, got {self.swivel!r}")
+        if not 0 <= int(self.winch_elements) <= len(self.node_masses) - 3 or (self.swivel is None) != (
+                self.winch_elements == 0):
+            raise SceneError(f"winch_elements must be 0 for a point exit and leave 2 elements above the inlet "
+                             f"over a swivel pulley, got {self.winch_elements!r}")
 
     @property
     def n_elements(self) -> int:
@@ -89,7 +123,7 @@ class SpatialChainCable:
 
     @property
     def unstrained_length(self) -> float:
-        """L = n l0 [m]."""
+        """L = n l0 [m] (over a swivel pulley the winch line's elements included)."""
         return self.n_elements * self.element_length
 
 
@@ -128,37 +162,124 @@ class SpatialChainRobot:
         """True when every anchor sits at the centre of mass (no rotation to balance)."""
         return all(np.allclose(c.anchor, 0.0) for c in self.cables)
 
+    @property
+    def swivel_cables(self) -> list:
+        """Indices of the cables that run over a swivel pulley."""
+        return [i for i, c in enumerate(self.cables) if c.swivel is not None]
 
-def spatial_chain_robot(scene, anchor_spring_factor: float | None = None) -> SpatialChainRobot:
+
+def winch_line_elements(winch_line: float, element_length: float) -> int:
+    """Elements of a cable below a swivel pulley's inlet (its winch line along the axis): the
+    winch line ``winch_line`` [m] in elements of ``element_length`` [m], at least 2 (the builder's)."""
+    return max(2, int(round(winch_line / element_length)))
+
+
+def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, contact_stiffness):
+    """Straight unstrained reference (winch end first) and the catenary statics' node positions of a
+    cable over a swivel pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``.
+
+    From the anchor: the catenary up to the tangent point; then the wrap as the lumped
+    cable lies on it, a polygon of chords of the stretched element length (on the arc
+    instead, each chord is short by r_p theta^3 / 24 and pushes with up to 3 kN at
+    l_e = r_p: Newton then diverged), each node inside the groove by the depth that carries
+    its share of the pressure, ``T l_e / (r_p k_p)`` (on the rim itself psi has no stiffness:
+    Exudyn's static solver met a singular matrix); then down the axis to the winch end.
+    The tension is the catenary's at the tangent point (frictionless wrap, its weight
+    left out, as in the statics). The winch end (the first row of both) is where the
+    cable is held: the builder holds it there, and so do the chain statics.
+
+    Parameters
+    ----------
+    equilibrium_cable : SpatialCableState
+        The cable in the catenary statics (:func:`cdpr_exu.physics.spatial_statics.solve_spatial_statics`).
+    length : float [m]
+        Unstrained length from the inlet to the anchor (the catenary's).
+    n_elements, winch_elements : int
+        Elements from the inlet to the anchor, and below the inlet.
+    contact_stiffness : float [N/m]
+        The pulley's penalty stiffness k_p.
+    """
+    element = length / n_elements
+    inlet = equilibrium_cable.inlet
+    axial = equilibrium_cable.cable.axial_stiffness
+    tension = equilibrium_cable.tension_at_exit
+    radius = equilibrium_cable.pulley_radius
+    direction = equilibrium_cable.horizontal_direction
+    suspended = equilibrium_cable.suspended_length
+    arcs = length - element * np.arange(-winch_elements, n_elements + 1)  # unstrained, from the anchor
+    hanging = arcs <= suspended
+    current = np.empty((len(arcs), 3))
+    current[hanging] = equilibrium_cable.points(arcs[hanging])
+    stretched = element * (1.0 + tension / axial)
+    chord_angle = 2.0 * math.asin(min(1.0, stretched / (2.0 * radius)))  # rim angle per element
+    angle = math.pi - equilibrium_cable.wrap_angle + (arcs[~hanging] - suspended) / element * chord_angle
+    depth = tension * stretched / (radius * contact_stiffness)
+    centre = inlet + radius * direction
+    rim = centre + np.outer((radius - depth) * np.cos(angle), direction) + np.outer((radius - depth) * np.sin(angle), _E_Z)
+    axis = inlet - np.outer((angle - math.pi) / chord_angle * stretched, _E_Z)
+    current[~hanging] = np.where((angle <= math.pi)[:, None], rim, axis)
+    # the winch end on the axis, below the inlet by the winch line stretched under the tension at
+    # the inlet less its own weight: where the paid-out length puts it, whatever the polygon
+    weight = equilibrium_cable.cable.weight_per_length
+    below = element * winch_elements
+    current[0] = inlet - (below * (1.0 + tension / axial) - weight * below**2 / (2.0 * axial)) * _E_Z
+    reference = current[0] + np.outer(element * np.arange(len(current)), _E_Z)
+    return reference, current
+
+
+def _anchor_azimuth(equilibrium_cable) -> float:
+    """Azimuth [rad] of the cable's anchor seen from its swivel axis: where the builder starts psi."""
+    return sp.exit_azimuth(equilibrium_cable.anchor_point, equilibrium_cable.inlet)
+
+
+def spatial_chain_robot(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
+                        catenary=None) -> SpatialChainRobot:
     """The chain-statics model of a spatial scene, with the effects its builder adds.
+
+    Parameters
+    ----------
+    scene : SpatialScene
+    anchor_spring_factor : float or None
+        See :class:`SpatialChainRobot`.
+    tension_only : bool, optional
+        Default the scene's ``effects.slack`` (the static mode builds spring elements: False).
+    catenary : SpatialEquilibrium, optional
+        The scene's catenary statics: a cable over a swivel pulley is held at the winch end
+        its start shape puts it (:func:`swivel_chain_start`), as the builder holds it; solved
+        here when not given and needed.
 
     Raises
     ------
     SceneError
-        For swivel exits (not modelled here) or a bending model other than the exact angle.
+        For a bending model other than the exact angle.
     """
-    if any(s is not None for s in scene.swivel_exits):
-        raise SceneError("spatial chain statics models point exits only: the scene's exits "
-                         f"{[i for i, s in enumerate(scene.swivel_exits) if s is not None]} are swivel pulleys "
-                         "(use cdpr static, Exudyn's static solve, for them)")
     effects = scene.effects
     if effects.bending and effects.bending_model != "exact":
         raise SceneError("spatial chain statics models the exact-angle bending only, "
                          f"got effects.bending_model = {effects.bending_model!r}")
     platform = scene.catenary_platform()  # what the builder builds from: weights, EA, gravity
     gravity = platform.gravity
+    swivels = scene.swivel_exits
+    if catenary is None and any(s is not None for s in swivels):
+        catenary = solve_spatial_statics(platform, scene.unstrained_lengths)
+    slack = bool(effects.slack if tension_only is None else tension_only)
     cables = []
-    for spec, cable in zip(scene.cables, platform.cables):
+    for i, (spec, cable, swivel) in enumerate(zip(scene.cables, platform.cables, swivels)):
         n, length = spec.n_elements, spec.unstrained_length
         l0 = length / n
+        below, held, pulley = 0, cable.exit_point, None
+        if swivel is not None:
+            below = winch_line_elements(swivel.winch_line, l0)
+            held = swivel_chain_start(catenary.cables[i], length, n, below, swivel.contact_stiffness)[1][0]
+            pulley = swivel.pulley()
         # the builder's lumping (:func:`cdpr_exu.builder.spatial_robot.build_spatial_robot`), to the last bit
-        masses = (node_masses_along(n, chain_element_mass(cable, length, n, gravity), spec.mass_lumping)
-                  if gravity > 0 else np.zeros(n + 1))
+        masses = (node_masses_along(n + below, chain_element_mass(cable, length, n, gravity), spec.mass_lumping)
+                  if gravity > 0 else np.zeros(n + below + 1))
         cables.append(SpatialChainCable(
-            exit_point=cable.exit_point, node_masses=tuple(float(m) for m in masses), element_length=l0,
+            exit_point=held, node_masses=tuple(float(m) for m in masses), element_length=l0,
             axial_stiffness=cable.axial_stiffness / l0,
             bending_stiffness=spec.youngs_modulus * spec.second_moment / l0 if effects.bending else 0.0,
-            slack=bool(effects.slack), anchor=cable.anchor))
+            slack=slack, anchor=cable.anchor, swivel=pulley, winch_elements=below))
     return SpatialChainRobot(tuple(cables), scene.platform.mass, gravity, anchor_spring_factor)
 
 
@@ -174,7 +295,7 @@ class SpatialChainEquilibrium:
         Platform frame to world frame (identity for a point mass).
     rotation_vector : ndarray, shape (3,) [rad]
     nodes : tuple of ndarray, each shape (n + 1, 3) [m]
-        Node positions of each cable, exit first.
+        Node positions of each cable, exit (or winch end) first.
     tensions : tuple of ndarray, each shape (n,) [N]
         Axial force of each element, exit first (positive in tension).
     forces_on_platform : ndarray, shape (m, 3) [N]
@@ -183,6 +304,8 @@ class SpatialChainEquilibrium:
     residual : float [N]
         Largest entry of the potential's gradient left (forces [N], moments [N m]).
     iterations : int
+    swivel_angles : ndarray, shape (m,) [rad]
+        Each swivel pulley's angle psi (NaN for a point exit).
     """
 
     position: np.ndarray
@@ -193,6 +316,7 @@ class SpatialChainEquilibrium:
     forces_on_platform: np.ndarray
     residual: float
     iterations: int
+    swivel_angles: np.ndarray | None = None
 
     @property
     def tensions_at_anchor(self) -> np.ndarray:
@@ -205,9 +329,11 @@ class _Model:
 
     Points (rows of ``P``, shape (n_points, 3)): the chain nodes of every cable, cable after
     cable, then (with penalty joints) one anchor point per cable. Each point is fixed
-    (the exit nodes), free (its own three unknowns) or on the platform (``x + R b``).
-    Unknowns ``v``: the free points' coordinates, then the platform position, then (rigid)
-    the rotation increment ``d`` (``R <- exp([d]x) R``).
+    (the held first nodes), free (its own three unknowns) or on the platform (``x + R b``).
+    The "point coordinates" are the points' 3 n_points coordinates followed by the swivel
+    angles psi (one per swivel cable). Unknowns ``v``: the free points' coordinates, then the
+    platform position, then (rigid) the rotation increment ``d`` (``R <- exp([d]x) R``), then
+    the swivel angles. A state is the tuple ``(free, x, R, psi)``.
     """
 
     def __init__(self, robot: SpatialChainRobot):
@@ -226,18 +352,23 @@ class _Model:
         fixed = set(int(f) for f in self.first)
         self.free = np.array([j for j in range(self.n_points) if j not in fixed and j not in body_points], dtype=int)
         self.n_free = 3 * self.free.size
-        self.n_unknowns = self.n_free + 3 + (3 if self.rigid else 0)
+        self.swivel_cables = robot.swivel_cables
+        self.n_psi = len(self.swivel_cables)
+        self.psi0 = self.n_free + 3 + (3 if self.rigid else 0)  # first psi unknown
+        self.n_unknowns = self.psi0 + self.n_psi
+        self.size = 3 * self.n_points + self.n_psi  # point coordinates and the swivel angles
         self.fixed_positions = {int(f): np.asarray(c.exit_point, float) for f, c in zip(self.first, robot.cables)}
         self.local = np.array([c.anchor for c in robot.cables], dtype=float)
         self.weights = np.zeros(self.n_points)
         self.weights[:n_chain] = np.concatenate([np.asarray(c.node_masses) for c in robot.cables]) * robot.gravity
         elements = [np.stack([np.arange(f, f + n - 1), np.arange(f + 1, f + n)], axis=1)
                     for f, n in zip(self.first, self.counts)]
-        self.elements = np.concatenate(elements).astype(int)
+        self.elements = np.ascontiguousarray(np.concatenate(elements).astype(np.int64))
         self.element_cable = np.concatenate([np.full(n - 1, i) for i, n in enumerate(self.counts)])
         self.k = np.array([robot.cables[c].axial_stiffness for c in self.element_cable])
         self.l0 = np.array([robot.cables[c].element_length for c in self.element_cable])
         self.slack = np.array([robot.cables[c].slack for c in self.element_cable])
+        self.axial_pattern = axial_3d.tension_only_pattern(self.elements)
         self.joints = bending_3d.chain_joints(self.counts)
         self.joint_k = np.concatenate([np.full(n - 2, c.bending_stiffness) for c, n in zip(robot.cables, self.counts)])
         if not np.any(self.joint_k > 0):
@@ -245,6 +376,15 @@ class _Model:
         self.pattern = bending_3d.spatial_bending_pattern(self.joints)
         self.penalty_k = (np.array([robot.anchor_spring_factor * c.axial_stiffness for c in robot.cables])
                           if self.penalty else np.zeros(0))
+        # each swivel pulley: its cable's nodes (all may touch it), the contact's sparse pattern in
+        # the cable's own coordinates (x, y, z per node, psi last) mapped to the point coordinates
+        self.contacts = []
+        for s, i in enumerate(self.swivel_cables):
+            count, first = self.counts[i], int(self.first[i])
+            nodes = np.arange(count, dtype=np.int64)
+            rows, columns = sp.swivel_contact_pattern(nodes, 3 * count + 1)
+            index = np.concatenate([3 * first + np.arange(3 * count), [3 * self.n_points + s]])
+            self.contacts.append((i, robot.cables[i].swivel, first, count, nodes, index[rows], index[columns], index))
 
     def points(self, free, x, R):
         """All points, shape (n_points, 3) [m]."""
@@ -257,55 +397,76 @@ class _Model:
         return p
 
     def _axial(self, p):
-        """Element lengths, unit vectors and axial forces (0 for slack compressed elements)."""
+        """Element lengths, unit vectors and axial forces (tension-only elements: the dynamic model's law)."""
         a, b = self.elements[:, 0], self.elements[:, 1]
         d = p[b] - p[a]
         length = np.linalg.norm(d, axis=1)
         t = d / length[:, None]
         force = self.k * (length - self.l0)
-        active = ~(self.slack & (force < 0.0))
-        return length, t, np.where(active, force, 0.0), active
+        if np.any(self.slack):
+            taut = np.zeros(len(self.elements))
+            axial_3d.tension_only_tensions(p.ravel(), np.zeros(p.size), self.elements, self.l0, self.k,
+                                           np.zeros(len(self.elements)), np.zeros(len(self.elements)), taut)
+            force = np.where(self.slack, taut, force)
+        return length, t, force
 
-    def energy(self, free, x, R):
+    def _contact_args(self, pulley):
+        return (pulley.inlet_array, pulley.radius, pulley.groove_radius, pulley.flange_height)
+
+    def energy(self, free, x, R, psi):
         """Total potential [J]."""
         p = self.points(free, x, R)
-        length, _, _, active = self._axial(p)
+        flat = p.ravel()
+        length, _, _ = self._axial(p)
         stretch = length - self.l0
-        energy = 0.5 * float(np.sum(self.k[active] * stretch[active] ** 2))
+        spring = ~self.slack
+        energy = 0.5 * float(np.sum(self.k[spring] * stretch[spring] ** 2))
+        if np.any(self.slack):
+            energy += axial_3d.tension_only_energy(flat, self.elements[self.slack], self.l0[self.slack],
+                                                   self.k[self.slack])
         energy += float(self.weights @ p[:, 2]) + self.robot.mass * self.robot.gravity * x[2]
         if self.joints.size:
-            energy += bending_3d.spatial_bending_energy(p.ravel(), self.joints, self.joint_k)
+            energy += bending_3d.spatial_bending_energy(flat, self.joints, self.joint_k)
         if self.penalty:
             for (j, i), k in zip(self.body, self.penalty_k):
                 energy += 0.5 * k * float(np.sum((p[self.last[i]] - p[j]) ** 2))
+        for s, (_, pulley, first, count, nodes, _, _, _) in enumerate(self.contacts):
+            energy += sp.swivel_contact_energy(flat[3 * first:3 * (first + count)].copy(), float(psi[s]), nodes,
+                                               *self._contact_args(pulley), pulley.contact_stiffness,
+                                               pulley.onset_band)
         return energy
 
-    def point_derivatives(self, p):
-        """Gradient (3N,) and Hessian (3N, 3N) of the potential in the point coordinates, and the
-        element forces (n_elements,) [N]."""
-        size = 3 * self.n_points
+    def point_derivatives(self, p, psi):
+        """Gradient (size,) and sparse Hessian (size, size) of the potential in the point coordinates
+        (and the swivel angles), and the element forces (n_elements,) [N]."""
+        size = self.size
         G = np.zeros(size)
-        H = np.zeros((size, size))
-        G[2::3] += self.weights
-        length, t, force, active = self._axial(p)
-        for e, (a, b) in enumerate(self.elements):
-            if not active[e]:
-                continue
-            f = force[e] * t[e]
-            G[3 * a:3 * a + 3] -= f
-            G[3 * b:3 * b + 3] += f
-            tt = np.outer(t[e], t[e])
-            block = self.k[e] * tt + force[e] / length[e] * (np.eye(3) - tt)
-            for r, s, sign in ((a, a, 1.0), (b, b, 1.0), (a, b, -1.0), (b, a, -1.0)):
-                H[3 * r:3 * r + 3, 3 * s:3 * s + 3] += sign * block
+        G[2:3 * self.n_points:3] += self.weights
+        flat = p.ravel().copy()
+        length, t, force = self._axial(p)
+        # axial: the force along each element, and its 6 x 6 block [[B, -B], [-B, B]] in the
+        # order of axial_3d.tension_only_pattern; a tension-only element's slope is its law's
+        np.subtract.at(G, 3 * self.elements[:, 0][:, None] + np.arange(3), force[:, None] * t)
+        np.add.at(G, 3 * self.elements[:, 1][:, None] + np.arange(3), force[:, None] * t)
+        tt = t[:, :, None] * t[:, None, :]
+        block = self.k[:, None, None] * tt + (force / length)[:, None, None] * (np.eye(3) - tt)
+        axial_values = np.block([[block, -block], [-block, block]]).reshape(-1)
+        if np.any(self.slack):
+            slack_values = np.zeros(36 * len(self.elements))
+            axial_3d.tension_only_triplet_values(flat, np.zeros(flat.size), self.elements, self.l0, self.k,
+                                                 np.zeros(len(self.elements)), np.zeros(len(self.elements)),
+                                                 1.0, 0.0, slack_values)
+            axial_values = np.where(np.repeat(self.slack, 36), slack_values, axial_values)
+        rows, columns, values_list = [self.axial_pattern[0]], [self.axial_pattern[1]], [axial_values]
         if self.joints.size:
-            flat = p.ravel().copy()
-            bend = np.zeros(size)
+            bend = np.zeros(3 * self.n_points)
             bending_3d.spatial_bending_force(flat, self.joints, self.joint_k, bend)
-            G -= bend
+            G[:3 * self.n_points] -= bend
             values = np.zeros(self.pattern[0].size)
             bending_3d.spatial_bending_stiffness(flat, self.joints, self.joint_k, 1.0, values)
-            np.add.at(H, self.pattern, values)
+            rows.append(self.pattern[0])
+            columns.append(self.pattern[1])
+            values_list.append(values)
         if self.penalty:
             for (j, i), k in zip(self.body, self.penalty_k):
                 last = self.last[i]
@@ -313,40 +474,78 @@ class _Model:
                 G[3 * last:3 * last + 3] += f
                 G[3 * j:3 * j + 3] -= f
                 for r, s, sign in ((last, last, 1.0), (j, j, 1.0), (last, j, -1.0), (j, last, -1.0)):
-                    H[3 * r:3 * r + 3, 3 * s:3 * s + 3] += sign * k * np.eye(3)
+                    rows.append(np.repeat(3 * r + np.arange(3), 3).astype(np.int64))
+                    columns.append(np.tile(3 * s + np.arange(3), 3).astype(np.int64))
+                    values_list.append(sign * k * np.eye(3).ravel())
+        for s, (_, pulley, first, count, nodes, contact_rows, contact_columns, index) in enumerate(self.contacts):
+            positions = flat[3 * first:3 * (first + count)].copy()
+            zero = np.zeros(3 * count)
+            contact_force = np.zeros(3 * count + 1)
+            # the dynamic model's kernels at rest: the force -dU/dq and K = -df/dq = d^2 U / dq^2
+            sp.swivel_contact_force(positions, zero, float(psi[s]), 0.0, nodes, *self._contact_args(pulley),
+                                    pulley.contact_stiffness, 0.0, pulley.onset_band, contact_force)
+            G[index] -= contact_force
+            values = np.zeros(contact_rows.size)
+            sp.swivel_contact_values(positions, zero, float(psi[s]), 0.0, nodes, *self._contact_args(pulley),
+                                     pulley.contact_stiffness, 0.0, pulley.onset_band, 1.0, 0.0, values)
+            rows.append(contact_rows)
+            columns.append(contact_columns)
+            values_list.append(values)
+        H = sparse.coo_matrix((np.concatenate(values_list), (np.concatenate(rows), np.concatenate(columns))),
+                              shape=(size, size)).tocsr()
         return G, H, force
 
-    def derivatives(self, free, x, R):
-        """Gradient and Hessian in the unknowns, the points, their gradient and the element forces."""
-        p = self.points(free, x, R)
-        G, H, force = self.point_derivatives(p)
-        T = np.zeros((3 * self.n_points, self.n_unknowns))
+    def _map(self, R):
+        """Sparse T = d(point coordinates)/d(unknowns), shape (size, n_unknowns)."""
+        rows, columns, values = [], [], []
         for c, j in enumerate(self.free):
-            T[3 * j:3 * j + 3, 3 * c:3 * c + 3] = np.eye(3)
+            rows.extend(3 * j + np.arange(3))
+            columns.extend(3 * c + np.arange(3))
+            values.extend([1.0, 1.0, 1.0])
         x0 = self.n_free
-        rotation_second = np.zeros((3, 3))
         for j, i in self.body:
-            T[3 * j:3 * j + 3, x0:x0 + 3] = np.eye(3)
+            rows.extend(3 * j + np.arange(3))
+            columns.extend(x0 + np.arange(3))
+            values.extend([1.0, 1.0, 1.0])
             if self.rigid:
-                arm = R @ self.local[i]
-                T[3 * j:3 * j + 3, x0 + 3:x0 + 6] = -skew(arm)  # d(exp([d]x) b) = d x b
-                g = G[3 * j:3 * j + 3]
-                rotation_second += 0.5 * (np.outer(g, arm) + np.outer(arm, g)) - float(g @ arm) * np.eye(3)
+                block = -skew(R @ self.local[i])  # d(exp([d]x) b) = d x b
+                for r in range(3):
+                    for s in range(3):
+                        rows.append(3 * j + r)
+                        columns.append(x0 + 3 + s)
+                        values.append(block[r, s])
+        for s in range(self.n_psi):
+            rows.append(3 * self.n_points + s)
+            columns.append(self.psi0 + s)
+            values.append(1.0)
+        return sparse.csr_matrix((values, (rows, columns)), shape=(self.size, self.n_unknowns))
+
+    def derivatives(self, free, x, R, psi):
+        """Gradient, sparse Hessian in the unknowns, the points, their gradient and the element forces."""
+        p = self.points(free, x, R)
+        G, H, force = self.point_derivatives(p, psi)
+        T = self._map(R)
+        x0 = self.n_free
         gradient = T.T @ G
         gradient[x0 + 2] += self.robot.mass * self.robot.gravity
-        hessian = T.T @ H @ T
+        hessian = (T.T @ H @ T).tolil()
         if self.rigid:
-            hessian[x0 + 3:, x0 + 3:] += rotation_second
-        return gradient, hessian, p, G, force
+            rotation_second = np.zeros((3, 3))
+            for j, i in self.body:
+                arm = R @ self.local[i]
+                g = G[3 * j:3 * j + 3]
+                rotation_second += 0.5 * (np.outer(g, arm) + np.outer(arm, g)) - float(g @ arm) * np.eye(3)
+            hessian[x0 + 3:x0 + 6, x0 + 3:x0 + 6] = hessian[x0 + 3:x0 + 6, x0 + 3:x0 + 6].toarray() + rotation_second
+        return gradient, hessian.tocsc(), p, G, force
 
-    def step(self, free, x, R, delta):
+    def step(self, free, x, R, psi, delta):
         """The state moved by ``delta`` (unknowns)."""
         x0 = self.n_free
         free = free + delta[:x0]
         x = x + delta[x0:x0 + 3]
         if self.rigid:
-            R = rotation_from_vector(delta[x0 + 3:]) @ R
-        return free, x, R
+            R = rotation_from_vector(delta[x0 + 3:x0 + 6]) @ R
+        return free, x, R, psi + delta[self.psi0:]
 
 
 def catenary_start(robot: SpatialChainRobot, equilibrium):
@@ -361,22 +560,31 @@ def catenary_start(robot: SpatialChainRobot, equilibrium):
     Returns
     -------
     nodes : list of ndarray, each shape (n + 1, 3) [m]
+        Over a swivel pulley the builder's start (:func:`swivel_chain_start`).
     position : ndarray, shape (3,) [m]
     rotation : ndarray, shape (3, 3)
+    swivel_angles : ndarray, shape (m,) [rad]
+        Each swivel pulley at its anchor's azimuth, as the builder starts it (NaN for a point exit).
     """
     if len(equilibrium.cables) != len(robot.cables):
         raise SceneError(f"equilibrium has {len(equilibrium.cables)} cables, the robot {len(robot.cables)}")
-    nodes = []
-    for cable, state in zip(robot.cables, equilibrium.cables):
+    nodes, angles = [], np.full(len(robot.cables), np.nan)
+    for i, (cable, state) in enumerate(zip(robot.cables, equilibrium.cables)):
         length = cable.unstrained_length
-        points = state.points(length - np.linspace(0.0, length, cable.n_elements + 1))
-        points[0] = cable.exit_point
+        if cable.swivel is not None:
+            n = cable.n_elements - cable.winch_elements
+            points = swivel_chain_start(state, n * cable.element_length, n, cable.winch_elements,
+                                        cable.swivel.contact_stiffness)[1]
+            angles[i] = _anchor_azimuth(state)
+        else:
+            points = state.points(length - np.linspace(0.0, length, cable.n_elements + 1))
+            points[0] = cable.exit_point
         points[-1] = state.anchor_point
         nodes.append(points)
-    return nodes, np.asarray(equilibrium.position, float), np.asarray(equilibrium.rotation, float)
+    return nodes, np.asarray(equilibrium.position, float), np.asarray(equilibrium.rotation, float), angles
 
 
-def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotation=None, *,
+def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotation=None, swivel_angles=None, *,
                                 tolerance: float = 1e-9, max_iterations: int = 100) -> SpatialChainEquilibrium:
     """The rest configuration of the chains and platform for the cables' unstrained lengths.
 
@@ -390,8 +598,12 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
         Start of the platform's centre of mass.
     rotation : ndarray, shape (3, 3), optional
         Start of the platform's rotation (default identity; ignored for a point mass).
+    swivel_angles : array_like, shape (m,) [rad], optional
+        Start of each swivel pulley's psi (entries of point exits ignored); default each
+        pulley turned towards its cable's last start node.
     tolerance : float [N]
-        Largest entry of the potential's gradient accepted (node forces, platform force, moment).
+        Largest entry of the potential's gradient accepted (node forces, platform force, moment,
+        torques on the swivels [N m]).
     max_iterations : int
 
     Returns
@@ -421,28 +633,29 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
     if model.penalty:
         for j, i in model.body:
             start[j] = x + R @ model.local[i]
-    free = start[model.free].ravel()
-    energy = model.energy(free, x, R)
+    if swivel_angles is None:
+        psi = np.array([sp.exit_azimuth(np.asarray(nodes[i], float)[-1], robot.cables[i].swivel.inlet_array)
+                        for i in model.swivel_cables])
+    else:
+        angles = np.asarray(swivel_angles, dtype=float)
+        if angles.shape != (len(robot.cables),) or not np.all(np.isfinite(angles[model.swivel_cables])):
+            raise SceneError(f"swivel_angles must give one finite angle per cable ({len(robot.cables)}, NaN "
+                             f"allowed at point exits), got {swivel_angles!r}")
+        psi = angles[model.swivel_cables].copy()
+    state = (start[model.free].ravel(), x, R, psi)
+    energy = model.energy(*state)
     for iteration in range(max_iterations):
-        gradient, hessian, p, G, force = model.derivatives(free, x, R)
+        gradient, hessian, p, G, force = model.derivatives(*state)
         if np.max(np.abs(gradient)) < tolerance:
             break
-        shift = 0.0
-        while True:
-            try:
-                step = np.linalg.solve(hessian + shift * np.eye(len(gradient)), -gradient)
-            except np.linalg.LinAlgError:
-                step = None
-            if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
-                break
-            shift = max(10.0 * shift, 1e-8 * np.abs(np.diag(hessian)).max())
+        step = _descent_step(hessian, gradient)
         slope = float(step @ gradient)
         # near the solution the energy's decrease ~ |g|^2 / k falls below its rounding: then the
         # full step is taken if it shrinks the gradient, and the iteration stops if it does not
         roundoff = 1e-13 * (1.0 + abs(energy))
         alpha, accepted = 1.0, False
         for _ in range(40):
-            trial = model.step(free, x, R, alpha * step)
+            trial = model.step(*state, alpha * step)
             trial_energy = model.energy(*trial)
             if trial_energy <= energy + 1e-4 * alpha * slope:
                 accepted = True
@@ -452,20 +665,44 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
                 break
             alpha *= 0.5
         if not accepted:
-            if np.max(np.abs(gradient)) < 10.0 * tolerance:  # stalled at rounding, close enough
+            # stalled at rounding, close enough: a coordinate's last bit (eps |p|) on the stiffest spring
+            # (a penalty joint, f k ~ 1e8 N/m) is a force of 1e-8 N, above the default tolerance
+            rounding = 16.0 * np.finfo(float).eps * float(np.abs(hessian.diagonal()).max()) * max(
+                1.0, float(np.abs(p).max()))
+            if np.max(np.abs(gradient)) < max(10.0 * tolerance, rounding):
                 break
             raise UnreachableError(f"spatial chain statics: the line search failed (force imbalance "
                                    f"{np.max(np.abs(gradient)):.3g} N after {iteration} iterations)")
-        free, x, R = trial
+        state = trial
         energy = trial_energy
     else:
         raise UnreachableError(f"spatial chain statics did not converge in {max_iterations} iterations "
                                f"(force imbalance {np.max(np.abs(gradient)):.3g} N)")
+    _, x, R, psi = state
     chain_nodes = tuple(p[f:f + n].copy() for f, n in zip(model.first, model.counts))
     tensions = tuple(force[model.element_cable == i] for i in range(len(robot.cables)))
     forces = _forces_on_platform(model, p, G)
+    angles = np.full(len(robot.cables), np.nan)
+    angles[model.swivel_cables] = psi
     return SpatialChainEquilibrium(x.copy(), R.copy(), rotation_vector(R) if model.rigid else np.zeros(3),
-                                   chain_nodes, tensions, forces, float(np.max(np.abs(gradient))), iteration)
+                                   chain_nodes, tensions, forces, float(np.max(np.abs(gradient))), iteration,
+                                   angles)
+
+
+def _descent_step(hessian, gradient):
+    """Newton's step -H^-1 g, with H shifted by a multiple of the identity until it is a descent direction
+    (an indefinite or singular H: psi on the rim has no stiffness, a slack element none)."""
+    identity = sparse.identity(hessian.shape[0], format="csc")
+    scale = float(np.abs(hessian.diagonal()).max())
+    shift = 0.0
+    while True:
+        try:
+            step = sparse_linalg.splu((hessian + shift * identity).tocsc()).solve(-gradient)
+        except RuntimeError:  # exactly singular
+            step = None
+        if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
+            return step
+        shift = max(10.0 * shift, 1e-8 * scale)
 
 
 def _forces_on_platform(model: _Model, p, G):
@@ -480,17 +717,16 @@ def _forces_on_platform(model: _Model, p, G):
     return forces
 
 
-def spatial_chain_statics(scene, anchor_spring_factor: float | None = None, **kwargs) -> SpatialChainEquilibrium:
-    """The lumped robot of a spatial scene at rest, started on its catenary statics (as the static mode starts
+def spatial_chain_statics(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
+                          **kwargs) -> SpatialChainEquilibrium:
+    """The lumped robot of a spatial scene at rest, started on its catenary statics (as the builder starts
     Exudyn's); ``kwargs`` go to :func:`solve_spatial_chain_statics`.
 
     Raises
     ------
-    SceneError
-        For swivel exits (:func:`spatial_chain_robot`).
     UnreachableError
         If the catenary statics or the chains find no equilibrium.
     """
-    robot = spatial_chain_robot(scene, anchor_spring_factor)
     catenary = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    robot = spatial_chain_robot(scene, anchor_spring_factor, tension_only, catenary)
     return solve_spatial_chain_statics(robot, *catenary_start(robot, catenary), **kwargs)
