@@ -559,3 +559,17 @@ def test_explicit_rk44_refuses_driven_winches():
     them at their initial value: a driven winch would silently stand still."""
     with pytest.raises(SceneError, match=r"solver.integrator = 'rk44' needs winch.kind = 'fixed'"):
         shortened(PAPER, end_time=1e-3, step_size=1e-7, integrator="rk44")
+
+
+def test_fine_tension_only_cables_start_the_abrupt_circle_at_a_coarse_step():
+    """240 elements per cable at 1e-2 s: the first step used to fail at every size down to
+    1e-6 s (the first Jacobian held no axial term: every element lies on its rest length,
+    axial.ROUNDOFF_STRAIN). Measured with the fix: 0.5 s in 405 steps; here 0.1 s.
+    The platform follows the paper's push-capable springs at the same discretisation to
+    5 mm (the default lies 3.5 mm from them on the 15-element circle, docs/slack.md)."""
+    fine = with_cables(shortened(PAPER, end_time=0.1, output_period=0.01, step_size=1e-2), n_elements=240)
+    result = simulate(fine)
+    assert result.time[-1] == pytest.approx(0.1)
+    springs = simulate(fine.with_changes(effects=Effects.from_preset("paper")))
+    offset = np.abs(result.platform_pose[:, :2] - springs.platform_pose[:, :2]).max()
+    assert offset < 5e-3, offset
