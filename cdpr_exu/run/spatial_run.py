@@ -562,6 +562,7 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
 SPATIAL_CONTROLLERS = {
     "ideal_ik": IdealIKController,
     "tension_aware": SpatialTensionAwareController,
+    "tension_aware_chain": lambda: SpatialTensionAwareController(statics="chain"),
     "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
 }
 
