@@ -127,13 +127,13 @@ class SpatialTensionAwareController:
         """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued."""
         from cdpr_exu.core.errors import UnreachableError
         from cdpr_exu.physics.spatial_statics import solve_cable, solve_inverse_spatial_statics, solve_spatial_statics
-        from cdpr_exu.statics.spatial_chain_statics import (catenary_start, robot_paid_out,
-                                                            solve_inverse_spatial_chain_statics,
+        from cdpr_exu.statics.spatial_chain_statics import (InverseChainStatics, catenary_start, robot_paid_out,
                                                             solve_spatial_chain_statics, spatial_chain_robot)
         from cdpr_exu.core.geometry import rotation_from_vector
 
         platform = scene.catenary_platform()
         robot = spatial_chain_robot(scene)
+        inverse_statics = InverseChainStatics(robot)
         catenary_rest = solve_spatial_statics(platform, initial)
         started = robot_paid_out(robot, initial)
         rest = solve_spatial_chain_statics(started, *catenary_start(started, catenary_rest))
@@ -169,12 +169,11 @@ class SpatialTensionAwareController:
                 lengths = previous[0].unstrained_lengths + chords - previous[1]
                 nodes = previous[0].nodes
             try:
-                inverse = solve_inverse_spatial_chain_statics(robot, pose, state["tensions"], lengths, nodes, inertial)
+                inverse = inverse_statics.solve(pose, state["tensions"], lengths, nodes, inertial)
             except UnreachableError:
                 if previous is None:
                     raise
-                inverse = solve_inverse_spatial_chain_statics(robot, pose, state["tensions"],
-                                                              *catenary_guess(pose, inertial), inertial)
+                inverse = inverse_statics.solve(pose, state["tensions"], *catenary_guess(pose, inertial), inertial)
             state["tensions"] = inverse.tensions
             state["previous"] = (inverse, np.linalg.norm(exits - anchor_points(pose), axis=1))
             self.inverses.append(inverse)

@@ -307,7 +307,8 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
 
     The controller is any :class:`controllers.base.Controller` that works on spatial
     scenes (:class:`controllers.ideal_ik.IdealIKController`,
-    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController`,
+    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController` (catenary or, with
+    ``statics="chain"``, the simulator's own chains),
     :func:`controllers.spatial_feedback.spatial_closed_loop_tension_aware`); it is asked
     for the winch commands before every step, wrapped in
     :class:`controllers.base.SmoothStart` as on planar scenes (its commands start at the
@@ -566,6 +567,12 @@ SPATIAL_CONTROLLERS = {
     "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
 }
 
+def spatial_controller_names(scene: SpatialScene) -> list[str]:
+    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS`, but
+    ``tension_aware_chain`` where a cable leaves over a swivel pulley (the chain statics model point exits)."""
+    return [name for name in SPATIAL_CONTROLLERS if not (name == "tension_aware_chain" and scene.swivels)]
+
+
 _COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
             ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
             ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
@@ -597,7 +604,7 @@ def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: st
     controller's overview figure to ``out``. Returns the summaries by name."""
     from cdpr_exu.core.output import write_summary as _write
 
-    names = list(names or SPATIAL_CONTROLLERS)
+    names = list(names or spatial_controller_names(scene))
     unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
     if unknown:
         raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")

@@ -38,7 +38,7 @@ from cdpr_exu.physics.spatial_statics import chain_element_mass, node_masses_alo
 __all__ = ["SpatialChainCable", "SpatialChainRobot", "SpatialChainEquilibrium", "spatial_chain_robot",
            "solve_spatial_chain_statics", "catenary_start", "spatial_chain_statics", "cable_paid_out",
            "robot_paid_out", "HeldChain", "solve_held_chain", "SpatialChainInverse",
-           "solve_inverse_spatial_chain_statics", "rounding_floor"]
+           "solve_inverse_spatial_chain_statics", "InverseChainStatics", "rounding_floor"]
 
 
 @dataclass(frozen=True)
@@ -295,10 +295,12 @@ class _Model:
         a, b = self.elements[active, 0], self.elements[active, 1]
         if a.size:
             t, force, length, k = t[active], force[active], length[active], self.k[active]
+            # In a chain every node is the first node of one element at most, and the second of one at
+            # most: within each of the sums below the indices are distinct, and fancy-indexed += is exact.
             f = force[:, None] * t
             points = G.reshape(-1, 3)  # a view
-            np.add.at(points, a, -f)
-            np.add.at(points, b, f)
+            points[a] -= f
+            points[b] += f
             tt = t[:, :, None] * t[:, None, :]
             blocks = k[:, None, None] * tt + (force / length)[:, None, None] * (np.eye(3) - tt)
             # each element's 3 x 3 block on (a, a) and (b, b), its negative on (a, b) and (b, a)
@@ -306,7 +308,7 @@ class _Model:
             for r, s, sign in ((a, a, 1.0), (b, b, 1.0), (a, b, -1.0), (b, a, -1.0)):
                 rows = (3 * r)[:, None, None] + offsets[None, :, None]
                 cols = (3 * s)[:, None, None] + offsets[None, None, :]
-                np.add.at(H, (rows, cols), sign * blocks)
+                H[rows, cols] += sign * blocks
         if self.joints.size:
             flat = p.ravel().copy()
             bend = np.zeros(size)
@@ -594,14 +596,21 @@ def solve_held_chain(cable: SpatialChainCable, gravity: float, anchor_point, nod
         Start of the nodes, exit first; the ends are put on the exit and anchor points, the nodes
         between moved along by the same share of the ends' displacement as of the cable.
     tolerance : float [N]
-        Largest force left on a free node (at least the rounding of the element forces,
-        :func:`rounding_floor`: 4e-8 N on IPAnema's stiff cables, 2e-14 m of stretch).
+        Largest force left on a free node; below the rounding of the element forces
+        (:func:`rounding_floor`: 4e-8 N on IPAnema's stiff cables, 2e-14 m of stretch), the
+        iteration also stops once a Newton step no longer halves it.
 
     Raises
     ------
     UnreachableError
         If Newton finds no rest shape.
     """
+    return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations)
+
+
+def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, tolerance: float,
+                max_iterations: int) -> HeldChain:
+    """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other lengths)."""
     anchor_point = vector("anchor_point", anchor_point, 3)
     nodes = np.array(nodes, dtype=float)
     n = cable.n_elements
@@ -610,19 +619,25 @@ def solve_held_chain(cable: SpatialChainCable, gravity: float, anchor_point, nod
     share = np.linspace(0.0, 1.0, n + 1)[:, None]
     exit_point = np.asarray(cable.exit_point)
     nodes += (1.0 - share) * (exit_point - nodes[0]) + share * (anchor_point - nodes[-1])
-    model = _held_model(cable, gravity)
     R = np.eye(3)
     inner = slice(3, 3 * n)  # the free nodes' rows among the points (exit, free nodes, anchor)
     end = slice(3 * n, 3 * n + 3)
     free = nodes[1:-1].ravel().copy()
     energy = model.energy(free, anchor_point, R)
-    tolerance = max(tolerance, rounding_floor(model.k, nodes))
+    # Below the rounding floor Newton keeps gaining while it can: the anchor force of a chain stopped
+    # at the floor is off by about the floor, and m of them stall the platform's balance (CoGiRo's
+    # Gauss-Newton crawled for 30 iterations at 1e-5 N). So stop at the tolerance, or below the floor
+    # once a step no longer halves the imbalance.
+    floor = rounding_floor(model.k, nodes)
+    last = np.inf
     for iteration in range(max_iterations):
         nodes[1:-1] = free.reshape(-1, 3)
         G, H, force = model.point_derivatives(nodes)
         g = G[inner]
-        if np.max(np.abs(g)) < tolerance:
+        imbalance = float(np.max(np.abs(g)))
+        if imbalance < tolerance or (imbalance < floor and imbalance > 0.5 * last):
             break
+        last = imbalance
         step = _descent(H[inner, inner], g)
         slope = float(step @ g)
         roundoff = 1e-13 * (1.0 + abs(energy))
@@ -640,7 +655,7 @@ def solve_held_chain(cable: SpatialChainCable, gravity: float, anchor_point, nod
                 break
             alpha *= 0.5
         if not accepted:
-            if np.max(np.abs(g)) < 10.0 * tolerance:
+            if imbalance < max(10.0 * tolerance, floor):
                 break
             raise UnreachableError(f"held chain statics: the line search failed (force imbalance "
                                    f"{np.max(np.abs(g)):.3g} N after {iteration} iterations)")
@@ -750,6 +765,32 @@ def solve_inverse_spatial_chain_statics(robot: SpatialChainRobot, pose, tension_
         If no lengths with positive tensions balance the platform there (a cable would have to
         push or go slack), or the iteration does not converge.
     """
+    return InverseChainStatics(robot).solve(pose, tension_guess, lengths, nodes, external_wrench,
+                                            tolerance=tolerance, max_iterations=max_iterations)
+
+
+class InverseChainStatics:
+    """:func:`solve_inverse_spatial_chain_statics` for many poses of one robot: each cable's model is
+    built once (the lengths change by scaling it, :func:`_paid_out_model`).
+
+    Parameters
+    ----------
+    robot : SpatialChainRobot
+    """
+
+    def __init__(self, robot: SpatialChainRobot):
+        self.robot = robot
+        self.models = [_held_model(c, robot.gravity) for c in robot.cables]
+
+    def solve(self, pose, tension_guess, lengths, nodes, external_wrench=None, *, tolerance: float = 1e-9,
+              max_iterations: int = 30) -> SpatialChainInverse:
+        """As :func:`solve_inverse_spatial_chain_statics` (same parameters, robot aside)."""
+        return _solve_inverse(self.robot, self.models, pose, tension_guess, lengths, nodes, external_wrench,
+                              tolerance, max_iterations)
+
+
+def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench, tolerance, max_iterations):
+    """The Gauss-Newton of :func:`solve_inverse_spatial_chain_statics`, each cable's held model given."""
     from cdpr_exu.core.validation import real_array
 
     m = len(robot.cables)
@@ -775,8 +816,9 @@ def solve_inverse_spatial_chain_statics(robot: SpatialChainRobot, pose, tension_
     scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
 
     def held(trial_lengths, trial_nodes):
-        chains = [solve_held_chain(cable_paid_out(c, L), robot.gravity, a, start)
-                  for c, L, a, start in zip(robot.cables, trial_lengths, anchor_points, trial_nodes)]
+        chains = [_solve_held(_paid_out_model(model, L / c.unstrained_length), cable_paid_out(c, L), a, start,
+                              1e-9, 50)
+                  for model, c, L, a, start in zip(models, robot.cables, trial_lengths, anchor_points, trial_nodes)]
         forces = np.array([chain.force for chain in chains])
         total = np.concatenate([forces.sum(axis=0) + wrench[:3] - [0.0, 0.0, weight],
                                 np.cross(arms, forces).sum(axis=0) + wrench[3:]])[:rows] * scale
