@@ -1,14 +1,37 @@
-"""Tension-aware joint-space control of spatial robots: sag and stretch from the elastic catenaries.
+"""Tension-aware joint-space control of spatial robots: sag and stretch from the cables' statics.
 
-At samples of the reference (every :data:`SAMPLE_PERIOD` s) the controller solves the
-inverse spatial statics (:func:`cdpr_exu.physics.spatial_statics.solve_inverse_spatial_statics`):
-the unstrained lengths whose elastic catenaries hold the platform at the reference pose,
-with the reference's acceleration as a d'Alembert force, and the tensions nearest the
-previous sample's, starting from the tensions the robot actually has at rest (the
-catenary statics of its initial lengths). An over-constrained robot so keeps the internal
-tension it started with. The command is the initial paid-out length plus the change of
-these lengths, interpolated by a cubic spline (its derivative is the rate). Open loop:
-it reads neither pose nor tension. Units SI.
+At samples of the reference (every :data:`SAMPLE_PERIOD` s) the controller finds the
+unstrained lengths that hold the platform at the reference pose, with the reference's
+acceleration as a d'Alembert force (the platform's, -M a; the cables' inertia and the
+platform's angular acceleration are left out), and the tensions nearest the previous
+sample's, starting from the tensions the robot has at rest with the lengths it starts
+with. An over-constrained robot so keeps the internal tension it started with. The
+lengths are interpolated by a cubic spline (its derivative is the rate). Open loop: it
+reads neither pose nor tension.
+
+Two cable models (``statics``), as the planar :class:`controllers.tension_aware.TensionAwareController`:
+
+* ``"catenary"``: continuous elastic catenaries without bending
+  (:func:`cdpr_exu.physics.spatial_statics.solve_inverse_spatial_statics`, the horizontal
+  tensions kept near the previous sample's); the command is the initial paid-out length
+  plus the change of these lengths, which cancels at the start the offset between the
+  catenary and the simulator's chains (1e-5 m on IPAnema);
+* ``"chain"``: the simulator's own lumped cables, n straight elements with the nodes'
+  weight and the exact-angle bending (:func:`cdpr_exu.statics.spatial_chain_statics.
+  solve_inverse_spatial_chain_statics`, the tensions at the anchors kept near the previous
+  sample's). With the pose given, each chain hangs between two fixed points, so the cables
+  decouple and only the platform's balance (six equations) ties their m lengths together:
+  one small Newton solve per cable inside a Gauss-Newton on the lengths, started from the
+  previous sample's lengths plus the change of the straight exit-to-anchor distance (the
+  first sample from the catenary inverse). What it adds over the catenary is the
+  simulator's discretisation (chords for arcs, lumped weights) and the bending. The
+  command is these lengths themselves, as the planar chain version's: the run blends
+  the offset from the paid-out lengths in over its start
+  (:class:`controllers.base.SmoothStart`), so the platform also leaves where the
+  initial lengths hold it (20 um off IPAnema's reference) for the reference. Point
+  exits only (the chain statics do not model swivel pulleys).
+
+Units SI.
 """
 
 from __future__ import annotations
@@ -21,17 +44,36 @@ from .base import Measurement, WinchCommand
 #: Spacing of the statics samples along the reference [s].
 SAMPLE_PERIOD = 0.02
 
+#: Cable models the equilibria can be solved with (see the module notes).
+STATICS_MODELS = ("catenary", "chain")
+
 
 class SpatialTensionAwareController:
-    """Lengths of the elastic catenaries that hold the reference pose (spatial scenes)."""
+    """Lengths of the cables that hold the reference pose (spatial scenes).
 
-    name = "tension_aware"
+    Parameters
+    ----------
+    sample_period : float [s]
+        Spacing of the statics samples (a cubic spline between them).
+    statics : {"catenary", "chain"}
+        The cable model of the equilibria (see the module notes).
+    """
+
     uses_pose = False
     uses_tension = False
 
-    def __init__(self, sample_period: float = SAMPLE_PERIOD) -> None:
+    def __init__(self, sample_period: float = SAMPLE_PERIOD, statics: str = "catenary") -> None:
+        from cdpr_exu.core.errors import SceneError
+
+        if not np.isfinite(sample_period) or sample_period <= 0:
+            raise SceneError(f"sample_period must be positive [s], got {sample_period!r}")
+        if statics not in STATICS_MODELS:
+            raise SceneError(f"statics must be one of {STATICS_MODELS}, got {statics!r}")
         self.sample_period = float(sample_period)
+        self.statics = statics
+        self.name = "tension_aware" + ("_chain" if statics == "chain" else "")
         self._spline = None
+        self.inverses: list = []
 
     def reset(self, scene, initial_paid_out) -> None:
         """Solve the inverse statics along ``scene.trajectory`` and tabulate the commands.
@@ -39,30 +81,109 @@ class SpatialTensionAwareController:
         Raises
         ------
         UnreachableError
-            If a sampled reference pose cannot be held by cables that pull.
+            If a sampled reference pose cannot be held by cables that pull (naming the time).
+        SceneError
+            With ``statics="chain"``, for a scene the chain statics do not model (swivel pulleys).
         """
         from cdpr_exu.core.errors import UnreachableError
-        from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics, solve_spatial_statics
 
-        platform = scene.catenary_platform()
         initial = np.asarray(initial_paid_out, dtype=float)
-        rest = solve_spatial_statics(platform, initial)
-        tensions = np.array([c.catenary.horizontal_tension for c in rest.cables])
         end = scene.solver.end_time
         times = np.linspace(0.0, end, max(int(np.ceil(end / self.sample_period)), 3) + 1)
         poses = np.atleast_2d(scene.trajectory.pose(times))
         accelerations = np.atleast_2d(scene.trajectory.acceleration(times))
+        solve = self._chain_solver(scene, initial) if self.statics == "chain" else self._catenary_solver(scene, initial)
         lengths = np.empty((len(times), len(initial)))
+        self.inverses = []
         for k, (t, pose, acceleration) in enumerate(zip(times, poses, accelerations)):
-            inertial = np.concatenate([-platform.mass * acceleration[:3], np.zeros(3)])
             try:
-                inverse = solve_inverse_spatial_statics(platform, pose, tensions, external_wrench=inertial)
+                lengths[k] = solve(pose, acceleration)
             except UnreachableError as err:
                 raise UnreachableError(f"the reference at t = {t:.3f} s: {err}") from None
-            lengths[k] = inverse.unstrained_lengths
-            tensions = inverse.horizontal_tensions
-        self._spline = CubicSpline(times, initial + lengths - lengths[0], axis=0)
+        # catenary: the change of the lengths from the paid-out ones, which cancels the catenary's offset
+        # from the simulator's chains at the start; chain: the lengths themselves (the run blends
+        # the offset from the paid-out lengths in, SmoothStart), as the planar chain version
+        commands = lengths if self.statics == "chain" else initial + lengths - lengths[0]
+        self._spline = CubicSpline(times, commands, axis=0)
         self._rate = self._spline.derivative()
+
+    def _catenary_solver(self, scene, initial):
+        """pose, acceleration -> lengths [m] on elastic catenaries, the horizontal tensions continued."""
+        from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics, solve_spatial_statics
+
+        platform = scene.catenary_platform()
+        rest = solve_spatial_statics(platform, initial)
+        state = {"tensions": np.array([c.catenary.horizontal_tension for c in rest.cables])}
+
+        def solve(pose, acceleration):
+            inertial = np.concatenate([-platform.mass * acceleration[:3], np.zeros(3)])
+            inverse = solve_inverse_spatial_statics(platform, pose, state["tensions"], external_wrench=inertial)
+            state["tensions"] = inverse.horizontal_tensions
+            self.inverses.append(inverse)
+            return inverse.unstrained_lengths
+        return solve
+
+    def _chain_solver(self, scene, initial):
+        """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued."""
+        from cdpr_exu.core.errors import SceneError, UnreachableError
+        from cdpr_exu.physics.spatial_statics import solve_cable, solve_inverse_spatial_statics, solve_spatial_statics
+        from cdpr_exu.statics.spatial_chain_statics import (InverseChainStatics, catenary_start, robot_paid_out,
+                                                            solve_spatial_chain_statics, spatial_chain_robot)
+        from cdpr_exu.core.geometry import rotation_from_vector
+
+        platform = scene.catenary_platform()
+        robot = spatial_chain_robot(scene)
+        over_swivel = [i for i, cable in enumerate(robot.cables) if cable.swivel is not None]
+        if over_swivel:  # the held-chain inverse holds each cable at a fixed exit point
+            raise SceneError(f"tension_aware with statics='chain' needs point exits: cables {over_swivel} run over "
+                             "swivel pulleys (exits[i].kind = 'swivel'), which its inverse chain statics do not model "
+                             "yet; use statics='catenary'")
+        inverse_statics = InverseChainStatics(robot)
+        catenary_rest = solve_spatial_statics(platform, initial)
+        started = robot_paid_out(robot, initial)
+        rest = solve_spatial_chain_statics(started, *catenary_start(started, catenary_rest))
+        exits = np.array([c.exit_point for c in robot.cables])
+        anchors = np.array([c.anchor for c in robot.cables])
+        state = {"tensions": rest.tensions_at_anchor, "horizontal": np.array([c.catenary.horizontal_tension
+                                                                             for c in catenary_rest.cables]),
+                 "previous": None}
+
+        def anchor_points(pose):
+            rotation = np.eye(3) if robot.is_point_mass else rotation_from_vector(pose[3:6])
+            return pose[:3] + anchors @ rotation.T
+
+        def catenary_guess(pose, inertial):
+            """Lengths and nodes of the catenary inverse at ``pose`` (a start far from any previous sample)."""
+            inverse = solve_inverse_spatial_statics(platform, pose, state["horizontal"], external_wrench=inertial)
+            state["horizontal"] = inverse.horizontal_tensions
+            points = anchor_points(pose)
+            nodes = []
+            for cable, chain, length, point in zip(platform.cables, robot.cables, inverse.unstrained_lengths, points):
+                shape, _ = solve_cable(cable, length, point)
+                nodes.append(shape.points(length - np.linspace(0.0, length, chain.n_elements + 1)))
+            return inverse.unstrained_lengths, nodes
+
+        def solve(pose, acceleration):
+            inertial = np.concatenate([-robot.mass * acceleration[:3], np.zeros(3)])
+            previous = state["previous"]
+            if previous is None:
+                lengths, nodes = catenary_guess(pose, inertial)
+            else:  # the previous lengths, changed as the straight cables change
+                points = anchor_points(pose)
+                chords = np.linalg.norm(exits - points, axis=1)
+                lengths = previous[0].unstrained_lengths + chords - previous[1]
+                nodes = previous[0].nodes
+            try:
+                inverse = inverse_statics.solve(pose, state["tensions"], lengths, nodes, inertial)
+            except UnreachableError:
+                if previous is None:
+                    raise
+                inverse = inverse_statics.solve(pose, state["tensions"], *catenary_guess(pose, inertial), inertial)
+            state["tensions"] = inverse.tensions
+            state["previous"] = (inverse, np.linalg.norm(exits - anchor_points(pose), axis=1))
+            self.inverses.append(inverse)
+            return inverse.unstrained_lengths
+        return solve
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if self._spline is None:

@@ -221,3 +221,55 @@ def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_contr
     assert closed["max_position_error_m"] < open_loop["max_position_error_m"] / 4.0, message
     assert closed["max_rotation_error_deg"] < open_loop["max_rotation_error_deg"] / 10.0, message
     assert closed["min_element_tension_N"] > 0.0 and closed["status"] == "completed"
+
+
+class _TensionSpy:
+    """Reads the cable tensions; holds the initial lengths."""
+
+    name, uses_pose, uses_tension = "tension_spy", False, True
+
+    def reset(self, scene, initial):
+        self.initial = np.asarray(initial, dtype=float)
+        self.seen = []
+
+    def command(self, measurement):
+        self.seen.append(measurement)
+        return WinchCommand(self.initial, np.zeros_like(self.initial))
+
+
+def test_a_controller_that_uses_the_tensions_gets_tensions_that_hold_the_platform_at_rest():
+    from cdpr_exu.statics.spatial_chain_statics import spatial_chain_robot, spatial_chain_statics
+
+    scene = ipanema(end_time=0.3, output_period=0.01)
+    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    spy = _TensionSpy()
+    result = simulate_spatial(scene, spy)
+    robot = spatial_chain_robot(scene)
+    rest = np.array([t[-1] for t in spatial_chain_statics(scene).tensions])  # the lumped robot's statics
+    anchor_weights = np.array([c.node_masses[-1] for c in robot.cables]) * robot.gravity
+    during = [m for m in spy.seen if m.state_time is not None]
+    assert during and all(m.cable_tensions.shape == (8,) and m.platform_pose.shape == (6,) for m in during)
+    checked = 0
+    for m in during:
+        k = np.flatnonzero(np.abs(result.time - m.state_time) < 1e-9)
+        if not k.size:
+            continue
+        k = k[0]
+        assert np.abs(m.platform_pose - result.pose[k]).max() < 1e-14  # the same state as the pose
+        # The platform feels each tension along its last element, less the anchor node's weight
+        # (the joints carry the anchor nodes). At rest these balance its weight and moment:
+        # measured 4.5e-4 N and 2e-4 N m at t = 0 (the 10-element chains start on the catenary,
+        # 2.4e-4 N off their own statics), below 5e-5 from 0.02 s on; M a of a platform at rest
+        # is what remains. 2e-3 N is 1e-5 of the 245 N weight: a tension taken from the wrong
+        # element (the next one differs by up to its node's weight, 0.06 N) or a wrong time fails it.
+        ends = np.array([nodes[k, -1] for nodes in result.nodes])
+        along = np.array([nodes[k, -2] for nodes in result.nodes]) - ends
+        forces = m.cable_tensions[:, None] * along / np.linalg.norm(along, axis=1)[:, None]
+        forces[:, 2] -= anchor_weights
+        balance = forces.sum(axis=0) - [0.0, 0.0, robot.mass * robot.gravity]
+        moment = np.cross(ends - result.pose[k, :3], forces).sum(axis=0)
+        assert np.abs(balance).max() < 2e-3 and np.abs(moment).max() < 2e-3
+        # and they are the lumped robot's static tensions (measured to 2.4e-4 N)
+        assert np.abs(m.cable_tensions - rest).max() < 1e-3
+        checked += 1
+    assert checked > 20

@@ -395,8 +395,9 @@ def anchor_forces(mbs, items):
 def element_forces(mbs, items, cable, current=True):
     """Axial force of each element of one cable [N], shape (n,), exit first (tension > 0).
 
-    As the model computes it: Exudyn's spring-damper k (l - l0) + c dl/dt with the
-    parameters the connectors hold now (negative when compressed), or, with
+    As the model computes it: Exudyn's spring-damper k (l - l0) + c (dl/dt - dl0/dt) with
+    the parameters the connectors hold now (``velocityOffset`` = dl0/dt while a winch pays
+    the cable out; negative when compressed), or, with
     ``tension_only``, the tension-only law with the arrays the chain's force reads
     (never negative).
     """
@@ -415,9 +416,9 @@ def element_forces(mbs, items, cable, current=True):
     delta, delta_rate = np.diff(points, axis=0), np.diff(velocities, axis=0)
     length = np.linalg.norm(delta, axis=1)
     rate = np.einsum("ij,ij->i", delta, delta_rate) / length
-    rest, stiffness, damping = (np.array([mbs.GetObjectParameter(spring, name) for spring in chain.springs])
-                                for name in ("referenceLength", "stiffness", "damping"))
-    return stiffness * (length - rest) + damping * rate
+    rest, stiffness, damping, offset = (np.array([mbs.GetObjectParameter(spring, name) for spring in chain.springs])
+                                        for name in ("referenceLength", "stiffness", "damping", "velocityOffset"))
+    return stiffness * (length - rest) + damping * (rate - offset)
 
 
 def anchor_points(mbs, items):

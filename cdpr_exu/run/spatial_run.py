@@ -43,7 +43,8 @@ from matplotlib.figure import Figure
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import write_npz, write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, platform_pose, start_at_rest
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
+    start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
@@ -311,18 +312,21 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
 
     The controller is any :class:`controllers.base.Controller` that works on spatial
     scenes (:class:`controllers.ideal_ik.IdealIKController`,
-    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController`,
+    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController` (catenary or, with
+    ``statics="chain"``, the simulator's own chains),
     :func:`controllers.spatial_feedback.spatial_closed_loop_tension_aware`); it is asked
     for the winch commands before every step, wrapped in
     :class:`controllers.base.SmoothStart` as on planar scenes (its commands start at the
     paid-out lengths). A controller with ``uses_pose`` reads the platform's pose
     (x, y, z, rotation vector) and velocity (linear, global angular) at the start of the
-    step (``Measurement.state_time``); one with ``uses_tension`` is refused so far.
+    step (``Measurement.state_time``); one with ``uses_tension`` reads these and each
+    cable's tension at its platform end (its last element's axial force, shape (m,) [N],
+    as planar runs give it) at the same state.
 
     Raises
     ------
     SceneError
-        If the scene has no ``[trajectory]``, or the controller reads the cable tensions.
+        If the scene has no ``[trajectory]``.
     UnreachableError
         If no static equilibrium of the scene's lengths exists to start from.
     SolverFailure
@@ -355,10 +359,13 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         angular = (np.zeros(3) if items.is_point_mass else
                    np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.AngularVelocity)))
         return np.concatenate([position, rotation_vector(rotation)]), np.concatenate([velocity, angular])
+    def measured_tensions() -> np.ndarray:
+        """Each cable's tension at its platform end now, shape (m,) [N]: its last element's axial force as
+        the model computes it (the Kelvin-Voigt law on the strain rate; tension-only where the scene says so),
+        as planar runs give it."""
+        return np.array([element_forces(mbs, items, i)[-1] for i in range(m)])
+
     controller = controller or IdealIKController()
-    if controller.uses_tension:
-        raise SceneError(f"controller {controller.name!r} reads the cable tensions: spatial runs give "
-                         "the platform's pose only so far")
     # Every controller starts from what the winches paid out at t = 0 (SmoothStart), as on planar scenes.
     controller = SmoothStart(controller)
     # It plans on its own model of the robot (the scene's [controller_model], if any); what the
@@ -369,10 +376,11 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
 
     def measurement(t: float) -> Measurement:
         """What the controller may see when asked for the command at ``t`` [s]."""
-        if not controller.uses_pose:
+        if not (controller.uses_pose or controller.uses_tension):
             return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)))
         pose, velocity = measured_state()
-        return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)), pose, velocity,
+        tensions = measured_tensions() if controller.uses_tension else None
+        return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)), pose, velocity, tensions,
                            state_time=state["step_start"])
 
     def record(t: float) -> None:
@@ -560,8 +568,15 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
 SPATIAL_CONTROLLERS = {
     "ideal_ik": IdealIKController,
     "tension_aware": SpatialTensionAwareController,
+    "tension_aware_chain": lambda: SpatialTensionAwareController(statics="chain"),
     "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
 }
+
+def spatial_controller_names(scene: SpatialScene) -> list[str]:
+    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS`, but
+    ``tension_aware_chain`` where a cable leaves over a swivel pulley (the chain statics model point exits)."""
+    return [name for name in SPATIAL_CONTROLLERS if not (name == "tension_aware_chain" and scene.swivels)]
+
 
 _COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
             ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
@@ -594,7 +609,7 @@ def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: st
     controller's overview figure to ``out``. Returns the summaries by name."""
     from cdpr_exu.core.output import write_summary as _write
 
-    names = list(names or SPATIAL_CONTROLLERS)
+    names = list(names or spatial_controller_names(scene))
     unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
     if unknown:
         raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")

@@ -7,7 +7,7 @@ nodes carry the mass (the scene's lumping, :meth:`CableSpec.node_masses`), with
 exact-angle bending springs at the interior nodes (:mod:`cdpr_exu.physics.bending_3d`).
 This module solves that discrete model at rest, without Exudyn, as the spatial analogue
 of :mod:`cdpr_exu.statics.chain_statics` (forward problem: the unstrained lengths given,
-the pose found):
+the pose found; the inverse, the pose given and the lengths found, is at the end):
 
 * each cable's first node is held at its exit point, or, over a swivel pulley, at its
   winch end on the pulley's vertical axis below the inlet (the cable then runs up the
@@ -39,7 +39,7 @@ The equilibrium at rest needs no damping. Units SI (m, N, kg, rad); z up, gravit
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sparse
@@ -54,7 +54,8 @@ from cdpr_exu.physics.spatial_statics import chain_element_mass, node_masses_alo
 
 __all__ = ["SpatialChainCable", "SpatialChainRobot", "SpatialChainEquilibrium", "spatial_chain_robot",
            "solve_spatial_chain_statics", "catenary_start", "spatial_chain_statics", "swivel_chain_start",
-           "winch_line_elements"]
+           "winch_line_elements", "cable_paid_out", "robot_paid_out", "HeldChain", "solve_held_chain",
+           "SpatialChainInverse", "solve_inverse_spatial_chain_statics", "InverseChainStatics", "rounding_floor"]
 
 _E_Z = np.array([0.0, 0.0, 1.0])
 
@@ -385,6 +386,7 @@ class _Model:
             rows, columns = sp.swivel_contact_pattern(nodes, 3 * count + 1)
             index = np.concatenate([3 * first + np.arange(3 * count), [3 * self.n_points + s]])
             self.contacts.append((i, robot.cables[i].swivel, first, count, nodes, index[rows], index[columns], index))
+        self.external_force = np.zeros(3)  # a constant force on the platform's centre of mass [N]
 
     def points(self, free, x, R):
         """All points, shape (n_points, 3) [m]."""
@@ -425,6 +427,7 @@ class _Model:
             energy += axial_3d.tension_only_energy(flat, self.elements[self.slack], self.l0[self.slack],
                                                    self.k[self.slack])
         energy += float(self.weights @ p[:, 2]) + self.robot.mass * self.robot.gravity * x[2]
+        energy -= float(self.external_force @ x)
         if self.joints.size:
             energy += bending_3d.spatial_bending_energy(flat, self.joints, self.joint_k)
         if self.penalty:
@@ -528,6 +531,7 @@ class _Model:
         x0 = self.n_free
         gradient = T.T @ G
         gradient[x0 + 2] += self.robot.mass * self.robot.gravity
+        gradient[x0:x0 + 3] -= self.external_force
         hessian = (T.T @ H @ T).tolil()
         if self.rigid:
             rotation_second = np.zeros((3, 3))
@@ -585,7 +589,8 @@ def catenary_start(robot: SpatialChainRobot, equilibrium):
 
 
 def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotation=None, swivel_angles=None, *,
-                                tolerance: float = 1e-9, max_iterations: int = 100) -> SpatialChainEquilibrium:
+                                tolerance: float = 1e-9, max_iterations: int = 100,
+                                external_force=None) -> SpatialChainEquilibrium:
     """The rest configuration of the chains and platform for the cables' unstrained lengths.
 
     Parameters
@@ -603,8 +608,13 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
         pulley turned towards its cable's last start node.
     tolerance : float [N]
         Largest entry of the potential's gradient accepted (node forces, platform force, moment,
-        torques on the swivels [N m]).
+        torques on the swivels [N m]); at least the rounding of the element forces
+        (:func:`rounding_floor`: 4e-9 N on the four-cable robot, 1.6e-7 N on CoGiRo's steel
+        ropes, where 1e-9 N cannot be reached).
     max_iterations : int
+    external_force : (fx, fy, fz) [N], optional
+        A constant extra force on the platform's centre of mass (eg the d'Alembert force
+        -M a of an acceleration); its potential is -F . x.
 
     Returns
     -------
@@ -618,6 +628,8 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
         On malformed input.
     """
     model = _Model(robot)
+    if external_force is not None:
+        model.external_force = vector("external_force", external_force, 3, " (fx, fy, fz) [N]")
     x = vector("position", position, 3)
     R = np.eye(3) if rotation is None or not model.rigid else np.asarray(rotation, float)
     if R.shape != (3, 3) or not np.allclose(R.T @ R, np.eye(3), atol=1e-9):
@@ -644,6 +656,7 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
         psi = angles[model.swivel_cables].copy()
     state = (start[model.free].ravel(), x, R, psi)
     energy = model.energy(*state)
+    tolerance = max(tolerance, rounding_floor(model.k, start))
     for iteration in range(max_iterations):
         gradient, hessian, p, G, force = model.derivatives(*state)
         if np.max(np.abs(gradient)) < tolerance:
@@ -730,3 +743,353 @@ def spatial_chain_statics(scene, anchor_spring_factor: float | None = None, tens
     catenary = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
     robot = spatial_chain_robot(scene, anchor_spring_factor, tension_only, catenary)
     return solve_spatial_chain_statics(robot, *catenary_start(robot, catenary), **kwargs)
+
+
+def rounding_floor(stiffness, points) -> float:
+    """The force [N] below which a chain's node forces are rounding: an element's k (l - l0), its length
+    computed from coordinates of size |p|, carries k |p| eps; 16 times that for the sums. ``stiffness``:
+    the elements' k [N/m]; ``points``: the coordinates [m]."""
+    return 16.0 * np.finfo(float).eps * float(np.max(stiffness)) * float(np.abs(points).max())
+
+
+#: The swivel angles of a chain without swivel pulleys (held chains have point exits).
+_NO_SWIVEL = np.zeros(0)
+
+
+# ---------------------------------------------------------------------------
+# the inverse: lengths whose chains hold a pose
+# ---------------------------------------------------------------------------
+def cable_paid_out(cable: SpatialChainCable, length: float) -> SpatialChainCable:
+    """``cable`` paid out to the unstrained ``length`` [m], as the run's variable-length winch changes it
+    (:class:`cdpr_exu.run.spatial_run._SpatialWinches`): the same n elements of length L / n, their
+    stiffness E A n / L, the node masses rho L / n and the bending stiffness E J n / L."""
+    length = finite("length", length)
+    if length <= 0:
+        raise SceneError(f"length must be positive [m], got {length!r}")
+    scale = length / cable.unstrained_length
+    return replace(cable, element_length=cable.element_length * scale, axial_stiffness=cable.axial_stiffness / scale,
+                   node_masses=tuple(m * scale for m in cable.node_masses),
+                   bending_stiffness=cable.bending_stiffness / scale)
+
+
+def robot_paid_out(robot: SpatialChainRobot, lengths) -> SpatialChainRobot:
+    """``robot`` with each cable paid out to ``lengths`` (m,) [m] (:func:`cable_paid_out`)."""
+    lengths = np.asarray(lengths, dtype=float).reshape(-1)
+    if lengths.size != len(robot.cables):
+        raise SceneError(f"lengths must give one length per cable ({len(robot.cables)}), got {lengths.size}")
+    return replace(robot, cables=tuple(cable_paid_out(c, L) for c, L in zip(robot.cables, lengths)))
+
+
+@dataclass(frozen=True, eq=False)
+class HeldChain:
+    """One lumped cable at rest between its exit point and a fixed anchor point.
+
+    Attributes
+    ----------
+    nodes : ndarray, shape (n + 1, 3) [m]
+        Exit first, the anchor point last.
+    tensions : ndarray, shape (n,) [N]
+        Axial force of each element, exit first.
+    force : ndarray, shape (3,) [N]
+        Force the cable exerts on the anchor (the last element's pull, the bending shear and
+        the anchor node's weight: what it exerts on the platform).
+    force_rate : ndarray, shape (3,) [N/m]
+        d(force)/d(unstrained length) with both ends held: the chain re-settles (implicit
+        function theorem on the nodes' balance).
+    """
+
+    nodes: np.ndarray
+    tensions: np.ndarray
+    force: np.ndarray
+    force_rate: np.ndarray
+
+
+def _held_model(cable: SpatialChainCable, gravity: float) -> _Model:
+    """The model of one cable whose anchor is a fixed point: a one-cable robot of no mass with the anchor at
+    its centre, whose position unknowns are kept fixed."""
+    return _Model(SpatialChainRobot((replace(cable, anchor=(0.0, 0.0, 0.0)),), 0.0, gravity))
+
+
+def solve_held_chain(cable: SpatialChainCable, gravity: float, anchor_point, nodes, *, tolerance: float = 1e-9,
+                     max_iterations: int = 50) -> HeldChain:
+    """The rest shape of one lumped cable held at its exit point and at ``anchor_point``.
+
+    Newton's method on its free nodes (the potential of :func:`solve_spatial_chain_statics`, with
+    the same line search), then the force on the anchor and its rate with the unstrained length.
+
+    Parameters
+    ----------
+    cable : SpatialChainCable
+        At the unstrained length wanted (:func:`cable_paid_out`); its ``anchor`` is not used.
+    gravity : float [m/s^2]
+    anchor_point : (x, y, z) [m]
+        World position of the anchor.
+    nodes : array_like, shape (n + 1, 3) [m]
+        Start of the nodes, exit first; the ends are put on the exit and anchor points, the nodes
+        between moved along by the same share of the ends' displacement as of the cable.
+    tolerance : float [N]
+        Largest force left on a free node; below the rounding of the element forces
+        (:func:`rounding_floor`: 4e-8 N on IPAnema's stiff cables, 2e-14 m of stretch), the
+        iteration also stops once a Newton step no longer halves it.
+
+    Raises
+    ------
+    UnreachableError
+        If Newton finds no rest shape.
+    """
+    return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations)
+
+
+def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, tolerance: float,
+                max_iterations: int) -> HeldChain:
+    """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other lengths)."""
+    anchor_point = vector("anchor_point", anchor_point, 3)
+    nodes = np.array(nodes, dtype=float)
+    n = cable.n_elements
+    if nodes.shape != (n + 1, 3) or not np.all(np.isfinite(nodes)):
+        raise SceneError(f"nodes must be finite, shape {(n + 1, 3)}, got {nodes.shape}")
+    share = np.linspace(0.0, 1.0, n + 1)[:, None]
+    exit_point = np.asarray(cable.exit_point)
+    nodes += (1.0 - share) * (exit_point - nodes[0]) + share * (anchor_point - nodes[-1])
+    R = np.eye(3)
+    inner = slice(3, 3 * n)  # the free nodes' rows among the points (exit, free nodes, anchor)
+    end = slice(3 * n, 3 * n + 3)
+    free = nodes[1:-1].ravel().copy()
+    energy = model.energy(free, anchor_point, R, _NO_SWIVEL)
+    # Below the rounding floor Newton keeps gaining while it can: the anchor force of a chain stopped
+    # at the floor is off by about the floor, and m of them stall the platform's balance (CoGiRo's
+    # Gauss-Newton crawled for 30 iterations at 1e-5 N). So stop at the tolerance, or below the floor
+    # once a step no longer halves the imbalance.
+    floor = rounding_floor(model.k, nodes)
+    last = np.inf
+    for iteration in range(max_iterations):
+        nodes[1:-1] = free.reshape(-1, 3)
+        G, H, force = model.point_derivatives(nodes, _NO_SWIVEL)
+        H = H.toarray()
+        g = G[inner]
+        imbalance = float(np.max(np.abs(g)))
+        if imbalance < tolerance or (imbalance < floor and imbalance > 0.5 * last):
+            break
+        last = imbalance
+        step = _descent(H[inner, inner], g)
+        slope = float(step @ g)
+        roundoff = 1e-13 * (1.0 + abs(energy))
+        alpha, accepted = 1.0, False
+        for _ in range(40):
+            trial = free + alpha * step
+            trial_energy = model.energy(trial, anchor_point, R, _NO_SWIVEL)
+            if trial_energy <= energy + 1e-4 * alpha * slope:
+                accepted = True
+                break
+            if abs(trial_energy - energy) <= roundoff:
+                moved = nodes.copy()
+                moved[1:-1] = trial.reshape(-1, 3)
+                accepted = np.max(np.abs(model.point_derivatives(moved, _NO_SWIVEL)[0][inner])) < np.max(np.abs(g))
+                break
+            alpha *= 0.5
+        if not accepted:
+            if imbalance < max(10.0 * tolerance, floor):
+                break
+            raise UnreachableError(f"held chain statics: the line search failed (force imbalance "
+                                   f"{np.max(np.abs(g)):.3g} N after {iteration} iterations)")
+        free, energy = trial, trial_energy
+    else:
+        raise UnreachableError(f"held chain statics did not converge in {max_iterations} iterations "
+                               f"(force imbalance {np.max(np.abs(g)):.3g} N)")
+    # d(gradient)/dL at fixed nodes by central differences of the chain paid out by +-dL (the run's
+    # scaling, :func:`cable_paid_out`), then the free nodes re-settle: d(free)/dL = -H^-1 dg_free/dL;
+    # the anchor's force is -(its gradient)
+    step = 1e-6
+    rate = (_paid_out_model(model, 1.0 + step).point_derivatives(nodes, _NO_SWIVEL)[0]
+            - _paid_out_model(model, 1.0 - step).point_derivatives(nodes, _NO_SWIVEL)[0]) / (2.0 * step * cable.unstrained_length)
+    settle = -np.linalg.solve(H[inner, inner], rate[inner])
+    force_rate = -(rate[end] + H[end, inner] @ settle)
+    return HeldChain(nodes, np.asarray(force, dtype=float).copy(), -G[end].copy(), force_rate)
+
+
+def _paid_out_model(model: _Model, scale: float) -> _Model:
+    """A copy of a one-cable ``model`` with its cable paid out ``scale`` times as long, as :func:`cable_paid_out`:
+    element lengths and weights times ``scale``, axial and bending stiffness over it."""
+    import copy
+
+    scaled = copy.copy(model)
+    scaled.l0, scaled.k = model.l0 * scale, model.k / scale
+    scaled.weights, scaled.joint_k = model.weights * scale, model.joint_k / scale
+    return scaled
+
+
+def _descent(hessian, gradient):
+    """Newton's step, shifted towards steepest descent until it descends."""
+    shift = 0.0
+    while True:
+        try:
+            step = np.linalg.solve(hessian + shift * np.eye(len(gradient)), -gradient)
+        except np.linalg.LinAlgError:
+            step = None
+        if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
+            return step
+        shift = max(10.0 * shift, 1e-8 * np.abs(np.diag(hessian)).max())
+
+
+@dataclass(frozen=True, eq=False)
+class SpatialChainInverse:
+    """Unstrained lengths whose lumped chains hold the platform at a pose.
+
+    Attributes
+    ----------
+    unstrained_lengths : ndarray, shape (m,) [m]
+    tensions : ndarray, shape (m,) [N]
+        Norm of each cable's force on the platform.
+    forces_on_platform : ndarray, shape (m, 3) [N]
+    nodes : tuple of ndarray, each shape (n + 1, 3) [m]
+        Each cable's nodes, exit first (a start for the next pose or the forward statics).
+    residual : float [N]
+        Largest force (and moment / arm) imbalance of the platform left.
+    iterations : int
+    """
+
+    unstrained_lengths: np.ndarray
+    tensions: np.ndarray
+    forces_on_platform: np.ndarray
+    nodes: tuple
+    residual: float
+    iterations: int
+
+
+def solve_inverse_spatial_chain_statics(robot: SpatialChainRobot, pose, tension_guess, lengths, nodes,
+                                        external_wrench=None, *, tolerance: float = 1e-9,
+                                        max_iterations: int = 30) -> SpatialChainInverse:
+    """Unstrained lengths whose lumped chains hold ``robot``'s platform at ``pose``, tensions nearest a guess.
+
+    With the pose given, every anchor is a fixed point, and each cable is a chain between two
+    held ends (:func:`solve_held_chain`): the cables decouple, and only the platform's balance
+    ties them, six equations (three for a point mass, or a rigid platform on fewer than six
+    cables, whose rotation is left free as in
+    :func:`cdpr_exu.physics.spatial_statics.solve_inverse_spatial_statics`) in the m lengths.
+    Gauss-Newton on the lengths, each cable's force derivative from its own chain: among the
+    length changes that cancel the imbalance to first order, the one whose tensions (the norm
+    of each cable's force on the platform) come nearest ``tension_guess``. Continuing from the
+    previous pose's tensions along a trajectory, a redundant robot keeps its internal tension.
+
+    Parameters
+    ----------
+    robot : SpatialChainRobot
+        The cables (any lengths: they are paid out to ``lengths``), anchors, platform mass.
+    pose : array_like, shape (3,) or (6,) [m, rad]
+        Centre of mass and (rigid) rotation vector.
+    tension_guess : array_like, shape (m,) [N]
+        Positive tensions to stay near (eg the previous pose's).
+    lengths : array_like, shape (m,) [m]
+        Start of the unstrained lengths (eg the catenaries' inverse, or the previous pose's).
+    nodes : sequence of array_like, each shape (n + 1, 3) [m]
+        Start of each cable's nodes, exit first (moved onto the anchors as :func:`solve_held_chain` does).
+    external_wrench : array_like, shape (6,) [N, N m], optional
+        Extra load on the platform about its centre of mass (eg the d'Alembert force).
+    tolerance : float
+        Imbalance accepted, relative to the larger of the weight and the largest cable force.
+
+    Returns
+    -------
+    SpatialChainInverse
+
+    Raises
+    ------
+    UnreachableError
+        If no lengths with positive tensions balance the platform there (a cable would have to
+        push or go slack), or the iteration does not converge.
+    """
+    return InverseChainStatics(robot).solve(pose, tension_guess, lengths, nodes, external_wrench,
+                                            tolerance=tolerance, max_iterations=max_iterations)
+
+
+class InverseChainStatics:
+    """:func:`solve_inverse_spatial_chain_statics` for many poses of one robot: each cable's model is
+    built once (the lengths change by scaling it, :func:`_paid_out_model`).
+
+    Parameters
+    ----------
+    robot : SpatialChainRobot
+    """
+
+    def __init__(self, robot: SpatialChainRobot):
+        self.robot = robot
+        self.models = [_held_model(c, robot.gravity) for c in robot.cables]
+
+    def solve(self, pose, tension_guess, lengths, nodes, external_wrench=None, *, tolerance: float = 1e-9,
+              max_iterations: int = 30) -> SpatialChainInverse:
+        """As :func:`solve_inverse_spatial_chain_statics` (same parameters, robot aside)."""
+        return _solve_inverse(self.robot, self.models, pose, tension_guess, lengths, nodes, external_wrench,
+                              tolerance, max_iterations)
+
+
+def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench, tolerance, max_iterations):
+    """The Gauss-Newton of :func:`solve_inverse_spatial_chain_statics`, each cable's held model given."""
+    from cdpr_exu.core.validation import real_array
+
+    m = len(robot.cables)
+    pose = real_array("pose", pose)
+    rigid = not robot.is_point_mass
+    if pose.shape != (6,) and not (not rigid and pose.shape == (3,)):
+        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {pose.tolist()!r}")
+    guess = real_array("tension_guess", tension_guess)
+    if guess.shape != (m,) or np.any(guess <= 0.0):
+        raise SceneError(f"tension_guess must be one positive tension per cable, got {tension_guess!r}")
+    lengths = real_array("lengths", lengths)
+    if lengths.shape != (m,) or np.any(lengths <= 0.0):
+        raise SceneError(f"lengths must be one positive length per cable, got {lengths!r}")
+    if len(nodes) != m:
+        raise SceneError(f"nodes must give one array per cable ({m}), got {len(nodes)}")
+    wrench = np.zeros(6) if external_wrench is None else vector("external_wrench", external_wrench, 6)
+    rotation = rotation_from_vector(pose[3:6]) if rigid else np.eye(3)
+    arms = np.array([c.anchor for c in robot.cables]) @ rotation.T
+    anchor_points = pose[:3] + arms
+    rows = 6 if (rigid and m >= 6) else 3
+    weight = robot.mass * robot.gravity
+    arm_scale = max(float(np.linalg.norm(arms, axis=1).max()), 1e-3)
+    scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
+
+    def held(trial_lengths, trial_nodes):
+        chains = [_solve_held(_paid_out_model(model, L / c.unstrained_length), cable_paid_out(c, L), a, start,
+                              1e-9, 50)
+                  for model, c, L, a, start in zip(models, robot.cables, trial_lengths, anchor_points, trial_nodes)]
+        forces = np.array([chain.force for chain in chains])
+        total = np.concatenate([forces.sum(axis=0) + wrench[:3] - [0.0, 0.0, weight],
+                                np.cross(arms, forces).sum(axis=0) + wrench[3:]])[:rows] * scale
+        return chains, forces, total
+
+    chains, forces, total = held(lengths, nodes)
+    residual = float(np.abs(total).max())
+    for iteration in range(max_iterations + 1):
+        if residual <= tolerance * max(weight, float(np.abs(forces).max()), 1e-12):
+            return SpatialChainInverse(lengths, np.linalg.norm(forces, axis=1), forces,
+                                       tuple(chain.nodes for chain in chains), residual, iteration)
+        if iteration == max_iterations:
+            break
+        tensions = np.linalg.norm(forces, axis=1)
+        rates = np.array([chain.force_rate for chain in chains])
+        slope = np.einsum("ij,ij->i", forces, rates) / tensions  # d(tension)/d(length): negative if taut
+        if np.any(tensions <= 0.0) or np.any(slope >= 0.0):
+            raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: cable(s) "
+                                   f"{(np.flatnonzero((tensions <= 0.0) | (slope >= 0.0)) + 1).tolist()} hang slack "
+                                   "at these lengths: the chains hold the platform only if a cable pushes")
+        jacobian = np.concatenate([rates.T, np.cross(arms, rates).T])[:rows] * scale[:, None]  # d(total)/d(lengths)
+        # in the tensions' variables y = slope * dL: the change nearest the guess that cancels the imbalance
+        in_tensions = jacobian / slope[None, :]
+        offset = tensions - guess
+        change = (-offset + np.linalg.pinv(in_tensions) @ (in_tensions @ offset - total)) / slope
+        for _ in range(20):  # halve the step until the imbalance falls
+            trial = lengths + change
+            if np.all(trial > 0.0):
+                try:
+                    trial_chains, trial_forces, trial_total = held(trial, [c.nodes for c in chains])
+                except UnreachableError:
+                    trial_total = None
+                if trial_total is not None and float(np.abs(trial_total).max()) < residual:
+                    break
+            change = 0.5 * change
+        else:
+            break
+        lengths, chains, forces, total = trial, trial_chains, trial_forces, trial_total
+        residual = float(np.abs(total).max())
+    raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: the chains' balance did not converge "
+                           f"(imbalance {residual:.3g} N after {iteration} iterations)")
