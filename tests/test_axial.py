@@ -121,9 +121,10 @@ def test_jacobian_matches_central_differences_inside_the_taut_band():
 
 
 def test_an_element_on_its_rest_length_gives_newton_the_taut_slopes_but_no_force():
-    """At t = 0 a straight cable's elements lie on their rest length to round-off: the
-    Jacobian takes the taut side's slopes there (else the first Newton iterate moves every
-    node as a free mass), while the force stays zero."""
+    """At t = 0 a straight cable's elements lie on their rest length to round-off: in the
+    run's first step (kink_strain = ROUNDOFF_STRAIN) the Jacobian takes the taut side's
+    slopes there (else the first Newton iterate moves every node as a free mass), while
+    the force stays zero; later (kink_strain = 0) the slack side's zero slopes again."""
     from cdpr_exu.physics.axial import ROUNDOFF_STRAIN
 
     k, c = np.array([100.0]), np.array([10.0])
@@ -132,12 +133,22 @@ def test_an_element_on_its_rest_length_gives_newton_the_taut_slopes_but_no_force
         # The law's own value: (3 x^2) k s at x = s / band <= 5e-8, below 1e-20 N.
         assert np.abs(_force(p, np.zeros(4), cable_elements([2]), np.array([1.0]), k, c)).max() < 1e-20
         stiffness = slack_axial_jacobian(p, np.zeros(4), cable_elements([2]), np.array([1.0]), k, c, 1.0, 0.0,
-                                         np.zeros((4, 4)))
+                                         np.zeros((4, 4)), ROUNDOFF_STRAIN)
         damping = slack_axial_jacobian(p, np.zeros(4), cable_elements([2]), np.array([1.0]), k, c, 0.0, 1.0,
-                                       np.zeros((4, 4)))
+                                       np.zeros((4, 4)), ROUNDOFF_STRAIN)
         # Along the element (x): k and c exactly, as a taut element's; nothing across it.
         assert stiffness[2, 2] == k[0] and damping[2, 2] == c[0] and stiffness[3, 3] == 0.0
     # A truly slack element (well past round-off) still gives Newton nothing.
     p = np.array([0.0, 0.0, 1.0 - 1e-9, 0.0])
+    assert not slack_axial_jacobian(p, np.zeros(4), cable_elements([2]), np.array([1.0]), k, c, 1.0, 1.0,
+                                    np.zeros((4, 4)), ROUNDOFF_STRAIN).any()
+    # After the first step (kink_strain = 0) only an element exactly on its rest length (a
+    # cable section that has only been carried along, bit for bit) keeps the taut slopes;
+    # one a round-off off it is slack again.
+    p = np.array([0.0, 0.0, 1.0, 0.0])
+    exact = slack_axial_jacobian(p, np.zeros(4), cable_elements([2]), np.array([1.0]), k, c, 1.0, 0.0,
+                                 np.zeros((4, 4)))
+    assert exact[2, 2] == k[0]
+    p = np.array([0.0, 0.0, 1.0 - 0.5 * ROUNDOFF_STRAIN, 0.0])
     assert not slack_axial_jacobian(p, np.zeros(4), cable_elements([2]), np.array([1.0]), k, c, 1.0, 1.0,
                                     np.zeros((4, 4))).any()

@@ -132,6 +132,10 @@ class CableForceItems:
     slack_arrays: tuple = ()
     #: The smooth node rim contacts (``Effects.pulley_contact_model = "node_smooth"``), or None.
     node_contact: NodePulleyContact | None = None
+    #: One entry: the strain within which a tension-only element counts as on its rest length for
+    #: Newton's Jacobian (the taut slopes, :func:`cdpr_exu.physics.axial._element_block`):
+    #: ``axial.ROUNDOFF_STRAIN`` until the run's first accepted step, which sets it to 0.
+    first_step_kink: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
 
 def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
@@ -205,6 +209,9 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     force_buffer = np.zeros(size)
     jacobian_buffer = np.zeros((size, size))
     no_force, no_matrix = np.zeros(0), np.zeros((0, 0))
+    # The tension-only elements' kink rule of the first step (axial._element_block); the run
+    # sets it to 0 after its first accepted step (CableForceItems.first_step_kink).
+    kink = np.array([axial.ROUNDOFF_STRAIN if effects.slack else 0.0])
     joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
 
     def fused_force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
@@ -214,7 +221,8 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
 
     def fused_jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
         return cable_forces.cable_jacobian(reference, np.asarray(q), np.asarray(q_t), positions, *joint_args,
-                                           float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer)
+                                           float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer,
+                                           kink[0])
 
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         np.add(reference, q, out=positions)
@@ -234,7 +242,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         jacobian = spring.jacobian_weighted(positions, velocities, f_q, f_q_t)
         if effects.slack:
             axial.slack_axial_jacobian(positions, velocities, elements, rest, axial_k, axial_c,
-                                       float(f_q), float(f_q_t), jacobian)
+                                       float(f_q), float(f_q_t), jacobian, kink[0])
         if contact is not None:
             contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
         if node_contact is not None:
@@ -247,7 +255,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     if sparse_jacobian and contact is None and not linear:
         blocks = [_bending_blocks(spring)]
         if effects.slack and len(elements):
-            blocks.append(_slack_blocks(elements, rest, axial_k, axial_c))
+            blocks.append(_slack_blocks(elements, rest, axial_k, axial_c, kink))
         if node_contact is not None:
             blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
         functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions))
@@ -270,7 +278,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         forceUserFunction=functions[0], jacobianUserFunction=functions[1], **matrices))
     segments = np.zeros((0, 2), np.int64) if contact is None else contact.segments
     return CableForceItems(obj, joints, stiffness, damping, elements, (spring, *functions, matrices),
-                           segments, contact, (rest, axial_k, axial_c) if effects.slack else (), node_contact)
+                           segments, contact, (rest, axial_k, axial_c) if effects.slack else (), node_contact, kink)
 
 
 def _bending_blocks(spring):
@@ -283,13 +291,14 @@ def _bending_blocks(spring):
     return rows, columns, fill
 
 
-def _slack_blocks(elements, rest, axial_k, axial_c):
-    """Sparse pattern and value filler of the tension-only elements' 4 x 4 blocks."""
+def _slack_blocks(elements, rest, axial_k, axial_c, kink):
+    """Sparse pattern and value filler of the tension-only elements' 4 x 4 blocks (``kink``: the
+    one-entry array of the first step's kink strain, :class:`CableForceItems`)."""
     rows, columns = axial.slack_triplet_pattern(elements)
 
     def fill(positions, velocities, factor_position, factor_velocity, out_values):
         axial.slack_triplet_values(positions, velocities, elements, rest, axial_k, axial_c,
-                                   factor_position, factor_velocity, out_values)
+                                   factor_position, factor_velocity, out_values, kink[0])
     return rows, columns, fill
 
 

@@ -108,23 +108,28 @@ def slack_axial_force(positions, velocities, elements, rest_length, stiffness, d
 
 @njit(cache=True)
 def _element_block(positions, velocities, a, b, rest_length, stiffness, damping, factor_position,
-                   factor_velocity, block):
+                   factor_velocity, block, kink_strain=0.0):
     """The (b, b) block, shape (2, 2), of ``factor_position * K + factor_velocity * D`` of one
     element into ``block``; the (a, a) block is the same, (a, b) and (b, a) its negative.
     Returns False (block untouched) when the element carries no force (slack).
 
-    An element within round-off of its rest length (:data:`ROUNDOFF_STRAIN`), as every
-    element of a cable placed straight at zero strain is at t = 0, sits on the kink of the
-    law, where its slopes are 0 on one side and (k, c) on the other: its block takes the
-    taut slopes (k, c) and no geometric term, though it carries no force. With the slack
-    side's zero slopes, the first Jacobian of such a start holds no axial term at all,
-    and the first Newton iterate moves every node as a free mass (strains of 20-40 %,
-    a residual of 4e6 N on 240 elements per cable).
+    With ``kink_strain`` > 0 (the run's first step only, :data:`ROUNDOFF_STRAIN`), an
+    element within that strain of its rest length, as every element of a cable placed
+    straight at zero strain is at t = 0, sits on the kink of the law, where its slopes are
+    0 on one side and (k, c) on the other: its block takes the taut slopes (k, c) and no
+    geometric term, though it carries no force. With the slack side's zero slopes, the
+    first Jacobian of such a start holds no axial term at all, and the first Newton
+    iterate moves every node as a free mass (strains of 20-40 %, a residual of 4e6 N on
+    240 elements per cable). Later in a run (``kink_strain`` = 0) only an element exactly
+    on its rest length keeps the taut slopes (a section carried along bit for bit, as the
+    winch line is in the first steps; without it 120 and 240 elements at 1e-2 s fail
+    again): an element passing *near* its rest length with a taut Jacobian stalled Newton
+    (the held catenary scene failed at 5.9e-5 s with 1e-12 throughout).
     """
     length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
     extension = length - rest_length
     force, k, c = tension_law(extension, rate, stiffness, damping, TAUT_BAND * rest_length)
-    if abs(extension) <= ROUNDOFF_STRAIN * rest_length:
+    if abs(extension) <= kink_strain * rest_length:
         force, k, c = 0.0, stiffness, damping
     elif force <= 0.0:
         return False
@@ -141,7 +146,7 @@ def _element_block(positions, velocities, a, b, rest_length, stiffness, damping,
 
 @njit(cache=True)
 def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness, damping,
-                         factor_position, factor_velocity, out):
+                         factor_position, factor_velocity, out, kink_strain=0.0):
     """Add ``factor_position * K + factor_velocity * D`` of the slack elements to ``out``.
 
     K = -df/dq and D = -df/dv (the left-hand-side Jacobians Exudyn expects), shape
@@ -152,7 +157,7 @@ def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness
     for e in range(elements.shape[0]):
         a, b = elements[e, 0], elements[e, 1]
         if not _element_block(positions, velocities, a, b, rest_length[e], stiffness[e], damping[e],
-                              factor_position, factor_velocity, block):
+                              factor_position, factor_velocity, block, kink_strain):
             continue
         for i in range(2):
             for j in range(2):
@@ -186,14 +191,14 @@ def slack_triplet_pattern(elements):
 
 @njit(cache=True)
 def slack_triplet_values(positions, velocities, elements, rest_length, stiffness, damping,
-                         factor_position, factor_velocity, out_values):
+                         factor_position, factor_velocity, out_values, kink_strain=0.0):
     """Values of ``factor_position * K + factor_velocity * D`` of the slack elements at
     :func:`slack_triplet_pattern`'s places (overwrites ``out_values``, shape (16 E,))."""
     out_values[:] = 0.0
     block = np.empty((2, 2))
     for e in range(elements.shape[0]):
         if not _element_block(positions, velocities, elements[e, 0], elements[e, 1], rest_length[e], stiffness[e],
-                              damping[e], factor_position, factor_velocity, block):
+                              damping[e], factor_position, factor_velocity, block, kink_strain):
             continue
         for i in range(2):
             for j in range(2):

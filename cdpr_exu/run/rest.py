@@ -373,7 +373,10 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
     pairs = _speed_indices(model)
     window = {"from": 0.0, "speed": 0.0}
 
+    kink = model.cable_forces.first_step_kink if model.cable_forces is not None else np.zeros(1)
+
     def post_step(mbs_, t):
+        kink[0] = 0.0  # past the first step: Newton sees the tension-only law as it is
         if t >= window["from"]:
             v = np.asarray(data.GetODE2Coordinates_t())[pairs]
             window["speed"] = max(window["speed"], float(np.sqrt((v**2).sum(axis=1)).max()))

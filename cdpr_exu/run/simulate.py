@@ -369,6 +369,8 @@ class _Stepper:
         self.stop_exception: Exception | None = None
         self.interrupted = {"interrupted": False}
         self.reservoir = _rope_reservoir(scene, model)
+        forces = model.cable_forces
+        self.first_step_kink = forces.first_step_kink if forces is not None else None
         # coordinates of each cable's first two nodes, shape (m, 2, 2): its winch element
         self.first_nodes = (np.array([self.indices[f"cable_{i}"][:2] for i in range(len(scene.cables))])
                             if self.reservoir else np.zeros((0, 2, 2), dtype=int))
@@ -455,6 +457,8 @@ class _Stepper:
     def post_step(self, mbs_, t: float) -> bool:  # noqa: ARG002 - Exudyn's signature
         """Exudyn's post-step function: record, check, report; False ends the integration."""
         self.step_start = t
+        if self.first_step_kink is not None:
+            self.first_step_kink[0] = 0.0  # the zero-strain start is behind: Newton sees the law as it is
         if self.interrupted["interrupted"]:
             return False  # Ctrl-C: end the integration, keep what was computed
         surplus = None if self.reservoir is None else self.reservoir.surplus
