@@ -271,5 +271,7 @@ def test_a_controller_that_uses_the_tensions_gets_tensions_that_hold_the_platfor
         assert np.abs(balance).max() < 2e-3 and np.abs(moment).max() < 2e-3
         # and they are the lumped robot's static tensions (measured to 2.4e-4 N)
         assert np.abs(m.cable_tensions - rest).max() < 1e-3
+        # the result records the same forces (spring and damper), the same bits
+        assert np.array_equal(np.array([t[k, -1] for t in result.tensions]), m.cable_tensions)
         checked += 1
     assert checked > 20

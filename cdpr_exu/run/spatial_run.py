@@ -143,7 +143,8 @@ class SpatialResult:
     nodes : list of ndarray, each (N, n + 1, 3) [m]
         Node positions of each cable, exit first.
     tensions : list of ndarray, each (N, n) [N]
-        Axial force of each element (spring part; positive in tension).
+        Axial force of each element, spring and damper as the model computes them (positive in
+        tension; never negative for tension-only elements).
     wall_time : float [s]
     steps, newton_iterations : int
     status : str
@@ -281,15 +282,6 @@ class _SpatialWinches:
             self.applied[i] = length
 
 
-def _element_tensions(nodes: np.ndarray, length: float, axial_rigidity: float, n: int,
-                      tension_only: bool, elements: int | None = None) -> np.ndarray:
-    """Spring force of each element [N], shape (elements,), for node positions (elements + 1, 3), elements of
-    unstrained length L / n (tension-only elements: nothing below the rest length)."""
-    element = length / n
-    force = axial_rigidity / element * (np.linalg.norm(np.diff(nodes, axis=0), axis=1) - element)
-    return np.maximum(force, 0.0) if tension_only else force
-
-
 def _warn_outside_measured_region(scene: SpatialScene) -> None:
     """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
     outside the region where runs over a swivel pulley were measured to keep their energy."""
@@ -348,7 +340,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     solver = scene.solver
     outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
     m, n = scene.n_cables, scene.cables[0].n_elements
-    times, poses, paid, node_series = [], [], [], [[] for _ in range(m)]
+    times, poses, paid, node_series, tension_series = [], [], [], [[] for _ in range(m)], [[] for _ in range(m)]
     kinematic = scene.winch.kind == "kinematic"
 
     def measured_state() -> tuple[np.ndarray, np.ndarray]:
@@ -390,6 +382,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         paid.append(winches.applied.copy())
         for i in range(m):
             node_series[i].append(chain_positions(mbs, items, i))
+            tension_series[i].append(element_forces(mbs, items, i))  # spring and damper, as the model has them
 
     def pre_step(mbs_, t):  # noqa: ARG001
         if not kinematic:
@@ -440,10 +433,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     pose = np.asarray(poses)
     paid_out = np.asarray(paid)
     nodes = [np.asarray(series) for series in node_series]
-    tensions = [np.array([_element_tensions(frame, lengths[i] if items.has_swivel(i) else length, cable.axial_rigidity,
-                                            n, scene.effects.slack, len(frame) - 1)
-                          for frame, length in zip(nodes[i], paid_out[:, i])])
-                for i, cable in enumerate(scene.cables)]
+    tensions = [np.asarray(series) for series in tension_series]
     iterations = mbs.sys["dynamicSolver"].it
     result = SpatialResult(scene.name, controller.name if kinematic else "fixed winches", time_array, pose,
                            np.atleast_2d(scene.trajectory.pose(time_array)), paid_out, nodes, tensions, wall,
