@@ -238,15 +238,17 @@ def test_newton_tolerance_reaches_exudyn_and_moves_the_paper_path_by_less_than_a
     """1e-6 (the default) against Exudyn's 1e-8 on 1 s of the paper circle. The paper's
     spring elements: measured 0.14 micrometres over the 10 s circle; bound 1 micrometre.
     Tension-only elements (the default): the winch elements go slack in the start-up, and
-    where they snap taut the path moves by 60 micrometres (measured); bound 0.2 mm, far
-    below the millimetres asked of a run."""
+    the first step is halved several times at t = 0 (docs/slack.md), in a sequence that
+    depends on the tolerance: the start-up path moves by 0.31 mm (measured; 60 micrometres
+    before the first step's round-off Jacobian rule); bound 0.5 mm, below the millimetres
+    asked of a run."""
     from dataclasses import replace
 
     from cdpr_exu.scenes.scene import load_scene
     from cdpr_exu.run.simulate import solver_settings
 
     paper = load_scene("paper-circle")
-    for preset, bound in (("paper", 1e-6), ("full", 2e-4)):
+    for preset, bound in (("paper", 1e-6), ("full", 5e-4)):
         short = paper.with_changes(solver=replace(paper.solver, end_time=1.0), effects=Effects.from_preset(preset))
         tight = short.with_changes(solver=replace(short.solver, newton_tolerance=1e-8))
         assert solver_settings(short).timeIntegration.newton.relativeTolerance == 1e-6

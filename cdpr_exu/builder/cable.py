@@ -133,9 +133,22 @@ class CableForceItems:
     #: The smooth node rim contacts (``Effects.pulley_contact_model = "node_smooth"``), or None.
     node_contact: NodePulleyContact | None = None
     #: One entry: the strain within which a tension-only element counts as on its rest length for
-    #: Newton's Jacobian (the taut slopes, :func:`cdpr_exu.physics.axial._element_block`):
-    #: ``axial.ROUNDOFF_STRAIN`` until the run's first accepted step, which sets it to 0.
+    #: Newton's Jacobian (the taut slopes, :func:`cdpr_exu.physics.axial._element_block`): 0 as
+    #: built; ``simulate`` and the run to rest set it to ``axial.ROUNDOFF_STRAIN`` before their
+    #: first step and back to 0 after it (:func:`arm_first_step_kink`).
     first_step_kink: np.ndarray = field(default_factory=lambda: np.zeros(1))
+
+
+def arm_first_step_kink(forces: CableForceItems | None) -> np.ndarray:
+    """Arm the round-off kink rule of the tension-only elements for a run's first step.
+
+    Returns the one-entry array the run's first post-step function sets to 0 (an empty
+    stand-in when the model has no cable forces). See :func:`cdpr_exu.physics.axial._element_block`.
+    """
+    if forces is None:
+        return np.zeros(1)
+    forces.first_step_kink[0] = axial.ROUNDOFF_STRAIN if len(forces.slack_elements) else 0.0
+    return forces.first_step_kink
 
 
 def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
@@ -209,9 +222,9 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     force_buffer = np.zeros(size)
     jacobian_buffer = np.zeros((size, size))
     no_force, no_matrix = np.zeros(0), np.zeros((0, 0))
-    # The tension-only elements' kink rule of the first step (axial._element_block); the run
-    # sets it to 0 after its first accepted step (CableForceItems.first_step_kink).
-    kink = np.array([axial.ROUNDOFF_STRAIN if effects.slack else 0.0])
+    # The tension-only elements' kink rule of a run's first step (axial._element_block): off
+    # until a run arms it, which clears it after its first accepted step (CableForceItems.first_step_kink).
+    kink = np.zeros(1)
     joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
 
     def fused_force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature

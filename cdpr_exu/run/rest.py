@@ -71,7 +71,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from cdpr_exu.builder.cable import element_tensions
+from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
@@ -373,7 +373,7 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
     pairs = _speed_indices(model)
     window = {"from": 0.0, "speed": 0.0}
 
-    kink = model.cable_forces.first_step_kink if model.cable_forces is not None else np.zeros(1)
+    kink = arm_first_step_kink(model.cable_forces)
 
     def post_step(mbs_, t):
         kink[0] = 0.0  # past the first step: Newton sees the tension-only law as it is

@@ -23,7 +23,7 @@ import numpy as np
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController
 
-from cdpr_exu.builder.cable import element_tensions
+from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
 from cdpr_exu.core.errors import RunInterrupted, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
@@ -369,8 +369,7 @@ class _Stepper:
         self.stop_exception: Exception | None = None
         self.interrupted = {"interrupted": False}
         self.reservoir = _rope_reservoir(scene, model)
-        forces = model.cable_forces
-        self.first_step_kink = forces.first_step_kink if forces is not None else None
+        self.first_step_kink = arm_first_step_kink(model.cable_forces)
         # coordinates of each cable's first two nodes, shape (m, 2, 2): its winch element
         self.first_nodes = (np.array([self.indices[f"cable_{i}"][:2] for i in range(len(scene.cables))])
                             if self.reservoir else np.zeros((0, 2, 2), dtype=int))
@@ -457,8 +456,7 @@ class _Stepper:
     def post_step(self, mbs_, t: float) -> bool:  # noqa: ARG002 - Exudyn's signature
         """Exudyn's post-step function: record, check, report; False ends the integration."""
         self.step_start = t
-        if self.first_step_kink is not None:
-            self.first_step_kink[0] = 0.0  # the zero-strain start is behind: Newton sees the law as it is
+        self.first_step_kink[0] = 0.0  # the zero-strain start is behind: Newton sees the law as it is
         if self.interrupted["interrupted"]:
             return False  # Ctrl-C: end the integration, keep what was computed
         surplus = None if self.reservoir is None else self.reservoir.surplus
