@@ -438,6 +438,36 @@ class _Inner:
                 "p": p, "rotation": rotation, "F": F, "K": K, "S": S, "S_lambda": S_lambda, "tension": tension}
 
 
+def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
+    """Newton's step -H^-1 g, with H shifted by a multiple of the identity until it is a descent direction.
+
+    An indefinite or singular Hessian (a node on a rim, a slack element, a swivel angle
+    with no stiffness) is shifted by ``relative_shift`` times its largest diagonal entry,
+    then ten times more each time. ``hessian``: dense (N, N) or a scipy sparse matrix;
+    ``gradient``: (N,). Returns the step, shape (N,).
+    """
+    import scipy.sparse as sparse
+
+    is_sparse = sparse.issparse(hessian)
+    if is_sparse:
+        import scipy.sparse.linalg as sparse_linalg
+
+        identity = sparse.identity(hessian.shape[0], format="csc")
+    scale = float(np.abs(hessian.diagonal()).max())
+    shift = 0.0
+    while True:
+        try:
+            if is_sparse:
+                step = sparse_linalg.splu((hessian + shift * identity).tocsc()).solve(-gradient)
+            else:
+                step = np.linalg.solve(hessian + shift * np.eye(len(gradient)), -gradient)
+        except (np.linalg.LinAlgError, RuntimeError):  # exactly singular
+            step = None
+        if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
+            return step
+        shift = max(10.0 * shift, relative_shift * scale)
+
+
 def _minimise(inner: _Inner, v, tolerance, max_iterations):
     """Newton's method on the potential with an Armijo line search; returns (v, state, iterations).
 
@@ -451,15 +481,7 @@ def _minimise(inner: _Inner, v, tolerance, max_iterations):
         if np.max(np.abs(state["gradient"])) < tolerance:
             return v, state, iteration
         g, H = state["gradient"], state["hessian"]
-        shift = 0.0
-        while True:
-            try:
-                step = np.linalg.solve(H + shift * np.eye(len(v)), -g)
-            except np.linalg.LinAlgError:
-                step = None
-            if step is not None and np.dot(step, g) < 0:
-                break
-            shift = max(10.0 * shift, 1e-6 * np.abs(np.diag(H)).max())
+        step = descent_step(H, g, relative_shift=1e-6)
         slope = float(np.dot(step, g))
         # Near the solution the energy's decrease, ~ |g|^2 / k_p, falls below its rounding
         # (~1e-16 |E|): there the full step is taken if it shrinks the gradient, and the

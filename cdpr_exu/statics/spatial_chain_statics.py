@@ -43,13 +43,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sparse
-import scipy.sparse.linalg as sparse_linalg
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector, skew
 from cdpr_exu.core.validation import finite, vector
 from cdpr_exu.physics import axial_3d, bending_3d
 from cdpr_exu.physics import swivel_pulley as sp
+from cdpr_exu.statics.chain_statics import descent_step
 from cdpr_exu.physics.spatial_statics import chain_element_mass, node_masses_along, solve_spatial_statics
 
 __all__ = ["SpatialChainCable", "SpatialChainRobot", "SpatialChainEquilibrium", "spatial_chain_robot",
@@ -661,7 +661,7 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
         gradient, hessian, p, G, force = model.derivatives(*state)
         if np.max(np.abs(gradient)) < tolerance:
             break
-        step = _descent_step(hessian, gradient)
+        step = descent_step(hessian, gradient)
         slope = float(step @ gradient)
         # near the solution the energy's decrease ~ |g|^2 / k falls below its rounding: then the
         # full step is taken if it shrinks the gradient, and the iteration stops if it does not
@@ -700,22 +700,6 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
     return SpatialChainEquilibrium(x.copy(), R.copy(), rotation_vector(R) if model.rigid else np.zeros(3),
                                    chain_nodes, tensions, forces, float(np.max(np.abs(gradient))), iteration,
                                    angles)
-
-
-def _descent_step(hessian, gradient):
-    """Newton's step -H^-1 g, with H shifted by a multiple of the identity until it is a descent direction
-    (an indefinite or singular H: psi on the rim has no stiffness, a slack element none)."""
-    identity = sparse.identity(hessian.shape[0], format="csc")
-    scale = float(np.abs(hessian.diagonal()).max())
-    shift = 0.0
-    while True:
-        try:
-            step = sparse_linalg.splu((hessian + shift * identity).tocsc()).solve(-gradient)
-        except RuntimeError:  # exactly singular
-            step = None
-        if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
-            return step
-        shift = max(10.0 * shift, 1e-8 * scale)
 
 
 def _forces_on_platform(model: _Model, p, G):
@@ -871,7 +855,7 @@ def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, to
         if imbalance < tolerance or (imbalance < floor and imbalance > 0.5 * last):
             break
         last = imbalance
-        step = _descent(H[inner, inner], g)
+        step = descent_step(H[inner, inner], g)
         slope = float(step @ g)
         roundoff = 1e-13 * (1.0 + abs(energy))
         alpha, accepted = 1.0, False
@@ -916,19 +900,6 @@ def _paid_out_model(model: _Model, scale: float) -> _Model:
     scaled.l0, scaled.k = model.l0 * scale, model.k / scale
     scaled.weights, scaled.joint_k = model.weights * scale, model.joint_k / scale
     return scaled
-
-
-def _descent(hessian, gradient):
-    """Newton's step, shifted towards steepest descent until it descends."""
-    shift = 0.0
-    while True:
-        try:
-            step = np.linalg.solve(hessian + shift * np.eye(len(gradient)), -gradient)
-        except np.linalg.LinAlgError:
-            step = None
-        if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
-            return step
-        shift = max(10.0 * shift, 1e-8 * np.abs(np.diag(hessian)).max())
 
 
 @dataclass(frozen=True, eq=False)
