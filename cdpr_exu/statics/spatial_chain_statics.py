@@ -755,7 +755,7 @@ def rounding_floor(stiffness, points) -> float:
     return 16.0 * np.finfo(float).eps * float(np.max(stiffness)) * float(np.abs(points).max())
 
 
-#: The swivel angles of a chain without swivel pulleys (held chains have point exits).
+#: The swivel angles of a chain without swivel pulleys.
 _NO_SWIVEL = np.zeros(0)
 
 
