@@ -28,8 +28,13 @@ Two cable models (``statics``), as the planar :class:`controllers.tension_aware.
   command is these lengths themselves, as the planar chain version's: the run blends
   the offset from the paid-out lengths in over its start
   (:class:`controllers.base.SmoothStart`), so the platform also leaves where the
-  initial lengths hold it (20 um off IPAnema's reference) for the reference. Point
-  exits only (the chain statics do not model swivel pulleys).
+  initial lengths hold it (20 um off IPAnema's reference) for the reference. Over a
+  swivel pulley the held chain runs from its winch end up the axis and over the disc,
+  psi solved with it, and a length is paid out as the run's swivel winch pays it out
+  (the elements kept, the winch end moved up the axis); the straight distance is then
+  the inlet's, and the first sample starts from the rest the robot starts in (the
+  catenaries, without the bending over the disc, hang 22 mm lower on
+  spatial-four-cable-swivel, and their nodes do not run over a disc).
 
 Units SI.
 """
@@ -83,7 +88,8 @@ class SpatialTensionAwareController:
         UnreachableError
             If a sampled reference pose cannot be held by cables that pull (naming the time).
         SceneError
-            With ``statics="chain"``, for a scene the chain statics do not model (swivel pulleys).
+            With ``statics="chain"``, for a scene the chain statics do not model (a bending model other
+            than the exact angle).
         """
         from cdpr_exu.core.errors import UnreachableError
 
@@ -125,40 +131,52 @@ class SpatialTensionAwareController:
 
     def _chain_solver(self, scene, initial):
         """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued."""
-        from cdpr_exu.core.errors import SceneError, UnreachableError
+        from cdpr_exu.core.errors import UnreachableError
         from cdpr_exu.physics.spatial_statics import solve_cable, solve_inverse_spatial_statics, solve_spatial_statics
-        from cdpr_exu.statics.spatial_chain_statics import (InverseChainStatics, catenary_start, robot_paid_out,
-                                                            solve_spatial_chain_statics, spatial_chain_robot)
+        from cdpr_exu.statics.spatial_chain_statics import (InverseChainStatics, SpatialChainInverse, catenary_start,
+                                                            robot_paid_out, solve_spatial_chain_statics,
+                                                            spatial_chain_robot)
         from cdpr_exu.core.geometry import rotation_from_vector
 
         platform = scene.catenary_platform()
         robot = spatial_chain_robot(scene)
-        over_swivel = [i for i, cable in enumerate(robot.cables) if cable.swivel is not None]
-        if over_swivel:  # the held-chain inverse holds each cable at a fixed exit point
-            raise SceneError(f"tension_aware with statics='chain' needs point exits: cables {over_swivel} run over "
-                             "swivel pulleys (exits[i].kind = 'swivel'), which its inverse chain statics do not model "
-                             "yet; use statics='catenary'")
+        over_swivel = [cable.swivel is not None for cable in robot.cables]
         inverse_statics = InverseChainStatics(robot)
         catenary_rest = solve_spatial_statics(platform, initial)
         started = robot_paid_out(robot, initial)
         rest = solve_spatial_chain_statics(started, *catenary_start(started, catenary_rest))
-        exits = np.array([c.exit_point for c in robot.cables])
+        # the straight distances change as the paid-out lengths: from the exit point, or the swivel pulley's inlet
+        exits = np.array([cable.swivel.inlet_array if swivel else cable.exit_point
+                          for cable, swivel in zip(robot.cables, over_swivel)])
         anchors = np.array([c.anchor for c in robot.cables])
         state = {"tensions": rest.tensions_at_anchor, "horizontal": np.array([c.catenary.horizontal_tension
                                                                              for c in catenary_rest.cables]),
                  "previous": None}
+        if any(over_swivel):
+            # Over swivel pulleys the first sample starts from the rest the robot starts in, not from the
+            # catenaries: these hang lower (no bending over the disc: 22 mm on spatial-four-cable-swivel), and
+            # their nodes cannot start a chain that runs up the axis and over the disc
+            state["previous"] = (SpatialChainInverse(np.array(initial, dtype=float), rest.tensions_at_anchor,
+                                                     rest.forces_on_platform, rest.nodes, rest.residual, 0,
+                                                     rest.swivel_angles),
+                                 np.linalg.norm(exits - rest.position - anchors @ rest.rotation.T, axis=1))
 
         def anchor_points(pose):
             rotation = np.eye(3) if robot.is_point_mass else rotation_from_vector(pose[3:6])
             return pose[:3] + anchors @ rotation.T
 
         def catenary_guess(pose, inertial):
-            """Lengths and nodes of the catenary inverse at ``pose`` (a start far from any previous sample)."""
+            """Lengths and nodes of the catenary inverse at ``pose`` (a start far from any previous sample);
+            a chain over a swivel pulley keeps the previous sample's nodes."""
             inverse = solve_inverse_spatial_statics(platform, pose, state["horizontal"], external_wrench=inertial)
             state["horizontal"] = inverse.horizontal_tensions
             points = anchor_points(pose)
             nodes = []
-            for cable, chain, length, point in zip(platform.cables, robot.cables, inverse.unstrained_lengths, points):
+            for i, (cable, chain, length, point) in enumerate(zip(platform.cables, robot.cables,
+                                                                  inverse.unstrained_lengths, points)):
+                if over_swivel[i]:
+                    nodes.append(state["previous"][0].nodes[i])
+                    continue
                 shape, _ = solve_cable(cable, length, point)
                 nodes.append(shape.points(length - np.linspace(0.0, length, chain.n_elements + 1)))
             return inverse.unstrained_lengths, nodes
@@ -166,19 +184,22 @@ class SpatialTensionAwareController:
         def solve(pose, acceleration):
             inertial = np.concatenate([-robot.mass * acceleration[:3], np.zeros(3)])
             previous = state["previous"]
+            angles = None
             if previous is None:
                 lengths, nodes = catenary_guess(pose, inertial)
             else:  # the previous lengths, changed as the straight cables change
                 points = anchor_points(pose)
                 chords = np.linalg.norm(exits - points, axis=1)
                 lengths = previous[0].unstrained_lengths + chords - previous[1]
-                nodes = previous[0].nodes
+                nodes, angles = previous[0].nodes, previous[0].swivel_angles
             try:
-                inverse = inverse_statics.solve(pose, state["tensions"], lengths, nodes, inertial)
+                inverse = inverse_statics.solve(pose, state["tensions"], lengths, nodes, inertial,
+                                                swivel_angles=angles)
             except UnreachableError:
                 if previous is None:
                     raise
-                inverse = inverse_statics.solve(pose, state["tensions"], *catenary_guess(pose, inertial), inertial)
+                inverse = inverse_statics.solve(pose, state["tensions"], *catenary_guess(pose, inertial), inertial,
+                                                swivel_angles=angles)
             state["tensions"] = inverse.tensions
             state["previous"] = (inverse, np.linalg.norm(exits - anchor_points(pose), axis=1))
             self.inverses.append(inverse)

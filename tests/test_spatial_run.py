@@ -167,17 +167,33 @@ def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_idea
     assert chain["min_element_tension_N"] > 0.0
 
 
-def test_the_chain_version_refuses_swivel_pulleys_and_cdpr_compare_leaves_it_out_there():
+def test_the_chain_version_runs_over_swivel_pulleys_and_follows_the_ramp_closer_than_ideal_ik():
     from cdpr_exu.run.spatial_run import spatial_controller_names
+    from controllers.ideal_ik import IdealIKController
     from controllers.spatial_tension_aware import SpatialTensionAwareController
 
     swivel = load_spatial_scene("spatial-four-cable-swivel")
-    with pytest.raises(SceneError, match="swivel"):
-        SpatialTensionAwareController(statics="chain").reset(swivel, swivel.unstrained_lengths)
-    assert "tension_aware_chain" not in spatial_controller_names(swivel)
+    assert "tension_aware_chain" in spatial_controller_names(swivel)
     assert "tension_aware_chain" in spatial_controller_names(load_spatial_scene("spatial-cogiro"))
     with pytest.raises(SceneError, match="statics"):
         SpatialTensionAwareController(statics="rope")
+    # The circle's ramp (0.8 s of its 1 s), slow enough to be nearly static: the held chains run over the
+    # discs with their bending, which the catenaries lack (they hang 22 mm lower on this robot).
+    scene = replace(swivel, solver=replace(swivel.solver, end_time=0.8))
+    controller = SpatialTensionAwareController(statics="chain")
+    controller.reset(scene, scene.unstrained_lengths)
+    # it starts from the rest the robot starts in: the first lengths are the paid-out ones, but for the
+    # reference's 11 um offset from that rest (measured 4.6 um)
+    assert np.abs(controller.inverses[0].unstrained_lengths - scene.unstrained_lengths).max() < 2e-5
+    assert all(np.all(np.isfinite(inverse.swivel_angles)) for inverse in controller.inverses)
+    ideal = simulate_spatial(scene, IdealIKController())
+    chain = simulate_spatial(scene, SpatialTensionAwareController(statics="chain"))
+    assert chain.status == "completed" and chain.controller == "tension_aware_chain"
+    # measured: max 0.86 mm against ideal IK's 3.86 mm (later the paying-out cables' winch lines go slack
+    # below the inlets at 1 rad/s, a dynamic lag both share: docs/spatial.md)
+    ideal_error = np.linalg.norm(ideal.position_error, axis=1).max()
+    chain_error = np.linalg.norm(chain.position_error, axis=1).max()
+    assert chain_error < ideal_error / 3.0
 
 
 def test_cdpr_compare_on_a_spatial_scene_writes_the_table_and_each_controller(tmp_path):

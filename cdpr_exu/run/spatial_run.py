@@ -563,9 +563,9 @@ SPATIAL_CONTROLLERS = {
 }
 
 def spatial_controller_names(scene: SpatialScene) -> list[str]:
-    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS`, but
-    ``tension_aware_chain`` where a cable leaves over a swivel pulley (the chain statics model point exits)."""
-    return [name for name in SPATIAL_CONTROLLERS if not (name == "tension_aware_chain" and scene.swivels)]
+    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS` (over
+    swivel pulleys too: the chain version's held chains run over the disc, their winch ends moved as the run's)."""
+    return list(SPATIAL_CONTROLLERS)
 
 
 _COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),

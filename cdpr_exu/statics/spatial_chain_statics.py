@@ -68,7 +68,8 @@ class SpatialChainCable:
     ----------
     exit_point : (x, y, z) [m]
         Where node 0 is held, world frame: the exit point, or over a swivel pulley the
-        winch end on the pulley's vertical axis below its inlet.
+        winch end on the pulley's vertical axis below its inlet, where the builder holds it
+        (``winch_travel`` moves it).
     node_masses : tuple of float, length n + 1 [kg]
         Exit node first (its weight is carried by the frame).
     element_length : float [m]
@@ -86,6 +87,10 @@ class SpatialChainCable:
         None for a point exit. Every node may touch it.
     winch_elements : int
         Over a swivel pulley: the elements of the winch line, below the inlet (0 for a point exit).
+    winch_travel : float [m]
+        Over a swivel pulley: how far the winch has moved the held winch end up the axis from
+        ``exit_point`` (paying out; 0 for a point exit). The run's swivel winch keeps the chain's
+        elements and moves only this end (:class:`cdpr_exu.run.spatial_run._SpatialWinches`).
     """
 
     exit_point: tuple
@@ -97,6 +102,7 @@ class SpatialChainCable:
     anchor: tuple
     swivel: sp.SwivelPulley | None = None
     winch_elements: int = 0
+    winch_travel: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "exit_point", tuple(vector("exit_point", self.exit_point, 3)))
@@ -117,6 +123,8 @@ class SpatialChainCable:
                 self.winch_elements == 0):
             raise SceneError(f"winch_elements must be 0 for a point exit and leave 2 elements above the inlet "
                              f"over a swivel pulley, got {self.winch_elements!r}")
+        if finite("winch_travel", self.winch_travel) != 0.0 and self.swivel is None:
+            raise SceneError(f"winch_travel must be 0 for a point exit, got {self.winch_travel!r}")
 
     @property
     def n_elements(self) -> int:
@@ -126,6 +134,17 @@ class SpatialChainCable:
     def unstrained_length(self) -> float:
         """L = n l0 [m] (over a swivel pulley the winch line's elements included)."""
         return self.n_elements * self.element_length
+
+    @property
+    def held_point(self) -> np.ndarray:
+        """Where node 0 is held [m]: ``exit_point``, over a swivel pulley moved up the axis by ``winch_travel``."""
+        return np.asarray(self.exit_point, dtype=float) + self.winch_travel * _E_Z
+
+    @property
+    def paid_out_length(self) -> float:
+        """The winch's paid-out length [m]: L = n l0 at a point exit; over a swivel pulley the length from the
+        inlet the cable was built with, (n - k) l0 (k = ``winch_elements``), plus ``winch_travel``."""
+        return (self.n_elements - self.winch_elements) * self.element_length + self.winch_travel
 
 
 @dataclass(frozen=True)
@@ -358,7 +377,7 @@ class _Model:
         self.psi0 = self.n_free + 3 + (3 if self.rigid else 0)  # first psi unknown
         self.n_unknowns = self.psi0 + self.n_psi
         self.size = 3 * self.n_points + self.n_psi  # point coordinates and the swivel angles
-        self.fixed_positions = {int(f): np.asarray(c.exit_point, float) for f, c in zip(self.first, robot.cables)}
+        self.fixed_positions = {int(f): c.held_point for f, c in zip(self.first, robot.cables)}
         self.local = np.array([c.anchor for c in robot.cables], dtype=float)
         self.weights = np.zeros(self.n_points)
         self.weights[:n_chain] = np.concatenate([np.asarray(c.node_masses) for c in robot.cables]) * robot.gravity
@@ -736,7 +755,7 @@ def rounding_floor(stiffness, points) -> float:
     return 16.0 * np.finfo(float).eps * float(np.max(stiffness)) * float(np.abs(points).max())
 
 
-#: The swivel angles of a chain without swivel pulleys (held chains have point exits).
+#: The swivel angles of a chain without swivel pulleys.
 _NO_SWIVEL = np.zeros(0)
 
 
@@ -745,11 +764,15 @@ _NO_SWIVEL = np.zeros(0)
 # ---------------------------------------------------------------------------
 def cable_paid_out(cable: SpatialChainCable, length: float) -> SpatialChainCable:
     """``cable`` paid out to the unstrained ``length`` [m], as the run's variable-length winch changes it
-    (:class:`cdpr_exu.run.spatial_run._SpatialWinches`): the same n elements of length L / n, their
-    stiffness E A n / L, the node masses rho L / n and the bending stiffness E J n / L."""
+    (:class:`cdpr_exu.run.spatial_run._SpatialWinches`): at a point exit the same n elements of length
+    L / n, their stiffness E A n / L, the node masses rho L / n and the bending stiffness E J n / L; over a
+    swivel pulley the same elements, the held winch end moved up the axis by the change of the paid-out
+    length (``winch_travel``, :attr:`SpatialChainCable.paid_out_length`), the cable running over the disc."""
     length = finite("length", length)
     if length <= 0:
         raise SceneError(f"length must be positive [m], got {length!r}")
+    if cable.swivel is not None:
+        return replace(cable, winch_travel=cable.winch_travel + length - cable.paid_out_length)
     scale = length / cable.unstrained_length
     return replace(cable, element_length=cable.element_length * scale, axial_stiffness=cable.axial_stiffness / scale,
                    node_masses=tuple(m * scale for m in cable.node_masses),
@@ -771,21 +794,26 @@ class HeldChain:
     Attributes
     ----------
     nodes : ndarray, shape (n + 1, 3) [m]
-        Exit first, the anchor point last.
+        Exit (over a swivel pulley the held winch end) first, the anchor point last.
     tensions : ndarray, shape (n,) [N]
         Axial force of each element, exit first.
     force : ndarray, shape (3,) [N]
         Force the cable exerts on the anchor (the last element's pull, the bending shear and
         the anchor node's weight: what it exerts on the platform).
     force_rate : ndarray, shape (3,) [N/m]
-        d(force)/d(unstrained length) with both ends held: the chain re-settles (implicit
-        function theorem on the nodes' balance).
+        d(force)/d(paid-out length) with the anchor held: the chain re-settles (implicit
+        function theorem on the nodes' and the swivel's balance). Paid out as the run's winch
+        pays out (:func:`cable_paid_out`): longer elements at a point exit, the winch end moved
+        up the axis over a swivel pulley.
+    swivel_angle : float [rad]
+        The swivel pulley's angle psi (NaN at a point exit).
     """
 
     nodes: np.ndarray
     tensions: np.ndarray
     force: np.ndarray
     force_rate: np.ndarray
+    swivel_angle: float = float("nan")
 
 
 def _held_model(cable: SpatialChainCable, gravity: float) -> _Model:
@@ -795,37 +823,41 @@ def _held_model(cable: SpatialChainCable, gravity: float) -> _Model:
 
 
 def solve_held_chain(cable: SpatialChainCable, gravity: float, anchor_point, nodes, *, tolerance: float = 1e-9,
-                     max_iterations: int = 50) -> HeldChain:
-    """The rest shape of one lumped cable held at its exit point and at ``anchor_point``.
+                     max_iterations: int = 50, swivel_angle: float | None = None) -> HeldChain:
+    """The rest shape of one lumped cable held at its exit point (or winch end) and at ``anchor_point``.
 
-    Newton's method on its free nodes (the potential of :func:`solve_spatial_chain_statics`, with
-    the same line search), then the force on the anchor and its rate with the unstrained length.
+    Newton's method on its free nodes and, over a swivel pulley, the pulley's angle psi (the
+    potential of :func:`solve_spatial_chain_statics`, with the same line search), then the force
+    on the anchor and its rate with the paid-out length.
 
     Parameters
     ----------
     cable : SpatialChainCable
-        At the unstrained length wanted (:func:`cable_paid_out`); its ``anchor`` is not used.
+        At the paid-out length wanted (:func:`cable_paid_out`); its ``anchor`` is not used.
     gravity : float [m/s^2]
     anchor_point : (x, y, z) [m]
         World position of the anchor.
     nodes : array_like, shape (n + 1, 3) [m]
-        Start of the nodes, exit first; the ends are put on the exit and anchor points, the nodes
+        Start of the nodes, exit first; the ends are put on the held and anchor points, the nodes
         between moved along by the same share of the ends' displacement as of the cable.
     tolerance : float [N]
         Largest force left on a free node; below the rounding of the element forces
         (:func:`rounding_floor`: 4e-8 N on IPAnema's stiff cables, 2e-14 m of stretch), the
         iteration also stops once a Newton step no longer halves it.
+    swivel_angle : float [rad], optional
+        Start of psi over a swivel pulley (default the anchor's azimuth about the axis).
 
     Raises
     ------
     UnreachableError
         If Newton finds no rest shape.
     """
-    return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations)
+    return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations,
+                       swivel_angle)
 
 
 def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, tolerance: float,
-                max_iterations: int) -> HeldChain:
+                max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
     """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other lengths)."""
     anchor_point = vector("anchor_point", anchor_point, 3)
     nodes = np.array(nodes, dtype=float)
@@ -833,42 +865,57 @@ def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, to
     if nodes.shape != (n + 1, 3) or not np.all(np.isfinite(nodes)):
         raise SceneError(f"nodes must be finite, shape {(n + 1, 3)}, got {nodes.shape}")
     share = np.linspace(0.0, 1.0, n + 1)[:, None]
-    exit_point = np.asarray(cable.exit_point)
-    nodes += (1.0 - share) * (exit_point - nodes[0]) + share * (anchor_point - nodes[-1])
+    held_point = model.fixed_positions[0]
+    if cable.swivel is None:
+        nodes += (1.0 - share) * (held_point - nodes[0]) + share * (anchor_point - nodes[-1])
+    else:
+        nodes = _swivel_start(nodes, cable.swivel, held_point, anchor_point)
+    if cable.swivel is None:
+        psi = _NO_SWIVEL
+    elif swivel_angle is None or not np.isfinite(swivel_angle):
+        psi = np.array([sp.exit_azimuth(anchor_point, cable.swivel.inlet_array)])
+    else:
+        psi = np.array([float(swivel_angle)])
     R = np.eye(3)
-    inner = slice(3, 3 * n)  # the free nodes' rows among the points (exit, free nodes, anchor)
+    # the unknowns among the point coordinates (exit, free nodes, anchor, then psi): the free nodes and psi
+    inner = np.concatenate([np.arange(3, 3 * n), np.arange(3 * (n + 1), model.size)])
     end = slice(3 * n, 3 * n + 3)
+    n_free = 3 * (n - 1)
     free = nodes[1:-1].ravel().copy()
-    energy = model.energy(free, anchor_point, R, _NO_SWIVEL)
+    energy = model.energy(free, anchor_point, R, psi)
     # Below the rounding floor Newton keeps gaining while it can: the anchor force of a chain stopped
     # at the floor is off by about the floor, and m of them stall the platform's balance (CoGiRo's
     # Gauss-Newton crawled for 30 iterations at 1e-5 N). So stop at the tolerance, or below the floor
     # once a step no longer halves the imbalance.
     floor = rounding_floor(model.k, nodes)
     last = np.inf
+    # a point exit's chain is solved dense (57 unknowns at 20 elements); over a swivel pulley sparse (SuperLU:
+    # 163 unknowns at 48 + 6 elements, whose dense solve took 0.14 s with OpenBLAS's threads on a busy machine)
+    dense = cable.swivel is None
     for iteration in range(max_iterations):
         nodes[1:-1] = free.reshape(-1, 3)
-        G, H, force = model.point_derivatives(nodes, _NO_SWIVEL)
-        H = H.toarray()
+        G, H, force = model.point_derivatives(nodes, psi)
+        H = H.toarray() if dense else H.tocsc()
+        H_inner = H[np.ix_(inner, inner)] if dense else H[inner][:, inner]
         g = G[inner]
         imbalance = float(np.max(np.abs(g)))
         if imbalance < tolerance or (imbalance < floor and imbalance > 0.5 * last):
             break
         last = imbalance
-        step = descent_step(H[inner, inner], g)
+        step = descent_step(H_inner, g)
         slope = float(step @ g)
         roundoff = 1e-13 * (1.0 + abs(energy))
         alpha, accepted = 1.0, False
         for _ in range(40):
-            trial = free + alpha * step
-            trial_energy = model.energy(trial, anchor_point, R, _NO_SWIVEL)
+            trial, trial_psi = free + alpha * step[:n_free], psi + alpha * step[n_free:]
+            trial_energy = model.energy(trial, anchor_point, R, trial_psi)
             if trial_energy <= energy + 1e-4 * alpha * slope:
                 accepted = True
                 break
             if abs(trial_energy - energy) <= roundoff:
                 moved = nodes.copy()
                 moved[1:-1] = trial.reshape(-1, 3)
-                accepted = np.max(np.abs(model.point_derivatives(moved, _NO_SWIVEL)[0][inner])) < np.max(np.abs(g))
+                accepted = np.max(np.abs(model.point_derivatives(moved, trial_psi)[0][inner])) < np.max(np.abs(g))
                 break
             alpha *= 0.5
         if not accepted:
@@ -876,24 +923,92 @@ def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, to
                 break
             raise UnreachableError(f"held chain statics: the line search failed (force imbalance "
                                    f"{np.max(np.abs(g)):.3g} N after {iteration} iterations)")
-        free, energy = trial, trial_energy
+        free, psi, energy = trial, trial_psi, trial_energy
     else:
         raise UnreachableError(f"held chain statics did not converge in {max_iterations} iterations "
                                f"(force imbalance {np.max(np.abs(g)):.3g} N)")
-    # d(gradient)/dL at fixed nodes by central differences of the chain paid out by +-dL (the run's
-    # scaling, :func:`cable_paid_out`), then the free nodes re-settle: d(free)/dL = -H^-1 dg_free/dL;
-    # the anchor's force is -(its gradient)
-    step = 1e-6
-    rate = (_paid_out_model(model, 1.0 + step).point_derivatives(nodes, _NO_SWIVEL)[0]
-            - _paid_out_model(model, 1.0 - step).point_derivatives(nodes, _NO_SWIVEL)[0]) / (2.0 * step * cable.unstrained_length)
-    settle = -np.linalg.solve(H[inner, inner], rate[inner])
-    force_rate = -(rate[end] + H[end, inner] @ settle)
-    return HeldChain(nodes, np.asarray(force, dtype=float).copy(), -G[end].copy(), force_rate)
+    if cable.swivel is None:
+        # d(gradient)/dL at fixed nodes by central differences of the chain paid out by +-dL (the run's
+        # scaling, :func:`cable_paid_out`)
+        step = 1e-6
+        rate = (_scaled_model(model, 1.0 + step).point_derivatives(nodes, psi)[0]
+                - _scaled_model(model, 1.0 - step).point_derivatives(nodes, psi)[0]) / (2.0 * step * cable.unstrained_length)
+    else:
+        # paying out moves the held winch end up the axis by dL, the elements kept: d(gradient)/dL at
+        # fixed free nodes is the Hessian's column of the held node's z
+        rate = H[:, 2].toarray().ravel()
+    # then the free nodes (and psi) re-settle: d(unknowns)/dL = -H^-1 dg/dL; the anchor's force is -(its gradient)
+    if dense:
+        settle = -np.linalg.solve(H_inner, rate[inner])
+    else:
+        from scipy.sparse.linalg import splu
+
+        settle = -splu(H_inner.tocsc()).solve(rate[inner])
+    force_rate = -(rate[end] + H[end][:, inner] @ settle)
+    return HeldChain(nodes, np.asarray(force, dtype=float).copy(), -G[end].copy(), force_rate,
+                     float(psi[0]) if psi.size else float("nan"))
 
 
-def _paid_out_model(model: _Model, scale: float) -> _Model:
-    """A copy of a one-cable ``model`` with its cable paid out ``scale`` times as long, as :func:`cable_paid_out`:
-    element lengths and weights times ``scale``, axial and bending stiffness over it."""
+def _swivel_start(nodes, pulley, held_point, anchor_point):
+    """Start nodes (n + 1, 3) [m] of a chain over a swivel pulley from ``nodes`` held elsewhere: turned about the
+    axis to the new anchor's azimuth (the wrap stays in the groove: shifted across, it cuts into the disc or its
+    flange at 1e6 N/m), all slid along themselves by the winch end's travel (the cable flows over the disc, its
+    elements keep their lengths: slid by a share of the travel, a 5 cm element's length changes by 0.15 mm per
+    8 mm of travel, 235 N of tension), and the hanging part beyond the wrap moved onto the anchor by the share
+    of its length (about across the cable when the travel follows the anchor's distance)."""
+    inlet = pulley.inlet_array
+    azimuth = sp.exit_azimuth(anchor_point, inlet)
+    turn = azimuth - sp.exit_azimuth(nodes[-1], inlet)
+    c, s = math.cos(turn), math.sin(turn)
+    turned = nodes - inlet
+    turned[:, :2] = turned[:, :2] @ np.array([[c, s], [-s, c]])
+    nodes = inlet + turned
+    centre = inlet + pulley.radius * np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
+    radii = np.linalg.norm(nodes - centre, axis=1)
+    slid, element, fraction = _slid(nodes, np.full(len(nodes), float(np.dot(held_point - nodes[0], _E_Z))))
+    # on the wrap, along the arc: a node slid along a chord sits inside the groove by up to the chord's
+    # sagitta (3 mm for 5 cm elements on a 0.1 m disc: 3 kN at 1e6 N/m, which Newton could not undo)
+    wrap = (radii[element] < 1.02 * pulley.radius) & (radii[element + 1] < 1.02 * pulley.radius)
+    radius = (1.0 - fraction) * radii[element] + fraction * radii[element + 1]
+    offset = slid - centre
+    slid[wrap] = centre + offset[wrap] * (radius[wrap] / np.linalg.norm(offset[wrap], axis=1))[:, None]
+    nodes = slid
+    touching = np.flatnonzero(np.linalg.norm(nodes - centre, axis=1) < 1.05 * pulley.radius)
+    tangent = int(touching.max()) if touching.size else 0
+    weight = np.clip((np.arange(len(nodes)) - tangent) / (len(nodes) - 1 - tangent), 0.0, 1.0)
+    nodes += weight[:, None] * (anchor_point - nodes[-1])
+    nodes[0] = held_point
+    return nodes
+
+
+def _slid(nodes, shift):
+    """``nodes`` (n + 1, 3) [m] each moved along their own polyline by ``shift`` (n + 1,) [m] of arc length
+    (positive: towards the last node; beyond the ends along the end elements); with the element each
+    lands on and the fraction along it, shape (n + 1,) each."""
+    lengths = np.linalg.norm(np.diff(nodes, axis=0), axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(lengths)])
+    target = arc + shift
+    element = np.clip(np.searchsorted(arc, target, side="right") - 1, 0, len(lengths) - 1)
+    fraction = (target - arc[element]) / lengths[element]
+    return nodes[element] + fraction[:, None] * (nodes[element + 1] - nodes[element]), element, fraction
+
+
+def _paid_out_model(model: _Model, cable: SpatialChainCable, length: float) -> _Model:
+    """A copy of the held ``model`` of ``cable`` (the model's own cable) paid out to ``length`` [m], as
+    :func:`cable_paid_out`: at a point exit scaled (:func:`_scaled_model`), over a swivel pulley its held
+    winch end moved up the axis."""
+    if cable.swivel is None:
+        return _scaled_model(model, length / cable.unstrained_length)
+    import copy
+
+    moved = copy.copy(model)
+    moved.fixed_positions = {0: cable_paid_out(cable, length).held_point}
+    return moved
+
+
+def _scaled_model(model: _Model, scale: float) -> _Model:
+    """A copy of a one-cable ``model`` with its cable paid out ``scale`` times as long, as :func:`cable_paid_out`
+    at a point exit: element lengths and weights times ``scale``, axial and bending stiffness over it."""
     import copy
 
     scaled = copy.copy(model)
@@ -909,6 +1024,7 @@ class SpatialChainInverse:
     Attributes
     ----------
     unstrained_lengths : ndarray, shape (m,) [m]
+        The paid-out lengths (:attr:`SpatialChainCable.paid_out_length`: over a swivel pulley from the inlet).
     tensions : ndarray, shape (m,) [N]
         Norm of each cable's force on the platform.
     forces_on_platform : ndarray, shape (m, 3) [N]
@@ -917,6 +1033,8 @@ class SpatialChainInverse:
     residual : float [N]
         Largest force (and moment / arm) imbalance of the platform left.
     iterations : int
+    swivel_angles : ndarray, shape (m,) [rad]
+        Each swivel pulley's angle psi (NaN at a point exit).
     """
 
     unstrained_lengths: np.ndarray
@@ -925,11 +1043,12 @@ class SpatialChainInverse:
     nodes: tuple
     residual: float
     iterations: int
+    swivel_angles: np.ndarray | None = None
 
 
 def solve_inverse_spatial_chain_statics(robot: SpatialChainRobot, pose, tension_guess, lengths, nodes,
                                         external_wrench=None, *, tolerance: float = 1e-9,
-                                        max_iterations: int = 30) -> SpatialChainInverse:
+                                        max_iterations: int = 30, swivel_angles=None) -> SpatialChainInverse:
     """Unstrained lengths whose lumped chains hold ``robot``'s platform at ``pose``, tensions nearest a guess.
 
     With the pose given, every anchor is a fixed point, and each cable is a chain between two
@@ -945,19 +1064,23 @@ def solve_inverse_spatial_chain_statics(robot: SpatialChainRobot, pose, tension_
     Parameters
     ----------
     robot : SpatialChainRobot
-        The cables (any lengths: they are paid out to ``lengths``), anchors, platform mass.
+        The cables (any lengths: they are paid out to ``lengths`` as the run's winches pay out,
+        :func:`cable_paid_out`; over a swivel pulley the winch end moves up the axis and psi is
+        solved with the chain), anchors, platform mass.
     pose : array_like, shape (3,) or (6,) [m, rad]
         Centre of mass and (rigid) rotation vector.
     tension_guess : array_like, shape (m,) [N]
         Positive tensions to stay near (eg the previous pose's).
     lengths : array_like, shape (m,) [m]
-        Start of the unstrained lengths (eg the catenaries' inverse, or the previous pose's).
+        Start of the paid-out lengths (eg the catenaries' inverse, or the previous pose's).
     nodes : sequence of array_like, each shape (n + 1, 3) [m]
         Start of each cable's nodes, exit first (moved onto the anchors as :func:`solve_held_chain` does).
     external_wrench : array_like, shape (6,) [N, N m], optional
         Extra load on the platform about its centre of mass (eg the d'Alembert force).
     tolerance : float
         Imbalance accepted, relative to the larger of the weight and the largest cable force.
+    swivel_angles : array_like, shape (m,) [rad], optional
+        Start of each swivel pulley's psi (NaN or default: the anchor's azimuth about its axis).
 
     Returns
     -------
@@ -970,12 +1093,13 @@ def solve_inverse_spatial_chain_statics(robot: SpatialChainRobot, pose, tension_
         push or go slack), or the iteration does not converge.
     """
     return InverseChainStatics(robot).solve(pose, tension_guess, lengths, nodes, external_wrench,
-                                            tolerance=tolerance, max_iterations=max_iterations)
+                                            tolerance=tolerance, max_iterations=max_iterations,
+                                            swivel_angles=swivel_angles)
 
 
 class InverseChainStatics:
     """:func:`solve_inverse_spatial_chain_statics` for many poses of one robot: each cable's model is
-    built once (the lengths change by scaling it, :func:`_paid_out_model`).
+    built once (the lengths change by scaling it, or by moving a swivel cable's winch end: :func:`_paid_out_model`).
 
     Parameters
     ----------
@@ -987,13 +1111,14 @@ class InverseChainStatics:
         self.models = [_held_model(c, robot.gravity) for c in robot.cables]
 
     def solve(self, pose, tension_guess, lengths, nodes, external_wrench=None, *, tolerance: float = 1e-9,
-              max_iterations: int = 30) -> SpatialChainInverse:
+              max_iterations: int = 30, swivel_angles=None) -> SpatialChainInverse:
         """As :func:`solve_inverse_spatial_chain_statics` (same parameters, robot aside)."""
         return _solve_inverse(self.robot, self.models, pose, tension_guess, lengths, nodes, external_wrench,
-                              tolerance, max_iterations)
+                              tolerance, max_iterations, swivel_angles)
 
 
-def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench, tolerance, max_iterations):
+def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench, tolerance, max_iterations,
+                   swivel_angles=None):
     """The Gauss-Newton of :func:`solve_inverse_spatial_chain_statics`, each cable's held model given."""
     from cdpr_exu.core.validation import real_array
 
@@ -1010,6 +1135,10 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
         raise SceneError(f"lengths must be one positive length per cable, got {lengths!r}")
     if len(nodes) != m:
         raise SceneError(f"nodes must give one array per cable ({m}), got {len(nodes)}")
+    angles = np.full(m, np.nan) if swivel_angles is None else real_array("swivel_angles", swivel_angles, require_finite=False)
+    if angles.shape != (m,):
+        raise SceneError(f"swivel_angles must give one angle per cable ({m}, NaN: the anchor's azimuth), "
+                         f"got {swivel_angles!r}")
     wrench = np.zeros(6) if external_wrench is None else vector("external_wrench", external_wrench, 6)
     rotation = rotation_from_vector(pose[3:6]) if rigid else np.eye(3)
     arms = np.array([c.anchor for c in robot.cables]) @ rotation.T
@@ -1019,21 +1148,22 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
     arm_scale = max(float(np.linalg.norm(arms, axis=1).max()), 1e-3)
     scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
 
-    def held(trial_lengths, trial_nodes):
-        chains = [_solve_held(_paid_out_model(model, L / c.unstrained_length), cable_paid_out(c, L), a, start,
-                              1e-9, 50)
-                  for model, c, L, a, start in zip(models, robot.cables, trial_lengths, anchor_points, trial_nodes)]
+    def held(trial_lengths, trial_nodes, trial_angles):
+        chains = [_solve_held(_paid_out_model(model, c, L), cable_paid_out(c, L), a, start, 1e-9, 50, psi)
+                  for model, c, L, a, start, psi in zip(models, robot.cables, trial_lengths, anchor_points,
+                                                        trial_nodes, trial_angles)]
         forces = np.array([chain.force for chain in chains])
         total = np.concatenate([forces.sum(axis=0) + wrench[:3] - [0.0, 0.0, weight],
                                 np.cross(arms, forces).sum(axis=0) + wrench[3:]])[:rows] * scale
         return chains, forces, total
 
-    chains, forces, total = held(lengths, nodes)
+    chains, forces, total = held(lengths, nodes, angles)
     residual = float(np.abs(total).max())
     for iteration in range(max_iterations + 1):
         if residual <= tolerance * max(weight, float(np.abs(forces).max()), 1e-12):
             return SpatialChainInverse(lengths, np.linalg.norm(forces, axis=1), forces,
-                                       tuple(chain.nodes for chain in chains), residual, iteration)
+                                       tuple(chain.nodes for chain in chains), residual, iteration,
+                                       np.array([chain.swivel_angle for chain in chains]))
         if iteration == max_iterations:
             break
         tensions = np.linalg.norm(forces, axis=1)
@@ -1052,7 +1182,8 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
             trial = lengths + change
             if np.all(trial > 0.0):
                 try:
-                    trial_chains, trial_forces, trial_total = held(trial, [c.nodes for c in chains])
+                    trial_chains, trial_forces, trial_total = held(trial, [c.nodes for c in chains],
+                                                                   [c.swivel_angle for c in chains])
                 except UnreachableError:
                     trial_total = None
                 if trial_total is not None and float(np.abs(trial_total).max()) < residual:
