@@ -1017,8 +1017,8 @@ class SpatialSceneError(SceneError):
 
 def _refuse_spatial(source: str | Path) -> None:
     raise SpatialSceneError(
-        f"scene {str(source)!r} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep` and "
-        "`animate` take spatial scenes; `study accuracy` and `view` take planar scenes only (see docs/spatial.md)")
+        f"scene {str(source)!r} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep`, "
+        "`study accuracy` and `animate` take spatial scenes; `view` takes planar scenes only (see docs/spatial.md)")
 
 
 def load_scene(source: str | Path) -> Scene:

@@ -29,6 +29,13 @@ on an idle core the two agree, but on a shared machine the wall time of the same
 varied by a factor of two with the load of other processes, the CPU time by a few
 per cent.
 
+Spatial scenes (``dimension = 3``) run through :func:`~cdpr_exu.run.spatial_run.simulate_spatial`
+under ideal inverse kinematics, on their own grids (:data:`SPATIAL_FULL_GRID`,
+:data:`SPATIAL_QUICK_GRID`: the ``catenary`` and ``full`` presets, as a spatial cable is
+lumped and elastic; fewer elements, as spatial runs cost more); the position error is
+the platform centre's 3-D distance and the rotation error the angle between the run's
+and the reference's orientation.
+
 Command line: ``cdpr study accuracy SCENE --out DIR [--quick]``.
 """
 
@@ -227,35 +234,113 @@ QUICK_GRID = AccuracyGrid(
 )
 
 
+#: The spatial ladder: a spatial scene's cables are lumped and elastic (``catenary`` and ``full``;
+#: the massless presets and the planar bending and contact models do not apply).
+SPATIAL_LADDER = (("catenary", ()), ("full", ()))
+
+#: Single-effect variants of the full model on a spatial scene.
+SPATIAL_EFFECT_VARIANTS = (
+    (("effects.bending_damping", False),),
+    (("effects.bending", False),),
+    (("effects.slack", False),),
+    (("cables.mass_lumping", "paper"),),
+)
+
+#: The grid of a spatial study (spatial runs cost more: 4 to 16 elements, reference at 32 and 2.5e-3 s).
+SPATIAL_FULL_GRID = AccuracyGrid(
+    models=SPATIAL_LADDER,
+    n_elements=(4, 6, 8, 12, 16),
+    step_sizes=(5.0e-3, 1.0e-2, 2.0e-2),
+    reference=Configuration("full", 32, 2.5e-3),
+    variants=SPATIAL_EFFECT_VARIANTS,
+    variant_resolution=(8, 1.0e-2),
+)
+
+#: The quick spatial grid: the full model at 4 and 8 elements, 1e-2 s, against 16 elements; 1.5 s.
+SPATIAL_QUICK_GRID = AccuracyGrid(
+    models=(("full", ()),),
+    n_elements=(4, 8),
+    step_sizes=(1.0e-2,),
+    reference=Configuration("full", 16, 1.0e-2),
+    end_time=1.5,
+    after=1.0,
+)
+
+
+def grid_for(scene, quick: bool = False) -> AccuracyGrid:
+    """The default grid of ``scene``: :data:`FULL_GRID` / :data:`QUICK_GRID` for planar scenes,
+    :data:`SPATIAL_FULL_GRID` / :data:`SPATIAL_QUICK_GRID` for spatial ones.
+
+    Over swivel pulleys a cable needs its elements short beside the pulley's radius (the
+    scene refuses coarser ones): there the spatial grid's element counts are scaled by the
+    factor that brings its coarsest cable to the fewest elements the scene takes
+    (:func:`fewest_spatial_elements`), e.g. 4, 8 and 16 to 48, 96 and 192.
+    """
+    from cdpr_exu.scenes.spatial_scene import is_spatial
+
+    if not is_spatial(scene):
+        return QUICK_GRID if quick else FULL_GRID
+    grid = SPATIAL_QUICK_GRID if quick else SPATIAL_FULL_GRID
+    factor = math.ceil(fewest_spatial_elements(scene) / min(grid.n_elements))
+    if factor <= 1:
+        return grid
+    resolution = grid.variant_resolution
+    return replace(grid, n_elements=tuple(factor * n for n in grid.n_elements),
+                   reference=replace(grid.reference, n_elements=factor * grid.reference.n_elements),
+                   variant_resolution=None if resolution is None else (factor * resolution[0], resolution[1]))
+
+
+def fewest_spatial_elements(scene) -> int:
+    """The fewest elements per cable a spatial scene takes: 1 over point exits; over a swivel
+    pulley of radius r, elements no longer than ``SAFE_ELEMENT_FRACTION`` r."""
+    from cdpr_exu.physics.swivel_pulley import SAFE_ELEMENT_FRACTION
+
+    fewest = 1
+    for cable, swivel in zip(scene.cables, scene.swivel_exits):
+        if swivel is not None:
+            fewest = max(fewest, math.ceil(cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius) - 1e-9))
+    return fewest
+
+
 # --------------------------------------------------------------------------- one run
 
 
 def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     """Simulate one configuration given as plain scene data; never raises.
 
-    The worker function of the study (top-level, plain data in and out).
+    The worker function of the study (top-level, plain data in and out); planar scenes
+    run :func:`~cdpr_exu.run.simulate.simulate`, spatial ones (``dimension = 3``)
+    :func:`~cdpr_exu.run.spatial_run.simulate_spatial` under ideal inverse kinematics.
 
     Returns
     -------
     dict
         ``status`` (``completed``, ``failed: ...``, ``refused: ...``), ``wall_time_s``,
         ``cpu_time_s`` (of the whole run, model building included), ``simulated_time_s``, ``steps``, ``newton_iterations``, ``failure_time_s``, and
-        for runs that produced samples: ``time`` (N,) [s], ``pose`` (N, 3) [m, m, rad],
-        ``end_tensions`` (N, m) [N] at the platform end of each cable, ``speed`` (N,)
-        [m/s] of the platform.
+        for runs that produced samples: ``time`` (N,) [s], ``pose`` (N, 3) [m, m, rad]
+        (spatial: (N, 6) [m, rad], centre and rotation vector), ``end_tensions`` (N, m)
+        [N] at the platform end of each cable, ``speed`` (N,) [m/s] of the platform
+        (spatial: by finite differences of the sampled positions).
     """
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)
     from cdpr_exu.core.errors import SolverFailure, UnreachableError
-    from cdpr_exu.scenes.scene import scene_from_dict
-    from cdpr_exu.run.simulate import simulate
+    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial
     from cdpr_exu.studies.study import _warm_up
 
     empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
              "newton_iterations": 0, "failure_time_s": math.nan}
     try:
-        scene = scene_from_dict(scene_data)
-        _warm_up(scene)
+        scene = any_scene_from_dict(scene_data)
+        spatial = is_spatial(scene)
+        if spatial:
+            from cdpr_exu.run.spatial_run import simulate_spatial as simulate
+
+            _warm_up_spatial(scene)
+        else:
+            from cdpr_exu.run.simulate import simulate
+
+            _warm_up(scene)
         cpu = time.process_time()
         try:
             result = simulate(scene, progress=False)
@@ -271,21 +356,49 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
         return {"status": "refused: " + " ".join(str(err).split()), **empty}
     except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
         return {"status": f"failed: {type(err).__name__}: " + " ".join(str(err).split()), **empty}
-    finite = np.all(np.isfinite(result.platform_pose), axis=1)
+    pose = np.asarray(result.pose if spatial else result.platform_pose)
+    finite = np.all(np.isfinite(pose), axis=1)
     tensions = np.column_stack([t[:, -1] for t in result.tensions]) if result.tensions else np.zeros((len(finite), 0))
+    times = np.asarray(result.time)[finite]
+    if spatial:
+        positions = pose[finite, :3]
+        speed = (np.linalg.norm(np.gradient(positions, times, axis=0), axis=1) if len(times) > 1
+                 else np.zeros(len(times)))
+    else:
+        speed = np.linalg.norm(result.platform_velocity[finite, :2], axis=1)
     return {
         "status": status,
         "wall_time_s": float(result.wall_time),
         "cpu_time_s": float(cpu),
-        "simulated_time_s": float(result.time[finite][-1]) if finite.any() else 0.0,
+        "simulated_time_s": float(times[-1]) if finite.any() else 0.0,
         "steps": int(result.steps),
         "newton_iterations": int(result.newton_iterations),
         "failure_time_s": math.nan if result.failure_time is None else float(result.failure_time),
-        "time": result.time[finite],
-        "pose": result.platform_pose[finite],
+        "time": times,
+        "pose": pose[finite],
         "end_tensions": tensions[finite],
-        "speed": np.linalg.norm(result.platform_velocity[finite, :2], axis=1),
+        "speed": speed,
     }
+
+
+_WARMED_SPATIAL: set[str] = set()
+
+
+def _warm_up_spatial(scene) -> None:
+    """Run two steps of the spatial ``scene`` once per process and effects, untimed (Numba's kernels
+    compile in the first run of a process: about 2 s of CPU time that would go to that run's cost)."""
+    key = json.dumps([scene.to_dict()["effects"], bool(scene.swivels)], sort_keys=True)
+    if key in _WARMED_SPATIAL:
+        return
+    _WARMED_SPATIAL.add(key)
+    from cdpr_exu.run.spatial_run import simulate_spatial
+
+    solver = scene.solver
+    short = replace(solver, end_time=2 * solver.step_size, output_period=solver.step_size)
+    try:
+        simulate_spatial(scene.with_changes(solver=short))
+    except Exception:  # noqa: BLE001 - only a warm-up; the real run reports any problem
+        pass
 
 
 # --------------------------------------------------------------------------- errors
@@ -324,7 +437,8 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
     if comparison == "final":
         if t_run[-1] < t_ref[-1] - 1e-9:
             return {**nan, "final_speed_m_s": speed}
-        pose_error = np.asarray(run["pose"])[-1:] - np.asarray(reference["pose"])[-1:]
+        reference_pose = np.asarray(reference["pose"])[-1:]
+        pose_error = np.asarray(run["pose"])[-1:] - reference_pose
         tension_error = np.asarray(run["end_tensions"])[-1:] - np.asarray(reference["end_tensions"])[-1:]
     elif comparison == "path":
         mask = t_ref >= min(after, t_ref[-1]) - 1e-9
@@ -333,26 +447,43 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
             return {**nan, "final_speed_m_s": speed}
         pose = np.column_stack([np.interp(times, t_run, column) for column in np.asarray(run["pose"]).T])
         tensions = np.column_stack([np.interp(times, t_run, column) for column in np.asarray(run["end_tensions"]).T])
-        pose_error = pose - np.asarray(reference["pose"])[mask]
+        reference_pose = np.asarray(reference["pose"])[mask]
+        pose_error = pose - reference_pose
         tension_error = tensions - np.asarray(reference["end_tensions"])[mask]
     else:
         raise SceneError(f"comparison must be 'path' or 'final', got {comparison!r}")
-    position = np.linalg.norm(pose_error[:, :2], axis=1)
+    if pose_error.shape[1] == 6:  # spatial: the centre's 3-D error, the angle between the orientations
+        position = np.linalg.norm(pose_error[:, :3], axis=1)
+        rotation = rotation_angles_deg(pose_error[:, 3:] + np.asarray(reference_pose)[:, 3:],
+                                       np.asarray(reference_pose)[:, 3:])
+    else:
+        position = np.linalg.norm(pose_error[:, :2], axis=1)
+        rotation = np.degrees(np.abs(pose_error[:, 2]))
     return {
         "position_error_max_m": float(position.max()),
         "position_error_rms_m": float(np.sqrt(np.mean(position**2))),
-        "rotation_error_max_deg": float(np.degrees(np.abs(pose_error[:, 2]).max())),
+        "rotation_error_max_deg": float(rotation.max()),
         "tension_error_max_N": float(np.abs(tension_error).max()),
         "tension_error_rms_N": float(np.sqrt(np.mean(tension_error**2))),
         "final_speed_m_s": speed,
     }
 
 
+def rotation_angles_deg(rotation_vectors: np.ndarray, reference_vectors: np.ndarray) -> np.ndarray:
+    """Angle [deg] of the rotation from each reference orientation to the run's, both given as
+    rotation vectors [rad], shapes (N, 3); returns shape (N,)."""
+    from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
+
+    return np.degrees([np.linalg.norm(rotation_vector(rotation_from_vector(r).T @ rotation_from_vector(v)))
+                       for v, r in zip(rotation_vectors, reference_vectors)])
+
+
 def comparison_for(scene) -> str:
     """``"final"`` for a static scene (held pose, fixed winches), else ``"path"``."""
+    from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
     from cdpr_exu.scenes.trajectories import HoldTrajectory
 
-    static = isinstance(scene.trajectory, HoldTrajectory) and scene.winch.kind == "fixed"
+    static = isinstance(scene.trajectory, (HoldTrajectory, SpatialHoldTrajectory)) and scene.winch.kind == "fixed"
     return "final" if static else "path"
 
 
@@ -426,15 +557,16 @@ def _estimated_cost(configuration: Configuration) -> float:
     return n ** 1.5 / configuration.step_size
 
 
-def run_accuracy_study(scene, grid: AccuracyGrid = FULL_GRID, *, out: str | Path | None = None,
+def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Path | None = None,
                        workers: int | None = None, executor: Executor | None = None, progress: bool = True,
                        comparison: str | None = None) -> AccuracyStudy:
     """Run ``scene`` on every configuration of ``grid`` and compare each with the reference.
 
     Parameters
     ----------
-    scene : Scene, or a shipped scene name or TOML path
-    grid : AccuracyGrid
+    scene : Scene or SpatialScene, or a shipped scene name or TOML path
+    grid : AccuracyGrid, optional
+        Default: :func:`grid_for` the scene (the full planar or spatial grid).
     out : path, optional
         Folder for the CSV, JSON, tables, Pareto plot and the reference's series.
     workers : int, optional
@@ -455,10 +587,14 @@ def run_accuracy_study(scene, grid: AccuracyGrid = FULL_GRID, *, out: str | Path
     SceneError
         If the reference run does not complete: nothing can be compared then.
     """
-    from cdpr_exu.scenes.scene import Scene, load_scene, scene_from_dict
+    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial, load_any_scene
     from cdpr_exu.studies.study import _executor_for, _progress_bar
 
-    base = scene if isinstance(scene, Scene) else load_scene(scene)
+    base = load_any_scene(scene) if isinstance(scene, (str, Path)) else scene
+    if is_spatial(base) and base.trajectory is None:
+        raise SceneError(f"scene {base.name!r} has no [trajectory]: `cdpr study accuracy` runs the scene's "
+                         "reference (`cdpr static` gives a spatial scene's static mode)")
+    grid = grid or grid_for(base)
     if grid.end_time is not None:
         base = base.with_changes(solver=replace(base.solver, end_time=grid.end_time))
     comparison = comparison or comparison_for(base)
@@ -474,7 +610,7 @@ def run_accuracy_study(scene, grid: AccuracyGrid = FULL_GRID, *, out: str | Path
                "is_reference": configuration == grid.reference}
         rows.append(row)
         try:
-            data = scene_from_dict(configuration.scene_data(base_data)).to_dict()
+            data = any_scene_from_dict(configuration.scene_data(base_data)).to_dict()
         except SceneError as err:
             row["status"] = "refused: " + " ".join(str(err).split())
         else:
@@ -573,7 +709,7 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
     """Write the CSV, JSON, tables, Pareto plot and the reference's series into ``out``."""
     from cdpr_exu.core.output import write_npz, write_summary
     from cdpr_exu.results.result import provenance
-    from cdpr_exu.scenes.scene import save_scene
+    from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -814,25 +950,34 @@ EPILOG_ACCURACY = """examples:
   cdpr study accuracy paper-circle --out results/accuracy/paper_circle
   cdpr study accuracy paper-catenary --out results/accuracy/paper_catenary
   cdpr study accuracy paper-circle --out /tmp/quick --quick
+  cdpr study accuracy spatial-ipanema --out /tmp/ipanema --quick
 
 runs the scene on every preset (ideal, elastic, catenary, full) and the full model
 with linear bending, over elements per cable (8..60) and step sizes (5e-4..1e-2 s),
 against a reference (full, 90 elements, 5e-4 s); --quick: a small grid, 1.5 s.
 A static scene (held pose, fixed winches) compares final states, others the path.
+
+spatial scenes (dimension = 3, with a [trajectory]) run under ideal inverse kinematics on
+the catenary and full presets over 4..16 elements and 5e-3..2e-2 s against (full, 32
+elements, 2.5e-3 s); --quick: full at 4 and 8 elements, 1e-2 s, against 16, 1.5 s.
+Errors: the platform centre's 3-D path and the angle between the orientations.
 writes accuracy.csv, accuracy.json, tables.md (tolerance table, effects table),
 pareto.png and reference.npz into --out.
 """
 
 
 def _cmd_accuracy(args: argparse.Namespace) -> int:
-    grid = QUICK_GRID if args.quick else FULL_GRID
+    from cdpr_exu.scenes.spatial_scene import load_any_scene
+
+    scene = load_any_scene(args.scene)  # planar or spatial
+    grid = grid_for(scene, args.quick)
     if args.end_time is not None:
         grid = replace(grid, end_time=args.end_time)
     from cdpr_exu.core.output import check_output_folder
 
     out = check_output_folder(args.out)
     start = time.perf_counter()
-    study = run_accuracy_study(args.scene, grid, out=out, workers=args.workers, progress=not args.quiet,
+    study = run_accuracy_study(scene, grid, out=out, workers=args.workers, progress=not args.quiet,
                                comparison=args.compare)
     if not args.quiet:
         print(format_tables(study))
