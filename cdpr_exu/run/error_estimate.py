@@ -21,9 +21,13 @@ Spatial scenes (``dimension = 3``, :mod:`cdpr_exu.run.spatial_run`) get the same
 on the platform centre's 3-D path. Measured on the four-cable robot without bending
 (``tests/test_error_estimate.py``): held on its catenary pose, the error falls as n^-2
 and the estimate is 1.05 (4 elements) and 1.03 (8) times the true error against the
-elastic catenary; during a 1 s point-to-point move the error falls more slowly (about
-n^-1.3 from 4 to 16 elements, the swinging platform's phase), and the estimate
-assuming order 2 is 0.8 times the error against 32 elements. Units SI.
+elastic catenary; during a 1 s point-to-point move the estimate at 8 elements is 1.46
+times the error against 32 elements at the same 1e-2 s step and 0.89 times that against
+64 elements at 2.5e-3 s. In motion the discretisation error is of order 2 too (1.96 from
+16 to 64 elements with linear spring-dampers, where the step and Newton leave it clean);
+what once looked like n^-1.3 was the 1e-2 s step's error and the Newton error of
+tension-only references at 32 elements and more (docs/accuracy.md, "The order of the
+spatial error in motion"). Units SI.
 """
 
 from __future__ import annotations
