@@ -39,10 +39,11 @@ def test_the_shipped_spatial_scene_loads_and_the_planar_loader_refuses_it_naming
         load_scene("spatial-four-cable")
 
 
-def test_the_planar_only_commands_refuse_a_spatial_scene_and_run_needs_a_trajectory(tmp_path):
+def test_run_and_the_accuracy_study_need_a_trajectory_on_a_spatial_scene(tmp_path):
     done = _cdpr("study", "accuracy", "spatial-four-cable", "--out", str(tmp_path / "study"))
     assert done.returncode == 2
-    assert "spatial (dimension = 3)" in done.stderr and "cdpr static" in done.stderr
+    assert "no [trajectory]" in done.stderr and "cdpr static" in done.stderr
+    assert not (tmp_path / "study").exists()  # refused before any run
     done = _cdpr("run", "spatial-four-cable")  # a static scene: no reference to follow
     assert done.returncode == 2 and "no [trajectory]" in done.stderr
 

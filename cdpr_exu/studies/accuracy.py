@@ -555,6 +555,20 @@ class AccuracyStudy:
         return next(r for r in self.rows if r["is_reference"])
 
 
+def check_study_scene(scene) -> None:
+    """Refuse a scene the study cannot run, before any run: a spatial scene without a ``[trajectory]``.
+
+    Raises
+    ------
+    SceneError
+    """
+    from cdpr_exu.scenes.spatial_scene import is_spatial
+
+    if is_spatial(scene) and scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr study accuracy` runs the scene's "
+                         "reference (`cdpr static` gives a spatial scene's static mode)")
+
+
 def _estimated_cost(configuration: Configuration) -> float:
     """Rough relative cost, to start the longest runs first."""
     n = configuration.n_elements or 4
@@ -591,13 +605,11 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
     SceneError
         If the reference run does not complete: nothing can be compared then.
     """
-    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial, load_any_scene
+    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, load_any_scene
     from cdpr_exu.studies.study import _executor_for, _progress_bar
 
     base = load_any_scene(scene) if isinstance(scene, (str, Path)) else scene
-    if is_spatial(base) and base.trajectory is None:
-        raise SceneError(f"scene {base.name!r} has no [trajectory]: `cdpr study accuracy` runs the scene's "
-                         "reference (`cdpr static` gives a spatial scene's static mode)")
+    check_study_scene(base)
     grid = grid or grid_for(base)
     if grid.end_time is not None:
         base = base.with_changes(solver=replace(base.solver, end_time=grid.end_time))
@@ -976,6 +988,7 @@ def _cmd_accuracy(args: argparse.Namespace) -> int:
     from cdpr_exu.scenes.spatial_scene import load_any_scene
 
     scene = load_any_scene(args.scene)  # planar or spatial
+    check_study_scene(scene)  # before the output folder is made
     grid = grid_for(scene, args.quick)
     if args.end_time is not None:
         grid = replace(grid, end_time=args.end_time)
