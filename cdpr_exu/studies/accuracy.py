@@ -339,12 +339,9 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
         spatial = is_spatial(scene)
         if spatial:
             from cdpr_exu.run.spatial_run import simulate_spatial as simulate
-
-            _warm_up_spatial(scene)
         else:
             from cdpr_exu.run.simulate import simulate
-
-            _warm_up(scene)
+        _warm_up(scene)
         cpu = time.process_time()
         try:
             result = simulate(scene, progress=False)
@@ -383,26 +380,6 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
         "end_tensions": tensions[finite],
         "speed": speed,
     }
-
-
-_WARMED_SPATIAL: set[str] = set()
-
-
-def _warm_up_spatial(scene) -> None:
-    """Run two steps of the spatial ``scene`` once per process and effects, untimed (Numba's kernels
-    compile in the first run of a process: about 2 s of CPU time that would go to that run's cost)."""
-    key = json.dumps([scene.to_dict()["effects"], bool(scene.swivels)], sort_keys=True)
-    if key in _WARMED_SPATIAL:
-        return
-    _WARMED_SPATIAL.add(key)
-    from cdpr_exu.run.spatial_run import simulate_spatial
-
-    solver = scene.solver
-    short = replace(solver, end_time=2 * solver.step_size, output_period=solver.step_size)
-    try:
-        simulate_spatial(scene.with_changes(solver=short))
-    except Exception:  # noqa: BLE001 - only a warm-up; the real run reports any problem
-        pass
 
 
 # --------------------------------------------------------------------------- errors

@@ -328,25 +328,29 @@ def _nan_figures() -> dict[str, Any]:
 _WARMED: set[str] = set()
 
 
-def _warm_up(scene: "Scene") -> None:
-    """Run two steps of ``scene`` once per process and model configuration, untimed.
+def _warm_up(scene) -> None:
+    """Run two steps of a planar or spatial ``scene`` once per process and model configuration, untimed.
 
     The first run in a process loads Numba's compiled kernels and Exudyn's code
-    paths (0.2 to 1 s); without this, whichever run a worker takes first would report
-    that in its wall time.
+    paths (0.2 to 1 s planar, about 2 s of CPU time spatial); without this, whichever
+    run a worker takes first would report that in its time.
     """
-    key = json.dumps([scene.to_dict()["effects"], scene.cable_exit, scene.winch.kind], sort_keys=True)
+    from cdpr_exu.run.error_estimate import simulate_any
+    from cdpr_exu.scenes.spatial_scene import is_spatial
+
+    effects = scene.to_dict()["effects"]
+    configuration = (["spatial", effects, bool(scene.swivels)] if is_spatial(scene)
+                     else ["planar", effects, scene.cable_exit, scene.winch.kind])
+    key = json.dumps(configuration, sort_keys=True)
     if key in _WARMED:
         return
     _WARMED.add(key)
     from dataclasses import replace
 
-    from cdpr_exu.run.simulate import simulate
-
     solver = scene.solver
     short = replace(solver, end_time=2 * solver.step_size, output_period=solver.step_size)
     try:
-        simulate(scene.with_changes(solver=short), progress=False)
+        simulate_any(scene.with_changes(solver=short))
     except Exception:  # noqa: BLE001 - only a warm-up; the real run reports any problem
         pass
 
