@@ -31,16 +31,21 @@ def main() -> None:
     for step in sorted(set(args.steps) | {min(args.steps) / 4}):
         scene = base.with_changes(solver=replace(base.solver, end_time=args.end_time, step_size=step))
         result = simulate(scene)
-        poses[step] = result.platform_pose
+        poses[step] = (result.time, result.platform_pose)
         print(f"{step:10.2e} {result.wall_time:9.2f} {result.wall_time / args.end_time:11.3f} "
               f"{args.end_time / result.wall_time:12.2f} {result.newton_iterations / max(result.steps, 1):15.2f}")
     finest = min(poses)
     print(f"\nagreement of the platform path with the finest step ({finest:.2e} s):")
-    for step, pose in sorted(poses.items()):
+    fine_time, fine_pose = poses[finest]
+    for step, (time, pose) in sorted(poses.items()):
         if step == finest:
             continue
-        diff = np.linalg.norm(pose[:, :2] - poses[finest][:, :2], axis=1)
-        print(f"  step {step:.2e} s: max {1000 * diff.max():.2f} mm, after 1 s {1000 * diff[pose.shape[0] // 10:].max():.2f} mm")
+        # at the same instants: a sample lies up to one step after its output time where
+        # Exudyn shrank a step (it is the real state at ``time``), so the finest path is
+        # interpolated there (compared by index, a 1.5 ms offset reads as 0.9 mm at 0.6 m/s)
+        fine = np.column_stack([np.interp(time, fine_time, fine_pose[:, k]) for k in range(2)])
+        diff = np.linalg.norm(pose[:, :2] - fine, axis=1)
+        print(f"  step {step:.2e} s: max {1000 * diff.max():.2f} mm, after 1 s {1000 * diff[time >= 1.0].max():.2f} mm")
 
 
 if __name__ == "__main__":
