@@ -218,7 +218,6 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         elements = np.zeros((0, 2), np.int64)
         rest, axial_k, axial_c = np.zeros(0), np.zeros(0), np.zeros(0)
     positions = np.zeros(size)
-    fused = contact is None and node_contact is None
     force_buffer = np.zeros(size)
     jacobian_buffer = np.zeros((size, size))
     no_force, no_matrix = np.zeros(0), np.zeros((0, 0))
@@ -227,22 +226,10 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     kink = np.zeros(1)
     joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
 
-    def fused_force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
-        # One compiled call (cable_forces): the same arithmetic as force_function below.
-        return cable_forces.cable_force(reference, np.asarray(q), np.asarray(q_t), positions, *joint_args,
-                                        force_buffer)
-
-    def fused_jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
-        return cable_forces.cable_jacobian(reference, np.asarray(q), np.asarray(q_t), positions, *joint_args,
-                                           float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer,
-                                           kink[0])
-
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
-        np.add(reference, q, out=positions)
+        # bending and tension-only elements in one compiled call (cable_forces), then any rim contact
         velocities = np.asarray(q_t)
-        force = spring.force(positions, velocities)
-        if effects.slack:
-            axial.slack_axial_force(positions, velocities, elements, rest, axial_k, axial_c, force)
+        force = cable_forces.cable_force(reference, np.asarray(q), velocities, positions, *joint_args, force_buffer)
         if contact is not None:
             contact.add_force(positions, velocities, force)
         if node_contact is not None:
@@ -250,12 +237,10 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         return force
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
-        np.add(reference, q, out=positions)
         velocities = np.asarray(q_t)
-        jacobian = spring.jacobian_weighted(positions, velocities, f_q, f_q_t)
-        if effects.slack:
-            axial.slack_axial_jacobian(positions, velocities, elements, rest, axial_k, axial_c,
-                                       float(f_q), float(f_q_t), jacobian, kink[0])
+        jacobian = cable_forces.cable_jacobian(reference, np.asarray(q), velocities, positions, *joint_args,
+                                               float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer,
+                                               kink[0])
         if contact is not None:
             contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
         if node_contact is not None:
@@ -263,7 +248,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         return jacobian
 
     nodes = [n for it in items for n in it.nodes]
-    functions = (fused_force_function, fused_jacobian_function) if fused else (force_function, jacobian_function)
+    functions = (force_function, jacobian_function)
     mass = np.zeros((size, size))
     if sparse_jacobian and contact is None and not linear:
         blocks = [_bending_blocks(spring)]
