@@ -423,23 +423,43 @@ def solve_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=D
     return equilibrium, stiffness
 
 
-def _solve_swivel_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
-    """:func:`solve_cable` over a swivel pulley: the planar pulley cable in the plane through the axis and the anchor."""
+def _swivel_plane(cable, anchor_point):
+    """The vertical plane through a swivel pulley's axis and ``anchor_point`` (3,) [m], where its cable hangs.
+
+    Returns the inlet (3,) [m], the plane's horizontal unit vector e_rho (3,), the anchor's
+    span from the inlet in the plane (rho, dz) (2,) [m], and the planar pulley cable of
+    :mod:`cdpr_exu.statics.statics` whose disc touches the axis at the plane's origin.
+
+    Raises
+    ------
+    UnreachableError
+        If the anchor lies on the axis (its azimuth, and so the plane, is undefined).
+    """
     from cdpr_exu.core.geometry import Pulley
-    from cdpr_exu.statics.statics import SuspendedCable, _forward_cable
+    from cdpr_exu.statics.statics import SuspendedCable
 
     inlet = np.array(cable.exit_point)
-    offset = anchor_point - inlet
+    offset = np.asarray(anchor_point, dtype=float) - inlet
     rho = float(math.hypot(offset[0], offset[1]))
     if rho <= 1e-12 * (float(np.linalg.norm(offset)) + cable.pulley_radius):
-        raise UnreachableError(f"anchor {anchor_point.tolist()} lies on the axis of the swivel pulley at "
+        raise UnreachableError(f"anchor {np.asarray(anchor_point).tolist()} lies on the axis of the swivel pulley at "
                                f"{inlet.tolist()}: its azimuth is undefined")
     e_rho = np.array([offset[0], offset[1], 0.0]) / rho
     radius = cable.pulley_radius
     planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
                                   pulley=Pulley((radius, 0.0), radius, -1))
-    planar, planar_stiffness, new_guess = _forward_cable(planar_cable, float(unstrained_length),
-                                                         np.array([rho, offset[2]]), guess, max_strain, max_tension)
+    return inlet, e_rho, np.array([rho, offset[2]]), planar_cable
+
+
+def _solve_swivel_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
+    """:func:`solve_cable` over a swivel pulley: the planar pulley cable in the plane through the axis and the anchor."""
+    from cdpr_exu.statics.statics import _forward_cable
+
+    inlet, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
+    rho = span[0]
+    radius = cable.pulley_radius
+    planar, planar_stiffness, new_guess = _forward_cable(planar_cable, float(unstrained_length), span, guess,
+                                                         max_strain, max_tension)
     basis = np.column_stack([e_rho, _E_Z])
     force = planar.force_on_platform
     stiffness = basis @ planar_stiffness @ basis.T + force[0] / rho * (_HORIZONTAL - np.outer(e_rho, e_rho))
@@ -722,21 +742,11 @@ def _inverse_swivel_cable(cable, anchor_point, horizontal_tension):
     """:func:`_inverse_cable` over a swivel pulley: the planar pulley cable's inverse (``statics._inverse_cable``)
     in the vertical plane through the axis and the anchor, as :func:`_solve_swivel_cable` solves it forward.
     The length counts from the inlet, the wrap included."""
-    from cdpr_exu.core.geometry import Pulley
-    from cdpr_exu.statics.statics import SuspendedCable, _inverse_cable as _planar_inverse_cable
+    from cdpr_exu.statics.statics import _inverse_cable as _planar_inverse_cable
 
-    inlet = np.array(cable.exit_point)
-    offset = np.asarray(anchor_point, dtype=float) - inlet
-    rho = float(math.hypot(offset[0], offset[1]))
-    if rho <= 1e-12 * (float(np.linalg.norm(offset)) + cable.pulley_radius):
-        raise UnreachableError(f"anchor {np.asarray(anchor_point).tolist()} lies on the axis of the swivel pulley at "
-                               f"{inlet.tolist()}: its azimuth is undefined")
-    e_rho = np.array([offset[0], offset[1], 0.0]) / rho
-    radius = cable.pulley_radius
-    planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
-                                  pulley=Pulley((radius, 0.0), radius, -1))
-    planar, _, _, _ = _planar_inverse_cable(planar_cable, float(horizontal_tension), np.array([rho, offset[2]]),
-                                            None, DEFAULT_MAX_STRAIN, None)
+    _, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
+    planar, _, _, _ = _planar_inverse_cable(planar_cable, float(horizontal_tension), span, None,
+                                            DEFAULT_MAX_STRAIN, None)
     force = planar.force_on_platform
     return planar.unstrained_length, force[0] * e_rho + force[1] * _E_Z
 
