@@ -403,11 +403,9 @@ def element_forces(mbs, items, cable, current=True):
     """
     chain = items.chains[cable]
     configuration = _configuration(current)
-    q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
-                        for node in chain.nodes])
+    positions = chain_positions(mbs, items, cable, current).ravel()
     v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
                         for node in chain.nodes])
-    positions = chain.reference + q
     if chain.tension_only:
         return axial_3d.tension_only_tensions(positions, v, chain.axial_elements, chain.axial_rest_length,
                                               chain.axial_stiffness, chain.axial_damping, chain.axial_rest_rate,

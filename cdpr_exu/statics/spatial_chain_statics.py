@@ -699,8 +699,7 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
         if not accepted:
             # stalled at rounding, close enough: a coordinate's last bit (eps |p|) on the stiffest spring
             # (a penalty joint, f k ~ 1e8 N/m) is a force of 1e-8 N, above the default tolerance
-            rounding = 16.0 * np.finfo(float).eps * float(np.abs(hessian.diagonal()).max()) * max(
-                1.0, float(np.abs(p).max()))
+            rounding = rounding_floor(np.abs(hessian.diagonal()), max(1.0, float(np.abs(p).max())))
             if np.max(np.abs(gradient)) < max(10.0 * tolerance, rounding):
                 break
             raise UnreachableError(f"spatial chain statics: the line search failed (force imbalance "
