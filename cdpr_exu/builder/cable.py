@@ -224,11 +224,13 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     # The tension-only elements' kink rule of a run's first step (axial._element_block): off
     # until a run arms it, which clears it after its first accepted step (CableForceItems.first_step_kink).
     kink = np.zeros(1)
+    cut = axial.CutSlopes()  # damper-cut elements keep their taut slopes in a step's first iterations
     joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
 
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         # bending and tension-only elements in one compiled call (cable_forces), then any rim contact
         velocities = np.asarray(q_t)
+        cut.force_evaluated(t)
         force = cable_forces.cable_force(reference, np.asarray(q), velocities, positions, *joint_args, force_buffer)
         if contact is not None:
             contact.add_force(positions, velocities, force)
@@ -240,7 +242,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         velocities = np.asarray(q_t)
         jacobian = cable_forces.cable_jacobian(reference, np.asarray(q), velocities, positions, *joint_args,
                                                float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer,
-                                               kink[0])
+                                               kink[0], cut.active)
         if contact is not None:
             contact.add_jacobian(positions, velocities, f_q, f_q_t, jacobian)
         if node_contact is not None:
@@ -253,7 +255,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     if sparse_jacobian and contact is None and not linear:
         blocks = [_bending_blocks(spring)]
         if effects.slack and len(elements):
-            blocks.append(_slack_blocks(elements, rest, axial_k, axial_c, kink))
+            blocks.append(_slack_blocks(elements, rest, axial_k, axial_c, kink, cut))
         if node_contact is not None:
             blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
         functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions))
@@ -289,14 +291,15 @@ def _bending_blocks(spring):
     return rows, columns, fill
 
 
-def _slack_blocks(elements, rest, axial_k, axial_c, kink):
+def _slack_blocks(elements, rest, axial_k, axial_c, kink, cut):
     """Sparse pattern and value filler of the tension-only elements' 4 x 4 blocks (``kink``: the
-    one-entry array of the first step's kink strain, :class:`CableForceItems`)."""
+    one-entry array of the first step's kink strain, :class:`CableForceItems`; ``cut``: the
+    :class:`cdpr_exu.physics.axial.CutSlopes` of the force function)."""
     rows, columns = axial.slack_triplet_pattern(elements)
 
     def fill(positions, velocities, factor_position, factor_velocity, out_values):
         axial.slack_triplet_values(positions, velocities, elements, rest, axial_k, axial_c,
-                                   factor_position, factor_velocity, out_values, kink[0])
+                                   factor_position, factor_velocity, out_values, kink[0], cut.active)
     return rows, columns, fill
 
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.physics import bending_3d
-from cdpr_exu.physics.axial import cable_elements
+from cdpr_exu.physics.axial import CutSlopes, cable_elements
 
 
 @dataclass
@@ -174,9 +174,11 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     current = np.zeros(size)
     force = np.zeros(size)
     container = exu.MatrixContainer()
+    cut = CutSlopes()  # damper-cut elements keep their taut slopes in a step's first iterations
 
     def force_function(mbs_, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         np.add(reference, q, out=current)
+        cut.force_evaluated(t)
         bending_3d.spatial_bending_force(current, bending_joints, stiffness, force)  # overwrites
         if damped:
             bending_3d.add_spatial_bending_damping_force(current, np.asarray(q_t), bending_joints, damping, bend, force)
@@ -194,7 +196,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         if tension_only:
             triplets[split:, 2] = axial_3d.tension_only_triplet_values(
                 current, np.asarray(q_t), elements, rest, axial_k, axial_c, rest_rate, float(f_q), float(f_q_t),
-                axial_values)
+                axial_values, cut.active)
         container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
         return container
 

@@ -154,7 +154,9 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
     node never moves where its element would be shorter than ``threshold`` of its
     nominal length: the rope that does not go into the node's motion is kept as
     *surplus* at the drum, added to the first element's rest length. Hauling in a slack
-    cable takes up the surplus first; once the cable is taut again (the first element at
+    cable takes up the surplus first, but no more of it than the element's slack (reeling in
+    more at once would stretch the element by the excess within one step: the 240-element
+    circle's winch element snapped taut at 0.37 % strain where its steps ran longer); once the cable is taut again (the first element at
     or beyond its rest length, surplus included), the surplus is rope of that taut element
     and hauling in moves the node. (Taking it up by shrinking the rest length of a taut
     element instead strains that one element at the haul-in rate over its length; with
@@ -184,8 +186,11 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
         The new offset of the winch node and the new surplus (>= 0).
     """
     wanted = paid_out_change - surplus  # where the node goes if the surplus stays
-    taut = element_length >= rest_length + surplus
-    node = wanted if (wanted > node_offset or taut) else min(node_offset, paid_out_change)
+    slack = rest_length + surplus - element_length  # how much shorter than its rest length the element is
+    if wanted > node_offset or slack <= 0.0:
+        node = wanted
+    else:  # the surplus goes first, but no more of it than the slack: the rest of the haul moves the node
+        node = min(node_offset, paid_out_change, wanted + slack)
     highest = node_offset + element_length - threshold * rest_length  # the first element at its shortest
     node = min(node, highest)
     return node, paid_out_change - node

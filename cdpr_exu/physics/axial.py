@@ -80,6 +80,64 @@ def tension_law(extension, rate, stiffness, damping, band):
 
 
 @njit(cache=True)
+def newton_slopes(extension, rate, stiffness, damping, band, cut_slopes):
+    """:func:`tension_law` as Newton's Jacobian sees it: (tension, slope in s, slope in ds/dt).
+
+    With ``cut_slopes`` an element stretched past the band whose damper cuts its force
+    (k s + c ds/dt <= 0: it shortens faster than it relaxes) keeps the taut slopes (k, c)
+    with its force of zero. Elsewhere, and without ``cut_slopes``, the law's own slopes.
+    See :class:`CutSlopes` for why and when.
+    """
+    force, k, c = tension_law(extension, rate, stiffness, damping, band)
+    if cut_slopes and force == 0.0 and extension >= band:
+        return 0.0, stiffness, damping
+    return force, k, c
+
+
+#: Newton iterations (force evaluations at one time) of a step during which the Jacobian gives
+#: damper-cut elements their taut slopes (:class:`CutSlopes`); after them, the law's own.
+CUT_SLOPE_ITERATIONS = 10
+
+
+class CutSlopes:
+    """When Newton's Jacobian gives a damper-cut tension-only element its taut slopes.
+
+    In an implicit step a Newton update of the positions by dq changes the velocities by
+    gamma / (beta h) dq (200 dq / s at h = 1e-2 s), so the damper of a Kelvin-Voigt cable
+    (retardation c / k of about 1 s) sees a change some hundred times larger than the
+    spring: an iterate that shortens a taut element by a few nanometres cuts its force to
+    zero (k s + c ds/dt <= 0), and with the law's zero slopes there the next Jacobian has
+    no axial term for it. On the spatial four-cable move at 32 elements this happened in
+    17 % of the force evaluations; Newton took 18 to 70 iterations per step and cut the
+    steps, although every converged state kept its elements above 4.9 N. A cut element
+    that keeps its taut slopes (:func:`newton_slopes`) is pulled back by the next iterate,
+    and wherever the converged state is taut the Jacobian there is exact.
+
+    An element that the converged state truly cuts (a cable snapped slack faster than it
+    relaxes) would then converge only linearly. So the rule holds for the first
+    :data:`CUT_SLOPE_ITERATIONS` Newton iterations of each attempt at a step, counted as
+    force evaluations at one time ``t``; after them the Jacobian is the law's own. The
+    force is never changed: what Newton converges to is the same law.
+    """
+
+    def __init__(self, iterations: int = CUT_SLOPE_ITERATIONS):
+        self.iterations = int(iterations)
+        self.time = None
+        self.count = 0
+
+    def force_evaluated(self, t: float) -> None:
+        """Count one force evaluation at time ``t`` [s] (a new ``t``: a new attempt at a step)."""
+        if t != self.time:
+            self.time, self.count = t, 0
+        self.count += 1
+
+    @property
+    def active(self) -> bool:
+        """True while the current attempt at a step is within its first iterations."""
+        return self.count <= self.iterations
+
+
+@njit(cache=True)
 def slack_axial_force(positions, velocities, elements, rest_length, stiffness, damping, out):
     """Add the tension-only axial forces to ``out`` (2N,) [N] and return it.
 
@@ -108,7 +166,7 @@ def slack_axial_force(positions, velocities, elements, rest_length, stiffness, d
 
 @njit(cache=True)
 def _element_block(positions, velocities, a, b, rest_length, stiffness, damping, factor_position,
-                   factor_velocity, block, kink_strain=0.0):
+                   factor_velocity, block, kink_strain=0.0, cut_slopes=False):
     """The (b, b) block, shape (2, 2), of ``factor_position * K + factor_velocity * D`` of one
     element into ``block``; the (a, a) block is the same, (a, b) and (b, a) its negative.
     Returns False (block untouched) when the element carries no force (slack).
@@ -125,13 +183,15 @@ def _element_block(positions, velocities, a, b, rest_length, stiffness, damping,
     winch line is in the first steps; without it 120 and 240 elements at 1e-2 s fail
     again): an element passing *near* its rest length with a taut Jacobian stalled Newton
     (the held catenary scene failed at 5.9e-5 s with 1e-12 throughout).
+
+    With ``cut_slopes`` a damper-cut element keeps its taut slopes (:func:`newton_slopes`).
     """
     length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
     extension = length - rest_length
-    force, k, c = tension_law(extension, rate, stiffness, damping, TAUT_BAND * rest_length)
+    force, k, c = newton_slopes(extension, rate, stiffness, damping, TAUT_BAND * rest_length, cut_slopes)
     if abs(extension) <= kink_strain * rest_length:
         force, k, c = 0.0, stiffness, damping
-    elif force <= 0.0:
+    elif k == 0.0 and c == 0.0:
         return False
     u = (ux, uy)
     # d(rate)/d(p_b) = (dv - u rate) / l
@@ -146,18 +206,19 @@ def _element_block(positions, velocities, a, b, rest_length, stiffness, damping,
 
 @njit(cache=True)
 def slack_axial_jacobian(positions, velocities, elements, rest_length, stiffness, damping,
-                         factor_position, factor_velocity, out, kink_strain=0.0):
+                         factor_position, factor_velocity, out, kink_strain=0.0, cut_slopes=False):
     """Add ``factor_position * K + factor_velocity * D`` of the slack elements to ``out``.
 
     K = -df/dq and D = -df/dv (the left-hand-side Jacobians Exudyn expects), shape
     (2N, 2N); zero for an element whose force is not positive (slack). The element's
-    stiffness and damping are the slopes of :func:`tension_law` in the extension and its rate.
+    stiffness and damping are the slopes of :func:`tension_law` in the extension and its rate
+    (:func:`newton_slopes` with ``cut_slopes``).
     """
     block = np.empty((2, 2))
     for e in range(elements.shape[0]):
         a, b = elements[e, 0], elements[e, 1]
         if not _element_block(positions, velocities, a, b, rest_length[e], stiffness[e], damping[e],
-                              factor_position, factor_velocity, block, kink_strain):
+                              factor_position, factor_velocity, block, kink_strain, cut_slopes):
             continue
         for i in range(2):
             for j in range(2):
@@ -191,14 +252,14 @@ def slack_triplet_pattern(elements):
 
 @njit(cache=True)
 def slack_triplet_values(positions, velocities, elements, rest_length, stiffness, damping,
-                         factor_position, factor_velocity, out_values, kink_strain=0.0):
+                         factor_position, factor_velocity, out_values, kink_strain=0.0, cut_slopes=False):
     """Values of ``factor_position * K + factor_velocity * D`` of the slack elements at
     :func:`slack_triplet_pattern`'s places (overwrites ``out_values``, shape (16 E,))."""
     out_values[:] = 0.0
     block = np.empty((2, 2))
     for e in range(elements.shape[0]):
         if not _element_block(positions, velocities, elements[e, 0], elements[e, 1], rest_length[e], stiffness[e],
-                              damping[e], factor_position, factor_velocity, block, kink_strain):
+                              damping[e], factor_position, factor_velocity, block, kink_strain, cut_slopes):
             continue
         for i in range(2):
             for j in range(2):

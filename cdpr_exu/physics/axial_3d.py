@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from cdpr_exu.physics.axial import TAUT_BAND, tension_law
+from cdpr_exu.physics.axial import TAUT_BAND, newton_slopes, tension_law
 
 #: Triplets per element: the 6 x 6 block on (p_a, p_b).
 TRIPLETS_PER_ELEMENT = 36
@@ -142,17 +142,18 @@ def tension_only_pattern(elements):
 
 @njit(cache=True)
 def tension_only_triplet_values(positions, velocities, elements, rest_length, stiffness, damping, rest_rate,
-                                factor_position, factor_velocity, out_values):
+                                factor_position, factor_velocity, out_values, cut_slopes=False):
     """``factor_position * K + factor_velocity * D`` (K = -df/dq, D = -df/dv) at
-    :func:`tension_only_pattern`'s places; overwrites ``out_values`` (36 E,)."""
+    :func:`tension_only_pattern`'s places; overwrites ``out_values`` (36 E,). With ``cut_slopes``
+    a damper-cut element keeps its taut slopes (:func:`cdpr_exu.physics.axial.newton_slopes`)."""
     out_values[:] = 0.0
     u = np.empty(3)
     dv = np.empty(3)
     for e in range(elements.shape[0]):
         length, rate = _element_state(positions, velocities, elements[e, 0], elements[e, 1], u, dv)
-        force, k, c = tension_law(length - rest_length[e], rate - rest_rate[e], stiffness[e], damping[e],
-                                  TAUT_BAND * rest_length[e])
-        if force <= 0.0:
+        force, k, c = newton_slopes(length - rest_length[e], rate - rest_rate[e], stiffness[e], damping[e],
+                                    TAUT_BAND * rest_length[e], cut_slopes)
+        if k == 0.0 and c == 0.0:
             continue
         for i in range(3):
             for j in range(3):

@@ -45,17 +45,18 @@ def cable_force(reference, q, q_t, positions, joints, stiffness, damping, elemen
 @njit(cache=True)
 def cable_jacobian(reference, q, q_t, positions, joints, stiffness, damping, elements, rest_length,
                    axial_stiffness, axial_damping, factor_position, factor_velocity, no_force, no_matrix, out,
-                   kink_strain=0.0):
+                   kink_strain=0.0, cut_slopes=False):
     """``factor_position * K + factor_velocity * D`` of the same forces, dense (2N, 2N), into ``out``.
 
     K = -df/dq, D = -df/dq_t; ``no_force`` (0,) and ``no_matrix`` (0, 0) are empty arrays
     (what the bending kernel takes for "no force" and "weighted sum"); ``kink_strain`` as
-    :func:`cdpr_exu.physics.axial.slack_axial_jacobian` (the run's first step only).
+    :func:`cdpr_exu.physics.axial.slack_axial_jacobian` (the run's first step only), ``cut_slopes``
+    as there (:class:`cdpr_exu.physics.axial.CutSlopes`).
     """
     for i in range(positions.shape[0]):
         positions[i] = reference[i] + q[i]
     bending_jacobian_kernel(positions, q_t, joints, stiffness, damping, factor_position, factor_velocity,
                             no_force, out, no_matrix)
     slack_axial_jacobian(positions, q_t, elements, rest_length, axial_stiffness, axial_damping,
-                         factor_position, factor_velocity, out, kink_strain)
+                         factor_position, factor_velocity, out, kink_strain, cut_slopes)
     return out
