@@ -152,3 +152,44 @@ def test_an_element_on_its_rest_length_gives_newton_the_taut_slopes_but_no_force
     p = np.array([0.0, 0.0, 1.0 - 0.5 * ROUNDOFF_STRAIN, 0.0])
     assert not slack_axial_jacobian(p, np.zeros(4), cable_elements([2]), np.array([1.0]), k, c, 1.0, 1.0,
                                     np.zeros((4, 4))).any()
+
+
+def test_a_damper_cut_element_gives_newton_its_taut_slopes_only_when_asked_and_no_force():
+    """Stretched by 1 % but closing at 1 m/s with c = 10 N s/m: k s + c ds/dt = 1 - 10 < 0, so
+    the law cuts its force to zero, and its own slopes there are zero. With ``cut_slopes``
+    (a step's first Newton iterations, :class:`cdpr_exu.physics.axial.CutSlopes`) the Jacobian
+    takes the taut element's k u u^T and c u u^T (exactly: no geometric term, as the force is
+    0, and no w term, as the velocity is along the element); without it, nothing."""
+    k, c = np.array([100.0]), np.array([10.0])
+    p = np.array([0.0, 0.0, 1.01, 0.0])
+    v = np.array([0.0, 0.0, -1.0, 0.0])
+    elements, rest = cable_elements([2]), np.array([1.0])
+    assert np.all(_force(p, v, elements, rest, k, c) == 0.0)
+    stiffness = slack_axial_jacobian(p, v, elements, rest, k, c, 1.0, 0.0, np.zeros((4, 4)), 0.0, True)
+    damping = slack_axial_jacobian(p, v, elements, rest, k, c, 0.0, 1.0, np.zeros((4, 4)), 0.0, True)
+    u = np.array([1.0, 0.0])
+    block = np.outer(u, u)
+    np.testing.assert_array_equal(stiffness, np.block([[block, -block], [-block, block]]) * k[0])
+    np.testing.assert_array_equal(damping, np.block([[block, -block], [-block, block]]) * c[0])
+    assert not slack_axial_jacobian(p, v, elements, rest, k, c, 1.0, 1.0, np.zeros((4, 4))).any()
+    # Inside the switch band (1e-5 strain) or shorter than the rest length it stays the law's zero.
+    for length in (1.0 + 5e-6, 0.99):
+        p = np.array([0.0, 0.0, length, 0.0])
+        assert not slack_axial_jacobian(p, v, elements, rest, k, c, 1.0, 1.0, np.zeros((4, 4)), 0.0, True).any()
+
+
+def test_cut_slopes_hold_for_the_first_newton_iterations_of_each_attempt_at_a_step():
+    """Counted as force evaluations at one time: the first CUT_SLOPE_ITERATIONS are active, the
+    next is not (Newton then sees the law's own slopes: an element the converged state truly
+    cuts would converge only linearly with taut slopes); a new time, a new step or a retried
+    shorter one, starts again."""
+    from cdpr_exu.physics.axial import CUT_SLOPE_ITERATIONS, CutSlopes
+
+    cut = CutSlopes()
+    for _ in range(CUT_SLOPE_ITERATIONS):
+        cut.force_evaluated(0.01)
+        assert cut.active
+    cut.force_evaluated(0.01)
+    assert not cut.active
+    cut.force_evaluated(0.005)
+    assert cut.active

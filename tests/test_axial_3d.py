@@ -41,10 +41,10 @@ def _force(p, v, elements, rest, k, c):
     return axial_3d.tension_only_force(p, v, elements, rest, k, c, np.zeros(len(elements)), np.zeros(p.size))
 
 
-def _dense(p, v, elements, rest, k, c, f_q, f_q_t):
+def _dense(p, v, elements, rest, k, c, f_q, f_q_t, cut_slopes=False):
     rows, columns = axial_3d.tension_only_pattern(elements)
     values = axial_3d.tension_only_triplet_values(p, v, elements, rest, k, c, np.zeros(len(elements)), f_q, f_q_t,
-                                                  np.zeros(rows.size))
+                                                  np.zeros(rows.size), cut_slopes)
     matrix = np.zeros((p.size, p.size))
     np.add.at(matrix, (rows, columns), values)
     return matrix
@@ -138,6 +138,30 @@ def test_a_slack_element_gives_exactly_zero_force_and_jacobian_whatever_its_velo
         assert np.all(axial_3d.tension_only_tensions(p, velocities, elements, rest, k, c, np.zeros(3), np.ones(3)) == 0.0)
         assert np.all(_dense(p, velocities, elements, rest, k, c, 1.0, 1.0) == 0.0)
     assert axial_3d.tension_only_energy(p, elements, rest, k) == 0.0
+
+
+def test_a_damper_cut_element_gives_newton_its_taut_slopes_only_when_asked_and_no_force():
+    """Stretched by 1e-3 and closing fast (velocities x 1000: k s + c ds/dt < 0 for every
+    element): no force, the law's zero Jacobian; with ``cut_slopes`` (a step's first Newton
+    iterations, :class:`cdpr_exu.physics.axial.CutSlopes`) each element's taut block
+    [[G, -G], [-G, G]] with G = f_q (k u u^T + c u w^T) + f_q_t c u u^T and no force term."""
+    p, v, elements, rest, k, c = _chain([1e-3, 1e-3, 1e-3], 3)
+    points, velocities = p.reshape(-1, 3), np.zeros_like(p)
+    u = np.diff(points, axis=0) / np.linalg.norm(np.diff(points, axis=0), axis=1)[:, None]
+    for e in range(3):  # node e + 1 runs back along the element at 10 m/s: every element closes fast
+        velocities[3 * (e + 1):3 * (e + 2)] -= 10.0 * u[e] * (e + 1)
+    assert np.all(_force(p, velocities, elements, rest, k, c) == 0.0)
+    assert not _dense(p, velocities, elements, rest, k, c, 1.0, 1.0).any()
+    expected = np.zeros((p.size, p.size))
+    for e, (a, b) in enumerate(elements):
+        length = np.linalg.norm(points[b] - points[a])
+        dv = velocities[3 * b:3 * b + 3] - velocities[3 * a:3 * a + 3]
+        w = (dv - u[e] * (u[e] @ dv)) / length
+        g = 0.7 * (k[e] * np.outer(u[e], u[e]) + c[e] * np.outer(u[e], w)) + 0.003 * c[e] * np.outer(u[e], u[e])
+        for (i, j), sign in (((a, a), 1), ((b, b), 1), ((a, b), -1), ((b, a), -1)):
+            expected[3 * i:3 * i + 3, 3 * j:3 * j + 3] += sign * g
+    np.testing.assert_allclose(_dense(p, velocities, elements, rest, k, c, 0.7, 0.003, True), expected,
+                               rtol=0, atol=1e-12 * np.abs(expected).max())
 
 
 @pytest.mark.parametrize("azimuth_deg", [0.0, 30.0])

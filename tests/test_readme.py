@@ -57,10 +57,10 @@ def test_bending_free_claim_matches_the_run():
     """The README says the bending-free run at spectral radius 0.5 with the paper's springs
     stops at 0.27 s, the platform above the pulleys; with tension-only elements it is
     flung decimetres off its path (10 s), its cables slack for seconds. That motion is
-    chaotic: its error was 0.71 m before a change of Newton's Jacobian that moves no
-    converged state, and 0.14 / 0.28 / 0.45 m at Newton tolerances of 1e-6 / 1e-7 / 1e-8,
-    so the test asserts what every run shares: above 0.1 m, more than a second slack per
-    cable, no element pushing."""
+    chaotic: changes of Newton's Jacobian that move no converged state gave 0.71, 0.14 and
+    0.69 m, and Newton tolerances of 1e-6 / 1e-7 / 1e-8 give 0.69 / 0.34 / 0.62 m, so the
+    test asserts what every run shares: 0.1 to 1 m, more than a second slack per cable, no
+    element pushing, and the README's figure for the default tolerance."""
     from cdpr_exu import SolverFailure, load_scene, simulate
     from cdpr_exu.scenes.scene import Effects
 
@@ -74,7 +74,7 @@ def test_bending_free_claim_matches_the_run():
     tension_only = scene.with_changes(effects=Effects.from_preset("catenary"),
                                       solver=replace(solver, end_time=10.0))
     summary = simulate(tension_only).summary()
-    assert summary["status"] == "completed" and summary["max_position_error_m"] > 0.1
+    assert summary["status"] == "completed" and 0.1 < summary["max_position_error_m"] < 1.0
     assert min(summary["slack_time_per_cable_s"]) > 1.0 and not summary["elements_pushed"]
     assert "decimetres off its path" in README and f"{summary['max_position_error_m']:.2f}" in README
 
