@@ -528,11 +528,36 @@ def _pose(platform, coordinates):
     return position, rotation_from_vector(theta), theta
 
 
+def _straight_path(cable, exit_point, point):
+    """Length [m] of a straight, massless cable from its exit to ``point`` (3,), and the unit
+    vector (3,) along its last straight part towards ``point`` (the length's gradient in ``point``).
+
+    Over a swivel pulley the path wraps the disc in the plane through the axis and ``point``
+    (:func:`cdpr_exu.physics.spatial_kinematics.swivel_pulley_exit`: arc plus free length);
+    where that is undefined (``point`` on the axis or inside the disc, only ever an iterate of
+    the starting guess) the straight distance from the inlet stands in.
+    """
+    span = point - exit_point
+    distance = float(np.linalg.norm(span))
+    if cable.pulley_radius > 0.0:
+        from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+
+        try:
+            path = swivel_pulley_exit(exit_point, cable.pulley_radius, point)
+        except UnreachableError:
+            pass
+        else:
+            return float(path.arc_length + path.free_length), np.asarray(path.unit_vector, dtype=float)
+    return distance, span / distance if distance > 0.0 else np.zeros(3)
+
+
 def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
     """Equilibrium pose on straight, massless, elastic cables that may go slack (the starting guess).
 
     Minimises ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2`` with ``l_i``
-    the straight anchor-exit distance and ``k_i = EA_i / L_i``.
+    the straight anchor-exit distance (over a swivel pulley: the wrapped arc plus the
+    tangent, :func:`_straight_path`; the inlet distance overestimated the reach there, and
+    the shrunk swivel scene's statics started beyond it) and ``k_i = EA_i / L_i``.
 
     Parameters
     ----------
@@ -559,12 +584,11 @@ def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
         value = weight * position[2] - wrench[:3] @ position - (wrench[3:] @ theta if dof == 6 else 0.0)
         force = np.array([0.0, 0.0, weight]) - wrench[:3]
         moment = -wrench[3:].copy()
-        for arm, exit_point, length, k in zip(arms, exits, lengths, stiffness):
-            span = position + arm - exit_point
-            distance = float(np.linalg.norm(span))
+        for cable, arm, exit_point, length, k in zip(platform.cables, arms, exits, lengths, stiffness):
+            distance, direction = _straight_path(cable, exit_point, position + arm)
             if distance > length:
                 value += 0.5 * k * (distance - length) ** 2
-                pull = k * (distance - length) * span / distance
+                pull = k * (distance - length) * direction
                 force += pull
                 moment += np.cross(arm, pull)
         gradient = force if dof == 3 else np.concatenate([force, left_jacobian(theta).T @ moment])
