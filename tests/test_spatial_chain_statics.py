@@ -375,3 +375,68 @@ def test_over_swivel_pulleys_the_inverse_chain_statics_give_back_the_rest_and_th
     assert forward.iterations >= 2
     assert np.abs(forward.position - pose).max() < 1e-9
     assert np.abs(forward.swivel_angles - inverse.swivel_angles).max() < 1e-9
+
+
+def _swivel_jump(scene, rest, offset):
+    """The pose ``offset`` [m] from the rest of the swivel scene, and the paid-out lengths changed as the straight
+    distances from the inlets (the chain controller's start)."""
+    pose = rest.position + np.asarray(offset, dtype=float)
+    inlets = np.array([s.inlet for s in scene.swivels])
+    lengths = np.asarray(scene.unstrained_lengths) + np.linalg.norm(inlets - pose, axis=1) \
+        - np.linalg.norm(inlets - rest.position, axis=1)
+    return pose, lengths
+
+
+def test_over_a_swivel_pulley_a_held_chain_started_10_cm_away_converges_to_the_chain_solved_in_small_steps(
+        monkeypatch):
+    import cdpr_exu.statics.spatial_chain_statics as statics
+    from cdpr_exu.core.errors import UnreachableError
+
+    scene = load_spatial_scene("spatial-four-cable-swivel")
+    robot, rest = spatial_chain_robot(scene), spatial_chain_statics(scene)
+    direction = np.array([1.0, -0.6, 0.4]) / np.linalg.norm([1.0, -0.6, 0.4])  # across and up: the hardest way
+    pose, lengths = _swivel_jump(scene, rest, 0.1 * direction)
+    cable = statics.cable_paid_out(robot.cables[1], lengths[1])  # paying out 9 cm: slides over the disc
+    chain = statics.solve_held_chain(cable, robot.gravity, pose, rest.nodes[1],
+                                     swivel_angle=rest.swivel_angles[1])
+    # the independent reference: Newton alone (no continuation) in 20 steps of 5 mm along the way, each
+    # from the last step's chain, as the controller's samples (2 mm apart) go; and in one jump Newton alone
+    # stalls (it did from 2 cm up or 5 cm across)
+    monkeypatch.setattr(statics, "CONTINUATION_HALVINGS", 0)
+    with pytest.raises(UnreachableError, match="did not converge"):
+        statics.solve_held_chain(cable, robot.gravity, pose, rest.nodes[1], swivel_angle=rest.swivel_angles[1])
+    nodes, psi = rest.nodes[1], rest.swivel_angles[1]
+    for share in np.linspace(0.05, 1.0, 20):
+        step_pose, step_lengths = _swivel_jump(scene, rest, share * 0.1 * direction)
+        small = statics.solve_held_chain(statics.cable_paid_out(robot.cables[1], step_lengths[1]), robot.gravity,
+                                         step_pose, nodes, swivel_angle=psi)
+        nodes, psi = small.nodes, small.swivel_angle
+    # Both are converged: the force left on every free node and on psi below the solver's 1e-9 N (measured
+    # 2.7e-10 N), so they are the same rest shape: the anchor forces agree to 1e-6 relative (measured 1.4e-12,
+    # the rounding of 1.6e6 N/m elements' forces), the nodes to 1e-9 m (measured 1e-14 m)
+    model = statics._held_model(cable, robot.gravity)
+    n = cable.n_elements
+    gradient = model.point_derivatives(chain.nodes, np.array([chain.swivel_angle]))[0]
+    assert np.abs(np.concatenate([gradient[3:3 * n], gradient[3 * (n + 1):]])).max() < 1e-9
+    assert np.abs(chain.force - small.force).max() < 1e-6 * np.linalg.norm(small.force)
+    assert np.abs(chain.nodes - small.nodes).max() < 1e-9
+    assert abs(chain.swivel_angle - small.swivel_angle) < 1e-9
+
+
+def test_over_swivel_pulleys_the_inverse_chain_statics_from_the_rest_5_cm_away_hold_that_pose():
+    from cdpr_exu.statics.spatial_chain_statics import (robot_paid_out, solve_inverse_spatial_chain_statics,
+                                                        solve_spatial_chain_statics)
+
+    scene = load_spatial_scene("spatial-four-cable-swivel")
+    robot, rest = spatial_chain_robot(scene), spatial_chain_statics(scene)
+    # 5.2 cm up and across, started from the rest's chains (without continuation a held chain stalled at 157 N)
+    pose, lengths = _swivel_jump(scene, rest, [0.03, -0.03, 0.03])
+    inverse = solve_inverse_spatial_chain_statics(robot, pose, rest.tensions_at_anchor, lengths, rest.nodes,
+                                                  swivel_angles=rest.swivel_angles)
+    assert np.all(inverse.tensions > 0.0)
+    # the forward statics of these lengths, started 1 mm away, find the pose again (measured 1.4e-12 m; the
+    # inverse took 3 Gauss-Newton iterations)
+    forward = solve_spatial_chain_statics(robot_paid_out(robot, inverse.unstrained_lengths), inverse.nodes,
+                                          pose + 1e-3, swivel_angles=inverse.swivel_angles)
+    assert np.abs(forward.position - pose).max() < 1e-9
+    assert np.abs(forward.swivel_angles - inverse.swivel_angles).max() < 1e-9

@@ -827,7 +827,14 @@ def solve_held_chain(cable: SpatialChainCable, gravity: float, anchor_point, nod
 
     Newton's method on its free nodes and, over a swivel pulley, the pulley's angle psi (the
     potential of :func:`solve_spatial_chain_statics`, with the same line search), then the force
-    on the anchor and its rate with the paid-out length.
+    on the anchor and its rate with the paid-out length. If Newton fails from ``nodes``, the
+    anchor (and a swivel cable's winch end) is moved there from the start's in sub-steps, each
+    solved from the last (:func:`_solve_held`). Over the swivel pulleys of
+    spatial-four-cable-swivel, started from the rest's chains with the length changed as the
+    straight distance from the inlet: Newton alone crawled (line search) and stopped at 50
+    iterations from 2 cm up or 5 cm across; with the sub-steps, 30 cm across and 20 cm up
+    converge (0.5 to 4 s, to within 1e-10 relative of Newton alone given 2000 iterations),
+    30 cm up does not.
 
     Parameters
     ----------
@@ -849,20 +856,78 @@ def solve_held_chain(cable: SpatialChainCable, gravity: float, anchor_point, nod
     Raises
     ------
     UnreachableError
-        If Newton finds no rest shape.
+        If Newton finds no rest shape, neither from ``nodes`` nor in sub-steps.
     """
     return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations,
                        swivel_angle)
 
 
+#: Halvings of a held chain's jump the continuation may make (:func:`_solve_held`): at most 2^5 = 32 sub-steps.
+CONTINUATION_HALVINGS = 5
+
+
 def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, tolerance: float,
                 max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
-    """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other lengths)."""
+    """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other lengths).
+
+    Newton from ``nodes`` first; only if it fails, by continuation: the anchor moved from the start's last
+    node to ``anchor_point`` (and over a swivel pulley the held winch end from the start's height on the axis
+    to the model's) in sub-steps, each solved from the previous one's chain, a sub-step that fails halved
+    again, at most :data:`CONTINUATION_HALVINGS` times. A start that converges keeps its answer bit for bit.
+    """
     anchor_point = vector("anchor_point", anchor_point, 3)
     nodes = np.array(nodes, dtype=float)
     n = cable.n_elements
     if nodes.shape != (n + 1, 3) or not np.all(np.isfinite(nodes)):
         raise SceneError(f"nodes must be finite, shape {(n + 1, 3)}, got {nodes.shape}")
+    try:
+        return _newton_held(model, cable, anchor_point, nodes, tolerance, max_iterations, swivel_angle)
+    except UnreachableError as failure:
+        direct = failure
+    held_point = model.fixed_positions[0]
+    start_anchor = nodes[-1].copy()
+    # over a swivel pulley the start's winch end is its height on the axis (the start is slid along itself to it)
+    travel = float(np.dot(nodes[0] - held_point, _E_Z)) if cable.swivel is not None else 0.0
+
+    def at(share):
+        """The model and anchor point [m] a ``share`` (0 to 1) of the way from the start's to the target's."""
+        if share == 1.0:
+            return model, anchor_point
+        import copy
+
+        moved = copy.copy(model)
+        moved.fixed_positions = {0: held_point + (1.0 - share) * travel * _E_Z}
+        return moved, start_anchor + share * (anchor_point - start_anchor)
+
+    def continued(chain_nodes, psi, begin, finish, halvings, failed=False):
+        """The chain at share ``finish`` from ``chain_nodes`` (n + 1, 3) [m] and ``psi`` [rad] at share ``begin``
+        (``failed``: Newton from there is known to fail)."""
+        if not failed:
+            sub_model, sub_anchor = at(finish)
+            try:
+                return _newton_held(sub_model, cable, sub_anchor, chain_nodes, tolerance, max_iterations, psi)
+            except UnreachableError:
+                if halvings == 0:
+                    raise
+        middle = 0.5 * (begin + finish)
+        half = continued(chain_nodes, psi, begin, middle, halvings - 1)
+        return continued(half.nodes, half.swivel_angle, middle, finish, halvings - 1)
+
+    if CONTINUATION_HALVINGS == 0:
+        raise direct
+    try:
+        return continued(nodes, swivel_angle, 0.0, 1.0, CONTINUATION_HALVINGS, failed=True)
+    except UnreachableError as failure:
+        raise UnreachableError(f"{direct}; and by continuation in up to {2 ** CONTINUATION_HALVINGS} sub-steps: "
+                               f"{failure}") from None
+
+
+def _newton_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, tolerance: float,
+                 max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
+    """Newton for :func:`_solve_held` from ``nodes`` (n + 1, 3) [m] (checked), its ends first moved onto the held
+    and anchor points (over a swivel pulley by :func:`_swivel_start`)."""
+    nodes = np.array(nodes, dtype=float)
+    n = cable.n_elements
     share = np.linspace(0.0, 1.0, n + 1)[:, None]
     held_point = model.fixed_positions[0]
     if cable.swivel is None:
