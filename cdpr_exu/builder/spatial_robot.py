@@ -392,8 +392,11 @@ def anchor_forces(mbs, items):
                      for joint in items.joints])
 
 
-def element_forces(mbs, items, cable, current=True):
+def element_forces(mbs, items, cable, current=True, positions=None):
     """Axial force of each element of one cable [N], shape (n,), exit first (tension > 0).
+
+    ``positions`` (n + 1, 3) [m]: the cable's node positions when the caller has read them
+    already (:func:`chain_positions` of the same configuration), else read here.
 
     As the model computes it: Exudyn's spring-damper k (l - l0) + c (dl/dt - dl0/dt) with
     the parameters the connectors hold now (``velocityOffset`` = dl0/dt while a winch pays
@@ -403,7 +406,7 @@ def element_forces(mbs, items, cable, current=True):
     """
     chain = items.chains[cable]
     configuration = _configuration(current)
-    positions = chain_positions(mbs, items, cable, current).ravel()
+    positions = (chain_positions(mbs, items, cable, current) if positions is None else np.asarray(positions)).ravel()
     v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
                         for node in chain.nodes])
     if chain.tension_only:

@@ -381,8 +381,9 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         poses.append(np.concatenate([position, rotation_vector(rotation)]))
         paid.append(winches.applied.copy())
         for i in range(m):
-            node_series[i].append(chain_positions(mbs, items, i))
-            tension_series[i].append(element_forces(mbs, items, i))  # spring and damper, as the model has them
+            positions = chain_positions(mbs, items, i)
+            node_series[i].append(positions)
+            tension_series[i].append(element_forces(mbs, items, i, positions=positions))  # spring and damper
 
     def pre_step(mbs_, t):  # noqa: ARG001
         if not kinematic:
