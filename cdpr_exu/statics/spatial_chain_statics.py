@@ -38,6 +38,7 @@ The equilibrium at rest needs no damping. Units SI (m, N, kg, rad); z up, gravit
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, replace
 
@@ -893,8 +894,6 @@ def _solve_held(model: _Model, cable: SpatialChainCable, anchor_point, nodes, to
         """The model and anchor point [m] a ``share`` (0 to 1) of the way from the start's to the target's."""
         if share == 1.0:
             return model, anchor_point
-        import copy
-
         moved = copy.copy(model)
         moved.fixed_positions = {0: held_point + (1.0 - share) * travel * _E_Z}
         return moved, start_anchor + share * (anchor_point - start_anchor)
