@@ -142,6 +142,11 @@ def servo_force(servo: ServoItems, error_integral: float, error: float, error_ra
 #: length while slack; rope that would shorten it further goes into the reservoir.
 RESERVOIR_THRESHOLD = 0.75
 
+#: Strain past its rest length to which hauling in a slack cable's surplus may take the winch element
+#: (:func:`reservoir_split`): two widths of the tension law's switch band (:data:`cdpr_exu.physics.axial.TAUT_BAND`),
+#: so that the element lands taut rather than on the law's kink, where Newton converges slowly.
+TAUT_MARGIN = 2.0e-5
+
 
 def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, element_length: float,
                     rest_length: float, threshold: float = RESERVOIR_THRESHOLD) -> tuple[float, float]:
@@ -154,9 +159,11 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
     node never moves where its element would be shorter than ``threshold`` of its
     nominal length: the rope that does not go into the node's motion is kept as
     *surplus* at the drum, added to the first element's rest length. Hauling in a slack
-    cable takes up the surplus first, but no more of it than the element's slack (reeling in
-    more at once would stretch the element by the excess within one step: the 240-element
-    circle's winch element snapped taut at 0.37 % strain where its steps ran longer); once the cable is taut again (the first element at
+    cable takes up the surplus first, but no more of it than the element's slack and
+    :data:`TAUT_MARGIN` (reeling in more at once would stretch the element by the excess within
+    one step: the 240-element circle's winch element snapped taut at 0.37 % strain where its
+    steps ran longer; reeling in exactly the slack leaves the element on the law's kink, where
+    Newton converges slowly: the same circle at 1e-2 s took 3505 steps instead of 1727); once the cable is taut again (the first element at
     or beyond its rest length, surplus included), the surplus is rope of that taut element
     and hauling in moves the node. (Taking it up by shrinking the rest length of a taut
     element instead strains that one element at the haul-in rate over its length; with
@@ -189,8 +196,8 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
     slack = rest_length + surplus - element_length  # how much shorter than its rest length the element is
     if wanted > node_offset or slack <= 0.0:
         node = wanted
-    else:  # the surplus goes first, but no more of it than the slack: the rest of the haul moves the node
-        node = min(node_offset, paid_out_change, wanted + slack)
+    else:  # the surplus goes first, but no more of it than the slack (and a margin): the rest moves the node
+        node = min(node_offset, paid_out_change, wanted + slack + TAUT_MARGIN * rest_length)
     highest = node_offset + element_length - threshold * rest_length  # the first element at its shortest
     node = min(node, highest)
     return node, paid_out_change - node
