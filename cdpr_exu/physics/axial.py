@@ -80,14 +80,18 @@ def tension_law(extension, rate, stiffness, damping, band):
 
 
 @njit(cache=True)
-def newton_slopes(extension, rate, stiffness, damping, band, cut_slopes):
+def newton_slopes(extension, rate, stiffness, damping, band, cut_slopes, kink=-1.0):
     """:func:`tension_law` as Newton's Jacobian sees it: (tension, slope in s, slope in ds/dt).
 
-    With ``cut_slopes`` an element stretched past the band whose damper cuts its force
-    (k s + c ds/dt <= 0: it shortens faster than it relaxes) keeps the taut slopes (k, c)
-    with its force of zero. Elsewhere, and without ``cut_slopes``, the law's own slopes.
-    See :class:`CutSlopes` for why and when.
+    Two places where the law's own slopes mislead Newton get the taut slopes (k, c) with a
+    force of zero: an element within ``kink`` [m] of its rest length, on the law's kink
+    (:func:`_element_block`; 0: exactly on it; negative, the default: no such rule), and,
+    with ``cut_slopes``, an element stretched past the band whose damper cuts its force
+    (k s + c ds/dt <= 0: it shortens faster than it relaxes; see :class:`CutSlopes` for why
+    and when). Elsewhere the law's own slopes.
     """
+    if abs(extension) <= kink:
+        return 0.0, stiffness, damping
     force, k, c = tension_law(extension, rate, stiffness, damping, band)
     if cut_slopes and force == 0.0 and extension >= band:
         return 0.0, stiffness, damping
@@ -193,10 +197,9 @@ def _element_block(positions, velocities, a, b, rest_length, stiffness, damping,
     """
     length, ux, uy, rate, dvx, dvy = _element_state(positions, velocities, a, b)
     extension = length - rest_length
-    force, k, c = newton_slopes(extension, rate, stiffness, damping, TAUT_BAND * rest_length, cut_slopes)
-    if abs(extension) <= kink_strain * rest_length:
-        force, k, c = 0.0, stiffness, damping
-    elif k == 0.0 and c == 0.0:
+    force, k, c = newton_slopes(extension, rate, stiffness, damping, TAUT_BAND * rest_length, cut_slopes,
+                                kink_strain * rest_length)
+    if k == 0.0 and c == 0.0:
         return False
     u = (ux, uy)
     # d(rate)/d(p_b) = (dv - u rate) / l
