@@ -33,6 +33,7 @@ from matplotlib.figure import Figure
 
 from cdpr_exu.core.output import write_summary
 from cdpr_exu.results.result import provenance
+from cdpr_exu.run.error_estimate import path_distance
 from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.scenes.spatial_scene import load_spatial_scene
 
@@ -46,13 +47,6 @@ def scene_for(n_elements: int, damped: bool):
     scene = load_spatial_scene(NAME)
     return replace(scene, effects=replace(scene.effects, bending_damping=damped),
                    cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables))
-
-
-def distance_after(a, b) -> float:
-    """Largest distance [m] of path ``a``'s centre from path ``b``'s (interpolated onto a's times) after AFTER."""
-    mask = a.time >= AFTER - 1e-9
-    on = np.column_stack([np.interp(a.time[mask], b.time, b.pose[:, k]) for k in range(3)])
-    return float(np.linalg.norm(a.pose[mask, :3] - on, axis=1).max())
 
 
 def slack_fraction(result) -> float:
@@ -99,9 +93,9 @@ def main(argv=None) -> int:
         finer = COUNTS[i + 1] if i + 1 < len(COUNTS) else None
         rows.append({
             "n_elements": n, "element_length_m": scene_for(n, True).cables[0].element_length,
-            "damping_moves_path_m": distance_after(on, off),
-            "change_to_finer_damped_m": distance_after(on, results[finer, True]) if finer else None,
-            "change_to_finer_undamped_m": distance_after(off, results[finer, False]) if finer else None,
+            "damping_moves_path_m": path_distance(on, off, AFTER),
+            "change_to_finer_damped_m": path_distance(on, results[finer, True], AFTER) if finer else None,
+            "change_to_finer_undamped_m": path_distance(off, results[finer, False], AFTER) if finer else None,
             "slack_sample_fraction_damped": slack_fraction(on),
             "slack_sample_fraction_undamped": slack_fraction(off),
             "max_error_damped_m": on.summary(AFTER)["max_position_error_m"],

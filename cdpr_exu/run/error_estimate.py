@@ -141,6 +141,19 @@ def platform_positions(result) -> np.ndarray:
     return np.asarray(result.pose)[:, :3]
 
 
+def path_distance(result, other, after: float = 0.0) -> float:
+    """Largest distance [m] of ``result``'s platform centre from ``other``'s from ``after`` [s] on.
+
+    Both runs sample at the output times, or up to a step after them where a step was
+    shrunk: ``other``'s path is interpolated onto ``result``'s sample times.
+    """
+    mask = result.time >= after - 1e-9
+    positions, other_positions = platform_positions(result), platform_positions(other)
+    path = np.column_stack([np.interp(result.time[mask], other.time, other_positions[:, k])
+                            for k in range(other_positions.shape[1])])
+    return float(np.linalg.norm(positions[mask] - path, axis=1).max())
+
+
 def _not_applicable(note: str) -> ErrorEstimate:
     return ErrorEstimate(None, None, ORDER, AFTER, note)
 
@@ -179,15 +192,9 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     except (SolverFailure, CdprError) as err:
         return _not_applicable(f"the companion run at {n_companion} elements did not complete: {str(err)[:200]}")
     wall = time.perf_counter() - start
-    # Both runs sample at the output times, or up to a step after them where a step was
-    # shrunk: the companion's path is interpolated onto this run's sample times.
-    times = result.time[mask]
-    if companion.time[-1] < times[-1] - 1e-9:
+    if companion.time[-1] < result.time[-1] - 1e-9:
         return _not_applicable("the companion run ended before this run")
-    positions, companion_positions = platform_positions(result), platform_positions(companion)
-    companion_path = np.column_stack([np.interp(times, companion.time, companion_positions[:, k])
-                                      for k in range(companion_positions.shape[1])])
-    difference = np.linalg.norm(positions[mask] - companion_path, axis=1).max()
+    difference = path_distance(result, companion, after)
     ratio = n_companion / n
     estimate = float(difference * richardson_factor(ratio))
     note = (f"Richardson from a companion run at {n_companion} elements per cable (this run: {n}), the error "
