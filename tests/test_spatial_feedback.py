@@ -43,9 +43,10 @@ OFFSET = 0.005
 
 
 class _Spy:
-    """Reads the pose; commands the initial lengths plus OFFSET at once (SmoothStart must blend it in)."""
+    """Reads the pose; commands the initial lengths plus ``offset`` at once (SmoothStart must blend it in)."""
 
     name, uses_pose, uses_tension = "spy", True, False
+    offset = OFFSET
 
     def reset(self, scene, initial):
         self.initial = np.asarray(initial, dtype=float)
@@ -53,7 +54,7 @@ class _Spy:
 
     def command(self, measurement):
         self.seen.append(measurement)
-        return WinchCommand(self.initial + OFFSET, np.zeros_like(self.initial))
+        return WinchCommand(self.initial + self.offset, np.zeros_like(self.initial))
 
 
 @pytest.fixture(scope="module")
@@ -223,18 +224,11 @@ def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_contr
     assert closed["min_element_tension_N"] > 0.0 and closed["status"] == "completed"
 
 
-class _TensionSpy:
+class _TensionSpy(_Spy):
     """Reads the cable tensions; holds the initial lengths."""
 
     name, uses_pose, uses_tension = "tension_spy", False, True
-
-    def reset(self, scene, initial):
-        self.initial = np.asarray(initial, dtype=float)
-        self.seen = []
-
-    def command(self, measurement):
-        self.seen.append(measurement)
-        return WinchCommand(self.initial, np.zeros_like(self.initial))
+    offset = 0.0
 
 
 def test_a_controller_that_uses_the_tensions_gets_tensions_that_hold_the_platform_at_rest():

@@ -351,6 +351,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         angular = (np.zeros(3) if items.is_point_mass else
                    np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.AngularVelocity)))
         return np.concatenate([position, rotation_vector(rotation)]), np.concatenate([velocity, angular])
+
     def measured_tensions() -> np.ndarray:
         """Each cable's tension at its platform end now, shape (m,) [N]: its last element's axial force as
         the model computes it (the Kelvin-Voigt law on the strain rate; tension-only where the scene says so),
