@@ -50,6 +50,18 @@ def run_dir(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.fixture(scope="module")
+def spatial_run_dir(tmp_path_factory) -> Path:
+    """A run folder of a small spatial scene over 0.3 s (31 samples), as `cdpr run --out` writes it."""
+    from conftest import small_spatial_scene
+
+    from cdpr_exu.run.spatial_run import run_spatial_scene
+
+    out = tmp_path_factory.mktemp("spatial") / "small_spatial"
+    run_spatial_scene(small_spatial_scene(END_TIME), out, quiet=True, figures=False)
+    return out
+
+
 def _env_without_display() -> dict[str, str]:
     env = {k: v for k, v in os.environ.items()
            if k not in ("DISPLAY", "WAYLAND_DISPLAY", "EXUDYN_SUPPRESS_UI_WINDOW_OPEN")}
@@ -186,6 +198,39 @@ def test_animation_inside_a_file_is_refused_naming_the_file(run_dir, tmp_path):
     with pytest.raises(viewer.CdprError, match="is a file, not a folder"):
         viewer.render_animation(run_dir, taken / "anim.gif")
     assert taken.read_text() == "keep me"
+
+
+@pytest.mark.parametrize("fps", ["0", "nan", "-5", "inf", "101"])
+@pytest.mark.parametrize("dimension", ["planar", "spatial"])
+def test_a_bad_fps_is_refused_naming_it_before_any_work_for_both_dimensions(run_dir, spatial_run_dir, tmp_path,
+                                                                             capsys, dimension, fps):
+    """Issue 23.12: on spatial runs --fps 0 and nan crashed with tracebacks, -5 after the whole
+    rendering (49 s on CoGiRo), inf wrote a GIF of zero frame times; 101 frames/s is more than
+    a GIF's hundredths of a second can store. One check, before anything is written, for both."""
+    folder = run_dir if dimension == "planar" else spatial_run_dir
+    out, frames = tmp_path / "a.gif", tmp_path / "frames"
+    code = main(["animate", str(folder), "--fps", fps, "--out", str(out), "--frames-dir", str(frames), "-q"])
+    assert code == 2
+    assert "--fps" in capsys.readouterr().err
+    assert not out.exists() and not frames.exists()
+
+
+def test_spatial_animation_writes_its_frames_into_frames_dir(spatial_run_dir, tmp_path):
+    """Issue 23.12: --frames-dir was ignored on spatial runs. The frames are the animation's, one per
+    chosen sample, of the asked size, none blank."""
+    out, frames_dir = tmp_path / "spatial.gif", tmp_path / "frames"
+    code = main(["animate", str(spatial_run_dir), "--out", str(out), "--every", "5", "--size", "160x120",
+                 "--fps", "10", "--frames-dir", str(frames_dir), "--quiet"])
+    assert code == 0
+    expected = len(range(0, EXPECTED_ROWS, 5))  # samples 0, 5, ..., 30
+    with Image.open(out) as gif:
+        assert gif.n_frames == expected and gif.size == (160, 120) and gif.info["duration"] == 100
+    names = sorted(p.name for p in frames_dir.iterdir())
+    assert names == [f"frame_{i:05d}.png" for i in range(expected)]
+    for name in names:
+        with Image.open(frames_dir / name) as frame:
+            assert frame.size == (160, 120)
+            assert np.asarray(frame.convert("L"), dtype=float).var() > 0.0, f"{name} is blank"
 
 
 # ============================================================================ helpers
