@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import re
 import sys
 import warnings
 from dataclasses import replace
@@ -19,7 +18,7 @@ from pathlib import Path
 
 from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
                      RunInterrupted, SceneError, SolverFailure)
-from cdpr_exu.core.output import check_output_folder, fixed, write_summary
+from cdpr_exu.core.output import check_output_folder, fixed, undate_solution_file, write_summary  # noqa: F401
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
@@ -171,21 +170,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     if failure is not None:
         raise failure
     return summary
-
-
-def undate_solution_file(path: Path) -> None:
-    """Blank the date in the header of Exudyn's solution file, so it is stable from run to run.
-
-    The binary header and footer hold the start and end times as ``YYYY-MM-DD,HH:MM:SS``;
-    they are overwritten in place with zeros of the same length (the file stays readable
-    by SolutionViewer).
-    """
-    data = bytearray(path.read_bytes())
-    pattern = re.compile(rb"\d{4}-\d{2}-\d{2},\d{2}:\d{2}:\d{2}")
-    for offset in (0, max(0, len(data) - 256)):
-        for match in pattern.finditer(bytes(data[offset:offset + 1024])):
-            data[offset + match.start():offset + match.end()] = b"0000-00-00,00:00:00"
-    path.write_bytes(bytes(data))
 
 
 def _elements_for(scene, tolerance: float, quiet: bool):

@@ -122,6 +122,76 @@ def test_missing_folder_and_files_are_named(run_dir, tmp_path):
     assert main(["animate", str(partial)]) == 2
 
 
+# ============================================================================ spatial runs (issue 23.8)
+
+
+def test_a_spatial_run_writes_scene_pose_csv_and_solution_file_as_every_run(spatial_run_dir):
+    """Issue 23.8: spatial runs wrote no scene.toml, pose.csv or solution.sol, which the README
+    promises for `cdpr run`. pose.csv holds time, pose and reference with units in the header,
+    the numbers of result.npz to its 9 significant digits."""
+    from conftest import small_spatial_scene
+
+    from cdpr_exu.scenes.spatial_scene import load_any_scene
+
+    for name in ("scene.toml", "result.npz", "pose.csv", "summary.json", "solution.sol"):
+        assert (spatial_run_dir / name).stat().st_size > 0, name
+    assert load_any_scene(spatial_run_dir / "scene.toml") == small_spatial_scene(END_TIME)
+    header = (spatial_run_dir / "pose.csv").read_text().splitlines()[0].split(",")
+    assert header == ["time_s", "x_m", "y_m", "z_m", "rotation_x_rad", "rotation_y_rad", "rotation_z_rad",
+                      "x_ref_m", "y_ref_m", "z_ref_m", "rotation_x_ref_rad", "rotation_y_ref_rad", "rotation_z_ref_rad"]
+    table = np.loadtxt(spatial_run_dir / "pose.csv", delimiter=",", skiprows=1)
+    with np.load(spatial_run_dir / "result.npz") as data:
+        np.testing.assert_allclose(table[:, 0], data["time"], rtol=1e-8, atol=1e-12)
+        np.testing.assert_allclose(table[:, 1:7], data["pose"], rtol=1e-8, atol=1e-12)
+        np.testing.assert_allclose(table[:, 7:], data["reference"], rtol=1e-8, atol=1e-12)
+
+
+def test_a_spatial_solution_file_replays_in_the_rebuilt_robot_at_the_recorded_poses(spatial_run_dir):
+    """The solution file fits the robot rebuilt from scene.toml (as SolutionViewer needs), row for
+    row at the result's times, and each row puts the platform where result.npz recorded it: both are
+    the solver's state at the same step ends (31 unshrunk steps), so they agree to round-off."""
+    replay = viewer.load_replay(spatial_run_dir)
+    assert isinstance(replay, viewer.SpatialReplay) and replay.n_rows == EXPECTED_ROWS
+    with np.load(spatial_run_dir / "result.npz") as data:
+        np.testing.assert_allclose(replay.times, data["time"], atol=1e-9)
+        np.testing.assert_allclose(replay.platform_pose(), data["pose"], atol=1e-9)
+
+
+def test_the_rebuilt_spatial_robot_draws_in_the_views_camera(spatial_run_dir):
+    """What `cdpr view` shows of a spatial run, drawn headless by Exudyn's raytracer at the view's
+    settings: the last row's cables and nodes on a white background (not a blank frame)."""
+    import exudyn as exu
+    from exudyn.utilities import SetSolutionState
+
+    replay = viewer.load_replay(spatial_run_dir)
+    viewer._style_spatial(replay, size=(160, 120))
+    for configuration in (exu.ConfigurationType.Current, exu.ConfigurationType.Visualization):
+        SetSolutionState(replay.mbs, replay.solution, replay.n_rows - 1, configuration)
+    image = np.asarray(replay.mbs.GetSystemContainer().renderer.RedrawAndGetImage(useRaytracer=True))[:, :, :3]
+    assert image.shape[:2] == (120, 160)
+    drawn = (image < 200).any(axis=2).mean()  # share of pixels that are not background
+    assert 0.001 < drawn < 0.5, drawn
+
+
+def test_a_rerun_from_the_written_spatial_scene_writes_the_same_result(spatial_run_dir, tmp_path):
+    """scene.toml is the scene as run: `cdpr run` on it writes the same result, pose table and
+    (date blanked) solution file byte for byte."""
+    out = tmp_path / "rerun"
+    assert main(["run", str(spatial_run_dir / "scene.toml"), "--out", str(out), "--no-figures",
+                 "--no-error-estimate", "-q"]) == 0
+    for name in ("result.npz", "pose.csv", "solution.sol", "scene.toml"):
+        assert (out / name).read_bytes() == (spatial_run_dir / name).read_bytes(), name
+
+
+def test_view_of_a_spatial_run_without_display_exits_1_with_a_hint(spatial_run_dir):
+    """Issue 23.8: `cdpr view` on a spatial run said the folder lacks the scene.toml that `cdpr run`
+    writes. It now finds the run and refuses only for the missing display, as on planar runs."""
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "view", str(spatial_run_dir)],
+                          env=_env_without_display(), capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1, done.stderr
+    assert "no display" in done.stderr and "cdpr animate" in done.stderr and "not found" not in done.stderr
+
+
 # ============================================================================ view
 
 

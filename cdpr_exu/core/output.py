@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import zipfile
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -106,6 +107,48 @@ def write_npz(path: str | Path, **arrays: Any) -> Path:
             with archive.open(info, "w") as member:
                 np.lib.format.write_array(member, np.asanyarray(value), allow_pickle=False)
     return path
+
+
+#: Pose columns of a planar run's ``pose.csv`` (after ``time_s``; the reference's follow, ``x_ref_m``, ...).
+PLANAR_POSE_COLUMNS: tuple[str, ...] = ("x_m", "z_m", "rotation_rad")
+#: Pose columns of a spatial run's ``pose.csv``: the centre of mass and the rotation vector.
+SPATIAL_POSE_COLUMNS: tuple[str, ...] = ("x_m", "y_m", "z_m", "rotation_x_rad", "rotation_y_rad", "rotation_z_rad")
+
+
+def write_pose_csv(path: str | Path, time: Any, pose: Any, reference: Any, columns: Sequence[str]) -> Path:
+    """Write a run's platform path as CSV: time, the pose, the reference pose, units in the header.
+
+    Parameters
+    ----------
+    path : path
+    time : array_like, shape (N,) [s]
+    pose, reference : array_like, shape (N, len(columns))
+    columns : names of the pose columns with their unit last (:data:`PLANAR_POSE_COLUMNS`,
+        :data:`SPATIAL_POSE_COLUMNS`); the reference's are the same with ``_ref`` before the unit.
+    """
+    path = Path(path)
+    references = [f"{name.rsplit('_', 1)[0]}_ref_{name.rsplit('_', 1)[1]}" for name in columns]
+    header = ",".join(["time_s", *columns, *references])
+    table = np.column_stack([np.asarray(time, dtype=float), np.asarray(pose, dtype=float),
+                             np.asarray(reference, dtype=float)])
+    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.9g")
+    return path
+
+
+def undate_solution_file(path: str | Path) -> None:
+    """Blank the date in the header of Exudyn's solution file, so it is stable from run to run.
+
+    The binary header and footer hold the start and end times as ``YYYY-MM-DD,HH:MM:SS``;
+    they are overwritten in place with zeros of the same length (the file stays readable
+    by SolutionViewer).
+    """
+    path = Path(path)
+    data = bytearray(path.read_bytes())
+    pattern = re.compile(rb"\d{4}-\d{2}-\d{2},\d{2}:\d{2}:\d{2}")
+    for offset in (0, max(0, len(data) - 256)):
+        for match in pattern.finditer(bytes(data[offset:offset + 1024])):
+            data[offset + match.start():offset + match.end()] = b"0000-00-00,00:00:00"
+    path.write_bytes(bytes(data))
 
 
 def check_output_folder(path: str | Path | None, option: str = "--out") -> Path | None:

@@ -1,9 +1,10 @@
 """Replay a finished run: Exudyn's SolutionViewer, or a headless GIF/MP4 animation.
 
 A run folder written by ``cdpr run SCENE --out DIR`` holds ``scene.toml`` and
-``solution.sol`` (Exudyn's binary solution file). The scene rebuilds the identical
-Exudyn system (:func:`cdpr_exu.builder.model.build_model`); each row of the solution file
-is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
+``solution.sol`` (Exudyn's binary solution file), for planar and spatial scenes alike. The
+scene rebuilds the identical Exudyn system (:func:`cdpr_exu.builder.model.build_model`, or
+for a spatial scene :func:`cdpr_exu.run.spatial_run.build_spatial_model`); each row of the
+solution file is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
 
 - :func:`view_solution` (``cdpr view DIR``) replays the run in Exudyn's interactive
   ``SolutionViewer``: it needs a display. Without one it raises
@@ -11,7 +12,9 @@ is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
   whole process there).
 - :func:`render_animation` (``cdpr animate DIR``) draws each chosen row with Exudyn's
   software raytracer (no window, no OpenGL) and writes a GIF (Pillow) or an MP4
-  (the optional package ``imageio-ffmpeg``), and optionally the PNG frames.
+  (the optional package ``imageio-ffmpeg``), and optionally the PNG frames; a spatial
+  run is drawn from its ``result.npz`` with matplotlib's 3-D axes
+  (:mod:`cdpr_exu.post.spatial_animation`).
 
 Both add drawing-only items before replaying (:func:`decorate_model`): the pulleys
 as discs, the platform as its rectangle (``platform.size``) and the reference path
@@ -178,17 +181,18 @@ def load_solution(path: str | Path) -> dict:
     return solution
 
 
-def check_solution_fits(model: Model, solution: dict, source: str = "the solution") -> None:
+def check_solution_fits(model, solution: dict, source: str = "the solution") -> None:
     """Refuse a solution whose coordinate layout differs from the model's.
 
     Compares the exported sizes (positions, velocities, accelerations, ODE1,
-    algebraic and data coordinates) with the model's system sizes.
+    algebraic and data coordinates) with the system sizes of ``model`` (a :class:`Model`
+    or an Exudyn ``MainSystem``).
 
     Raises
     ------
     SolutionMismatchError
     """
-    data = model.mbs.systemData
+    data = getattr(model, "mbs", model).systemData
     n_ode2, n_vel2, n_acc2, n_ode1, n_vel1, n_algebraic, n_data = (int(n) for n in solution["columnsExported"])
     expected = {"ODE2 coordinates": (n_ode2, data.ODE2Size()), "ODE1 coordinates": (n_ode1, data.ODE1Size()),
                 "algebraic coordinates": (n_algebraic, data.AEsize()), "data coordinates": (n_data, data.DataSize())}
@@ -204,7 +208,46 @@ def check_solution_fits(model: Model, solution: dict, source: str = "the solutio
             "edited, or the package changed, after the run? Run the scene again with `cdpr run`")
 
 
-def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
+@dataclass
+class SpatialReplay:
+    """A spatial run folder loaded for replay: its scene, the rebuilt robot and the solution.
+
+    Attributes
+    ----------
+    run_dir : Path
+    scene : SpatialScene
+    mbs : exudyn.MainSystem
+        Rebuilt from ``scene.toml`` (:func:`cdpr_exu.run.spatial_run.build_spatial_model`).
+    items : SpatialRobotItems
+    solution : dict
+        As for :class:`Replay`.
+    """
+
+    run_dir: Path
+    scene: object
+    mbs: object
+    items: object
+    solution: dict
+
+    n_rows = Replay.n_rows
+    times = Replay.times
+
+    def platform_pose(self) -> np.ndarray:
+        """The platform's pose in each row: centre of mass [m] and rotation vector [rad], shape (n_rows, 6)."""
+        from exudyn.utilities import SetSolutionState
+
+        from cdpr_exu.builder.spatial_robot import platform_pose
+        from cdpr_exu.core.geometry import rotation_vector
+
+        poses = []
+        for row in range(self.n_rows):
+            SetSolutionState(self.mbs, self.solution, row, exu.ConfigurationType.Current)
+            position, rotation = platform_pose(self.mbs, self.items)
+            poses.append(np.concatenate([position, rotation_vector(rotation)]))
+        return np.asarray(poses)
+
+
+def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | SpatialReplay:
     """Load a run folder: scene, rebuilt (and decorated) model, solution file.
 
     Parameters
@@ -212,15 +255,28 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
     run_dir : path
         Folder written by ``cdpr run SCENE --out DIR``.
     decorate : bool
-        Add pulleys, platform rectangle and reference path (:func:`decorate_model`).
+        Add pulleys, platform rectangle and reference path (:func:`decorate_model`; planar runs).
+
+    Returns
+    -------
+    Replay or SpatialReplay
+        By the dimension of the folder's scene.
 
     Raises
     ------
     RunFolderError, SolutionMismatchError, SceneError
     """
+    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+
     scene_file, solution_file = run_files(run_dir)
-    scene = load_scene(scene_file)
+    scene = load_any_scene(scene_file)
     solution = load_solution(solution_file)
+    if is_spatial(scene):
+        from cdpr_exu.run.spatial_run import build_spatial_model
+
+        mbs, items = build_spatial_model(scene)
+        check_solution_fits(mbs, solution, f"solution file {str(solution_file)!r}")
+        return SpatialReplay(Path(run_dir), scene, mbs, items, solution)
     model = build_model(scene)
     check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
     if decorate:
@@ -357,6 +413,32 @@ def _style(model: Model) -> None:
     settings.general.autoFitScene = False
 
 
+def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768)) -> None:
+    """Visualization settings of a spatial replay: small nodes, no load arrows or markers, and a view
+    from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
+    from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
+
+    settings = replay.mbs.GetSystemContainer().visualizationSettings
+    points = np.vstack([np.asarray(replay.scene.exits, dtype=float), replay.platform_pose()[:, :3]])
+    low, high = points.min(axis=0), points.max(axis=0)
+    extent = float((high - low).max()) or 1.0
+    settings.loads.show = False
+    settings.markers.show = False
+    settings.connectors.springNumberOfWindings = 1
+    settings.nodes.drawNodesAsPoint = False
+    settings.nodes.defaultSize = 0.006 * extent
+    settings.nodes.defaultColor = NODE_COLOR
+    settings.nodes.tiling = 8
+    settings.general.autoFitScene = False
+    settings.view0.window.renderWindowSize = [int(size[0]), int(size[1])]
+    advanced = settings.openGL.advanced
+    advanced.initialCenterPoint = [float(x) for x in (low + high) / 2.0]
+    advanced.initialZoom = 0.7 * extent
+    advanced.initialMaxSceneSize = 4.0 * extent
+    # Exudyn takes the transpose of the view's rotation: this one shows z up, x to the right, seen from -y.
+    advanced.initialModelRotation = (RotationMatrixX(-0.5 * np.pi) @ RotationMatrixZ(-0.15 * np.pi)).T.tolist()
+
+
 # --------------------------------------------------------------------------- camera
 
 
@@ -488,7 +570,7 @@ def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
     Parameters
     ----------
     run_dir : path
-        Folder written by ``cdpr run SCENE --out DIR``.
+        Folder written by ``cdpr run SCENE --out DIR`` (planar or spatial scene).
     every : int, optional
         Show every ``every``-th stored row; default: about real time at 25 frames/s.
 
@@ -512,12 +594,17 @@ def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
     from exudyn.interactive import SolutionViewer
 
     replay = load_replay(run_dir)
-    _style(replay.model)
-    camera = fit_camera(_view_points(replay), (1024, 768), caption_band=0.12)
-    camera.apply(replay.model)
+    if isinstance(replay, SpatialReplay):  # a 3-D robot: Exudyn's own view, fitted to the scene
+        mbs = replay.mbs
+        _style_spatial(replay)
+    else:
+        mbs = replay.model.mbs
+        _style(replay.model)
+        camera = fit_camera(_view_points(replay), (1024, 768), caption_band=0.12)
+        camera.apply(replay.model)
     if every is None:
         every = _rows_per_frame(replay.times, DEFAULT_FPS)
-    SolutionViewer(replay.model.mbs, replay.solution, rowIncrement=min(int(every), replay.n_rows),
+    SolutionViewer(mbs, replay.solution, rowIncrement=min(int(every), replay.n_rows),
                    timeout=1.0 / DEFAULT_FPS, runOnStart=True, runMode=0,
                    title=f"cdpr view: {replay.scene.name} ({replay.run_dir})")
 

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from cdpr_exu.core.output import json_text, write_npz, write_summary
+from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, json_text, write_npz, write_pose_csv, write_summary
 
 
 @dataclass
@@ -179,9 +179,7 @@ class Result:
         # The wall time lives in timing.json, so that result.npz is the same from run to run.
         info.pop("wall_time")
         write_npz(folder / "result.npz", info=np.array(json_text(info)), **arrays)
-        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
-        table = np.column_stack([self.time, self.platform_pose, self.reference_pose])
-        np.savetxt(folder / "pose.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+        write_pose_csv(folder / "pose.csv", self.time, self.platform_pose, self.reference_pose, PLANAR_POSE_COLUMNS)
         summary = {**self.summary(after=summary_after), **provenance()}
         summary.update({k: v for k, v in self.metadata.items() if k not in summary})
         write_summary(folder, summary)

@@ -42,7 +42,7 @@ from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import write_npz, write_summary
+from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, undate_solution_file, write_npz, write_pose_csv, write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
@@ -57,7 +57,7 @@ from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
 
-__all__ = ["SpatialResult", "simulate_spatial", "check_spatial_reference", "run_spatial_scene"]
+__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference", "run_spatial_scene"]
 
 
 #: Samples of the reference checked before a run.
@@ -212,14 +212,16 @@ class SpatialResult:
 
     def save(self, folder: str | Path, after: float = 1.0, figures: bool = True,
              extra: dict | None = None) -> list[Path]:
-        """Write result.npz, summary.json (with ``extra``'s entries) and (``figures``) overview.png into
-        ``folder``; returns the paths."""
+        """Write result.npz, pose.csv (time, pose and reference: x, y, z [m] and the rotation vector [rad]),
+        summary.json (with ``extra``'s entries) and (``figures``) overview.png into ``folder``; returns the
+        paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = nodes, tensions
         written = [write_npz(folder / "result.npz", **arrays),
+                   write_pose_csv(folder / "pose.csv", self.time, self.pose, self.reference, SPATIAL_POSE_COLUMNS),
                    write_summary(folder, {**self.summary(after), **provenance(), **(extra or {})})]
         if figures:
             written.append(plot_spatial_run(self, folder / "overview.png", after))
@@ -299,7 +301,43 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
         return
 
 
-def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False) -> SpatialResult:
+def check_runnable(scene: SpatialScene) -> None:
+    """Refuse a scene ``cdpr run`` cannot run, before anything is built or written: no ``[trajectory]``,
+    or a reference the cables cannot follow (:func:`check_spatial_reference`).
+
+    Raises
+    ------
+    SceneError, UnreachableError
+    """
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
+    check_spatial_reference(scene)
+
+
+def build_spatial_model(scene: SpatialScene):
+    """The scene's lumped robot in a new Exudyn system, assembled in its catenary start; returns (mbs, items).
+
+    What :func:`simulate_spatial` integrates and what a replay of its solution file
+    (:func:`cdpr_exu.post.viewer.load_replay`) rebuilds: the same items in the same order, so the
+    same coordinates. The start over swivel pulleys (:func:`start_at_rest`) moves only the
+    initial coordinates, which a replay takes from the solution file.
+
+    Raises
+    ------
+    UnreachableError
+        If no static equilibrium of the scene's lengths exists to start from.
+    """
+    platform = scene.catenary_platform()
+    lengths = scene.unstrained_lengths
+    start = solve_spatial_statics(platform, lengths)
+    mbs = exu.SystemContainer().AddSystem()
+    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start, swivels=scene.swivel_exits)
+    mbs.Assemble()
+    return mbs, items
+
+
+def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False, *,
+                     solution_file: str | Path | None = None) -> SpatialResult:
     """Run ``scene``'s reference under ``controller`` (default: ideal inverse kinematics).
 
     The controller is any :class:`controllers.base.Controller` that works on spatial
@@ -315,6 +353,9 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     cable's tension at its platform end (its last element's axial force, shape (m,) [N],
     as planar runs give it) at the same state.
 
+    ``solution_file`` also writes Exudyn's solution file there (every output period), for
+    ``SolutionViewer`` on the model :func:`build_spatial_model` rebuilds.
+
     Raises
     ------
     SceneError
@@ -324,15 +365,9 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     SolverFailure
         If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed.
     """
-    if scene.trajectory is None:
-        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
-    check_spatial_reference(scene)
-    platform = scene.catenary_platform()
+    check_runnable(scene)
+    mbs, items = build_spatial_model(scene)
     lengths = scene.unstrained_lengths
-    start = solve_spatial_statics(platform, lengths)
-    mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start, swivels=scene.swivel_exits)
-    mbs.Assemble()
     if scene.swivels:
         _warn_outside_measured_region(scene)
         start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
@@ -425,7 +460,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     wall_start = _time.perf_counter()
     with interrupt_flag() as interrupted, quiet_exudyn():
         try:
-            mbs.SolveDynamic(solver_settings(scene))
+            mbs.SolveDynamic(solver_settings(scene, solution_file))
         except (exu.SolverError, RuntimeError, SystemError) as err:
             state["failure"] = " ".join(str(err).split())
     wall = _time.perf_counter() - wall_start
@@ -498,20 +533,36 @@ def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0
 
 def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
                       after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
-    """``cdpr run`` on a spatial scene: run, write (``out``: scene.toml-free result folder), print a summary.
+    """``cdpr run`` on a spatial scene: run, write into ``out``, print a summary.
 
-    On a solver failure the partial result is written before the error propagates. With
-    ``error_estimate`` a companion run estimates the discretisation error
-    (:mod:`cdpr_exu.run.error_estimate`): ``error_estimate`` in summary.json and a printed line.
+    Writes what ``cdpr run`` writes for every scene: ``scene.toml`` (the scene as run: a
+    rerun from it gives the same result), ``result.npz``, ``pose.csv``, ``summary.json``
+    (wall-clock figures in ``timing.json``), ``solution.sol`` (Exudyn's solution file, its
+    date blanked, for ``cdpr view``) and (``figures``) ``overview.png``. The scene and its
+    reference are checked before anything is written. On a solver failure or Ctrl-C the
+    partial result is written before the error propagates. With ``error_estimate`` a
+    companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`):
+    ``error_estimate`` in summary.json and a printed line.
     """
     from cdpr_exu.run.error_estimate import estimate_error, estimate_line, summary_entry
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    check_runnable(scene)  # before scene.toml is in the folder
+    solution_file = None
+    if out is not None:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        save_any_scene(scene, out / "scene.toml")
+        solution_file = out / "solution.sol"
 
     def write(result: SpatialResult, extra: dict | None = None) -> None:
         if out is not None:
             result.save(out, after, figures, extra)
+            if solution_file.is_file():
+                undate_solution_file(solution_file)
 
     try:
-        result = simulate_spatial(scene, progress=not quiet)
+        result = simulate_spatial(scene, progress=not quiet, solution_file=solution_file)
     except (SolverFailure, RunInterrupted) as err:  # keep what was computed
         if err.partial_result is not None:
             write(err.partial_result)

@@ -175,7 +175,7 @@ def markdown_table(summaries: dict[str, dict]) -> str:
 
 
 def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    from cdpr_exu.core.output import write_summary
+    from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, write_pose_csv, write_summary
     from cdpr_exu.post.plots import plot_comparison
     from cdpr_exu.scenes.scene import save_scene
 
@@ -187,9 +187,8 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
     (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
                                        + markdown_table(summaries))
     for name, result in results.items():
-        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
-        table = np.column_stack([result.time, result.platform_pose, result.reference_pose])
-        np.savetxt(out / f"pose_{name}.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+        write_pose_csv(out / f"pose_{name}.csv", result.time, result.platform_pose, result.reference_pose,
+                       PLANAR_POSE_COLUMNS)
     if results:
         plot_comparison(scene, results, out)
 
