@@ -18,7 +18,8 @@ from pathlib import Path
 
 from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
                      RunInterrupted, SceneError, SolverFailure)
-from cdpr_exu.core.output import check_output_folder, fixed, undate_solution_file, write_summary  # noqa: F401
+from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, undate_solution_file,  # noqa: F401
+                                  write_summary)
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
@@ -105,7 +106,9 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     """Run ``scene`` and write its files into ``out``; returns the summary.
 
     Writes ``scene.toml``, ``result.npz``, ``pose.csv``, ``summary.json``,
-    ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures.
+    ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures,
+    after removing the files of an earlier run there (:func:`cdpr_exu.core.output.clear_outputs`;
+    a folder of another command's output is refused).
     A failed or interrupted (Ctrl-C) run still writes what was computed up to then,
     then re-raises. ``out`` and the reference (:func:`cdpr_exu.statics.workspace.check_reference`)
     are checked before anything is written. With ``error_estimate``
@@ -120,7 +123,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     check_reference(scene)
     solution_file = None
     if out is not None:
-        out = check_output_folder(out)
+        out = check_output_folder(out, command="run")
+        clear_outputs(out, "run")  # none of the run this one replaces stays beside it
         save_scene(scene, out / "scene.toml")
         solution_file = out / "solution.sol"
     failure = None
@@ -191,7 +195,7 @@ def _elements_for(scene, tolerance: float, quiet: bool):
 def _cmd_run(args: argparse.Namespace) -> int:
     from cdpr_exu.run.error_estimate import parse_length
 
-    out = check_output_folder(args.out)
+    out = check_output_folder(args.out, command="run")
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 

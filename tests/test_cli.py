@@ -254,20 +254,27 @@ def test_sweep_csv_leaves_not_applicable_cells_empty_and_its_json_is_strict(tmp_
 @pytest.mark.slow
 def test_the_readme_command_writes_the_committed_result_folder_byte_for_byte(tmp_path):
     """Issue 11.12, as the README promises: `cdpr run paper-circle --out results/paper_circle`
-    leaves `git status` clean. The same command into a fresh folder writes every tracked file
-    of results/paper_circle byte for byte (timing.json is untracked; variants.* come from
-    examples/paper_reproduction.py). Fails when the code moved the answer and the committed
-    results were not regenerated."""
+    leaves `git status` clean. The same command into a copy of the committed folder (which
+    also holds variants.* of examples/paper_reproduction.py, and a stale timing.json) rewrites
+    every tracked file byte for byte, removes none and adds only the untracked timing.json
+    (issue 23.15: a run clears only the files a run writes). Fails when the code moved the
+    answer and the committed results were not regenerated."""
+    import shutil
     from pathlib import Path
 
     committed = Path(__file__).resolve().parents[1] / "results" / "paper_circle"
+    tracked = sorted(p.name for p in committed.iterdir() if p.name != "timing.json")
     out = tmp_path / "paper_circle"
+    shutil.copytree(committed, out)
+    (out / "timing.json").write_text('{"wall_time_s": 1e9}\n')
     _cdpr("run", "paper-circle", "--out", str(out), "-q")
     written = sorted(p.name for p in out.iterdir() if p.name != "timing.json")
-    assert {"summary.json", "result.npz", "solution.sol", "pose.csv", "scene.toml", "overview.png"} <= set(written)
-    changed = [name for name in written
-               if not (committed / name).is_file() or (committed / name).read_bytes() != (out / name).read_bytes()]
+    assert written == tracked
+    assert {"summary.json", "result.npz", "solution.sol", "pose.csv", "scene.toml", "overview.png",
+            "variants.md"} <= set(written)
+    changed = [name for name in written if (committed / name).read_bytes() != (out / name).read_bytes()]
     assert changed == [], f"regenerate results/paper_circle: {changed} differ from what the code writes"
+    assert json.loads((out / "timing.json").read_text())["wall_time_s"] < 1e9  # this run's, not the stale one
 
 
 def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, monkeypatch):

@@ -327,3 +327,31 @@ def test_parse_size_refuses_bad_sizes(text):
     with pytest.raises(ValueError, match="size"):
         viewer.parse_size(text)
 
+
+
+# ============================================================================ a folder of an earlier run (issue 23.15)
+
+
+def test_a_spatial_run_into_a_planar_runs_folder_leaves_none_of_the_planar_runs_files(run_dir, spatial_run_dir,
+                                                                                      tmp_path):
+    """Issue 23.15: a spatial run into a planar run's folder kept that run's scene.toml,
+    solution.sol and figures, and `cdpr view` replayed the old run. Now the folder holds the
+    new run's files only, plus what no run writes (a user's notes)."""
+    folder = tmp_path / "reused"
+    shutil.copytree(run_dir, folder)
+    (folder / "snapshots.png").write_bytes(b"a planar figure the spatial run does not draw")
+    (folder / "notes.txt").write_text("mine")
+    assert main(["run", str(spatial_run_dir / "scene.toml"), "--out", str(folder), "--no-figures",
+                 "--no-error-estimate", "-q"]) == 0
+    assert sorted(p.name for p in folder.iterdir()) == sorted([p.name for p in spatial_run_dir.iterdir()] + ["notes.txt"])
+    assert (folder / "notes.txt").read_text() == "mine"
+    assert isinstance(viewer.load_replay(folder), viewer.SpatialReplay)  # `cdpr view` replays the new run
+
+
+def test_a_comparison_into_a_run_folder_is_refused_before_any_work(run_dir, tmp_path, capsys):
+    folder = tmp_path / "run"
+    shutil.copytree(run_dir, folder)
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    assert main(["compare", "paper-circle", "--controllers", "ideal_ik", "--out", str(folder), "-q"]) == 2
+    assert "holds the output of `cdpr run`" in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before

@@ -151,13 +151,47 @@ def undate_solution_file(path: str | Path) -> None:
     path.write_bytes(bytes(data))
 
 
-def check_output_folder(path: str | Path | None, option: str = "--out") -> Path | None:
+#: What each command writes into its output folder: file names and ``glob`` patterns. Before it
+#: writes, a command removes these (:func:`clear_outputs`), so that no file of the run it replaces
+#: stays beside its own (a spatial run into a planar run's folder kept that run's scene.toml,
+#: solution.sol and figures, and `cdpr view` replayed the old run); every other file is left alone
+#: (results/paper_circle/variants.* of examples/paper_reproduction.py, a user's notes).
+COMMAND_OUTPUTS: dict[str, tuple[str, ...]] = {
+    "run": ("scene.toml", "result.npz", "pose.csv", "summary.json", "timing.json", "solution.sol",
+            "overview.png", "snapshots.png", "path.png", "rotation.png", "errors.png", "tensions.png",
+            "animation.gif", "animation.mp4"),  # `cdpr animate`'s default files show the run they were made of
+    "compare": ("scene.toml", "summary.json", "timing.json", "comparison.md", "pose_*.csv",
+                "comparison_paths.png", "comparison_errors.png", "overview_*.png"),
+    "static": ("scene.toml", "summary.json", "timing.json", "rest.npz", "rest_profile.png"),
+    "study sweep": ("base_scene.toml", "study.csv", "study.json", "timing.json", "vs_*.png", "heatmap.png"),
+    "study accuracy": ("base_scene.toml", "accuracy.csv", "accuracy.json", "timing.json", "tables.md", "pareto.png",
+                       "reference.npz"),
+    "animate --frames-dir": ("frame_*.png",),
+}
+#: Files that only one command writes: a folder holding one of them holds that command's output.
+COMMAND_MARKERS: dict[str, tuple[str, ...]] = {
+    "run": ("result.npz", "solution.sol"),
+    "compare": ("comparison.md",),
+    "static": ("rest.npz", "rest_profile.png"),
+    "study sweep": ("study.json", "study.csv"),
+    "study accuracy": ("accuracy.json", "accuracy.csv"),
+}
+
+
+def check_output_folder(path: str | Path | None, option: str = "--out", command: str | None = None) -> Path | None:
     """Make sure ``path`` can be the output folder, before any work starts; create it.
+
+    With ``command`` (a key of :data:`COMMAND_OUTPUTS`), a folder that holds another
+    command's output (one of its :data:`COMMAND_MARKERS`) is refused: the two commands'
+    files would lie side by side, and what reads the folder (``cdpr view``, a reader of
+    summary.json) would mix them. A folder of the same command's earlier output is
+    accepted; the command clears those files before it writes (:func:`clear_outputs`).
 
     Raises
     ------
     OutputError
-        If ``path`` (or one of its parents) is an existing file, or cannot be created.
+        If ``path`` (or one of its parents) is an existing file, cannot be created, or holds
+        another command's output.
     """
     if path is None:
         return None
@@ -167,8 +201,33 @@ def check_output_folder(path: str | Path | None, option: str = "--out") -> Path 
     for parent in path.parents:
         if parent.exists() and not parent.is_dir():
             raise OutputError(f"{option} {path}: {parent} is a file, so no folder can be made inside it")
+    if command is not None and path.is_dir():
+        for other, markers in COMMAND_MARKERS.items():
+            found = [name for name in markers if (path / name).is_file()]
+            if other != command and found:
+                raise OutputError(f"{option} {path}: holds the output of `cdpr {other}` ({', '.join(found)}); "
+                                  f"`cdpr {command}` there would leave the two side by side. Give another folder, "
+                                  "or remove that output first")
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise OutputError(f"{option} {path}: cannot create the folder ({err.strerror or err})") from err
     return path
+
+
+def clear_outputs(folder: str | Path, command: str) -> list[Path]:
+    """Remove the files ``command`` writes (:data:`COMMAND_OUTPUTS`) from ``folder``; returns them.
+
+    Called by each command just before it writes its first file, so that a new run leaves
+    none of the run it replaces (a figure that the new run does not draw, a
+    ``pose_<controller>.csv`` of a controller it did not run). Other files, and folders,
+    are left alone.
+    """
+    folder = Path(folder)
+    removed = []
+    for pattern in COMMAND_OUTPUTS[command]:
+        for path in sorted(folder.glob(pattern)):
+            if path.is_file():
+                path.unlink()
+                removed.append(path)
+    return removed

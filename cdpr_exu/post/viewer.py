@@ -901,6 +901,10 @@ def _render_animation(run_dir, out_file, *, fps, every, size, frames_dir, progre
         source = _PlanarFrames(request.run_dir, request.size, multi_sampling)
     step = request.every if request.every is not None else _rows_per_frame(source.times, request.fps)
     rows = range(0, len(source.times), step)
+    if request.frames_dir is not None:
+        from cdpr_exu.core.output import clear_outputs
+
+        clear_outputs(request.frames_dir, "animate --frames-dir")  # no frame of a longer, older animation stays
 
     start = _time.perf_counter()
     writer = _Writer(request.out_file, request.fps, request.size)

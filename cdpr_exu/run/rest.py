@@ -75,7 +75,7 @@ from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
-from cdpr_exu.core.output import write_npz, write_summary
+from cdpr_exu.core.output import clear_outputs, write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import static_settings
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import Scene
@@ -690,6 +690,7 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
     """Write what a failed ``cdpr static`` knows: the scene, the cause and the last state."""
     from cdpr_exu.scenes.scene import save_scene
 
+    clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
     save_scene(scene, out / "scene.toml")
     partial = err.partial_result if isinstance(err.partial_result, dict) else {}
     write_summary(out, {"scene": scene.name, "status": f"failed: {err}", "failure_time_s": err.time,
@@ -702,6 +703,7 @@ def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
 
     rest = solve_spatial_rest(scene)
     if out is not None:
+        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         rest.save(out)
     if not quiet:
         print_spatial_rest(rest, out)
@@ -711,7 +713,7 @@ def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
 def _cmd_static(args: argparse.Namespace) -> int:
     from cdpr_exu.core.output import check_output_folder, fixed
 
-    out = check_output_folder(args.out)
+    out = check_output_folder(args.out, command="static")
     scene = load_any_scene(args.scene)
     if is_spatial(scene):
         return _static_spatial(scene, out, args.quiet)
@@ -723,6 +725,7 @@ def _cmd_static(args: argparse.Namespace) -> int:
             print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
         raise
     if out is not None:
+        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         rest.save(out)
         plot_rest(scene, rest, out / "rest_profile.png")
     if not args.quiet:

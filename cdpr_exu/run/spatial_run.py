@@ -42,7 +42,8 @@ from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, undate_solution_file, write_npz, write_pose_csv, write_summary
+from cdpr_exu.core.output import (SPATIAL_POSE_COLUMNS, check_output_folder, clear_outputs, undate_solution_file,
+                                  write_npz, write_pose_csv, write_summary)
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
@@ -550,8 +551,8 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
     check_runnable(scene)  # before scene.toml is in the folder
     solution_file = None
     if out is not None:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        out = check_output_folder(out, command="run")
+        clear_outputs(out, "run")  # none of the run this one replaces stays beside it (a planar one's figures)
         save_any_scene(scene, out / "scene.toml")
         solution_file = out / "solution.sol"
 
@@ -656,6 +657,8 @@ def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: st
     unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
     if unknown:
         raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
+    if out is not None:  # an earlier comparison's files go before the first of this one is written
+        clear_outputs(check_output_folder(out, command="compare"), "compare")
     summaries = {}
     for name in names:
         try:

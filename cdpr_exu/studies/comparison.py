@@ -175,11 +175,11 @@ def markdown_table(summaries: dict[str, dict]) -> str:
 
 
 def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, write_pose_csv, write_summary
+    from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, check_output_folder, clear_outputs, write_pose_csv, write_summary
     from cdpr_exu.post.plots import plot_comparison
     from cdpr_exu.scenes.scene import save_scene
 
-    out.mkdir(parents=True, exist_ok=True)
+    clear_outputs(check_output_folder(out, command="compare"), "compare")  # no file of an earlier comparison stays
     save_scene(scene, out / "scene.toml")
     document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
                 "controllers": summaries, **provenance()}
@@ -223,7 +223,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from cdpr_exu.core.output import check_output_folder
     from cdpr_exu.statics.workspace import check_reference
 
-    check_output_folder(args.out)
+    check_output_folder(args.out, command="compare")
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
     scene = load_any_scene(args.scene)

@@ -610,12 +610,12 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
                 variations: Sequence[Variation], *, mode: str = "grid", after: float = 1.0,
                 plots: bool = True) -> dict[str, Path]:
     """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
-    from cdpr_exu.core.output import write_summary
+    from cdpr_exu.core.output import check_output_folder, clear_outputs, write_summary
     from cdpr_exu.results.result import provenance
     from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_output_folder(out, command="study sweep")
+    clear_outputs(out, "study sweep")  # no figure of an earlier study's parameters stays
     paths = {"scene": save_scene(base_scene, out / STUDY_FILES["scene"])}
     columns = study_columns(rows, variations)
     with open(out / STUDY_FILES["csv"], "w", newline="") as handle:
@@ -850,7 +850,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         print("cdpr study: --workers is ignored with a remote --scheduler (its workers run the study)",
               file=sys.stderr)
     variations = _as_variations(args.param)
-    out = check_output_folder(args.out)
+    out = check_output_folder(args.out, command="study sweep")
     rows = run_study(scene, variations, out=out, progress=not args.quiet, after=args.after,
                      mode="zip" if args.zip else "grid", workers=args.workers, scheduler=args.scheduler)
     if not args.quiet:
