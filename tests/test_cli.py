@@ -301,3 +301,55 @@ def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, m
     summary = _strict_json(out / "summary.json")
     assert list(summary["controllers"]) == ["ideal_ik"]
     assert summary["controllers"]["ideal_ik"]["status"] == "completed"
+
+
+# --------------------------------------------------------------------------- wall clock apart (issue 23.18)
+
+
+def _written(folder):
+    return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
+
+
+def _same_apart_from_timing(first, second):
+    """The names of the files that differ between two output folders, timing.json aside."""
+    a, b = _written(first), _written(second)
+    assert sorted(a) == sorted(b)
+    return [name for name in sorted(a) if name != "timing.json" and a[name] != b[name]]
+
+
+@pytest.mark.parametrize("dimension", ["planar", "spatial"])
+def test_two_comparisons_write_identical_files_apart_from_timing_json(tmp_path, dimension):
+    """Issue 23.18: "everything else a run writes is identical" was false for `cdpr compare`:
+    each controller's wall time and real-time factor sat in summary.json and comparison.md's
+    "wall time [s]" column. They are in timing.json now, and two comparisons write the same
+    bytes in every other file (tables, pose CSVs, figures)."""
+    from conftest import small_spatial_scene
+
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    if dimension == "planar":
+        scene, controllers = _scene_file(tmp_path, "short", end_time=0.3), ["ideal_ik", "tension_aware"]
+    else:  # the small robot's 5 cm in 0.2 s is beyond the catenary controllers' workspace: ideal IK only
+        scene, controllers = save_any_scene(small_spatial_scene(0.2), tmp_path / "small.toml"), ["ideal_ik"]
+    for name in ("a", "b"):
+        _cdpr("compare", str(scene), "--controllers", ",".join(controllers), "--after", "0",
+              "--out", str(tmp_path / name), "-q")
+    assert _same_apart_from_timing(tmp_path / "a", tmp_path / "b") == []
+    assert "wall" not in (tmp_path / "a" / "comparison.md").read_text()
+    timing = json.loads((tmp_path / "a" / "timing.json").read_text())
+    assert sorted(timing["controllers"]) == controllers
+    assert all(t["wall_time_s"] > 0 for t in timing["controllers"].values())
+
+
+def test_two_sweeps_write_identical_files_apart_from_timing_json(tmp_path):
+    """Issue 23.18, `cdpr study sweep`: study.csv and study.json held each run's wall time and
+    real-time factor, and vs_<parameter>.png plotted the wall time; the figure now plots the
+    Newton iterations, and the wall-clock figures are in timing.json only."""
+    for name in ("a", "b"):
+        _cdpr("study", "sweep", "paper-circle", "--end-time", "0.2", "--param", "platform.mass=2,3",
+              "--workers", "1", "--after", "0", "--out", str(tmp_path / name), "-q")
+    assert _same_apart_from_timing(tmp_path / "a", tmp_path / "b") == []
+    header = (tmp_path / "a" / "study.csv").read_text().splitlines()[0].split(",")
+    assert "wall_time_s" not in header and "real_time_factor" not in header and "newton_iterations" in header
+    timing = json.loads((tmp_path / "a" / "timing.json").read_text())
+    assert [r["wall_time_s"] > 0 for r in timing["rows"]] == [True, True] and "date" in timing

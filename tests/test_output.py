@@ -117,3 +117,15 @@ def test_a_folder_of_the_same_commands_earlier_output_is_accepted(tmp_path):
     for name in ("result.npz", "solution.sol", "summary.json", "variants.md"):
         (tmp_path / name).write_text("old")
     assert check_output_folder(tmp_path, command="run") == tmp_path
+
+
+def test_split_timing_finds_wall_clock_figures_at_any_depth_and_keeps_what_is_asked():
+    """Issue 23.18: a comparison's per-controller and a study's per-row wall times sat in the tracked
+    JSON because only top-level keys were split off."""
+    summary = {"controllers": {"a": {"wall_time_s": 1.0, "max": 2.0}, "b": {"max": 3.0}},
+               "rows": [{"real_time_factor": 5.0, "n": 1}, {"n": 2}], "date": "d"}
+    stable, timing = split_timing(summary)
+    assert stable == {"controllers": {"a": {"max": 2.0}, "b": {"max": 3.0}}, "rows": [{"n": 1}, {"n": 2}]}
+    assert timing == {"controllers": {"a": {"wall_time_s": 1.0}}, "rows": [{"real_time_factor": 5.0}, {}], "date": "d"}
+    stable, timing = split_timing({"rows": [{"cpu_time_s": 1.0}], "date": "d"}, keep=("cpu_time_s",))
+    assert stable == {"rows": [{"cpu_time_s": 1.0}]} and timing == {"date": "d"}

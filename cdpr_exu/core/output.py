@@ -76,20 +76,42 @@ def fixed(value: float, digits: int = 2) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
-def split_timing(summary: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Split a summary into (stable figures, timing figures that change from run to run)."""
-    stable, timing = {}, {}
-    for key, value in summary.items():
-        (timing if key in TIMING_KEYS else stable)[key] = value
-    return stable, timing
+def split_timing(summary: Any, keep: Sequence[str] = ()) -> tuple[Any, Any]:
+    """Split a summary into (stable figures, timing figures that change from run to run).
+
+    The :data:`TIMING_KEYS` go to the timing part at any depth, under the same keys and list
+    positions (a comparison's ``controllers.ideal_ik.wall_time_s``, a study's
+    ``rows[3].real_time_factor``), so that no wall-clock figure hides in a nested table.
+    ``keep`` names timing keys that stay in the stable part because they are what the
+    file is about (the accuracy study's cost columns). The timing part is empty where
+    there is none.
+    """
+    if isinstance(summary, Mapping):
+        stable, timing = {}, {}
+        for key, value in summary.items():
+            if key in TIMING_KEYS and key not in keep:
+                timing[key] = value
+                continue
+            stable[key], nested = split_timing(value, keep)
+            if nested:
+                timing[key] = nested
+        return stable, timing
+    if isinstance(summary, (list, tuple)):
+        parts = [split_timing(value, keep) for value in summary]
+        timing = [nested or {} for _, nested in parts]
+        return [stable for stable, _ in parts], (timing if any(timing) else {})
+    return summary, {}
 
 
-def write_summary(folder: str | Path, summary: Mapping[str, Any], name: str = "summary.json") -> Path:
-    """Write ``summary`` into ``folder``: the stable part as ``name``, wall-clock figures as ``timing.json``."""
+def write_summary(folder: str | Path, summary: Mapping[str, Any], name: str = "summary.json", *,
+                  timing_name: str = "timing.json", keep: Sequence[str] = ()) -> Path:
+    """Write ``summary`` into ``folder``: the stable part as ``name``, wall-clock figures (at any depth,
+    :func:`split_timing`) as ``timing_name`` (git-ignored under results/); ``keep``: timing keys the stable
+    file keeps because they are its subject."""
     folder = Path(folder)
-    stable, timing = split_timing(summary)
+    stable, timing = split_timing(summary, keep)
     if timing:
-        write_json(folder / "timing.json", timing)
+        write_json(folder / timing_name, timing)
     return write_json(folder / name, stable)
 
 
