@@ -15,6 +15,7 @@ import dataclasses
 import math
 import re
 import time
+import tomllib
 
 import numpy as np
 import pytest
@@ -39,6 +40,7 @@ from cdpr_exu.scenes.scene import (
     scene_from_dict,
 )
 from cdpr_exu.run.simulate import simulate
+from cdpr_exu.scenes.spatial_scene import shipped_spatial_text, spatial_scene_from_dict
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 
 NAN, INF = float("nan"), float("inf")
@@ -256,6 +258,107 @@ def test_malformed_toml_file_is_refused_naming_the_file(tmp_path):
         load_scene(path)
     with pytest.raises(SceneError, match="does not exist"):
         load_scene(tmp_path / "missing.toml")
+
+
+# ============================================================================ required fields, numbers (issue 23.2)
+
+#: A scene of each kind as plain data (every field given): planar, spatial rigid, spatial over swivel pulleys.
+SCENE_DATA = {
+    "planar": load_scene("paper-circle").to_dict(),
+    "spatial": tomllib.loads(shipped_spatial_text("spatial-four-cable")),
+    "swivel": tomllib.loads(shipped_spatial_text("spatial-four-cable-swivel")),
+}
+
+
+def _from_dict(kind, data):
+    return (scene_from_dict if kind == "planar" else spatial_scene_from_dict)(data)
+
+
+@pytest.mark.parametrize("kind, path, field", [
+    # a 1 kg platform instead (274 mm off on a spatial run), a 3.75 m cable, a platform at (0, -2):
+    # each was a silent default before
+    ("planar", ("platform", "mass"), "platform.mass [kg]"),
+    ("planar", ("cables", 1, "unstrained_length"), "cables[1].unstrained_length [m]"),
+    ("planar", ("platform", "anchors"), "platform.anchors [m]"),
+    ("planar", ("platform", "inertia"), "platform.inertia [kg m^2]"),  # its anchors are off the centre
+    ("planar", ("platform", "initial_pose"), "platform.initial_pose [m, m, rad]"),
+    ("planar", ("pulleys", 0, "center"), "pulleys[0].center [m]"),
+    ("planar", ("pulleys", 1, "radius"), "pulleys[1].radius [m]"),
+    ("planar", ("pulleys", 1, "side"), "pulleys[1].side [-1 or +1]"),
+    ("spatial", ("platform", "mass"), "platform.mass [kg]"),
+    ("spatial", ("cables", 2, "unstrained_length"), "cables[2].unstrained_length [m]"),
+    ("spatial", ("platform", "inertia"), "platform.inertia [kg m^2]"),
+    ("swivel", ("platform", "mass"), "platform.mass [kg]"),
+    ("swivel", ("exits", 0, "inlet"), "exits[0].inlet [m]"),
+    ("swivel", ("exits", 3, "radius"), "exits[3].radius [m]"),
+])
+def test_a_scene_without_a_required_field_is_refused_naming_it_with_its_unit(kind, path, field):
+    data = copy.deepcopy(SCENE_DATA[kind])
+    del _get(data, path[:-1])[path[-1]]
+    with pytest.raises(SceneError, match=re.escape(f"lacks {field}")):
+        _from_dict(kind, data)
+
+
+def test_a_point_mass_needs_no_inertia_and_a_point_exit_no_pulley_radius():
+    """Required only where it changes the answer: a point mass feels no moment; a cable fixed at the
+    pulley centre (cable_exit = "point") never touches the pulley."""
+    spatial = copy.deepcopy(SCENE_DATA["swivel"])  # a point-mass platform
+    assert "inertia" not in spatial["platform"]
+    assert spatial_scene_from_dict(spatial).platform.inertia == (0.0, 0.0, 0.0)
+    planar = load_scene("paper-catenary-fixed").to_dict()
+    for pulley in planar["pulleys"]:
+        del pulley["radius"], pulley["side"]
+    del planar["platform"]["inertia"]
+    assert scene_from_dict(planar).platform.is_point_mass
+
+
+def test_a_required_field_is_asked_for_only_after_the_values_given_are_checked():
+    data = copy.deepcopy(SCENE_DATA["planar"])
+    del data["platform"]["mass"]
+    data["cables"][1]["radius"] = -1.0
+    with pytest.raises(SceneError, match=r"cables\[1\]\.radius must be positive"):
+        scene_from_dict(data)
+
+
+@pytest.mark.parametrize("kind, path, value, field", [
+    ("planar", ("platform", "mass"), "2.5", "platform.mass"),
+    ("planar", ("platform", "mass"), True, "platform.mass"),
+    ("planar", ("cables", 0, "radius"), "0.005", "cables[0].radius"),
+    ("planar", ("gravity",), "9.8", "gravity"),
+    ("planar", ("platform", "initial_pose", 1), "-2.0", "platform.initial_pose[1]"),
+    ("planar", ("pulleys", 0, "center", 0), False, "pulleys[0].center[0]"),
+    ("planar", ("trajectory", "radius"), "0.4", "trajectory.radius"),
+    ("planar", ("trajectory", "angular_rate"), True, "trajectory.angular_rate"),
+    ("spatial", ("platform", "mass"), "1.0", "platform.mass"),
+    ("spatial", ("platform", "mass"), True, "platform.mass"),
+    ("spatial", ("platform", "inertia", 0), "0.05", "platform.inertia"),
+    ("spatial", ("platform", "inertia", 1), True, "platform.inertia"),
+    ("spatial", ("platform", "anchors", 0, 2), "0.05", "platform.anchors[0]"),
+    ("spatial", ("exits", 1, "point", 0), True, "exits[1].point"),
+    ("spatial", ("cables", 3, "unstrained_length"), "2.55", "cables[3].unstrained_length"),
+    ("swivel", ("exits", 0, "inlet", 2), False, "exits[0].inlet"),
+    ("swivel", ("exits", 0, "winch_line"), "0.3", "exits[0].winch_line"),
+    ("swivel", ("trajectory", "center", 2), "-0.842", "trajectory.center[2]"),
+    ("swivel", ("solver", "step_size"), "1e-2", "solver.step_size"),
+])
+def test_text_and_booleans_are_refused_where_a_number_belongs(kind, path, value, field):
+    """The string "1.0" and true/false were taken as numbers (float() accepts both)."""
+    data = copy.deepcopy(SCENE_DATA[kind])
+    _get(data, path[:-1])[path[-1]] = value
+    with pytest.raises(SceneError, match=re.escape(field)) as caught:
+        _from_dict(kind, data)
+    assert "number" in str(caught.value), str(caught.value)
+
+
+@pytest.mark.parametrize("value", ["1.0", True, np.bool_(True), None, b"1"])
+def test_the_one_number_check_refuses_text_and_booleans_and_takes_numpy_numbers(value):
+    from cdpr_exu.core.validation import finite, real_array, vector
+
+    for check in (lambda v: finite("x", v), lambda v: real_array("x", [1.0, v]), lambda v: vector("x", [v, 0.0], 2)):
+        with pytest.raises(SceneError, match="x must be"):
+            check(value)
+    assert finite("x", np.float32(1.5)) == 1.5 and finite("x", np.int64(3)) == 3.0
+    assert vector("x", np.array([1, 2]), 2).tolist() == [1.0, 2.0]
 
 
 # ============================================================================ public functions

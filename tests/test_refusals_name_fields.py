@@ -17,14 +17,17 @@ from test_input_validation import malformed_scene_dicts
 
 TABLES = r"(?:name|description|gravity|cable_exit|cable|cables|pulley|pulleys|platform|winch|effects|solver|trajectory)"
 #: A field path: a scene table with an index or dotted fields (``pulleys[0]``, ``trajectory.radius``,
-#: ``platform.anchors[1]``), or a table named as the subject of the refusal (``winch must be a table``).
+#: ``platform.anchors[1]``), or a table named as the subject of the refusal (``winch must be a table``),
+#: or as what a scene lacks (``scene lacks platform``).
 FIELD_PATH = re.compile(r"\b" + TABLES + r"(?:\[\d+\](?:\.[a-z_]+(?:\[\d+\])?)*|(?:\.[a-z_]+(?:\[\d+\])?)+)"
-                        + r"|^(?:scene )?" + TABLES + r"\b (?:must|has|is|lacks)")
+                        + r"|^(?:scene )?" + TABLES + r"\b (?:must|has|is|lacks)"
+                        + r"|^scene (?:'[^']*' )?lacks " + TABLES + r"\b")
 
 
 def test_field_path_pattern_accepts_paths_and_rejects_bare_names():
     for text in ("trajectory.radius must be >= 0", "pulleys[0].center", "platform.anchors[1] enters",
-                 "gravity must be finite", "winch must be a table, got None", "cables[0] has unknown field(s)"):
+                 "gravity must be finite", "winch must be a table, got None", "cables[0] has unknown field(s)",
+                 "scene lacks platform: a scene file must give [platform]"):
         assert FIELD_PATH.search(text), text
     for text in ("radius must be >= 0 [m], got -1.0", "anchor [-0.15, -1.9] lies inside the pulley disc"):
         assert not FIELD_PATH.search(text), text

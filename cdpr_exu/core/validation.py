@@ -1,26 +1,56 @@
 """Argument checks shared by the scene, the catenary and the statics.
 
 Each returns the value as a float or raises :class:`~cdpr_exu.core.errors.SceneError`
-naming the parameter and the offending value. Booleans are refused: ``True`` is no
-length.
+naming the parameter and the offending value. Numbers must be numbers: text (``"1.0"``)
+and booleans (``true`` is no length) are refused, not converted, wherever a number is
+expected (:func:`is_number`), in scalars and in arrays alike.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 from cdpr_exu.core.errors import SceneError
 
 
+def is_number(value: Any) -> bool:
+    """True for a real number as TOML, Python and NumPy give one: an int, a float, a NumPy
+    integer or float scalar, or a one-element NumPy array of those. False for text
+    (``"1.0"``), booleans, None and everything else."""
+    import numpy as np
+
+    if isinstance(value, (bool, np.bool_)):
+        return False
+    if isinstance(value, numbers.Real):
+        return True
+    return isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf"
+
+
+def _refuse_non_numbers(value: Any, message: str) -> None:
+    """Raise SceneError(``message``) if ``value`` (a number, a nested list or an array) holds
+    anything but numbers: text, booleans, None, tables."""
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind in "iuf":
+            return
+        if value.dtype.kind != "O":
+            raise SceneError(message)
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        for item in value:
+            _refuse_non_numbers(item, message)
+    elif not is_number(value):
+        raise SceneError(message)
+
+
 def finite(name: str, value: Any) -> float:
-    """``value`` as a finite float."""
-    if isinstance(value, bool):
+    """``value`` as a finite float; text and booleans are refused, not converted."""
+    if not is_number(value):
         raise SceneError(f"{name} must be a real number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a real number, got {value!r}") from None
+    number = float(value)
     if not math.isfinite(number):
         raise SceneError(f"{name} must be finite, got {value!r}")
     return number
@@ -43,9 +73,10 @@ def non_negative(name: str, value: Any) -> float:
 
 
 def real_array(name: str, value: Any, *, require_finite: bool = True):
-    """``value`` as a float ndarray (any shape); text, objects and NaN/inf are refused."""
+    """``value`` as a float ndarray (any shape); text, booleans, objects and NaN/inf are refused."""
     import numpy as np
 
+    _refuse_non_numbers(value, f"{name} must be real numbers, got {value!r}")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -87,6 +118,7 @@ def vector(name: str, value: Any, length: int, meaning: str = ""):
     """
     import numpy as np
 
+    _refuse_non_numbers(value, f"{name} must be {length} numbers{meaning}, got {value!r}")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):

@@ -952,12 +952,59 @@ def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list
     return [{**e, **shared} if plural not in data else {**shared, **dict(e)} for e in entries]
 
 
-def scene_from_dict(data: Mapping[str, Any]) -> Scene:
+#: The fields a scene file (or its plain data) must give, with their units: the robot's
+#: geometry, lengths and masses, for which no default would be the robot its author meant.
+#: Which of them apply depends on the scene (a pulley's radius and side only where the
+#: cables run over pulleys, a platform's inertia only where an anchor is off its centre of
+#: mass): :func:`missing_fields` is given the names that apply. Every other field keeps a
+#: documented default that is a model choice (the paper's cable material, elements, contact
+#: law, solver settings, effect flags).
+REQUIRED_FIELDS: dict[str, str] = {
+    "unstrained_length": "m", "center": "m", "radius": "m", "side": "-1 or +1", "mass": "kg",
+    "inertia": "kg m^2", "anchors": "m", "initial_pose": "m, m, rad", "point": "m", "inlet": "m",
+}
+
+
+def missing_fields(path: str, given: Mapping[str, Any], names: tuple[str, ...]) -> list[str]:
+    """The required ``names`` (keys of :data:`REQUIRED_FIELDS`) that the table ``given`` leaves
+    out, each as a field path ``path.name`` with its unit, e.g. ``"platform.mass [kg]"``."""
+    return [f"{path}.{name} [{REQUIRED_FIELDS[name]}]" for name in names if name not in given]
+
+
+def refuse_missing(missing: list[str], source: str | None = None) -> None:
+    """Raise SceneError naming every required field a scene leaves out (see :func:`missing_fields`).
+
+    Called once the values given are checked, and before the scene's parts are put together
+    (so that no default stands in for a missing field in a later check or message).
+    """
+    if missing:
+        where = "scene" if source is None else f"scene {source!r}"
+        raise SceneError(f"{where} lacks {', '.join(missing)}: a scene must give "
+                         f"{'it' if len(missing) == 1 else 'each'}, as no default would be the robot you mean "
+                         "(see the scene reference in the README)")
+
+
+def _planar_missing(data: Mapping[str, Any], cable_dicts, pulley_dicts, platform: "PlatformSpec") -> list[str]:
+    """The required fields a planar scene's plain data leaves out (its tables are checked apart)."""
+    missing = [field_ for i, c in enumerate(cable_dicts)
+               for field_ in missing_fields(f"cables[{i}]", c, ("unstrained_length",))]
+    over_pulleys = data.get("cable_exit", "pulley") == "pulley"
+    for i, p in enumerate(pulley_dicts):
+        missing += missing_fields(f"pulleys[{i}]", p, ("center", "radius", "side") if over_pulleys else ("center",))
+    if isinstance(data.get("platform"), Mapping):
+        names = ("mass", "anchors", "initial_pose") + (() if platform.is_point_mass else ("inertia",))
+        missing += missing_fields("platform", data["platform"], names)
+    return missing
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene:
     """Make a validated Scene from plain data (as read from TOML).
 
     ``[cable]`` and ``[pulley]`` tables hold values shared by every cable or pulley;
     ``[[cables]]`` and ``[[pulleys]]`` entries override them one by one. ``[effects]``
-    may name a ``preset`` and override single effects.
+    may name a ``preset`` and override single effects. The values given are checked
+    first; then the tables (:data:`REQUIRED_TABLES`) and fields (:data:`REQUIRED_FIELDS`)
+    a scene must give are required. ``source`` names the file in those messages.
     """
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {data!r}")
@@ -1001,6 +1048,8 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     for key in ("name", "description", "gravity", "cable_exit"):
         if key in data:
             kwargs[key] = data[key]
+    _check_required_tables(data, source)
+    refuse_missing(_planar_missing(data, cable_dicts, pulley_dicts, platform), source)
     return Scene(**kwargs)
 
 
@@ -1051,9 +1100,7 @@ def load_scene(source: str | Path) -> Scene:
         raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
     if isinstance(data, Mapping) and data.get("dimension") == 3:
         _refuse_spatial(source)
-    scene = scene_from_dict(data)  # the values given are checked first
-    _check_required(data, str(source))
-    return scene
+    return scene_from_dict(data, source=str(source))
 
 
 #: What a scene file must say: no default would be the robot or the motion its author meant.
@@ -1064,13 +1111,14 @@ REQUIRED_TABLES: dict[str, str] = {
 }
 
 
-def _check_required(data: Mapping[str, Any], source: str) -> None:
-    """Refuse a scene file that leaves out a table it cannot sensibly do without."""
+def _check_required_tables(data: Mapping[str, Any], source: str | None) -> None:
+    """Refuse a planar scene file that leaves out a table it cannot sensibly do without."""
     missing = [name for name in REQUIRED_TABLES if name not in data]
-    if "pulleys" in missing and "pulley" in data and "center" in data["pulley"]:
+    if "pulleys" in missing and isinstance(data.get("pulley"), Mapping) and "center" in data["pulley"]:
         missing.remove("pulleys")
     if missing:
-        raise SceneError(f"scene {source!r} lacks {', '.join(missing)}: a scene file must give "
+        where = "scene" if source is None else f"scene {source!r}"
+        raise SceneError(f"{where} lacks {', '.join(missing)}: a scene file must give "
                          + "; ".join(REQUIRED_TABLES[name] for name in missing)
                          + " (see the scene reference in the README)")
 

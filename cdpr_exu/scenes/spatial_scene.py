@@ -45,7 +45,8 @@ from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
-                                  _build, _override, _per_cable, controller_model_from_dict, load_scene)
+                                  _build, _override, _per_cable, controller_model_from_dict, load_scene, missing_fields,
+                                  refuse_missing)
 from cdpr_exu.core.validation import non_negative, positive, vector
 
 __all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
@@ -62,28 +63,33 @@ class SpatialPlatformSpec:
     Parameters
     ----------
     mass : float [kg]
-    inertia : (float, float, float) [kg m^2]
+    inertia : (float, float, float) or None [kg m^2]
         Principal moments of inertia about the centre of mass, along the platform axes
-        (positive for a rigid platform).
+        (positive for a rigid platform). None (not given): zero for a point mass; refused
+        for a rigid platform, whose turning it decides.
     anchors : sequence of (x, y, z) [m]
         Cable anchor points in the platform frame (centre of mass at 0), one per cable.
     """
 
     mass: float = 1.0
-    inertia: tuple = (0.0, 0.0, 0.0)
+    inertia: tuple | None = None
     anchors: tuple = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mass", non_negative("platform.mass", self.mass))
-        inertia = vector("platform.inertia", self.inertia, 3, " (principal moments) [kg m^2]")
-        if np.any(inertia < 0.0):
-            raise SceneError(f"platform.inertia must be zero or positive, got {self.inertia!r}")
-        object.__setattr__(self, "inertia", tuple(float(v) for v in inertia))
         if isinstance(self.anchors, (str, bytes, Mapping)):
             raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {self.anchors!r}")
         anchors = tuple(tuple(float(v) for v in vector(f"platform.anchors[{i}]", a, 3, " (x, y, z) [m]"))
                         for i, a in enumerate(self.anchors))
         object.__setattr__(self, "anchors", anchors)
+        if self.inertia is None:
+            if not self.is_point_mass:
+                refuse_missing(missing_fields("platform", {}, ("inertia",)))
+            object.__setattr__(self, "inertia", (0.0, 0.0, 0.0))
+        inertia = vector("platform.inertia", self.inertia, 3, " (principal moments) [kg m^2]")
+        if np.any(inertia < 0.0):
+            raise SceneError(f"platform.inertia must be zero or positive, got {self.inertia!r}")
+        object.__setattr__(self, "inertia", tuple(float(v) for v in inertia))
         if not self.is_point_mass and (self.mass <= 0.0 or min(self.inertia) <= 0.0):
             raise SceneError(f"a rigid platform (an anchor off its centre of mass) needs platform.mass > 0 and "
                              f"every platform.inertia > 0, got mass {self.mass!r}, inertia {self.inertia!r}")
@@ -413,12 +419,16 @@ def is_spatial(scene: Any) -> bool:
     return getattr(scene, "dimension", 2) == 3
 
 
-def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
+def spatial_scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> SpatialScene:
     """Make a validated SpatialScene from plain data (as read from TOML).
 
     ``[cable]`` holds values shared by every cable; ``[[cables]]`` entries override them
     one by one (at least one entry per cable). ``[[exits]]`` give each cable's exit
-    ``point``; ``[effects]`` may name a ``preset`` and override single effects.
+    ``point``; ``[effects]`` may name a ``preset`` and override single effects. The values
+    given are checked first; then the fields a scene must give are required (each cable's
+    ``unstrained_length``, a swivel's ``inlet`` and ``radius``, the platform's ``mass``,
+    ``anchors`` and, with an anchor off its centre, ``inertia``). ``source`` names the file
+    in that message.
     """
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {data!r}")
@@ -437,18 +447,19 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
     if not isinstance(exits, list):
         raise SceneError(f"exits must be an array of tables, each a point exit (point = [x, y, z]) or a swivel "
                          f"pulley (kind = 'swivel', inlet = [x, y, z], radius, ...), got {exits!r}")
+    exit_dicts = exits
     exits = [_exit_from_dict(e, i) for i, e in enumerate(exits)]
     swivels = tuple(e if isinstance(e, SwivelSpec) else None for e in exits)
-    cables = tuple(_build(CableSpec, c, f"cables[{i}]")
-                   for i, c in enumerate(_per_cable(data, "cable", "cables", [])))
+    cable_dicts = _per_cable(data, "cable", "cables", [])
+    cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
     effects_data = data.get("effects", {})
     if not isinstance(effects_data, Mapping):
         raise SceneError(f"effects must be a table, got {effects_data!r}")
     effects_data = dict(effects_data)
     effects = Effects.from_preset(effects_data.pop("preset", "full"), **effects_data)
+    platform = _build(SpatialPlatformSpec, data["platform"], "platform")
     kwargs: dict[str, Any] = dict(cables=cables, exits=tuple(None if isinstance(e, SwivelSpec) else e for e in exits),
-                                  swivels=swivels if any(swivels) else (),
-                                  platform=_build(SpatialPlatformSpec, data["platform"], "platform"), effects=effects,
+                                  swivels=swivels if any(swivels) else (), platform=platform, effects=effects,
                                   solver=_build(SolverSpec, data.get("solver", {}), "solver"),
                                   winch=_build(WinchSpec, data.get("winch", {}), "winch"))
     if "trajectory" in data:
@@ -460,7 +471,22 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
     for key in ("name", "description", "gravity"):
         if key in data:
             kwargs[key] = data[key]
+    refuse_missing(_spatial_missing(cable_dicts, exit_dicts, swivels, data["platform"], platform), source)
     return SpatialScene(**kwargs)
+
+
+def _spatial_missing(cable_dicts, exit_dicts, swivels, platform_data, platform: SpatialPlatformSpec) -> list[str]:
+    """The required fields (:data:`cdpr_exu.scenes.scene.REQUIRED_FIELDS`) a spatial scene's plain data
+    leaves out: each cable's length, each swivel pulley's inlet and radius (a point exit's point is
+    checked with its table), the platform's mass and anchors, and its inertia when an anchor is off
+    its centre of mass."""
+    missing = [field_ for i, c in enumerate(cable_dicts)
+               for field_ in missing_fields(f"cables[{i}]", c, ("unstrained_length",))]
+    for i, (entry, swivel) in enumerate(zip(exit_dicts, swivels)):
+        if swivel is not None:
+            missing += missing_fields(f"exits[{i}]", entry, ("inlet", "radius"))
+    names = ("mass", "anchors") + (() if platform.is_point_mass else ("inertia",))
+    return missing + missing_fields("platform", platform_data, names)
 
 
 def shipped_spatial_scenes() -> list[str]:
@@ -491,7 +517,7 @@ def load_spatial_scene(source: str | Path) -> SpatialScene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
-    return spatial_scene_from_dict(data)
+    return spatial_scene_from_dict(data, source=str(source))
 
 
 def load_any_scene(source: str | Path) -> Scene | SpatialScene:

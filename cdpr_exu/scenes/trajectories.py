@@ -12,7 +12,6 @@ The paper's reference (scenario 1) is ``CircleTrajectory()``:
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from dataclasses import fields as dataclass_fields
@@ -20,6 +19,7 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.validation import finite
 
 __all__ = [
     "Trajectory",
@@ -34,13 +34,8 @@ __all__ = [
 # argument checks
 # ----------------------------------------------------------------------------------
 def _finite_float(name, value):
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as exc:
-        raise SceneError(f"{name} must be a finite number, got {value!r}") from exc
-    if not math.isfinite(number):
-        raise SceneError(f"{name} must be finite, got {value!r}")
-    return number
+    """``value`` as a finite float: the scenes' one number check (text and booleans refused)."""
+    return finite(name, value)
 
 
 def _finite_tuple(name, value, size):
