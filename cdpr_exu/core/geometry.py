@@ -46,6 +46,7 @@ from cdpr_exu.core.validation import real_array
 
 __all__ = [
     "Pulley",
+    "above_exits",
     "PulleyExit",
     "rotation_matrix",
     "rotation_from_vector",
@@ -539,12 +540,55 @@ class Pulley:
         hang = self.hang_point
         return np.array([hang[0], hang[1] - (unstrained_length - paid_out)])
 
+    @property
+    def top(self) -> float:
+        """Height [m] of the highest point the cable can leave this exit from: the top of the rim,
+        ``c_z + r_p`` (the centre of a point exit). See :func:`above_exits`."""
+        return self.center[1] + self.radius
+
     def paid_out_length(self, unstrained_length: float, winch_end) -> float:
         """Paid-out length lambda [m] of a cable of unstrained length ``L0`` [m] whose winch end is at ``winch_end`` (2,) [m].
 
         The inverse of :meth:`winch_end`: all of the cable but the part hanging below the hang point.
         """
         return float(unstrained_length - (self.center[1] - winch_end[1]))
+
+
+# ----------------------------------------------------------------------------------
+# a platform above its exits
+# ----------------------------------------------------------------------------------
+def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None:
+    """Why no cable can hold the platform up, or None: every anchor at or above the top of its exit.
+
+    A cable pulls its anchor towards the point where it leaves its exit, which lies no
+    higher than the exit's top (the top of a pulley's rim, an exit point itself). When
+    every anchor is at or above its exit's top, no cable pulls the platform upwards, and
+    as cables cannot push, none holds its weight. One test for planar and spatial robots.
+
+    Parameters
+    ----------
+    anchor_heights : array_like, shape (m,) [m]
+        Height of each cable's anchor (z, the vertical axis of both dimensions).
+    exit_tops : array_like, shape (m,) [m]
+        Height of the top of each cable's exit (:attr:`Pulley.top`; a swivel pulley's
+        inlet height plus its radius; an exit point's height).
+    exits : str
+        The scene field of the exits, for the message (``"pulleys"`` or ``"exits"``).
+
+    Returns
+    -------
+    str or None
+        ``"every anchor is at or above the top of its exit (platform.anchors[0] at z = 0.4 m,
+        pulleys[0] up to z = 0.25 m; ...): no cable can hold a platform above its exits, as
+        cables cannot push"``; None if some anchor lies below its exit's top.
+    """
+    heights, tops = np.asarray(anchor_heights, dtype=float), np.asarray(exit_tops, dtype=float)
+    if heights.shape != tops.shape or np.any(heights < tops):
+        return None
+    where = "; ".join(f"platform.anchors[{i}] at z = {h:.4g} m, {exits}[{i}] up to z = {t:.4g} m"
+                      for i, (h, t) in enumerate(zip(heights, tops)))
+    return (f"every anchor is at or above the top of its exit ({where}): no cable can hold a platform above its "
+            "exits, as cables cannot push")
 
 
 # ----------------------------------------------------------------------------------

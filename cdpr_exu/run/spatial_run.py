@@ -72,7 +72,8 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     the reference's acceleration, ``M (a + g e_z)``, with non-negative tensions (within
     the cables' ``min_tension`` / ``max_tension`` where given). Like the planar check,
     this is the force part of the wrench-feasible workspace: the platform's rotation is
-    free to balance the moment.
+    free to balance the moment. A pose with every anchor above its exit is such a pose; the
+    message then says so (:meth:`SpatialScene.above_exits`).
 
     Raises
     ------
@@ -112,11 +113,12 @@ def check_spatial_reference(scene: SpatialScene) -> None:
         k, residual, free = unheld
         why = ("with non-negative tensions" if limits is None
                else f"within the cables' tension limits ({limits_text(free, limits)})")
+        above = scene.above_exits(poses[k, :3], rotation_from_vector(poses[k, 3:]))
         raise UnreachableError(
             f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) at "
             f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight and "
             f"the reference's acceleration ({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
-            "remain unbalanced")
+            "remain unbalanced" + ("" if above is None else f"; the pose is above the exits: {above}"))
 
 
 def rotation_error_deg(pose: np.ndarray, reference: np.ndarray) -> np.ndarray:

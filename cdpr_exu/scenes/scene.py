@@ -25,7 +25,7 @@ import numpy as np
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, UnreachableError
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
-from cdpr_exu.core.geometry import Pulley, anchor_points
+from cdpr_exu.core.geometry import Pulley, above_exits, anchor_points
 from cdpr_exu.core.validation import finite, non_negative, positive
 from cdpr_exu.scenes.trajectories import Trajectory, trajectory_from_dict
 
@@ -833,8 +833,13 @@ class Scene:
         return self.controller_model.apply(self)
 
     def _check_reachable(self) -> None:
-        """Refuse an initial pose the cables cannot reach (before any simulation)."""
+        """Refuse an initial pose the cables cannot reach or hold (before any simulation)."""
         anchors = anchor_points(np.asarray(self.platform.initial_pose), np.asarray(self.platform.anchors))
+        above = above_exits(anchors[:, 1], [exit_.top for exit_ in self.exits])
+        if above is not None and self.gravity > 0.0 and self.effects.gravity:
+            raise UnreachableError(
+                f"platform.initial_pose {list(self.platform.initial_pose)} (x [m], z [m], rotation [rad]) is above "
+                f"the pulleys: {above}; give a platform.initial_pose below them")
         for i, (cable, pulley, exit_) in enumerate(zip(self.cables, self.pulleys, self.exits)):
             if exit_.is_point_exit:
                 needed = float(np.linalg.norm(anchors[i] - np.asarray(exit_.center)))

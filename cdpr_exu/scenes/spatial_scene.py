@@ -43,6 +43,7 @@ import numpy as np
 
 from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.geometry import above_exits
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
                                   _build, _override, _per_cable, controller_model_from_dict, load_scene, missing_fields,
@@ -356,6 +357,26 @@ class SpatialScene:
     def pulley_radii(self) -> np.ndarray:
         """Each exit's pulley radius [m], 0 for a point exit, shape (m,) (the ideal kinematics' ``pulley_radii``)."""
         return np.array([0.0 if s is None else s.radius for s in self.swivel_exits])
+
+    @property
+    def exit_tops(self) -> np.ndarray:
+        """Height [m] of the highest point each cable can leave its exit from, shape (m,): an exit point's
+        height, a swivel pulley's inlet height plus its radius (:func:`cdpr_exu.core.geometry.above_exits`)."""
+        return np.asarray(self.exits, dtype=float)[:, 2] + self.pulley_radii
+
+    def anchor_heights(self, position, rotation=None) -> np.ndarray:
+        """Height [m] of each anchor, shape (m,), with the platform's centre of mass at ``position`` (3,) [m]
+        and its frame turned by ``rotation`` (3, 3) (default: not turned)."""
+        anchors = np.asarray(self.platform.anchors, dtype=float)
+        turned = anchors if rotation is None else anchors @ np.asarray(rotation, dtype=float).T
+        return float(position[2]) + turned[:, 2]
+
+    def above_exits(self, position, rotation=None) -> str | None:
+        """Why no cable can hold the platform at this pose (every anchor at or above its exit's top), or
+        None (:func:`cdpr_exu.core.geometry.above_exits`); None also when the platform has no weight."""
+        if self.gravity == 0.0 or not self.effects.gravity:
+            return None
+        return above_exits(self.anchor_heights(position, rotation), self.exit_tops, exits="exits")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (TOML-ready) of the scene; :func:`spatial_scene_from_dict` reads it back."""
