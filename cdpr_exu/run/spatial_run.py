@@ -301,6 +301,18 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
         return
 
 
+def _refuse_start_above_exits(scene: SpatialScene, mbs, items, catenary) -> None:
+    """Refuse to run from a rest of the lumped robot that holds the platform above its exits
+    (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: held by its bending or pushing elements)."""
+    from cdpr_exu.run.spatial_rest import rest_above_exits
+
+    position, rotation = platform_pose(mbs, items, current=False)
+    lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
+    above = rest_above_exits(scene, position, rotation, lowest, catenary)
+    if above is not None:
+        raise SolverFailure(f"the spatial run cannot start from the robot's rest: {above}", time=0.0)
+
+
 def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False) -> SpatialResult:
     """Run ``scene``'s reference under ``controller`` (default: ideal inverse kinematics).
 
@@ -324,7 +336,9 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     UnreachableError
         If no static equilibrium of the scene's lengths exists to start from.
     SolverFailure
-        If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed.
+        If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed. Also
+        (at t = 0, no partial result) if the lumped robot's rest over swivel pulleys holds the
+        platform above its exits.
     """
     if scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
@@ -338,6 +352,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     if scene.swivels:
         _warn_outside_measured_region(scene)
         start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
+        _refuse_start_above_exits(scene, mbs, items, start)
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
