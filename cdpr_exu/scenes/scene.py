@@ -1097,7 +1097,7 @@ def load_scene(source: str | Path) -> Scene:
         if not resource.is_file() and resources.files("cdpr_exu.scenes").joinpath("spatial", name).is_file():
             _refuse_spatial(source)
         if not resource.is_file():
-            raise SceneError(f"no scene named {str(source)!r}; shipped scenes: {', '.join(shipped_scenes())}")
+            raise unknown_scene(source)
         text = resource.read_text()
     try:
         data = tomllib.loads(text)
@@ -1128,10 +1128,42 @@ def _check_required_tables(data: Mapping[str, Any], source: str | None) -> None:
                          + " (see the scene reference in the README)")
 
 
+def shipped_names(folder: str | None = None) -> list[str]:
+    """Names of the scenes shipped in the package's ``scenes`` folder (or its sub-folder ``folder``)."""
+    files = resources.files("cdpr_exu.scenes")
+    files = files if folder is None else files.joinpath(folder)
+    return sorted(p.name[:-5].replace("_", "-") for p in files.iterdir() if p.name.endswith(".toml"))
+
+
 def shipped_scenes() -> list[str]:
-    """Names of the scenes shipped with the package."""
-    folder = resources.files("cdpr_exu.scenes")
-    return sorted(p.name[:-5].replace("_", "-") for p in folder.iterdir() if p.name.endswith(".toml"))
+    """Names of the planar scenes shipped with the package."""
+    return shipped_names()
+
+
+def closest_names(name: str, names: list[str]) -> list[str]:
+    """The names a misspelt ``name`` most likely meant: those that contain it, else those whose
+    similarity (difflib's ratio) is at least 0.6 and within 0.1 of the best, the closest first."""
+    import difflib
+
+    key = name.replace("_", "-").lower()
+    if len(key) >= 3 and any(key in n for n in names):
+        return [n for n in names if key in n]
+    scores = {n: difflib.SequenceMatcher(None, key, n).ratio() for n in names}
+    floor = max(0.6, max(scores.values(), default=0.0) - 0.1)
+    return sorted((n for n in names if scores[n] >= floor), key=lambda n: -scores[n])
+
+
+def unknown_scene(source: str | Path) -> SceneError:
+    """The refusal of a scene name that no shipped scene has: it lists every shipped scene, planar and
+    spatial (``cdpr scenes``), after the likeliest (:func:`closest_names`), e.g. "did you mean 'spatial-cogiro'?"."""
+    from cdpr_exu.scenes.spatial_scene import SPATIAL_FOLDER
+
+    name = str(source)
+    planar, spatial = shipped_names(), shipped_names(SPATIAL_FOLDER)
+    close = closest_names(name, planar + spatial)
+    guess = f"did you mean {' or '.join(map(repr, close))}? " if close else ""
+    return SceneError(f"no scene named {name!r}; {guess}shipped scenes: {', '.join(planar)}; spatial: "
+                      f"{', '.join(spatial)} (or give the path of a .toml scene file)")
 
 
 def save_scene(scene: Scene, path: str | Path) -> Path:

@@ -47,7 +47,7 @@ from cdpr_exu.core.geometry import above_exits
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
                                   _build, _override, _per_cable, controller_model_from_dict, load_scene, missing_fields,
-                                  refuse_missing)
+                                  refuse_missing, shipped_names, unknown_scene)
 from cdpr_exu.core.validation import non_negative, positive, vector
 
 __all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
@@ -512,8 +512,7 @@ def _spatial_missing(cable_dicts, exit_dicts, swivels, platform_data, platform: 
 
 def shipped_spatial_scenes() -> list[str]:
     """Names of the spatial scenes shipped with the package."""
-    folder = resources.files("cdpr_exu.scenes").joinpath(SPATIAL_FOLDER)
-    return sorted(p.name[:-5].replace("_", "-") for p in folder.iterdir() if p.name.endswith(".toml"))
+    return shipped_names(SPATIAL_FOLDER)
 
 
 def shipped_spatial_text(name: str) -> str | None:
@@ -532,8 +531,7 @@ def load_spatial_scene(source: str | Path) -> SpatialScene:
     else:
         text = shipped_spatial_text(str(source))
         if text is None:
-            raise SceneError(f"no spatial scene named {str(source)!r}; shipped spatial scenes: "
-                             f"{', '.join(shipped_spatial_scenes())}")
+            raise unknown_scene(source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
