@@ -483,6 +483,63 @@ def test_former_validation_gaps_are_refused_with_scene_error(name):
         FORMER_GAPS[name]()
 
 
+#: Bad values given as NumPy numbers (as a study or a script passes them): each message shows
+#: plain numbers (issue 23.9: "got np.float64(-2.0)", "got array([nan])").
+NUMPY_VALUES = {
+    "PlatformSpec mass": lambda: PlatformSpec(mass=np.float64(-2.0)),
+    "CableSpec n_elements": lambda: CableSpec(n_elements=np.int64(1)),
+    "PulleySpec side": lambda: PulleySpec(side=np.int64(0)),
+    "SolverSpec spectral_radius": lambda: SolverSpec(spectral_radius=np.float64(1.5)),
+    "CircleTrajectory radius": lambda: CircleTrajectory(radius=np.float64(-2.0)),
+    "PointToPointTrajectory end": lambda: PointToPointTrajectory(end=np.array([0.0, -1.6])),
+    "SpatialPlatformSpec mass": lambda: _spatial_platform(mass=np.float64(-2.0)),
+    "SpatialPlatformSpec inertia": lambda: _spatial_platform(inertia=np.array([-1.0, 1.0, 1.0])),
+    "SwivelSpec radius": lambda: _swivel(radius=np.float64(-0.1)),
+    "real_array NaN": lambda: _validation().real_array("x", np.array([np.nan, 1.0])),
+    "per_item negative": lambda: _validation().per_item("x", np.array([-1.0, 1.0]), 2),
+    "CatenaryCable length": lambda: catenary.CatenaryCable(np.float64(-1.0), 1.0, 1.0),
+    "pulley_exit radius": lambda: kinematics.pulley_exit((0.0, 0.0), np.float64(-1.0), -1, [1.0, -1.0]),
+    "solve_forward_statics lengths": lambda: statics.solve_forward_statics(POINT_PLATFORM, np.array([-1.0, 2.0])),
+    "SuspendedPlatform mass": lambda: statics.SuspendedPlatform(POINT_PLATFORM.cables, np.float64(np.nan)),
+}
+
+
+def _spatial_platform(**changes):
+    from cdpr_exu.scenes.spatial_scene import SpatialPlatformSpec
+
+    return SpatialPlatformSpec(**{"mass": 5.0, "inertia": (1.0, 1.0, 1.0), "anchors": ((0.1, 0.0, 0.0),), **changes})
+
+
+def _swivel(**changes):
+    from cdpr_exu.scenes.spatial_scene import SwivelSpec
+
+    return SwivelSpec(**{"inlet": (0.0, 0.0, 0.0), **changes})
+
+
+def _validation():
+    from cdpr_exu.core import validation
+
+    return validation
+
+
+@pytest.mark.parametrize("name", list(NUMPY_VALUES))
+def test_refusals_show_numpy_values_as_plain_numbers(name):
+    with pytest.raises(SceneError) as caught:
+        NUMPY_VALUES[name]()
+    message = str(caught.value)
+    assert "np." not in message and "array(" not in message and "float64" not in message, message
+
+
+@pytest.mark.parametrize("value, text", [
+    (np.float64(-2.0), "-2.0"), (np.int64(3), "3"), (np.array([1.0, np.nan]), "[1.0, nan]"), ("abc", "'abc'"),
+    ((np.float64(1.5), 2), "(1.5, 2)"), (None, "None"), (np.bool_(True), "True"),
+])
+def test_shown_gives_plain_numbers_and_quoted_text(value, text):
+    from cdpr_exu.core.validation import shown
+
+    assert shown(value) == text
+
+
 # ============================================================================ property test
 
 PAPER_DICT = load_scene("paper-circle").to_dict()

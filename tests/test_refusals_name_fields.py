@@ -24,6 +24,10 @@ FIELD_PATH = re.compile(r"\b" + TABLES + r"(?:\[\d+\](?:\.[a-z_]+(?:\[\d+\])?)*|
                         + r"|^scene (?:'[^']*' )?lacks " + TABLES + r"\b")
 
 
+#: A NumPy repr in a message: ``np.float64(-2.0)``, ``array([1., 2.])``.
+NUMPY_REPR = re.compile(r"\bnp\.[a-z_]+\d*\(|\barray\(")
+
+
 def test_field_path_pattern_accepts_paths_and_rejects_bare_names():
     for text in ("trajectory.radius must be >= 0", "pulleys[0].center", "platform.anchors[1] enters",
                  "gravity must be finite", "winch must be a table, got None", "cables[0] has unknown field(s)",
@@ -41,3 +45,4 @@ def test_every_refusal_of_a_malformed_scene_names_a_field_path(data):
         check_reference(scene_from_dict(data))
     except CdprError as err:
         assert FIELD_PATH.search(str(err)), str(err)
+        assert not NUMPY_REPR.search(str(err)), str(err)  # plain numbers (issue 23.9)

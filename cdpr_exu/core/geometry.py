@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.validation import real_array
+from cdpr_exu.core.validation import real_array, shown
 
 __all__ = [
     "Pulley",
@@ -77,23 +77,23 @@ def finite_array(name, value, last_dims=None):
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise SceneError(f"{name} must be numeric, got {value!r}") from exc
+        raise SceneError(f"{name} must be numeric, got {shown(value)}") from exc
     if last_dims is not None:
         if array.ndim < len(last_dims) or array.shape[array.ndim - len(last_dims):] != tuple(last_dims):
             raise SceneError(
-                f"{name} must have trailing shape {tuple(last_dims)}, got shape {array.shape}: {value!r}"
+                f"{name} must have trailing shape {tuple(last_dims)}, got shape {array.shape}: {shown(value)}"
             )
     if not np.all(np.isfinite(array)):
-        raise SceneError(f"{name} must be finite, got {value!r}")
+        raise SceneError(f"{name} must be finite, got {shown(value)}")
     return array
 
 
 def check_radius(name, radius):
     radius = finite_array(name, radius)
     if radius.ndim != 0:
-        raise SceneError(f"{name} must be a scalar, got {radius!r}")
+        raise SceneError(f"{name} must be a scalar, got {shown(radius)}")
     if radius < 0.0:
-        raise SceneError(f"{name} must be >= 0 [m], got {float(radius)!r}")
+        raise SceneError(f"{name} must be >= 0 [m], got {shown(float(radius))}")
     return float(radius)
 
 
@@ -101,9 +101,9 @@ def check_side(name, side):
     try:
         side_float = float(side)
     except (TypeError, ValueError) as exc:
-        raise SceneError(f"{name} must be -1 or +1, got {side!r}") from exc
+        raise SceneError(f"{name} must be -1 or +1, got {shown(side)}") from exc
     if side_float not in (-1.0, 1.0):
-        raise SceneError(f"{name} must be -1 (cable on the left) or +1 (on the right), got {side!r}")
+        raise SceneError(f"{name} must be -1 (cable on the left) or +1 (on the right), got {shown(side)}")
     return int(side_float)
 
 

@@ -70,7 +70,7 @@ from cdpr_exu.physics.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, Cate
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
 from cdpr_exu.statics.statics import PlatformEquilibriumViews, _minimise_energy  # the planar statics' line search, reused
-from cdpr_exu.core.validation import non_negative, positive, real_array, vector
+from cdpr_exu.core.validation import non_negative, positive, real_array, shown, vector
 
 _RELATIVE_TOLERANCE = 1e-12
 """Target of the scaled wrench residual (the cables are solved to 1e-12 of their length)."""
@@ -161,15 +161,15 @@ class SpatialPlatform:
         try:
             cables = tuple(self.cables)
         except TypeError:
-            raise SceneError(f"cables must be a sequence of SpatialCable, got {self.cables!r}") from None
+            raise SceneError(f"cables must be a sequence of SpatialCable, got {shown(self.cables)}") from None
         if not all(isinstance(c, SpatialCable) for c in cables):
-            raise SceneError(f"cables must be a sequence of SpatialCable, got {self.cables!r}")
+            raise SceneError(f"cables must be a sequence of SpatialCable, got {shown(self.cables)}")
         object.__setattr__(self, "cables", cables)
         object.__setattr__(self, "mass", non_negative("mass", self.mass))
         object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
         inertia = vector("inertia", self.inertia, 3, " (principal moments) [kg m^2]")
         if np.any(inertia < 0.0):
-            raise SceneError(f"inertia must be zero or positive, got {self.inertia!r}")
+            raise SceneError(f"inertia must be zero or positive, got {shown(self.inertia)}")
         object.__setattr__(self, "inertia", tuple(inertia))
         exits = np.array([c.exit_point for c in cables]).reshape(-1, 3)
         anchors = np.array([c.anchor for c in cables]).reshape(-1, 3)
@@ -489,9 +489,9 @@ def _lengths(platform, unstrained_lengths):
     lengths = real_array("unstrained_lengths", unstrained_lengths)
     if lengths.shape != (len(platform.cables),):
         raise SceneError(f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
-                         f"got {unstrained_lengths!r}")
+                         f"got {shown(unstrained_lengths)}")
     if np.any(lengths <= 0.0):
-        raise SceneError(f"unstrained_lengths must be positive, got {unstrained_lengths!r}")
+        raise SceneError(f"unstrained_lengths must be positive, got {shown(unstrained_lengths)}")
     return lengths
 
 
@@ -646,7 +646,7 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
         no equilibrium is found within the tension limits.
     """
     if not isinstance(platform, SpatialPlatform):
-        raise SceneError(f"platform must be a SpatialPlatform, got {platform!r}")
+        raise SceneError(f"platform must be a SpatialPlatform, got {shown(platform)}")
     lengths = _lengths(platform, unstrained_lengths)
     wrench = _wrench(external_wrench)
     max_strain = positive("max_strain", max_strain)
@@ -656,7 +656,7 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
     if initial_pose is not None:
         start = real_array("initial_pose", initial_pose)
         if start.shape != (dof,):
-            raise SceneError(f"initial_pose must have {dof} entries for this platform, got {initial_pose!r}")
+            raise SceneError(f"initial_pose must have {dof} entries for this platform, got {shown(initial_pose)}")
     _check_reach(platform, lengths, max_strain, max_tension)
     if initial_pose is None:
         start = straight_cable_pose(platform, lengths, wrench)
@@ -811,10 +811,10 @@ def solve_inverse_spatial_statics(platform, pose, horizontal_guess, external_wre
     pose = real_array("pose", pose)
     dof = platform.degrees_of_freedom
     if pose.shape != (6,) and not (dof == 3 and pose.shape == (3,)):
-        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {pose.tolist()!r}")
+        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {shown(pose.tolist())}")
     guess = real_array("horizontal_guess", horizontal_guess)
     if guess.shape != (len(platform.cables),) or np.any(guess <= 0.0):
-        raise SceneError(f"horizontal_guess must be one positive tension per cable, got {horizontal_guess!r}")
+        raise SceneError(f"horizontal_guess must be one positive tension per cable, got {shown(horizontal_guess)}")
     wrench = _wrench(external_wrench)
     position = pose[:3]
     rotation = rotation_from_vector(pose[3:6]) if pose.shape == (6,) and dof == 6 else np.eye(3)

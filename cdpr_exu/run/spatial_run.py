@@ -92,13 +92,17 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     for i, swivel in enumerate(scene.swivel_exits):
         if swivel is None:
             continue
-        room = swivel.winch_line - 2.0 * scene.cables[i].element_length  # the winch end stays two elements below
+        margin = 2.0 * scene.cables[i].element_length  # the winch end stays two elements below the inlet
+        room = swivel.winch_line - margin
         gain = lengths[:, i] - lengths[0, i]
         if gain.max() > room:
             k = int(np.argmax(gain))
-            raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
-                                   f"cable {i + 1} paid out by {gain[k]:.4f} m over its swivel pulley: more than "
-                                   f"exits[{i}].winch_line = {swivel.winch_line:g} m less two elements holds")
+            raise UnreachableError(
+                f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs cable {i + 1} paid "
+                f"out by {1000 * gain[k]:.3g} mm over its swivel pulley, more than its winch line holds: "
+                f"exits[{i}].winch_line = {1000 * swivel.winch_line:.3g} mm less two elements (2 x "
+                f"{1000 * margin / 2:.3g} mm, the winch end's margin below the inlet) leaves {1000 * room:.3g} mm; give "
+                f"exits[{i}].winch_line = {1000 * (margin + max(gain[k], 0.0)):.3g} mm or more")
     from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors
 
     anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)

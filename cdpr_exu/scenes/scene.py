@@ -26,7 +26,7 @@ import numpy as np
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, UnreachableError
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
 from cdpr_exu.core.geometry import Pulley, above_exits, anchor_points
-from cdpr_exu.core.validation import finite, non_negative, positive
+from cdpr_exu.core.validation import finite, non_negative, positive, shown
 from cdpr_exu.scenes.trajectories import Trajectory, trajectory_from_dict
 
 # --------------------------------------------------------------------------- checks
@@ -35,26 +35,26 @@ from cdpr_exu.scenes.trajectories import Trajectory, trajectory_from_dict
 def _vector(path: str, value: Any, length: int) -> tuple[float, ...]:
     """Return ``value`` as a tuple of ``length`` finite floats."""
     if isinstance(value, (str, bytes, Mapping)):
-        raise SceneError(f"{path} must be a list of {length} numbers, got {value!r}")
+        raise SceneError(f"{path} must be a list of {length} numbers, got {shown(value)}")
     try:
         items = list(value)
     except TypeError:
-        raise SceneError(f"{path} must be a list of {length} numbers, got {value!r}") from None
+        raise SceneError(f"{path} must be a list of {length} numbers, got {shown(value)}") from None
     if len(items) != length:
-        raise SceneError(f"{path} must have {length} entries, got {len(items)}: {value!r}")
+        raise SceneError(f"{path} must have {length} entries, got {len(items)}: {shown(value)}")
     return tuple(finite(f"{path}[{i}]", v) for i, v in enumerate(items))
 
 
 def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
     if value not in choices:
-        raise SceneError(f"{path} must be one of {', '.join(map(repr, choices))}, got {value!r}")
+        raise SceneError(f"{path} must be one of {', '.join(map(repr, choices))}, got {shown(value)}")
     return value
 
 
 def _whole(path: str, value: Any, low: int, high: int) -> int:
     """Return ``value`` as an int in [low, high], or raise SceneError naming ``path``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
-        raise SceneError(f"{path} must be a whole number from {low} to {high}, got {value!r}")
+        raise SceneError(f"{path} must be a whole number from {low} to {high}, got {shown(value)}")
     return int(value)
 
 
@@ -121,18 +121,18 @@ class CableSpec:
             if getattr(self, name) is not None:
                 _set(self, name, non_negative(f"cable.{name}", getattr(self, name)))
         if self.min_tension is not None and self.max_tension is not None and self.min_tension >= self.max_tension:
-            raise SceneError(f"cable.min_tension = {self.min_tension!r} N must be below cable.max_tension = "
-                             f"{self.max_tension!r} N")
+            raise SceneError(f"cable.min_tension = {shown(self.min_tension)} N must be below cable.max_tension = "
+                             f"{shown(self.max_tension)} N")
         _set(self, "radius", positive("cable.radius", self.radius))
         _set(self, "linear_density", positive("cable.linear_density", self.linear_density))
         _set(self, "youngs_modulus", positive("cable.youngs_modulus", self.youngs_modulus))
         _set(self, "damping_constant", non_negative("cable.damping_constant", self.damping_constant))
         if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
-            raise SceneError(f"cable.n_elements must be a whole number, got {self.n_elements!r}")
+            raise SceneError(f"cable.n_elements must be a whole number, got {shown(self.n_elements)}")
         if self.n_elements < 2:
-            raise SceneError(f"cable.n_elements must be at least 2, got {self.n_elements!r}")
+            raise SceneError(f"cable.n_elements must be at least 2, got {shown(self.n_elements)}")
         if self.n_elements > MAX_ELEMENTS:
-            raise SceneError(f"cable.n_elements must be at most {MAX_ELEMENTS}, got {self.n_elements!r}")
+            raise SceneError(f"cable.n_elements must be at most {MAX_ELEMENTS}, got {shown(self.n_elements)}")
         _set(self, "n_elements", int(self.n_elements))
         _choice("cable.mass_lumping", self.mass_lumping, ("consistent", "paper"))
         self._check_derived()
@@ -154,8 +154,8 @@ class CableSpec:
                 value = math.inf
             zero_allowed = name.endswith("damping") and self.damping_constant == 0.0
             if not math.isfinite(value) or (value <= 0.0 and not zero_allowed):
-                given = ", ".join(f"cable.{f} = {getattr(self, f)!r}" for f in fields_)
-                raise SceneError(f"{given} give(s) an element {name.replace('_', ' ')} of {value!r}, "
+                given = ", ".join(f"cable.{f} = {shown(getattr(self, f))}" for f in fields_)
+                raise SceneError(f"{given} give(s) an element {name.replace('_', ' ')} of {shown(value)}, "
                                  "out of floating-point range")
 
     # Derived quantities of the paper's Table 2 -------------------------------------
@@ -258,7 +258,7 @@ class PulleySpec(Pulley):
         _set(self, "center", _vector("pulley.center", self.center, 2))
         _set(self, "radius", positive("pulley.radius", self.radius))
         if self.side not in (-1, 1) or isinstance(self.side, bool):
-            raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {self.side!r}")
+            raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {shown(self.side)}")
         _set(self, "side", int(self.side))
         _set(self, "contact_stiffness", positive("pulley.contact_stiffness", self.contact_stiffness))
         _set(self, "contact_damping", non_negative("pulley.contact_damping", self.contact_damping))
@@ -294,7 +294,7 @@ class PlatformSpec:
         anchors = np.asarray(self.anchors, dtype=object)
         if anchors.ndim != 2 or anchors.shape[1] != 2 or anchors.shape[0] < 1:
             raise SceneError(
-                f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), got {self.anchors!r}"
+                f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), got {shown(self.anchors)}"
             )
         _set(self, "anchors", tuple(_vector(f"platform.anchors[{i}]", a, 2) for i, a in enumerate(self.anchors)))
         _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3))
@@ -438,7 +438,7 @@ class Effects:
         _choice("effects.preset", self.preset, tuple(PRESETS))
         for f in fields(self):
             if f.type in ("bool", bool) and not isinstance(getattr(self, f.name), bool):
-                raise SceneError(f"effects.{f.name} must be true or false, got {getattr(self, f.name)!r}")
+                raise SceneError(f"effects.{f.name} must be true or false, got {shown(getattr(self, f.name))}")
         _choice("effects.bending_model", self.bending_model, ("exact", "linear"))
         _choice("effects.pulley_contact_model", self.pulley_contact_model, PULLEY_CONTACT_MODELS)
         if not self.cable_mass:
@@ -529,7 +529,7 @@ class SolverSpec:
 
     def __post_init__(self) -> None:
         if not isinstance(self.initial_accelerations, bool):
-            raise SceneError(f"solver.initial_accelerations must be true or false, got {self.initial_accelerations!r}")
+            raise SceneError(f"solver.initial_accelerations must be true or false, got {shown(self.initial_accelerations)}")
         _set(self, "end_time", positive("solver.end_time", self.end_time))
         _set(self, "step_size", positive("solver.step_size", self.step_size))
         if self.step_size > self.end_time:
@@ -539,7 +539,7 @@ class SolverSpec:
                              f"{self.end_time / self.step_size:.3g} steps; at most {MAX_STEPS:.0e} are allowed")
         rho = finite("solver.spectral_radius", self.spectral_radius)
         if not 0.0 <= rho <= 1.0:
-            raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {self.spectral_radius!r}")
+            raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {shown(self.spectral_radius)}")
         _set(self, "spectral_radius", rho)
         _choice("solver.newton", self.newton, ("modified", "full"))
         _set(self, "output_period", positive("solver.output_period", self.output_period))
@@ -556,7 +556,7 @@ class SolverSpec:
         _choice("solver.integrator", self.integrator, ("generalized_alpha", "rk44"))
         tolerance = positive("solver.newton_tolerance", self.newton_tolerance)
         if tolerance > 1e-3:
-            raise SceneError(f"solver.newton_tolerance must be at most 1e-3 (relative), got {self.newton_tolerance!r}")
+            raise SceneError(f"solver.newton_tolerance must be at most 1e-3 (relative), got {shown(self.newton_tolerance)}")
         _set(self, "newton_tolerance", tolerance)
 
     @property
@@ -582,7 +582,7 @@ MODEL_FIELDS: dict[str, tuple[str, ...]] = {
 def _overrides(path: str, data: Any, part: str) -> dict[str, Any]:
     """A copy of one override table, refusing keys the controllers' model cannot override."""
     if not isinstance(data, Mapping):
-        raise SceneError(f"{path} must be a table, got {data!r}")
+        raise SceneError(f"{path} must be a table, got {shown(data)}")
     known = MODEL_FIELDS[part]
     unknown = sorted(set(data) - set(known))
     if unknown:
@@ -641,7 +641,7 @@ class ControllerModel:
         for name, part in (("cables", "cable"), ("pulleys", "pulley")):
             entries = getattr(self, name)
             if isinstance(entries, (str, bytes, Mapping)) or not hasattr(entries, "__iter__"):
-                raise SceneError(f"controller_model.{name} must be an array of tables, got {entries!r}")
+                raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(entries)}")
             _set(self, name, tuple(_overrides(f"controller_model.{name}[{i}]", e, part)
                                    for i, e in enumerate(entries)))
         if self.gravity is not None:
@@ -710,7 +710,7 @@ def _override(part: Any, changes: Mapping[str, Any], path: str, head: str) -> An
 def controller_model_from_dict(data: Any) -> ControllerModel:
     """A :class:`ControllerModel` from its TOML table, refusing unknown keys (named)."""
     if not isinstance(data, Mapping):
-        raise SceneError(f"controller_model must be a table, got {data!r}")
+        raise SceneError(f"controller_model must be a table, got {shown(data)}")
     known = {f.name for f in fields(ControllerModel)}
     unknown = sorted(set(data) - known)
     if unknown:
@@ -718,7 +718,7 @@ def controller_model_from_dict(data: Any) -> ControllerModel:
     values = dict(data)
     for name in ("cables", "pulleys"):
         if name in values and not (isinstance(values[name], list) and all(isinstance(e, Mapping) for e in values[name])):
-            raise SceneError(f"controller_model.{name} must be an array of tables, got {values[name]!r}")
+            raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(values[name])}")
     return ControllerModel(**values)
 
 
@@ -771,24 +771,24 @@ class Scene:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
-            raise SceneError(f"name must be a non-empty string, got {self.name!r}")
+            raise SceneError(f"name must be a non-empty string, got {shown(self.name)}")
         if not isinstance(self.description, str):
-            raise SceneError(f"description must be a string, got {self.description!r}")
+            raise SceneError(f"description must be a string, got {shown(self.description)}")
         for name, kind in (("cables", CableSpec), ("pulleys", PulleySpec)):
             parts = getattr(self, name)
             if isinstance(parts, (str, bytes, Mapping)) or not hasattr(parts, "__iter__"):
-                raise SceneError(f"{name} must be a sequence of {kind.__name__}, got {parts!r}")
+                raise SceneError(f"{name} must be a sequence of {kind.__name__}, got {shown(parts)}")
             parts = tuple(parts)
             for i, part in enumerate(parts):
                 if not isinstance(part, kind):
-                    raise SceneError(f"{name}[{i}] must be a {kind.__name__}, got {part!r}")
+                    raise SceneError(f"{name}[{i}] must be a {kind.__name__}, got {shown(part)}")
             _set(self, name, parts)
         for name, kind in (("platform", PlatformSpec), ("winch", WinchSpec), ("effects", Effects),
                            ("solver", SolverSpec)):
             if not isinstance(getattr(self, name), kind):
-                raise SceneError(f"{name} must be a {kind.__name__}, got {getattr(self, name)!r}")
+                raise SceneError(f"{name} must be a {kind.__name__}, got {shown(getattr(self, name))}")
         if self.trajectory is not None and not isinstance(self.trajectory, Trajectory):
-            raise SceneError(f"trajectory must be a Trajectory, got {self.trajectory!r}")
+            raise SceneError(f"trajectory must be a Trajectory, got {shown(self.trajectory)}")
         m = len(self.cables)
         if m < 1:
             raise SceneError("cables must list at least one cable")
@@ -806,8 +806,8 @@ class Scene:
             raise SceneError("cable_exit = 'point' needs winch.kind = 'fixed' (the cable starts at the pulley centre)")
         if self.solver.integrator != "generalized_alpha" and self.winch.kind != "fixed":
             raise SceneError(
-                f"solver.integrator = {self.solver.integrator!r} needs winch.kind = 'fixed', got "
-                f"{self.winch.kind!r}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
+                f"solver.integrator = {shown(self.solver.integrator)} needs winch.kind = 'fixed', got "
+                f"{shown(self.winch.kind)}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
                 "and hold them at their initial value, ignoring every winch command")
         if self.trajectory is None:
             from cdpr_exu.scenes.trajectories import HoldTrajectory
@@ -816,7 +816,7 @@ class Scene:
         self._check_reachable()
         if self.controller_model is not None:
             if not isinstance(self.controller_model, ControllerModel):
-                raise SceneError(f"controller_model must be a ControllerModel, got {self.controller_model!r}")
+                raise SceneError(f"controller_model must be a ControllerModel, got {shown(self.controller_model)}")
             if self.controller_model.is_empty():
                 _set(self, "controller_model", None)
             else:
@@ -927,7 +927,7 @@ def _listify(value: Any) -> Any:
 def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
     """Make dataclass ``cls`` from a mapping, refusing unknown keys."""
     if not isinstance(data, Mapping):
-        raise SceneError(f"{path} must be a table, got {data!r}")
+        raise SceneError(f"{path} must be a table, got {shown(data)}")
     known = {f.name for f in fields(cls)}
     unknown = set(data) - known
     if unknown:
@@ -949,11 +949,11 @@ def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list
     """Merge the shared table ``[single]`` into each entry of ``[[plural]]`` (or of ``defaults``)."""
     shared = data.get(single, {})
     if not isinstance(shared, Mapping):
-        raise SceneError(f"{single} must be a table, got {shared!r}")
+        raise SceneError(f"{single} must be a table, got {shown(shared)}")
     shared = dict(shared)
     entries = data.get(plural, defaults)
     if not isinstance(entries, list) or not all(isinstance(e, Mapping) for e in entries):
-        raise SceneError(f"{plural} must be an array of tables, got {entries!r}")
+        raise SceneError(f"{plural} must be an array of tables, got {shown(entries)}")
     return [{**e, **shared} if plural not in data else {**shared, **dict(e)} for e in entries]
 
 
@@ -983,7 +983,7 @@ def refuse_missing(missing: list[str], source: str | None = None) -> None:
     (so that no default stands in for a missing field in a later check or message).
     """
     if missing:
-        where = "scene" if source is None else f"scene {source!r}"
+        where = "scene" if source is None else f"scene {shown(source)}"
         raise SceneError(f"{where} lacks {', '.join(missing)}: a scene must give "
                          f"{'it' if len(missing) == 1 else 'each'}, as no default would be the robot you mean "
                          "(see the scene reference in the README)")
@@ -1012,10 +1012,10 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     a scene must give are required. ``source`` names the file in those messages.
     """
     if not isinstance(data, Mapping):
-        raise SceneError(f"a scene must be a table (mapping), got {data!r}")
+        raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
     data = dict(data)
     if data.get("dimension", 2) != 2:
-        raise SceneError(f"dimension must be 2 (planar) or 3 (spatial), got {data['dimension']!r}")
+        raise SceneError(f"dimension must be 2 (planar) or 3 (spatial), got {shown(data['dimension'])}")
     data.pop("dimension", None)
     top_known = {
         "name", "description", "gravity", "cable_exit", "cable", "cables", "pulley", "pulleys",
@@ -1033,7 +1033,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     platform = _build(PlatformSpec, data.get("platform", {}), "platform")
     effects_data = data.get("effects", {})
     if not isinstance(effects_data, Mapping):
-        raise SceneError(f"effects must be a table, got {effects_data!r}")
+        raise SceneError(f"effects must be a table, got {shown(effects_data)}")
     effects_data = dict(effects_data)
     preset = effects_data.pop("preset", "full")
     effects = Effects.from_preset(preset, **effects_data)
@@ -1071,7 +1071,7 @@ class SpatialSceneError(SceneError):
 
 def _refuse_spatial(source: str | Path) -> None:
     raise SpatialSceneError(
-        f"scene {str(source)!r} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep`, "
+        f"scene {shown(str(source))} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep`, "
         "`study accuracy` and `animate` take spatial scenes; `view` takes planar scenes only (see docs/spatial.md)")
 
 
@@ -1086,10 +1086,10 @@ def load_scene(source: str | Path) -> Scene:
     path = Path(source)
     if path.suffix == ".toml" or path.exists():
         if path.is_dir():
-            raise SceneError(f"scene {str(path)!r} is a directory; give a .toml scene file or a shipped "
+            raise SceneError(f"scene {shown(str(path))} is a directory; give a .toml scene file or a shipped "
                              "scene name (see `cdpr scenes`)")
         if not path.is_file():
-            raise SceneError(f"scene file {str(path)!r} does not exist")
+            raise SceneError(f"scene file {shown(str(path))} does not exist")
         text = path.read_text()
     else:
         name = str(source).replace("-", "_") + ".toml"
@@ -1102,7 +1102,7 @@ def load_scene(source: str | Path) -> Scene:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
+        raise SceneError(f"scene {shown(str(source))} is not valid TOML: {err}") from None
     if isinstance(data, Mapping) and data.get("dimension") == 3:
         _refuse_spatial(source)
     return scene_from_dict(data, source=str(source))
@@ -1122,7 +1122,7 @@ def _check_required_tables(data: Mapping[str, Any], source: str | None) -> None:
     if "pulleys" in missing and isinstance(data.get("pulley"), Mapping) and "center" in data["pulley"]:
         missing.remove("pulleys")
     if missing:
-        where = "scene" if source is None else f"scene {source!r}"
+        where = "scene" if source is None else f"scene {shown(source)}"
         raise SceneError(f"{where} lacks {', '.join(missing)}: a scene file must give "
                          + "; ".join(REQUIRED_TABLES[name] for name in missing)
                          + " (see the scene reference in the README)")
@@ -1162,7 +1162,7 @@ def unknown_scene(source: str | Path) -> SceneError:
     planar, spatial = shipped_names(), shipped_names(SPATIAL_FOLDER)
     close = closest_names(name, planar + spatial)
     guess = f"did you mean {' or '.join(map(repr, close))}? " if close else ""
-    return SceneError(f"no scene named {name!r}; {guess}shipped scenes: {', '.join(planar)}; spatial: "
+    return SceneError(f"no scene named {shown(name)}; {guess}shipped scenes: {', '.join(planar)}; spatial: "
                       f"{', '.join(spatial)} (or give the path of a .toml scene file)")
 
 

@@ -48,7 +48,7 @@ from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
                                   _build, _override, _per_cable, controller_model_from_dict, load_scene, missing_fields,
                                   refuse_missing, shipped_names, unknown_scene)
-from cdpr_exu.core.validation import non_negative, positive, vector
+from cdpr_exu.core.validation import non_negative, positive, shown, vector
 
 __all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
            "shipped_spatial_scenes", "is_spatial", "load_any_scene", "any_scene_from_dict", "save_any_scene"]
@@ -79,7 +79,7 @@ class SpatialPlatformSpec:
     def __post_init__(self) -> None:
         object.__setattr__(self, "mass", non_negative("platform.mass", self.mass))
         if isinstance(self.anchors, (str, bytes, Mapping)):
-            raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {self.anchors!r}")
+            raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {shown(self.anchors)}")
         anchors = tuple(tuple(float(v) for v in vector(f"platform.anchors[{i}]", a, 3, " (x, y, z) [m]"))
                         for i, a in enumerate(self.anchors))
         object.__setattr__(self, "anchors", anchors)
@@ -89,11 +89,11 @@ class SpatialPlatformSpec:
             object.__setattr__(self, "inertia", (0.0, 0.0, 0.0))
         inertia = vector("platform.inertia", self.inertia, 3, " (principal moments) [kg m^2]")
         if np.any(inertia < 0.0):
-            raise SceneError(f"platform.inertia must be zero or positive, got {self.inertia!r}")
+            raise SceneError(f"platform.inertia must be zero or positive, got {shown(self.inertia)}")
         object.__setattr__(self, "inertia", tuple(float(v) for v in inertia))
         if not self.is_point_mass and (self.mass <= 0.0 or min(self.inertia) <= 0.0):
             raise SceneError(f"a rigid platform (an anchor off its centre of mass) needs platform.mass > 0 and "
-                             f"every platform.inertia > 0, got mass {self.mass!r}, inertia {self.inertia!r}")
+                             f"every platform.inertia > 0, got mass {shown(self.mass)}, inertia {shown(self.inertia)}")
 
     @property
     def is_point_mass(self) -> bool:
@@ -173,7 +173,7 @@ def _exit_from_dict(entry: Any, index: int):
     """One ``[[exits]]`` table: a point (3-tuple) or a :class:`SwivelSpec`."""
     path = f"exits[{index}]"
     if not isinstance(entry, Mapping):
-        raise SceneError(f"{path} must be a table, got {entry!r}")
+        raise SceneError(f"{path} must be a table, got {shown(entry)}")
     entry = dict(entry)
     kind = entry.pop("kind", "point")
     if kind == "point":
@@ -183,7 +183,7 @@ def _exit_from_dict(entry: Any, index: int):
         return entry["point"]
     if kind == "swivel":
         return _build(SwivelSpec, entry, path)
-    raise SceneError(f"{path}.kind must be 'point' or 'swivel', got {kind!r}")
+    raise SceneError(f"{path}.kind must be 'point' or 'swivel', got {shown(kind)}")
 
 
 @dataclass(frozen=True)
@@ -248,7 +248,7 @@ class SpatialScene:
 
     def __post_init__(self) -> None:
         if not self.cables or not all(isinstance(c, CableSpec) for c in self.cables):
-            raise SceneError(f"cables must be a non-empty list of cable tables, got {self.cables!r}")
+            raise SceneError(f"cables must be a non-empty list of cable tables, got {shown(self.cables)}")
         object.__setattr__(self, "cables", tuple(self.cables))
         self._set_swivels()
         exits = tuple(tuple(float(v) for v in vector(f"exits[{i}].point", e, 3, " (x, y, z) [m]"))
@@ -261,16 +261,16 @@ class SpatialScene:
         if len(self.platform.anchors) != m:
             raise SceneError(f"platform.anchors must give one anchor per cable ({m}), got {len(self.platform.anchors)}")
         if not isinstance(self.effects, Effects):
-            raise SceneError(f"effects must be an effects table, got {self.effects!r}")
+            raise SceneError(f"effects must be an effects table, got {shown(self.effects)}")
         if not (self.effects.cable_mass and self.effects.axial_elasticity):
-            raise SceneError(f"effects.preset = {self.effects.preset!r}: a spatial scene needs lumped, elastic cables "
+            raise SceneError(f"effects.preset = {shown(self.effects.preset)}: a spatial scene needs lumped, elastic cables "
                              "(effects.cable_mass and effects.axial_elasticity); use the 'full' or 'catenary' preset")
         first = self.cables[0]
         for i, cable in enumerate(self.cables[1:], start=1):
             for name in ("n_elements", "radius", "youngs_modulus", "damping_constant", "mass_lumping"):
                 if getattr(cable, name) != getattr(first, name):
-                    raise SceneError(f"cables[{i}].{name} = {getattr(cable, name)!r} differs from cables[0].{name} = "
-                                     f"{getattr(first, name)!r}: the cables of a spatial scene share one "
+                    raise SceneError(f"cables[{i}].{name} = {shown(getattr(cable, name))} differs from cables[0].{name} = "
+                                     f"{shown(getattr(first, name))}: the cables of a spatial scene share one "
                                      "discretisation, damping and bending so far")
         self.catenary_platform()  # refuses coincident exits, too few cables, anchors on one line
         if self.winch.kind == "servo":
@@ -279,7 +279,7 @@ class SpatialScene:
             raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
         if self.controller_model is not None:
             if not isinstance(self.controller_model, ControllerModel):
-                raise SceneError(f"controller_model must be a controller-model table, got {self.controller_model!r}")
+                raise SceneError(f"controller_model must be a controller-model table, got {shown(self.controller_model)}")
             if self.controller_model.pulley or self.controller_model.pulleys:
                 raise SceneError("controller_model.pulley / controller_model.pulleys: a spatial scene has exits, "
                                  "not pulleys; its controller model overrides cable, cables, platform and gravity")
@@ -319,7 +319,7 @@ class SpatialScene:
         m = len(self.cables)
         swivels = tuple(self.swivels) if self.swivels else (None,) * len(self.exits)
         if len(swivels) != len(self.exits) or not all(s is None or isinstance(s, SwivelSpec) for s in swivels):
-            raise SceneError(f"swivels must give a SwivelSpec or None per exit ({len(self.exits)}), got {self.swivels!r}")
+            raise SceneError(f"swivels must give a SwivelSpec or None per exit ({len(self.exits)}), got {shown(self.swivels)}")
         exits = list(self.exits)
         for i, swivel in enumerate(swivels):
             if swivel is None:
@@ -327,18 +327,18 @@ class SpatialScene:
             if exits[i] is None or isinstance(exits[i], SwivelSpec):
                 exits[i] = swivel.inlet
             elif np.any(np.asarray(exits[i], dtype=float) != np.asarray(swivel.inlet)):
-                raise SceneError(f"exits[{i}].inlet = {list(swivel.inlet)} differs from exits[{i}] = {exits[i]!r}: "
+                raise SceneError(f"exits[{i}].inlet = {list(swivel.inlet)} differs from exits[{i}] = {shown(exits[i])}: "
                                  "a swivel pulley's cable leaves the frame at its inlet")
             if swivel.radius >= self.cables[min(i, m - 1)].unstrained_length:
-                raise SceneError(f"exits[{i}].radius = {swivel.radius!r} m: the cable (cables[{i}].unstrained_length = "
-                                 f"{self.cables[min(i, m - 1)].unstrained_length!r} m) would not reach past the disc")
+                raise SceneError(f"exits[{i}].radius = {shown(swivel.radius)} m: the cable (cables[{i}].unstrained_length = "
+                                 f"{shown(self.cables[min(i, m - 1)].unstrained_length)} m) would not reach past the disc")
             from cdpr_exu.physics.swivel_pulley import SAFE_ELEMENT_FRACTION
 
             cable = self.cables[min(i, m - 1)]
             if cable.element_length > SAFE_ELEMENT_FRACTION * swivel.radius * (1.0 + 1e-9):
                 raise SceneError(
                     f"cables[{i}].n_elements = {cable.n_elements}: its elements ({cable.element_length:.4g} m) are longer "
-                    f"than {SAFE_ELEMENT_FRACTION:g} of the swivel pulley's radius (exits[{i}].radius = {swivel.radius!r} "
+                    f"than {SAFE_ELEMENT_FRACTION:g} of the swivel pulley's radius (exits[{i}].radius = {shown(swivel.radius)} "
                     f"m); give at least {math.ceil(cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius))} "
                     "(measured: coarser chains lose the wrap and gain energy, and Exudyn's static solver fails)")
         object.__setattr__(self, "exits", tuple(exits))
@@ -452,14 +452,14 @@ def spatial_scene_from_dict(data: Mapping[str, Any], source: str | None = None) 
     in that message.
     """
     if not isinstance(data, Mapping):
-        raise SceneError(f"a scene must be a table (mapping), got {data!r}")
+        raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
     known = {"name", "description", "dimension", "gravity", "cable", "cables", "exits", "platform", "effects",
              "trajectory", "solver", "winch", "controller_model"}
     unknown = set(data) - known
     if unknown:
         raise SceneError(f"spatial scene has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
     if data.get("dimension") != 3:
-        raise SceneError(f"a spatial scene says dimension = 3, got {data.get('dimension')!r}")
+        raise SceneError(f"a spatial scene says dimension = 3, got {shown(data.get('dimension'))}")
     for table in ("cables", "exits", "platform"):
         if table not in data:
             raise SceneError(f"spatial scene lacks {table}: give [[cables]] (one per cable, at least its "
@@ -467,7 +467,7 @@ def spatial_scene_from_dict(data: Mapping[str, Any], source: str | None = None) 
     exits = data["exits"]
     if not isinstance(exits, list):
         raise SceneError(f"exits must be an array of tables, each a point exit (point = [x, y, z]) or a swivel "
-                         f"pulley (kind = 'swivel', inlet = [x, y, z], radius, ...), got {exits!r}")
+                         f"pulley (kind = 'swivel', inlet = [x, y, z], radius, ...), got {shown(exits)}")
     exit_dicts = exits
     exits = [_exit_from_dict(e, i) for i, e in enumerate(exits)]
     swivels = tuple(e if isinstance(e, SwivelSpec) else None for e in exits)
@@ -475,7 +475,7 @@ def spatial_scene_from_dict(data: Mapping[str, Any], source: str | None = None) 
     cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
     effects_data = data.get("effects", {})
     if not isinstance(effects_data, Mapping):
-        raise SceneError(f"effects must be a table, got {effects_data!r}")
+        raise SceneError(f"effects must be a table, got {shown(effects_data)}")
     effects_data = dict(effects_data)
     effects = Effects.from_preset(effects_data.pop("preset", "full"), **effects_data)
     platform = _build(SpatialPlatformSpec, data["platform"], "platform")
@@ -526,7 +526,7 @@ def load_spatial_scene(source: str | Path) -> SpatialScene:
     path = Path(source)
     if path.suffix == ".toml" or path.exists():
         if not path.is_file():
-            raise SceneError(f"scene file {str(path)!r} does not exist")
+            raise SceneError(f"scene file {shown(str(path))} does not exist")
         text = path.read_text()
     else:
         text = shipped_spatial_text(str(source))
@@ -535,7 +535,7 @@ def load_spatial_scene(source: str | Path) -> SpatialScene:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
+        raise SceneError(f"scene {shown(str(source))} is not valid TOML: {err}") from None
     return spatial_scene_from_dict(data, source=str(source))
 
 
