@@ -1075,6 +1075,46 @@ def _refuse_spatial(source: str | Path) -> None:
         "`study accuracy` and `animate` take spatial scenes; `view` takes planar scenes only (see docs/spatial.md)")
 
 
+def is_scene_file(source: str | Path) -> bool:
+    """True when ``source`` names a file (a ``.toml`` path, or anything that exists) rather than a shipped scene."""
+    path = Path(source)
+    return path.suffix == ".toml" or path.exists()
+
+
+def read_scene_file(source: str | Path) -> dict[str, Any]:
+    """The plain data of the TOML scene file ``source``, or SceneError naming the file and what is wrong.
+
+    Refused: a folder, a missing or unreadable file, a file that is not UTF-8 text (TOML is UTF-8:
+    a Latin-1 or binary file), and text that is not valid TOML. An empty file is valid TOML (no
+    tables); the loaders then say which tables it lacks.
+    """
+    path = Path(source)
+    if path.is_dir():
+        raise SceneError(f"scene {shown(str(path))} is a directory; give a .toml scene file or a shipped "
+                         "scene name (see `cdpr scenes`)")
+    if not path.is_file():
+        raise SceneError(f"scene file {shown(str(path))} does not exist")
+    try:
+        raw = path.read_bytes()
+    except OSError as err:
+        raise SceneError(f"scene file {shown(str(path))} cannot be read: {err.strerror or err}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise SceneError(f"scene file {shown(str(path))} is not UTF-8 TOML: byte {err.start} is 0x{raw[err.start]:02x} "
+                         "(a binary file, or text saved in another encoding such as Latin-1); save it as UTF-8 "
+                         "text") from None
+    return parse_scene_text(text, source)
+
+
+def parse_scene_text(text: str, source: str | Path) -> dict[str, Any]:
+    """The plain data of a scene's TOML ``text``; SceneError naming ``source`` if it is not valid TOML."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"scene {shown(str(source))} is not valid TOML: {err}") from None
+
+
 def load_scene(source: str | Path) -> Scene:
     """Load a planar scene by shipped name (e.g. ``"paper-circle"``) or from a TOML file path.
 
@@ -1082,15 +1122,11 @@ def load_scene(source: str | Path) -> Scene:
     ------
     SpatialSceneError
         For a spatial scene (:func:`cdpr_exu.scenes.spatial_scene.load_spatial_scene` loads those).
+    SceneError
+        For a file that cannot be read as a scene (:func:`read_scene_file`), and for a bad scene.
     """
-    path = Path(source)
-    if path.suffix == ".toml" or path.exists():
-        if path.is_dir():
-            raise SceneError(f"scene {shown(str(path))} is a directory; give a .toml scene file or a shipped "
-                             "scene name (see `cdpr scenes`)")
-        if not path.is_file():
-            raise SceneError(f"scene file {shown(str(path))} does not exist")
-        text = path.read_text()
+    if is_scene_file(source):
+        data = read_scene_file(source)
     else:
         name = str(source).replace("-", "_") + ".toml"
         resource = resources.files("cdpr_exu.scenes").joinpath(name)
@@ -1098,11 +1134,7 @@ def load_scene(source: str | Path) -> Scene:
             _refuse_spatial(source)
         if not resource.is_file():
             raise unknown_scene(source)
-        text = resource.read_text()
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise SceneError(f"scene {shown(str(source))} is not valid TOML: {err}") from None
+        data = parse_scene_text(resource.read_text(encoding="utf-8"), source)
     if isinstance(data, Mapping) and data.get("dimension") == 3:
         _refuse_spatial(source)
     return scene_from_dict(data, source=str(source))

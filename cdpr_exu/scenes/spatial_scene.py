@@ -33,7 +33,6 @@ message that says so.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
@@ -46,8 +45,9 @@ from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.geometry import above_exits
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
-                                  _build, _override, _per_cable, controller_model_from_dict, load_scene, missing_fields,
-                                  refuse_missing, shipped_names, unknown_scene)
+                                  _build, _override, _per_cable, controller_model_from_dict, is_scene_file, load_scene,
+                                  missing_fields, parse_scene_text, read_scene_file, refuse_missing, shipped_names,
+                                  unknown_scene)
 from cdpr_exu.core.validation import non_negative, positive, shown, vector
 
 __all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
@@ -518,24 +518,18 @@ def shipped_spatial_scenes() -> list[str]:
 def shipped_spatial_text(name: str) -> str | None:
     """The TOML text of the shipped spatial scene ``name``, or None."""
     resource = resources.files("cdpr_exu.scenes").joinpath(SPATIAL_FOLDER, str(name).replace("-", "_") + ".toml")
-    return resource.read_text() if resource.is_file() else None
+    return resource.read_text(encoding="utf-8") if resource.is_file() else None
 
 
 def load_spatial_scene(source: str | Path) -> SpatialScene:
     """Load a spatial scene by shipped name (e.g. ``"spatial-four-cable"``) or from a TOML file path."""
-    path = Path(source)
-    if path.suffix == ".toml" or path.exists():
-        if not path.is_file():
-            raise SceneError(f"scene file {shown(str(path))} does not exist")
-        text = path.read_text()
+    if is_scene_file(source):
+        data = read_scene_file(source)
     else:
         text = shipped_spatial_text(str(source))
         if text is None:
             raise unknown_scene(source)
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise SceneError(f"scene {shown(str(source))} is not valid TOML: {err}") from None
+        data = parse_scene_text(text, source)
     return spatial_scene_from_dict(data, source=str(source))
 
 
