@@ -70,29 +70,35 @@ def _refuse_non_numbers(value: Any, message: str) -> None:
         raise SceneError(message)
 
 
-def finite(name: str, value: Any) -> float:
-    """``value`` as a finite float; text and booleans are refused, not converted."""
+def _unit(unit: str) -> str:
+    """`` [unit]`` for a message, or nothing."""
+    return f" [{unit}]" if unit else ""
+
+
+def finite(name: str, value: Any, unit: str = "") -> float:
+    """``value`` as a finite float; text and booleans are refused, not converted. ``unit`` (e.g. ``"kg"``)
+    is named in the message: "platform.mass must be a real number [kg], got '2.5'"."""
     if not is_number(value):
-        raise SceneError(f"{name} must be a real number, got {shown(value)}")
+        raise SceneError(f"{name} must be a real number{_unit(unit)}, got {shown(value)}")
     number = float(value)
     if not math.isfinite(number):
-        raise SceneError(f"{name} must be finite, got {shown(value)}")
+        raise SceneError(f"{name} must be finite{_unit(unit)}, got {shown(value)}")
     return number
 
 
-def positive(name: str, value: Any) -> float:
-    """``value`` as a finite float > 0."""
-    number = finite(name, value)
+def positive(name: str, value: Any, unit: str = "") -> float:
+    """``value`` as a finite float > 0 ("platform.mass must be positive [kg], got -2.5")."""
+    number = finite(name, value, unit)
     if number <= 0.0:
-        raise SceneError(f"{name} must be positive, got {shown(value)}")
+        raise SceneError(f"{name} must be positive{_unit(unit)}, got {shown(value)}")
     return number
 
 
-def non_negative(name: str, value: Any) -> float:
+def non_negative(name: str, value: Any, unit: str = "") -> float:
     """``value`` as a finite float >= 0."""
-    number = finite(name, value)
+    number = finite(name, value, unit)
     if number < 0.0:
-        raise SceneError(f"{name} must be zero or positive, got {shown(value)}")
+        raise SceneError(f"{name} must be zero or positive{_unit(unit)}, got {shown(value)}")
     return number
 
 

@@ -318,11 +318,13 @@ class SwivelPulley:
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
-        set_(self, "inlet", tuple(float(v) for v in vector("swivel.inlet", self.inlet, 3)))
+        set_(self, "inlet", tuple(float(v) for v in vector("swivel.inlet", self.inlet, 3, " (x, y, z) [m]")))
+        units = {"radius": "m", "groove_radius": "m", "flange_height": "m", "contact_stiffness": "N/m",
+                 "swivel_inertia": "kg m^2", "contact_damping": "N s/m", "bearing_damping": "N m s", "onset_band": "m"}
         for name in ("radius", "groove_radius", "flange_height", "contact_stiffness", "swivel_inertia"):
-            set_(self, name, positive(f"swivel.{name}", getattr(self, name)))
+            set_(self, name, positive(f"swivel.{name}", getattr(self, name), units[name]))
         for name in ("contact_damping", "bearing_damping", "onset_band"):
-            set_(self, name, non_negative(f"swivel.{name}", getattr(self, name)))
+            set_(self, name, non_negative(f"swivel.{name}", getattr(self, name), units[name]))
         if self.groove_radius >= self.radius:
             raise SceneError(f"swivel.groove_radius must be smaller than swivel.radius = {shown(self.radius)}, "
                              f"got {shown(self.groove_radius)}")

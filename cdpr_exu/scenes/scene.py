@@ -32,16 +32,17 @@ from cdpr_exu.scenes.trajectories import Trajectory, trajectory_from_dict
 # --------------------------------------------------------------------------- checks
 
 
-def _vector(path: str, value: Any, length: int) -> tuple[float, ...]:
-    """Return ``value`` as a tuple of ``length`` finite floats."""
+def _vector(path: str, value: Any, length: int, unit: str = "") -> tuple[float, ...]:
+    """Return ``value`` as a tuple of ``length`` finite floats; ``unit`` is named in the messages."""
+    units = f" [{unit}]" if unit else ""
     if isinstance(value, (str, bytes, Mapping)):
-        raise SceneError(f"{path} must be a list of {length} numbers, got {shown(value)}")
+        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}")
     try:
         items = list(value)
     except TypeError:
-        raise SceneError(f"{path} must be a list of {length} numbers, got {shown(value)}") from None
+        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}") from None
     if len(items) != length:
-        raise SceneError(f"{path} must have {length} entries, got {len(items)}: {shown(value)}")
+        raise SceneError(f"{path} must have {length} entries{units}, got {len(items)}: {shown(value)}")
     return tuple(finite(f"{path}[{i}]", v) for i, v in enumerate(items))
 
 
@@ -116,17 +117,17 @@ class CableSpec:
     max_tension: float | None = None
 
     def __post_init__(self) -> None:
-        _set(self, "unstrained_length", positive("cable.unstrained_length", self.unstrained_length))
+        _set(self, "unstrained_length", positive("cable.unstrained_length", self.unstrained_length, "m"))
         for name in ("min_tension", "max_tension"):
             if getattr(self, name) is not None:
-                _set(self, name, non_negative(f"cable.{name}", getattr(self, name)))
+                _set(self, name, non_negative(f"cable.{name}", getattr(self, name), "N"))
         if self.min_tension is not None and self.max_tension is not None and self.min_tension >= self.max_tension:
             raise SceneError(f"cable.min_tension = {shown(self.min_tension)} N must be below cable.max_tension = "
                              f"{shown(self.max_tension)} N")
-        _set(self, "radius", positive("cable.radius", self.radius))
-        _set(self, "linear_density", positive("cable.linear_density", self.linear_density))
-        _set(self, "youngs_modulus", positive("cable.youngs_modulus", self.youngs_modulus))
-        _set(self, "damping_constant", non_negative("cable.damping_constant", self.damping_constant))
+        _set(self, "radius", positive("cable.radius", self.radius, "m"))
+        _set(self, "linear_density", positive("cable.linear_density", self.linear_density, "kg/m"))
+        _set(self, "youngs_modulus", positive("cable.youngs_modulus", self.youngs_modulus, "Pa"))
+        _set(self, "damping_constant", non_negative("cable.damping_constant", self.damping_constant, "N s/m^2"))
         if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
             raise SceneError(f"cable.n_elements must be a whole number, got {shown(self.n_elements)}")
         if self.n_elements < 2:
@@ -255,13 +256,13 @@ class PulleySpec(Pulley):
     contact_damping: float = 10.0
 
     def __post_init__(self) -> None:
-        _set(self, "center", _vector("pulley.center", self.center, 2))
-        _set(self, "radius", positive("pulley.radius", self.radius))
+        _set(self, "center", _vector("pulley.center", self.center, 2, "m"))
+        _set(self, "radius", positive("pulley.radius", self.radius, "m"))
         if self.side not in (-1, 1) or isinstance(self.side, bool):
             raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {shown(self.side)}")
         _set(self, "side", int(self.side))
-        _set(self, "contact_stiffness", positive("pulley.contact_stiffness", self.contact_stiffness))
-        _set(self, "contact_damping", non_negative("pulley.contact_damping", self.contact_damping))
+        _set(self, "contact_stiffness", positive("pulley.contact_stiffness", self.contact_stiffness, "N/m"))
+        _set(self, "contact_damping", non_negative("pulley.contact_damping", self.contact_damping, "N s/m"))
 
 
 @dataclass(frozen=True)
@@ -289,18 +290,18 @@ class PlatformSpec:
     size: tuple[float, float] = (0.3, 0.2)
 
     def __post_init__(self) -> None:
-        _set(self, "mass", positive("platform.mass", self.mass))
-        _set(self, "inertia", positive("platform.inertia", self.inertia))
+        _set(self, "mass", positive("platform.mass", self.mass, "kg"))
+        _set(self, "inertia", positive("platform.inertia", self.inertia, "kg m^2"))
         anchors = np.asarray(self.anchors, dtype=object)
         if anchors.ndim != 2 or anchors.shape[1] != 2 or anchors.shape[0] < 1:
             raise SceneError(
                 f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), got {shown(self.anchors)}"
             )
-        _set(self, "anchors", tuple(_vector(f"platform.anchors[{i}]", a, 2) for i, a in enumerate(self.anchors)))
-        _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3))
-        size = _vector("platform.size", self.size, 2)
+        _set(self, "anchors", tuple(_vector(f"platform.anchors[{i}]", a, 2, "m") for i, a in enumerate(self.anchors)))
+        _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3, "m, m, rad"))
+        size = _vector("platform.size", self.size, 2, "m")
         for i, s in enumerate(size):
-            non_negative(f"platform.size[{i}]", s)
+            non_negative(f"platform.size[{i}]", s, "m")
         _set(self, "size", size)
 
     @property
@@ -339,10 +340,10 @@ class WinchSpec:
 
     def __post_init__(self) -> None:
         _choice("winch.kind", self.kind, ("kinematic", "servo", "fixed"))
-        _set(self, "drum_radius", positive("winch.drum_radius", self.drum_radius))
-        _set(self, "drum_inertia", positive("winch.drum_inertia", self.drum_inertia))
+        _set(self, "drum_radius", positive("winch.drum_radius", self.drum_radius, "m"))
+        _set(self, "drum_inertia", positive("winch.drum_inertia", self.drum_inertia, "kg m^2"))
         _choice("winch.servo_design", self.servo_design, ("pole_placement", "lqr"))
-        _set(self, "servo_bandwidth", positive("winch.servo_bandwidth", self.servo_bandwidth))
+        _set(self, "servo_bandwidth", positive("winch.servo_bandwidth", self.servo_bandwidth, "rad/s"))
 
     @property
     def drum_mass(self) -> float:
@@ -530,8 +531,8 @@ class SolverSpec:
     def __post_init__(self) -> None:
         if not isinstance(self.initial_accelerations, bool):
             raise SceneError(f"solver.initial_accelerations must be true or false, got {shown(self.initial_accelerations)}")
-        _set(self, "end_time", positive("solver.end_time", self.end_time))
-        _set(self, "step_size", positive("solver.step_size", self.step_size))
+        _set(self, "end_time", positive("solver.end_time", self.end_time, "s"))
+        _set(self, "step_size", positive("solver.step_size", self.step_size, "s"))
         if self.step_size > self.end_time:
             raise SceneError(f"solver.step_size ({self.step_size}) must not exceed solver.end_time ({self.end_time})")
         if self.end_time / self.step_size > MAX_STEPS:
@@ -542,7 +543,7 @@ class SolverSpec:
             raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {shown(self.spectral_radius)}")
         _set(self, "spectral_radius", rho)
         _choice("solver.newton", self.newton, ("modified", "full"))
-        _set(self, "output_period", positive("solver.output_period", self.output_period))
+        _set(self, "output_period", positive("solver.output_period", self.output_period, "s"))
         if self.output_period < self.step_size * (1 - 1e-9):
             samples = int(math.floor(self.end_time / self.step_size + 1e-9)) + 1
             warnings.warn(
@@ -645,7 +646,7 @@ class ControllerModel:
             _set(self, name, tuple(_overrides(f"controller_model.{name}[{i}]", e, part)
                                    for i, e in enumerate(entries)))
         if self.gravity is not None:
-            _set(self, "gravity", non_negative("controller_model.gravity", self.gravity))
+            _set(self, "gravity", non_negative("controller_model.gravity", self.gravity, "m/s^2"))
 
     def is_empty(self) -> bool:
         """True when it overrides nothing (the controllers know the plant)."""
@@ -798,7 +799,7 @@ class Scene:
             raise SceneError(
                 f"platform.anchors must list one anchor per cable ({m}), got {len(self.platform.anchors)}"
             )
-        _set(self, "gravity", non_negative("gravity", self.gravity))
+        _set(self, "gravity", non_negative("gravity", self.gravity, "m/s^2"))
         _choice("cable_exit", self.cable_exit, ("pulley", "point"))
         if self.winch.kind == "servo" and not self.effects.cable_mass:
             raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")

@@ -77,7 +77,7 @@ class SpatialPlatformSpec:
     anchors: tuple = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "mass", non_negative("platform.mass", self.mass))
+        object.__setattr__(self, "mass", non_negative("platform.mass", self.mass, "kg"))
         if isinstance(self.anchors, (str, bytes, Mapping)):
             raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {shown(self.anchors)}")
         anchors = tuple(tuple(float(v) for v in vector(f"platform.anchors[{i}]", a, 3, " (x, y, z) [m]"))
@@ -145,7 +145,7 @@ class SwivelSpec:
     winch_line: float = 0.3
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "winch_line", positive("swivel.winch_line", self.winch_line))
+        object.__setattr__(self, "winch_line", positive("swivel.winch_line", self.winch_line, "m"))
         pulley = self.pulley()  # refuses bad fields, naming them swivel.<field>
         for name in ("inlet", "radius", "contact_stiffness", "contact_damping", "swivel_inertia", "bearing_damping",
                      "groove_radius", "flange_height"):
@@ -254,7 +254,7 @@ class SpatialScene:
         exits = tuple(tuple(float(v) for v in vector(f"exits[{i}].point", e, 3, " (x, y, z) [m]"))
                       for i, e in enumerate(self.exits))
         object.__setattr__(self, "exits", exits)
-        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
+        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity, "m/s^2"))
         m = len(self.cables)
         if len(exits) != m:
             raise SceneError(f"exits must give one exit point per cable ({m}), got {len(exits)}")
