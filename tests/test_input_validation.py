@@ -19,7 +19,7 @@ import tomllib
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
 from cdpr_exu.physics import bending
@@ -40,7 +40,7 @@ from cdpr_exu.scenes.scene import (
     scene_from_dict,
 )
 from cdpr_exu.run.simulate import simulate
-from cdpr_exu.scenes.spatial_scene import shipped_spatial_text, spatial_scene_from_dict
+from cdpr_exu.scenes.spatial_scene import load_any_scene, shipped_spatial_text, spatial_scene_from_dict
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 
 NAN, INF = float("nan"), float("inf")
@@ -563,26 +563,32 @@ def _paths(data, path=()):
             yield from _paths(value, path + (index,))
 
 
+def _number_paths(base, paths):
+    """The paths to numbers (not booleans) of ``base``."""
+    return [path for path in paths if isinstance(_get(base, path), (int, float)) and not isinstance(_get(base, path), bool)]
+
+
 PATHS = sorted(_paths(PAPER_DICT), key=repr)
 #: The numbers among them, drawn half the time: their mutants are accepted more
 #: often, so that the simulation itself meets extreme values, not only the validation.
-NUMBER_PATHS = [path for path in PATHS if isinstance(_get(PAPER_DICT, path), (int, float))
-                and not isinstance(_get(PAPER_DICT, path), bool)]
+NUMBER_PATHS = _number_paths(PAPER_DICT, PATHS)
 
 EXTREME_NUMBERS = st.sampled_from([0.0, -0.0, -1.0, 1e300, -1e300, 1e-300, 5e-324, NAN, INF, -INF, 10**30, 3, 2.5, 1e-9])
-WRONG_TYPES = st.sampled_from([None, True, "abc", "", [], {}, [1.0], {"a": 1}, [[1.0, 2.0]]])
+WRONG_TYPES = st.sampled_from([None, True, "abc", "", [], {}, [1.0], {"a": 1}, [[1.0, 2.0]], "1.0", False])
 
 
-@st.composite
-def malformed_scene_dicts(draw):
-    """The paper scene's plain data with one to three fields broken."""
-    data = copy.deepcopy(PAPER_DICT)
+def _broken(draw, base, paths, number_paths):
+    """``base`` (plain scene data) with one to three of its fields broken: an extreme number, a
+    scaled one, a wrong type, a list of the wrong length, or the field removed."""
+    data = copy.deepcopy(base)
     for _ in range(draw(st.integers(1, 3))):
-        path = draw(st.sampled_from(NUMBER_PATHS) | st.sampled_from(PATHS))
+        path = draw(st.sampled_from(number_paths) | st.sampled_from(paths))
         try:
             parent, old = _get(data, path[:-1]), _get(data, path)
         except (KeyError, IndexError, TypeError):
             continue  # an earlier mutation removed or replaced this path
+        if not isinstance(parent, (dict, list)):
+            continue  # replaced by text, which indexes too
         kind = draw(st.sampled_from(["number", "scaled", "type", "length", "delete"]))
         if kind == "number":
             new = draw(EXTREME_NUMBERS | st.floats(allow_nan=True, allow_infinity=True))
@@ -597,6 +603,27 @@ def malformed_scene_dicts(draw):
             new = draw(WRONG_TYPES)
         parent[path[-1]] = new
     return data
+
+
+@st.composite
+def malformed_scene_dicts(draw):
+    """The paper scene's plain data with one to three fields broken."""
+    return _broken(draw, PAPER_DICT, PATHS, NUMBER_PATHS)
+
+
+#: Spatial scenes as plain data: a rigid platform on point exits (no trajectory), a point mass
+#: over swivel pulleys (with trajectory, solver and winch).
+SPATIAL_DICTS = [load_any_scene(name).to_dict() for name in ("spatial-four-cable", "spatial-four-cable-swivel")]
+SPATIAL_PATHS = [sorted(_paths(base), key=repr) for base in SPATIAL_DICTS]
+SPATIAL_NUMBER_PATHS = [_number_paths(base, paths) for base, paths in zip(SPATIAL_DICTS, SPATIAL_PATHS)]
+
+
+@st.composite
+def malformed_spatial_scene_dicts(draw):
+    """A shipped spatial scene's plain data (rigid on point exits, or over swivel pulleys) with one to
+    three fields broken, as :func:`malformed_scene_dicts` breaks the planar one."""
+    k = draw(st.integers(0, len(SPATIAL_DICTS) - 1))
+    return _broken(draw, SPATIAL_DICTS[k], SPATIAL_PATHS[k], SPATIAL_NUMBER_PATHS[k])
 
 
 def _short(scene: Scene) -> Scene:
@@ -623,6 +650,70 @@ def test_malformed_scenes_are_refused_or_run_without_crash_hang_or_nan(data):
     assert time.perf_counter() - start < 120.0
     for series in [result.platform_pose, result.platform_velocity, *result.nodes, *result.tensions]:
         assert np.all(np.isfinite(series))
+
+
+@seed(20261124)
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(malformed_spatial_scene_dicts())
+def test_malformed_spatial_scenes_are_refused_with_the_projects_errors_only(data):
+    """Issue 23 (evidence): the planar fuzz extended to spatial scene dicts; validation and the
+    reference check that runs before any spatial run give SceneError or UnreachableError, never
+    another exception (a TypeError, an IndexError, a ValueError of NumPy's). (A colleague's fuzz
+    runs the accepted ones.)"""
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+
+    try:
+        scene = spatial_scene_from_dict(data)
+        if scene.trajectory is not None:
+            check_spatial_reference(scene)
+    except (SceneError, UnreachableError) as err:
+        assert str(err)
+
+
+#: What the spatial fuzz found (issue 23), each a foreign exception or a message naming no field before:
+#: (scene, key path, value, words of the refusal).
+FUZZ_FINDINGS = [
+    (0, ("gravity",), 1.7976931348623157e308, "give a weight of inf N"),  # ValueError in nnls
+    (1, ("gravity",), 1.7976931348623157e308, "platform.mass = 5.0 kg and gravity"),
+    (1, ("trajectory", "angular_rate"), 1e300, "trajectory is out of floating-point range: its acceleration at "
+     "t = 0.010 s is [-inf, inf, 0.0]"),  # ValueError in nnls
+    (1, ("cables", 0, "unstrained_length"), 1e308, "it would take inf, more than the 300 allowed"),  # OverflowError
+    (0, ("platform", "anchors"), True, "platform.anchors must be a list of (x, y, z) points, got True"),  # TypeError
+    (0, ("exits", 1, "point"), [1.5, 1.5, 0.0], "share the exit_point [1.5, 1.5, 0.0] m"),  # np.float64(1.5)
+    (0, ("dimension",), None, "dimension must be 3 for a spatial scene, got None"),
+    (1, ("cables", 0, "linear_density"), 1e308, "give a weight per length of inf N/m"),  # 'weight_per_length'
+]
+
+
+@pytest.mark.parametrize("k, path, value, words", FUZZ_FINDINGS)
+def test_what_the_spatial_fuzz_found_is_refused_naming_the_field(k, path, value, words):
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+
+    data = copy.deepcopy(SPATIAL_DICTS[k])
+    _get(data, path[:-1])[path[-1]] = value
+    with pytest.raises((SceneError, UnreachableError), match=re.escape(words)):
+        scene = spatial_scene_from_dict(data)
+        check_spatial_reference(scene)
+
+
+def test_a_spatial_rotation_vector_of_1e300_rad_gives_a_rotation_matrix():
+    """rotation_from_vector squared the angle (OverflowError beyond 1e154 rad): the fuzz's trajectory.rotation."""
+    from cdpr_exu.core.geometry import rotation_from_vector
+
+    rotation = rotation_from_vector([1e300, 0.0, 0.05])
+    assert np.all(np.isfinite(rotation)) and np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
+    assert np.allclose(rotation[0], [1.0, 0.0, 0.0], atol=1e-12)  # about x (the 0.05 is lost at 1e300)
+
+
+def test_a_planar_circle_too_fast_to_sample_is_refused_naming_its_rate():
+    """The planar reference check took one sample per quarter turn: at 1e300 rad/s NumPy's "Maximum
+    allowed size exceeded" (a ValueError, found while hunting the spatial fuzz's findings)."""
+    from cdpr_exu.statics.workspace import check_reference
+
+    data = copy.deepcopy(PAPER_DICT)
+    data["trajectory"]["angular_rate"] = 1e300
+    with pytest.raises(SceneError, match=r"trajectory\.angular_rate = 1e\+300 rad/s makes 6\.37e\+300 quarter turns"):
+        check_reference(scene_from_dict(data))
 
 
 @pytest.mark.parametrize("value", [0.0, -1e-6, 1e-2, float("nan"), "tight"])

@@ -12,10 +12,12 @@ from hypothesis import HealthCheck, given, seed, settings
 
 from cdpr_exu.core.errors import CdprError
 from cdpr_exu.scenes.scene import scene_from_dict
+from cdpr_exu.scenes.spatial_scene import spatial_scene_from_dict
 from cdpr_exu.statics.workspace import check_reference
-from test_input_validation import malformed_scene_dicts
+from test_input_validation import malformed_scene_dicts, malformed_spatial_scene_dicts
 
-TABLES = r"(?:name|description|gravity|cable_exit|cable|cables|pulley|pulleys|platform|winch|effects|solver|trajectory)"
+TABLES = (r"(?:name|description|gravity|cable_exit|cable|cables|pulley|pulleys|platform|winch|effects|solver|trajectory"
+          r"|dimension|exits|controller_model)")
 #: A field path: a scene table with an index or dotted fields (``pulleys[0]``, ``trajectory.radius``,
 #: ``platform.anchors[1]``), or a table named as the subject of the refusal (``winch must be a table``),
 #: or as what a scene lacks (``scene lacks platform``).
@@ -46,3 +48,20 @@ def test_every_refusal_of_a_malformed_scene_names_a_field_path(data):
     except CdprError as err:
         assert FIELD_PATH.search(str(err)), str(err)
         assert not NUMPY_REPR.search(str(err)), str(err)  # plain numbers (issue 23.9)
+
+
+@seed(20261124)
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(malformed_spatial_scene_dicts())
+def test_every_refusal_of_a_malformed_spatial_scene_names_a_field_path(data):
+    """The same for spatial scenes (issue 23): a shipped spatial scene's plain data with one to
+    three fields broken, refused by the validation or by the reference check of `cdpr run`."""
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+
+    try:
+        scene = spatial_scene_from_dict(data)
+        if scene.trajectory is not None:
+            check_spatial_reference(scene)
+    except CdprError as err:
+        assert FIELD_PATH.search(str(err)), str(err)
+        assert not NUMPY_REPR.search(str(err)), str(err)

@@ -420,6 +420,10 @@ def rotation_from_vector(rotation_vector):
     """Spatial rotation matrix ``R = exp([theta]x)`` of a rotation vector ``theta`` [rad] (Rodrigues), shape (3, 3)."""
     theta = np.asarray(rotation_vector, dtype=float)
     angle = float(np.linalg.norm(theta))
+    if not angle < 1e150:  # [theta]x squared (and the norm) overflow: the same formula on the unit axis
+        angle = math.hypot(*theta)
+        k = skew(theta / angle)
+        return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
     k = skew(theta)
     if angle < 1e-8:  # series: 1 - a^2/6 and 1/2 - a^2/24, exact to round-off here
         return np.eye(3) + (1.0 - angle**2 / 6.0) * k + (0.5 - angle**2 / 24.0) * (k @ k)

@@ -177,7 +177,7 @@ class SpatialPlatform:
         for i in range(len(cables)):
             for j in range(i):
                 if np.linalg.norm(exits[i] - exits[j]) <= 1e-9 * size:
-                    raise SceneError(f"cables[{j}] and cables[{i}] share the exit_point {tuple(exits[i])} m")
+                    raise SceneError(f"cables[{j}] and cables[{i}] share the exit_point {shown(exits[i])} m")
         needed = 1 if self.is_point_mass else 2
         if len(cables) < needed:
             kind = "a point mass" if needed == 1 else "a rigid platform"
@@ -187,7 +187,7 @@ class SpatialPlatform:
             for i in range(len(cables)):
                 for j in range(i):
                     if np.linalg.norm(anchors[i] - anchors[j]) <= 1e-9 * arm:
-                        raise SceneError(f"cables[{j}] and cables[{i}] share the anchor {tuple(anchors[i])} m "
+                        raise SceneError(f"cables[{j}] and cables[{i}] share the anchor {shown(anchors[i])} m "
                                          f"on a rigid platform")
             if np.linalg.matrix_rank(anchors, tol=1e-9 * arm) < 2:
                 raise SceneError(f"cables: the anchors {anchors.tolist()} m lie on one line through the centre "
@@ -754,7 +754,7 @@ def _inverse_cable(cable, anchor_point, horizontal_tension):
     span = exit_point - anchor_point
     horizontal = float(math.hypot(span[0], span[1]))
     if horizontal <= 0.0:
-        raise UnreachableError(f"cable from {tuple(exit_point)} hangs vertically above its anchor: its horizontal "
+        raise UnreachableError(f"cable from {shown(exit_point)} hangs vertically above its anchor: its horizontal "
                                "tension is zero and the inverse catenary has no answer")
     direction = np.array([span[0], span[1], 0.0]) / horizontal
     length, state = solve_inverse((horizontal, span[2]), cable.weight_per_length, cable.axial_stiffness,

@@ -43,6 +43,7 @@ from matplotlib.figure import Figure
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import write_npz, write_summary
+from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
@@ -82,13 +83,25 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     """
     times = np.linspace(0.0, scene.solver.end_time, REFERENCE_SAMPLES)
     poses = np.atleast_2d(scene.trajectory.pose(times))
-    ideal, _ = ideal_paid_out(scene, poses)
+    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
+    for name, values in (("pose", poses), ("acceleration", acceleration)):
+        if not np.all(np.isfinite(values)):
+            k = int(np.argmin(np.all(np.isfinite(values), axis=1)))
+            raise UnreachableError(f"trajectory is out of floating-point range: its {name} at t = {times[k]:.3f} s is "
+                                   f"{shown(values[k])} (a trajectory field far beyond any robot, e.g. its "
+                                   "angular_rate or radius)")
+    try:
+        ideal, _ = ideal_paid_out(scene, poses)
+    except UnreachableError as err:
+        raise UnreachableError(f"trajectory is refused before the run: {err}") from None
     lengths = scene.unstrained_lengths + ideal - ideal[0]
     short = np.argwhere(lengths <= 0.0)
     if short.size:
         k, i = short[0]
         raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
-                               f"cable {i + 1} paid out to {lengths[k, i]:.4f} m: it would be reeled in completely")
+                               f"cable {i + 1} paid out to {lengths[k, i]:.4g} m from its "
+                               f"cables[{i}].unstrained_length = {scene.cables[i].unstrained_length:.4g} m at the start: "
+                               "it would be reeled in completely")
     for i, swivel in enumerate(scene.swivel_exits):
         if swivel is None:
             continue
@@ -109,7 +122,6 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     points = poses[:, :3] if anchors is None else poses
     directions = np.swapaxes(cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii), 1, 2)
     gravity = scene.gravity if scene.effects.gravity else 0.0
-    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
     needed = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
     limits = tension_limits(scene.cables)
     unheld = first_unheld(directions, needed, limits)
@@ -120,8 +132,9 @@ def check_spatial_reference(scene: SpatialScene) -> None:
         above = scene.above_exits(poses[k, :3], rotation_from_vector(poses[k, 3:]))
         raise UnreachableError(
             f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) at "
-            f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight and "
-            f"the reference's acceleration ({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
+            f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight "
+            f"(platform.mass = {scene.platform.mass:g} kg) and the reference's acceleration "
+            f"({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
             "remain unbalanced" + ("" if above is None else f"; the pose is above the exits: {above}"))
 
 

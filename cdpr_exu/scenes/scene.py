@@ -70,6 +70,14 @@ MAX_STEPS = 1.0e9
 MAX_NEWTON_ITERATIONS = 1000
 
 
+def check_weight(mass: float, gravity: float) -> None:
+    """Refuse a platform whose weight, ``mass`` [kg] x ``gravity`` [m/s^2], is out of floating-point range
+    (naming platform.mass and gravity; each alone is finite)."""
+    if not math.isfinite(mass * gravity):
+        raise SceneError(f"platform.mass = {shown(mass)} kg and gravity = {shown(gravity)} m/s^2 give a weight of "
+                         f"{shown(mass * gravity)} N, out of floating-point range")
+
+
 def _set(obj: Any, name: str, value: Any) -> None:
     """Normalise a field of a frozen dataclass inside ``__post_init__``."""
     object.__setattr__(obj, name, value)
@@ -800,6 +808,7 @@ class Scene:
                 f"platform.anchors must list one anchor per cable ({m}), got {len(self.platform.anchors)}"
             )
         _set(self, "gravity", non_negative("gravity", self.gravity, "m/s^2"))
+        check_weight(self.platform.mass, self.gravity)
         _choice("cable_exit", self.cable_exit, ("pulley", "point"))
         if self.winch.kind == "servo" and not self.effects.cable_mass:
             raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")

@@ -44,10 +44,10 @@ from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.geometry import above_exits
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
-from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
-                                  _build, _override, _per_cable, controller_model_from_dict, is_scene_file, load_scene,
-                                  missing_fields, parse_scene_text, read_scene_file, refuse_missing, shipped_names,
-                                  unknown_scene)
+from cdpr_exu.scenes.scene import (MAX_ELEMENTS, CableSpec, ControllerModel, Effects, Scene, SolverSpec,
+                                  SpatialSceneError, WinchSpec, _build, _override, _per_cable, check_weight,
+                                  controller_model_from_dict, is_scene_file, load_scene, missing_fields,
+                                  parse_scene_text, read_scene_file, refuse_missing, shipped_names, unknown_scene)
 from cdpr_exu.core.validation import non_negative, positive, shown, vector
 
 __all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
@@ -78,7 +78,7 @@ class SpatialPlatformSpec:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mass", non_negative("platform.mass", self.mass, "kg"))
-        if isinstance(self.anchors, (str, bytes, Mapping)):
+        if isinstance(self.anchors, (str, bytes, Mapping)) or not isinstance(self.anchors, (list, tuple, np.ndarray)):
             raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {shown(self.anchors)}")
         anchors = tuple(tuple(float(v) for v in vector(f"platform.anchors[{i}]", a, 3, " (x, y, z) [m]"))
                         for i, a in enumerate(self.anchors))
@@ -255,6 +255,7 @@ class SpatialScene:
                       for i, e in enumerate(self.exits))
         object.__setattr__(self, "exits", exits)
         object.__setattr__(self, "gravity", non_negative("gravity", self.gravity, "m/s^2"))
+        check_weight(self.platform.mass, self.gravity)
         m = len(self.cables)
         if len(exits) != m:
             raise SceneError(f"exits must give one exit point per cable ({m}), got {len(exits)}")
@@ -336,11 +337,14 @@ class SpatialScene:
 
             cable = self.cables[min(i, m - 1)]
             if cable.element_length > SAFE_ELEMENT_FRACTION * swivel.radius * (1.0 + 1e-9):
+                needed = cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius)
+                give = (f"give at least {math.ceil(needed)}" if needed <= MAX_ELEMENTS else
+                        f"it would take {needed:.3g}, more than the {MAX_ELEMENTS} allowed: give a larger radius")
                 raise SceneError(
                     f"cables[{i}].n_elements = {cable.n_elements}: its elements ({cable.element_length:.4g} m) are longer "
                     f"than {SAFE_ELEMENT_FRACTION:g} of the swivel pulley's radius (exits[{i}].radius = {shown(swivel.radius)} "
-                    f"m); give at least {math.ceil(cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius))} "
-                    "(measured: coarser chains lose the wrap and gain energy, and Exudyn's static solver fails)")
+                    f"m); {give} (measured: coarser chains lose the wrap and gain energy, and Exudyn's static solver "
+                    "fails)")
         object.__setattr__(self, "exits", tuple(exits))
         object.__setattr__(self, "swivels", swivels if any(s is not None for s in swivels) else ())
 
@@ -411,9 +415,14 @@ class SpatialScene:
         """The scene as elastic catenaries (:mod:`cdpr_exu.physics.spatial_statics`)."""
         gravity = self.gravity if self.effects.gravity else 0.0
         weighs = self.effects.cable_mass and self.effects.gravity
-        cables = [SpatialCable(e, c.linear_density * gravity if weighs else 0.0, c.axial_rigidity, anchor=a,
-                               pulley_radius=r)
-                  for c, e, a, r in zip(self.cables, self.exits, self.platform.anchors, self.pulley_radii)]
+        weights = [c.linear_density * gravity if weighs else 0.0 for c in self.cables]
+        for i, (cable, weight) in enumerate(zip(self.cables, weights)):
+            if not math.isfinite(weight):
+                raise SceneError(f"cables[{i}].linear_density = {shown(cable.linear_density)} kg/m and gravity = "
+                                 f"{shown(gravity)} m/s^2 give a weight per length of {shown(weight)} N/m, out of "
+                                 "floating-point range")
+        cables = [SpatialCable(e, w, c.axial_rigidity, anchor=a, pulley_radius=r)
+                  for c, w, e, a, r in zip(self.cables, weights, self.exits, self.platform.anchors, self.pulley_radii)]
         return SpatialPlatform(cables, self.platform.mass, gravity, self.platform.inertia)
 
     def chain_spec(self, anchor_spring_factor: float | None = None, tension_only: bool | None = None):
@@ -459,11 +468,11 @@ def spatial_scene_from_dict(data: Mapping[str, Any], source: str | None = None) 
     if unknown:
         raise SceneError(f"spatial scene has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
     if data.get("dimension") != 3:
-        raise SceneError(f"a spatial scene says dimension = 3, got {shown(data.get('dimension'))}")
+        raise SceneError(f"dimension must be 3 for a spatial scene, got {shown(data.get('dimension'))}")
     for table in ("cables", "exits", "platform"):
         if table not in data:
-            raise SceneError(f"spatial scene lacks {table}: give [[cables]] (one per cable, at least its "
-                             "unstrained_length), [[exits]] (each with a point) and [platform] (mass, anchors)")
+            raise SceneError(f"scene lacks {table}: a spatial scene must give [[cables]] (one per cable, at least "
+                             "its unstrained_length), [[exits]] (each with a point) and [platform] (mass, anchors)")
     exits = data["exits"]
     if not isinstance(exits, list):
         raise SceneError(f"exits must be an array of tables, each a point exit (point = [x, y, z]) or a swivel "

@@ -135,12 +135,29 @@ def circle_phase(t, angular_rate: float, ramp_time: float):
             angular_rate * blend_rate / ramp_time)
 
 
+#: Most quarter turns of a circle a reference check samples (25 000 turns): beyond, the
+#: reference turns faster than any robot could follow, and the samples would not fit in memory.
+MAX_QUARTER_TURNS = 100_000
+
+
 def quarter_turn_times(end_time: float, angular_rate: float, ramp_time: float, moves: bool) -> np.ndarray:
     """Times [s] where a circle's phase is a multiple of pi/2, up to ``end_time``; none for a
-    ramped (no closed form), standing or motionless (``moves`` false) circle."""
+    ramped (no closed form), standing or motionless (``moves`` false) circle.
+
+    Raises
+    ------
+    SceneError
+        Naming trajectory.angular_rate when the circle makes more than :data:`MAX_QUARTER_TURNS`
+        quarter turns before ``end_time``.
+    """
     if ramp_time > 0.0 or angular_rate == 0.0 or not moves:
         return np.zeros(0)
-    return np.arange(0.0, end_time + 1e-12, 0.5 * np.pi / abs(angular_rate))
+    quarter = 0.5 * np.pi / abs(angular_rate)
+    if end_time / quarter > MAX_QUARTER_TURNS:
+        raise SceneError(f"trajectory.angular_rate = {shown(angular_rate)} rad/s makes {end_time / quarter:.3g} quarter "
+                         f"turns in {shown(end_time)} s, more than the {MAX_QUARTER_TURNS} a reference check samples "
+                         "(a circle far faster than any robot)")
+    return np.arange(0.0, end_time + 1e-12, quarter)
 
 
 @dataclass(frozen=True)
