@@ -177,7 +177,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
 
 
 def _elements_for(scene, tolerance: float, quiet: bool):
-    """The scene (planar or spatial) with the fewest elements per cable that the error model says meet ``tolerance`` [m]."""
+    """The scene (planar or spatial) with the fewest elements per cable, never fewer than it has, that the error
+    model says meet ``tolerance`` [m] (:func:`cdpr_exu.run.error_estimate.elements_for_tolerance` says why not fewer)."""
     from cdpr_exu.run.error_estimate import elements_for_tolerance, estimate_error, simulate_any
 
     n = max(c.n_elements for c in scene.cables)
@@ -251,8 +252,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--no-error-estimate", action="store_true",
                      help="skip the companion run that estimates the discretisation error")
     run.add_argument("--tolerance", metavar="LENGTH",
-                     help="position error to meet, e.g. 5mm: the fewest elements per cable the error model "
-                     "says meet it are chosen (a pilot run and its estimate first) and printed")
+                     help="position error to meet, e.g. 5mm: a pilot run with the scene's elements and its "
+                     "error estimate first, then the fewest elements per cable, never fewer than the scene has, "
+                     "that the error model says meet it (printed)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     run.set_defaults(func=_cmd_run)
 

@@ -159,6 +159,32 @@ def test_a_directory_given_as_the_scene_is_named_a_directory(tmp_path):
     assert done.returncode == 2 and "is a directory" in done.stderr
 
 
+#: Scene files that are no TOML scene, and what the refusal says (issue 23.11: the first two were
+#: UnicodeDecodeError tracebacks, exit 1).
+MALFORMED_FILES = {
+    "latin-1": (b'name = "caf\xe9"\n', "is not UTF-8 TOML: byte 11 is 0xe9"),
+    "binary": (bytes(range(128, 256)) * 3, "is not UTF-8 TOML: byte 0 is 0x80"),
+    "NUL bytes": (b"\x00\x01\x02", "is not valid TOML: Invalid statement"),
+    "empty": (b"", "lacks pulleys, platform, trajectory"),
+    "TOML syntax error": (b"name = 'x'\n[cable\n", "is not valid TOML: Expected ']'"),
+    "spatial, Latin-1": (b'dimension = 3\nname = "caf\xe9"\n', "is not UTF-8 TOML: byte 25 is 0xe9"),
+}
+
+
+@pytest.mark.parametrize("kind", list(MALFORMED_FILES))
+@pytest.mark.parametrize("command", ["run", "static"])
+def test_a_scene_file_that_is_no_toml_scene_exits_2_naming_the_file(tmp_path, capsys, command, kind):
+    from cdpr_exu.cli import main
+
+    content, words = MALFORMED_FILES[kind]
+    path = tmp_path / "scene.toml"
+    path.write_bytes(content)
+    assert main([command, str(path)]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"cdpr: error: scene {'file ' if 'UTF-8' in words else ''}'{path}'"), error
+    assert words in error, error
+
+
 def test_static_output_numbers_cables_from_one_and_prints_no_negative_zero():
     done = _cdpr("static", "paper-catenary-fixed")
     assert "cable 1:" in done.stdout and "cable 2:" in done.stdout and "cable 0" not in done.stdout

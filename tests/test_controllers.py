@@ -103,9 +103,9 @@ def test_tension_aware_options_are_checked():
 
 def test_a_reference_that_needs_a_pushing_cable_is_refused_before_the_run():
     # Above the pulleys both cables pull the platform down: only pushing cables could
-    # hold its weight.
-    scene = PAPER.with_changes(trajectory=HoldTrajectory((0.0, 0.6, 0.0)),
-                               platform=replace(PAPER.platform, initial_pose=(0.0, 0.6, 0.0)))
+    # hold its weight. (The platform starts below them: a scene starting above them is
+    # refused when it is made, tests/test_scene.py.)
+    scene = PAPER.with_changes(trajectory=HoldTrajectory((0.0, 0.6, 0.0)))
     with pytest.raises(UnreachableError, match="t = 0.000 s"):
         TensionAwareController().reset(scene, np.array([3.0, 1.2]))
 

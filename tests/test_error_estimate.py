@@ -45,6 +45,16 @@ def test_bad_tolerance_is_refused_naming_the_option(text):
         parse_length(text)
 
 
+def test_tolerance_never_chooses_fewer_elements_than_the_scene_has_and_its_help_says_so():
+    """Issue 23.19: the help said "the fewest elements per cable"; the model is fitted on n and 2n and is
+    not extrapolated below n, so an error 100 times below the tolerance keeps the scene's 15."""
+    from cdpr_exu.cli import build_parser
+
+    assert elements_for_tolerance(15, 1e-5, 1e-3) == 15
+    run = build_parser()._subparsers._group_actions[0].choices["run"]
+    assert "never fewer than the scene has" in " ".join(run.format_help().split())
+
+
 def test_elements_for_tolerance_follows_the_second_order_model_and_is_monotone():
     assert elements_for_tolerance(15, 0.018, 0.020) == 15  # already met
     assert elements_for_tolerance(15, 0.018, 0.005) == 29  # ceil(15 sqrt(3.6))

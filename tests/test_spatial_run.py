@@ -143,6 +143,16 @@ def test_a_reference_above_the_exits_is_refused_before_the_run_naming_the_time_a
         simulate_spatial(scene)
 
 
+def test_a_reference_that_starts_above_the_exits_is_refused_saying_so():
+    """Issue 23.6: the swivel robot told to hold its point mass 0.4 m above the tops of its pulleys
+    (inlets at z = 0, radius 0.1 m): refused before the run, the message says why."""
+    scene = load_spatial_scene("spatial-four-cable-swivel")
+    scene = replace(scene, trajectory=SpatialHoldTrajectory((0.0, 0.0, 0.5, 0.0, 0.0, 0.0)))
+    with pytest.raises(UnreachableError, match=r"at t = 0\.000 s is outside the workspace.*the pose is above the "
+                       r"exits: .*platform\.anchors\[0\] at z = 0\.5 m, exits\[0\] up to z = 0\.1 m.*cables cannot push"):
+        simulate_spatial(scene)
+
+
 def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_ideal_ik():
     from controllers.ideal_ik import IdealIKController
     from controllers.spatial_tension_aware import SpatialTensionAwareController

@@ -54,3 +54,8 @@ class CdprWarning(UserWarning):
 
 class CoarseOutputWarning(CdprWarning):
     """The output is sampled more coarsely than asked (its error figures come from fewer samples)."""
+
+
+class SuspectAnswerWarning(CdprWarning):
+    """A computation completed, but its answer is one a cable robot could hardly give: far from an
+    independent answer to the same question, or held by elements that push."""

@@ -221,7 +221,15 @@ def summary_entry(estimate: ErrorEstimate) -> dict:
 
 
 def elements_for_tolerance(n: int, estimated_error: float, tolerance: float, order: float = ORDER) -> int:
-    """Fewest elements per cable whose error, by e(n) = C n^-p through (n, estimated_error), is below ``tolerance``."""
+    """Fewest elements per cable, never fewer than ``n``, whose error by e(n) = C n^-p through (n, estimated_error)
+    is below ``tolerance``.
+
+    Never fewer than the scene's ``n``: the model is fitted on n and the companion run's 2n
+    (Richardson), and below n it would be extrapolated out of the measured range, where coarser
+    cables meet other limits the model knows nothing of (elements too long for the pulley are
+    refused, swivel pulleys need elements of at most half their radius, and the error's order
+    in motion is not 2: docs/accuracy.md). A tolerance met already keeps ``n``.
+    """
     if estimated_error <= tolerance:
         return n
     needed = math.ceil(n * (estimated_error / tolerance) ** (1.0 / order))

@@ -62,6 +62,7 @@ from __future__ import annotations
 import argparse
 import sys
 import math
+import warnings
 import time as _time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -72,7 +73,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
-from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure, SuspectAnswerWarning
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
 from cdpr_exu.core.output import clear_outputs, write_npz, write_summary
@@ -682,7 +683,9 @@ EPILOG = """examples:
 
 A spatial scene (dimension = 3) is solved directly by Exudyn's static solver, started on
 its elastic-catenary statics (--tolerance, --max-time and --no-polish do not apply), and
-reports the platform's position and rotation beside the catenary answer.
+reports the platform's position and rotation beside the catenary answer; it warns when the
+two lie more than 5 % of the shortest cable apart or an element is compressed, and fails
+(exit 3, with the cause) on an equilibrium that holds the platform above its exits.
 """
 
 
@@ -698,15 +701,24 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
 
 
 def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
-    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`)."""
+    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`); its warnings go to the console
+    (and are in summary.json), a failure writes the scene, the cause and the last state."""
     from cdpr_exu.run.spatial_rest import print_spatial_rest, solve_spatial_rest
 
-    rest = solve_spatial_rest(scene)
+    try:
+        rest = solve_spatial_rest(scene)
+    except SolverFailure as err:
+        if out is not None:
+            _write_static_failure(scene, err, out)
+            print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
+        raise
     if out is not None:
         clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         rest.save(out)
     if not quiet:
         print_spatial_rest(rest, out)
+    for text in rest.warnings:
+        warnings.warn(text, SuspectAnswerWarning, stacklevel=2)
     return EXIT_OK
 
 

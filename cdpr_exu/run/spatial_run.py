@@ -44,6 +44,7 @@ from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, Unre
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import (SPATIAL_POSE_COLUMNS, check_output_folder, clear_outputs, undate_solution_file,
                                   write_npz, write_pose_csv, write_summary)
+from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
@@ -73,7 +74,8 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     the reference's acceleration, ``M (a + g e_z)``, with non-negative tensions (within
     the cables' ``min_tension`` / ``max_tension`` where given). Like the planar check,
     this is the force part of the wrench-feasible workspace: the platform's rotation is
-    free to balance the moment.
+    free to balance the moment. A pose with every anchor above its exit is such a pose; the
+    message then says so (:meth:`SpatialScene.above_exits`).
 
     Raises
     ------
@@ -82,30 +84,45 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     """
     times = np.linspace(0.0, scene.solver.end_time, REFERENCE_SAMPLES)
     poses = np.atleast_2d(scene.trajectory.pose(times))
-    ideal, _ = ideal_paid_out(scene, poses)
+    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
+    for name, values in (("pose", poses), ("acceleration", acceleration)):
+        if not np.all(np.isfinite(values)):
+            k = int(np.argmin(np.all(np.isfinite(values), axis=1)))
+            raise UnreachableError(f"trajectory is out of floating-point range: its {name} at t = {times[k]:.3f} s is "
+                                   f"{shown(values[k])} (a trajectory field far beyond any robot, e.g. its "
+                                   "angular_rate or radius)")
+    try:
+        ideal, _ = ideal_paid_out(scene, poses)
+    except UnreachableError as err:
+        raise UnreachableError(f"trajectory is refused before the run: {err}") from None
     lengths = scene.unstrained_lengths + ideal - ideal[0]
     short = np.argwhere(lengths <= 0.0)
     if short.size:
         k, i = short[0]
         raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
-                               f"cable {i + 1} paid out to {lengths[k, i]:.4f} m: it would be reeled in completely")
+                               f"cable {i + 1} paid out to {lengths[k, i]:.4g} m from its "
+                               f"cables[{i}].unstrained_length = {scene.cables[i].unstrained_length:.4g} m at the start: "
+                               "it would be reeled in completely")
     for i, swivel in enumerate(scene.swivel_exits):
         if swivel is None:
             continue
-        room = swivel.winch_line - 2.0 * scene.cables[i].element_length  # the winch end stays two elements below
+        margin = 2.0 * scene.cables[i].element_length  # the winch end stays two elements below the inlet
+        room = swivel.winch_line - margin
         gain = lengths[:, i] - lengths[0, i]
         if gain.max() > room:
             k = int(np.argmax(gain))
-            raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
-                                   f"cable {i + 1} paid out by {gain[k]:.4f} m over its swivel pulley: more than "
-                                   f"exits[{i}].winch_line = {swivel.winch_line:g} m less two elements holds")
+            raise UnreachableError(
+                f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs cable {i + 1} paid "
+                f"out by {1000 * gain[k]:.3g} mm over its swivel pulley, more than its winch line holds: "
+                f"exits[{i}].winch_line = {1000 * swivel.winch_line:.3g} mm less two elements (2 x "
+                f"{1000 * margin / 2:.3g} mm, the winch end's margin below the inlet) leaves {1000 * room:.3g} mm; give "
+                f"exits[{i}].winch_line = {1000 * (margin + max(gain[k], 0.0)):.3g} mm or more")
     from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors
 
     anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
     points = poses[:, :3] if anchors is None else poses
     directions = np.swapaxes(cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii), 1, 2)
     gravity = scene.gravity if scene.effects.gravity else 0.0
-    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
     needed = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
     limits = tension_limits(scene.cables)
     unheld = first_unheld(directions, needed, limits)
@@ -113,11 +130,13 @@ def check_spatial_reference(scene: SpatialScene) -> None:
         k, residual, free = unheld
         why = ("with non-negative tensions" if limits is None
                else f"within the cables' tension limits ({limits_text(free, limits)})")
+        above = scene.above_exits(poses[k, :3], rotation_from_vector(poses[k, 3:]))
         raise UnreachableError(
             f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) at "
-            f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight and "
-            f"the reference's acceleration ({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
-            "remain unbalanced")
+            f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight "
+            f"(platform.mass = {scene.platform.mass:g} kg) and the reference's acceleration "
+            f"({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
+            "remain unbalanced" + ("" if above is None else f"; the pose is above the exits: {above}"))
 
 
 def rotation_error_deg(pose: np.ndarray, reference: np.ndarray) -> np.ndarray:
@@ -302,6 +321,18 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
         return
 
 
+def _refuse_start_above_exits(scene: SpatialScene, mbs, items, catenary) -> None:
+    """Refuse to run from a rest of the lumped robot that holds the platform above its exits
+    (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: held by its bending or pushing elements)."""
+    from cdpr_exu.run.spatial_rest import rest_above_exits
+
+    position, rotation = platform_pose(mbs, items, current=False)
+    lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
+    above = rest_above_exits(scene, position, rotation, lowest, catenary)
+    if above is not None:
+        raise SolverFailure(f"the spatial run cannot start from the robot's rest: {above}", time=0.0)
+
+
 def check_runnable(scene: SpatialScene) -> None:
     """Refuse a scene ``cdpr run`` cannot run, before anything is built or written: no ``[trajectory]``,
     or a reference the cables cannot follow (:func:`check_spatial_reference`).
@@ -364,7 +395,9 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     UnreachableError
         If no static equilibrium of the scene's lengths exists to start from.
     SolverFailure
-        If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed.
+        If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed. Also
+        (at t = 0, no partial result) if the lumped robot's rest over swivel pulleys holds the
+        platform above its exits.
     """
     check_runnable(scene)
     mbs, items = build_spatial_model(scene)
@@ -372,6 +405,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     if scene.swivels:
         _warn_outside_measured_region(scene)
         start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
+        _refuse_start_above_exits(scene, mbs, items, items.initial)
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
