@@ -37,8 +37,9 @@ EPILOG_RUN = """examples:
 """ + EXIT_CODES
 
 
-def _scene_with_overrides(args: argparse.Namespace) -> Scene:
-    scene = load_scene(args.scene)
+def _scene_with_overrides(args: argparse.Namespace, scene: Scene | None = None) -> Scene:
+    """``scene`` (default: the one ``args.scene`` names, loaded) with ``--end-time`` and ``--step-size`` applied."""
+    scene = load_scene(args.scene) if scene is None else scene
     changes = {}
     if getattr(args, "end_time", None) is not None:
         changes["end_time"] = args.end_time
@@ -211,18 +212,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
-    spatial = load_any_scene(args.scene)
-    if is_spatial(spatial):
+    scene = load_any_scene(args.scene)  # loaded once: a warning of the scene file is printed once
+    if is_spatial(scene):
         from cdpr_exu.run.spatial_run import run_spatial_scene
 
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
-        spatial = replace(spatial, solver=replace(spatial.solver, **changes))
+        scene = replace(scene, solver=replace(scene.solver, **changes))
         if tolerance is not None:
-            spatial = _elements_for(spatial, tolerance, args.quiet)
-        run_spatial_scene(spatial, out, quiet=args.quiet, figures=not args.no_figures,
+            scene = _elements_for(scene, tolerance, args.quiet)
+        run_spatial_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,
                           error_estimate=not args.no_error_estimate)
         return EXIT_OK
-    scene = _scene_with_overrides(args)
+    scene = _scene_with_overrides(args, scene)
     if tolerance is not None:
         scene = _elements_for(scene, tolerance, args.quiet)
     run_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,

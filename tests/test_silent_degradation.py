@@ -99,3 +99,17 @@ def test_a_real_run_thrown_above_the_pulleys_gets_the_hint_for_that_cause():
     hint = message.split("Likely cause:")[1]
     assert "thrown upwards" in hint and "a sudden jump of the winch command" not in hint
     assert 0.0 < failure.value.time < 1.5 and len(failure.value.partial_result.time) > 1
+
+
+def test_a_scene_file_whose_step_is_longer_than_its_output_period_warns_once(tmp_path):
+    """Issue 23.10c: `cdpr run` loaded a planar scene file twice (once to tell planar from
+    spatial, once more to apply --end-time / --step-size), so the file's coarse-output
+    warning was printed twice."""
+    from cdpr_exu.scenes.scene import save_scene
+
+    path = tmp_path / "coarse.toml"
+    save_scene(PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.04, step_size=0.02, output_period=0.02)), path)
+    path.write_text(path.read_text().replace("output_period = 0.02", "output_period = 0.01"))
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", str(path), "--end-time", "0.04", "-q",
+                           "--no-error-estimate"], capture_output=True, text=True, timeout=300)
+    assert done.stderr.count("cdpr: warning: solver.step_size = 0.02 s") == 1, done.stderr
