@@ -19,7 +19,7 @@ from pathlib import Path
 
 from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
                      RunInterrupted, SceneError, SolverFailure)
-from cdpr_exu.core.output import check_output_folder, fixed, write_summary
+from cdpr_exu.core.output import check_output_folder, fixed, length_text, write_summary
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
@@ -199,7 +199,7 @@ def _elements_for(scene, tolerance: float, quiet: bool):
         raise CdprError(f"--tolerance: no error estimate for this scene ({pilot.note})")
     needed = elements_for_tolerance(n, pilot.max_position_error_m, tolerance)
     if not quiet:
-        print(f"--tolerance {1000 * tolerance:g} mm: estimated {1000 * pilot.max_position_error_m:.2f} mm at {n} "
+        print(f"--tolerance {1000 * tolerance:g} mm: estimated {length_text(pilot.max_position_error_m)} at {n} "
               f"elements per cable; the error model e ~ n^-2 asks for {needed} elements"
               + (" (kept)" if needed == n else ""))
     return scene.with_changes(cables=tuple(replace(c, n_elements=needed) for c in scene.cables))
