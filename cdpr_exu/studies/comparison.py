@@ -218,12 +218,22 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
     return EXIT_RUN_FAILED if failed else EXIT_OK
 
 
+def _check_time_options(args: argparse.Namespace) -> None:
+    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
+    on planar and spatial scenes alike)."""
+    from cdpr_exu.core.validation import non_negative
+
+    non_negative("--after", args.after)
+    non_negative("--ramp-time", args.ramp_time)
+
+
 def _cmd_compare(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from cdpr_exu.core.output import check_output_folder
     from cdpr_exu.statics.workspace import check_reference
 
+    _check_time_options(args)
     check_output_folder(args.out)
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
