@@ -12,7 +12,8 @@ from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.scenes.spatial_scene import load_spatial_scene
-from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialPointToPointTrajectory
+from cdpr_exu.scenes.spatial_trajectories import (SpatialCircleTrajectory, SpatialHoldTrajectory,
+                                                   SpatialPointToPointTrajectory)
 
 
 def four_cable(n_elements=10, bending=False, **solver):
@@ -264,3 +265,23 @@ def test_a_spatial_run_reports_each_tension_limit_crossed_as_the_planar_run_does
     assert "tension limit violations" in spatial_comparison_table({"ideal_ik": summary})
     assert "violations" not in spatial_comparison_table({"ideal_ik": simulate_spatial(replace(
         scene, cables=tuple(replace(c, min_tension=None, max_tension=None) for c in scene.cables))).summary()})
+
+
+def test_a_run_whose_solver_shrank_its_steps_completes_and_records_its_end_time():
+    """Issue 23.4: with the output period equal to the step, an end time off the output grid
+    and steps the solver shrank, the last recorded sample fell short of the end time and a
+    finite run that reached it was reported failed ("stopped before the end time"). A 328 kg
+    platform on two-element cables of E = 5.5e11 Pa makes Exudyn shrink the 0.03 s steps
+    (measured 144 steps instead of 12); the run is judged by the time the solver reached,
+    and its final state is recorded at the end time."""
+    base = four_cable()
+    cables = tuple(replace(c, n_elements=2, youngs_modulus=5.5e11) for c in base.cables)
+    scene = replace(base, cables=cables, platform=replace(base.platform, mass=328.0),
+                    trajectory=SpatialCircleTrajectory(center=(0.0, 0.1, -1.9), radius=0.1, angular_rate=1.0,
+                                                       ramp_time=0.1),
+                    solver=replace(base.solver, step_size=0.03, output_period=0.03, end_time=0.35))
+    result = simulate_spatial(scene)
+    assert result.steps > 2 * scene.solver.n_steps  # the solver shrank its steps
+    assert result.status == "completed" and np.all(np.isfinite(result.pose))
+    assert result.time[-1] == pytest.approx(0.35, abs=1e-12)  # the final state, at the end time
+    assert np.all(np.diff(result.time) > 0.0)

@@ -232,6 +232,13 @@ class _Monitor:
         return None
 
 
+def output_times(end_time: float, output_period: float) -> np.ndarray:
+    """The output times of a run [s], shape (N,): the multiples of ``output_period`` from 0 up to
+    ``end_time`` (none after it; the end time is one of them only when it is a multiple)."""
+    count = int(math.floor(end_time / output_period + 1e-9)) + 1
+    return np.arange(count) * output_period
+
+
 class _Recorder:
     """Stores Exudyn's coordinates at the output times (called once per step).
 
@@ -248,8 +255,8 @@ class _Recorder:
     def __init__(self, model: Model, output_period: float, end_time: float):
         self.model = model
         self.indices = model.coordinate_indices()
-        count = int(math.floor(end_time / output_period + 1e-9)) + 1
-        self.output_times = np.arange(count) * output_period
+        self.output_times = output_times(end_time, output_period)
+        count = len(self.output_times)
         size = model.mbs.systemData.GetODE2Coordinates().size
         self.q = np.full((count, size), np.nan)
         self.v = np.full((count, size), np.nan)

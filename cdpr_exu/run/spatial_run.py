@@ -52,7 +52,7 @@ from controllers.spatial_feedback import spatial_closed_loop_tension_aware
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
 from cdpr_exu.results.result import provenance, slack_time, tension_limit_report
-from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, quiet_exudyn, solver_settings
+from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, output_times, quiet_exudyn, solver_settings
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
@@ -338,7 +338,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
-    outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
+    outputs = output_times(solver.end_time, solver.output_period)
     m, n = scene.n_cables, scene.cables[0].n_elements
     times, poses, paid, node_series, tension_series = [], [], [], [[] for _ in range(m)], [[] for _ in range(m)]
     kinematic = scene.winch.kind == "kinematic"
@@ -365,7 +365,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     # winches paid out at t = 0 and the pose it starts from are the plant's.
     controller.reset(scene.controller_scene(), lengths.copy(),
                      initial_pose=measured_state()[0] if controller.uses_pose else None)
-    state = {"next": 0, "failure": None, "step_start": 0.0}
+    state = {"next": 0, "failure": None, "step_start": 0.0, "reached": 0.0}
 
     def measurement(t: float) -> Measurement:
         """What the controller may see when asked for the command at ``t`` [s]."""
@@ -403,13 +403,16 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         return True
 
     def post_step(mbs_, t):  # noqa: ARG001
-        state["step_start"] = t  # the state the solver has for the next step's command
+        state["step_start"] = state["reached"] = t  # the state the solver has for the next step's command
         if interrupted["interrupted"]:
             return False
         # One sample per step that reaches an output time, with the step's own time, as the
         # planar run records: a real state, labelled when it was. After a shrunk step the
-        # steps end up to one step after the output times; the time says so.
-        if state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
+        # steps end up to one step after the output times; the time says so. The step that
+        # ends the run is recorded too, so the result ends at the end time, on the output
+        # grid or not.
+        due = state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9
+        if due or (t >= solver.end_time - 1e-9 and t > times[-1]):
             record(float(t))
             while state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
                 state["next"] += 1
@@ -442,7 +445,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
                            int(iterations.currentStepIndex), int(iterations.newtonStepsCount))
     if tension_limits(scene.cables) is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
-    reached = float(time_array[-1])
+    reached = state["reached"]  # the solver's own time: the samples may end up to one output period before it
     if interrupted["interrupted"]:
         result.status, result.failure_time = f"interrupted at t = {reached:.4f} s", reached
         raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
