@@ -20,6 +20,7 @@ from pathlib import Path
 from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
                      RunInterrupted, SceneError, SolverFailure)
 from cdpr_exu.core.output import check_output_folder, fixed, length_text, write_summary
+from cdpr_exu.results.result import status_text
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
@@ -71,14 +72,14 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
 
     factor = summary["real_time_factor"]
     rows = [
-        ("status", summary["status"], ""),
+        ("status", status_text(summary), ""),
         ("max |error x|", *pair("max_abs_error_x_m", 100, "cm")),
         ("max |error z|", *pair("max_abs_error_z_m", 100, "cm")),
         ("error z range", z_range(summary), z_range(settled)),
         ("max |rotation|", *pair("max_abs_rotation_deg", 1, "deg")),
-        ("min element tension", *pair("min_element_tension_N", 1, "N")),
-        ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]),
-         " / ".join(_figure(v, 1, "N") for v in settled["min_tension_per_cable_N"])),
+        # tensions, slack and limits: over the whole run only (Result.summary)
+        ("min element tension", _figure(summary["min_element_tension_N"], 1, "N"), ""),
+        ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]), ""),
         ("slack time per cable", " / ".join(_figure(v, 1, "s") for v in summary["slack_time_per_cable_s"]), ""),
         ("max pulley penetration", _figure(summary["max_pulley_penetration_m"], 1000, "mm", 3), ""),
         ("simulated / wall time", f"{summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s",
@@ -86,9 +87,8 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
         ("steps / Newton iterations", f"{summary['steps']} / {summary['newton_iterations']}", ""),
     ]
     if "tension_limit_violations" in summary:
-        def count(s):
-            return f"{len(s['tension_limit_violations'])} violation(s)" if s["tension_limit_violations"] else "none"
-        rows.append(("tension limits", count(summary), count(settled)))
+        violations = summary["tension_limit_violations"]
+        rows.append(("tension limits", f"{len(violations)} violation(s)" if violations else "none", ""))
     print(f"{summary['scene']} under {summary['controller']} (error = actual - reference)")
     print(f"  {'':26s} {'whole run':>22s}   {'after ' + str(SETTLED_AFTER) + ' s':>18s}")
     for name, whole, after in rows:
@@ -113,7 +113,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     are checked before anything is written. With ``error_estimate``
     a companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`).
     """
-    from cdpr_exu.results.result import provenance
+    from cdpr_exu.results.result import Result, after_start_up, provenance, raise_warnings
     from cdpr_exu.run.simulate import simulate
     from cdpr_exu.statics.workspace import check_reference
 
@@ -151,10 +151,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
 
             data.update(summary_entry(estimate))
         data.update({k: v for k, v in result.metadata.items() if k not in data})
-        data["after_start_up"] = {k: settled[k] for k in (
-            "errors_measured_after_s", "max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m",
-            "max_error_z_m", "max_position_error_m", "rms_position_error_m", "max_abs_rotation_deg",
-            "min_element_tension_N", "notes")}
+        data["after_start_up"] = after_start_up(settled, Result.ERROR_FIGURES)
         data["error_convention"] = "actual - reference"
         write_summary(out, data)
         if solution_file is not None and solution_file.is_file():
@@ -163,6 +160,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
             from cdpr_exu.post.plots import plot_overview
 
             plot_overview(scene, result, out)
+    if failure is None:  # a completed run that pushed is not clean: say so once, quiet or not
+        raise_warnings(summary, f"{scene.name} under {result.controller}: ")
     if not quiet:
         _print_summary(summary, settled, out)
         if estimate is not None:

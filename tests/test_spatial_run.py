@@ -1,6 +1,7 @@
 """Dynamic runs of spatial scenes (cdpr_exu.run.spatial_run), real solver: the variable-length winch and ideal IK."""
 
 import json
+import re
 import subprocess
 import sys
 from dataclasses import replace
@@ -10,7 +11,8 @@ import pytest
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
-from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.results.result import slack_time
+from cdpr_exu.run.spatial_run import simulate_spatial, spatial_comparison_table
 from cdpr_exu.scenes.spatial_scene import load_spatial_scene
 from cdpr_exu.scenes.spatial_trajectories import (SpatialCircleTrajectory, SpatialHoldTrajectory,
                                                    SpatialPointToPointTrajectory)
@@ -38,11 +40,15 @@ def test_a_robot_told_to_hold_its_equilibrium_stays_there():
     # error (6.6e-5 m measured for this robot, tests/test_spatial_robot.py); it settles there.
     assert np.abs(result.position_error).max() < 1.5e-4
     assert np.ptp(result.paid_out, axis=0).max() < 1e-12  # the winches did not move (round-off of the IK)
-    # every cable taut after the first sample (at t = 0 two elements of the catenary start
-    # sit at their rest length to round-off): lowest tension positive, no time slack
-    summary = result.summary(after=result.time[1])
-    assert min(summary["min_tension_per_cable_N"]) > 0.0
-    assert summary["slack_time_per_cable_s"] == [0.0] * 4
+    # every cable taut after the first sample: lowest tension positive, no time slack. At t = 0
+    # the catenary start leaves the lowest elements of cables 2 and 4 at or below their rest
+    # length (tension-only: 0 N), and the summary, over the whole run, counts that first interval.
+    later = [t[1:] for t in result.tensions]
+    assert min(t.min() for t in later) > 0.0
+    assert [slack_time(result.time[1:], t) for t in later] == [0.0] * 4
+    summary = result.summary()
+    assert summary["slack_time_per_cable_s"] == [0.0, result.time[1], 0.0, result.time[1]]
+    assert summary["min_element_tension_N"] == 0.0 and not summary["elements_pushed"]
 
 
 def test_a_spatial_run_reports_how_long_each_cable_was_slack():
@@ -285,3 +291,49 @@ def test_a_run_whose_solver_shrank_its_steps_completes_and_records_its_end_time(
     assert result.status == "completed" and np.all(np.isfinite(result.pose))
     assert result.time[-1] == pytest.approx(0.35, abs=1e-12)  # the final state, at the end time
     assert np.all(np.diff(result.time) > 0.0)
+
+
+def pushing_four_cable(end_time=0.5):
+    """The coarse four-cable robot held at its catenary start with spring elements (effects.slack = false):
+    the catenary is not the 10-element chains' own equilibrium, and at t = 0 the lowest elements of
+    cables 2 and 4 are compressed (-0.1 N and -4.86 N measured)."""
+    scene = four_cable(end_time=end_time)
+    scene = replace(scene, effects=replace(scene.effects, slack=False))
+    return replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+
+
+def test_a_run_shorter_than_the_error_window_still_reports_its_pushing_cables():
+    """Issue 23.1: the spatial summary measured tensions only after the first second, so a 1 s run
+    whose recorded tensions reached -24,094 N reported elements_pushed: false. The safety figures
+    cover the whole run, the start included; only the errors keep the window."""
+    result = simulate_spatial(pushing_four_cable())
+    lowest = min(t.min() for t in result.tensions)
+    assert lowest < -1.0  # a recorded fact of the run (-4.86 N at t = 0)
+    summary = result.summary(after=1.0)
+    assert summary["status"] == "completed" and summary["max_position_error_m"] is None
+    assert summary["elements_pushed"] and summary["min_element_tension_N"] == lowest
+    assert summary["platform_above_exits"] is False and summary["highest_exit_z_m"] == 0.0
+    assert len(summary["warnings"]) == 1 and "elements pushed (lowest tension -4.856 N, cable 4 at t = 0.0000 s" in summary["warnings"][0]
+    assert "cables pushed" in spatial_comparison_table({"ideal_ik": summary})
+
+
+def test_cdpr_run_on_a_spatial_run_that_pushes_warns_once_and_prints_each_cables_slack_time(tmp_path):
+    """Issues 23.1 and 23.10b: `cdpr run` wrote elements_pushed: false for such a run and printed no
+    slack time per cable. Now: one console warning, the flag in summary.json (figures over the whole
+    run, errors after 1 s under after_start_up), and a slack time per cable, as planar runs print."""
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    path = save_any_scene(pushing_four_cable(), tmp_path / "pushing.toml")
+    out = tmp_path / "run"
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", str(path), "--out", str(out),
+                           "--no-figures", "--no-error-estimate"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    warnings = [line for line in done.stderr.splitlines() if line.startswith("cdpr: warning:")]
+    assert len(warnings) == 1 and "elements pushed" in warnings[0], done.stderr
+    assert "completed (cables pushed: see the warnings)" in done.stdout
+    slack = re.search(r"slack time per cable +(.*)", done.stdout).group(1)
+    assert slack.count(" s") == 4, done.stdout
+    summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
+    assert summary["status"] == "completed" and summary["elements_pushed"] and summary["min_element_tension_N"] < 0
+    assert summary["max_position_error_m"] is not None  # the whole run's
+    assert summary["after_start_up"]["max_position_error_m"] is None  # no sample after 1 s

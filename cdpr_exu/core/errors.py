@@ -54,3 +54,9 @@ class CdprWarning(UserWarning):
 
 class CoarseOutputWarning(CdprWarning):
     """The output is sampled more coarsely than asked (its error figures come from fewer samples)."""
+
+
+class UnphysicalResultWarning(CdprWarning):
+    """A run recorded what no real cable robot can do: elements that push (compression in a cable), or a
+    platform above its exits, where only pushing cables could hold it. Its summary says so too
+    (``elements_pushed``, ``platform_above_exits``, ``warnings``)."""

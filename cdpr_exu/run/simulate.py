@@ -564,7 +564,9 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     if stepper.reservoir is not None:
         result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
     result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
-                       "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts()}
+                       "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts(),
+                       # above the highest pulley centre every cable pulls the platform down (Result.summary)
+                       "highest_exit_z_m": max(float(p.center[1]) for p in scene.pulleys)}
     if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     last_time = float(result.time[-1]) if len(result.time) else 0.0

@@ -42,7 +42,7 @@ from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import write_npz, write_summary
+from cdpr_exu.core.output import fixed, length_text, write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
@@ -51,7 +51,8 @@ from controllers.ideal_ik import IdealIKController, ideal_paid_out
 from controllers.spatial_feedback import spatial_closed_loop_tension_aware
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.results.result import provenance, slack_time, tension_limit_report
+from cdpr_exu.results.result import (after_start_up, provenance, raise_warnings, safety_figures, status_text,
+                                     warning_flags)
 from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, output_times, quiet_exudyn, solver_settings
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
@@ -119,6 +120,11 @@ def check_spatial_reference(scene: SpatialScene) -> None:
             "remain unbalanced")
 
 
+def highest_exit(scene: SpatialScene) -> float:
+    """Height [m] of the scene's highest exit point or swivel inlet: above it every cable pulls the platform down."""
+    return float(np.asarray(scene.exits, dtype=float)[:, 2].max())
+
+
 def rotation_error_deg(pose: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """Angle [deg] of the rotation from the reference orientation to the actual one, shape (N,)."""
     angles = []
@@ -172,23 +178,28 @@ class SpatialResult:
         """Actual minus reference position, shape (N, 3) [m]."""
         return self.pose[:, :3] - self.reference[:, :3]
 
+    #: The figures of :meth:`summary` measured from its ``after`` on (the rest cover the whole run).
+    ERROR_FIGURES = ("max_position_error_m", "rms_position_error_m", "max_abs_error_m", "max_rotation_error_deg")
+
     def summary(self, after: float = 1.0) -> dict[str, Any]:
-        """Error and tension figures from ``after`` [s] on (strict JSON: null where there is no sample)."""
+        """Figures of the run (strict JSON: null where there is no sample): errors (:data:`ERROR_FIGURES`)
+        from ``after`` [s] on, the safety figures (tensions, slack, pushing, tension limits, a platform above
+        its exits) over the whole run, the start included (:func:`~cdpr_exu.results.result.safety_figures`,
+        as planar summaries)."""
         mask = self.time >= after
         error = np.linalg.norm(self.position_error[mask], axis=1)
         rotation = rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
-        tensions = np.concatenate([t[mask].ravel() for t in self.tensions]) if self.tensions else np.zeros(0)
 
         def extreme(values, pick):
             return float(pick(values)) if values.size else None
 
-        pushed = bool(tensions.size) and float(tensions.min()) < 0.0
+        safety = safety_figures(self.time, self.tensions, self.pose[:, 2] if len(self.time) else None,
+                                self.metadata.get("highest_exit_z_m"), self.metadata.get("tension_limits_N"))
+        limits = {k: safety.pop(k) for k in ("tension_limits_N", "tension_limit_violations") if k in safety}
+        warnings_ = safety.pop("warnings")
         notes = []
-        if pushed:
-            notes.append(f"elements pushed (lowest tension {tensions.min():.3g} N): the lumped cable carries "
-                         "compression, which a real cable cannot")
         if not mask.any():
-            notes.append(f"no sample at or after t = {after:g} s: its error and tension figures are null")
+            notes.append(f"no sample at or after t = {after:g} s: its error figures are null")
         simulated = float(self.time[-1]) if len(self.time) else 0.0
         return {
             "scene": self.scene_name, "controller": self.controller, "dimension": 3, "status": self.status,
@@ -197,30 +208,30 @@ class SpatialResult:
             "rms_position_error_m": float(np.sqrt(np.mean(error**2))) if error.size else None,
             "max_abs_error_m": [extreme(np.abs(self.position_error[mask, k]), np.max) for k in range(3)],
             "max_rotation_error_deg": extreme(rotation, np.max),
-            "min_element_tension_N": extreme(tensions, np.min),
-            "max_element_tension_N": extreme(tensions, np.max),
-            "min_tension_per_cable_N": [extreme(t[mask].ravel(), np.min) for t in self.tensions],
-            "slack_time_per_cable_s": [slack_time(self.time[mask], t[mask]) for t in self.tensions],
-            "elements_pushed": pushed,
+            **safety,
             "wall_time_s": self.wall_time, "simulated_time_s": simulated,
             "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
             "steps": int(self.steps), "newton_iterations": int(self.newton_iterations),
-            "failure_time_s": self.failure_time, "notes": notes,
-            **tension_limit_report(self.time[mask], [t[mask] for t in self.tensions],
-                                   self.metadata.get("tension_limits_N")),
+            "failure_time_s": self.failure_time, "notes": notes, "warnings": warnings_,
+            **limits,
         }
+
+    def run_summary(self, after: float = 1.0) -> dict[str, Any]:
+        """The summary ``cdpr run`` writes, as the planar run's: every figure over the whole run, and the
+        errors from ``after`` [s] on under ``after_start_up``."""
+        return {**self.summary(0.0), "after_start_up": after_start_up(self.summary(after), self.ERROR_FIGURES)}
 
     def save(self, folder: str | Path, after: float = 1.0, figures: bool = True,
              extra: dict | None = None) -> list[Path]:
-        """Write result.npz, summary.json (with ``extra``'s entries) and (``figures``) overview.png into
-        ``folder``; returns the paths."""
+        """Write result.npz, summary.json (:meth:`run_summary`, with ``extra``'s entries) and (``figures``)
+        overview.png into ``folder``; returns the paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = nodes, tensions
         written = [write_npz(folder / "result.npz", **arrays),
-                   write_summary(folder, {**self.summary(after), **provenance(), **(extra or {})})]
+                   write_summary(folder, {**self.run_summary(after), **provenance(), **(extra or {})})]
         if figures:
             written.append(plot_spatial_run(self, folder / "overview.png", after))
         return written
@@ -445,6 +456,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
                            int(iterations.currentStepIndex), int(iterations.newtonStepsCount))
     if tension_limits(scene.cables) is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
+    result.metadata["highest_exit_z_m"] = highest_exit(scene)
     reached = state["reached"]  # the solver's own time: the samples may end up to one output period before it
     if interrupted["interrupted"]:
         result.status, result.failure_time = f"interrupted at t = {reached:.4f} s", reached
@@ -499,6 +511,43 @@ def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0
     return path
 
 
+def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> None:
+    """Print a spatial run's :meth:`SpatialResult.run_summary`: errors over the whole run and after ``after`` [s],
+    each cable's lowest tension and slack time (whole run), its tension-limit violations and notes."""
+    settled = summary["after_start_up"]
+
+    def errors(s):
+        return f"{length_text(s['max_position_error_m'])} / {length_text(s['rms_position_error_m'])}"
+
+    def degrees(s):
+        return "n/a" if s["max_rotation_error_deg"] is None else f"{s['max_rotation_error_deg']:.4f} deg"
+
+    def per_cable(values, unit, digits):
+        return " / ".join("n/a" if v is None else f"{fixed(v, digits)} {unit}" for v in values)
+
+    factor = summary["real_time_factor"]
+    print(f"{summary['scene']} under {summary['controller']} (spatial; error = actual - reference)")
+    print(f"  {'':26s} {'whole run':>22s}   {'after ' + f'{after:g}' + ' s':>22s}")
+    print(f"  {'status':26s} {status_text(summary)}")
+    print(f"  {'max / RMS position error':26s} {errors(summary):>22s}   {errors(settled):>22s}")
+    print(f"  {'max rotation error':26s} {degrees(summary):>22s}   {degrees(settled):>22s}")
+    print(f"  {'min tension per cable':26s} {per_cable(summary['min_tension_per_cable_N'], 'N', 1)}")
+    print(f"  {'slack time per cable':26s} {per_cable(summary['slack_time_per_cable_s'], 's', 3)}")
+    print(f"  {'simulated / wall time':26s} {summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s"
+          + ("" if factor is None else f" ({factor:.1f}x real time)")
+          + f", {summary['steps']} steps, {summary['newton_iterations']} Newton iterations")
+    if "tension_limit_violations" in summary:
+        count = len(summary["tension_limit_violations"])
+        print(f"  {'tension limits':26s} {f'{count} violation(s)' if count else 'none'}")
+    for v in summary.get("tension_limit_violations", []):
+        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
+              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
+    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
+        print(f"  note: {note}")
+    if out is not None:
+        print(f"  written to {out}/")
+
+
 def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
                       after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
     """``cdpr run`` on a spatial scene: run, write (``out``: scene.toml-free result folder), print a summary.
@@ -528,30 +577,10 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
         except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
             interrupt = err
     write(result, None if estimate is None else summary_entry(estimate))
+    summary = result.run_summary(after)
+    raise_warnings(summary, f"{scene.name} under {result.controller}: ")  # not clean: said once, quiet or not
     if not quiet:
-        s = result.summary(after)
-
-        def mm(value):
-            return "n/a" if value is None else f"{1000 * value:.2f} mm"
-        print(f"{scene.name} under {result.controller} (spatial; error = actual - reference, after {after:g} s)")
-        print(f"  status                     {s['status']}")
-        print(f"  max / RMS position error   {mm(s['max_position_error_m'])} / {mm(s['rms_position_error_m'])}")
-        rotation = s["max_rotation_error_deg"]
-        print(f"  max rotation error         {'n/a' if rotation is None else f'{rotation:.4f} deg'}")
-        print("  min tension per cable      " + " / ".join("n/a" if v is None else f"{v:.1f} N"
-                                                          for v in s["min_tension_per_cable_N"]))
-        print(f"  simulated / wall time      {s['simulated_time_s']:.2f} s / {s['wall_time_s']:.2f} s "
-              f"({s['real_time_factor']:.1f}x real time), {s['steps']} steps, {s['newton_iterations']} Newton iterations")
-        if "tension_limit_violations" in s:
-            count = len(s["tension_limit_violations"])
-            print(f"  tension limits             {f'{count} violation(s)' if count else 'none'}")
-        for v in s.get("tension_limit_violations", []):
-            print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
-                  f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
-        for note in s["notes"]:
-            print(f"  note: {note}")
-        if out is not None:
-            print(f"  written to {out}/")
+        _print_spatial_summary(summary, after, out)
         if estimate is not None:
             print(estimate_line(estimate))
     if interrupt is not None:
@@ -593,8 +622,8 @@ def spatial_comparison_table(summaries: dict) -> str:
         cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in columns]
         worst = s.get("max_position_error_m")
         ratio = f"{base / worst:.1f}x" if base and worst else ""
-        pushed = "; cables pushed" if s.get("elements_pushed") else ""
-        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{pushed} |")
+        flags = "".join(f"; {flag}" for flag in warning_flags(s))  # what a real robot cannot do
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{flags} |")
     return "\n".join(lines) + "\n"
 
 
