@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.results.result import slack_time
 from cdpr_exu.run.spatial_run import simulate_spatial, spatial_comparison_table
@@ -337,3 +337,71 @@ def test_cdpr_run_on_a_spatial_run_that_pushes_warns_once_and_prints_each_cables
     assert summary["status"] == "completed" and summary["elements_pushed"] and summary["min_element_tension_N"] < 0
     assert summary["max_position_error_m"] is not None  # the whole run's
     assert summary["after_start_up"]["max_position_error_m"] is None  # no sample after 1 s
+
+
+def test_a_rotation_the_cables_cannot_hold_is_refused_before_the_run_naming_the_moment():
+    """Issue 23.5: IPAnema told to rock by 10 rad in yaw (trajectory.tilt = [0, 0, 10]) passed the
+    force-only check, ran 566 s and ended "SolveDynamic terminated", 175 degrees off. With six
+    cables or more on a rigid platform the check asks for the whole wrench: the force and the
+    moment about the centre of mass (zero when static, plus the reference's angular acceleration
+    and velocity with platform.inertia). The shipped scenes (yaw rocking of 0.05 rad at most) pass."""
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+    from cdpr_exu.scenes.spatial_scene import shipped_spatial_scenes
+
+    for name in shipped_spatial_scenes():
+        scene = load_spatial_scene(name)
+        if scene.trajectory is not None:
+            check_spatial_reference(scene)
+    scene = load_spatial_scene("spatial-ipanema")
+    scene = replace(scene, trajectory=replace(scene.trajectory, tilt=(0.0, 0.0, 10.0)))
+    pattern = r"the reference pose \[.*\] \(x, y, z \[m\], rotation vector \[rad\]\) at t = \d+\.\d{3} s .*moment"
+    with pytest.raises(UnreachableError, match=pattern) as refusal:
+        check_spatial_reference(scene)
+    assert "platform.inertia" in str(refusal.value)
+    with pytest.raises(UnreachableError, match=pattern):
+        simulate_spatial(scene)  # before anything is built
+
+
+def test_a_spatial_run_that_fails_says_what_exudyn_said():
+    """Issue 23.5: a failed spatial run said only "SolveDynamic terminated"; the cause Exudyn's solver
+    stored (here one Newton iteration per step: the step shrinks to its minimum) is in the message."""
+    scene = four_cable(end_time=0.3, max_newton_iterations=1)
+    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    with pytest.raises(SolverFailure, match=r"failed at t = 0\.\d{4} s of 0\.3 s: Exudyn's solver stopped "
+                                            r"\(SolveDynamic terminated\): reduction of step size reached minimum"):
+        simulate_spatial(scene)
+
+
+class ReelIn:
+    """Reels every cable in by ``fraction`` of its length within ``duration`` [s], then holds."""
+
+    name, uses_pose, uses_tension = "reel_in", False, False
+
+    def __init__(self, fraction, duration):
+        self.fraction, self.duration = fraction, duration
+
+    def reset(self, scene_, initial):
+        self.initial = np.asarray(initial, dtype=float)
+
+    def command(self, measurement):
+        from controllers.base import WinchCommand
+
+        s = min(measurement.time / self.duration, 1.0)
+        rate = -self.fraction * self.initial / self.duration if s < 1.0 else np.zeros_like(self.initial)
+        return WinchCommand(self.initial * (1.0 - self.fraction * s), rate)
+
+
+def test_a_platform_thrown_above_its_exits_stops_the_run_and_its_summary_flags_it():
+    """Issues 23.5 and 23.1: reeling the four cables in by 10 % within 0.05 s throws the platform up
+    through the plane of its exits (measured up to z = +0.97 m, the exits at z = 0), and the run
+    was reported completed. It now stops when the platform passes its highest exit, with the
+    cause, keeping what was computed; that partial result's summary flags it."""
+    scene = four_cable(n_elements=4, end_time=0.5)
+    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))),
+                    solver=replace(scene.solver, step_size=2e-3, output_period=0.01))
+    with pytest.raises(SolverFailure, match=r"the platform rose above its highest exit at t = 0\.\d{4} s") as failure:
+        simulate_spatial(scene, ReelIn(0.1, 0.05))
+    partial = failure.value.partial_result
+    assert partial.status.startswith("failed") and 0.0 < partial.pose[-1, 2] < 0.1  # stopped as it passed z = 0
+    summary = partial.summary()
+    assert summary["platform_above_exits"] and any("above its highest exit (z = 0 m)" in w for w in summary["warnings"])

@@ -53,7 +53,8 @@ from controllers.spatial_tension_aware import SpatialTensionAwareController
 
 from cdpr_exu.results.result import (after_start_up, provenance, raise_warnings, safety_figures, status_text,
                                      warning_flags)
-from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, output_times, quiet_exudyn, solver_settings
+from cdpr_exu.run.simulate import (_progress_reporter, _solver_report, interrupt_flag, output_times, quiet_exudyn,
+                                   solver_settings)
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
@@ -71,9 +72,12 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     At 401 samples of the reference: every commanded paid-out length stays positive, and
     straight cables from the exits to the anchors can give the platform its weight and
     the reference's acceleration, ``M (a + g e_z)``, with non-negative tensions (within
-    the cables' ``min_tension`` / ``max_tension`` where given). Like the planar check,
-    this is the force part of the wrench-feasible workspace: the platform's rotation is
-    free to balance the moment.
+    the cables' ``min_tension`` / ``max_tension`` where given): the force part of the
+    wrench-feasible workspace, as the planar check. With six cables or more on a rigid
+    platform whose structure matrix has full rank, the rotation is not free: the same
+    tensions must also give the moment about the centre of mass that the reference's
+    rotation needs (:func:`reference_wrenches`), the whole wrench-feasible workspace.
+    With fewer cables the platform turns to balance the moment, and only the force is asked.
 
     Raises
     ------
@@ -99,25 +103,72 @@ def check_spatial_reference(scene: SpatialScene) -> None:
             raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
                                    f"cable {i + 1} paid out by {gain[k]:.4f} m over its swivel pulley: more than "
                                    f"exits[{i}].winch_line = {swivel.winch_line:g} m less two elements holds")
-    from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors
+    from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 
     anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
     points = poses[:, :3] if anchors is None else poses
-    directions = np.swapaxes(cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii), 1, 2)
-    gravity = scene.gravity if scene.effects.gravity else 0.0
-    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
-    needed = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
+    units = cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii)
+    wrenches = reference_wrenches(scene, times)
     limits = tension_limits(scene.cables)
-    unheld = first_unheld(directions, needed, limits)
+
+    def why(free: np.ndarray) -> str:
+        return ("with non-negative tensions" if limits is None
+                else f"within the cables' tension limits ({limits_text(free, limits)})")
+
+    where = (lambda k: f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) "
+                       f"at t = {times[k]:.3f} s is outside the workspace")
+    unheld = first_unheld(np.swapaxes(units, 1, 2), wrenches[:, :3], limits)
     if unheld is not None:
         k, residual, free = unheld
-        why = ("with non-negative tensions" if limits is None
-               else f"within the cables' tension limits ({limits_text(free, limits)})")
         raise UnreachableError(
-            f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) at "
-            f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight and "
-            f"the reference's acceleration ({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
-            "remain unbalanced")
+            f"{where(k)}: the cables cannot give the platform its weight and the reference's acceleration "
+            f"({np.round(wrenches[k, :3], 4).tolist()} N) {why(free)}; "
+            f"{residual:.4g} N would remain unbalanced")
+    if anchors is None or scene.n_cables < 6:
+        return  # the platform turns to balance the moment (a point mass has none)
+    matrices = structure_matrix(poses, anchors, units)  # (N, 6, m): force and moment about the centre of mass
+    if np.linalg.matrix_rank(matrices[0]) < 6:
+        return  # the cables cannot turn the platform about some axis: its rotation there is free
+    unheld = first_unheld(matrices, wrenches, limits)
+    if unheld is not None:
+        k, residual, free = unheld
+        raise UnreachableError(
+            f"{where(k)}: the cables can give the platform the force it needs ({np.round(wrenches[k, :3], 4).tolist()} "
+            f"N, its weight and the reference's acceleration), but not together with the moment about its centre "
+            f"of mass that the reference's rotation needs ({np.round(wrenches[k, 3:], 4).tolist()} N m: zero at rest, "
+            f"plus the angular acceleration and velocity with platform.inertia = {list(scene.platform.inertia)} kg m^2) "
+            f"{why(free)}; {residual:.4g} (N, N m) would remain unbalanced")
+
+
+def reference_wrenches(scene: SpatialScene, times: np.ndarray) -> np.ndarray:
+    """The wrench the cables must give the platform to follow the reference, shape (N, 6) [N, N m].
+
+    The force ``M (a + g e_z)`` and the moment about the centre of mass ``I w' + w x I w``
+    (Euler's equations in the world frame, ``I = R diag(platform.inertia) R^T``): zero
+    for a platform at rest, whatever its orientation. The angular velocity is
+    ``w = J_l(theta) theta'``; its rate comes from a central difference over 1e-6 s
+    (one-sided at t = 0, where the reference starts).
+    """
+    from cdpr_exu.core.geometry import left_jacobian
+
+    times = np.asarray(times, dtype=float)
+    gravity = scene.gravity if scene.effects.gravity else 0.0
+    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
+    force = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
+
+    def angular_velocity(t):
+        pose, rate = np.atleast_2d(scene.trajectory.pose(t)), np.atleast_2d(scene.trajectory.velocity(t))
+        return np.einsum("nij,nj->ni", np.array([left_jacobian(theta) for theta in pose[:, 3:]]), rate[:, 3:])
+
+    delta = 1e-6
+    before, after = np.maximum(times - delta, 0.0), times + delta
+    omega = angular_velocity(times)
+    omega_rate = (angular_velocity(after) - angular_velocity(before)) / (after - before)[:, None]
+    rotations = np.array([rotation_from_vector(theta) for theta in np.atleast_2d(scene.trajectory.pose(times))[:, 3:]])
+    inertia = np.einsum("nij,j,nkj->nik", rotations, np.asarray(scene.platform.inertia, dtype=float), rotations)
+    spin = np.einsum("nij,nj->ni", inertia, omega)
+    moment = np.einsum("nij,nj->ni", inertia, omega_rate) + np.cross(omega, spin)
+    return np.column_stack([force, moment])
 
 
 def highest_exit(scene: SpatialScene) -> float:
@@ -293,6 +344,42 @@ class _SpatialWinches:
             self.applied[i] = length
 
 
+#: A run stops when the platform has turned farther than this from the reference's orientation [deg]:
+#: it has left the workspace (issue 23.5: IPAnema ran on for 566 s to end 175 degrees off).
+MAX_ROTATION_ERROR_DEG = 90.0
+
+
+class _SpatialMonitor:
+    """Checks the platform after each step for states the run cannot come back from (the spatial
+    counterpart of the planar monitor): coordinates no longer finite, a platform above its highest
+    exit (when it started below it: only pushing cables could hold it there), or one turned more
+    than :data:`MAX_ROTATION_ERROR_DEG` from the reference's orientation."""
+
+    def __init__(self, scene: SpatialScene, start_height: float):
+        self.trajectory = scene.trajectory
+        self.exit_height = highest_exit(scene)
+        self.ceiling = self.exit_height if start_height < self.exit_height else np.inf
+        self.turns = not scene.platform.is_point_mass
+
+    def problem(self, t: float, position: np.ndarray, rotation: np.ndarray) -> str | None:
+        """What is wrong at time ``t`` [s] with the platform at ``position`` (3,) [m], turned by ``rotation`` (3, 3),
+        or None."""
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(rotation))):
+            return f"the coordinates are no longer finite at t = {t:.4f} s"
+        if position[2] > self.ceiling:
+            return (f"the platform rose above its highest exit at t = {t:.4f} s (z = {position[2]:.3f} m, the exit at "
+                    f"{self.exit_height:.3f} m): only pushing cables could hold it there; the run has diverged (a "
+                    "winch command that jumps, or a smaller solver.step_size)")
+        if self.turns:
+            reference = rotation_from_vector(np.asarray(self.trajectory.pose(t))[3:])
+            angle = np.degrees(np.linalg.norm(rotation_vector(reference.T @ rotation)))
+            if angle > MAX_ROTATION_ERROR_DEG:
+                return (f"the platform turned {angle:.0f} degrees away from the reference's orientation at "
+                        f"t = {t:.4f} s (limit {MAX_ROTATION_ERROR_DEG:g}): it has left the workspace the cables hold "
+                        "it in; the run is stopped")
+        return None
+
+
 def _warn_outside_measured_region(scene: SpatialScene) -> None:
     """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
     outside the region where runs over a swivel pulley were measured to keep their energy."""
@@ -427,11 +514,19 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
             record(float(t))
             while state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
                 state["next"] += 1
+        position, rotation = platform_pose(mbs, items)
+        problem = monitor.problem(t, position, rotation)
+        if problem is not None:
+            if t > times[-1]:
+                record(float(t))  # the state that stopped the run belongs to its result
+            state["failure"] = problem
+            return False  # ends the integration; what was computed is kept
         if report is not None:
             report(t, _time.perf_counter() - wall_start)
         return True
 
     report = _progress_reporter(progress, scene)
+    monitor = _SpatialMonitor(scene, float(platform_pose(mbs, items)[0][2]))
     record(0.0)
     state["next"] = 1
     mbs.SetPreStepUserFunction(pre_step)
@@ -440,8 +535,8 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     with interrupt_flag() as interrupted, quiet_exudyn():
         try:
             mbs.SolveDynamic(solver_settings(scene))
-        except (exu.SolverError, RuntimeError, SystemError) as err:
-            state["failure"] = " ".join(str(err).split())
+        except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn's own cause, not only "terminated"
+            state["failure"] = state["failure"] or _solver_report(mbs, " ".join(str(err).split()))
     wall = _time.perf_counter() - wall_start
     if report is not None:
         report(None, wall)
