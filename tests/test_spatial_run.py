@@ -405,3 +405,40 @@ def test_a_platform_thrown_above_its_exits_stops_the_run_and_its_summary_flags_i
     assert partial.status.startswith("failed") and 0.0 < partial.pose[-1, 2] < 0.1  # stopped as it passed z = 0
     summary = partial.summary()
     assert summary["platform_above_exits"] and any("above its highest exit (z = 0 m)" in w for w in summary["warnings"])
+
+
+def test_ctrl_c_in_a_spatial_comparison_keeps_the_controllers_done_and_the_partial_run(tmp_path, monkeypatch):
+    """Issue 23.13: Ctrl-C during a spatial `cdpr compare` left only the overview PNGs of the runs
+    done; the summaries were lost (the planar comparison keeps them). The Ctrl-C (a real SIGINT)
+    comes from the second controller, 0.1 s into its run: summary.json and comparison.md hold the
+    first controller's completed summary and the second's partial one, then the interrupt goes on."""
+    import os
+    import signal
+
+    from controllers.ideal_ik import IdealIKController
+    from cdpr_exu.core.errors import RunInterrupted
+    from cdpr_exu.run import spatial_run
+
+    class CtrlC(IdealIKController):
+        name = "ctrl_c"
+
+        def command(self, measurement):
+            if measurement.time >= 0.1 and not getattr(self, "sent", False):
+                self.sent = True
+                os.kill(os.getpid(), signal.SIGINT)  # the run's handler stops the integration after this step
+            return super().command(measurement)
+
+    monkeypatch.setitem(spatial_run.SPATIAL_CONTROLLERS, "ctrl_c", CtrlC)
+    scene = four_cable(end_time=0.3)
+    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    out = tmp_path / "compare"
+    with pytest.raises(RunInterrupted):
+        spatial_run.compare_spatial(scene, ["ideal_ik", "ctrl_c"], out, after=0.0)
+    summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
+    assert list(summary["controllers"]) == ["ideal_ik", "ctrl_c"]
+    assert summary["controllers"]["ideal_ik"]["status"] == "completed"
+    partial = summary["controllers"]["ctrl_c"]
+    assert partial["status"].startswith("interrupted at t = 0.1") and 0.1 <= partial["simulated_time_s"] < 0.3
+    table = (out / "comparison.md").read_text()
+    assert "| ideal_ik |" in table and "| ctrl_c |" in table
+    assert (out / "overview_ideal_ik.png").exists() and (out / "overview_ctrl_c.png").exists()

@@ -40,7 +40,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import fixed, length_text, write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
@@ -503,6 +503,8 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     def post_step(mbs_, t):  # noqa: ARG001
         state["step_start"] = state["reached"] = t  # the state the solver has for the next step's command
         if interrupted["interrupted"]:
+            if t > times[-1]:
+                record(float(t))  # the last state computed belongs to the partial result
             return False
         # One sample per step that reaches an output time, with the step's own time, as the
         # planar run records: a real state, labelled when it was. After a shrunk step the
@@ -725,29 +727,53 @@ def spatial_comparison_table(summaries: dict) -> str:
 def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
                     after: float = 1.0, quiet: bool = True) -> dict[str, dict]:
     """Run a spatial scene under each named controller; write summary.json, comparison.md and each
-    controller's overview figure to ``out``. Returns the summaries by name."""
-    from cdpr_exu.core.output import write_summary as _write
+    controller's overview figure to ``out``. Returns the summaries by name.
 
+    As the planar comparison: a run that fails is recorded with its status and partial
+    figures, a controller that refuses the scene with ``refused: ...``, and the others still
+    run; on Ctrl-C (inside a run or between two) the controllers done so far and the
+    interrupted one's partial run are written before the interrupt goes on.
+    """
     names = list(names or spatial_controller_names(scene))
     unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
     if unknown:
         raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
-    summaries = {}
-    for name in names:
-        try:
-            result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
-        except SolverFailure as err:
-            result = err.partial_result
-        summaries[name] = result.summary(after)
-        if out is not None:
-            Path(out).mkdir(parents=True, exist_ok=True)
-            plot_spatial_run(result, Path(out) / f"overview_{name}.png", after)
-        if not quiet:
-            worst = summaries[name]["max_position_error_m"]
-            print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   {summaries[name]['status']}")
+    summaries, results = {}, {}
+    try:
+        for name in names:
+            try:
+                result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
+            except SolverFailure as err:
+                result = err.partial_result
+                if result is None:  # it failed before its first step (settling the robot)
+                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
+                    continue
+            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
+                results[name] = err.partial_result
+                summaries[name] = err.partial_result.summary(after)
+                raise
+            except CdprError as err:  # a controller that refuses the scene is a result of the comparison too
+                summaries[name] = {"controller": name, "status": f"refused: {err}"}
+                continue
+            results[name], summaries[name] = result, result.summary(after)
+            if not quiet:
+                worst = summaries[name]["max_position_error_m"]
+                print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   "
+                      f"{status_text(summaries[name])}")
+    except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
+        if out is not None and summaries:
+            _write_spatial_comparison(scene, summaries, results, Path(out), after)
+        raise
     if out is not None:
-        _write(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
-                     "error_convention": "actual - reference", "controllers": summaries, **provenance()})
-        (Path(out) / "comparison.md").write_text(spatial_comparison_table(summaries))
+        _write_spatial_comparison(scene, summaries, results, Path(out), after)
     return summaries
 
+
+def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
+    """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    write_summary(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
+                        "error_convention": "actual - reference", "controllers": summaries, **provenance()})
+    (out / "comparison.md").write_text(spatial_comparison_table(summaries))
+    for name, result in results.items():
+        plot_spatial_run(result, out / f"overview_{name}.png", after)
