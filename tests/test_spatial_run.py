@@ -442,3 +442,19 @@ def test_ctrl_c_in_a_spatial_comparison_keeps_the_controllers_done_and_the_parti
     table = (out / "comparison.md").read_text()
     assert "| ideal_ik |" in table and "| ctrl_c |" in table
     assert (out / "overview_ideal_ik.png").exists() and (out / "overview_ctrl_c.png").exists()
+
+
+def test_a_robot_that_comes_to_rest_above_its_exits_is_not_run():
+    """Fuzzing the swivel robot (issue 23, evidence): with cables of E = 1.8e11 Pa (bending on) under a
+    10.8 kg platform, the lumped robot's own rest over the swivel pulleys puts the platform 0.654 m
+    above the inlets (measured), held up by the chains' bending; the run then "completed" there.
+    No cable robot's run starts from such a state: it fails at t = 0 with the cause."""
+    base = load_spatial_scene("spatial-four-cable-swivel")
+    scene = replace(base, cables=tuple(replace(c, n_elements=50, youngs_modulus=1.8e11) for c in base.cables),
+                    platform=replace(base.platform, mass=10.8),
+                    solver=replace(base.solver, step_size=0.0057, output_period=0.0057, end_time=0.133))
+    with pytest.raises(SolverFailure, match=r"failed at t = 0\.0000 s .* rests above its highest exit at t = 0 "
+                                            r"\(z = 0\.65\d m, the exit at 0\.000 m\)") as failure:
+        simulate_spatial(scene)
+    partial = failure.value.partial_result
+    assert len(partial.time) == 1 and partial.summary()["platform_above_exits"]

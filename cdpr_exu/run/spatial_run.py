@@ -350,15 +350,14 @@ MAX_ROTATION_ERROR_DEG = 90.0
 
 
 class _SpatialMonitor:
-    """Checks the platform after each step for states the run cannot come back from (the spatial
-    counterpart of the planar monitor): coordinates no longer finite, a platform above its highest
-    exit (when it started below it: only pushing cables could hold it there), or one turned more
-    than :data:`MAX_ROTATION_ERROR_DEG` from the reference's orientation."""
+    """Checks the platform at the start and after each step for states the run cannot come back from
+    (the spatial counterpart of the planar monitor): coordinates no longer finite, a platform above
+    its highest exit (every cable pulls it down there: only cables that push could hold it), or one
+    turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference's orientation."""
 
-    def __init__(self, scene: SpatialScene, start_height: float):
+    def __init__(self, scene: SpatialScene):
         self.trajectory = scene.trajectory
-        self.exit_height = highest_exit(scene)
-        self.ceiling = self.exit_height if start_height < self.exit_height else np.inf
+        self.ceiling = highest_exit(scene)
         self.turns = not scene.platform.is_point_mass
 
     def problem(self, t: float, position: np.ndarray, rotation: np.ndarray) -> str | None:
@@ -367,8 +366,12 @@ class _SpatialMonitor:
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(rotation))):
             return f"the coordinates are no longer finite at t = {t:.4f} s"
         if position[2] > self.ceiling:
+            if t == 0.0:  # where the robot came to rest (over swivel pulleys: the chain statics)
+                return (f"the platform rests above its highest exit at t = 0 (z = {position[2]:.3f} m, the exit at "
+                        f"{self.ceiling:.3f} m): only cables that push or bend could hold it there, which the "
+                        "lumped chains do and a real cable cannot (cables too stiff in bending for their load?)")
             return (f"the platform rose above its highest exit at t = {t:.4f} s (z = {position[2]:.3f} m, the exit at "
-                    f"{self.exit_height:.3f} m): only pushing cables could hold it there; the run has diverged (a "
+                    f"{self.ceiling:.3f} m): only cables that push could hold it there; the run has diverged (a "
                     "winch command that jumps, or a smaller solver.step_size)")
         if self.turns:
             reference = rotation_from_vector(np.asarray(self.trajectory.pose(t))[3:])
@@ -528,15 +531,17 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         return True
 
     report = _progress_reporter(progress, scene)
-    monitor = _SpatialMonitor(scene, float(platform_pose(mbs, items)[0][2]))
+    monitor = _SpatialMonitor(scene)
     record(0.0)
     state["next"] = 1
+    state["failure"] = monitor.problem(0.0, *platform_pose(mbs, items))  # a start no run can come back from
     mbs.SetPreStepUserFunction(pre_step)
     mbs.SetPostStepUserFunction(post_step)
     wall_start = _time.perf_counter()
     with interrupt_flag() as interrupted, quiet_exudyn():
         try:
-            mbs.SolveDynamic(solver_settings(scene))
+            if state["failure"] is None:
+                mbs.SolveDynamic(solver_settings(scene))
         except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn's own cause, not only "terminated"
             state["failure"] = state["failure"] or _solver_report(mbs, " ".join(str(err).split()))
     wall = _time.perf_counter() - wall_start
@@ -547,10 +552,11 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     paid_out = np.asarray(paid)
     nodes = [np.asarray(series) for series in node_series]
     tensions = [np.asarray(series) for series in tension_series]
-    iterations = mbs.sys["dynamicSolver"].it
+    solved = mbs.sys.get("dynamicSolver")  # none when the start was refused
+    steps, newton = (0, 0) if solved is None else (solved.it.currentStepIndex, solved.it.newtonStepsCount)
     result = SpatialResult(scene.name, controller.name if kinematic else "fixed winches", time_array, pose,
                            np.atleast_2d(scene.trajectory.pose(time_array)), paid_out, nodes, tensions, wall,
-                           int(iterations.currentStepIndex), int(iterations.newtonStepsCount))
+                           int(steps), int(newton))
     if tension_limits(scene.cables) is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     result.metadata["highest_exit_z_m"] = highest_exit(scene)
