@@ -436,7 +436,12 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     mbs.Assemble()
     if scene.swivels:
         _warn_outside_measured_region(scene)
-        start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
+        try:
+            start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
+        except SolverFailure as failure:  # the settle's solver knows why it stopped
+            exudyn_said = str(failure).split(": ", 1)[-1]  # "SolveDynamic terminated", and no more
+            raise SolverFailure(f"settling the robot over its swivel pulleys before the run failed: "
+                                f"{_solver_report(mbs, exudyn_said)}", time=0.0) from None
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = output_times(solver.end_time, solver.output_period)
