@@ -115,8 +115,10 @@ def check_spatial_reference(scene: SpatialScene) -> None:
         return ("with non-negative tensions" if limits is None
                 else f"within the cables' tension limits ({limits_text(free, limits)})")
 
-    where = (lambda k: f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) "
-                       f"at t = {times[k]:.3f} s is outside the workspace")
+    def where(k: int) -> str:
+        return (f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) "
+                f"at t = {times[k]:.3f} s is outside the workspace")
+
     unheld = first_unheld(np.swapaxes(units, 1, 2), wrenches[:, :3], limits)
     if unheld is not None:
         k, residual, free = unheld
