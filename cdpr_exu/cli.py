@@ -18,8 +18,9 @@ from pathlib import Path
 
 from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
                      RunInterrupted, SceneError, SolverFailure)
-from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, undate_solution_file,  # noqa: F401
-                                  write_summary)
+from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text,  # noqa: F401
+                                  undate_solution_file, write_summary)
+from cdpr_exu.results.result import status_text
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
@@ -37,8 +38,9 @@ EPILOG_RUN = """examples:
 """ + EXIT_CODES
 
 
-def _scene_with_overrides(args: argparse.Namespace) -> Scene:
-    scene = load_scene(args.scene)
+def _scene_with_overrides(args: argparse.Namespace, scene: Scene | None = None) -> Scene:
+    """``scene`` (default: the one ``args.scene`` names, loaded) with ``--end-time`` and ``--step-size`` applied."""
+    scene = load_scene(args.scene) if scene is None else scene
     changes = {}
     if getattr(args, "end_time", None) is not None:
         changes["end_time"] = args.end_time
@@ -70,14 +72,14 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
 
     factor = summary["real_time_factor"]
     rows = [
-        ("status", summary["status"], ""),
+        ("status", status_text(summary), ""),
         ("max |error x|", *pair("max_abs_error_x_m", 100, "cm")),
         ("max |error z|", *pair("max_abs_error_z_m", 100, "cm")),
         ("error z range", z_range(summary), z_range(settled)),
         ("max |rotation|", *pair("max_abs_rotation_deg", 1, "deg")),
-        ("min element tension", *pair("min_element_tension_N", 1, "N")),
-        ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]),
-         " / ".join(_figure(v, 1, "N") for v in settled["min_tension_per_cable_N"])),
+        # tensions, slack and limits: over the whole run only (Result.summary)
+        ("min element tension", _figure(summary["min_element_tension_N"], 1, "N"), ""),
+        ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]), ""),
         ("slack time per cable", " / ".join(_figure(v, 1, "s") for v in summary["slack_time_per_cable_s"]), ""),
         ("max pulley penetration", _figure(summary["max_pulley_penetration_m"], 1000, "mm", 3), ""),
         ("simulated / wall time", f"{summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s",
@@ -85,9 +87,8 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
         ("steps / Newton iterations", f"{summary['steps']} / {summary['newton_iterations']}", ""),
     ]
     if "tension_limit_violations" in summary:
-        def count(s):
-            return f"{len(s['tension_limit_violations'])} violation(s)" if s["tension_limit_violations"] else "none"
-        rows.append(("tension limits", count(summary), count(settled)))
+        violations = summary["tension_limit_violations"]
+        rows.append(("tension limits", f"{len(violations)} violation(s)" if violations else "none", ""))
     print(f"{summary['scene']} under {summary['controller']} (error = actual - reference)")
     print(f"  {'':26s} {'whole run':>22s}   {'after ' + str(SETTLED_AFTER) + ' s':>18s}")
     for name, whole, after in rows:
@@ -114,7 +115,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     are checked before anything is written. With ``error_estimate``
     a companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`).
     """
-    from cdpr_exu.results.result import provenance
+    from cdpr_exu.results.result import Result, after_start_up, provenance, raise_warnings
     from cdpr_exu.run.simulate import simulate
     from cdpr_exu.statics.workspace import check_reference
 
@@ -153,10 +154,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
 
             data.update(summary_entry(estimate))
         data.update({k: v for k, v in result.metadata.items() if k not in data})
-        data["after_start_up"] = {k: settled[k] for k in (
-            "errors_measured_after_s", "max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m",
-            "max_error_z_m", "max_position_error_m", "rms_position_error_m", "max_abs_rotation_deg",
-            "min_element_tension_N", "notes")}
+        data["after_start_up"] = after_start_up(settled, Result.ERROR_FIGURES)
         data["error_convention"] = "actual - reference"
         write_summary(out, data)
         if solution_file is not None and solution_file.is_file():
@@ -165,6 +163,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
             from cdpr_exu.post.plots import plot_overview
 
             plot_overview(scene, result, out)
+    if failure is None:  # a completed run that pushed is not clean: say so once, quiet or not
+        raise_warnings(summary, f"{scene.name} under {result.controller}: ")
     if not quiet:
         _print_summary(summary, settled, out)
         if estimate is not None:
@@ -187,7 +187,7 @@ def _elements_for(scene, tolerance: float, quiet: bool):
         raise CdprError(f"--tolerance: no error estimate for this scene ({pilot.note})")
     needed = elements_for_tolerance(n, pilot.max_position_error_m, tolerance)
     if not quiet:
-        print(f"--tolerance {1000 * tolerance:g} mm: estimated {1000 * pilot.max_position_error_m:.2f} mm at {n} "
+        print(f"--tolerance {1000 * tolerance:g} mm: estimated {length_text(pilot.max_position_error_m)} at {n} "
               f"elements per cable; the error model e ~ n^-2 asks for {needed} elements"
               + (" (kept)" if needed == n else ""))
     return scene.with_changes(cables=tuple(replace(c, n_elements=needed) for c in scene.cables))
@@ -200,18 +200,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
-    spatial = load_any_scene(args.scene)
-    if is_spatial(spatial):
+    scene = load_any_scene(args.scene)  # loaded once: a warning of the scene file is printed once
+    if is_spatial(scene):
         from cdpr_exu.run.spatial_run import run_spatial_scene
 
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
-        spatial = replace(spatial, solver=replace(spatial.solver, **changes))
+        scene = replace(scene, solver=replace(scene.solver, **changes))
         if tolerance is not None:
-            spatial = _elements_for(spatial, tolerance, args.quiet)
-        run_spatial_scene(spatial, out, quiet=args.quiet, figures=not args.no_figures,
+            scene = _elements_for(scene, tolerance, args.quiet)
+        run_spatial_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,
                           error_estimate=not args.no_error_estimate)
         return EXIT_OK
-    scene = _scene_with_overrides(args)
+    scene = _scene_with_overrides(args, scene)
     if tolerance is not None:
         scene = _elements_for(scene, tolerance, args.quiet)
     run_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,

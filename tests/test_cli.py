@@ -379,3 +379,19 @@ def test_two_sweeps_write_identical_files_apart_from_timing_json(tmp_path):
     assert "wall_time_s" not in header and "real_time_factor" not in header and "newton_iterations" in header
     timing = json.loads((tmp_path / "a" / "timing.json").read_text())
     assert [r["wall_time_s"] > 0 for r in timing["rows"]] == [True, True] and "date" in timing
+
+
+@pytest.mark.parametrize("scene, option, value", [("spatial-ipanema", "--ramp-time", "-1"),
+                                                  ("spatial-ipanema", "--after", "-1"),
+                                                  ("paper-circle", "--after", "-1"),
+                                                  ("paper-circle", "--after", "nan"),
+                                                  ("paper-circle", "--ramp-time", "nan")])
+def test_compare_refuses_a_negative_or_nan_time_option_naming_it_before_any_run(tmp_path, scene, option, value):
+    """Issue 23.14: `--ramp-time -1` was accepted on spatial scenes (it never reached a check),
+    `--after -1` on both kinds."""
+    out = tmp_path / "cmp"
+    done = _cdpr("compare", scene, option, value, "--controllers", "ideal_ik", "--end-time", "0.05",
+                 "--out", str(out), check=False)
+    assert done.returncode == 2, done.stderr
+    assert f"{option} must be" in done.stderr and "Traceback" not in done.stderr
+    assert "comparing controllers" not in done.stdout and not out.exists()

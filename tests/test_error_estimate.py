@@ -241,3 +241,14 @@ def test_tension_only_spatial_references_converge_at_order_two_and_keep_their_st
         paths[n] = result
     first, second = path_distance(paths[16], paths[32], 1.0), path_distance(paths[32], paths[64], 1.0)
     assert second > 0.0 and first / second > 3.0
+
+
+@pytest.mark.parametrize("metres, text", [(0.018032786894909426, "18.03 mm"), (2.345e-4, "0.23 mm"),
+                                          (4.2e-5, "42 um"), (2.3456e-6, "2.35 um"), (0.0, "0 um")])
+def test_the_estimate_line_prints_micrometres_with_significant_digits(metres, text):
+    """Issue 23.10a: an estimate of micrometres printed as "0.00 mm". From 0.1 mm on the line keeps
+    millimetres with two decimals (the README's "18.03 mm"); below, micrometres to three digits."""
+    from cdpr_exu.run.error_estimate import ErrorEstimate, estimate_line
+
+    line = estimate_line(ErrorEstimate(metres, 30, 2.0, 1.0, "a note"))
+    assert f"after 1.0 s: {text} (a note)" in line

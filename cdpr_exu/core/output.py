@@ -76,6 +76,16 @@ def fixed(value: float, digits: int = 2) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
+def length_text(metres: float | None) -> str:
+    """A length [m] as printed: millimetres with two decimals from 0.1 mm on, micrometres to three
+    significant digits below (never "0.00 mm" for a micrometre); "n/a" for None."""
+    if metres is None:
+        return "n/a"
+    if abs(metres) >= 1e-4:
+        return f"{fixed(1000.0 * metres, 2)} mm"
+    return f"{1e6 * metres:.3g} um".replace("-0 um", "0 um")
+
+
 def split_timing(summary: Any, keep: Sequence[str] = ()) -> tuple[Any, Any]:
     """Split a summary into (stable figures, timing figures that change from run to run).
 

@@ -41,6 +41,7 @@ from typing import Callable
 import numpy as np
 
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
+from cdpr_exu.core.output import length_text
 
 #: Order of the error in the number of elements assumed by the estimate (see above).
 ORDER = 2.0
@@ -205,9 +206,8 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
 
 def estimate_line(estimate: ErrorEstimate) -> str:
     """The line ``cdpr run`` prints for an estimate (planar and spatial)."""
-    value = estimate.max_position_error_m
     return (f"  estimated discretisation error after {estimate.after_s} s: "
-            + ("n/a" if value is None else f"{1000 * value:.2f} mm") + f" ({estimate.note})")
+            f"{length_text(estimate.max_position_error_m)} ({estimate.note})")
 
 
 def summary_entry(estimate: ErrorEstimate) -> dict:

@@ -29,7 +29,7 @@ from controllers.tension_aware import ClosedLoopTensionAwareController, TensionA
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import fixed
-from cdpr_exu.results.result import Result, provenance
+from cdpr_exu.results.result import Result, provenance, raise_warnings, warning_flags
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
                                       ilc_controller, model_feed_forward_controller)
@@ -168,9 +168,9 @@ def markdown_table(summaries: dict[str, dict]) -> str:
             value = summary.get(key)
             cells.append("" if value is None else (str(value) if isinstance(value, int) else fixed(scale * value, 2)))
         ratio = summary.get("error_reduction_vs_ideal_ik")
-        flag = "; cables pushed" if summary.get("elements_pushed") else ""  # a real cable cannot
+        flags = "".join(f"; {flag}" for flag in warning_flags(summary))  # what a real robot cannot do
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {'' if ratio is None else f'{ratio:.1f}x'} | "
-                     f"{summary.get('status', '')}{flag} |")
+                     f"{summary.get('status', '')}{flags} |")
     return "\n".join(lines) + "\n"
 
 
@@ -208,6 +208,8 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
     if not args.quiet:
         print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
     summaries = compare_spatial(scene, names, args.out, args.after, quiet=args.quiet)
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
     if not args.quiet:
         print()
         print(spatial_comparison_table(summaries))
@@ -217,12 +219,22 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
     return EXIT_RUN_FAILED if failed else EXIT_OK
 
 
+def _check_time_options(args: argparse.Namespace) -> None:
+    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
+    on planar and spatial scenes alike)."""
+    from cdpr_exu.core.validation import non_negative
+
+    non_negative("--after", args.after)
+    non_negative("--ramp-time", args.ramp_time)
+
+
 def _cmd_compare(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from cdpr_exu.core.output import check_output_folder
     from cdpr_exu.statics.workspace import check_reference
 
+    _check_time_options(args)
     check_output_folder(args.out, command="compare")
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
@@ -247,6 +259,8 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
     summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet,
                                     learning_rule=rule)
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
     if not args.quiet:
         print()
         print(markdown_table(summaries))
