@@ -424,16 +424,15 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
         return
 
 
-def _refuse_start_above_exits(scene: SpatialScene, mbs, items, catenary) -> None:
-    """Refuse to run from a rest of the lumped robot that holds the platform above its exits
-    (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: held by its bending or pushing elements)."""
+def _rest_above_exits(scene: SpatialScene, mbs, items) -> str | None:
+    """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
+    above its exits (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: its bending or pushing elements do)."""
     from cdpr_exu.run.spatial_rest import rest_above_exits
 
     position, rotation = platform_pose(mbs, items, current=False)
     lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
-    above = rest_above_exits(scene, position, rotation, lowest, catenary)
-    if above is not None:
-        raise SolverFailure(f"the spatial run cannot start from the robot's rest: {above}", time=0.0)
+    above = rest_above_exits(scene, position, rotation, lowest, items.initial)
+    return None if above is None else f"the run cannot start from the robot's rest: {above}"
 
 
 def check_runnable(scene: SpatialScene) -> None:
@@ -513,7 +512,6 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
             exudyn_said = str(failure).split(": ", 1)[-1]  # "SolveDynamic terminated", and no more
             raise SolverFailure(f"settling the robot over its swivel pulleys before the run failed: "
                                 f"{_solver_report(mbs, exudyn_said)}", time=0.0) from None
-        _refuse_start_above_exits(scene, mbs, items, items.initial)
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = output_times(solver.end_time, solver.output_period)
@@ -611,7 +609,9 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     monitor = _SpatialMonitor(scene)
     record(0.0)
     state["next"] = 1
-    state["failure"] = monitor.problem(0.0, *platform_pose(mbs, items))  # a start no run can come back from
+    # a start no run can come back from: over swivel pulleys, a rest held up by the chains' bending (with its cause)
+    state["failure"] = (_rest_above_exits(scene, mbs, items) if scene.swivels else None) \
+        or monitor.problem(0.0, *platform_pose(mbs, items))
     mbs.SetPreStepUserFunction(pre_step)
     mbs.SetPostStepUserFunction(post_step)
     wall_start = _time.perf_counter()
