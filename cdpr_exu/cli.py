@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import re
 import sys
 import warnings
 from dataclasses import replace
@@ -19,7 +18,9 @@ from pathlib import Path
 
 from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
                      RunInterrupted, SceneError, SolverFailure)
-from cdpr_exu.core.output import check_output_folder, fixed, write_summary
+from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text,  # noqa: F401
+                                  undate_solution_file, write_summary)
+from cdpr_exu.results.result import status_text
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
 
 #: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
@@ -37,8 +38,9 @@ EPILOG_RUN = """examples:
 """ + EXIT_CODES
 
 
-def _scene_with_overrides(args: argparse.Namespace) -> Scene:
-    scene = load_scene(args.scene)
+def _scene_with_overrides(args: argparse.Namespace, scene: Scene | None = None) -> Scene:
+    """``scene`` (default: the one ``args.scene`` names, loaded) with ``--end-time`` and ``--step-size`` applied."""
+    scene = load_scene(args.scene) if scene is None else scene
     changes = {}
     if getattr(args, "end_time", None) is not None:
         changes["end_time"] = args.end_time
@@ -70,14 +72,14 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
 
     factor = summary["real_time_factor"]
     rows = [
-        ("status", summary["status"], ""),
+        ("status", status_text(summary), ""),
         ("max |error x|", *pair("max_abs_error_x_m", 100, "cm")),
         ("max |error z|", *pair("max_abs_error_z_m", 100, "cm")),
         ("error z range", z_range(summary), z_range(settled)),
         ("max |rotation|", *pair("max_abs_rotation_deg", 1, "deg")),
-        ("min element tension", *pair("min_element_tension_N", 1, "N")),
-        ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]),
-         " / ".join(_figure(v, 1, "N") for v in settled["min_tension_per_cable_N"])),
+        # tensions, slack and limits: over the whole run only (Result.summary)
+        ("min element tension", _figure(summary["min_element_tension_N"], 1, "N"), ""),
+        ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]), ""),
         ("slack time per cable", " / ".join(_figure(v, 1, "s") for v in summary["slack_time_per_cable_s"]), ""),
         ("max pulley penetration", _figure(summary["max_pulley_penetration_m"], 1000, "mm", 3), ""),
         ("simulated / wall time", f"{summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s",
@@ -85,9 +87,8 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
         ("steps / Newton iterations", f"{summary['steps']} / {summary['newton_iterations']}", ""),
     ]
     if "tension_limit_violations" in summary:
-        def count(s):
-            return f"{len(s['tension_limit_violations'])} violation(s)" if s["tension_limit_violations"] else "none"
-        rows.append(("tension limits", count(summary), count(settled)))
+        violations = summary["tension_limit_violations"]
+        rows.append(("tension limits", f"{len(violations)} violation(s)" if violations else "none", ""))
     print(f"{summary['scene']} under {summary['controller']} (error = actual - reference)")
     print(f"  {'':26s} {'whole run':>22s}   {'after ' + str(SETTLED_AFTER) + ' s':>18s}")
     for name, whole, after in rows:
@@ -106,13 +107,15 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     """Run ``scene`` and write its files into ``out``; returns the summary.
 
     Writes ``scene.toml``, ``result.npz``, ``pose.csv``, ``summary.json``,
-    ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures.
+    ``solution.sol`` (Exudyn's solution file, for ``SolutionViewer``) and the figures,
+    after removing the files of an earlier run there (:func:`cdpr_exu.core.output.clear_outputs`;
+    a folder of another command's output is refused).
     A failed or interrupted (Ctrl-C) run still writes what was computed up to then,
     then re-raises. ``out`` and the reference (:func:`cdpr_exu.statics.workspace.check_reference`)
     are checked before anything is written. With ``error_estimate``
     a companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`).
     """
-    from cdpr_exu.results.result import provenance
+    from cdpr_exu.results.result import Result, after_start_up, provenance, raise_warnings
     from cdpr_exu.run.simulate import simulate
     from cdpr_exu.statics.workspace import check_reference
 
@@ -121,7 +124,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     check_reference(scene)
     solution_file = None
     if out is not None:
-        out = check_output_folder(out)
+        out = check_output_folder(out, command="run")
+        clear_outputs(out, "run")  # none of the run this one replaces stays beside it
         save_scene(scene, out / "scene.toml")
         solution_file = out / "solution.sol"
     failure = None
@@ -150,10 +154,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
 
             data.update(summary_entry(estimate))
         data.update({k: v for k, v in result.metadata.items() if k not in data})
-        data["after_start_up"] = {k: settled[k] for k in (
-            "errors_measured_after_s", "max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m",
-            "max_error_z_m", "max_position_error_m", "rms_position_error_m", "max_abs_rotation_deg",
-            "min_element_tension_N", "notes")}
+        data["after_start_up"] = after_start_up(settled, Result.ERROR_FIGURES)
         data["error_convention"] = "actual - reference"
         write_summary(out, data)
         if solution_file is not None and solution_file.is_file():
@@ -162,6 +163,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
             from cdpr_exu.post.plots import plot_overview
 
             plot_overview(scene, result, out)
+    if failure is None:  # a completed run that pushed is not clean: say so once, quiet or not
+        raise_warnings(summary, f"{scene.name} under {result.controller}: ")
     if not quiet:
         _print_summary(summary, settled, out)
         if estimate is not None:
@@ -173,23 +176,9 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     return summary
 
 
-def undate_solution_file(path: Path) -> None:
-    """Blank the date in the header of Exudyn's solution file, so it is stable from run to run.
-
-    The binary header and footer hold the start and end times as ``YYYY-MM-DD,HH:MM:SS``;
-    they are overwritten in place with zeros of the same length (the file stays readable
-    by SolutionViewer).
-    """
-    data = bytearray(path.read_bytes())
-    pattern = re.compile(rb"\d{4}-\d{2}-\d{2},\d{2}:\d{2}:\d{2}")
-    for offset in (0, max(0, len(data) - 256)):
-        for match in pattern.finditer(bytes(data[offset:offset + 1024])):
-            data[offset + match.start():offset + match.end()] = b"0000-00-00,00:00:00"
-    path.write_bytes(bytes(data))
-
-
 def _elements_for(scene, tolerance: float, quiet: bool):
-    """The scene (planar or spatial) with the fewest elements per cable that the error model says meet ``tolerance`` [m]."""
+    """The scene (planar or spatial) with the fewest elements per cable, never fewer than it has, that the error
+    model says meet ``tolerance`` [m] (:func:`cdpr_exu.run.error_estimate.elements_for_tolerance` says why not fewer)."""
     from cdpr_exu.run.error_estimate import elements_for_tolerance, estimate_error, simulate_any
 
     n = max(c.n_elements for c in scene.cables)
@@ -198,7 +187,7 @@ def _elements_for(scene, tolerance: float, quiet: bool):
         raise CdprError(f"--tolerance: no error estimate for this scene ({pilot.note})")
     needed = elements_for_tolerance(n, pilot.max_position_error_m, tolerance)
     if not quiet:
-        print(f"--tolerance {1000 * tolerance:g} mm: estimated {1000 * pilot.max_position_error_m:.2f} mm at {n} "
+        print(f"--tolerance {1000 * tolerance:g} mm: estimated {length_text(pilot.max_position_error_m)} at {n} "
               f"elements per cable; the error model e ~ n^-2 asks for {needed} elements"
               + (" (kept)" if needed == n else ""))
     return scene.with_changes(cables=tuple(replace(c, n_elements=needed) for c in scene.cables))
@@ -207,22 +196,22 @@ def _elements_for(scene, tolerance: float, quiet: bool):
 def _cmd_run(args: argparse.Namespace) -> int:
     from cdpr_exu.run.error_estimate import parse_length
 
-    out = check_output_folder(args.out)
+    out = check_output_folder(args.out, command="run")
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
-    spatial = load_any_scene(args.scene)
-    if is_spatial(spatial):
+    scene = load_any_scene(args.scene)  # loaded once: a warning of the scene file is printed once
+    if is_spatial(scene):
         from cdpr_exu.run.spatial_run import run_spatial_scene
 
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
-        spatial = replace(spatial, solver=replace(spatial.solver, **changes))
+        scene = replace(scene, solver=replace(scene.solver, **changes))
         if tolerance is not None:
-            spatial = _elements_for(spatial, tolerance, args.quiet)
-        run_spatial_scene(spatial, out, quiet=args.quiet, figures=not args.no_figures,
+            scene = _elements_for(scene, tolerance, args.quiet)
+        run_spatial_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,
                           error_estimate=not args.no_error_estimate)
         return EXIT_OK
-    scene = _scene_with_overrides(args)
+    scene = _scene_with_overrides(args, scene)
     if tolerance is not None:
         scene = _elements_for(scene, tolerance, args.quiet)
     run_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,
@@ -263,8 +252,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--no-error-estimate", action="store_true",
                      help="skip the companion run that estimates the discretisation error")
     run.add_argument("--tolerance", metavar="LENGTH",
-                     help="position error to meet, e.g. 5mm: the fewest elements per cable the error model "
-                     "says meet it are chosen (a pilot run and its estimate first) and printed")
+                     help="position error to meet, e.g. 5mm: a pilot run with the scene's elements and its "
+                     "error estimate first, then the fewest elements per cable, never fewer than the scene has, "
+                     "that the error model says meet it (printed)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     run.set_defaults(func=_cmd_run)
 

@@ -23,6 +23,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from cdpr_exu.core.validation import shown
+
 #: Duration of the blend from the paid-out lengths at t = 0 into a controller's commands [s].
 START_BLEND_TIME = 0.5
 
@@ -137,7 +139,7 @@ class SmoothStart:
 
     def __init__(self, controller: Controller, duration: float = START_BLEND_TIME) -> None:
         if not np.isfinite(duration) or duration <= 0:
-            raise ValueError(f"duration must be positive [s], got {duration!r}")
+            raise ValueError(f"duration must be positive [s], got {shown(duration)}")
         self.controller = controller
         self.duration = float(duration)
         self.name = controller.name

@@ -37,6 +37,7 @@ import numpy as np
 
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.statics.kinematics import cable_unit_vectors, pulley_arrays
+from cdpr_exu.core.validation import shown
 
 from .base import Measurement, WinchCommand, quintic_blend
 
@@ -68,11 +69,11 @@ class FilteredPositionPI:
                  start_time: float = 0.5):
         for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
             if not np.isfinite(value) or value < 0:
-                raise SceneError(f"{name} must be zero or positive, got {value!r}")
+                raise SceneError(f"{name} must be zero or positive, got {shown(value)}")
         if not np.isfinite(start_time) or start_time < 0:
-            raise SceneError(f"start_time must be zero or positive, got {start_time!r}")
+            raise SceneError(f"start_time must be zero or positive, got {shown(start_time)}")
         if not np.isfinite(cutoff) or cutoff <= 0:
-            raise SceneError(f"cutoff must be positive [Hz], got {cutoff!r}")
+            raise SceneError(f"cutoff must be positive [Hz], got {shown(cutoff)}")
         self.proportional_gain = float(proportional_gain)
         self.integral_gain = float(integral_gain)
         self.cutoff = float(cutoff)
@@ -226,14 +227,14 @@ class ClosedLoopController:
 
     def __init__(self, name: str, feed_forward, feedback: FilteredPositionPI, follow: str = "expected"):
         if not callable(getattr(feed_forward, "command", None)) or not callable(getattr(feed_forward, "reset", None)):
-            raise SceneError(f"feed_forward must be a controller (reset and command), got {feed_forward!r}")
+            raise SceneError(f"feed_forward must be a controller (reset and command), got {shown(feed_forward)}")
         if getattr(feed_forward, "uses_pose", True) or getattr(feed_forward, "uses_tension", True):
             raise SceneError(f"feed_forward must be open loop (uses_pose and uses_tension False), "
-                             f"got {getattr(feed_forward, 'name', feed_forward)!r}")
+                             f"got {shown(getattr(feed_forward, 'name', feed_forward))}")
         if not isinstance(feedback, FilteredPositionPI):
-            raise SceneError(f"feedback must be a FilteredPositionPI, got {feedback!r}")
+            raise SceneError(f"feedback must be a FilteredPositionPI, got {shown(feedback)}")
         if follow not in FOLLOW:
-            raise SceneError(f"follow must be one of {FOLLOW}, got {follow!r}")
+            raise SceneError(f"follow must be one of {FOLLOW}, got {shown(follow)}")
         self.name = name
         self.feed_forward = feed_forward
         self.feedback = feedback
@@ -251,7 +252,7 @@ class ClosedLoopController:
             expected = getattr(self.feed_forward, "expected_position", None)
             if expected is None or expected(0.0) is None:
                 raise SceneError(f"follow = 'expected' needs a feed-forward that expects a path (expected_position), "
-                                 f"{getattr(self.feed_forward, 'name', self.feed_forward)!r} does not")
+                                 f"{shown(getattr(self.feed_forward, 'name', self.feed_forward))} does not")
         self.feedback.reset(scene)
 
     def command(self, measurement: Measurement) -> WinchCommand:

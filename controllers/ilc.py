@@ -44,6 +44,7 @@ from scipy.signal import butter, filtfilt
 
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.statics.kinematics import cable_unit_vectors, pulley_arrays
+from cdpr_exu.core.validation import shown
 
 from .base import Measurement, WinchCommand
 from .ideal_ik import ideal_paid_out
@@ -211,16 +212,16 @@ class LearningLaw:
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.gain) or not 0.0 < self.gain < 2.0:
-            raise SceneError(f"gain must lie in (0, 2), got {self.gain!r}")
+            raise SceneError(f"gain must lie in (0, 2), got {shown(self.gain)}")
         if not np.isfinite(self.lead) or self.lead < 0:
-            raise SceneError(f"lead must be zero or positive [s], got {self.lead!r}")
+            raise SceneError(f"lead must be zero or positive [s], got {shown(self.lead)}")
         if not np.isfinite(self.cutoff) or self.cutoff <= 0:
-            raise SceneError(f"cutoff must be positive [Hz], got {self.cutoff!r}")
+            raise SceneError(f"cutoff must be positive [Hz], got {shown(self.cutoff)}")
         if isinstance(self.filter_order, bool) or not isinstance(self.filter_order, (int, np.integer)) \
                 or not 1 <= self.filter_order <= 8:
-            raise SceneError(f"filter_order must be an integer from 1 to 8, got {self.filter_order!r}")
+            raise SceneError(f"filter_order must be an integer from 1 to 8, got {shown(self.filter_order)}")
         if not np.isfinite(self.fade_time) or self.fade_time < 0:
-            raise SceneError(f"fade_time must be zero or positive [s], got {self.fade_time!r}")
+            raise SceneError(f"fade_time must be zero or positive [s], got {shown(self.fade_time)}")
 
     def low_pass(self, signal: np.ndarray, sample_time: float) -> np.ndarray:
         """Q: zero-phase low-pass of ``signal`` (shape (N, ...)) along time, sampled every ``sample_time`` [s]."""
@@ -286,9 +287,9 @@ class StoppingRule:
     def __post_init__(self) -> None:
         if isinstance(self.max_trials, bool) or not isinstance(self.max_trials, (int, np.integer)) \
                 or self.max_trials < 1:
-            raise SceneError(f"max_trials must be an integer >= 1, got {self.max_trials!r}")
+            raise SceneError(f"max_trials must be an integer >= 1, got {shown(self.max_trials)}")
         if not np.isfinite(self.min_improvement) or not 0.0 <= self.min_improvement < 1.0:
-            raise SceneError(f"min_improvement must lie in [0, 1), got {self.min_improvement!r}")
+            raise SceneError(f"min_improvement must lie in [0, 1), got {shown(self.min_improvement)}")
 
     def reason_to_stop(self, max_errors: list[float]) -> str | None:
         """Why to stop after the trials whose maximum errors [m] are ``max_errors``, or None to go on."""
@@ -317,7 +318,7 @@ class LearnedController(ReplayController):
 
     def __init__(self, name: str, learner: Callable):
         if not callable(learner):
-            raise SceneError(f"learner must be callable, got {learner!r}")
+            raise SceneError(f"learner must be callable, got {shown(learner)}")
         self.name = name
         self.learner = learner
         self.table = None
@@ -327,5 +328,5 @@ class LearnedController(ReplayController):
         """Learn the commands for ``scene`` and prepare their replay."""
         self.table = self.learner(scene, np.asarray(initial_paid_out, dtype=float))
         if not isinstance(self.table, CommandTable):
-            raise SceneError(f"the learner of {self.name!r} must return a CommandTable, got {type(self.table).__name__}")
+            raise SceneError(f"the learner of {shown(self.name)} must return a CommandTable, got {type(self.table).__name__}")
         super().reset(scene, initial_paid_out)

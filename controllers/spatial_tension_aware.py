@@ -44,6 +44,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from cdpr_exu.core.validation import shown
+
 from .base import Measurement, WinchCommand
 
 #: Spacing of the statics samples along the reference [s].
@@ -71,9 +73,9 @@ class SpatialTensionAwareController:
         from cdpr_exu.core.errors import SceneError
 
         if not np.isfinite(sample_period) or sample_period <= 0:
-            raise SceneError(f"sample_period must be positive [s], got {sample_period!r}")
+            raise SceneError(f"sample_period must be positive [s], got {shown(sample_period)}")
         if statics not in STATICS_MODELS:
-            raise SceneError(f"statics must be one of {STATICS_MODELS}, got {statics!r}")
+            raise SceneError(f"statics must be one of {STATICS_MODELS}, got {shown(statics)}")
         self.sample_period = float(sample_period)
         self.statics = statics
         self.name = "tension_aware" + ("_chain" if statics == "chain" else "")

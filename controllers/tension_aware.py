@@ -47,6 +47,7 @@ from cdpr_exu.statics import chain_statics
 from cdpr_exu.statics import statics
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes
+from cdpr_exu.core.validation import shown
 
 from .base import Measurement, WinchCommand
 from .feedback import FilteredPositionPI
@@ -119,11 +120,11 @@ class TensionAwareController:
     def __init__(self, dynamic: bool = False, table_period: float = 0.02,
                  chordal_correction: bool = False, statics: str = "catenary", table_spacing: float = 2e-3):
         if not np.isfinite(table_period) or table_period <= 0:
-            raise SceneError(f"table_period must be positive, got {table_period!r}")
+            raise SceneError(f"table_period must be positive, got {shown(table_period)}")
         if not np.isfinite(table_spacing) or table_spacing < 0:
-            raise SceneError(f"table_spacing must be zero or positive, got {table_spacing!r}")
+            raise SceneError(f"table_spacing must be zero or positive, got {shown(table_spacing)}")
         if statics not in STATICS_MODELS:
-            raise SceneError(f"statics must be one of {STATICS_MODELS}, got {statics!r}")
+            raise SceneError(f"statics must be one of {STATICS_MODELS}, got {shown(statics)}")
         if statics == "chain" and chordal_correction:
             raise SceneError("chordal_correction is for statics='catenary': the chain statics has the polygon already")
         self.dynamic = bool(dynamic)

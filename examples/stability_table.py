@@ -46,6 +46,7 @@ import numpy as np
 
 from cdpr_exu.results.energy import energy_rise, mechanical_energy
 from cdpr_exu.core.errors import CdprError, SolverFailure
+from cdpr_exu.core.output import write_json
 from cdpr_exu.scenes.scene import Effects, Scene, WinchSpec, load_scene
 from cdpr_exu.run.simulate import explicit_step_limit, simulate
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
@@ -305,7 +306,7 @@ def write(rows: list[dict], out: Path, wall: float) -> None:
     fields = ["case", "description", "implicit_largest_stable_step_s", "implicit_first_unstable_step_s",
               "implicit_unstable_because", "implicit_start_up_energy_jolt_J", "implicit_largest_jolt_free_step_s",
               "implicit_deviation_at_largest_m", "rk44_largest_stable_step_s", "rk44_estimated_limit_s",
-              "rk44_first_unstable_step_s", "step_ratio_implicit_to_rk44", "implicit_wall_s", "rk44_wall_s"]
+              "rk44_first_unstable_step_s", "step_ratio_implicit_to_rk44"]
     with open(out / "stability.csv", "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=fields)
         writer.writeheader()
@@ -324,12 +325,15 @@ def write(rows: list[dict], out: Path, wall: float) -> None:
                 "rk44_estimated_limit_s": _s(exp["estimate"]),
                 "rk44_first_unstable_step_s": _s(exp["first_unstable"]),
                 "step_ratio_implicit_to_rk44": _s(ratio),
-                "implicit_wall_s": f"{imp['wall']:.1f}", "rk44_wall_s": f"{exp['wall']:.1f}",
             })
+    # Wall-clock figures change from run to run: in the untracked timing.json, not in the tables.
+    write_json(out / "timing.json", {"wall_time_s": wall, "cases": [
+        {"case": r["case"], "implicit_wall_time_s": r["implicit"]["wall"], "rk44_wall_time_s": r["explicit"]["wall"]}
+        for r in rows]})
     lines = [
         "# Largest stable step: implicit generalized-alpha vs explicit RK44",
         "",
-        f"Written by `examples/stability_table.py` in {wall / 60:.1f} min. Paper scene "
+        "Written by `examples/stability_table.py` (its wall times in timing.json). Paper scene "
         f"(`paper-circle`, spectral radius {PAPER.solver.spectral_radius:g}, modified Newton), one hard change per row.",
         "",
         "| case | implicit: largest stable step [s] | first unstable [s], why | start-up energy jolt at it [J] "

@@ -159,6 +159,32 @@ def test_a_directory_given_as_the_scene_is_named_a_directory(tmp_path):
     assert done.returncode == 2 and "is a directory" in done.stderr
 
 
+#: Scene files that are no TOML scene, and what the refusal says (issue 23.11: the first two were
+#: UnicodeDecodeError tracebacks, exit 1).
+MALFORMED_FILES = {
+    "latin-1": (b'name = "caf\xe9"\n', "is not UTF-8 TOML: byte 11 is 0xe9"),
+    "binary": (bytes(range(128, 256)) * 3, "is not UTF-8 TOML: byte 0 is 0x80"),
+    "NUL bytes": (b"\x00\x01\x02", "is not valid TOML: Invalid statement"),
+    "empty": (b"", "lacks pulleys, platform, trajectory"),
+    "TOML syntax error": (b"name = 'x'\n[cable\n", "is not valid TOML: Expected ']'"),
+    "spatial, Latin-1": (b'dimension = 3\nname = "caf\xe9"\n', "is not UTF-8 TOML: byte 25 is 0xe9"),
+}
+
+
+@pytest.mark.parametrize("kind", list(MALFORMED_FILES))
+@pytest.mark.parametrize("command", ["run", "static"])
+def test_a_scene_file_that_is_no_toml_scene_exits_2_naming_the_file(tmp_path, capsys, command, kind):
+    from cdpr_exu.cli import main
+
+    content, words = MALFORMED_FILES[kind]
+    path = tmp_path / "scene.toml"
+    path.write_bytes(content)
+    assert main([command, str(path)]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"cdpr: error: scene {'file ' if 'UTF-8' in words else ''}'{path}'"), error
+    assert words in error, error
+
+
 def test_static_output_numbers_cables_from_one_and_prints_no_negative_zero():
     done = _cdpr("static", "paper-catenary-fixed")
     assert "cable 1:" in done.stdout and "cable 2:" in done.stdout and "cable 0" not in done.stdout
@@ -254,20 +280,27 @@ def test_sweep_csv_leaves_not_applicable_cells_empty_and_its_json_is_strict(tmp_
 @pytest.mark.slow
 def test_the_readme_command_writes_the_committed_result_folder_byte_for_byte(tmp_path):
     """Issue 11.12, as the README promises: `cdpr run paper-circle --out results/paper_circle`
-    leaves `git status` clean. The same command into a fresh folder writes every tracked file
-    of results/paper_circle byte for byte (timing.json is untracked; variants.* come from
-    examples/paper_reproduction.py). Fails when the code moved the answer and the committed
-    results were not regenerated."""
+    leaves `git status` clean. The same command into a copy of the committed folder (which
+    also holds variants.* of examples/paper_reproduction.py, and a stale timing.json) rewrites
+    every tracked file byte for byte, removes none and adds only the untracked timing.json
+    (issue 23.15: a run clears only the files a run writes). Fails when the code moved the
+    answer and the committed results were not regenerated."""
+    import shutil
     from pathlib import Path
 
     committed = Path(__file__).resolve().parents[1] / "results" / "paper_circle"
+    tracked = sorted(p.name for p in committed.iterdir() if p.name != "timing.json")
     out = tmp_path / "paper_circle"
+    shutil.copytree(committed, out)
+    (out / "timing.json").write_text('{"wall_time_s": 1e9}\n')
     _cdpr("run", "paper-circle", "--out", str(out), "-q")
     written = sorted(p.name for p in out.iterdir() if p.name != "timing.json")
-    assert {"summary.json", "result.npz", "solution.sol", "pose.csv", "scene.toml", "overview.png"} <= set(written)
-    changed = [name for name in written
-               if not (committed / name).is_file() or (committed / name).read_bytes() != (out / name).read_bytes()]
+    assert written == tracked
+    assert {"summary.json", "result.npz", "solution.sol", "pose.csv", "scene.toml", "overview.png",
+            "variants.md"} <= set(written)
+    changed = [name for name in written if (committed / name).read_bytes() != (out / name).read_bytes()]
     assert changed == [], f"regenerate results/paper_circle: {changed} differ from what the code writes"
+    assert json.loads((out / "timing.json").read_text())["wall_time_s"] < 1e9  # this run's, not the stale one
 
 
 def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, monkeypatch):
@@ -294,3 +327,71 @@ def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, m
     summary = _strict_json(out / "summary.json")
     assert list(summary["controllers"]) == ["ideal_ik"]
     assert summary["controllers"]["ideal_ik"]["status"] == "completed"
+
+
+# --------------------------------------------------------------------------- wall clock apart (issue 23.18)
+
+
+def _written(folder):
+    return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
+
+
+def _same_apart_from_timing(first, second):
+    """The names of the files that differ between two output folders, timing.json aside."""
+    a, b = _written(first), _written(second)
+    assert sorted(a) == sorted(b)
+    return [name for name in sorted(a) if name != "timing.json" and a[name] != b[name]]
+
+
+@pytest.mark.parametrize("dimension", ["planar", "spatial"])
+def test_two_comparisons_write_identical_files_apart_from_timing_json(tmp_path, dimension):
+    """Issue 23.18: "everything else a run writes is identical" was false for `cdpr compare`:
+    each controller's wall time and real-time factor sat in summary.json and comparison.md's
+    "wall time [s]" column. They are in timing.json now, and two comparisons write the same
+    bytes in every other file (tables, pose CSVs, figures)."""
+    from conftest import small_spatial_scene
+
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    if dimension == "planar":
+        scene, controllers = _scene_file(tmp_path, "short", end_time=0.3), ["ideal_ik", "tension_aware"]
+    else:  # the small robot's 5 cm in 0.2 s is beyond the catenary controllers' workspace: ideal IK only
+        scene, controllers = save_any_scene(small_spatial_scene(0.2), tmp_path / "small.toml"), ["ideal_ik"]
+    for name in ("a", "b"):
+        _cdpr("compare", str(scene), "--controllers", ",".join(controllers), "--after", "0",
+              "--out", str(tmp_path / name), "-q")
+    assert _same_apart_from_timing(tmp_path / "a", tmp_path / "b") == []
+    assert "wall" not in (tmp_path / "a" / "comparison.md").read_text()
+    timing = json.loads((tmp_path / "a" / "timing.json").read_text())
+    assert sorted(timing["controllers"]) == controllers
+    assert all(t["wall_time_s"] > 0 for t in timing["controllers"].values())
+
+
+def test_two_sweeps_write_identical_files_apart_from_timing_json(tmp_path):
+    """Issue 23.18, `cdpr study sweep`: study.csv and study.json held each run's wall time and
+    real-time factor, and vs_<parameter>.png plotted the wall time; the figure now plots the
+    Newton iterations, and the wall-clock figures are in timing.json only."""
+    for name in ("a", "b"):
+        _cdpr("study", "sweep", "paper-circle", "--end-time", "0.2", "--param", "platform.mass=2,3",
+              "--workers", "1", "--after", "0", "--out", str(tmp_path / name), "-q")
+    assert _same_apart_from_timing(tmp_path / "a", tmp_path / "b") == []
+    header = (tmp_path / "a" / "study.csv").read_text().splitlines()[0].split(",")
+    assert "wall_time_s" not in header and "real_time_factor" not in header and "newton_iterations" in header
+    timing = json.loads((tmp_path / "a" / "timing.json").read_text())
+    assert [r["wall_time_s"] > 0 for r in timing["rows"]] == [True, True] and "date" in timing
+
+
+@pytest.mark.parametrize("scene, option, value", [("spatial-ipanema", "--ramp-time", "-1"),
+                                                  ("spatial-ipanema", "--after", "-1"),
+                                                  ("paper-circle", "--after", "-1"),
+                                                  ("paper-circle", "--after", "nan"),
+                                                  ("paper-circle", "--ramp-time", "nan")])
+def test_compare_refuses_a_negative_or_nan_time_option_naming_it_before_any_run(tmp_path, scene, option, value):
+    """Issue 23.14: `--ramp-time -1` was accepted on spatial scenes (it never reached a check),
+    `--after -1` on both kinds."""
+    out = tmp_path / "cmp"
+    done = _cdpr("compare", scene, option, value, "--controllers", "ideal_ik", "--end-time", "0.05",
+                 "--out", str(out), check=False)
+    assert done.returncode == 2, done.stderr
+    assert f"{option} must be" in done.stderr and "Traceback" not in done.stderr
+    assert "comparing controllers" not in done.stdout and not out.exists()

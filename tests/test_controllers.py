@@ -103,9 +103,9 @@ def test_tension_aware_options_are_checked():
 
 def test_a_reference_that_needs_a_pushing_cable_is_refused_before_the_run():
     # Above the pulleys both cables pull the platform down: only pushing cables could
-    # hold its weight.
-    scene = PAPER.with_changes(trajectory=HoldTrajectory((0.0, 0.6, 0.0)),
-                               platform=replace(PAPER.platform, initial_pose=(0.0, 0.6, 0.0)))
+    # hold its weight. (The platform starts below them: a scene starting above them is
+    # refused when it is made, tests/test_scene.py.)
+    scene = PAPER.with_changes(trajectory=HoldTrajectory((0.0, 0.6, 0.0)))
     with pytest.raises(UnreachableError, match="t = 0.000 s"):
         TensionAwareController().reset(scene, np.array([3.0, 1.2]))
 
@@ -195,6 +195,7 @@ def test_the_closed_loop_keeps_the_winch_commands_smooth_where_the_unfiltered_lo
     slack winch element snapped taut and the solver failed at 1.21 s. The filtered loop
     runs through, with commands as smooth as the reference's (3.2 and 6.7 m/s^2 measured
     on the 10 ms output grid; the circle itself needs about 1 m/s^2)."""
+    from cdpr_exu.results.result import slack_time
     from cdpr_exu.run.simulate import simulate
 
     scene = SMOOTH.with_changes(solver=replace(SMOOTH.solver, end_time=1.6))
@@ -277,6 +278,7 @@ def test_the_smooth_start_leaves_ideal_ik_on_the_paper_start_unchanged():
 def test_with_the_smooth_start_no_tension_only_element_goes_slack_in_the_first_second(controller):
     """On paper-circle-mismatch (tension-only cables, circle from rest over 1 s) every element
     stays taut after t = 0; the paper's start at full speed throws the cables slack."""
+    from cdpr_exu.results.result import slack_time
     from cdpr_exu.run.simulate import simulate
 
     scene = SMOOTH.with_changes(solver=replace(SMOOTH.solver, end_time=1.0))
@@ -286,10 +288,11 @@ def test_with_the_smooth_start_no_tension_only_element_goes_slack_in_the_first_s
     lowest = min(t[after].min() for t in smooth.tensions)
     # Measured 13.1 N (ideal IK) and 11.5 N (tension-aware), at 0.57-0.64 s; 5 N is the margin.
     assert lowest > 5.0
-    assert max(smooth._slack_time(t, after) for t in smooth.tensions) == 0.0
+    assert max(slack_time(smooth.time[after], t[after]) for t in smooth.tensions) == 0.0
     abrupt = simulate(scene.with_changes(trajectory=replace(scene.trajectory, ramp_time=0.0)), controller)
     # Measured 0.12 s and 0.16 s of slack in the first second.
-    assert max(abrupt._slack_time(t, abrupt.time > 0.0) for t in abrupt.tensions) > 0.05
+    later = abrupt.time > 0.0
+    assert max(slack_time(abrupt.time[later], t[later]) for t in abrupt.tensions) > 0.05
 
 
 def test_the_ideal_ik_table_lookup_is_np_interp_on_every_column():

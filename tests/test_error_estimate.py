@@ -45,6 +45,16 @@ def test_bad_tolerance_is_refused_naming_the_option(text):
         parse_length(text)
 
 
+def test_tolerance_never_chooses_fewer_elements_than_the_scene_has_and_its_help_says_so():
+    """Issue 23.19: the help said "the fewest elements per cable"; the model is fitted on n and 2n and is
+    not extrapolated below n, so an error 100 times below the tolerance keeps the scene's 15."""
+    from cdpr_exu.cli import build_parser
+
+    assert elements_for_tolerance(15, 1e-5, 1e-3) == 15
+    run = build_parser()._subparsers._group_actions[0].choices["run"]
+    assert "never fewer than the scene has" in " ".join(run.format_help().split())
+
+
 def test_elements_for_tolerance_follows_the_second_order_model_and_is_monotone():
     assert elements_for_tolerance(15, 0.018, 0.020) == 15  # already met
     assert elements_for_tolerance(15, 0.018, 0.005) == 29  # ceil(15 sqrt(3.6))
@@ -231,3 +241,14 @@ def test_tension_only_spatial_references_converge_at_order_two_and_keep_their_st
         paths[n] = result
     first, second = path_distance(paths[16], paths[32], 1.0), path_distance(paths[32], paths[64], 1.0)
     assert second > 0.0 and first / second > 3.0
+
+
+@pytest.mark.parametrize("metres, text", [(0.018032786894909426, "18.03 mm"), (2.345e-4, "0.23 mm"),
+                                          (4.2e-5, "42 um"), (2.3456e-6, "2.35 um"), (0.0, "0 um")])
+def test_the_estimate_line_prints_micrometres_with_significant_digits(metres, text):
+    """Issue 23.10a: an estimate of micrometres printed as "0.00 mm". From 0.1 mm on the line keeps
+    millimetres with two decimals (the README's "18.03 mm"); below, micrometres to three digits."""
+    from cdpr_exu.run.error_estimate import ErrorEstimate, estimate_line
+
+    line = estimate_line(ErrorEstimate(metres, 30, 2.0, 1.0, "a note"))
+    assert f"after 1.0 s: {text} (a note)" in line

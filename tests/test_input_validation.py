@@ -15,10 +15,11 @@ import dataclasses
 import math
 import re
 import time
+import tomllib
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
 from cdpr_exu.physics import bending
@@ -39,6 +40,7 @@ from cdpr_exu.scenes.scene import (
     scene_from_dict,
 )
 from cdpr_exu.run.simulate import simulate
+from cdpr_exu.scenes.spatial_scene import load_any_scene, shipped_spatial_text, spatial_scene_from_dict
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 
 NAN, INF = float("nan"), float("inf")
@@ -258,6 +260,107 @@ def test_malformed_toml_file_is_refused_naming_the_file(tmp_path):
         load_scene(tmp_path / "missing.toml")
 
 
+# ============================================================================ required fields, numbers (issue 23.2)
+
+#: A scene of each kind as plain data (every field given): planar, spatial rigid, spatial over swivel pulleys.
+SCENE_DATA = {
+    "planar": load_scene("paper-circle").to_dict(),
+    "spatial": tomllib.loads(shipped_spatial_text("spatial-four-cable")),
+    "swivel": tomllib.loads(shipped_spatial_text("spatial-four-cable-swivel")),
+}
+
+
+def _from_dict(kind, data):
+    return (scene_from_dict if kind == "planar" else spatial_scene_from_dict)(data)
+
+
+@pytest.mark.parametrize("kind, path, field", [
+    # a 1 kg platform instead (274 mm off on a spatial run), a 3.75 m cable, a platform at (0, -2):
+    # each was a silent default before
+    ("planar", ("platform", "mass"), "platform.mass [kg]"),
+    ("planar", ("cables", 1, "unstrained_length"), "cables[1].unstrained_length [m]"),
+    ("planar", ("platform", "anchors"), "platform.anchors [m]"),
+    ("planar", ("platform", "inertia"), "platform.inertia [kg m^2]"),  # its anchors are off the centre
+    ("planar", ("platform", "initial_pose"), "platform.initial_pose [m, m, rad]"),
+    ("planar", ("pulleys", 0, "center"), "pulleys[0].center [m]"),
+    ("planar", ("pulleys", 1, "radius"), "pulleys[1].radius [m]"),
+    ("planar", ("pulleys", 1, "side"), "pulleys[1].side [-1 or +1]"),
+    ("spatial", ("platform", "mass"), "platform.mass [kg]"),
+    ("spatial", ("cables", 2, "unstrained_length"), "cables[2].unstrained_length [m]"),
+    ("spatial", ("platform", "inertia"), "platform.inertia [kg m^2]"),
+    ("swivel", ("platform", "mass"), "platform.mass [kg]"),
+    ("swivel", ("exits", 0, "inlet"), "exits[0].inlet [m]"),
+    ("swivel", ("exits", 3, "radius"), "exits[3].radius [m]"),
+])
+def test_a_scene_without_a_required_field_is_refused_naming_it_with_its_unit(kind, path, field):
+    data = copy.deepcopy(SCENE_DATA[kind])
+    del _get(data, path[:-1])[path[-1]]
+    with pytest.raises(SceneError, match=re.escape(f"lacks {field}")):
+        _from_dict(kind, data)
+
+
+def test_a_point_mass_needs_no_inertia_and_a_point_exit_no_pulley_radius():
+    """Required only where it changes the answer: a point mass feels no moment; a cable fixed at the
+    pulley centre (cable_exit = "point") never touches the pulley."""
+    spatial = copy.deepcopy(SCENE_DATA["swivel"])  # a point-mass platform
+    assert "inertia" not in spatial["platform"]
+    assert spatial_scene_from_dict(spatial).platform.inertia == (0.0, 0.0, 0.0)
+    planar = load_scene("paper-catenary-fixed").to_dict()
+    for pulley in planar["pulleys"]:
+        del pulley["radius"], pulley["side"]
+    del planar["platform"]["inertia"]
+    assert scene_from_dict(planar).platform.is_point_mass
+
+
+def test_a_required_field_is_asked_for_only_after_the_values_given_are_checked():
+    data = copy.deepcopy(SCENE_DATA["planar"])
+    del data["platform"]["mass"]
+    data["cables"][1]["radius"] = -1.0
+    with pytest.raises(SceneError, match=r"cables\[1\]\.radius must be positive"):
+        scene_from_dict(data)
+
+
+@pytest.mark.parametrize("kind, path, value, field", [
+    ("planar", ("platform", "mass"), "2.5", "platform.mass"),
+    ("planar", ("platform", "mass"), True, "platform.mass"),
+    ("planar", ("cables", 0, "radius"), "0.005", "cables[0].radius"),
+    ("planar", ("gravity",), "9.8", "gravity"),
+    ("planar", ("platform", "initial_pose", 1), "-2.0", "platform.initial_pose[1]"),
+    ("planar", ("pulleys", 0, "center", 0), False, "pulleys[0].center[0]"),
+    ("planar", ("trajectory", "radius"), "0.4", "trajectory.radius"),
+    ("planar", ("trajectory", "angular_rate"), True, "trajectory.angular_rate"),
+    ("spatial", ("platform", "mass"), "1.0", "platform.mass"),
+    ("spatial", ("platform", "mass"), True, "platform.mass"),
+    ("spatial", ("platform", "inertia", 0), "0.05", "platform.inertia"),
+    ("spatial", ("platform", "inertia", 1), True, "platform.inertia"),
+    ("spatial", ("platform", "anchors", 0, 2), "0.05", "platform.anchors[0]"),
+    ("spatial", ("exits", 1, "point", 0), True, "exits[1].point"),
+    ("spatial", ("cables", 3, "unstrained_length"), "2.55", "cables[3].unstrained_length"),
+    ("swivel", ("exits", 0, "inlet", 2), False, "exits[0].inlet"),
+    ("swivel", ("exits", 0, "winch_line"), "0.3", "exits[0].winch_line"),
+    ("swivel", ("trajectory", "center", 2), "-0.842", "trajectory.center[2]"),
+    ("swivel", ("solver", "step_size"), "1e-2", "solver.step_size"),
+])
+def test_text_and_booleans_are_refused_where_a_number_belongs(kind, path, value, field):
+    """The string "1.0" and true/false were taken as numbers (float() accepts both)."""
+    data = copy.deepcopy(SCENE_DATA[kind])
+    _get(data, path[:-1])[path[-1]] = value
+    with pytest.raises(SceneError, match=re.escape(field)) as caught:
+        _from_dict(kind, data)
+    assert "number" in str(caught.value), str(caught.value)
+
+
+@pytest.mark.parametrize("value", ["1.0", True, np.bool_(True), None, b"1"])
+def test_the_one_number_check_refuses_text_and_booleans_and_takes_numpy_numbers(value):
+    from cdpr_exu.core.validation import finite, real_array, vector
+
+    for check in (lambda v: finite("x", v), lambda v: real_array("x", [1.0, v]), lambda v: vector("x", [v, 0.0], 2)):
+        with pytest.raises(SceneError, match="x must be"):
+            check(value)
+    assert finite("x", np.float32(1.5)) == 1.5 and finite("x", np.int64(3)) == 3.0
+    assert vector("x", np.array([1, 2]), 2).tolist() == [1.0, 2.0]
+
+
 # ============================================================================ public functions
 
 PULLEY = ((-1.75, 0.0), 0.25, -1)
@@ -380,6 +483,63 @@ def test_former_validation_gaps_are_refused_with_scene_error(name):
         FORMER_GAPS[name]()
 
 
+#: Bad values given as NumPy numbers (as a study or a script passes them): each message shows
+#: plain numbers (issue 23.9: "got np.float64(-2.0)", "got array([nan])").
+NUMPY_VALUES = {
+    "PlatformSpec mass": lambda: PlatformSpec(mass=np.float64(-2.0)),
+    "CableSpec n_elements": lambda: CableSpec(n_elements=np.int64(1)),
+    "PulleySpec side": lambda: PulleySpec(side=np.int64(0)),
+    "SolverSpec spectral_radius": lambda: SolverSpec(spectral_radius=np.float64(1.5)),
+    "CircleTrajectory radius": lambda: CircleTrajectory(radius=np.float64(-2.0)),
+    "PointToPointTrajectory end": lambda: PointToPointTrajectory(end=np.array([0.0, -1.6])),
+    "SpatialPlatformSpec mass": lambda: _spatial_platform(mass=np.float64(-2.0)),
+    "SpatialPlatformSpec inertia": lambda: _spatial_platform(inertia=np.array([-1.0, 1.0, 1.0])),
+    "SwivelSpec radius": lambda: _swivel(radius=np.float64(-0.1)),
+    "real_array NaN": lambda: _validation().real_array("x", np.array([np.nan, 1.0])),
+    "per_item negative": lambda: _validation().per_item("x", np.array([-1.0, 1.0]), 2),
+    "CatenaryCable length": lambda: catenary.CatenaryCable(np.float64(-1.0), 1.0, 1.0),
+    "pulley_exit radius": lambda: kinematics.pulley_exit((0.0, 0.0), np.float64(-1.0), -1, [1.0, -1.0]),
+    "solve_forward_statics lengths": lambda: statics.solve_forward_statics(POINT_PLATFORM, np.array([-1.0, 2.0])),
+    "SuspendedPlatform mass": lambda: statics.SuspendedPlatform(POINT_PLATFORM.cables, np.float64(np.nan)),
+}
+
+
+def _spatial_platform(**changes):
+    from cdpr_exu.scenes.spatial_scene import SpatialPlatformSpec
+
+    return SpatialPlatformSpec(**{"mass": 5.0, "inertia": (1.0, 1.0, 1.0), "anchors": ((0.1, 0.0, 0.0),), **changes})
+
+
+def _swivel(**changes):
+    from cdpr_exu.scenes.spatial_scene import SwivelSpec
+
+    return SwivelSpec(**{"inlet": (0.0, 0.0, 0.0), **changes})
+
+
+def _validation():
+    from cdpr_exu.core import validation
+
+    return validation
+
+
+@pytest.mark.parametrize("name", list(NUMPY_VALUES))
+def test_refusals_show_numpy_values_as_plain_numbers(name):
+    with pytest.raises(SceneError) as caught:
+        NUMPY_VALUES[name]()
+    message = str(caught.value)
+    assert "np." not in message and "array(" not in message and "float64" not in message, message
+
+
+@pytest.mark.parametrize("value, text", [
+    (np.float64(-2.0), "-2.0"), (np.int64(3), "3"), (np.array([1.0, np.nan]), "[1.0, nan]"), ("abc", "'abc'"),
+    ((np.float64(1.5), 2), "(1.5, 2)"), (None, "None"), (np.bool_(True), "True"),
+])
+def test_shown_gives_plain_numbers_and_quoted_text(value, text):
+    from cdpr_exu.core.validation import shown
+
+    assert shown(value) == text
+
+
 # ============================================================================ property test
 
 PAPER_DICT = load_scene("paper-circle").to_dict()
@@ -403,26 +563,32 @@ def _paths(data, path=()):
             yield from _paths(value, path + (index,))
 
 
+def _number_paths(base, paths):
+    """The paths to numbers (not booleans) of ``base``."""
+    return [path for path in paths if isinstance(_get(base, path), (int, float)) and not isinstance(_get(base, path), bool)]
+
+
 PATHS = sorted(_paths(PAPER_DICT), key=repr)
 #: The numbers among them, drawn half the time: their mutants are accepted more
 #: often, so that the simulation itself meets extreme values, not only the validation.
-NUMBER_PATHS = [path for path in PATHS if isinstance(_get(PAPER_DICT, path), (int, float))
-                and not isinstance(_get(PAPER_DICT, path), bool)]
+NUMBER_PATHS = _number_paths(PAPER_DICT, PATHS)
 
 EXTREME_NUMBERS = st.sampled_from([0.0, -0.0, -1.0, 1e300, -1e300, 1e-300, 5e-324, NAN, INF, -INF, 10**30, 3, 2.5, 1e-9])
-WRONG_TYPES = st.sampled_from([None, True, "abc", "", [], {}, [1.0], {"a": 1}, [[1.0, 2.0]]])
+WRONG_TYPES = st.sampled_from([None, True, "abc", "", [], {}, [1.0], {"a": 1}, [[1.0, 2.0]], "1.0", False])
 
 
-@st.composite
-def malformed_scene_dicts(draw):
-    """The paper scene's plain data with one to three fields broken."""
-    data = copy.deepcopy(PAPER_DICT)
+def _broken(draw, base, paths, number_paths):
+    """``base`` (plain scene data) with one to three of its fields broken: an extreme number, a
+    scaled one, a wrong type, a list of the wrong length, or the field removed."""
+    data = copy.deepcopy(base)
     for _ in range(draw(st.integers(1, 3))):
-        path = draw(st.sampled_from(NUMBER_PATHS) | st.sampled_from(PATHS))
+        path = draw(st.sampled_from(number_paths) | st.sampled_from(paths))
         try:
             parent, old = _get(data, path[:-1]), _get(data, path)
         except (KeyError, IndexError, TypeError):
             continue  # an earlier mutation removed or replaced this path
+        if not isinstance(parent, (dict, list)):
+            continue  # replaced by text, which indexes too
         kind = draw(st.sampled_from(["number", "scaled", "type", "length", "delete"]))
         if kind == "number":
             new = draw(EXTREME_NUMBERS | st.floats(allow_nan=True, allow_infinity=True))
@@ -437,6 +603,27 @@ def malformed_scene_dicts(draw):
             new = draw(WRONG_TYPES)
         parent[path[-1]] = new
     return data
+
+
+@st.composite
+def malformed_scene_dicts(draw):
+    """The paper scene's plain data with one to three fields broken."""
+    return _broken(draw, PAPER_DICT, PATHS, NUMBER_PATHS)
+
+
+#: Spatial scenes as plain data: a rigid platform on point exits (no trajectory), a point mass
+#: over swivel pulleys (with trajectory, solver and winch).
+SPATIAL_DICTS = [load_any_scene(name).to_dict() for name in ("spatial-four-cable", "spatial-four-cable-swivel")]
+SPATIAL_PATHS = [sorted(_paths(base), key=repr) for base in SPATIAL_DICTS]
+SPATIAL_NUMBER_PATHS = [_number_paths(base, paths) for base, paths in zip(SPATIAL_DICTS, SPATIAL_PATHS)]
+
+
+@st.composite
+def malformed_spatial_scene_dicts(draw):
+    """A shipped spatial scene's plain data (rigid on point exits, or over swivel pulleys) with one to
+    three fields broken, as :func:`malformed_scene_dicts` breaks the planar one."""
+    k = draw(st.integers(0, len(SPATIAL_DICTS) - 1))
+    return _broken(draw, SPATIAL_DICTS[k], SPATIAL_PATHS[k], SPATIAL_NUMBER_PATHS[k])
 
 
 def _short(scene: Scene) -> Scene:
@@ -463,6 +650,70 @@ def test_malformed_scenes_are_refused_or_run_without_crash_hang_or_nan(data):
     assert time.perf_counter() - start < 120.0
     for series in [result.platform_pose, result.platform_velocity, *result.nodes, *result.tensions]:
         assert np.all(np.isfinite(series))
+
+
+@seed(20261124)
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(malformed_spatial_scene_dicts())
+def test_malformed_spatial_scenes_are_refused_with_the_projects_errors_only(data):
+    """Issue 23 (evidence): the planar fuzz extended to spatial scene dicts; validation and the
+    reference check that runs before any spatial run give SceneError or UnreachableError, never
+    another exception (a TypeError, an IndexError, a ValueError of NumPy's). (A colleague's fuzz
+    runs the accepted ones.)"""
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+
+    try:
+        scene = spatial_scene_from_dict(data)
+        if scene.trajectory is not None:
+            check_spatial_reference(scene)
+    except (SceneError, UnreachableError) as err:
+        assert str(err)
+
+
+#: What the spatial fuzz found (issue 23), each a foreign exception or a message naming no field before:
+#: (scene, key path, value, words of the refusal).
+FUZZ_FINDINGS = [
+    (0, ("gravity",), 1.7976931348623157e308, "give a weight of inf N"),  # ValueError in nnls
+    (1, ("gravity",), 1.7976931348623157e308, "platform.mass = 5.0 kg and gravity"),
+    (1, ("trajectory", "angular_rate"), 1e300, "trajectory is out of floating-point range: its acceleration at "
+     "t = 0.010 s is [-inf, inf, 0.0]"),  # ValueError in nnls
+    (1, ("cables", 0, "unstrained_length"), 1e308, "it would take inf, more than the 300 allowed"),  # OverflowError
+    (0, ("platform", "anchors"), True, "platform.anchors must be a list of (x, y, z) points, got True"),  # TypeError
+    (0, ("exits", 1, "point"), [1.5, 1.5, 0.0], "share the exit_point [1.5, 1.5, 0.0] m"),  # np.float64(1.5)
+    (0, ("dimension",), None, "dimension must be 3 for a spatial scene, got None"),
+    (1, ("cables", 0, "linear_density"), 1e308, "give a weight per length of inf N/m"),  # 'weight_per_length'
+]
+
+
+@pytest.mark.parametrize("k, path, value, words", FUZZ_FINDINGS)
+def test_what_the_spatial_fuzz_found_is_refused_naming_the_field(k, path, value, words):
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+
+    data = copy.deepcopy(SPATIAL_DICTS[k])
+    _get(data, path[:-1])[path[-1]] = value
+    with pytest.raises((SceneError, UnreachableError), match=re.escape(words)):
+        scene = spatial_scene_from_dict(data)
+        check_spatial_reference(scene)
+
+
+def test_a_spatial_rotation_vector_of_1e300_rad_gives_a_rotation_matrix():
+    """rotation_from_vector squared the angle (OverflowError beyond 1e154 rad): the fuzz's trajectory.rotation."""
+    from cdpr_exu.core.geometry import rotation_from_vector
+
+    rotation = rotation_from_vector([1e300, 0.0, 0.05])
+    assert np.all(np.isfinite(rotation)) and np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
+    assert np.allclose(rotation[0], [1.0, 0.0, 0.0], atol=1e-12)  # about x (the 0.05 is lost at 1e300)
+
+
+def test_a_planar_circle_too_fast_to_sample_is_refused_naming_its_rate():
+    """The planar reference check took one sample per quarter turn: at 1e300 rad/s NumPy's "Maximum
+    allowed size exceeded" (a ValueError, found while hunting the spatial fuzz's findings)."""
+    from cdpr_exu.statics.workspace import check_reference
+
+    data = copy.deepcopy(PAPER_DICT)
+    data["trajectory"]["angular_rate"] = 1e300
+    with pytest.raises(SceneError, match=r"trajectory\.angular_rate = 1e\+300 rad/s makes 6\.37e\+300 quarter turns"):
+        check_reference(scene_from_dict(data))
 
 
 @pytest.mark.parametrize("value", [0.0, -1e-6, 1e-2, float("nan"), "tight"])

@@ -91,3 +91,30 @@ def test_python_example_prints_the_controllers_table_figure(tmp_path, monkeypatc
     row = next(line for line in README.splitlines() if line.startswith("| closed_loop_tension_aware |"))
     assert f"{expected:.2f}" == row.split("|")[2].strip()
     assert (tmp_path / "out" / "run" / "summary.json").is_file()
+
+
+def _layout_section() -> str:
+    """The README's "Layout" section: from its heading to the next heading."""
+    return README.split("\n## Layout\n", 1)[1].split("\n## ", 1)[0]
+
+
+def test_the_layout_section_names_every_module_example_and_benchmark():
+    """Issue 23.19: the layout had drifted (feedback.py, ilc.py, spatial_feedback.py, three
+    examples and the benchmarks were missing). Every .py file of the four source folders but
+    the packages' __init__.py is named there, as a whole file name (``bending.py`` does not
+    count as named by ``bench_bending.py``)."""
+    layout = _layout_section()
+    missing = [str(path.relative_to(ROOT))
+               for folder in ("cdpr_exu", "controllers", "examples", "benchmarks")
+               for path in sorted((ROOT / folder).rglob("*.py"))
+               if path.name != "__init__.py" and not re.search(r"(?<![\w/.])" + re.escape(path.name), layout)]
+    assert missing == [], f"name these in the README's Layout section: {missing}"
+
+
+def test_virtual_environments_are_ignored_by_git():
+    """Issue 23.19: a `.venv/` made in the clone (as the quick start invites) showed up in `git status`."""
+    import subprocess
+
+    for name in (".venv", "venv"):
+        done = subprocess.run(["git", "check-ignore", "-q", f"{name}/bin/python"], cwd=ROOT)
+        assert done.returncode == 0, f"{name}/ is not in .gitignore"

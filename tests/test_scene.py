@@ -187,3 +187,21 @@ def test_the_package_exports_what_a_user_needs_and_imports_without_exudyn():
     assert isinstance(controller, cdpr_exu.ClosedLoopTensionAwareController)
     with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
         cdpr_exu.no_such_name  # noqa: B018
+
+
+def test_an_initial_pose_above_the_pulleys_is_refused_naming_it_before_any_run():
+    """Issue 23.6: a platform started above the pulleys ran, and its failure was blamed on "cable
+    slipping through the pulley ... use more elements". Anchors at z = 0.4 m, pulley tops at 0.25 m."""
+    from cdpr_exu.core.errors import UnreachableError
+
+    data = load_scene("paper-circle").to_dict()
+    data["platform"]["initial_pose"] = [0.0, 0.3, 0.0]
+    with pytest.raises(UnreachableError) as err:
+        scene_from_dict(data)
+    message = str(err.value)
+    assert message.startswith("platform.initial_pose [0.0, 0.3, 0.0] (x [m], z [m], rotation [rad]) is above the "
+                              "pulleys"), message
+    assert "platform.anchors[0] at z = 0.4 m, pulleys[0] up to z = 0.25 m" in message
+    assert "cables cannot push" in message
+    data["gravity"] = 0.0  # without weight nothing has to hold it up: not this refusal
+    assert scene_from_dict(data).platform.initial_pose == (0.0, 0.3, 0.0)

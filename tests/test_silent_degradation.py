@@ -6,6 +6,7 @@ import sys
 import warnings
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure
@@ -76,9 +77,17 @@ def test_a_result_that_needs_cables_to_push_is_flagged_and_tension_only_cables_a
     from cdpr_exu.scenes.scene import Effects
 
     short = PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.5))
-    spring = simulate(short.with_changes(effects=Effects.from_preset("paper"))).summary()
+    result = simulate(short.with_changes(effects=Effects.from_preset("paper")))
+    spring = result.summary()
     assert spring["elements_pushed"] and spring["min_element_tension_N"] < 0
-    assert any("pushed" in note for note in spring["notes"])
+    assert any("pushed" in warning for warning in spring["warnings"])
+    # Issue 23.1: the safety figures cover the whole run whatever the error window: measured
+    # from 1 s on, this 0.5 s run has no error figures, but its pushing is reported all the same.
+    windowed = result.summary(after=1.0)
+    assert windowed["max_position_error_m"] is None
+    for key in ("elements_pushed", "min_element_tension_N", "min_tension_per_cable_N", "slack_time_per_cable_s",
+                "warnings"):
+        assert windowed[key] == spring[key], key
     assert min(spring["min_tension_per_cable_N"]) == spring["min_element_tension_N"]
     assert all(0.0 < t <= 0.5 for t in spring["slack_time_per_cable_s"])
     tension_only = simulate(short).summary()  # the default "full" preset: tension-only elements
@@ -99,3 +108,53 @@ def test_a_real_run_thrown_above_the_pulleys_gets_the_hint_for_that_cause():
     hint = message.split("Likely cause:")[1]
     assert "thrown upwards" in hint and "a sudden jump of the winch command" not in hint
     assert 0.0 < failure.value.time < 1.5 and len(failure.value.partial_result.time) > 1
+
+
+def test_a_scene_file_whose_step_is_longer_than_its_output_period_warns_once(tmp_path):
+    """Issue 23.10c: `cdpr run` loaded a planar scene file twice (once to tell planar from
+    spatial, once more to apply --end-time / --step-size), so the file's coarse-output
+    warning was printed twice."""
+    from cdpr_exu.scenes.scene import save_scene
+
+    path = tmp_path / "coarse.toml"
+    save_scene(PAPER.with_changes(solver=replace(PAPER.solver, end_time=0.04, step_size=0.02, output_period=0.02)), path)
+    path.write_text(path.read_text().replace("output_period = 0.02", "output_period = 0.01"))
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", str(path), "--end-time", "0.04", "-q",
+                           "--no-error-estimate"], capture_output=True, text=True, timeout=300)
+    assert done.stderr.count("cdpr: warning: solver.step_size = 0.02 s") == 1, done.stderr
+
+
+def test_a_platform_above_its_highest_exit_is_flagged_with_the_time_and_height():
+    """Issue 23.1: the safety figures both summaries share (results.result.safety_figures) flag a
+    platform above its highest exit (planar: pulley centre; spatial: exit point or swivel
+    inlet), where every cable pulls it down, as they flag elements that push."""
+    from cdpr_exu.results.result import safety_figures
+
+    times = np.array([0.0, 0.1, 0.2, 0.3])
+    tensions = [np.array([[5.0, 4.0], [3.0, 1.0], [0.0, -2.0], [1.0, 2.0]])]
+    figures = safety_figures(times, tensions, heights=np.array([-1.0, -0.2, 0.05, 0.3]), highest_exit=0.0)
+    assert figures["platform_above_exits"] and figures["elements_pushed"]
+    assert figures["min_element_tension_N"] == -2.0 and figures["slack_time_per_cable_s"] == [pytest.approx(0.1)]
+    pushed, above = figures["warnings"]
+    assert "lowest tension -2 N, cable 1 at t = 0.2000 s; first push at t = 0.2000 s" in pushed
+    assert "above its highest exit (z = 0 m) at t = 0.2000 s, up to z = 0.3 m" in above
+    level = safety_figures(times, tensions, heights=np.full(4, -0.5), highest_exit=0.0)
+    assert level["platform_above_exits"] is False and len(level["warnings"]) == 1
+    assert safety_figures(times, tensions)["platform_above_exits"] is None  # no geometry: unknown, not "no"
+
+
+def test_cdpr_run_says_once_that_a_completed_run_pushed(tmp_path):
+    """Issue 23.1 on the console: a completed run whose recorded tensions push (the paper's spring
+    elements at the start-up, -6.5 N measured) is not reported as a clean "completed": one
+    UnphysicalResultWarning line, and the status says why."""
+    from cdpr_exu.scenes.scene import Effects, save_scene
+
+    path = tmp_path / "spring.toml"
+    save_scene(PAPER.with_changes(effects=Effects.from_preset("paper"),
+                                  solver=replace(PAPER.solver, end_time=0.5)), path)
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", str(path), "--no-error-estimate"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    warnings_ = [line for line in done.stderr.splitlines() if line.startswith("cdpr: warning:")]
+    assert len(warnings_) == 1 and "paper-circle under ideal_ik: elements pushed" in warnings_[0], done.stderr
+    assert "completed (cables pushed: see the warnings)" in done.stdout

@@ -173,3 +173,20 @@ def test_a_spatial_scene_gets_the_planar_bending_damping_constant_only_with_effe
                                                               rel=1e-12)
             else:
                 assert chain.bending_damping is None and chain.bending_stiffness is not None
+
+
+def test_a_misspelt_scene_name_lists_every_shipped_scene_and_the_likeliest_first(capsys):
+    """Issue 23.7: `cdpr run spatial-cogiroo` listed only the planar scenes as alternatives."""
+    from cdpr_exu.cli import main
+    from cdpr_exu.scenes.scene import shipped_scenes
+
+    assert main(["run", "spatial-cogiroo"]) == 2
+    message = capsys.readouterr().err
+    assert "no scene named 'spatial-cogiroo'; did you mean 'spatial-cogiro'? shipped scenes:" in message, message
+    for name in shipped_scenes() + shipped_spatial_scenes():
+        assert name in message, name
+    for misspelt, meant in (("paper-circel", "'paper-circle' or 'paper-circle-slow'"), ("ipanema", "'spatial-ipanema'")):
+        with pytest.raises(SceneError, match=f"did you mean {meant}\\?"):
+            load_any_scene(misspelt)
+    with pytest.raises(SceneError, match="did you mean 'spatial-four-cable' or 'spatial-four-cable-swivel'"):
+        load_spatial_scene("spatial-four")

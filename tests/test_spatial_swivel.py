@@ -269,3 +269,105 @@ def test_the_catenary_statics_find_a_small_swivel_robot_whose_straight_start_lay
     assert np.abs(equilibrium.position[:2]).max() < 1e-9
     rest = solve_spatial_rest(scene)
     assert np.linalg.norm(rest.position - equilibrium.position) < 8e-4
+
+
+def stiff_swivel(youngs_modulus, mass=16.8):
+    """The shipped swivel robot with stiffer cables and a heavier platform (issue 23.3's scene at 2.4e11 Pa)."""
+    scene = load_spatial_scene(NAME)
+    return replace(scene, cables=tuple(replace(c, youngs_modulus=youngs_modulus) for c in scene.cables),
+                   platform=replace(scene.platform, mass=mass))
+
+
+def _cdpr(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "cdpr_exu.cli", *args], capture_output=True, text=True, timeout=600)
+
+
+def test_a_static_answer_above_the_pulleys_fails_with_its_cause_instead_of_exiting_0(tmp_path):
+    """Issue 23.3: at E = 2.4e11 Pa (a solid steel rod's J, bending length sqrt(E J / T) = 1.08 m at the
+    catenaries' 102 N against 0.1 m pulleys) the lumped robot's equilibrium stands the platform 0.64 m
+    above its pulley inlets, 1.50 m from its catenaries' answer (-0.87 m), with elements pushing (-65 N);
+    `cdpr static` exited 0 with a note. It is the bending model's equilibrium, not a start's accident
+    (tension-only chain statics give 0.63 m too): refused, exit 3, with the cause and the state."""
+    import json
+
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    path = save_any_scene(stiff_swivel(2.4e11), tmp_path / "stiff.toml")
+    out = tmp_path / "static"
+    done = _cdpr("static", str(path), "--out", str(out))
+    assert done.returncode == 3, done.stderr
+    for words in ("every anchor is at or above the top of its exit", "exits[0] up to z = 0.1 m",
+                  "bending length sqrt(E J / T) = 1.08 m", "11 times the pulleys' radius", "youngs_modulus"):
+        assert words in done.stderr, words
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"].startswith("failed: no rest of a cable robot")
+    # the state it refused, for a look: 0.636 m up, 1.504 m from the catenaries (measured)
+    assert summary["last_state"]["platform_position_m"][2] == pytest.approx(0.636, abs=0.01)
+    assert summary["last_state"]["lumped_minus_catenary_position_m"] == pytest.approx(1.504, abs=0.01)
+
+
+def test_a_static_answer_far_from_its_catenaries_warns_in_the_summary_and_on_the_console(tmp_path):
+    """E = 1e10 Pa: the platform hangs below its pulleys but 132 mm (5.5 % of the 2.4 m cables, measured)
+    from its catenaries' answer, the bending's doing; the shipped robot's 22 mm (0.9 %) is not flagged."""
+    import json
+
+    from cdpr_exu.run.spatial_rest import FAR_FROM_CATENARY
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    shipped = solve_spatial_rest(load_spatial_scene(NAME))
+    assert shipped.catenary_distance < 0.2 * FAR_FROM_CATENARY * 2.4 and shipped.warnings == []  # 22 mm of 120
+    path = save_any_scene(stiff_swivel(1e10), tmp_path / "stiffer.toml")
+    out = tmp_path / "static"
+    done = _cdpr("static", str(path), "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "cdpr: warning: the lumped robot rests 132 mm from its elastic catenaries' answer, more than 5 %" \
+        in done.stderr, done.stderr
+    warnings = json.loads((out / "summary.json").read_text())["warnings"]
+    assert len(warnings) == 1 and "bending length sqrt(E J / T) = 0.22 m" in warnings[0]
+
+
+def test_a_run_does_not_start_from_a_rest_above_the_pulleys():
+    """The run over swivel pulleys starts from the chain statics' rest: at 2.4e11 Pa that stood the
+    platform 0.63 m above the inlets, and the run reported `completed`."""
+    from cdpr_exu.core.errors import SolverFailure
+    from cdpr_exu.run.spatial_run import simulate_spatial
+
+    scene = stiff_swivel(2.4e11)
+    scene = replace(scene, solver=replace(scene.solver, end_time=0.05))
+    with pytest.raises(SolverFailure, match=r"failed at t = 0\.0000 s.*cannot start from the robot's rest: .* at z = 0\.63\d+ m .*above the top"):
+        simulate_spatial(scene)
+
+
+def test_a_winch_line_shorter_than_its_margin_is_refused_in_millimetres_with_what_to_give():
+    """Issue 23.9: a 0.1 mm winch_line was refused as "paid out by 0.0000 m ... more than
+    exits[0].winch_line = 0.0001 m less two elements holds"."""
+    from cdpr_exu.core.errors import UnreachableError
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+
+    data = load_spatial_scene(NAME).to_dict()
+    for entry in data["exits"]:
+        entry["winch_line"] = 1e-4
+    with pytest.raises(UnreachableError) as caught:
+        check_spatial_reference(spatial_scene_from_dict(data))
+    message = str(caught.value)
+    for words in ("exits[0].winch_line = 0.1 mm less two elements (2 x 50 mm", "leaves -99.9 mm",
+                  "give exits[0].winch_line = 100 mm or more"):
+        assert words in message, message
+    assert "0.0000" not in message
+
+
+def test_an_anchor_on_a_swivel_axis_says_what_to_change_in_the_scene():
+    """Issue 23.9: the refusal asked for `azimuth_hint`, which no scene has."""
+    from cdpr_exu.core.errors import UnreachableError
+    from cdpr_exu.run.spatial_run import check_spatial_reference
+
+    data = load_spatial_scene(NAME).to_dict()
+    data["trajectory"] = {"kind": "hold", "pose": [1.5, 1.5, -0.5, 0.0, 0.0, 0.0]}  # below the first inlet
+    with pytest.raises(UnreachableError) as caught:
+        check_spatial_reference(spatial_scene_from_dict(data))
+    message = str(caught.value)
+    assert "start the reference (the scene's trajectory) with every anchor off the vertical axis" in message, message
+    assert "give azimuth_hint" not in message

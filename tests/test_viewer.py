@@ -50,6 +50,18 @@ def run_dir(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.fixture(scope="module")
+def spatial_run_dir(tmp_path_factory) -> Path:
+    """A run folder of a small spatial scene over 0.3 s (31 samples), as `cdpr run --out` writes it."""
+    from conftest import small_spatial_scene
+
+    from cdpr_exu.run.spatial_run import run_spatial_scene
+
+    out = tmp_path_factory.mktemp("spatial") / "small_spatial"
+    run_spatial_scene(small_spatial_scene(END_TIME), out, quiet=True, figures=False)
+    return out
+
+
 def _env_without_display() -> dict[str, str]:
     env = {k: v for k, v in os.environ.items()
            if k not in ("DISPLAY", "WAYLAND_DISPLAY", "EXUDYN_SUPPRESS_UI_WINDOW_OPEN")}
@@ -108,6 +120,76 @@ def test_missing_folder_and_files_are_named(run_dir, tmp_path):
     with pytest.raises(viewer.RunFolderError, match="solution.sol"):
         viewer.render_animation(partial)
     assert main(["animate", str(partial)]) == 2
+
+
+# ============================================================================ spatial runs (issue 23.8)
+
+
+def test_a_spatial_run_writes_scene_pose_csv_and_solution_file_as_every_run(spatial_run_dir):
+    """Issue 23.8: spatial runs wrote no scene.toml, pose.csv or solution.sol, which the README
+    promises for `cdpr run`. pose.csv holds time, pose and reference with units in the header,
+    the numbers of result.npz to its 9 significant digits."""
+    from conftest import small_spatial_scene
+
+    from cdpr_exu.scenes.spatial_scene import load_any_scene
+
+    for name in ("scene.toml", "result.npz", "pose.csv", "summary.json", "solution.sol"):
+        assert (spatial_run_dir / name).stat().st_size > 0, name
+    assert load_any_scene(spatial_run_dir / "scene.toml") == small_spatial_scene(END_TIME)
+    header = (spatial_run_dir / "pose.csv").read_text().splitlines()[0].split(",")
+    assert header == ["time_s", "x_m", "y_m", "z_m", "rotation_x_rad", "rotation_y_rad", "rotation_z_rad",
+                      "x_ref_m", "y_ref_m", "z_ref_m", "rotation_x_ref_rad", "rotation_y_ref_rad", "rotation_z_ref_rad"]
+    table = np.loadtxt(spatial_run_dir / "pose.csv", delimiter=",", skiprows=1)
+    with np.load(spatial_run_dir / "result.npz") as data:
+        np.testing.assert_allclose(table[:, 0], data["time"], rtol=1e-8, atol=1e-12)
+        np.testing.assert_allclose(table[:, 1:7], data["pose"], rtol=1e-8, atol=1e-12)
+        np.testing.assert_allclose(table[:, 7:], data["reference"], rtol=1e-8, atol=1e-12)
+
+
+def test_a_spatial_solution_file_replays_in_the_rebuilt_robot_at_the_recorded_poses(spatial_run_dir):
+    """The solution file fits the robot rebuilt from scene.toml (as SolutionViewer needs), row for
+    row at the result's times, and each row puts the platform where result.npz recorded it: both are
+    the solver's state at the same step ends (31 unshrunk steps), so they agree to round-off."""
+    replay = viewer.load_replay(spatial_run_dir)
+    assert isinstance(replay, viewer.SpatialReplay) and replay.n_rows == EXPECTED_ROWS
+    with np.load(spatial_run_dir / "result.npz") as data:
+        np.testing.assert_allclose(replay.times, data["time"], atol=1e-9)
+        np.testing.assert_allclose(replay.platform_pose(), data["pose"], atol=1e-9)
+
+
+def test_the_rebuilt_spatial_robot_draws_in_the_views_camera(spatial_run_dir):
+    """What `cdpr view` shows of a spatial run, drawn headless by Exudyn's raytracer at the view's
+    settings: the last row's cables and nodes on a white background (not a blank frame)."""
+    import exudyn as exu
+    from exudyn.utilities import SetSolutionState
+
+    replay = viewer.load_replay(spatial_run_dir)
+    viewer._style_spatial(replay, size=(160, 120))
+    for configuration in (exu.ConfigurationType.Current, exu.ConfigurationType.Visualization):
+        SetSolutionState(replay.mbs, replay.solution, replay.n_rows - 1, configuration)
+    image = np.asarray(replay.mbs.GetSystemContainer().renderer.RedrawAndGetImage(useRaytracer=True))[:, :, :3]
+    assert image.shape[:2] == (120, 160)
+    drawn = (image < 200).any(axis=2).mean()  # share of pixels that are not background
+    assert 0.001 < drawn < 0.5, drawn
+
+
+def test_a_rerun_from_the_written_spatial_scene_writes_the_same_result(spatial_run_dir, tmp_path):
+    """scene.toml is the scene as run: `cdpr run` on it writes the same result, pose table and
+    (date blanked) solution file byte for byte."""
+    out = tmp_path / "rerun"
+    assert main(["run", str(spatial_run_dir / "scene.toml"), "--out", str(out), "--no-figures",
+                 "--no-error-estimate", "-q"]) == 0
+    for name in ("result.npz", "pose.csv", "solution.sol", "scene.toml"):
+        assert (out / name).read_bytes() == (spatial_run_dir / name).read_bytes(), name
+
+
+def test_view_of_a_spatial_run_without_display_exits_1_with_a_hint(spatial_run_dir):
+    """Issue 23.8: `cdpr view` on a spatial run said the folder lacks the scene.toml that `cdpr run`
+    writes. It now finds the run and refuses only for the missing display, as on planar runs."""
+    done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "view", str(spatial_run_dir)],
+                          env=_env_without_display(), capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1, done.stderr
+    assert "no display" in done.stderr and "cdpr animate" in done.stderr and "not found" not in done.stderr
 
 
 # ============================================================================ view
@@ -188,6 +270,39 @@ def test_animation_inside_a_file_is_refused_naming_the_file(run_dir, tmp_path):
     assert taken.read_text() == "keep me"
 
 
+@pytest.mark.parametrize("fps", ["0", "nan", "-5", "inf", "101"])
+@pytest.mark.parametrize("dimension", ["planar", "spatial"])
+def test_a_bad_fps_is_refused_naming_it_before_any_work_for_both_dimensions(run_dir, spatial_run_dir, tmp_path,
+                                                                             capsys, dimension, fps):
+    """Issue 23.12: on spatial runs --fps 0 and nan crashed with tracebacks, -5 after the whole
+    rendering (49 s on CoGiRo), inf wrote a GIF of zero frame times; 101 frames/s is more than
+    a GIF's hundredths of a second can store. One check, before anything is written, for both."""
+    folder = run_dir if dimension == "planar" else spatial_run_dir
+    out, frames = tmp_path / "a.gif", tmp_path / "frames"
+    code = main(["animate", str(folder), "--fps", fps, "--out", str(out), "--frames-dir", str(frames), "-q"])
+    assert code == 2
+    assert "--fps" in capsys.readouterr().err
+    assert not out.exists() and not frames.exists()
+
+
+def test_spatial_animation_writes_its_frames_into_frames_dir(spatial_run_dir, tmp_path):
+    """Issue 23.12: --frames-dir was ignored on spatial runs. The frames are the animation's, one per
+    chosen sample, of the asked size, none blank."""
+    out, frames_dir = tmp_path / "spatial.gif", tmp_path / "frames"
+    code = main(["animate", str(spatial_run_dir), "--out", str(out), "--every", "5", "--size", "160x120",
+                 "--fps", "10", "--frames-dir", str(frames_dir), "--quiet"])
+    assert code == 0
+    expected = len(range(0, EXPECTED_ROWS, 5))  # samples 0, 5, ..., 30
+    with Image.open(out) as gif:
+        assert gif.n_frames == expected and gif.size == (160, 120) and gif.info["duration"] == 100
+    names = sorted(p.name for p in frames_dir.iterdir())
+    assert names == [f"frame_{i:05d}.png" for i in range(expected)]
+    for name in names:
+        with Image.open(frames_dir / name) as frame:
+            assert frame.size == (160, 120)
+            assert np.asarray(frame.convert("L"), dtype=float).var() > 0.0, f"{name} is blank"
+
+
 # ============================================================================ helpers
 
 
@@ -212,3 +327,31 @@ def test_parse_size_refuses_bad_sizes(text):
     with pytest.raises(ValueError, match="size"):
         viewer.parse_size(text)
 
+
+
+# ============================================================================ a folder of an earlier run (issue 23.15)
+
+
+def test_a_spatial_run_into_a_planar_runs_folder_leaves_none_of_the_planar_runs_files(run_dir, spatial_run_dir,
+                                                                                      tmp_path):
+    """Issue 23.15: a spatial run into a planar run's folder kept that run's scene.toml,
+    solution.sol and figures, and `cdpr view` replayed the old run. Now the folder holds the
+    new run's files only, plus what no run writes (a user's notes)."""
+    folder = tmp_path / "reused"
+    shutil.copytree(run_dir, folder)
+    (folder / "snapshots.png").write_bytes(b"a planar figure the spatial run does not draw")
+    (folder / "notes.txt").write_text("mine")
+    assert main(["run", str(spatial_run_dir / "scene.toml"), "--out", str(folder), "--no-figures",
+                 "--no-error-estimate", "-q"]) == 0
+    assert sorted(p.name for p in folder.iterdir()) == sorted([p.name for p in spatial_run_dir.iterdir()] + ["notes.txt"])
+    assert (folder / "notes.txt").read_text() == "mine"
+    assert isinstance(viewer.load_replay(folder), viewer.SpatialReplay)  # `cdpr view` replays the new run
+
+
+def test_a_comparison_into_a_run_folder_is_refused_before_any_work(run_dir, tmp_path, capsys):
+    folder = tmp_path / "run"
+    shutil.copytree(run_dir, folder)
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    assert main(["compare", "paper-circle", "--controllers", "ideal_ik", "--out", str(folder), "-q"]) == 2
+    assert "holds the output of `cdpr run`" in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before

@@ -76,7 +76,7 @@ import numpy as np
 from exudyn.rigidBodyUtilities import RigidBodyInertia, RotationMatrix2EulerParameters
 
 from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
-from cdpr_exu.core.validation import non_negative, positive
+from cdpr_exu.core.validation import non_negative, positive, shown
 
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
@@ -131,14 +131,14 @@ class SpatialChainSpec:
 
     def __post_init__(self):
         if self.mass_lumping not in ("consistent", "paper"):
-            raise SceneError(f"mass_lumping must be 'consistent' or 'paper', got {self.mass_lumping!r}")
+            raise SceneError(f"mass_lumping must be 'consistent' or 'paper', got {shown(self.mass_lumping)}")
         if not isinstance(self.tension_only, (bool, np.bool_)):
-            raise SceneError(f"tension_only must be True or False, got {self.tension_only!r}")
+            raise SceneError(f"tension_only must be True or False, got {shown(self.tension_only)}")
         object.__setattr__(self, "tension_only", bool(self.tension_only))
         if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
-            raise SceneError(f"n_elements must be a whole number, got {self.n_elements!r}")
+            raise SceneError(f"n_elements must be a whole number, got {shown(self.n_elements)}")
         if self.n_elements < 2:
-            raise SceneError(f"n_elements must be at least 2, got {self.n_elements!r}")
+            raise SceneError(f"n_elements must be at least 2, got {shown(self.n_elements)}")
         object.__setattr__(self, "n_elements", int(self.n_elements))
         object.__setattr__(self, "axial_damping_constant",
                            non_negative("axial_damping_constant", self.axial_damping_constant))
@@ -257,22 +257,22 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         Naming the field, before anything is added to ``mbs``.
     """
     if not isinstance(platform, SpatialPlatform):
-        raise SceneError(f"platform must be a SpatialPlatform, got {platform!r}")
+        raise SceneError(f"platform must be a SpatialPlatform, got {shown(platform)}")
     lengths = _lengths(platform, unstrained_lengths)
     chain = SpatialChainSpec() if chain is None else chain
     if not isinstance(chain, SpatialChainSpec):
-        raise SceneError(f"chain must be a SpatialChainSpec, got {chain!r}")
+        raise SceneError(f"chain must be a SpatialChainSpec, got {shown(chain)}")
     gravity = positive("gravity", platform.gravity)  # the chains' mass is weight_per_length / gravity
     inertia = np.array(platform.inertia)
     if not platform.is_point_mass and np.any(inertia <= 0.0):
-        raise SceneError(f"inertia must be positive for a rigid platform, got {platform.inertia!r}")
+        raise SceneError(f"inertia must be positive for a rigid platform, got {shown(platform.inertia)}")
     if not platform.is_point_mass and platform.mass <= 0.0:
-        raise SceneError(f"mass must be positive for a rigid platform, got {platform.mass!r}")
+        raise SceneError(f"mass must be positive for a rigid platform, got {shown(platform.mass)}")
     if initial is None:
         initial = solve_spatial_statics(platform, lengths)
     elif not isinstance(initial, SpatialEquilibrium) or len(initial.cables) != len(platform.cables):
         raise SceneError(f"initial must be a SpatialEquilibrium of this platform's {len(platform.cables)} cables, "
-                         f"got {initial!r}")
+                         f"got {shown(initial)}")
 
     swivels = [None] * len(platform.cables) if swivels is None else list(swivels)
     if len(swivels) != len(platform.cables):
@@ -281,7 +281,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         radius = 0.0 if swivel is None else swivel.radius
         if cable.pulley_radius != radius or (swivel is not None and tuple(swivel.inlet) != cable.exit_point):
             raise SceneError(f"swivels[{i}] does not match cables[{i}] of the platform (pulley_radius "
-                             f"{cable.pulley_radius!r} m, exit_point {cable.exit_point})")
+                             f"{shown(cable.pulley_radius)} m, exit_point {cable.exit_point})")
 
     n = chain.n_elements
     element_lengths = lengths / n

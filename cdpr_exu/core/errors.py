@@ -54,3 +54,14 @@ class CdprWarning(UserWarning):
 
 class CoarseOutputWarning(CdprWarning):
     """The output is sampled more coarsely than asked (its error figures come from fewer samples)."""
+
+
+class SuspectAnswerWarning(CdprWarning):
+    """A computation completed, but its answer is one a cable robot could hardly give: far from an
+    independent answer to the same question, or held by elements that push."""
+
+
+class UnphysicalResultWarning(CdprWarning):
+    """A run recorded what no real cable robot can do: elements that push (compression in a cable), or a
+    platform above its exits, where only pushing cables could hold it. Its summary says so too
+    (``elements_pushed``, ``platform_above_exits``, ``warnings``)."""

@@ -42,10 +42,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.validation import real_array
+from cdpr_exu.core.validation import real_array, shown
 
 __all__ = [
     "Pulley",
+    "above_exits",
     "PulleyExit",
     "rotation_matrix",
     "rotation_from_vector",
@@ -76,23 +77,23 @@ def finite_array(name, value, last_dims=None):
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise SceneError(f"{name} must be numeric, got {value!r}") from exc
+        raise SceneError(f"{name} must be numeric, got {shown(value)}") from exc
     if last_dims is not None:
         if array.ndim < len(last_dims) or array.shape[array.ndim - len(last_dims):] != tuple(last_dims):
             raise SceneError(
-                f"{name} must have trailing shape {tuple(last_dims)}, got shape {array.shape}: {value!r}"
+                f"{name} must have trailing shape {tuple(last_dims)}, got shape {array.shape}: {shown(value)}"
             )
     if not np.all(np.isfinite(array)):
-        raise SceneError(f"{name} must be finite, got {value!r}")
+        raise SceneError(f"{name} must be finite, got {shown(value)}")
     return array
 
 
 def check_radius(name, radius):
     radius = finite_array(name, radius)
     if radius.ndim != 0:
-        raise SceneError(f"{name} must be a scalar, got {radius!r}")
+        raise SceneError(f"{name} must be a scalar, got {shown(radius)}")
     if radius < 0.0:
-        raise SceneError(f"{name} must be >= 0 [m], got {float(radius)!r}")
+        raise SceneError(f"{name} must be >= 0 [m], got {shown(float(radius))}")
     return float(radius)
 
 
@@ -100,9 +101,9 @@ def check_side(name, side):
     try:
         side_float = float(side)
     except (TypeError, ValueError) as exc:
-        raise SceneError(f"{name} must be -1 or +1, got {side!r}") from exc
+        raise SceneError(f"{name} must be -1 or +1, got {shown(side)}") from exc
     if side_float not in (-1.0, 1.0):
-        raise SceneError(f"{name} must be -1 (cable on the left) or +1 (on the right), got {side!r}")
+        raise SceneError(f"{name} must be -1 (cable on the left) or +1 (on the right), got {shown(side)}")
     return int(side_float)
 
 
@@ -419,6 +420,10 @@ def rotation_from_vector(rotation_vector):
     """Spatial rotation matrix ``R = exp([theta]x)`` of a rotation vector ``theta`` [rad] (Rodrigues), shape (3, 3)."""
     theta = np.asarray(rotation_vector, dtype=float)
     angle = float(np.linalg.norm(theta))
+    if not angle < 1e150:  # [theta]x squared (and the norm) overflow: the same formula on the unit axis
+        angle = math.hypot(*theta)
+        k = skew(theta / angle)
+        return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
     k = skew(theta)
     if angle < 1e-8:  # series: 1 - a^2/6 and 1/2 - a^2/24, exact to round-off here
         return np.eye(3) + (1.0 - angle**2 / 6.0) * k + (0.5 - angle**2 / 24.0) * (k @ k)
@@ -539,12 +544,55 @@ class Pulley:
         hang = self.hang_point
         return np.array([hang[0], hang[1] - (unstrained_length - paid_out)])
 
+    @property
+    def top(self) -> float:
+        """Height [m] of the highest point the cable can leave this exit from: the top of the rim,
+        ``c_z + r_p`` (the centre of a point exit). See :func:`above_exits`."""
+        return self.center[1] + self.radius
+
     def paid_out_length(self, unstrained_length: float, winch_end) -> float:
         """Paid-out length lambda [m] of a cable of unstrained length ``L0`` [m] whose winch end is at ``winch_end`` (2,) [m].
 
         The inverse of :meth:`winch_end`: all of the cable but the part hanging below the hang point.
         """
         return float(unstrained_length - (self.center[1] - winch_end[1]))
+
+
+# ----------------------------------------------------------------------------------
+# a platform above its exits
+# ----------------------------------------------------------------------------------
+def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None:
+    """Why no cable can hold the platform up, or None: every anchor at or above the top of its exit.
+
+    A cable pulls its anchor towards the point where it leaves its exit, which lies no
+    higher than the exit's top (the top of a pulley's rim, an exit point itself). When
+    every anchor is at or above its exit's top, no cable pulls the platform upwards, and
+    as cables cannot push, none holds its weight. One test for planar and spatial robots.
+
+    Parameters
+    ----------
+    anchor_heights : array_like, shape (m,) [m]
+        Height of each cable's anchor (z, the vertical axis of both dimensions).
+    exit_tops : array_like, shape (m,) [m]
+        Height of the top of each cable's exit (:attr:`Pulley.top`; a swivel pulley's
+        inlet height plus its radius; an exit point's height).
+    exits : str
+        The scene field of the exits, for the message (``"pulleys"`` or ``"exits"``).
+
+    Returns
+    -------
+    str or None
+        ``"every anchor is at or above the top of its exit (platform.anchors[0] at z = 0.4 m,
+        pulleys[0] up to z = 0.25 m; ...): no cable can hold a platform above its exits, as
+        cables cannot push"``; None if some anchor lies below its exit's top.
+    """
+    heights, tops = np.asarray(anchor_heights, dtype=float), np.asarray(exit_tops, dtype=float)
+    if heights.shape != tops.shape or np.any(heights < tops):
+        return None
+    where = "; ".join(f"platform.anchors[{i}] at z = {h:.4g} m, {exits}[{i}] up to z = {t:.4g} m"
+                      for i, (h, t) in enumerate(zip(heights, tops)))
+    return (f"every anchor is at or above the top of its exit ({where}): no cable can hold a platform above its "
+            "exits, as cables cannot push")
 
 
 # ----------------------------------------------------------------------------------

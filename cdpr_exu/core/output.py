@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import zipfile
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -75,20 +76,52 @@ def fixed(value: float, digits: int = 2) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
-def split_timing(summary: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Split a summary into (stable figures, timing figures that change from run to run)."""
-    stable, timing = {}, {}
-    for key, value in summary.items():
-        (timing if key in TIMING_KEYS else stable)[key] = value
-    return stable, timing
+def length_text(metres: float | None) -> str:
+    """A length [m] as printed: millimetres with two decimals from 0.1 mm on, micrometres to three
+    significant digits below (never "0.00 mm" for a micrometre); "n/a" for None."""
+    if metres is None:
+        return "n/a"
+    if abs(metres) >= 1e-4:
+        return f"{fixed(1000.0 * metres, 2)} mm"
+    return f"{1e6 * metres:.3g} um".replace("-0 um", "0 um")
 
 
-def write_summary(folder: str | Path, summary: Mapping[str, Any], name: str = "summary.json") -> Path:
-    """Write ``summary`` into ``folder``: the stable part as ``name``, wall-clock figures as ``timing.json``."""
+def split_timing(summary: Any, keep: Sequence[str] = ()) -> tuple[Any, Any]:
+    """Split a summary into (stable figures, timing figures that change from run to run).
+
+    The :data:`TIMING_KEYS` go to the timing part at any depth, under the same keys and list
+    positions (a comparison's ``controllers.ideal_ik.wall_time_s``, a study's
+    ``rows[3].real_time_factor``), so that no wall-clock figure hides in a nested table.
+    ``keep`` names timing keys that stay in the stable part because they are what the
+    file is about (the accuracy study's cost columns). The timing part is empty where
+    there is none.
+    """
+    if isinstance(summary, Mapping):
+        stable, timing = {}, {}
+        for key, value in summary.items():
+            if key in TIMING_KEYS and key not in keep:
+                timing[key] = value
+                continue
+            stable[key], nested = split_timing(value, keep)
+            if nested:
+                timing[key] = nested
+        return stable, timing
+    if isinstance(summary, (list, tuple)):
+        parts = [split_timing(value, keep) for value in summary]
+        timing = [nested or {} for _, nested in parts]
+        return [stable for stable, _ in parts], (timing if any(timing) else {})
+    return summary, {}
+
+
+def write_summary(folder: str | Path, summary: Mapping[str, Any], name: str = "summary.json", *,
+                  timing_name: str = "timing.json", keep: Sequence[str] = ()) -> Path:
+    """Write ``summary`` into ``folder``: the stable part as ``name``, wall-clock figures (at any depth,
+    :func:`split_timing`) as ``timing_name`` (git-ignored under results/); ``keep``: timing keys the stable
+    file keeps because they are its subject."""
     folder = Path(folder)
-    stable, timing = split_timing(summary)
+    stable, timing = split_timing(summary, keep)
     if timing:
-        write_json(folder / "timing.json", timing)
+        write_json(folder / timing_name, timing)
     return write_json(folder / name, stable)
 
 
@@ -108,13 +141,89 @@ def write_npz(path: str | Path, **arrays: Any) -> Path:
     return path
 
 
-def check_output_folder(path: str | Path | None, option: str = "--out") -> Path | None:
+#: Pose columns of a planar run's ``pose.csv`` (after ``time_s``; the reference's follow, ``x_ref_m``, ...).
+PLANAR_POSE_COLUMNS: tuple[str, ...] = ("x_m", "z_m", "rotation_rad")
+#: Pose columns of a spatial run's ``pose.csv``: the centre of mass and the rotation vector.
+SPATIAL_POSE_COLUMNS: tuple[str, ...] = ("x_m", "y_m", "z_m", "rotation_x_rad", "rotation_y_rad", "rotation_z_rad")
+
+
+def write_pose_csv(path: str | Path, time: Any, pose: Any, reference: Any, columns: Sequence[str]) -> Path:
+    """Write a run's platform path as CSV: time, the pose, the reference pose, units in the header.
+
+    Parameters
+    ----------
+    path : path
+    time : array_like, shape (N,) [s]
+    pose, reference : array_like, shape (N, len(columns))
+    columns : names of the pose columns with their unit last (:data:`PLANAR_POSE_COLUMNS`,
+        :data:`SPATIAL_POSE_COLUMNS`); the reference's are the same with ``_ref`` before the unit.
+    """
+    path = Path(path)
+    references = [f"{name.rsplit('_', 1)[0]}_ref_{name.rsplit('_', 1)[1]}" for name in columns]
+    header = ",".join(["time_s", *columns, *references])
+    table = np.column_stack([np.asarray(time, dtype=float), np.asarray(pose, dtype=float),
+                             np.asarray(reference, dtype=float)])
+    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.9g")
+    return path
+
+
+def undate_solution_file(path: str | Path) -> None:
+    """Blank the date in the header of Exudyn's solution file, so it is stable from run to run.
+
+    The binary header and footer hold the start and end times as ``YYYY-MM-DD,HH:MM:SS``;
+    they are overwritten in place with zeros of the same length (the file stays readable
+    by SolutionViewer).
+    """
+    path = Path(path)
+    data = bytearray(path.read_bytes())
+    pattern = re.compile(rb"\d{4}-\d{2}-\d{2},\d{2}:\d{2}:\d{2}")
+    for offset in (0, max(0, len(data) - 256)):
+        for match in pattern.finditer(bytes(data[offset:offset + 1024])):
+            data[offset + match.start():offset + match.end()] = b"0000-00-00,00:00:00"
+    path.write_bytes(bytes(data))
+
+
+#: What each command writes into its output folder: file names and ``glob`` patterns. Before it
+#: writes, a command removes these (:func:`clear_outputs`), so that no file of the run it replaces
+#: stays beside its own (a spatial run into a planar run's folder kept that run's scene.toml,
+#: solution.sol and figures, and `cdpr view` replayed the old run); every other file is left alone
+#: (results/paper_circle/variants.* of examples/paper_reproduction.py, a user's notes).
+COMMAND_OUTPUTS: dict[str, tuple[str, ...]] = {
+    "run": ("scene.toml", "result.npz", "pose.csv", "summary.json", "timing.json", "solution.sol",
+            "overview.png", "snapshots.png", "path.png", "rotation.png", "errors.png", "tensions.png",
+            "animation.gif", "animation.mp4"),  # `cdpr animate`'s default files show the run they were made of
+    "compare": ("scene.toml", "summary.json", "timing.json", "comparison.md", "pose_*.csv",
+                "comparison_paths.png", "comparison_errors.png", "overview_*.png"),
+    "static": ("scene.toml", "summary.json", "timing.json", "rest.npz", "rest_profile.png"),
+    "study sweep": ("base_scene.toml", "study.csv", "study.json", "timing.json", "vs_*.png", "heatmap.png"),
+    "study accuracy": ("base_scene.toml", "accuracy.csv", "accuracy.json", "timing.json", "tables.md", "pareto.png",
+                       "reference.npz"),
+    "animate --frames-dir": ("frame_*.png",),
+}
+#: Files that only one command writes: a folder holding one of them holds that command's output.
+COMMAND_MARKERS: dict[str, tuple[str, ...]] = {
+    "run": ("result.npz", "solution.sol"),
+    "compare": ("comparison.md",),
+    "static": ("rest.npz", "rest_profile.png"),
+    "study sweep": ("study.json", "study.csv"),
+    "study accuracy": ("accuracy.json", "accuracy.csv"),
+}
+
+
+def check_output_folder(path: str | Path | None, option: str = "--out", command: str | None = None) -> Path | None:
     """Make sure ``path`` can be the output folder, before any work starts; create it.
+
+    With ``command`` (a key of :data:`COMMAND_OUTPUTS`), a folder that holds another
+    command's output (one of its :data:`COMMAND_MARKERS`) is refused: the two commands'
+    files would lie side by side, and what reads the folder (``cdpr view``, a reader of
+    summary.json) would mix them. A folder of the same command's earlier output is
+    accepted; the command clears those files before it writes (:func:`clear_outputs`).
 
     Raises
     ------
     OutputError
-        If ``path`` (or one of its parents) is an existing file, or cannot be created.
+        If ``path`` (or one of its parents) is an existing file, cannot be created, or holds
+        another command's output.
     """
     if path is None:
         return None
@@ -124,8 +233,33 @@ def check_output_folder(path: str | Path | None, option: str = "--out") -> Path 
     for parent in path.parents:
         if parent.exists() and not parent.is_dir():
             raise OutputError(f"{option} {path}: {parent} is a file, so no folder can be made inside it")
+    if command is not None and path.is_dir():
+        for other, markers in COMMAND_MARKERS.items():
+            found = [name for name in markers if (path / name).is_file()]
+            if other != command and found:
+                raise OutputError(f"{option} {path}: holds the output of `cdpr {other}` ({', '.join(found)}); "
+                                  f"`cdpr {command}` there would leave the two side by side. Give another folder, "
+                                  "or remove that output first")
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise OutputError(f"{option} {path}: cannot create the folder ({err.strerror or err})") from err
     return path
+
+
+def clear_outputs(folder: str | Path, command: str) -> list[Path]:
+    """Remove the files ``command`` writes (:data:`COMMAND_OUTPUTS`) from ``folder``; returns them.
+
+    Called by each command just before it writes its first file, so that a new run leaves
+    none of the run it replaces (a figure that the new run does not draw, a
+    ``pose_<controller>.csv`` of a controller it did not run). Other files, and folders,
+    are left alone.
+    """
+    folder = Path(folder)
+    removed = []
+    for pattern in COMMAND_OUTPUTS[command]:
+        for path in sorted(folder.glob(pattern)):
+            if path.is_file():
+                path.unlink()
+                removed.append(path)
+    return removed

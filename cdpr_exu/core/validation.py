@@ -1,57 +1,118 @@
 """Argument checks shared by the scene, the catenary and the statics.
 
 Each returns the value as a float or raises :class:`~cdpr_exu.core.errors.SceneError`
-naming the parameter and the offending value. Booleans are refused: ``True`` is no
-length.
+naming the parameter and the offending value. Numbers must be numbers: text (``"1.0"``)
+and booleans (``true`` is no length) are refused, not converted, wherever a number is
+expected (:func:`is_number`), in scalars and in arrays alike.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 from cdpr_exu.core.errors import SceneError
 
 
-def finite(name: str, value: Any) -> float:
-    """``value`` as a finite float."""
-    if isinstance(value, bool):
-        raise SceneError(f"{name} must be a real number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a real number, got {value!r}") from None
+def plain(value: Any) -> Any:
+    """``value`` with NumPy scalars as Python numbers and NumPy arrays as lists, recursively (tuples
+    stay tuples, mappings become dicts); anything else unchanged."""
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, tuple):
+        return tuple(plain(v) for v in value)
+    if isinstance(value, list):
+        return [plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: plain(v) for k, v in value.items()}
+    return value
+
+
+def shown(value: Any) -> str:
+    """``value`` as a message shows it: plain numbers (``-2.0``, never ``np.float64(-2.0)``), arrays as
+    lists (``[1.0, 2.0]``, never ``array([1., 2.])``), text quoted (``'abc'``): the repr of :func:`plain`."""
+    return repr(plain(value))
+
+
+def is_number(value: Any) -> bool:
+    """True for a real number as TOML, Python and NumPy give one: an int, a float, a NumPy
+    integer or float scalar, or a one-element NumPy array of those. False for text
+    (``"1.0"``), booleans, None and everything else."""
+    import numpy as np
+
+    if isinstance(value, (bool, np.bool_)):
+        return False
+    if isinstance(value, numbers.Real):
+        return True
+    return isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iuf"
+
+
+def _refuse_non_numbers(value: Any, message: str) -> None:
+    """Raise SceneError(``message``) if ``value`` (a number, a nested list or an array) holds
+    anything but numbers: text, booleans, None, tables."""
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind in "iuf":
+            return
+        if value.dtype.kind != "O":
+            raise SceneError(message)
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        for item in value:
+            _refuse_non_numbers(item, message)
+    elif not is_number(value):
+        raise SceneError(message)
+
+
+def _unit(unit: str) -> str:
+    """`` [unit]`` for a message, or nothing."""
+    return f" [{unit}]" if unit else ""
+
+
+def finite(name: str, value: Any, unit: str = "") -> float:
+    """``value`` as a finite float; text and booleans are refused, not converted. ``unit`` (e.g. ``"kg"``)
+    is named in the message: "platform.mass must be a real number [kg], got '2.5'"."""
+    if not is_number(value):
+        raise SceneError(f"{name} must be a real number{_unit(unit)}, got {shown(value)}")
+    number = float(value)
     if not math.isfinite(number):
-        raise SceneError(f"{name} must be finite, got {value!r}")
+        raise SceneError(f"{name} must be finite{_unit(unit)}, got {shown(value)}")
     return number
 
 
-def positive(name: str, value: Any) -> float:
-    """``value`` as a finite float > 0."""
-    number = finite(name, value)
+def positive(name: str, value: Any, unit: str = "") -> float:
+    """``value`` as a finite float > 0 ("platform.mass must be positive [kg], got -2.5")."""
+    number = finite(name, value, unit)
     if number <= 0.0:
-        raise SceneError(f"{name} must be positive, got {value!r}")
+        raise SceneError(f"{name} must be positive{_unit(unit)}, got {shown(value)}")
     return number
 
 
-def non_negative(name: str, value: Any) -> float:
+def non_negative(name: str, value: Any, unit: str = "") -> float:
     """``value`` as a finite float >= 0."""
-    number = finite(name, value)
+    number = finite(name, value, unit)
     if number < 0.0:
-        raise SceneError(f"{name} must be zero or positive, got {value!r}")
+        raise SceneError(f"{name} must be zero or positive{_unit(unit)}, got {shown(value)}")
     return number
 
 
 def real_array(name: str, value: Any, *, require_finite: bool = True):
-    """``value`` as a float ndarray (any shape); text, objects and NaN/inf are refused."""
+    """``value`` as a float ndarray (any shape); text, booleans, objects and NaN/inf are refused."""
     import numpy as np
 
+    _refuse_non_numbers(value, f"{name} must be real numbers, got {shown(value)}")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
-        raise SceneError(f"{name} must be real numbers, got {value!r}") from None
+        raise SceneError(f"{name} must be real numbers, got {shown(value)}") from None
     if require_finite and not np.all(np.isfinite(array)):
-        raise SceneError(f"{name} must be finite, got {value!r}")
+        raise SceneError(f"{name} must be finite, got {shown(value)}")
     return array
 
 
@@ -61,7 +122,7 @@ def whole_array(name: str, value: Any):
 
     array = real_array(name, value)
     if not np.all(array == np.round(array)):
-        raise SceneError(f"{name} must be whole numbers, got {value!r}")
+        raise SceneError(f"{name} must be whole numbers, got {shown(value)}")
     return array.astype(np.int64)
 
 
@@ -87,12 +148,13 @@ def vector(name: str, value: Any, length: int, meaning: str = ""):
     """
     import numpy as np
 
+    _refuse_non_numbers(value, f"{name} must be {length} numbers{meaning}, got {shown(value)}")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
-        raise SceneError(f"{name} must be a {length}-vector{meaning}, got {value!r}") from None
+        raise SceneError(f"{name} must be a {length}-vector{meaning}, got {shown(value)}") from None
     if array.shape != (length,) or not np.all(np.isfinite(array)):
-        raise SceneError(f"{name} must be a finite {length}-vector{meaning}, got {value!r}")
+        raise SceneError(f"{name} must be a finite {length}-vector{meaning}, got {shown(value)}")
     return array
 
 
@@ -110,7 +172,7 @@ def per_item(name: str, values: Any, count: int, positive: bool = False):
         raise SceneError(f"{name} must be a scalar or have shape ({count},); got shape {array.shape}")
     array = np.ascontiguousarray(array, dtype=np.float64)
     if not np.isfinite(array).all() or (array <= 0.0 if positive else array < 0.0).any():
-        raise SceneError(f"{name} must be finite and {'positive' if positive else 'zero or positive'}; got {values!r}")
+        raise SceneError(f"{name} must be finite and {'positive' if positive else 'zero or positive'}; got {shown(values)}")
     return array
 
 

@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import flat_coordinates, real_array, whole_array
+from cdpr_exu.core.validation import flat_coordinates, real_array, shown, whole_array
 
 __all__ = [
     "BendingSpringDamper",
@@ -253,7 +253,7 @@ def _as_joints(joints, n_nodes):
 def _as_per_joint(name, values, n_joints):
     array = real_array(name, values)
     if np.any(array < 0):
-        raise SceneError(f"{name} must be zero or positive, got {values!r}")
+        raise SceneError(f"{name} must be zero or positive, got {shown(values)}")
     if array.ndim == 0:
         array = np.full(n_joints, float(array))
     elif array.shape != (n_joints,):

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.validation import finite, non_negative, positive, real_array, vector
+from cdpr_exu.core.validation import finite, non_negative, positive, real_array, shown, vector
 
 STANDARD_GRAVITY = 9.81
 """Default gravitational acceleration [m/s^2]."""
@@ -379,7 +379,7 @@ def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizon
     H = non_negative("horizontal_tension", horizontal_tension)
     V_B = finite("vertical_tension_b", vertical_tension_b)
     if horizontal_sign not in (1, -1, 1.0, -1.0):
-        raise SceneError(f"horizontal_sign must be +1 or -1, got {horizontal_sign!r}")
+        raise SceneError(f"horizontal_sign must be +1 or -1, got {shown(horizontal_sign)}")
     return _make_state(cable, H, V_B, float(horizontal_sign))
 
 
@@ -600,7 +600,7 @@ def solve_forward(
     """
     span = _span_vector(span)
     if not isinstance(cable, CatenaryCable):
-        raise SceneError(f"cable must be a CatenaryCable, got {cable!r}")
+        raise SceneError(f"cable must be a CatenaryCable, got {shown(cable)}")
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
     tension_limit = _strain_limits(EA, max_strain, max_tension)
     sign_x = -1.0 if span[0] < 0.0 else 1.0
@@ -828,7 +828,7 @@ def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_
         cable (a U of zero width: no horizontal stiffness).
     """
     if not isinstance(cable, CatenaryCable):
-        raise SceneError(f"cable must be a CatenaryCable, got {cable!r}")
+        raise SceneError(f"cable must be a CatenaryCable, got {shown(cable)}")
     H, V_B = positive("horizontal_tension", horizontal_tension), finite("vertical_tension_b", vertical_tension_b)
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
     sign = -1.0 if horizontal_sign < 0 else 1.0

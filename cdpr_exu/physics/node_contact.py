@@ -36,7 +36,7 @@ from numba import njit
 
 from cdpr_exu.physics.axial import tension_law
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import per_item, points_per_item, whole_array
+from cdpr_exu.core.validation import per_item, points_per_item, shown, whole_array
 
 __all__ = ["CONTACT_ONSET_DEPTH", "NodePulleyContact", "node_contact_force_kernel",
            "node_contact_triplet_pattern", "node_contact_triplet_values"]
@@ -184,7 +184,7 @@ class NodePulleyContact:
         self.damping = per_item("damping", damping, count)
         band = float(band)
         if not np.isfinite(band) or band < 0.0:
-            raise SceneError(f"band must be a finite length >= 0 [m]; got {band!r}")
+            raise SceneError(f"band must be a finite length >= 0 [m]; got {shown(band)}")
         self.band = band
 
     def add_force(self, positions, velocities, out):

@@ -66,7 +66,7 @@ from scipy.optimize import nnls
 from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import Pulley, PulleyExit, finite_array, left_jacobian, rotation_from_vector
-from cdpr_exu.core.validation import non_negative, per_item, vector
+from cdpr_exu.core.validation import non_negative, per_item, shown, vector
 
 __all__ = [
     "SwivelExit",
@@ -143,8 +143,10 @@ def _fill_azimuths(azimuth, on_axis, azimuth_hint, radius, anchor, inlet):
             if radius > 0.0:
                 raise UnreachableError(
                     f"anchor {flat_anchor[k].tolist()} lies on the axis of the swivel pulley (inlet "
-                    f"{inlet.tolist()}, radius {radius} m): its azimuth is undefined; give azimuth_hint "
-                    "(the previous azimuth) or start the trajectory off the axis")
+                    f"{inlet.tolist()}, radius {radius} m): which way the pulley turns (its azimuth) is undefined "
+                    "there; start the reference (the scene's trajectory) with every anchor off the vertical axis "
+                    "of its swivel pulley (in Python, swivel_pulley_exit also takes the previous azimuth as "
+                    "azimuth_hint)")
             previous = 0.0  # a point exit: the vertical cable does not depend on it
         flat_azimuth[k] = previous
     return flat_azimuth.reshape(azimuth.shape)
@@ -357,7 +359,7 @@ def _check_hints(n_cables, azimuth_hints):
         return [None] * n_cables
     hints = finite_array("azimuth_hints", azimuth_hints)
     if hints.shape != (n_cables,):
-        raise SceneError(f"azimuth_hints must have shape ({n_cables},), got {azimuth_hints!r}")
+        raise SceneError(f"azimuth_hints must have shape ({n_cables},), got {shown(azimuth_hints)}")
     return [float(h) for h in hints]
 
 
@@ -531,8 +533,8 @@ def _tension_limits(min_tension, max_tension, n_cables):
         limits.append(per_item(name, value, n_cables))  # >= 0: cables cannot push
     lower, upper = limits
     if np.any(lower > upper):
-        raise SceneError(f"min_tension must not exceed max_tension, got min_tension {min_tension!r} "
-                         f"and max_tension {max_tension!r} [N]")
+        raise SceneError(f"min_tension must not exceed max_tension, got min_tension {shown(min_tension)} "
+                         f"and max_tension {shown(max_tension)} [N]")
     return lower, upper
 
 

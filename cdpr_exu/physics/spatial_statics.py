@@ -70,7 +70,7 @@ from cdpr_exu.physics.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, Cate
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
 from cdpr_exu.statics.statics import PlatformEquilibriumViews, _minimise_energy  # the planar statics' line search, reused
-from cdpr_exu.core.validation import non_negative, positive, real_array, vector
+from cdpr_exu.core.validation import non_negative, positive, real_array, shown, vector
 
 _RELATIVE_TOLERANCE = 1e-12
 """Target of the scaled wrench residual (the cables are solved to 1e-12 of their length)."""
@@ -161,15 +161,15 @@ class SpatialPlatform:
         try:
             cables = tuple(self.cables)
         except TypeError:
-            raise SceneError(f"cables must be a sequence of SpatialCable, got {self.cables!r}") from None
+            raise SceneError(f"cables must be a sequence of SpatialCable, got {shown(self.cables)}") from None
         if not all(isinstance(c, SpatialCable) for c in cables):
-            raise SceneError(f"cables must be a sequence of SpatialCable, got {self.cables!r}")
+            raise SceneError(f"cables must be a sequence of SpatialCable, got {shown(self.cables)}")
         object.__setattr__(self, "cables", cables)
         object.__setattr__(self, "mass", non_negative("mass", self.mass))
         object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
         inertia = vector("inertia", self.inertia, 3, " (principal moments) [kg m^2]")
         if np.any(inertia < 0.0):
-            raise SceneError(f"inertia must be zero or positive, got {self.inertia!r}")
+            raise SceneError(f"inertia must be zero or positive, got {shown(self.inertia)}")
         object.__setattr__(self, "inertia", tuple(inertia))
         exits = np.array([c.exit_point for c in cables]).reshape(-1, 3)
         anchors = np.array([c.anchor for c in cables]).reshape(-1, 3)
@@ -177,7 +177,7 @@ class SpatialPlatform:
         for i in range(len(cables)):
             for j in range(i):
                 if np.linalg.norm(exits[i] - exits[j]) <= 1e-9 * size:
-                    raise SceneError(f"cables[{j}] and cables[{i}] share the exit_point {tuple(exits[i])} m")
+                    raise SceneError(f"cables[{j}] and cables[{i}] share the exit_point {shown(exits[i])} m")
         needed = 1 if self.is_point_mass else 2
         if len(cables) < needed:
             kind = "a point mass" if needed == 1 else "a rigid platform"
@@ -187,7 +187,7 @@ class SpatialPlatform:
             for i in range(len(cables)):
                 for j in range(i):
                     if np.linalg.norm(anchors[i] - anchors[j]) <= 1e-9 * arm:
-                        raise SceneError(f"cables[{j}] and cables[{i}] share the anchor {tuple(anchors[i])} m "
+                        raise SceneError(f"cables[{j}] and cables[{i}] share the anchor {shown(anchors[i])} m "
                                          f"on a rigid platform")
             if np.linalg.matrix_rank(anchors, tol=1e-9 * arm) < 2:
                 raise SceneError(f"cables: the anchors {anchors.tolist()} m lie on one line through the centre "
@@ -489,9 +489,9 @@ def _lengths(platform, unstrained_lengths):
     lengths = real_array("unstrained_lengths", unstrained_lengths)
     if lengths.shape != (len(platform.cables),):
         raise SceneError(f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
-                         f"got {unstrained_lengths!r}")
+                         f"got {shown(unstrained_lengths)}")
     if np.any(lengths <= 0.0):
-        raise SceneError(f"unstrained_lengths must be positive, got {unstrained_lengths!r}")
+        raise SceneError(f"unstrained_lengths must be positive, got {shown(unstrained_lengths)}")
     return lengths
 
 
@@ -646,7 +646,7 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
         no equilibrium is found within the tension limits.
     """
     if not isinstance(platform, SpatialPlatform):
-        raise SceneError(f"platform must be a SpatialPlatform, got {platform!r}")
+        raise SceneError(f"platform must be a SpatialPlatform, got {shown(platform)}")
     lengths = _lengths(platform, unstrained_lengths)
     wrench = _wrench(external_wrench)
     max_strain = positive("max_strain", max_strain)
@@ -656,7 +656,7 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
     if initial_pose is not None:
         start = real_array("initial_pose", initial_pose)
         if start.shape != (dof,):
-            raise SceneError(f"initial_pose must have {dof} entries for this platform, got {initial_pose!r}")
+            raise SceneError(f"initial_pose must have {dof} entries for this platform, got {shown(initial_pose)}")
     _check_reach(platform, lengths, max_strain, max_tension)
     if initial_pose is None:
         start = straight_cable_pose(platform, lengths, wrench)
@@ -754,7 +754,7 @@ def _inverse_cable(cable, anchor_point, horizontal_tension):
     span = exit_point - anchor_point
     horizontal = float(math.hypot(span[0], span[1]))
     if horizontal <= 0.0:
-        raise UnreachableError(f"cable from {tuple(exit_point)} hangs vertically above its anchor: its horizontal "
+        raise UnreachableError(f"cable from {shown(exit_point)} hangs vertically above its anchor: its horizontal "
                                "tension is zero and the inverse catenary has no answer")
     direction = np.array([span[0], span[1], 0.0]) / horizontal
     length, state = solve_inverse((horizontal, span[2]), cable.weight_per_length, cable.axial_stiffness,
@@ -811,10 +811,10 @@ def solve_inverse_spatial_statics(platform, pose, horizontal_guess, external_wre
     pose = real_array("pose", pose)
     dof = platform.degrees_of_freedom
     if pose.shape != (6,) and not (dof == 3 and pose.shape == (3,)):
-        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {pose.tolist()!r}")
+        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {shown(pose.tolist())}")
     guess = real_array("horizontal_guess", horizontal_guess)
     if guess.shape != (len(platform.cables),) or np.any(guess <= 0.0):
-        raise SceneError(f"horizontal_guess must be one positive tension per cable, got {horizontal_guess!r}")
+        raise SceneError(f"horizontal_guess must be one positive tension per cable, got {shown(horizontal_guess)}")
     wrench = _wrench(external_wrench)
     position = pose[:3]
     rotation = rotation_from_vector(pose[3:6]) if pose.shape == (6,) and dof == 6 else np.eye(3)

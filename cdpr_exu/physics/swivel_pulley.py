@@ -51,7 +51,7 @@ from numba import njit
 
 from cdpr_exu.physics.axial import tension_law
 from cdpr_exu.core.errors import CdprWarning, SceneError
-from cdpr_exu.core.validation import non_negative, positive, vector
+from cdpr_exu.core.validation import non_negative, positive, shown, vector
 
 __all__ = ["SAFE_ELEMENT_FRACTION", "SAFE_NEWTON_TOLERANCE", "SwivelPulley", "SwivelStabilityWarning",
            "stability_concerns",
@@ -318,17 +318,19 @@ class SwivelPulley:
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
-        set_(self, "inlet", tuple(float(v) for v in vector("swivel.inlet", self.inlet, 3)))
+        set_(self, "inlet", tuple(float(v) for v in vector("swivel.inlet", self.inlet, 3, " (x, y, z) [m]")))
+        units = {"radius": "m", "groove_radius": "m", "flange_height": "m", "contact_stiffness": "N/m",
+                 "swivel_inertia": "kg m^2", "contact_damping": "N s/m", "bearing_damping": "N m s", "onset_band": "m"}
         for name in ("radius", "groove_radius", "flange_height", "contact_stiffness", "swivel_inertia"):
-            set_(self, name, positive(f"swivel.{name}", getattr(self, name)))
+            set_(self, name, positive(f"swivel.{name}", getattr(self, name), units[name]))
         for name in ("contact_damping", "bearing_damping", "onset_band"):
-            set_(self, name, non_negative(f"swivel.{name}", getattr(self, name)))
+            set_(self, name, non_negative(f"swivel.{name}", getattr(self, name), units[name]))
         if self.groove_radius >= self.radius:
-            raise SceneError(f"swivel.groove_radius must be smaller than swivel.radius = {self.radius!r}, "
-                             f"got {self.groove_radius!r}")
+            raise SceneError(f"swivel.groove_radius must be smaller than swivel.radius = {shown(self.radius)}, "
+                             f"got {shown(self.groove_radius)}")
         if self.flange_height >= self.radius:
-            raise SceneError(f"swivel.flange_height must be smaller than swivel.radius = {self.radius!r}, "
-                             f"got {self.flange_height!r}")
+            raise SceneError(f"swivel.flange_height must be smaller than swivel.radius = {shown(self.radius)}, "
+                             f"got {shown(self.flange_height)}")
 
     @property
     def inlet_array(self) -> np.ndarray:
@@ -348,7 +350,7 @@ def cable_path_over_swivel(pulley: SwivelPulley, psi: float, winch_length: float
     radius = pulley.radius
     wrap = math.pi - free_angle
     if not 0.0 < wrap <= math.pi:
-        raise SceneError(f"free_angle must lie in [0, pi) [rad], got {free_angle!r}")
+        raise SceneError(f"free_angle must lie in [0, pi) [rad], got {shown(free_angle)}")
     inlet = pulley.inlet_array
     e_r = np.array([math.cos(psi), math.sin(psi), 0.0])
     e_z = np.array([0.0, 0.0, 1.0])

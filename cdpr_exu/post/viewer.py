@@ -1,9 +1,10 @@
 """Replay a finished run: Exudyn's SolutionViewer, or a headless GIF/MP4 animation.
 
 A run folder written by ``cdpr run SCENE --out DIR`` holds ``scene.toml`` and
-``solution.sol`` (Exudyn's binary solution file). The scene rebuilds the identical
-Exudyn system (:func:`cdpr_exu.builder.model.build_model`); each row of the solution file
-is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
+``solution.sol`` (Exudyn's binary solution file), for planar and spatial scenes alike. The
+scene rebuilds the identical Exudyn system (:func:`cdpr_exu.builder.model.build_model`, or
+for a spatial scene :func:`cdpr_exu.run.spatial_run.build_spatial_model`); each row of the
+solution file is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
 
 - :func:`view_solution` (``cdpr view DIR``) replays the run in Exudyn's interactive
   ``SolutionViewer``: it needs a display. Without one it raises
@@ -11,7 +12,9 @@ is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
   whole process there).
 - :func:`render_animation` (``cdpr animate DIR``) draws each chosen row with Exudyn's
   software raytracer (no window, no OpenGL) and writes a GIF (Pillow) or an MP4
-  (the optional package ``imageio-ffmpeg``), and optionally the PNG frames.
+  (the optional package ``imageio-ffmpeg``), and optionally the PNG frames; a spatial
+  run is drawn from its ``result.npz`` with matplotlib's 3-D axes
+  (:mod:`cdpr_exu.post.spatial_animation`).
 
 Both add drawing-only items before replaying (:func:`decorate_model`): the pulleys
 as discs, the platform as its rectangle (``platform.size``) and the reference path
@@ -51,6 +54,8 @@ SOLUTION_FILE = "solution.sol"
 DEFAULT_SIZE = (640, 480)
 #: Default frame rate of ``cdpr animate`` [frames per second].
 DEFAULT_FPS = 25.0
+#: Highest frame rate a GIF can store: its frame times are whole hundredths of a second [frames per second].
+MAX_GIF_FPS = 100.0
 #: Share of the scene's extent left free around it in an animation frame.
 FRAME_MARGIN = 0.06
 #: Height of the caption band at the top of an animation frame, as a share of its height.
@@ -176,17 +181,18 @@ def load_solution(path: str | Path) -> dict:
     return solution
 
 
-def check_solution_fits(model: Model, solution: dict, source: str = "the solution") -> None:
+def check_solution_fits(model, solution: dict, source: str = "the solution") -> None:
     """Refuse a solution whose coordinate layout differs from the model's.
 
     Compares the exported sizes (positions, velocities, accelerations, ODE1,
-    algebraic and data coordinates) with the model's system sizes.
+    algebraic and data coordinates) with the system sizes of ``model`` (a :class:`Model`
+    or an Exudyn ``MainSystem``).
 
     Raises
     ------
     SolutionMismatchError
     """
-    data = model.mbs.systemData
+    data = getattr(model, "mbs", model).systemData
     n_ode2, n_vel2, n_acc2, n_ode1, n_vel1, n_algebraic, n_data = (int(n) for n in solution["columnsExported"])
     expected = {"ODE2 coordinates": (n_ode2, data.ODE2Size()), "ODE1 coordinates": (n_ode1, data.ODE1Size()),
                 "algebraic coordinates": (n_algebraic, data.AEsize()), "data coordinates": (n_data, data.DataSize())}
@@ -202,7 +208,46 @@ def check_solution_fits(model: Model, solution: dict, source: str = "the solutio
             "edited, or the package changed, after the run? Run the scene again with `cdpr run`")
 
 
-def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
+@dataclass
+class SpatialReplay:
+    """A spatial run folder loaded for replay: its scene, the rebuilt robot and the solution.
+
+    Attributes
+    ----------
+    run_dir : Path
+    scene : SpatialScene
+    mbs : exudyn.MainSystem
+        Rebuilt from ``scene.toml`` (:func:`cdpr_exu.run.spatial_run.build_spatial_model`).
+    items : SpatialRobotItems
+    solution : dict
+        As for :class:`Replay`.
+    """
+
+    run_dir: Path
+    scene: object
+    mbs: object
+    items: object
+    solution: dict
+
+    n_rows = Replay.n_rows
+    times = Replay.times
+
+    def platform_pose(self) -> np.ndarray:
+        """The platform's pose in each row: centre of mass [m] and rotation vector [rad], shape (n_rows, 6)."""
+        from exudyn.utilities import SetSolutionState
+
+        from cdpr_exu.builder.spatial_robot import platform_pose
+        from cdpr_exu.core.geometry import rotation_vector
+
+        poses = []
+        for row in range(self.n_rows):
+            SetSolutionState(self.mbs, self.solution, row, exu.ConfigurationType.Current)
+            position, rotation = platform_pose(self.mbs, self.items)
+            poses.append(np.concatenate([position, rotation_vector(rotation)]))
+        return np.asarray(poses)
+
+
+def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | SpatialReplay:
     """Load a run folder: scene, rebuilt (and decorated) model, solution file.
 
     Parameters
@@ -210,15 +255,28 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
     run_dir : path
         Folder written by ``cdpr run SCENE --out DIR``.
     decorate : bool
-        Add pulleys, platform rectangle and reference path (:func:`decorate_model`).
+        Add pulleys, platform rectangle and reference path (:func:`decorate_model`; planar runs).
+
+    Returns
+    -------
+    Replay or SpatialReplay
+        By the dimension of the folder's scene.
 
     Raises
     ------
     RunFolderError, SolutionMismatchError, SceneError
     """
+    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+
     scene_file, solution_file = run_files(run_dir)
-    scene = load_scene(scene_file)
+    scene = load_any_scene(scene_file)
     solution = load_solution(solution_file)
+    if is_spatial(scene):
+        from cdpr_exu.run.spatial_run import build_spatial_model
+
+        mbs, items = build_spatial_model(scene)
+        check_solution_fits(mbs, solution, f"solution file {str(solution_file)!r}")
+        return SpatialReplay(Path(run_dir), scene, mbs, items, solution)
     model = build_model(scene)
     check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
     if decorate:
@@ -355,6 +413,32 @@ def _style(model: Model) -> None:
     settings.general.autoFitScene = False
 
 
+def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768)) -> None:
+    """Visualization settings of a spatial replay: small nodes, no load arrows or markers, and a view
+    from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
+    from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
+
+    settings = replay.mbs.GetSystemContainer().visualizationSettings
+    points = np.vstack([np.asarray(replay.scene.exits, dtype=float), replay.platform_pose()[:, :3]])
+    low, high = points.min(axis=0), points.max(axis=0)
+    extent = float((high - low).max()) or 1.0
+    settings.loads.show = False
+    settings.markers.show = False
+    settings.connectors.springNumberOfWindings = 1
+    settings.nodes.drawNodesAsPoint = False
+    settings.nodes.defaultSize = 0.006 * extent
+    settings.nodes.defaultColor = NODE_COLOR
+    settings.nodes.tiling = 8
+    settings.general.autoFitScene = False
+    settings.view0.window.renderWindowSize = [int(size[0]), int(size[1])]
+    advanced = settings.openGL.advanced
+    advanced.initialCenterPoint = [float(x) for x in (low + high) / 2.0]
+    advanced.initialZoom = 0.7 * extent
+    advanced.initialMaxSceneSize = 4.0 * extent
+    # Exudyn takes the transpose of the view's rotation: this one shows z up, x to the right, seen from -y.
+    advanced.initialModelRotation = (RotationMatrixX(-0.5 * np.pi) @ RotationMatrixZ(-0.15 * np.pi)).T.tolist()
+
+
 # --------------------------------------------------------------------------- camera
 
 
@@ -486,7 +570,7 @@ def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
     Parameters
     ----------
     run_dir : path
-        Folder written by ``cdpr run SCENE --out DIR``.
+        Folder written by ``cdpr run SCENE --out DIR`` (planar or spatial scene).
     every : int, optional
         Show every ``every``-th stored row; default: about real time at 25 frames/s.
 
@@ -510,12 +594,17 @@ def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
     from exudyn.interactive import SolutionViewer
 
     replay = load_replay(run_dir)
-    _style(replay.model)
-    camera = fit_camera(_view_points(replay), (1024, 768), caption_band=0.12)
-    camera.apply(replay.model)
+    if isinstance(replay, SpatialReplay):  # a 3-D robot: Exudyn's own view, fitted to the scene
+        mbs = replay.mbs
+        _style_spatial(replay)
+    else:
+        mbs = replay.model.mbs
+        _style(replay.model)
+        camera = fit_camera(_view_points(replay), (1024, 768), caption_band=0.12)
+        camera.apply(replay.model)
     if every is None:
         every = _rows_per_frame(replay.times, DEFAULT_FPS)
-    SolutionViewer(replay.model.mbs, replay.solution, rowIncrement=min(int(every), replay.n_rows),
+    SolutionViewer(mbs, replay.solution, rowIncrement=min(int(every), replay.n_rows),
                    timeout=1.0 / DEFAULT_FPS, runOnStart=True, runMode=0,
                    title=f"cdpr view: {replay.scene.name} ({replay.run_dir})")
 
@@ -586,11 +675,14 @@ class _Writer:
     """Collects frames into a GIF (Pillow) or streams them into an MP4 (imageio-ffmpeg)."""
 
     @staticmethod
-    def check(path: Path, size: tuple[int, int]) -> None:
+    def check(path: Path, size: tuple[int, int], fps: float = DEFAULT_FPS) -> None:
         """Refuse an animation file this writer cannot make, before any rendering."""
         suffix = path.suffix.lower()
         if suffix not in (".gif", ".mp4"):
             raise CdprError(f"animation file {str(path)!r} must end in .gif or .mp4")
+        if suffix == ".gif" and fps > MAX_GIF_FPS:
+            raise CdprError(f"--fps {fps:g}: a GIF stores frame times in hundredths of a second, so it plays at "
+                            f"most {MAX_GIF_FPS:g} frames/s; lower --fps (and raise --every), or write an .mp4")
         if suffix == ".mp4":
             try:
                 import imageio_ffmpeg  # noqa: F401
@@ -639,15 +731,124 @@ class _Writer:
         self.frames = []
 
 
+@dataclass(frozen=True)
+class AnimationRequest:
+    """The checked options of an animation (:func:`check_animation_request`).
+
+    Attributes
+    ----------
+    run_dir : Path
+    out_file : Path
+        ``.gif`` or ``.mp4``.
+    fps : float [1/s]
+    every : int or None
+        Row step; None: real-time playback at ``fps``.
+    size : (width, height) [pixels]
+    frames_dir : Path or None
+        Created; its old ``frame_*.png`` are removed when the rendering starts.
+    spatial : bool
+        A spatial run (drawn from ``result.npz`` with matplotlib) or a planar one
+        (Exudyn's raytracer on the solution file).
+    """
+
+    run_dir: Path
+    out_file: Path
+    fps: float
+    every: int | None
+    size: tuple[int, int]
+    frames_dir: Path | None
+    spatial: bool
+
+
+def check_animation_request(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
+                            every: int | None = None, size: tuple[int, int] = DEFAULT_SIZE,
+                            frames_dir: str | Path | None = None) -> AnimationRequest:
+    """Check every option of an animation, for planar and spatial runs alike, before any work.
+
+    The one check behind ``cdpr animate`` and :func:`render_animation` (issue 23.12: a
+    spatial ``--fps 0`` or ``nan`` crashed, ``-5`` crashed after the whole rendering, ``inf``
+    wrote a GIF of zero frame times). Messages name the option as the command line spells it.
+
+    Raises
+    ------
+    CdprError
+        A frame rate that is not a finite number > 0 (or more than a GIF can store), a
+        row step that is not a whole number >= 1, a bad size, an animation file of another
+        kind or in a missing folder, a ``--frames-dir`` that is a file.
+    RunFolderError
+        A folder that holds no run.
+    """
+    from cdpr_exu.core.output import check_output_folder
+    from cdpr_exu.post.spatial_animation import is_spatial_run
+
+    if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(fps) and fps > 0):
+        raise CdprError(f"--fps must be a finite number of frames per second > 0, got {fps!r}")
+    if every is not None and (isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1):
+        raise CdprError(f"--every must be a whole number >= 1, got {every!r}")
+    try:
+        width, height = (int(n) for n in size)
+    except (TypeError, ValueError):
+        raise CdprError(f"--size must be (width, height) in pixels, got {size!r}") from None
+    if not (32 <= width <= 8192 and 32 <= height <= 8192):
+        raise CdprError(f"--size must be between 32x32 and 8192x8192 pixels, got {width}x{height}")
+    run_dir = Path(run_dir)
+    if not run_dir.is_dir():
+        raise RunFolderError(f"run folder {str(run_dir)!r} does not exist; write one with "
+                             f"`cdpr run SCENE --out {run_dir}`")
+    spatial = is_spatial_run(run_dir)
+    if not spatial:
+        run_files(run_dir)
+    out_file = Path(out_file) if out_file is not None else run_dir / "animation.gif"
+    _Writer.check(out_file, (width, height), float(fps))
+    if frames_dir is not None:
+        frames_dir = check_output_folder(frames_dir, "--frames-dir")
+    return AnimationRequest(run_dir, out_file, float(fps), None if every is None else int(every), (width, height),
+                            frames_dir, spatial)
+
+
+class _PlanarFrames:
+    """The frames of a planar run: its solution file's rows in the rebuilt model, drawn by Exudyn's raytracer."""
+
+    def __init__(self, run_dir: Path, size: tuple[int, int], multi_sampling: int):
+        self.replay = replay = load_replay(run_dir)
+        model = replay.model
+        _style(model)
+        settings = model.system_container.visualizationSettings
+        settings.raytracer.multiSampling = int(multi_sampling)
+        settings.raytracer.numberOfThreads = max(1, os.cpu_count() or 1)
+        settings.raytracer.advanced.showText = False  # the caption replaces Exudyn's text
+        camera = fit_camera(_view_points(replay), size)
+        camera.apply(model)
+        trail = replay.positions()["platform"][:, :2]
+        self.caption = _Caption(replay.scene.name, camera, trail, replay.scene.trajectory is not None)
+        self.name, self.times = replay.scene.name, replay.times
+
+    def frame(self, row: int):
+        """Row ``row`` as a PIL RGB image."""
+        from exudyn.utilities import SetSolutionState
+        from PIL import Image
+
+        model, solution = self.replay.model, self.replay.solution
+        SetSolutionState(model.mbs, solution, row, exu.ConfigurationType.Current)
+        SetSolutionState(model.mbs, solution, row, exu.ConfigurationType.Visualization)
+        pixels = model.system_container.renderer.RedrawAndGetImage(useRaytracer=True)
+        image = Image.fromarray(np.asarray(pixels, dtype=np.uint8)[:, :, :3])
+        return self.caption.draw(image, row, float(self.times[row]))
+
+
 def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
                      every: int | None = None, size: tuple[int, int] = DEFAULT_SIZE,
                      frames_dir: str | Path | None = None, progress: bool = False,
                      multi_sampling: int = 2) -> Path:
-    """Render a run folder to a GIF or MP4 with Exudyn's raytracer (no display needed).
+    """Render a run folder to a GIF or MP4 without a display.
 
-    Each chosen row of the solution file is loaded into the rebuilt model and drawn;
-    a caption gives scene name and time, and the platform's travelled path is drawn
-    over the frame next to the reference path.
+    A planar run: each chosen row of the solution file is loaded into the rebuilt model
+    and drawn with Exudyn's raytracer; a caption gives scene name and time, and the
+    platform's travelled path is drawn over the frame next to the reference path. A
+    spatial run: each chosen sample of ``result.npz`` is drawn with matplotlib's 3-D axes
+    (:class:`cdpr_exu.post.spatial_animation.SpatialFrames`). Both go through the same
+    checks (:func:`check_animation_request`), frames folder and file writer.
 
     Parameters
     ----------
@@ -657,17 +858,17 @@ def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *,
         ``.gif`` or ``.mp4`` (MP4 needs the package imageio-ffmpeg); default
         ``run_dir/animation.gif``.
     fps : float [1/s]
-        Frame rate of the animation (GIF stores it in steps of 10 ms).
+        Frame rate of the animation (GIF stores it in steps of 10 ms, so at most 100).
     every : int, optional
         Use every ``every``-th stored row; default: the step that plays the run in
         real time at ``fps``.
     size : (width, height) [pixels]
     frames_dir : path, optional
-        Also write each frame there as ``frame_00000.png``, ...
+        Also write each frame there as ``frame_00000.png``, ... (its older frames are removed).
     progress : bool
         Show a progress bar (only on a terminal).
     multi_sampling : int
-        Raytracer samples per pixel (1, 2 or 4); 1 leaves thin lines broken.
+        Raytracer samples per pixel (1, 2 or 4); 1 leaves thin lines broken (planar runs).
 
     Returns
     -------
@@ -689,55 +890,36 @@ def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *,
 def _render_animation(run_dir, out_file, *, fps, every, size, frames_dir, progress,
                       multi_sampling) -> tuple[Path, int, float]:
     """:func:`render_animation`, also returning the frame count and seconds per frame."""
-    from PIL import Image
     from tqdm import tqdm
 
-    if not (np.isfinite(fps) and fps > 0):
-        raise CdprError(f"fps must be a positive number, got {fps!r}")
-    if every is not None and (isinstance(every, bool) or int(every) < 1):
-        raise CdprError(f"every must be a whole number >= 1, got {every!r}")
-    size = (int(size[0]), int(size[1]))
-    out_file = Path(out_file) if out_file is not None else Path(run_dir) / "animation.gif"
-    run_files(run_dir)
-    _Writer.check(out_file, size)  # before the slow part
-    replay = load_replay(run_dir)
-    model, mbs = replay.model, replay.model.mbs
-    _style(model)
-    settings = model.system_container.visualizationSettings
-    settings.raytracer.multiSampling = int(multi_sampling)
-    settings.raytracer.numberOfThreads = max(1, os.cpu_count() or 1)
-    settings.raytracer.advanced.showText = False  # the caption replaces Exudyn's text
-    camera = fit_camera(_view_points(replay), size)
-    camera.apply(model)
+    request = check_animation_request(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir)
+    if request.spatial:
+        from cdpr_exu.post.spatial_animation import SpatialFrames
 
-    times = replay.times
-    step = int(every) if every is not None else _rows_per_frame(times, fps)
-    rows = range(0, replay.n_rows, step)
-    trail = replay.positions()["platform"][:, :2]
-    caption = _Caption(replay.scene.name, camera, trail, replay.scene.trajectory is not None)
-    if frames_dir is not None:
-        frames_dir = Path(frames_dir)
-        frames_dir.mkdir(parents=True, exist_ok=True)
-    from exudyn.utilities import SetSolutionState
+        source = SpatialFrames(request.run_dir, request.size)
+    else:
+        source = _PlanarFrames(request.run_dir, request.size, multi_sampling)
+    step = request.every if request.every is not None else _rows_per_frame(source.times, request.fps)
+    rows = range(0, len(source.times), step)
+    if request.frames_dir is not None:
+        from cdpr_exu.core.output import clear_outputs
+
+        clear_outputs(request.frames_dir, "animate --frames-dir")  # no frame of a longer, older animation stays
 
     start = _time.perf_counter()
-    writer = _Writer(out_file, fps, size)
+    writer = _Writer(request.out_file, request.fps, request.size)
     try:
-        for frame, row in enumerate(tqdm(rows, unit="frame", desc=f"{replay.scene.name} ",
+        for frame, row in enumerate(tqdm(rows, unit="frame", desc=f"{source.name} ",
                                          disable=None if progress else True)):
-            SetSolutionState(mbs, replay.solution, row, exu.ConfigurationType.Current)
-            SetSolutionState(mbs, replay.solution, row, exu.ConfigurationType.Visualization)
-            pixels = model.system_container.renderer.RedrawAndGetImage(useRaytracer=True)
-            image = Image.fromarray(np.asarray(pixels, dtype=np.uint8)[:, :, :3])
-            image = caption.draw(image, row, float(times[row]))
-            if frames_dir is not None:
-                image.save(frames_dir / f"frame_{frame:05d}.png")
+            image = source.frame(row)
+            if request.frames_dir is not None:
+                image.save(request.frames_dir / f"frame_{frame:05d}.png")
             writer.add(image)
     except BaseException:
         writer.abort()
         raise
     writer.close()
-    return out_file, len(rows), (_time.perf_counter() - start) / max(1, len(rows))
+    return request.out_file, len(rows), (_time.perf_counter() - start) / max(1, len(rows))
 
 
 # --------------------------------------------------------------------------- CLI
@@ -780,13 +962,6 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
 
 def _cmd_animate(args: argparse.Namespace) -> int:
-    from cdpr_exu.post.spatial_animation import is_spatial_run, render_spatial_animation
-
-    if is_spatial_run(args.run_dir):  # matplotlib's 3-D axes, not Exudyn's renderer
-        out, frames = render_spatial_animation(args.run_dir, args.out, fps=args.fps, every=args.every, size=args.size)
-        if not args.quiet:
-            print(f"wrote {out}: {frames} frames of {args.size[0]}x{args.size[1]} at {args.fps:g} frames/s")
-        return 0
     out, frames, seconds = _render_animation(args.run_dir, args.out, fps=args.fps, every=args.every,
                                              size=args.size, frames_dir=args.frames_dir,
                                              progress=not args.quiet, multi_sampling=2)
@@ -811,7 +986,7 @@ def add_commands(subparsers) -> None:
         "animate", help="render a run to a GIF or MP4 without a display",
         description="Render a run folder (written by `cdpr run SCENE --out DIR`) with Exudyn's software "
         "raytracer, no display needed, into a GIF (or an MP4 with imageio-ffmpeg installed); a spatial run "
-        "folder is drawn with matplotlib's 3-D axes into a GIF.",
+        "folder is drawn with matplotlib's 3-D axes. The options are checked before any rendering.",
         epilog=EPILOG_ANIMATE + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     animate.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
     animate.add_argument("--out", help="animation file, .gif or .mp4 (default: RUN_DIR/animation.gif)")

@@ -11,6 +11,7 @@ from __future__ import annotations
 import datetime
 import json
 import platform as _platform
+import warnings as _warnings
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -18,7 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from cdpr_exu.core.output import json_text, write_npz, write_summary
+from cdpr_exu.core.errors import UnphysicalResultWarning
+from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, json_text, write_npz, write_pose_csv, write_summary
 
 
 @dataclass
@@ -86,51 +88,45 @@ class Result:
     def simulated_time(self) -> float:
         return float(self.time[-1]) if len(self.time) else 0.0
 
+    #: The figures of :meth:`summary` measured from its ``after`` on (the rest cover the whole run).
+    ERROR_FIGURES = ("max_abs_error_x_m", "max_abs_error_z_m", "min_error_z_m", "max_error_z_m",
+                     "max_position_error_m", "rms_position_error_m", "max_abs_rotation_deg")
+
     def summary(self, after: float = 0.0) -> dict[str, Any]:
-        """Scalar figures of the run (errors measured from time ``after`` on) [SI, degrees].
+        """Scalar figures of the run [SI, degrees]: errors (:data:`ERROR_FIGURES`) measured from time
+        ``after`` on, the safety figures (tensions, slack, pushing, tension limits, a platform above
+        its pulleys) over the whole run, the start included (:func:`safety_figures`).
 
         A figure that does not exist (no sample at or after ``after``: a run shorter than
-        the error window, or one that failed before it) is None, and ``notes`` says why.
+        the error window, or one that failed before it) is None, and ``notes`` says why;
+        ``warnings`` says what no real robot can do (elements that push, a platform above
+        its pulleys).
         """
         mask = self.time >= after
         err = self.error[mask]
         position_error = np.linalg.norm(err[:, :2], axis=1) if len(err) else np.zeros(0)
-        taut = np.concatenate([t[mask].ravel() for t in self.tensions]) if self.tensions else np.zeros(0)
-
-        def _max(a):
-            a = np.asarray(a, dtype=float)
-            return float(np.nanmax(a)) if a.size and np.isfinite(a).any() else None
-
-        def _min(a):
-            a = np.asarray(a, dtype=float)
-            return float(np.nanmin(a)) if a.size and np.isfinite(a).any() else None
-
+        safety = safety_figures(self.time, self.tensions, self.platform_pose[:, 1] if len(self.time) else None,
+                                self.metadata.get("highest_exit_z_m"), self.metadata.get("tension_limits_N"))
         notes = []
-        pushing = bool(taut.size) and float(np.nanmin(taut)) < 0.0
-        if pushing:
-            notes.append(f"elements pushed (lowest tension {float(np.nanmin(taut)):.3g} N): this model lets cables "
-                         "carry compression, which a real cable cannot; effects.slack = true makes them tension-only")
         if not len(err):
             notes.append(f"no sample at or after t = {after:g} s (the run reached {self.simulated_time:g} s): "
-                         "its error, rotation and tension figures do not exist and are null")
+                         "its error and rotation figures do not exist and are null")
+        limits = {k: safety.pop(k) for k in ("tension_limits_N", "tension_limit_violations") if k in safety}
+        warnings_ = safety.pop("warnings")
         return {
             "scene": self.scene_name,
             "controller": self.controller,
             "status": self.status,
             "errors_measured_after_s": after,
-            "max_abs_error_x_m": _max(np.abs(err[:, 0])),
-            "max_abs_error_z_m": _max(np.abs(err[:, 1])),
-            "min_error_z_m": _min(err[:, 1]),
-            "max_error_z_m": _max(err[:, 1]),
-            "max_position_error_m": _max(position_error),
+            "max_abs_error_x_m": _nan_max(np.abs(err[:, 0])),
+            "max_abs_error_z_m": _nan_max(np.abs(err[:, 1])),
+            "min_error_z_m": _nan_min(err[:, 1]),
+            "max_error_z_m": _nan_max(err[:, 1]),
+            "max_position_error_m": _nan_max(position_error),
             "rms_position_error_m": float(np.sqrt(np.mean(position_error**2))) if len(err) else None,
-            "max_abs_rotation_deg": _max(np.degrees(np.abs(self.platform_pose[mask, 2]))),
-            "min_element_tension_N": _min(taut),
-            "max_element_tension_N": _max(taut),
-            "min_tension_per_cable_N": [_min(t[mask]) for t in self.tensions],
-            "slack_time_per_cable_s": [self._slack_time(t, mask) for t in self.tensions],
-            "elements_pushed": pushing,
-            "max_pulley_penetration_m": _max(self.pulley_penetration),
+            "max_abs_rotation_deg": _nan_max(np.degrees(np.abs(self.platform_pose[mask, 2]))),
+            **safety,
+            "max_pulley_penetration_m": _nan_max(self.pulley_penetration),
             "wall_time_s": self.wall_time,
             "simulated_time_s": self.simulated_time,
             "real_time_factor": self.simulated_time / self.wall_time if self.wall_time > 0 else None,
@@ -140,17 +136,9 @@ class Result:
             "max_winch_reservoir_m": (None if self.winch_reservoir is None or not len(self.winch_reservoir)
                                       else self.winch_reservoir.max(axis=0).tolist()),
             "notes": notes,
-            **self._violations(mask),
+            "warnings": warnings_,
+            **limits,
         }
-
-    def _violations(self, mask: np.ndarray) -> dict[str, Any]:
-        """``tension_limit_violations`` of the samples in ``mask`` (:func:`tension_limit_report`)."""
-        return tension_limit_report(self.time[mask], [t[mask] for t in self.tensions],
-                                    self.metadata.get("tension_limits_N"))
-
-    def _slack_time(self, tensions: np.ndarray, mask: np.ndarray) -> float | None:
-        """Time [s] during which some element of a cable carries no tension (:func:`slack_time`)."""
-        return slack_time(self.time[mask], tensions[mask])
 
     # ----------------------------------------------------------------- files
     def save(self, folder: str | Path, summary_after: float = 0.0) -> dict[str, Path]:
@@ -179,9 +167,7 @@ class Result:
         # The wall time lives in timing.json, so that result.npz is the same from run to run.
         info.pop("wall_time")
         write_npz(folder / "result.npz", info=np.array(json_text(info)), **arrays)
-        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
-        table = np.column_stack([self.time, self.platform_pose, self.reference_pose])
-        np.savetxt(folder / "pose.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+        write_pose_csv(folder / "pose.csv", self.time, self.platform_pose, self.reference_pose, PLANAR_POSE_COLUMNS)
         summary = {**self.summary(after=summary_after), **provenance()}
         summary.update({k: v for k, v in self.metadata.items() if k not in summary})
         write_summary(folder, summary)
@@ -241,6 +227,114 @@ def slack_time(times: np.ndarray, tensions: np.ndarray) -> float | None:
     slack = np.any(np.asarray(tensions).reshape(len(times), -1) <= 0.0, axis=1)
     widths = np.diff(times, append=times[-1])
     return float(np.sum(widths[slack]))
+
+
+def _nan_max(values) -> float | None:
+    """Largest finite entry of ``values``, or None when there is none."""
+    values = np.asarray(values, dtype=float)
+    return float(np.nanmax(values)) if values.size and np.isfinite(values).any() else None
+
+
+def _nan_min(values) -> float | None:
+    """Smallest finite entry of ``values``, or None when there is none."""
+    values = np.asarray(values, dtype=float)
+    return float(np.nanmin(values)) if values.size and np.isfinite(values).any() else None
+
+
+def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = None,
+                   highest_exit: float | None = None, limits=None) -> dict[str, Any]:
+    """What a run did that a real robot could not, over all its samples (the start included).
+
+    One computation for planar and spatial summaries: the element tensions, each cable's
+    slack time, elements that pushed (a negative tension: the lumped cable carried
+    compression), the tension limits crossed (:func:`tension_limit_report`) and a platform
+    above its highest exit (every cable then pulls it down: only pushing cables could
+    hold it there). Never limited to an error window: a run shorter than the window, or
+    a jolt at its start, is reported all the same.
+
+    Parameters
+    ----------
+    times : ndarray, shape (N,) [s]
+    tensions : sequence of ndarray, each shape (N, n_i) [N]
+        Element tensions of each cable (tension positive).
+    heights : ndarray, shape (N,) [m], optional
+        Height (z) of the platform's centre of mass.
+    highest_exit : float [m], optional
+        Height of the highest exit: the highest pulley centre (planar), exit point or swivel
+        inlet (spatial). Without it (or ``heights``), ``platform_above_exits`` is None.
+    limits : list of [t_min or None, t_max or None] [N], one per cable, or None
+
+    Returns
+    -------
+    dict
+        ``min_element_tension_N``, ``max_element_tension_N``, ``min_tension_per_cable_N``,
+        ``slack_time_per_cable_s``, ``elements_pushed``, ``platform_above_exits``,
+        ``highest_exit_z_m``, ``warnings`` (one sentence per fact above) and, with ``limits``,
+        ``tension_limits_N`` and ``tension_limit_violations``.
+    """
+    times = np.asarray(times, dtype=float)
+    tensions = [np.asarray(t, dtype=float) for t in tensions]
+    lowest = [_nan_min(t) for t in tensions]
+    known = [value for value in lowest if value is not None]
+    pushed = bool(known) and min(known) < 0.0
+    warnings_ = []
+    if pushed:
+        cable = int(np.argmin([np.inf if value is None else value for value in lowest]))
+        series = tensions[cable].reshape(len(times), -1)
+        per_sample = np.min(np.where(np.isfinite(series), series, np.inf), axis=1)
+        warnings_.append(f"elements pushed (lowest tension {min(known):.4g} N, cable {cable + 1} at "
+                         f"t = {times[int(np.argmin(per_sample))]:.4f} s; first push at "
+                         f"t = {times[int(np.argmax(per_sample < 0.0))]:.4f} s): the lumped cable carried compression, "
+                         "which a real cable cannot; effects.slack = true makes the elements tension-only")
+    above = None
+    if heights is not None and highest_exit is not None and len(times):
+        heights = np.asarray(heights, dtype=float)
+        rise = np.isfinite(heights) & (heights > highest_exit)
+        above = bool(rise.any())
+        if above:
+            warnings_.append(f"the platform rose above its highest exit (z = {highest_exit:.4g} m) at "
+                             f"t = {times[int(np.argmax(rise))]:.4f} s, up to z = {np.nanmax(heights):.4g} m: every "
+                             "cable pulls it down there, so only cables that push could hold it")
+    return {
+        "min_element_tension_N": min(known) if known else None,
+        "max_element_tension_N": _nan_max(np.concatenate([t.ravel() for t in tensions])) if tensions else None,
+        "min_tension_per_cable_N": lowest,
+        "slack_time_per_cable_s": [slack_time(times, t) for t in tensions],
+        "elements_pushed": pushed,
+        "platform_above_exits": above,
+        "highest_exit_z_m": highest_exit,
+        "warnings": warnings_,
+        **tension_limit_report(times, tensions, limits),
+    }
+
+
+def after_start_up(settled: dict[str, Any], error_figures) -> dict[str, Any]:
+    """The ``after_start_up`` entry of a run's summary.json: the error figures ``error_figures`` of a
+    summary measured after the start-up (``settled``), with its window and notes (its safety figures
+    cover the whole run, as the summary's own)."""
+    return {key: settled[key] for key in ("errors_measured_after_s", *error_figures, "notes")}
+
+
+def warning_flags(summary: dict[str, Any]) -> list[str]:
+    """What a summary's safety figures flag, in words ("cables pushed", "platform above its exits"): the
+    comparison tables and the printed status show them beside the status."""
+    return [text for key, text in (("elements_pushed", "cables pushed"), ("platform_above_exits",
+                                                                          "platform above its exits"))
+            if summary.get(key)]
+
+
+def status_text(summary: dict[str, Any]) -> str:
+    """A summary's status as printed: "completed" is not clean when its safety figures flag something
+    ("completed (cables pushed: see the warnings)")."""
+    flags = warning_flags(summary)
+    return summary["status"] + (f" ({', '.join(flags)}: see the warnings)" if flags else "")
+
+
+def raise_warnings(summary: dict[str, Any], label: str = "") -> None:
+    """Issue each of ``summary``'s ``warnings`` as an :class:`~cdpr_exu.core.errors.UnphysicalResultWarning`
+    (prefixed with ``label``): the ``cdpr`` command prints each once, as one line."""
+    for text in summary.get("warnings", ()):
+        _warnings.warn(f"{label}{text}", UnphysicalResultWarning, stacklevel=2)
 
 
 def tension_limit_report(times: np.ndarray, tensions, limits) -> dict[str, Any]:

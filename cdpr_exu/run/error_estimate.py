@@ -41,6 +41,7 @@ from typing import Callable
 import numpy as np
 
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
+from cdpr_exu.core.output import length_text
 
 #: Order of the error in the number of elements assumed by the estimate (see above).
 ORDER = 2.0
@@ -205,9 +206,8 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
 
 def estimate_line(estimate: ErrorEstimate) -> str:
     """The line ``cdpr run`` prints for an estimate (planar and spatial)."""
-    value = estimate.max_position_error_m
     return (f"  estimated discretisation error after {estimate.after_s} s: "
-            + ("n/a" if value is None else f"{1000 * value:.2f} mm") + f" ({estimate.note})")
+            f"{length_text(estimate.max_position_error_m)} ({estimate.note})")
 
 
 def summary_entry(estimate: ErrorEstimate) -> dict:
@@ -221,7 +221,15 @@ def summary_entry(estimate: ErrorEstimate) -> dict:
 
 
 def elements_for_tolerance(n: int, estimated_error: float, tolerance: float, order: float = ORDER) -> int:
-    """Fewest elements per cable whose error, by e(n) = C n^-p through (n, estimated_error), is below ``tolerance``."""
+    """Fewest elements per cable, never fewer than ``n``, whose error by e(n) = C n^-p through (n, estimated_error)
+    is below ``tolerance``.
+
+    Never fewer than the scene's ``n``: the model is fitted on n and the companion run's 2n
+    (Richardson), and below n it would be extrapolated out of the measured range, where coarser
+    cables meet other limits the model knows nothing of (elements too long for the pulley are
+    refused, swivel pulleys need elements of at most half their radius, and the error's order
+    in motion is not 2: docs/accuracy.md). A tolerance met already keeps ``n``.
+    """
     if estimated_error <= tolerance:
         return n
     needed = math.ceil(n * (estimated_error / tolerance) ** (1.0 / order))

@@ -62,6 +62,7 @@ from __future__ import annotations
 import argparse
 import sys
 import math
+import warnings
 import time as _time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -72,10 +73,10 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
-from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure, SuspectAnswerWarning
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
-from cdpr_exu.core.output import write_npz, write_summary
+from cdpr_exu.core.output import clear_outputs, write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import static_settings
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import Scene
@@ -682,7 +683,9 @@ EPILOG = """examples:
 
 A spatial scene (dimension = 3) is solved directly by Exudyn's static solver, started on
 its elastic-catenary statics (--tolerance, --max-time and --no-polish do not apply), and
-reports the platform's position and rotation beside the catenary answer.
+reports the platform's position and rotation beside the catenary answer; it warns when the
+two lie more than 5 % of the shortest cable apart or an element is compressed, and fails
+(exit 3, with the cause) on an equilibrium that holds the platform above its exits.
 """
 
 
@@ -690,6 +693,7 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
     """Write what a failed ``cdpr static`` knows: the scene, the cause and the last state."""
     from cdpr_exu.scenes.scene import save_scene
 
+    clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
     save_scene(scene, out / "scene.toml")
     partial = err.partial_result if isinstance(err.partial_result, dict) else {}
     write_summary(out, {"scene": scene.name, "status": f"failed: {err}", "failure_time_s": err.time,
@@ -697,21 +701,31 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
 
 
 def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
-    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`)."""
+    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`); its warnings go to the console
+    (and are in summary.json), a failure writes the scene, the cause and the last state."""
     from cdpr_exu.run.spatial_rest import print_spatial_rest, solve_spatial_rest
 
-    rest = solve_spatial_rest(scene)
+    try:
+        rest = solve_spatial_rest(scene)
+    except SolverFailure as err:
+        if out is not None:
+            _write_static_failure(scene, err, out)
+            print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
+        raise
     if out is not None:
+        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         rest.save(out)
     if not quiet:
         print_spatial_rest(rest, out)
+    for text in rest.warnings:
+        warnings.warn(text, SuspectAnswerWarning, stacklevel=2)
     return EXIT_OK
 
 
 def _cmd_static(args: argparse.Namespace) -> int:
     from cdpr_exu.core.output import check_output_folder, fixed
 
-    out = check_output_folder(args.out)
+    out = check_output_folder(args.out, command="static")
     scene = load_any_scene(args.scene)
     if is_spatial(scene):
         return _static_spatial(scene, out, args.quiet)
@@ -723,6 +737,7 @@ def _cmd_static(args: argparse.Namespace) -> int:
             print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
         raise
     if out is not None:
+        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         rest.save(out)
         plot_rest(scene, rest, out / "rest_profile.png")
     if not args.quiet:

@@ -232,6 +232,13 @@ class _Monitor:
         return None
 
 
+def output_times(end_time: float, output_period: float) -> np.ndarray:
+    """The output times of a run [s], shape (N,): the multiples of ``output_period`` from 0 up to
+    ``end_time`` (none after it; the end time is one of them only when it is a multiple)."""
+    count = int(math.floor(end_time / output_period + 1e-9)) + 1
+    return np.arange(count) * output_period
+
+
 class _Recorder:
     """Stores Exudyn's coordinates at the output times (called once per step).
 
@@ -248,8 +255,8 @@ class _Recorder:
     def __init__(self, model: Model, output_period: float, end_time: float):
         self.model = model
         self.indices = model.coordinate_indices()
-        count = int(math.floor(end_time / output_period + 1e-9)) + 1
-        self.output_times = np.arange(count) * output_period
+        self.output_times = output_times(end_time, output_period)
+        count = len(self.output_times)
         size = model.mbs.systemData.GetODE2Coordinates().size
         self.q = np.full((count, size), np.nan)
         self.v = np.full((count, size), np.nan)
@@ -557,7 +564,9 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     if stepper.reservoir is not None:
         result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
     result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
-                       "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts()}
+                       "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts(),
+                       # above the highest pulley centre every cable pulls the platform down (Result.summary)
+                       "highest_exit_z_m": max(float(p.center[1]) for p in scene.pulleys)}
     if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     last_time = float(result.time[-1]) if len(result.time) else 0.0

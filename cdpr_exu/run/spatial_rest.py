@@ -27,6 +27,7 @@ equilibrium, and a compressed element is reported. Units SI; z up, gravity along
 
 from __future__ import annotations
 
+import math
 import time as _time
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,6 +37,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from cdpr_exu.core.errors import SolverFailure
 from cdpr_exu.core.output import write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static, \
     start_at_rest, swivel_angles
@@ -52,6 +54,15 @@ PENALTY = 100.0
 
 #: Points per catenary curve in the figure.
 CURVE_SAMPLES = 60
+
+#: A static answer farther than this fraction of the shortest cable's unstrained length from
+#: its own elastic-catenary answer is flagged (``warnings`` in the summary, and on the console).
+#: The two differ by the discretisation (n^-2: at most 0.5 mm on the shipped point-exit
+#: robots) and by the bending the catenary leaves out: the shipped swivel robot, whose cables
+#: wrap 0.1 m pulleys, rests 22 mm from its catenaries, 0.9 % of its 2.4 m cables (measured).
+#: 5 % is over five times that; beyond it the answer is the bending model's more than a
+#: hanging cable's (E = 1e10 Pa on the same robot: 132 mm, 5.5 %; 1e11 Pa: above its pulleys).
+FAR_FROM_CATENARY = 0.05
 
 
 def rotation_angles_deg(rotation: np.ndarray) -> np.ndarray:
@@ -108,6 +119,29 @@ class SpatialRest:
         """The lowest axial force of all elements [N] (negative: compressed)."""
         return float(min(t.min() for t in self.element_tensions))
 
+    @property
+    def catenary_distance(self) -> float:
+        """Distance [m] from the lumped robot's platform position to its elastic catenaries' answer."""
+        return float(np.linalg.norm(self.position - self.catenary.position))
+
+    @property
+    def warnings(self) -> list[str]:
+        """What makes this answer suspect (empty: nothing): an answer far from the catenaries'
+        (:data:`FAR_FROM_CATENARY`) and compressed elements, each with its figures."""
+        found = []
+        shortest = float(self.scene.unstrained_lengths.min())
+        if self.catenary_distance > FAR_FROM_CATENARY * shortest:
+            found.append(
+                f"the lumped robot rests {1000 * self.catenary_distance:.0f} mm from its elastic catenaries' answer, "
+                f"more than {100 * FAR_FROM_CATENARY:g} % of its shortest cable ({shortest:.4g} m); "
+                + bending_text(self.scene, self.catenary, "what the catenary leaves out and moves it"))
+        lowest = self.lowest_element_tension
+        if lowest < 0.0:
+            found.append(f"an element is compressed ({lowest:.3g} N), which a real cable cannot be (the static solve "
+                         "uses spring elements): a cable is slack at rest (longer than the catenary the lumped model "
+                         "can hang), or the cables' bending holds the platform up")
+        return found
+
     def summary(self) -> dict:
         """Plain data for summary.json (SI units in the key names)."""
         catenary = self.catenary
@@ -129,12 +163,13 @@ class SpatialRest:
             "catenary_tension_at_anchor_N": catenary.tensions_at_anchor.tolist(),
             "min_element_tension_N": self.lowest_element_tension,
             "elements_pushed": self.lowest_element_tension < 0.0,
-            "lumped_minus_catenary_position_m": float(np.linalg.norm(self.position - catenary.position)),
+            "lumped_minus_catenary_position_m": self.catenary_distance,
             "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(self.rotation_vector - catenary.rotation_vector)),
             "wall_time_s": self.wall_time,
             **({} if self.swivel_angles is None else {
                 "swivel_angle_rad": [None if np.isnan(a) else float(a) for a in self.swivel_angles],
                 "catenary_wrap_angle_rad": [float(c.wrap_angle) for c in catenary.cables]}),
+            "warnings": self.warnings,
             **provenance(),
         }
 
@@ -145,15 +180,66 @@ class SpatialRest:
         return [write_summary(out, self.summary()), plot_spatial_rest(self, out / "rest_profile.png")]
 
 
+def bending_text(scene: SpatialScene, catenary, what: str) -> str:
+    """The cables' bending against their pulleys, for messages: ``what`` (e.g. "what moves it") is
+    the bending E J [N m^2] whose bending length sqrt(E J / T) at the catenaries' largest tension T
+    is compared with the smallest swivel radius (or the shortest cable: point exits)."""
+    cable = scene.cables[0]
+    if not scene.effects.bending:
+        return "the cables have no bending (effects.bending = false)"
+    stiffness = cable.youngs_modulus * cable.second_moment
+    tension = float(np.max(catenary.tensions_at_anchor))
+    length = math.sqrt(stiffness / tension) if tension > 0.0 else math.inf
+    radii = scene.pulley_radii[scene.pulley_radii > 0.0]
+    scale, name = ((float(radii.min()), "the pulleys' radius") if radii.size
+                   else (float(scene.unstrained_lengths.min()), "the shortest cable"))
+    return (f"{what} is the cables' bending: E J = {stiffness:.3g} N m^2 (cables[0].youngs_modulus = "
+            f"{cable.youngs_modulus:.3g} Pa on the solid section pi r^4 / 4) has a bending length sqrt(E J / T) = "
+            f"{length:.3g} m at the catenaries' tension T = {tension:.4g} N, {length / scale:.2g} times {name} "
+            f"({scale:.4g} m)")
+
+
+def rest_above_exits(scene: SpatialScene, position, rotation, lowest_tension: float, catenary) -> str | None:
+    """Why a rest of the lumped robot with every anchor above its exit is no cable robot's rest, or None.
+
+    Such a rest is held by elements that push or by the cables' bending, not by hanging cables
+    (:meth:`SpatialScene.above_exits`): cables whose bending length sqrt(E J / T) is many
+    times their pulleys' radius stand up like rods rather than wrap their pulleys (measured on
+    the swivel robot: E = 1e11 Pa, 16.8 kg: 6.9 times, platform 0.14 m above the inlets).
+
+    Parameters
+    ----------
+    position : (3,) [m]; rotation : (3, 3)
+        The platform's pose at that rest.
+    lowest_tension : float [N]
+        The lowest element force there (negative: compressed).
+    catenary : SpatialEquilibrium
+        The scene's elastic-catenary statics.
+    """
+    above = scene.above_exits(position, rotation)
+    if above is None:
+        return None
+    return (f"the lumped robot's equilibrium holds the platform at z = {float(position[2]):.4g} m (its elastic "
+            f"catenaries hang it at z = {float(catenary.position[2]):.4g} m, {1000 * float(np.linalg.norm(np.asarray(position) - catenary.position)):.0f} mm away) and {above}; "
+            + bending_text(scene, catenary, "what holds it up")
+            + f", and its lowest element force is {lowest_tension:.3g} N. Give the cables a smaller "
+            "youngs_modulus or radius (a wire rope bends far more easily than a solid rod of its modulus)")
+
+
 def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     """Bring a spatial scene to rest: catenary statics, then Exudyn's static solve of the lumped robot.
+
+    The answer's :attr:`SpatialRest.warnings` say what makes it suspect (far from the catenaries,
+    compressed elements); an equilibrium with the platform above its exits is refused.
 
     Raises
     ------
     UnreachableError
         If the catenary statics find no equilibrium (cables that cannot hold the platform).
     SolverFailure
-        If Exudyn's static solver does not converge.
+        If Exudyn's static solver does not converge, or its equilibrium holds the platform above
+        its exits (:func:`rest_above_exits` gives the cause); ``partial_result`` is then the
+        rest's summary.
     """
     start = _time.perf_counter()
     platform = scene.catenary_platform()
@@ -170,9 +256,13 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
     tensions = tuple(element_forces(mbs, items, i) for i in range(scene.n_cables))
     joint = f"penalty spherical joints of {PENALTY:g} element stiffnesses" if rigid else "exact spherical joints"
-    return SpatialRest(scene, static.position, static.rotation, static.rotation_vector, static.tensions_at_anchor,
+    rest = SpatialRest(scene, static.position, static.rotation, static.rotation_vector, static.tensions_at_anchor,
                        static.forces_on_platform, nodes, tensions, catenary, joint, _time.perf_counter() - start,
                        swivel_angles(mbs, items) if scene.swivels else None)
+    above = rest_above_exits(scene, rest.position, rest.rotation, rest.lowest_element_tension, catenary)
+    if above is not None:
+        raise SolverFailure(f"no rest of a cable robot: {above}", partial_result=rest.summary())
+    return rest
 
 
 def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
@@ -225,7 +315,7 @@ def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
 
 
 def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
-    """The static mode's summary on the terminal."""
+    """The static mode's summary on the terminal (its :attr:`SpatialRest.warnings` are the caller's to issue)."""
     x, y, z = rest.position
     roll, pitch, yaw = rotation_angles_deg(rest.rotation)
     catenary = rest.catenary
@@ -246,10 +336,6 @@ def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
             if azimuth is not None:
                 print(f"  swivel pulley {i + 1}: psi = {np.degrees(psi):.4f} deg (anchor azimuth {azimuth:.4f} deg), "
                       f"wrap {np.degrees(catenary.cables[i].wrap_angle):.2f} deg")
-    lowest = rest.lowest_element_tension
-    if lowest < 0.0:
-        print(f"  note: an element is compressed ({lowest:.3g} N), which a real cable cannot be: that cable is "
-              "slack at rest, and its length is longer than the catenary the lumped model can hang")
     if out is not None:
         print(f"  written to {out}/")
 

@@ -40,9 +40,11 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import write_npz, write_summary
+from cdpr_exu.core.output import (SPATIAL_POSE_COLUMNS, check_output_folder, clear_outputs, fixed, length_text,
+                                  undate_solution_file, write_npz, write_pose_csv, write_summary)
+from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
@@ -51,13 +53,15 @@ from controllers.ideal_ik import IdealIKController, ideal_paid_out
 from controllers.spatial_feedback import spatial_closed_loop_tension_aware
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.results.result import provenance, slack_time, tension_limit_report
-from cdpr_exu.run.simulate import _progress_reporter, interrupt_flag, quiet_exudyn, solver_settings
+from cdpr_exu.results.result import (after_start_up, provenance, raise_warnings, safety_figures, status_text,
+                                     warning_flags)
+from cdpr_exu.run.simulate import (_progress_reporter, _solver_report, interrupt_flag, output_times, quiet_exudyn,
+                                   solver_settings)
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
 
-__all__ = ["SpatialResult", "simulate_spatial", "check_spatial_reference", "run_spatial_scene"]
+__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference", "run_spatial_scene"]
 
 
 #: Samples of the reference checked before a run.
@@ -70,9 +74,13 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     At 401 samples of the reference: every commanded paid-out length stays positive, and
     straight cables from the exits to the anchors can give the platform its weight and
     the reference's acceleration, ``M (a + g e_z)``, with non-negative tensions (within
-    the cables' ``min_tension`` / ``max_tension`` where given). Like the planar check,
-    this is the force part of the wrench-feasible workspace: the platform's rotation is
-    free to balance the moment.
+    the cables' ``min_tension`` / ``max_tension`` where given): the force part of the
+    wrench-feasible workspace, as the planar check. With six cables or more on a rigid
+    platform whose structure matrix has full rank, the rotation is not free: the same
+    tensions must also give the moment about the centre of mass that the reference's
+    rotation needs (:func:`reference_wrenches`), the whole wrench-feasible workspace.
+    With fewer cables the platform turns to balance the moment, and only the force is asked. A pose with every anchor above its exit is such a pose; the
+    message then says so (:meth:`SpatialScene.above_exits`).
 
     Raises
     ------
@@ -81,42 +89,113 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     """
     times = np.linspace(0.0, scene.solver.end_time, REFERENCE_SAMPLES)
     poses = np.atleast_2d(scene.trajectory.pose(times))
-    ideal, _ = ideal_paid_out(scene, poses)
+    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
+    for name, values in (("pose", poses), ("acceleration", acceleration)):
+        if not np.all(np.isfinite(values)):
+            k = int(np.argmin(np.all(np.isfinite(values), axis=1)))
+            raise UnreachableError(f"trajectory is out of floating-point range: its {name} at t = {times[k]:.3f} s is "
+                                   f"{shown(values[k])} (a trajectory field far beyond any robot, e.g. its "
+                                   "angular_rate or radius)")
+    try:
+        ideal, _ = ideal_paid_out(scene, poses)
+    except UnreachableError as err:
+        raise UnreachableError(f"trajectory is refused before the run: {err}") from None
     lengths = scene.unstrained_lengths + ideal - ideal[0]
     short = np.argwhere(lengths <= 0.0)
     if short.size:
         k, i = short[0]
         raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
-                               f"cable {i + 1} paid out to {lengths[k, i]:.4f} m: it would be reeled in completely")
+                               f"cable {i + 1} paid out to {lengths[k, i]:.4g} m from its "
+                               f"cables[{i}].unstrained_length = {scene.cables[i].unstrained_length:.4g} m at the start: "
+                               "it would be reeled in completely")
     for i, swivel in enumerate(scene.swivel_exits):
         if swivel is None:
             continue
-        room = swivel.winch_line - 2.0 * scene.cables[i].element_length  # the winch end stays two elements below
+        margin = 2.0 * scene.cables[i].element_length  # the winch end stays two elements below the inlet
+        room = swivel.winch_line - margin
         gain = lengths[:, i] - lengths[0, i]
         if gain.max() > room:
             k = int(np.argmax(gain))
-            raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
-                                   f"cable {i + 1} paid out by {gain[k]:.4f} m over its swivel pulley: more than "
-                                   f"exits[{i}].winch_line = {swivel.winch_line:g} m less two elements holds")
-    from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors
+            raise UnreachableError(
+                f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs cable {i + 1} paid "
+                f"out by {1000 * gain[k]:.3g} mm over its swivel pulley, more than its winch line holds: "
+                f"exits[{i}].winch_line = {1000 * swivel.winch_line:.3g} mm less two elements (2 x "
+                f"{1000 * margin / 2:.3g} mm, the winch end's margin below the inlet) leaves {1000 * room:.3g} mm; give "
+                f"exits[{i}].winch_line = {1000 * (margin + max(gain[k], 0.0)):.3g} mm or more")
+    from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 
     anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
     points = poses[:, :3] if anchors is None else poses
-    directions = np.swapaxes(cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii), 1, 2)
-    gravity = scene.gravity if scene.effects.gravity else 0.0
-    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
-    needed = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
+    units = cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii)
+    wrenches = reference_wrenches(scene, times)
     limits = tension_limits(scene.cables)
-    unheld = first_unheld(directions, needed, limits)
+
+    def why(free: np.ndarray) -> str:
+        return ("with non-negative tensions" if limits is None
+                else f"within the cables' tension limits ({limits_text(free, limits)})")
+
+    def where(k: int) -> str:
+        return (f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) "
+                f"at t = {times[k]:.3f} s is outside the workspace")
+
+    unheld = first_unheld(np.swapaxes(units, 1, 2), wrenches[:, :3], limits)
     if unheld is not None:
         k, residual, free = unheld
-        why = ("with non-negative tensions" if limits is None
-               else f"within the cables' tension limits ({limits_text(free, limits)})")
+        above = scene.above_exits(poses[k, :3], rotation_from_vector(poses[k, 3:]))
         raise UnreachableError(
-            f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) at "
-            f"t = {times[k]:.3f} s is outside the workspace: the cables cannot give the platform its weight and "
-            f"the reference's acceleration ({np.round(needed[k], 4).tolist()} N) {why}; {residual:.4g} N would "
-            "remain unbalanced")
+            f"{where(k)}: the cables cannot give the platform its weight and the reference's acceleration "
+            f"({np.round(wrenches[k, :3], 4).tolist()} N) {why(free)}; "
+            f"{residual:.4g} N would remain unbalanced" + ("" if above is None else f"; the pose is above the exits: {above}"))
+    if anchors is None or scene.n_cables < 6:
+        return  # the platform turns to balance the moment (a point mass has none)
+    matrices = structure_matrix(poses, anchors, units)  # (N, 6, m): force and moment about the centre of mass
+    if np.linalg.matrix_rank(matrices[0]) < 6:
+        return  # the cables cannot turn the platform about some axis: its rotation there is free
+    unheld = first_unheld(matrices, wrenches, limits)
+    if unheld is not None:
+        k, residual, free = unheld
+        raise UnreachableError(
+            f"{where(k)}: the cables can give the platform the force it needs ({np.round(wrenches[k, :3], 4).tolist()} "
+            f"N, its weight and the reference's acceleration), but not together with the moment about its centre "
+            f"of mass that the reference's rotation needs ({np.round(wrenches[k, 3:], 4).tolist()} N m: zero at rest, "
+            f"plus the angular acceleration and velocity with platform.inertia = {list(scene.platform.inertia)} kg m^2) "
+            f"{why(free)}; {residual:.4g} (N, N m) would remain unbalanced")
+
+
+def reference_wrenches(scene: SpatialScene, times: np.ndarray) -> np.ndarray:
+    """The wrench the cables must give the platform to follow the reference, shape (N, 6) [N, N m].
+
+    The force ``M (a + g e_z)`` and the moment about the centre of mass ``I w' + w x I w``
+    (Euler's equations in the world frame, ``I = R diag(platform.inertia) R^T``): zero
+    for a platform at rest, whatever its orientation. The angular velocity is
+    ``w = J_l(theta) theta'``; its rate comes from a central difference over 1e-6 s
+    (one-sided at t = 0, where the reference starts).
+    """
+    from cdpr_exu.core.geometry import left_jacobian
+
+    times = np.asarray(times, dtype=float)
+    gravity = scene.gravity if scene.effects.gravity else 0.0
+    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
+    force = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
+
+    def angular_velocity(t):
+        pose, rate = np.atleast_2d(scene.trajectory.pose(t)), np.atleast_2d(scene.trajectory.velocity(t))
+        return np.einsum("nij,nj->ni", np.array([left_jacobian(theta) for theta in pose[:, 3:]]), rate[:, 3:])
+
+    delta = 1e-6
+    before, after = np.maximum(times - delta, 0.0), times + delta
+    omega = angular_velocity(times)
+    omega_rate = (angular_velocity(after) - angular_velocity(before)) / (after - before)[:, None]
+    rotations = np.array([rotation_from_vector(theta) for theta in np.atleast_2d(scene.trajectory.pose(times))[:, 3:]])
+    inertia = np.einsum("nij,j,nkj->nik", rotations, np.asarray(scene.platform.inertia, dtype=float), rotations)
+    spin = np.einsum("nij,nj->ni", inertia, omega)
+    moment = np.einsum("nij,nj->ni", inertia, omega_rate) + np.cross(omega, spin)
+    return np.column_stack([force, moment])
+
+
+def highest_exit(scene: SpatialScene) -> float:
+    """Height [m] of the scene's highest exit point or swivel inlet: above it every cable pulls the platform down."""
+    return float(np.asarray(scene.exits, dtype=float)[:, 2].max())
 
 
 def rotation_error_deg(pose: np.ndarray, reference: np.ndarray) -> np.ndarray:
@@ -172,23 +251,28 @@ class SpatialResult:
         """Actual minus reference position, shape (N, 3) [m]."""
         return self.pose[:, :3] - self.reference[:, :3]
 
+    #: The figures of :meth:`summary` measured from its ``after`` on (the rest cover the whole run).
+    ERROR_FIGURES = ("max_position_error_m", "rms_position_error_m", "max_abs_error_m", "max_rotation_error_deg")
+
     def summary(self, after: float = 1.0) -> dict[str, Any]:
-        """Error and tension figures from ``after`` [s] on (strict JSON: null where there is no sample)."""
+        """Figures of the run (strict JSON: null where there is no sample): errors (:data:`ERROR_FIGURES`)
+        from ``after`` [s] on, the safety figures (tensions, slack, pushing, tension limits, a platform above
+        its exits) over the whole run, the start included (:func:`~cdpr_exu.results.result.safety_figures`,
+        as planar summaries)."""
         mask = self.time >= after
         error = np.linalg.norm(self.position_error[mask], axis=1)
         rotation = rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
-        tensions = np.concatenate([t[mask].ravel() for t in self.tensions]) if self.tensions else np.zeros(0)
 
         def extreme(values, pick):
             return float(pick(values)) if values.size else None
 
-        pushed = bool(tensions.size) and float(tensions.min()) < 0.0
+        safety = safety_figures(self.time, self.tensions, self.pose[:, 2] if len(self.time) else None,
+                                self.metadata.get("highest_exit_z_m"), self.metadata.get("tension_limits_N"))
+        limits = {k: safety.pop(k) for k in ("tension_limits_N", "tension_limit_violations") if k in safety}
+        warnings_ = safety.pop("warnings")
         notes = []
-        if pushed:
-            notes.append(f"elements pushed (lowest tension {tensions.min():.3g} N): the lumped cable carries "
-                         "compression, which a real cable cannot")
         if not mask.any():
-            notes.append(f"no sample at or after t = {after:g} s: its error and tension figures are null")
+            notes.append(f"no sample at or after t = {after:g} s: its error figures are null")
         simulated = float(self.time[-1]) if len(self.time) else 0.0
         return {
             "scene": self.scene_name, "controller": self.controller, "dimension": 3, "status": self.status,
@@ -197,22 +281,23 @@ class SpatialResult:
             "rms_position_error_m": float(np.sqrt(np.mean(error**2))) if error.size else None,
             "max_abs_error_m": [extreme(np.abs(self.position_error[mask, k]), np.max) for k in range(3)],
             "max_rotation_error_deg": extreme(rotation, np.max),
-            "min_element_tension_N": extreme(tensions, np.min),
-            "max_element_tension_N": extreme(tensions, np.max),
-            "min_tension_per_cable_N": [extreme(t[mask].ravel(), np.min) for t in self.tensions],
-            "slack_time_per_cable_s": [slack_time(self.time[mask], t[mask]) for t in self.tensions],
-            "elements_pushed": pushed,
+            **safety,
             "wall_time_s": self.wall_time, "simulated_time_s": simulated,
             "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
             "steps": int(self.steps), "newton_iterations": int(self.newton_iterations),
-            "failure_time_s": self.failure_time, "notes": notes,
-            **tension_limit_report(self.time[mask], [t[mask] for t in self.tensions],
-                                   self.metadata.get("tension_limits_N")),
+            "failure_time_s": self.failure_time, "notes": notes, "warnings": warnings_,
+            **limits,
         }
+
+    def run_summary(self, after: float = 1.0) -> dict[str, Any]:
+        """The summary ``cdpr run`` writes, as the planar run's: every figure over the whole run, and the
+        errors from ``after`` [s] on under ``after_start_up``."""
+        return {**self.summary(0.0), "after_start_up": after_start_up(self.summary(after), self.ERROR_FIGURES)}
 
     def save(self, folder: str | Path, after: float = 1.0, figures: bool = True,
              extra: dict | None = None) -> list[Path]:
-        """Write result.npz, summary.json (with ``extra``'s entries) and (``figures``) overview.png into
+        """Write result.npz, pose.csv (time, pose and reference: x, y, z [m] and the rotation vector [rad]),
+        summary.json (:meth:`run_summary`, with ``extra``'s entries) and (``figures``) overview.png into
         ``folder``; returns the paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
@@ -220,7 +305,8 @@ class SpatialResult:
         for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
             arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = nodes, tensions
         written = [write_npz(folder / "result.npz", **arrays),
-                   write_summary(folder, {**self.summary(after), **provenance(), **(extra or {})})]
+                   write_pose_csv(folder / "pose.csv", self.time, self.pose, self.reference, SPATIAL_POSE_COLUMNS),
+                   write_summary(folder, {**self.run_summary(after), **provenance(), **(extra or {})})]
         if figures:
             written.append(plot_spatial_run(self, folder / "overview.png", after))
         return written
@@ -282,6 +368,45 @@ class _SpatialWinches:
             self.applied[i] = length
 
 
+#: A run stops when the platform has turned farther than this from the reference's orientation [deg]:
+#: it has left the workspace (issue 23.5: IPAnema ran on for 566 s to end 175 degrees off).
+MAX_ROTATION_ERROR_DEG = 90.0
+
+
+class _SpatialMonitor:
+    """Checks the platform at the start and after each step for states the run cannot come back from
+    (the spatial counterpart of the planar monitor): coordinates no longer finite, a platform above
+    its highest exit (every cable pulls it down there: only cables that push could hold it), or one
+    turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference's orientation."""
+
+    def __init__(self, scene: SpatialScene):
+        self.trajectory = scene.trajectory
+        self.ceiling = highest_exit(scene)
+        self.turns = not scene.platform.is_point_mass
+
+    def problem(self, t: float, position: np.ndarray, rotation: np.ndarray) -> str | None:
+        """What is wrong at time ``t`` [s] with the platform at ``position`` (3,) [m], turned by ``rotation`` (3, 3),
+        or None."""
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(rotation))):
+            return f"the coordinates are no longer finite at t = {t:.4f} s"
+        if position[2] > self.ceiling:
+            if t == 0.0:  # where the robot came to rest (over swivel pulleys: the chain statics)
+                return (f"the platform rests above its highest exit at t = 0 (z = {position[2]:.3f} m, the exit at "
+                        f"{self.ceiling:.3f} m): only cables that push or bend could hold it there, which the "
+                        "lumped chains do and a real cable cannot (cables too stiff in bending for their load?)")
+            return (f"the platform rose above its highest exit at t = {t:.4f} s (z = {position[2]:.3f} m, the exit at "
+                    f"{self.ceiling:.3f} m): only cables that push could hold it there; the run has diverged (a "
+                    "winch command that jumps, or a smaller solver.step_size)")
+        if self.turns:
+            reference = rotation_from_vector(np.asarray(self.trajectory.pose(t))[3:])
+            angle = np.degrees(np.linalg.norm(rotation_vector(reference.T @ rotation)))
+            if angle > MAX_ROTATION_ERROR_DEG:
+                return (f"the platform turned {angle:.0f} degrees away from the reference's orientation at "
+                        f"t = {t:.4f} s (limit {MAX_ROTATION_ERROR_DEG:g}): it has left the workspace the cables hold "
+                        "it in; the run is stopped")
+        return None
+
+
 def _warn_outside_measured_region(scene: SpatialScene) -> None:
     """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
     outside the region where runs over a swivel pulley were measured to keep their energy."""
@@ -299,7 +424,54 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
         return
 
 
-def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False) -> SpatialResult:
+def _rest_above_exits(scene: SpatialScene, mbs, items) -> str | None:
+    """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
+    above its exits (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: its bending or pushing elements do)."""
+    from cdpr_exu.run.spatial_rest import rest_above_exits
+
+    position, rotation = platform_pose(mbs, items, current=False)
+    lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
+    above = rest_above_exits(scene, position, rotation, lowest, items.initial)
+    return None if above is None else f"the run cannot start from the robot's rest: {above}"
+
+
+def check_runnable(scene: SpatialScene) -> None:
+    """Refuse a scene ``cdpr run`` cannot run, before anything is built or written: no ``[trajectory]``,
+    or a reference the cables cannot follow (:func:`check_spatial_reference`).
+
+    Raises
+    ------
+    SceneError, UnreachableError
+    """
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
+    check_spatial_reference(scene)
+
+
+def build_spatial_model(scene: SpatialScene):
+    """The scene's lumped robot in a new Exudyn system, assembled in its catenary start; returns (mbs, items).
+
+    What :func:`simulate_spatial` integrates and what a replay of its solution file
+    (:func:`cdpr_exu.post.viewer.load_replay`) rebuilds: the same items in the same order, so the
+    same coordinates. The start over swivel pulleys (:func:`start_at_rest`) moves only the
+    initial coordinates, which a replay takes from the solution file.
+
+    Raises
+    ------
+    UnreachableError
+        If no static equilibrium of the scene's lengths exists to start from.
+    """
+    platform = scene.catenary_platform()
+    lengths = scene.unstrained_lengths
+    start = solve_spatial_statics(platform, lengths)
+    mbs = exu.SystemContainer().AddSystem()
+    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start, swivels=scene.swivel_exits)
+    mbs.Assemble()
+    return mbs, items
+
+
+def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False, *,
+                     solution_file: str | Path | None = None) -> SpatialResult:
     """Run ``scene``'s reference under ``controller`` (default: ideal inverse kinematics).
 
     The controller is any :class:`controllers.base.Controller` that works on spatial
@@ -315,6 +487,9 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     cable's tension at its platform end (its last element's axial force, shape (m,) [N],
     as planar runs give it) at the same state.
 
+    ``solution_file`` also writes Exudyn's solution file there (every output period), for
+    ``SolutionViewer`` on the model :func:`build_spatial_model` rebuilds.
+
     Raises
     ------
     SceneError
@@ -322,23 +497,24 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     UnreachableError
         If no static equilibrium of the scene's lengths exists to start from.
     SolverFailure
-        If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed.
+        If the solver fails; ``.time`` and ``.partial_result`` say when and what was computed. Also
+        (at t = 0, no partial result) if the lumped robot's rest over swivel pulleys holds the
+        platform above its exits.
     """
-    if scene.trajectory is None:
-        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
-    check_spatial_reference(scene)
-    platform = scene.catenary_platform()
+    check_runnable(scene)
+    mbs, items = build_spatial_model(scene)
     lengths = scene.unstrained_lengths
-    start = solve_spatial_statics(platform, lengths)
-    mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start, swivels=scene.swivel_exits)
-    mbs.Assemble()
     if scene.swivels:
         _warn_outside_measured_region(scene)
-        start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
+        try:
+            start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
+        except SolverFailure as failure:  # the settle's solver knows why it stopped
+            exudyn_said = str(failure).split(": ", 1)[-1]  # "SolveDynamic terminated", and no more
+            raise SolverFailure(f"settling the robot over its swivel pulleys before the run failed: "
+                                f"{_solver_report(mbs, exudyn_said)}", time=0.0) from None
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
-    outputs = np.arange(0.0, solver.end_time + 0.5 * solver.output_period, solver.output_period)
+    outputs = output_times(solver.end_time, solver.output_period)
     m, n = scene.n_cables, scene.cables[0].n_elements
     times, poses, paid, node_series, tension_series = [], [], [], [[] for _ in range(m)], [[] for _ in range(m)]
     kinematic = scene.winch.kind == "kinematic"
@@ -365,7 +541,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     # winches paid out at t = 0 and the pose it starts from are the plant's.
     controller.reset(scene.controller_scene(), lengths.copy(),
                      initial_pose=measured_state()[0] if controller.uses_pose else None)
-    state = {"next": 0, "failure": None, "step_start": 0.0}
+    state = {"next": 0, "failure": None, "step_start": 0.0, "reached": 0.0}
 
     def measurement(t: float) -> Measurement:
         """What the controller may see when asked for the command at ``t`` [s]."""
@@ -403,31 +579,48 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         return True
 
     def post_step(mbs_, t):  # noqa: ARG001
-        state["step_start"] = t  # the state the solver has for the next step's command
+        state["step_start"] = state["reached"] = t  # the state the solver has for the next step's command
         if interrupted["interrupted"]:
+            if t > times[-1]:
+                record(float(t))  # the last state computed belongs to the partial result
             return False
         # One sample per step that reaches an output time, with the step's own time, as the
         # planar run records: a real state, labelled when it was. After a shrunk step the
-        # steps end up to one step after the output times; the time says so.
-        if state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
+        # steps end up to one step after the output times; the time says so. The step that
+        # ends the run is recorded too, so the result ends at the end time, on the output
+        # grid or not.
+        due = state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9
+        if due or (t >= solver.end_time - 1e-9 and t > times[-1]):
             record(float(t))
             while state["next"] < len(outputs) and t >= outputs[state["next"]] - 1e-9:
                 state["next"] += 1
+        position, rotation = platform_pose(mbs, items)
+        problem = monitor.problem(t, position, rotation)
+        if problem is not None:
+            if t > times[-1]:
+                record(float(t))  # the state that stopped the run belongs to its result
+            state["failure"] = problem
+            return False  # ends the integration; what was computed is kept
         if report is not None:
             report(t, _time.perf_counter() - wall_start)
         return True
 
     report = _progress_reporter(progress, scene)
+    monitor = _SpatialMonitor(scene)
     record(0.0)
     state["next"] = 1
+    # a start no run can come back from: over swivel pulleys, a rest held up by the chains' bending (with its cause)
+    state["failure"] = (_rest_above_exits(scene, mbs, items) if scene.swivels else None) \
+        or monitor.problem(0.0, *platform_pose(mbs, items))
     mbs.SetPreStepUserFunction(pre_step)
     mbs.SetPostStepUserFunction(post_step)
     wall_start = _time.perf_counter()
     with interrupt_flag() as interrupted, quiet_exudyn():
         try:
-            mbs.SolveDynamic(solver_settings(scene))
-        except (exu.SolverError, RuntimeError, SystemError) as err:
-            state["failure"] = " ".join(str(err).split())
+            if state["failure"] is None:
+                mbs.SolveDynamic(solver_settings(scene, solution_file))
+        except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn's own cause, not only "terminated"
+            state["failure"] = state["failure"] or _solver_report(mbs, " ".join(str(err).split()))
     wall = _time.perf_counter() - wall_start
     if report is not None:
         report(None, wall)
@@ -436,13 +629,15 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     paid_out = np.asarray(paid)
     nodes = [np.asarray(series) for series in node_series]
     tensions = [np.asarray(series) for series in tension_series]
-    iterations = mbs.sys["dynamicSolver"].it
+    solved = mbs.sys.get("dynamicSolver")  # none when the start was refused
+    steps, newton = (0, 0) if solved is None else (solved.it.currentStepIndex, solved.it.newtonStepsCount)
     result = SpatialResult(scene.name, controller.name if kinematic else "fixed winches", time_array, pose,
                            np.atleast_2d(scene.trajectory.pose(time_array)), paid_out, nodes, tensions, wall,
-                           int(iterations.currentStepIndex), int(iterations.newtonStepsCount))
+                           int(steps), int(newton))
     if tension_limits(scene.cables) is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
-    reached = float(time_array[-1])
+    result.metadata["highest_exit_z_m"] = highest_exit(scene)
+    reached = state["reached"]  # the solver's own time: the samples may end up to one output period before it
     if interrupted["interrupted"]:
         result.status, result.failure_time = f"interrupted at t = {reached:.4f} s", reached
         raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
@@ -496,22 +691,75 @@ def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0
     return path
 
 
+def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> None:
+    """Print a spatial run's :meth:`SpatialResult.run_summary`: errors over the whole run and after ``after`` [s],
+    each cable's lowest tension and slack time (whole run), its tension-limit violations and notes."""
+    settled = summary["after_start_up"]
+
+    def errors(s):
+        return f"{length_text(s['max_position_error_m'])} / {length_text(s['rms_position_error_m'])}"
+
+    def degrees(s):
+        return "n/a" if s["max_rotation_error_deg"] is None else f"{s['max_rotation_error_deg']:.4f} deg"
+
+    def per_cable(values, unit, digits):
+        return " / ".join("n/a" if v is None else f"{fixed(v, digits)} {unit}" for v in values)
+
+    factor = summary["real_time_factor"]
+    print(f"{summary['scene']} under {summary['controller']} (spatial; error = actual - reference)")
+    print(f"  {'':26s} {'whole run':>22s}   {'after ' + f'{after:g}' + ' s':>22s}")
+    print(f"  {'status':26s} {status_text(summary)}")
+    print(f"  {'max / RMS position error':26s} {errors(summary):>22s}   {errors(settled):>22s}")
+    print(f"  {'max rotation error':26s} {degrees(summary):>22s}   {degrees(settled):>22s}")
+    print(f"  {'min tension per cable':26s} {per_cable(summary['min_tension_per_cable_N'], 'N', 1)}")
+    print(f"  {'slack time per cable':26s} {per_cable(summary['slack_time_per_cable_s'], 's', 3)}")
+    print(f"  {'simulated / wall time':26s} {summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s"
+          + ("" if factor is None else f" ({factor:.1f}x real time)")
+          + f", {summary['steps']} steps, {summary['newton_iterations']} Newton iterations")
+    if "tension_limit_violations" in summary:
+        count = len(summary["tension_limit_violations"])
+        print(f"  {'tension limits':26s} {f'{count} violation(s)' if count else 'none'}")
+    for v in summary.get("tension_limit_violations", []):
+        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
+              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
+    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
+        print(f"  note: {note}")
+    if out is not None:
+        print(f"  written to {out}/")
+
+
 def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
                       after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
-    """``cdpr run`` on a spatial scene: run, write (``out``: scene.toml-free result folder), print a summary.
+    """``cdpr run`` on a spatial scene: run, write into ``out``, print a summary.
 
-    On a solver failure the partial result is written before the error propagates. With
-    ``error_estimate`` a companion run estimates the discretisation error
-    (:mod:`cdpr_exu.run.error_estimate`): ``error_estimate`` in summary.json and a printed line.
+    Writes what ``cdpr run`` writes for every scene: ``scene.toml`` (the scene as run: a
+    rerun from it gives the same result), ``result.npz``, ``pose.csv``, ``summary.json``
+    (wall-clock figures in ``timing.json``), ``solution.sol`` (Exudyn's solution file, its
+    date blanked, for ``cdpr view``) and (``figures``) ``overview.png``. The scene and its
+    reference are checked before anything is written. On a solver failure or Ctrl-C the
+    partial result is written before the error propagates. With ``error_estimate`` a
+    companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`):
+    ``error_estimate`` in summary.json and a printed line.
     """
     from cdpr_exu.run.error_estimate import estimate_error, estimate_line, summary_entry
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    check_runnable(scene)  # before scene.toml is in the folder
+    solution_file = None
+    if out is not None:
+        out = check_output_folder(out, command="run")
+        clear_outputs(out, "run")  # none of the run this one replaces stays beside it (a planar one's figures)
+        save_any_scene(scene, out / "scene.toml")
+        solution_file = out / "solution.sol"
 
     def write(result: SpatialResult, extra: dict | None = None) -> None:
         if out is not None:
             result.save(out, after, figures, extra)
+            if solution_file.is_file():
+                undate_solution_file(solution_file)
 
     try:
-        result = simulate_spatial(scene, progress=not quiet)
+        result = simulate_spatial(scene, progress=not quiet, solution_file=solution_file)
     except (SolverFailure, RunInterrupted) as err:  # keep what was computed
         if err.partial_result is not None:
             write(err.partial_result)
@@ -525,30 +773,10 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
         except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
             interrupt = err
     write(result, None if estimate is None else summary_entry(estimate))
+    summary = result.run_summary(after)
+    raise_warnings(summary, f"{scene.name} under {result.controller}: ")  # not clean: said once, quiet or not
     if not quiet:
-        s = result.summary(after)
-
-        def mm(value):
-            return "n/a" if value is None else f"{1000 * value:.2f} mm"
-        print(f"{scene.name} under {result.controller} (spatial; error = actual - reference, after {after:g} s)")
-        print(f"  status                     {s['status']}")
-        print(f"  max / RMS position error   {mm(s['max_position_error_m'])} / {mm(s['rms_position_error_m'])}")
-        rotation = s["max_rotation_error_deg"]
-        print(f"  max rotation error         {'n/a' if rotation is None else f'{rotation:.4f} deg'}")
-        print("  min tension per cable      " + " / ".join("n/a" if v is None else f"{v:.1f} N"
-                                                          for v in s["min_tension_per_cable_N"]))
-        print(f"  simulated / wall time      {s['simulated_time_s']:.2f} s / {s['wall_time_s']:.2f} s "
-              f"({s['real_time_factor']:.1f}x real time), {s['steps']} steps, {s['newton_iterations']} Newton iterations")
-        if "tension_limit_violations" in s:
-            count = len(s["tension_limit_violations"])
-            print(f"  tension limits             {f'{count} violation(s)' if count else 'none'}")
-        for v in s.get("tension_limit_violations", []):
-            print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
-                  f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
-        for note in s["notes"]:
-            print(f"  note: {note}")
-        if out is not None:
-            print(f"  written to {out}/")
+        _print_spatial_summary(summary, after, out)
         if estimate is not None:
             print(estimate_line(estimate))
     if interrupt is not None:
@@ -590,37 +818,63 @@ def spatial_comparison_table(summaries: dict) -> str:
         cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in columns]
         worst = s.get("max_position_error_m")
         ratio = f"{base / worst:.1f}x" if base and worst else ""
-        pushed = "; cables pushed" if s.get("elements_pushed") else ""
-        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{pushed} |")
+        flags = "".join(f"; {flag}" for flag in warning_flags(s))  # what a real robot cannot do
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{flags} |")
     return "\n".join(lines) + "\n"
 
 
 def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
                     after: float = 1.0, quiet: bool = True) -> dict[str, dict]:
     """Run a spatial scene under each named controller; write summary.json, comparison.md and each
-    controller's overview figure to ``out``. Returns the summaries by name."""
-    from cdpr_exu.core.output import write_summary as _write
+    controller's overview figure to ``out``. Returns the summaries by name.
 
+    As the planar comparison: a run that fails is recorded with its status and partial
+    figures, a controller that refuses the scene with ``refused: ...``, and the others still
+    run; on Ctrl-C (inside a run or between two) the controllers done so far and the
+    interrupted one's partial run are written before the interrupt goes on.
+    """
     names = list(names or spatial_controller_names(scene))
     unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
     if unknown:
         raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
-    summaries = {}
-    for name in names:
-        try:
-            result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
-        except SolverFailure as err:
-            result = err.partial_result
-        summaries[name] = result.summary(after)
-        if out is not None:
-            Path(out).mkdir(parents=True, exist_ok=True)
-            plot_spatial_run(result, Path(out) / f"overview_{name}.png", after)
-        if not quiet:
-            worst = summaries[name]["max_position_error_m"]
-            print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   {summaries[name]['status']}")
+    if out is not None:  # an earlier comparison's files go before the first of this one is written
+        clear_outputs(check_output_folder(out, command="compare"), "compare")
+    summaries, results = {}, {}
+    try:
+        for name in names:
+            try:
+                result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
+            except SolverFailure as err:
+                result = err.partial_result
+                if result is None:  # it failed before its first step (settling the robot)
+                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
+                    continue
+            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
+                results[name] = err.partial_result
+                summaries[name] = err.partial_result.summary(after)
+                raise
+            except CdprError as err:  # a controller that refuses the scene is a result of the comparison too
+                summaries[name] = {"controller": name, "status": f"refused: {err}"}
+                continue
+            results[name], summaries[name] = result, result.summary(after)
+            if not quiet:
+                worst = summaries[name]["max_position_error_m"]
+                print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   "
+                      f"{status_text(summaries[name])}")
+    except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
+        if out is not None and summaries:
+            _write_spatial_comparison(scene, summaries, results, Path(out), after)
+        raise
     if out is not None:
-        _write(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
-                     "error_convention": "actual - reference", "controllers": summaries, **provenance()})
-        (Path(out) / "comparison.md").write_text(spatial_comparison_table(summaries))
+        _write_spatial_comparison(scene, summaries, results, Path(out), after)
     return summaries
 
+
+def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
+    """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    write_summary(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
+                        "error_convention": "actual - reference", "controllers": summaries, **provenance()})
+    (out / "comparison.md").write_text(spatial_comparison_table(summaries))
+    for name, result in results.items():
+        plot_spatial_run(result, out / f"overview_{name}.png", after)

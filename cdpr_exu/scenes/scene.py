@@ -25,36 +25,37 @@ import numpy as np
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, UnreachableError
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
-from cdpr_exu.core.geometry import Pulley, anchor_points
-from cdpr_exu.core.validation import finite, non_negative, positive
+from cdpr_exu.core.geometry import Pulley, above_exits, anchor_points
+from cdpr_exu.core.validation import finite, non_negative, positive, shown
 from cdpr_exu.scenes.trajectories import Trajectory, trajectory_from_dict
 
 # --------------------------------------------------------------------------- checks
 
 
-def _vector(path: str, value: Any, length: int) -> tuple[float, ...]:
-    """Return ``value`` as a tuple of ``length`` finite floats."""
+def _vector(path: str, value: Any, length: int, unit: str = "") -> tuple[float, ...]:
+    """Return ``value`` as a tuple of ``length`` finite floats; ``unit`` is named in the messages."""
+    units = f" [{unit}]" if unit else ""
     if isinstance(value, (str, bytes, Mapping)):
-        raise SceneError(f"{path} must be a list of {length} numbers, got {value!r}")
+        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}")
     try:
         items = list(value)
     except TypeError:
-        raise SceneError(f"{path} must be a list of {length} numbers, got {value!r}") from None
+        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}") from None
     if len(items) != length:
-        raise SceneError(f"{path} must have {length} entries, got {len(items)}: {value!r}")
+        raise SceneError(f"{path} must have {length} entries{units}, got {len(items)}: {shown(value)}")
     return tuple(finite(f"{path}[{i}]", v) for i, v in enumerate(items))
 
 
 def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
     if value not in choices:
-        raise SceneError(f"{path} must be one of {', '.join(map(repr, choices))}, got {value!r}")
+        raise SceneError(f"{path} must be one of {', '.join(map(repr, choices))}, got {shown(value)}")
     return value
 
 
 def _whole(path: str, value: Any, low: int, high: int) -> int:
     """Return ``value`` as an int in [low, high], or raise SceneError naming ``path``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
-        raise SceneError(f"{path} must be a whole number from {low} to {high}, got {value!r}")
+        raise SceneError(f"{path} must be a whole number from {low} to {high}, got {shown(value)}")
     return int(value)
 
 
@@ -67,6 +68,14 @@ MAX_ELEMENTS = 300
 MAX_STEPS = 1.0e9
 #: Most Newton iterations per step (beyond a few dozen, more never converge).
 MAX_NEWTON_ITERATIONS = 1000
+
+
+def check_weight(mass: float, gravity: float) -> None:
+    """Refuse a platform whose weight, ``mass`` [kg] x ``gravity`` [m/s^2], is out of floating-point range
+    (naming platform.mass and gravity; each alone is finite)."""
+    if not math.isfinite(mass * gravity):
+        raise SceneError(f"platform.mass = {shown(mass)} kg and gravity = {shown(gravity)} m/s^2 give a weight of "
+                         f"{shown(mass * gravity)} N, out of floating-point range")
 
 
 def _set(obj: Any, name: str, value: Any) -> None:
@@ -116,23 +125,23 @@ class CableSpec:
     max_tension: float | None = None
 
     def __post_init__(self) -> None:
-        _set(self, "unstrained_length", positive("cable.unstrained_length", self.unstrained_length))
+        _set(self, "unstrained_length", positive("cable.unstrained_length", self.unstrained_length, "m"))
         for name in ("min_tension", "max_tension"):
             if getattr(self, name) is not None:
-                _set(self, name, non_negative(f"cable.{name}", getattr(self, name)))
+                _set(self, name, non_negative(f"cable.{name}", getattr(self, name), "N"))
         if self.min_tension is not None and self.max_tension is not None and self.min_tension >= self.max_tension:
-            raise SceneError(f"cable.min_tension = {self.min_tension!r} N must be below cable.max_tension = "
-                             f"{self.max_tension!r} N")
-        _set(self, "radius", positive("cable.radius", self.radius))
-        _set(self, "linear_density", positive("cable.linear_density", self.linear_density))
-        _set(self, "youngs_modulus", positive("cable.youngs_modulus", self.youngs_modulus))
-        _set(self, "damping_constant", non_negative("cable.damping_constant", self.damping_constant))
+            raise SceneError(f"cable.min_tension = {shown(self.min_tension)} N must be below cable.max_tension = "
+                             f"{shown(self.max_tension)} N")
+        _set(self, "radius", positive("cable.radius", self.radius, "m"))
+        _set(self, "linear_density", positive("cable.linear_density", self.linear_density, "kg/m"))
+        _set(self, "youngs_modulus", positive("cable.youngs_modulus", self.youngs_modulus, "Pa"))
+        _set(self, "damping_constant", non_negative("cable.damping_constant", self.damping_constant, "N s/m^2"))
         if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, (int, np.integer)):
-            raise SceneError(f"cable.n_elements must be a whole number, got {self.n_elements!r}")
+            raise SceneError(f"cable.n_elements must be a whole number, got {shown(self.n_elements)}")
         if self.n_elements < 2:
-            raise SceneError(f"cable.n_elements must be at least 2, got {self.n_elements!r}")
+            raise SceneError(f"cable.n_elements must be at least 2, got {shown(self.n_elements)}")
         if self.n_elements > MAX_ELEMENTS:
-            raise SceneError(f"cable.n_elements must be at most {MAX_ELEMENTS}, got {self.n_elements!r}")
+            raise SceneError(f"cable.n_elements must be at most {MAX_ELEMENTS}, got {shown(self.n_elements)}")
         _set(self, "n_elements", int(self.n_elements))
         _choice("cable.mass_lumping", self.mass_lumping, ("consistent", "paper"))
         self._check_derived()
@@ -154,8 +163,8 @@ class CableSpec:
                 value = math.inf
             zero_allowed = name.endswith("damping") and self.damping_constant == 0.0
             if not math.isfinite(value) or (value <= 0.0 and not zero_allowed):
-                given = ", ".join(f"cable.{f} = {getattr(self, f)!r}" for f in fields_)
-                raise SceneError(f"{given} give(s) an element {name.replace('_', ' ')} of {value!r}, "
+                given = ", ".join(f"cable.{f} = {shown(getattr(self, f))}" for f in fields_)
+                raise SceneError(f"{given} give(s) an element {name.replace('_', ' ')} of {shown(value)}, "
                                  "out of floating-point range")
 
     # Derived quantities of the paper's Table 2 -------------------------------------
@@ -255,13 +264,13 @@ class PulleySpec(Pulley):
     contact_damping: float = 10.0
 
     def __post_init__(self) -> None:
-        _set(self, "center", _vector("pulley.center", self.center, 2))
-        _set(self, "radius", positive("pulley.radius", self.radius))
+        _set(self, "center", _vector("pulley.center", self.center, 2, "m"))
+        _set(self, "radius", positive("pulley.radius", self.radius, "m"))
         if self.side not in (-1, 1) or isinstance(self.side, bool):
-            raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {self.side!r}")
+            raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {shown(self.side)}")
         _set(self, "side", int(self.side))
-        _set(self, "contact_stiffness", positive("pulley.contact_stiffness", self.contact_stiffness))
-        _set(self, "contact_damping", non_negative("pulley.contact_damping", self.contact_damping))
+        _set(self, "contact_stiffness", positive("pulley.contact_stiffness", self.contact_stiffness, "N/m"))
+        _set(self, "contact_damping", non_negative("pulley.contact_damping", self.contact_damping, "N s/m"))
 
 
 @dataclass(frozen=True)
@@ -289,18 +298,18 @@ class PlatformSpec:
     size: tuple[float, float] = (0.3, 0.2)
 
     def __post_init__(self) -> None:
-        _set(self, "mass", positive("platform.mass", self.mass))
-        _set(self, "inertia", positive("platform.inertia", self.inertia))
+        _set(self, "mass", positive("platform.mass", self.mass, "kg"))
+        _set(self, "inertia", positive("platform.inertia", self.inertia, "kg m^2"))
         anchors = np.asarray(self.anchors, dtype=object)
         if anchors.ndim != 2 or anchors.shape[1] != 2 or anchors.shape[0] < 1:
             raise SceneError(
-                f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), got {self.anchors!r}"
+                f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), got {shown(self.anchors)}"
             )
-        _set(self, "anchors", tuple(_vector(f"platform.anchors[{i}]", a, 2) for i, a in enumerate(self.anchors)))
-        _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3))
-        size = _vector("platform.size", self.size, 2)
+        _set(self, "anchors", tuple(_vector(f"platform.anchors[{i}]", a, 2, "m") for i, a in enumerate(self.anchors)))
+        _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3, "m, m, rad"))
+        size = _vector("platform.size", self.size, 2, "m")
         for i, s in enumerate(size):
-            non_negative(f"platform.size[{i}]", s)
+            non_negative(f"platform.size[{i}]", s, "m")
         _set(self, "size", size)
 
     @property
@@ -339,10 +348,10 @@ class WinchSpec:
 
     def __post_init__(self) -> None:
         _choice("winch.kind", self.kind, ("kinematic", "servo", "fixed"))
-        _set(self, "drum_radius", positive("winch.drum_radius", self.drum_radius))
-        _set(self, "drum_inertia", positive("winch.drum_inertia", self.drum_inertia))
+        _set(self, "drum_radius", positive("winch.drum_radius", self.drum_radius, "m"))
+        _set(self, "drum_inertia", positive("winch.drum_inertia", self.drum_inertia, "kg m^2"))
         _choice("winch.servo_design", self.servo_design, ("pole_placement", "lqr"))
-        _set(self, "servo_bandwidth", positive("winch.servo_bandwidth", self.servo_bandwidth))
+        _set(self, "servo_bandwidth", positive("winch.servo_bandwidth", self.servo_bandwidth, "rad/s"))
 
     @property
     def drum_mass(self) -> float:
@@ -438,7 +447,7 @@ class Effects:
         _choice("effects.preset", self.preset, tuple(PRESETS))
         for f in fields(self):
             if f.type in ("bool", bool) and not isinstance(getattr(self, f.name), bool):
-                raise SceneError(f"effects.{f.name} must be true or false, got {getattr(self, f.name)!r}")
+                raise SceneError(f"effects.{f.name} must be true or false, got {shown(getattr(self, f.name))}")
         _choice("effects.bending_model", self.bending_model, ("exact", "linear"))
         _choice("effects.pulley_contact_model", self.pulley_contact_model, PULLEY_CONTACT_MODELS)
         if not self.cable_mass:
@@ -529,9 +538,9 @@ class SolverSpec:
 
     def __post_init__(self) -> None:
         if not isinstance(self.initial_accelerations, bool):
-            raise SceneError(f"solver.initial_accelerations must be true or false, got {self.initial_accelerations!r}")
-        _set(self, "end_time", positive("solver.end_time", self.end_time))
-        _set(self, "step_size", positive("solver.step_size", self.step_size))
+            raise SceneError(f"solver.initial_accelerations must be true or false, got {shown(self.initial_accelerations)}")
+        _set(self, "end_time", positive("solver.end_time", self.end_time, "s"))
+        _set(self, "step_size", positive("solver.step_size", self.step_size, "s"))
         if self.step_size > self.end_time:
             raise SceneError(f"solver.step_size ({self.step_size}) must not exceed solver.end_time ({self.end_time})")
         if self.end_time / self.step_size > MAX_STEPS:
@@ -539,10 +548,10 @@ class SolverSpec:
                              f"{self.end_time / self.step_size:.3g} steps; at most {MAX_STEPS:.0e} are allowed")
         rho = finite("solver.spectral_radius", self.spectral_radius)
         if not 0.0 <= rho <= 1.0:
-            raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {self.spectral_radius!r}")
+            raise SceneError(f"solver.spectral_radius must lie in [0, 1], got {shown(self.spectral_radius)}")
         _set(self, "spectral_radius", rho)
         _choice("solver.newton", self.newton, ("modified", "full"))
-        _set(self, "output_period", positive("solver.output_period", self.output_period))
+        _set(self, "output_period", positive("solver.output_period", self.output_period, "s"))
         if self.output_period < self.step_size * (1 - 1e-9):
             samples = int(math.floor(self.end_time / self.step_size + 1e-9)) + 1
             warnings.warn(
@@ -556,7 +565,7 @@ class SolverSpec:
         _choice("solver.integrator", self.integrator, ("generalized_alpha", "rk44"))
         tolerance = positive("solver.newton_tolerance", self.newton_tolerance)
         if tolerance > 1e-3:
-            raise SceneError(f"solver.newton_tolerance must be at most 1e-3 (relative), got {self.newton_tolerance!r}")
+            raise SceneError(f"solver.newton_tolerance must be at most 1e-3 (relative), got {shown(self.newton_tolerance)}")
         _set(self, "newton_tolerance", tolerance)
 
     @property
@@ -582,7 +591,7 @@ MODEL_FIELDS: dict[str, tuple[str, ...]] = {
 def _overrides(path: str, data: Any, part: str) -> dict[str, Any]:
     """A copy of one override table, refusing keys the controllers' model cannot override."""
     if not isinstance(data, Mapping):
-        raise SceneError(f"{path} must be a table, got {data!r}")
+        raise SceneError(f"{path} must be a table, got {shown(data)}")
     known = MODEL_FIELDS[part]
     unknown = sorted(set(data) - set(known))
     if unknown:
@@ -641,11 +650,11 @@ class ControllerModel:
         for name, part in (("cables", "cable"), ("pulleys", "pulley")):
             entries = getattr(self, name)
             if isinstance(entries, (str, bytes, Mapping)) or not hasattr(entries, "__iter__"):
-                raise SceneError(f"controller_model.{name} must be an array of tables, got {entries!r}")
+                raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(entries)}")
             _set(self, name, tuple(_overrides(f"controller_model.{name}[{i}]", e, part)
                                    for i, e in enumerate(entries)))
         if self.gravity is not None:
-            _set(self, "gravity", non_negative("controller_model.gravity", self.gravity))
+            _set(self, "gravity", non_negative("controller_model.gravity", self.gravity, "m/s^2"))
 
     def is_empty(self) -> bool:
         """True when it overrides nothing (the controllers know the plant)."""
@@ -710,7 +719,7 @@ def _override(part: Any, changes: Mapping[str, Any], path: str, head: str) -> An
 def controller_model_from_dict(data: Any) -> ControllerModel:
     """A :class:`ControllerModel` from its TOML table, refusing unknown keys (named)."""
     if not isinstance(data, Mapping):
-        raise SceneError(f"controller_model must be a table, got {data!r}")
+        raise SceneError(f"controller_model must be a table, got {shown(data)}")
     known = {f.name for f in fields(ControllerModel)}
     unknown = sorted(set(data) - known)
     if unknown:
@@ -718,7 +727,7 @@ def controller_model_from_dict(data: Any) -> ControllerModel:
     values = dict(data)
     for name in ("cables", "pulleys"):
         if name in values and not (isinstance(values[name], list) and all(isinstance(e, Mapping) for e in values[name])):
-            raise SceneError(f"controller_model.{name} must be an array of tables, got {values[name]!r}")
+            raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(values[name])}")
     return ControllerModel(**values)
 
 
@@ -771,24 +780,24 @@ class Scene:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
-            raise SceneError(f"name must be a non-empty string, got {self.name!r}")
+            raise SceneError(f"name must be a non-empty string, got {shown(self.name)}")
         if not isinstance(self.description, str):
-            raise SceneError(f"description must be a string, got {self.description!r}")
+            raise SceneError(f"description must be a string, got {shown(self.description)}")
         for name, kind in (("cables", CableSpec), ("pulleys", PulleySpec)):
             parts = getattr(self, name)
             if isinstance(parts, (str, bytes, Mapping)) or not hasattr(parts, "__iter__"):
-                raise SceneError(f"{name} must be a sequence of {kind.__name__}, got {parts!r}")
+                raise SceneError(f"{name} must be a sequence of {kind.__name__}, got {shown(parts)}")
             parts = tuple(parts)
             for i, part in enumerate(parts):
                 if not isinstance(part, kind):
-                    raise SceneError(f"{name}[{i}] must be a {kind.__name__}, got {part!r}")
+                    raise SceneError(f"{name}[{i}] must be a {kind.__name__}, got {shown(part)}")
             _set(self, name, parts)
         for name, kind in (("platform", PlatformSpec), ("winch", WinchSpec), ("effects", Effects),
                            ("solver", SolverSpec)):
             if not isinstance(getattr(self, name), kind):
-                raise SceneError(f"{name} must be a {kind.__name__}, got {getattr(self, name)!r}")
+                raise SceneError(f"{name} must be a {kind.__name__}, got {shown(getattr(self, name))}")
         if self.trajectory is not None and not isinstance(self.trajectory, Trajectory):
-            raise SceneError(f"trajectory must be a Trajectory, got {self.trajectory!r}")
+            raise SceneError(f"trajectory must be a Trajectory, got {shown(self.trajectory)}")
         m = len(self.cables)
         if m < 1:
             raise SceneError("cables must list at least one cable")
@@ -798,7 +807,8 @@ class Scene:
             raise SceneError(
                 f"platform.anchors must list one anchor per cable ({m}), got {len(self.platform.anchors)}"
             )
-        _set(self, "gravity", non_negative("gravity", self.gravity))
+        _set(self, "gravity", non_negative("gravity", self.gravity, "m/s^2"))
+        check_weight(self.platform.mass, self.gravity)
         _choice("cable_exit", self.cable_exit, ("pulley", "point"))
         if self.winch.kind == "servo" and not self.effects.cable_mass:
             raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")
@@ -806,8 +816,8 @@ class Scene:
             raise SceneError("cable_exit = 'point' needs winch.kind = 'fixed' (the cable starts at the pulley centre)")
         if self.solver.integrator != "generalized_alpha" and self.winch.kind != "fixed":
             raise SceneError(
-                f"solver.integrator = {self.solver.integrator!r} needs winch.kind = 'fixed', got "
-                f"{self.winch.kind!r}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
+                f"solver.integrator = {shown(self.solver.integrator)} needs winch.kind = 'fixed', got "
+                f"{shown(self.winch.kind)}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
                 "and hold them at their initial value, ignoring every winch command")
         if self.trajectory is None:
             from cdpr_exu.scenes.trajectories import HoldTrajectory
@@ -816,7 +826,7 @@ class Scene:
         self._check_reachable()
         if self.controller_model is not None:
             if not isinstance(self.controller_model, ControllerModel):
-                raise SceneError(f"controller_model must be a ControllerModel, got {self.controller_model!r}")
+                raise SceneError(f"controller_model must be a ControllerModel, got {shown(self.controller_model)}")
             if self.controller_model.is_empty():
                 _set(self, "controller_model", None)
             else:
@@ -833,8 +843,13 @@ class Scene:
         return self.controller_model.apply(self)
 
     def _check_reachable(self) -> None:
-        """Refuse an initial pose the cables cannot reach (before any simulation)."""
+        """Refuse an initial pose the cables cannot reach or hold (before any simulation)."""
         anchors = anchor_points(np.asarray(self.platform.initial_pose), np.asarray(self.platform.anchors))
+        above = above_exits(anchors[:, 1], [exit_.top for exit_ in self.exits])
+        if above is not None and self.gravity > 0.0 and self.effects.gravity:
+            raise UnreachableError(
+                f"platform.initial_pose {list(self.platform.initial_pose)} (x [m], z [m], rotation [rad]) is above "
+                f"the pulleys: {above}; give a platform.initial_pose below them")
         for i, (cable, pulley, exit_) in enumerate(zip(self.cables, self.pulleys, self.exits)):
             if exit_.is_point_exit:
                 needed = float(np.linalg.norm(anchors[i] - np.asarray(exit_.center)))
@@ -922,7 +937,7 @@ def _listify(value: Any) -> Any:
 def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
     """Make dataclass ``cls`` from a mapping, refusing unknown keys."""
     if not isinstance(data, Mapping):
-        raise SceneError(f"{path} must be a table, got {data!r}")
+        raise SceneError(f"{path} must be a table, got {shown(data)}")
     known = {f.name for f in fields(cls)}
     unknown = set(data) - known
     if unknown:
@@ -944,26 +959,73 @@ def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list
     """Merge the shared table ``[single]`` into each entry of ``[[plural]]`` (or of ``defaults``)."""
     shared = data.get(single, {})
     if not isinstance(shared, Mapping):
-        raise SceneError(f"{single} must be a table, got {shared!r}")
+        raise SceneError(f"{single} must be a table, got {shown(shared)}")
     shared = dict(shared)
     entries = data.get(plural, defaults)
     if not isinstance(entries, list) or not all(isinstance(e, Mapping) for e in entries):
-        raise SceneError(f"{plural} must be an array of tables, got {entries!r}")
+        raise SceneError(f"{plural} must be an array of tables, got {shown(entries)}")
     return [{**e, **shared} if plural not in data else {**shared, **dict(e)} for e in entries]
 
 
-def scene_from_dict(data: Mapping[str, Any]) -> Scene:
+#: The fields a scene file (or its plain data) must give, with their units: the robot's
+#: geometry, lengths and masses, for which no default would be the robot its author meant.
+#: Which of them apply depends on the scene (a pulley's radius and side only where the
+#: cables run over pulleys, a platform's inertia only where an anchor is off its centre of
+#: mass): :func:`missing_fields` is given the names that apply. Every other field keeps a
+#: documented default that is a model choice (the paper's cable material, elements, contact
+#: law, solver settings, effect flags).
+REQUIRED_FIELDS: dict[str, str] = {
+    "unstrained_length": "m", "center": "m", "radius": "m", "side": "-1 or +1", "mass": "kg",
+    "inertia": "kg m^2", "anchors": "m", "initial_pose": "m, m, rad", "point": "m", "inlet": "m",
+}
+
+
+def missing_fields(path: str, given: Mapping[str, Any], names: tuple[str, ...]) -> list[str]:
+    """The required ``names`` (keys of :data:`REQUIRED_FIELDS`) that the table ``given`` leaves
+    out, each as a field path ``path.name`` with its unit, e.g. ``"platform.mass [kg]"``."""
+    return [f"{path}.{name} [{REQUIRED_FIELDS[name]}]" for name in names if name not in given]
+
+
+def refuse_missing(missing: list[str], source: str | None = None) -> None:
+    """Raise SceneError naming every required field a scene leaves out (see :func:`missing_fields`).
+
+    Called once the values given are checked, and before the scene's parts are put together
+    (so that no default stands in for a missing field in a later check or message).
+    """
+    if missing:
+        where = "scene" if source is None else f"scene {shown(source)}"
+        raise SceneError(f"{where} lacks {', '.join(missing)}: a scene must give "
+                         f"{'it' if len(missing) == 1 else 'each'}, as no default would be the robot you mean "
+                         "(see the scene reference in the README)")
+
+
+def _planar_missing(data: Mapping[str, Any], cable_dicts, pulley_dicts, platform: "PlatformSpec") -> list[str]:
+    """The required fields a planar scene's plain data leaves out (its tables are checked apart)."""
+    missing = [field_ for i, c in enumerate(cable_dicts)
+               for field_ in missing_fields(f"cables[{i}]", c, ("unstrained_length",))]
+    over_pulleys = data.get("cable_exit", "pulley") == "pulley"
+    for i, p in enumerate(pulley_dicts):
+        missing += missing_fields(f"pulleys[{i}]", p, ("center", "radius", "side") if over_pulleys else ("center",))
+    if isinstance(data.get("platform"), Mapping):
+        names = ("mass", "anchors", "initial_pose") + (() if platform.is_point_mass else ("inertia",))
+        missing += missing_fields("platform", data["platform"], names)
+    return missing
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene:
     """Make a validated Scene from plain data (as read from TOML).
 
     ``[cable]`` and ``[pulley]`` tables hold values shared by every cable or pulley;
     ``[[cables]]`` and ``[[pulleys]]`` entries override them one by one. ``[effects]``
-    may name a ``preset`` and override single effects.
+    may name a ``preset`` and override single effects. The values given are checked
+    first; then the tables (:data:`REQUIRED_TABLES`) and fields (:data:`REQUIRED_FIELDS`)
+    a scene must give are required. ``source`` names the file in those messages.
     """
     if not isinstance(data, Mapping):
-        raise SceneError(f"a scene must be a table (mapping), got {data!r}")
+        raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
     data = dict(data)
     if data.get("dimension", 2) != 2:
-        raise SceneError(f"dimension must be 2 (planar) or 3 (spatial), got {data['dimension']!r}")
+        raise SceneError(f"dimension must be 2 (planar) or 3 (spatial), got {shown(data['dimension'])}")
     data.pop("dimension", None)
     top_known = {
         "name", "description", "gravity", "cable_exit", "cable", "cables", "pulley", "pulleys",
@@ -981,7 +1043,7 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     platform = _build(PlatformSpec, data.get("platform", {}), "platform")
     effects_data = data.get("effects", {})
     if not isinstance(effects_data, Mapping):
-        raise SceneError(f"effects must be a table, got {effects_data!r}")
+        raise SceneError(f"effects must be a table, got {shown(effects_data)}")
     effects_data = dict(effects_data)
     preset = effects_data.pop("preset", "full")
     effects = Effects.from_preset(preset, **effects_data)
@@ -1001,6 +1063,8 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     for key in ("name", "description", "gravity", "cable_exit"):
         if key in data:
             kwargs[key] = data[key]
+    _check_required_tables(data, source)
+    refuse_missing(_planar_missing(data, cable_dicts, pulley_dicts, platform), source)
     return Scene(**kwargs)
 
 
@@ -1017,8 +1081,48 @@ class SpatialSceneError(SceneError):
 
 def _refuse_spatial(source: str | Path) -> None:
     raise SpatialSceneError(
-        f"scene {str(source)!r} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep`, "
+        f"scene {shown(str(source))} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep`, "
         "`study accuracy` and `animate` take spatial scenes; `view` takes planar scenes only (see docs/spatial.md)")
+
+
+def is_scene_file(source: str | Path) -> bool:
+    """True when ``source`` names a file (a ``.toml`` path, or anything that exists) rather than a shipped scene."""
+    path = Path(source)
+    return path.suffix == ".toml" or path.exists()
+
+
+def read_scene_file(source: str | Path) -> dict[str, Any]:
+    """The plain data of the TOML scene file ``source``, or SceneError naming the file and what is wrong.
+
+    Refused: a folder, a missing or unreadable file, a file that is not UTF-8 text (TOML is UTF-8:
+    a Latin-1 or binary file), and text that is not valid TOML. An empty file is valid TOML (no
+    tables); the loaders then say which tables it lacks.
+    """
+    path = Path(source)
+    if path.is_dir():
+        raise SceneError(f"scene {shown(str(path))} is a directory; give a .toml scene file or a shipped "
+                         "scene name (see `cdpr scenes`)")
+    if not path.is_file():
+        raise SceneError(f"scene file {shown(str(path))} does not exist")
+    try:
+        raw = path.read_bytes()
+    except OSError as err:
+        raise SceneError(f"scene file {shown(str(path))} cannot be read: {err.strerror or err}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise SceneError(f"scene file {shown(str(path))} is not UTF-8 TOML: byte {err.start} is 0x{raw[err.start]:02x} "
+                         "(a binary file, or text saved in another encoding such as Latin-1); save it as UTF-8 "
+                         "text") from None
+    return parse_scene_text(text, source)
+
+
+def parse_scene_text(text: str, source: str | Path) -> dict[str, Any]:
+    """The plain data of a scene's TOML ``text``; SceneError naming ``source`` if it is not valid TOML."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(f"scene {shown(str(source))} is not valid TOML: {err}") from None
 
 
 def load_scene(source: str | Path) -> Scene:
@@ -1028,32 +1132,22 @@ def load_scene(source: str | Path) -> Scene:
     ------
     SpatialSceneError
         For a spatial scene (:func:`cdpr_exu.scenes.spatial_scene.load_spatial_scene` loads those).
+    SceneError
+        For a file that cannot be read as a scene (:func:`read_scene_file`), and for a bad scene.
     """
-    path = Path(source)
-    if path.suffix == ".toml" or path.exists():
-        if path.is_dir():
-            raise SceneError(f"scene {str(path)!r} is a directory; give a .toml scene file or a shipped "
-                             "scene name (see `cdpr scenes`)")
-        if not path.is_file():
-            raise SceneError(f"scene file {str(path)!r} does not exist")
-        text = path.read_text()
+    if is_scene_file(source):
+        data = read_scene_file(source)
     else:
         name = str(source).replace("-", "_") + ".toml"
         resource = resources.files("cdpr_exu.scenes").joinpath(name)
         if not resource.is_file() and resources.files("cdpr_exu.scenes").joinpath("spatial", name).is_file():
             _refuse_spatial(source)
         if not resource.is_file():
-            raise SceneError(f"no scene named {str(source)!r}; shipped scenes: {', '.join(shipped_scenes())}")
-        text = resource.read_text()
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
+            raise unknown_scene(source)
+        data = parse_scene_text(resource.read_text(encoding="utf-8"), source)
     if isinstance(data, Mapping) and data.get("dimension") == 3:
         _refuse_spatial(source)
-    scene = scene_from_dict(data)  # the values given are checked first
-    _check_required(data, str(source))
-    return scene
+    return scene_from_dict(data, source=str(source))
 
 
 #: What a scene file must say: no default would be the robot or the motion its author meant.
@@ -1064,21 +1158,54 @@ REQUIRED_TABLES: dict[str, str] = {
 }
 
 
-def _check_required(data: Mapping[str, Any], source: str) -> None:
-    """Refuse a scene file that leaves out a table it cannot sensibly do without."""
+def _check_required_tables(data: Mapping[str, Any], source: str | None) -> None:
+    """Refuse a planar scene file that leaves out a table it cannot sensibly do without."""
     missing = [name for name in REQUIRED_TABLES if name not in data]
-    if "pulleys" in missing and "pulley" in data and "center" in data["pulley"]:
+    if "pulleys" in missing and isinstance(data.get("pulley"), Mapping) and "center" in data["pulley"]:
         missing.remove("pulleys")
     if missing:
-        raise SceneError(f"scene {source!r} lacks {', '.join(missing)}: a scene file must give "
+        where = "scene" if source is None else f"scene {shown(source)}"
+        raise SceneError(f"{where} lacks {', '.join(missing)}: a scene file must give "
                          + "; ".join(REQUIRED_TABLES[name] for name in missing)
                          + " (see the scene reference in the README)")
 
 
+def shipped_names(folder: str | None = None) -> list[str]:
+    """Names of the scenes shipped in the package's ``scenes`` folder (or its sub-folder ``folder``)."""
+    files = resources.files("cdpr_exu.scenes")
+    files = files if folder is None else files.joinpath(folder)
+    return sorted(p.name[:-5].replace("_", "-") for p in files.iterdir() if p.name.endswith(".toml"))
+
+
 def shipped_scenes() -> list[str]:
-    """Names of the scenes shipped with the package."""
-    folder = resources.files("cdpr_exu.scenes")
-    return sorted(p.name[:-5].replace("_", "-") for p in folder.iterdir() if p.name.endswith(".toml"))
+    """Names of the planar scenes shipped with the package."""
+    return shipped_names()
+
+
+def closest_names(name: str, names: list[str]) -> list[str]:
+    """The names a misspelt ``name`` most likely meant: those that contain it, else those whose
+    similarity (difflib's ratio) is at least 0.6 and within 0.1 of the best, the closest first."""
+    import difflib
+
+    key = name.replace("_", "-").lower()
+    if len(key) >= 3 and any(key in n for n in names):
+        return [n for n in names if key in n]
+    scores = {n: difflib.SequenceMatcher(None, key, n).ratio() for n in names}
+    floor = max(0.6, max(scores.values(), default=0.0) - 0.1)
+    return sorted((n for n in names if scores[n] >= floor), key=lambda n: -scores[n])
+
+
+def unknown_scene(source: str | Path) -> SceneError:
+    """The refusal of a scene name that no shipped scene has: it lists every shipped scene, planar and
+    spatial (``cdpr scenes``), after the likeliest (:func:`closest_names`), e.g. "did you mean 'spatial-cogiro'?"."""
+    from cdpr_exu.scenes.spatial_scene import SPATIAL_FOLDER
+
+    name = str(source)
+    planar, spatial = shipped_names(), shipped_names(SPATIAL_FOLDER)
+    close = closest_names(name, planar + spatial)
+    guess = f"did you mean {' or '.join(map(repr, close))}? " if close else ""
+    return SceneError(f"no scene named {shown(name)}; {guess}shipped scenes: {', '.join(planar)}; spatial: "
+                      f"{', '.join(spatial)} (or give the path of a .toml scene file)")
 
 
 def save_scene(scene: Scene, path: str | Path) -> Path:

@@ -33,7 +33,6 @@ message that says so.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
@@ -43,10 +42,13 @@ import numpy as np
 
 from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.geometry import above_exits
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
-from cdpr_exu.scenes.scene import (CableSpec, ControllerModel, Effects, Scene, SolverSpec, SpatialSceneError, WinchSpec,
-                                  _build, _override, _per_cable, controller_model_from_dict, load_scene)
-from cdpr_exu.core.validation import non_negative, positive, vector
+from cdpr_exu.scenes.scene import (MAX_ELEMENTS, CableSpec, ControllerModel, Effects, Scene, SolverSpec,
+                                  SpatialSceneError, WinchSpec, _build, _override, _per_cable, check_weight,
+                                  controller_model_from_dict, is_scene_file, load_scene, missing_fields,
+                                  parse_scene_text, read_scene_file, refuse_missing, shipped_names, unknown_scene)
+from cdpr_exu.core.validation import non_negative, positive, shown, vector
 
 __all__ = ["SpatialPlatformSpec", "SwivelSpec", "SpatialScene", "spatial_scene_from_dict", "load_spatial_scene",
            "shipped_spatial_scenes", "is_spatial", "load_any_scene", "any_scene_from_dict", "save_any_scene"]
@@ -62,31 +64,36 @@ class SpatialPlatformSpec:
     Parameters
     ----------
     mass : float [kg]
-    inertia : (float, float, float) [kg m^2]
+    inertia : (float, float, float) or None [kg m^2]
         Principal moments of inertia about the centre of mass, along the platform axes
-        (positive for a rigid platform).
+        (positive for a rigid platform). None (not given): zero for a point mass; refused
+        for a rigid platform, whose turning it decides.
     anchors : sequence of (x, y, z) [m]
         Cable anchor points in the platform frame (centre of mass at 0), one per cable.
     """
 
     mass: float = 1.0
-    inertia: tuple = (0.0, 0.0, 0.0)
+    inertia: tuple | None = None
     anchors: tuple = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "mass", non_negative("platform.mass", self.mass))
-        inertia = vector("platform.inertia", self.inertia, 3, " (principal moments) [kg m^2]")
-        if np.any(inertia < 0.0):
-            raise SceneError(f"platform.inertia must be zero or positive, got {self.inertia!r}")
-        object.__setattr__(self, "inertia", tuple(float(v) for v in inertia))
-        if isinstance(self.anchors, (str, bytes, Mapping)):
-            raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {self.anchors!r}")
+        object.__setattr__(self, "mass", non_negative("platform.mass", self.mass, "kg"))
+        if isinstance(self.anchors, (str, bytes, Mapping)) or not isinstance(self.anchors, (list, tuple, np.ndarray)):
+            raise SceneError(f"platform.anchors must be a list of (x, y, z) points, got {shown(self.anchors)}")
         anchors = tuple(tuple(float(v) for v in vector(f"platform.anchors[{i}]", a, 3, " (x, y, z) [m]"))
                         for i, a in enumerate(self.anchors))
         object.__setattr__(self, "anchors", anchors)
+        if self.inertia is None:
+            if not self.is_point_mass:
+                refuse_missing(missing_fields("platform", {}, ("inertia",)))
+            object.__setattr__(self, "inertia", (0.0, 0.0, 0.0))
+        inertia = vector("platform.inertia", self.inertia, 3, " (principal moments) [kg m^2]")
+        if np.any(inertia < 0.0):
+            raise SceneError(f"platform.inertia must be zero or positive, got {shown(self.inertia)}")
+        object.__setattr__(self, "inertia", tuple(float(v) for v in inertia))
         if not self.is_point_mass and (self.mass <= 0.0 or min(self.inertia) <= 0.0):
             raise SceneError(f"a rigid platform (an anchor off its centre of mass) needs platform.mass > 0 and "
-                             f"every platform.inertia > 0, got mass {self.mass!r}, inertia {self.inertia!r}")
+                             f"every platform.inertia > 0, got mass {shown(self.mass)}, inertia {shown(self.inertia)}")
 
     @property
     def is_point_mass(self) -> bool:
@@ -138,7 +145,7 @@ class SwivelSpec:
     winch_line: float = 0.3
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "winch_line", positive("swivel.winch_line", self.winch_line))
+        object.__setattr__(self, "winch_line", positive("swivel.winch_line", self.winch_line, "m"))
         pulley = self.pulley()  # refuses bad fields, naming them swivel.<field>
         for name in ("inlet", "radius", "contact_stiffness", "contact_damping", "swivel_inertia", "bearing_damping",
                      "groove_radius", "flange_height"):
@@ -166,7 +173,7 @@ def _exit_from_dict(entry: Any, index: int):
     """One ``[[exits]]`` table: a point (3-tuple) or a :class:`SwivelSpec`."""
     path = f"exits[{index}]"
     if not isinstance(entry, Mapping):
-        raise SceneError(f"{path} must be a table, got {entry!r}")
+        raise SceneError(f"{path} must be a table, got {shown(entry)}")
     entry = dict(entry)
     kind = entry.pop("kind", "point")
     if kind == "point":
@@ -176,7 +183,7 @@ def _exit_from_dict(entry: Any, index: int):
         return entry["point"]
     if kind == "swivel":
         return _build(SwivelSpec, entry, path)
-    raise SceneError(f"{path}.kind must be 'point' or 'swivel', got {kind!r}")
+    raise SceneError(f"{path}.kind must be 'point' or 'swivel', got {shown(kind)}")
 
 
 @dataclass(frozen=True)
@@ -241,29 +248,30 @@ class SpatialScene:
 
     def __post_init__(self) -> None:
         if not self.cables or not all(isinstance(c, CableSpec) for c in self.cables):
-            raise SceneError(f"cables must be a non-empty list of cable tables, got {self.cables!r}")
+            raise SceneError(f"cables must be a non-empty list of cable tables, got {shown(self.cables)}")
         object.__setattr__(self, "cables", tuple(self.cables))
         self._set_swivels()
         exits = tuple(tuple(float(v) for v in vector(f"exits[{i}].point", e, 3, " (x, y, z) [m]"))
                       for i, e in enumerate(self.exits))
         object.__setattr__(self, "exits", exits)
-        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
+        object.__setattr__(self, "gravity", non_negative("gravity", self.gravity, "m/s^2"))
+        check_weight(self.platform.mass, self.gravity)
         m = len(self.cables)
         if len(exits) != m:
             raise SceneError(f"exits must give one exit point per cable ({m}), got {len(exits)}")
         if len(self.platform.anchors) != m:
             raise SceneError(f"platform.anchors must give one anchor per cable ({m}), got {len(self.platform.anchors)}")
         if not isinstance(self.effects, Effects):
-            raise SceneError(f"effects must be an effects table, got {self.effects!r}")
+            raise SceneError(f"effects must be an effects table, got {shown(self.effects)}")
         if not (self.effects.cable_mass and self.effects.axial_elasticity):
-            raise SceneError(f"effects.preset = {self.effects.preset!r}: a spatial scene needs lumped, elastic cables "
+            raise SceneError(f"effects.preset = {shown(self.effects.preset)}: a spatial scene needs lumped, elastic cables "
                              "(effects.cable_mass and effects.axial_elasticity); use the 'full' or 'catenary' preset")
         first = self.cables[0]
         for i, cable in enumerate(self.cables[1:], start=1):
             for name in ("n_elements", "radius", "youngs_modulus", "damping_constant", "mass_lumping"):
                 if getattr(cable, name) != getattr(first, name):
-                    raise SceneError(f"cables[{i}].{name} = {getattr(cable, name)!r} differs from cables[0].{name} = "
-                                     f"{getattr(first, name)!r}: the cables of a spatial scene share one "
+                    raise SceneError(f"cables[{i}].{name} = {shown(getattr(cable, name))} differs from cables[0].{name} = "
+                                     f"{shown(getattr(first, name))}: the cables of a spatial scene share one "
                                      "discretisation, damping and bending so far")
         self.catenary_platform()  # refuses coincident exits, too few cables, anchors on one line
         if self.winch.kind == "servo":
@@ -272,7 +280,7 @@ class SpatialScene:
             raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
         if self.controller_model is not None:
             if not isinstance(self.controller_model, ControllerModel):
-                raise SceneError(f"controller_model must be a controller-model table, got {self.controller_model!r}")
+                raise SceneError(f"controller_model must be a controller-model table, got {shown(self.controller_model)}")
             if self.controller_model.pulley or self.controller_model.pulleys:
                 raise SceneError("controller_model.pulley / controller_model.pulleys: a spatial scene has exits, "
                                  "not pulleys; its controller model overrides cable, cables, platform and gravity")
@@ -312,7 +320,7 @@ class SpatialScene:
         m = len(self.cables)
         swivels = tuple(self.swivels) if self.swivels else (None,) * len(self.exits)
         if len(swivels) != len(self.exits) or not all(s is None or isinstance(s, SwivelSpec) for s in swivels):
-            raise SceneError(f"swivels must give a SwivelSpec or None per exit ({len(self.exits)}), got {self.swivels!r}")
+            raise SceneError(f"swivels must give a SwivelSpec or None per exit ({len(self.exits)}), got {shown(self.swivels)}")
         exits = list(self.exits)
         for i, swivel in enumerate(swivels):
             if swivel is None:
@@ -320,20 +328,23 @@ class SpatialScene:
             if exits[i] is None or isinstance(exits[i], SwivelSpec):
                 exits[i] = swivel.inlet
             elif np.any(np.asarray(exits[i], dtype=float) != np.asarray(swivel.inlet)):
-                raise SceneError(f"exits[{i}].inlet = {list(swivel.inlet)} differs from exits[{i}] = {exits[i]!r}: "
+                raise SceneError(f"exits[{i}].inlet = {list(swivel.inlet)} differs from exits[{i}] = {shown(exits[i])}: "
                                  "a swivel pulley's cable leaves the frame at its inlet")
             if swivel.radius >= self.cables[min(i, m - 1)].unstrained_length:
-                raise SceneError(f"exits[{i}].radius = {swivel.radius!r} m: the cable (cables[{i}].unstrained_length = "
-                                 f"{self.cables[min(i, m - 1)].unstrained_length!r} m) would not reach past the disc")
+                raise SceneError(f"exits[{i}].radius = {shown(swivel.radius)} m: the cable (cables[{i}].unstrained_length = "
+                                 f"{shown(self.cables[min(i, m - 1)].unstrained_length)} m) would not reach past the disc")
             from cdpr_exu.physics.swivel_pulley import SAFE_ELEMENT_FRACTION
 
             cable = self.cables[min(i, m - 1)]
             if cable.element_length > SAFE_ELEMENT_FRACTION * swivel.radius * (1.0 + 1e-9):
+                needed = cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius)
+                give = (f"give at least {math.ceil(needed)}" if needed <= MAX_ELEMENTS else
+                        f"it would take {needed:.3g}, more than the {MAX_ELEMENTS} allowed: give a larger radius")
                 raise SceneError(
                     f"cables[{i}].n_elements = {cable.n_elements}: its elements ({cable.element_length:.4g} m) are longer "
-                    f"than {SAFE_ELEMENT_FRACTION:g} of the swivel pulley's radius (exits[{i}].radius = {swivel.radius!r} "
-                    f"m); give at least {math.ceil(cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius))} "
-                    "(measured: coarser chains lose the wrap and gain energy, and Exudyn's static solver fails)")
+                    f"than {SAFE_ELEMENT_FRACTION:g} of the swivel pulley's radius (exits[{i}].radius = {shown(swivel.radius)} "
+                    f"m); {give} (measured: coarser chains lose the wrap and gain energy, and Exudyn's static solver "
+                    "fails)")
         object.__setattr__(self, "exits", tuple(exits))
         object.__setattr__(self, "swivels", swivels if any(s is not None for s in swivels) else ())
 
@@ -350,6 +361,26 @@ class SpatialScene:
     def pulley_radii(self) -> np.ndarray:
         """Each exit's pulley radius [m], 0 for a point exit, shape (m,) (the ideal kinematics' ``pulley_radii``)."""
         return np.array([0.0 if s is None else s.radius for s in self.swivel_exits])
+
+    @property
+    def exit_tops(self) -> np.ndarray:
+        """Height [m] of the highest point each cable can leave its exit from, shape (m,): an exit point's
+        height, a swivel pulley's inlet height plus its radius (:func:`cdpr_exu.core.geometry.above_exits`)."""
+        return np.asarray(self.exits, dtype=float)[:, 2] + self.pulley_radii
+
+    def anchor_heights(self, position, rotation=None) -> np.ndarray:
+        """Height [m] of each anchor, shape (m,), with the platform's centre of mass at ``position`` (3,) [m]
+        and its frame turned by ``rotation`` (3, 3) (default: not turned)."""
+        anchors = np.asarray(self.platform.anchors, dtype=float)
+        turned = anchors if rotation is None else anchors @ np.asarray(rotation, dtype=float).T
+        return float(position[2]) + turned[:, 2]
+
+    def above_exits(self, position, rotation=None) -> str | None:
+        """Why no cable can hold the platform at this pose (every anchor at or above its exit's top), or
+        None (:func:`cdpr_exu.core.geometry.above_exits`); None also when the platform has no weight."""
+        if self.gravity == 0.0 or not self.effects.gravity:
+            return None
+        return above_exits(self.anchor_heights(position, rotation), self.exit_tops, exits="exits")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (TOML-ready) of the scene; :func:`spatial_scene_from_dict` reads it back."""
@@ -384,9 +415,14 @@ class SpatialScene:
         """The scene as elastic catenaries (:mod:`cdpr_exu.physics.spatial_statics`)."""
         gravity = self.gravity if self.effects.gravity else 0.0
         weighs = self.effects.cable_mass and self.effects.gravity
-        cables = [SpatialCable(e, c.linear_density * gravity if weighs else 0.0, c.axial_rigidity, anchor=a,
-                               pulley_radius=r)
-                  for c, e, a, r in zip(self.cables, self.exits, self.platform.anchors, self.pulley_radii)]
+        weights = [c.linear_density * gravity if weighs else 0.0 for c in self.cables]
+        for i, (cable, weight) in enumerate(zip(self.cables, weights)):
+            if not math.isfinite(weight):
+                raise SceneError(f"cables[{i}].linear_density = {shown(cable.linear_density)} kg/m and gravity = "
+                                 f"{shown(gravity)} m/s^2 give a weight per length of {shown(weight)} N/m, out of "
+                                 "floating-point range")
+        cables = [SpatialCable(e, w, c.axial_rigidity, anchor=a, pulley_radius=r)
+                  for c, w, e, a, r in zip(self.cables, weights, self.exits, self.platform.anchors, self.pulley_radii)]
         return SpatialPlatform(cables, self.platform.mass, gravity, self.platform.inertia)
 
     def chain_spec(self, anchor_spring_factor: float | None = None, tension_only: bool | None = None):
@@ -413,42 +449,47 @@ def is_spatial(scene: Any) -> bool:
     return getattr(scene, "dimension", 2) == 3
 
 
-def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
+def spatial_scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> SpatialScene:
     """Make a validated SpatialScene from plain data (as read from TOML).
 
     ``[cable]`` holds values shared by every cable; ``[[cables]]`` entries override them
     one by one (at least one entry per cable). ``[[exits]]`` give each cable's exit
-    ``point``; ``[effects]`` may name a ``preset`` and override single effects.
+    ``point``; ``[effects]`` may name a ``preset`` and override single effects. The values
+    given are checked first; then the fields a scene must give are required (each cable's
+    ``unstrained_length``, a swivel's ``inlet`` and ``radius``, the platform's ``mass``,
+    ``anchors`` and, with an anchor off its centre, ``inertia``). ``source`` names the file
+    in that message.
     """
     if not isinstance(data, Mapping):
-        raise SceneError(f"a scene must be a table (mapping), got {data!r}")
+        raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
     known = {"name", "description", "dimension", "gravity", "cable", "cables", "exits", "platform", "effects",
              "trajectory", "solver", "winch", "controller_model"}
     unknown = set(data) - known
     if unknown:
         raise SceneError(f"spatial scene has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
     if data.get("dimension") != 3:
-        raise SceneError(f"a spatial scene says dimension = 3, got {data.get('dimension')!r}")
+        raise SceneError(f"dimension must be 3 for a spatial scene, got {shown(data.get('dimension'))}")
     for table in ("cables", "exits", "platform"):
         if table not in data:
-            raise SceneError(f"spatial scene lacks {table}: give [[cables]] (one per cable, at least its "
-                             "unstrained_length), [[exits]] (each with a point) and [platform] (mass, anchors)")
+            raise SceneError(f"scene lacks {table}: a spatial scene must give [[cables]] (one per cable, at least "
+                             "its unstrained_length), [[exits]] (each with a point) and [platform] (mass, anchors)")
     exits = data["exits"]
     if not isinstance(exits, list):
         raise SceneError(f"exits must be an array of tables, each a point exit (point = [x, y, z]) or a swivel "
-                         f"pulley (kind = 'swivel', inlet = [x, y, z], radius, ...), got {exits!r}")
+                         f"pulley (kind = 'swivel', inlet = [x, y, z], radius, ...), got {shown(exits)}")
+    exit_dicts = exits
     exits = [_exit_from_dict(e, i) for i, e in enumerate(exits)]
     swivels = tuple(e if isinstance(e, SwivelSpec) else None for e in exits)
-    cables = tuple(_build(CableSpec, c, f"cables[{i}]")
-                   for i, c in enumerate(_per_cable(data, "cable", "cables", [])))
+    cable_dicts = _per_cable(data, "cable", "cables", [])
+    cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
     effects_data = data.get("effects", {})
     if not isinstance(effects_data, Mapping):
-        raise SceneError(f"effects must be a table, got {effects_data!r}")
+        raise SceneError(f"effects must be a table, got {shown(effects_data)}")
     effects_data = dict(effects_data)
     effects = Effects.from_preset(effects_data.pop("preset", "full"), **effects_data)
+    platform = _build(SpatialPlatformSpec, data["platform"], "platform")
     kwargs: dict[str, Any] = dict(cables=cables, exits=tuple(None if isinstance(e, SwivelSpec) else e for e in exits),
-                                  swivels=swivels if any(swivels) else (),
-                                  platform=_build(SpatialPlatformSpec, data["platform"], "platform"), effects=effects,
+                                  swivels=swivels if any(swivels) else (), platform=platform, effects=effects,
                                   solver=_build(SolverSpec, data.get("solver", {}), "solver"),
                                   winch=_build(WinchSpec, data.get("winch", {}), "winch"))
     if "trajectory" in data:
@@ -460,38 +501,45 @@ def spatial_scene_from_dict(data: Mapping[str, Any]) -> SpatialScene:
     for key in ("name", "description", "gravity"):
         if key in data:
             kwargs[key] = data[key]
+    refuse_missing(_spatial_missing(cable_dicts, exit_dicts, swivels, data["platform"], platform), source)
     return SpatialScene(**kwargs)
+
+
+def _spatial_missing(cable_dicts, exit_dicts, swivels, platform_data, platform: SpatialPlatformSpec) -> list[str]:
+    """The required fields (:data:`cdpr_exu.scenes.scene.REQUIRED_FIELDS`) a spatial scene's plain data
+    leaves out: each cable's length, each swivel pulley's inlet and radius (a point exit's point is
+    checked with its table), the platform's mass and anchors, and its inertia when an anchor is off
+    its centre of mass."""
+    missing = [field_ for i, c in enumerate(cable_dicts)
+               for field_ in missing_fields(f"cables[{i}]", c, ("unstrained_length",))]
+    for i, (entry, swivel) in enumerate(zip(exit_dicts, swivels)):
+        if swivel is not None:
+            missing += missing_fields(f"exits[{i}]", entry, ("inlet", "radius"))
+    names = ("mass", "anchors") + (() if platform.is_point_mass else ("inertia",))
+    return missing + missing_fields("platform", platform_data, names)
 
 
 def shipped_spatial_scenes() -> list[str]:
     """Names of the spatial scenes shipped with the package."""
-    folder = resources.files("cdpr_exu.scenes").joinpath(SPATIAL_FOLDER)
-    return sorted(p.name[:-5].replace("_", "-") for p in folder.iterdir() if p.name.endswith(".toml"))
+    return shipped_names(SPATIAL_FOLDER)
 
 
 def shipped_spatial_text(name: str) -> str | None:
     """The TOML text of the shipped spatial scene ``name``, or None."""
     resource = resources.files("cdpr_exu.scenes").joinpath(SPATIAL_FOLDER, str(name).replace("-", "_") + ".toml")
-    return resource.read_text() if resource.is_file() else None
+    return resource.read_text(encoding="utf-8") if resource.is_file() else None
 
 
 def load_spatial_scene(source: str | Path) -> SpatialScene:
     """Load a spatial scene by shipped name (e.g. ``"spatial-four-cable"``) or from a TOML file path."""
-    path = Path(source)
-    if path.suffix == ".toml" or path.exists():
-        if not path.is_file():
-            raise SceneError(f"scene file {str(path)!r} does not exist")
-        text = path.read_text()
+    if is_scene_file(source):
+        data = read_scene_file(source)
     else:
         text = shipped_spatial_text(str(source))
         if text is None:
-            raise SceneError(f"no spatial scene named {str(source)!r}; shipped spatial scenes: "
-                             f"{', '.join(shipped_spatial_scenes())}")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise SceneError(f"scene {str(source)!r} is not valid TOML: {err}") from None
-    return spatial_scene_from_dict(data)
+            raise unknown_scene(source)
+        data = parse_scene_text(text, source)
+    return spatial_scene_from_dict(data, source=str(source))
 
 
 def load_any_scene(source: str | Path) -> Scene | SpatialScene:

@@ -40,6 +40,7 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.validation import shown
 from cdpr_exu.scenes.trajectories import (PointToPointMotion, ReferenceTrajectory, _finite_float, _finite_tuple,
                                           _times, circle_phase, quarter_turn_times)
 
@@ -125,14 +126,14 @@ class SpatialCircleTrajectory(SpatialTrajectory):
         object.__setattr__(self, "center", _finite_tuple("trajectory.center", self.center, 3))
         radius = _finite_float("trajectory.radius", self.radius)
         if radius < 0.0:
-            raise SceneError(f"trajectory.radius must be >= 0 [m], got {self.radius!r}")
+            raise SceneError(f"trajectory.radius must be >= 0 [m], got {shown(self.radius)}")
         object.__setattr__(self, "radius", radius)
         object.__setattr__(self, "angular_rate", _finite_float("trajectory.angular_rate", self.angular_rate))
         object.__setattr__(self, "rotation", _finite_tuple("trajectory.rotation", self.rotation, 3))
         object.__setattr__(self, "tilt", _finite_tuple("trajectory.tilt", self.tilt, 3))
         ramp_time = _finite_float("trajectory.ramp_time", self.ramp_time)
         if ramp_time < 0.0:
-            raise SceneError(f"trajectory.ramp_time must be >= 0 [s], got {self.ramp_time!r}")
+            raise SceneError(f"trajectory.ramp_time must be >= 0 [s], got {shown(self.ramp_time)}")
         object.__setattr__(self, "ramp_time", ramp_time)
 
     def turning_times(self, end_time: float) -> np.ndarray:
@@ -238,7 +239,7 @@ class SpatialPointToPointTrajectory(PointToPointMotion, SpatialTrajectory):
         object.__setattr__(self, "end", _finite_tuple("trajectory.end", self.end, POSE_SIZE))
         duration = _finite_float("trajectory.duration", self.duration)
         if duration <= 0.0:
-            raise SceneError(f"trajectory.duration must be > 0 [s], got {self.duration!r}")
+            raise SceneError(f"trajectory.duration must be > 0 [s], got {shown(self.duration)}")
         object.__setattr__(self, "duration", duration)
         object.__setattr__(self, "start_time", _finite_float("trajectory.start_time", self.start_time))
 
@@ -282,20 +283,20 @@ def spatial_trajectory_from_dict(data):
         field is missing, or a value is invalid.
     """
     if not hasattr(data, "keys"):
-        raise SceneError(f"trajectory must be a table (dict), got {data!r}")
+        raise SceneError(f"trajectory must be a table (dict), got {shown(data)}")
     values = dict(data)
     kind = values.pop("kind", None)
     if not isinstance(kind, str) or kind not in _KINDS:
-        raise SceneError(f"trajectory.kind must be one of {sorted(_KINDS)}, got {kind!r}")
+        raise SceneError(f"trajectory.kind must be one of {sorted(_KINDS)}, got {shown(kind)}")
     cls = _KINDS[kind]
     # the dict keys: the field names, except hold's ``pose`` (its field is held_pose)
     allowed = sorted("pose" if field.name == "held_pose" else field.name for field in dataclass_fields(cls))
     unknown = sorted(set(values) - set(allowed))
     if unknown:
-        raise SceneError(f"trajectory of kind {kind!r} has unknown key(s) {unknown}; allowed: {allowed}")
+        raise SceneError(f"trajectory of kind {shown(kind)} has unknown key(s) {unknown}; allowed: {allowed}")
     missing = [name for name in REQUIRED_FIELDS[kind] if name not in values]
     if missing:
-        raise SceneError(f"trajectory.{missing[0]} is required for kind {kind!r} ({_WHAT[missing[0]]}); "
+        raise SceneError(f"trajectory.{missing[0]} is required for kind {shown(kind)} ({_WHAT[missing[0]]}); "
                          f"it has no sensible default")
     if cls is SpatialHoldTrajectory:
         values["held_pose"] = values.pop("pose")

@@ -12,7 +12,6 @@ The paper's reference (scenario 1) is ``CircleTrajectory()``:
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from dataclasses import fields as dataclass_fields
@@ -20,6 +19,7 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.validation import finite, shown
 
 __all__ = [
     "Trajectory",
@@ -34,22 +34,17 @@ __all__ = [
 # argument checks
 # ----------------------------------------------------------------------------------
 def _finite_float(name, value):
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as exc:
-        raise SceneError(f"{name} must be a finite number, got {value!r}") from exc
-    if not math.isfinite(number):
-        raise SceneError(f"{name} must be finite, got {value!r}")
-    return number
+    """``value`` as a finite float: the scenes' one number check (text and booleans refused)."""
+    return finite(name, value)
 
 
 def _finite_tuple(name, value, size):
     try:
         items = tuple(value)
     except TypeError as exc:
-        raise SceneError(f"{name} must be a sequence of {size} numbers, got {value!r}") from exc
+        raise SceneError(f"{name} must be a sequence of {size} numbers, got {shown(value)}") from exc
     if len(items) != size:
-        raise SceneError(f"{name} must have {size} entries, got {value!r}")
+        raise SceneError(f"{name} must have {size} entries, got {shown(value)}")
     return tuple(_finite_float(f"{name}[{i}]", item) for i, item in enumerate(items))
 
 
@@ -140,12 +135,29 @@ def circle_phase(t, angular_rate: float, ramp_time: float):
             angular_rate * blend_rate / ramp_time)
 
 
+#: Most quarter turns of a circle a reference check samples (25 000 turns): beyond, the
+#: reference turns faster than any robot could follow, and the samples would not fit in memory.
+MAX_QUARTER_TURNS = 100_000
+
+
 def quarter_turn_times(end_time: float, angular_rate: float, ramp_time: float, moves: bool) -> np.ndarray:
     """Times [s] where a circle's phase is a multiple of pi/2, up to ``end_time``; none for a
-    ramped (no closed form), standing or motionless (``moves`` false) circle."""
+    ramped (no closed form), standing or motionless (``moves`` false) circle.
+
+    Raises
+    ------
+    SceneError
+        Naming trajectory.angular_rate when the circle makes more than :data:`MAX_QUARTER_TURNS`
+        quarter turns before ``end_time``.
+    """
     if ramp_time > 0.0 or angular_rate == 0.0 or not moves:
         return np.zeros(0)
-    return np.arange(0.0, end_time + 1e-12, 0.5 * np.pi / abs(angular_rate))
+    quarter = 0.5 * np.pi / abs(angular_rate)
+    if end_time / quarter > MAX_QUARTER_TURNS:
+        raise SceneError(f"trajectory.angular_rate = {shown(angular_rate)} rad/s makes {end_time / quarter:.3g} quarter "
+                         f"turns in {shown(end_time)} s, more than the {MAX_QUARTER_TURNS} a reference check samples "
+                         "(a circle far faster than any robot)")
+    return np.arange(0.0, end_time + 1e-12, quarter)
 
 
 @dataclass(frozen=True)
@@ -183,13 +195,13 @@ class CircleTrajectory(Trajectory):
         object.__setattr__(self, "center", _finite_tuple("trajectory.center", self.center, 2))
         radius = _finite_float("trajectory.radius", self.radius)
         if radius < 0.0:
-            raise SceneError(f"trajectory.radius must be >= 0 [m], got {self.radius!r}")
+            raise SceneError(f"trajectory.radius must be >= 0 [m], got {shown(self.radius)}")
         object.__setattr__(self, "radius", radius)
         object.__setattr__(self, "angular_rate", _finite_float("trajectory.angular_rate", self.angular_rate))
         object.__setattr__(self, "rotation", _finite_float("trajectory.rotation", self.rotation))
         ramp_time = _finite_float("trajectory.ramp_time", self.ramp_time)
         if ramp_time < 0.0:
-            raise SceneError(f"trajectory.ramp_time must be >= 0 [s], got {self.ramp_time!r}")
+            raise SceneError(f"trajectory.ramp_time must be >= 0 [s], got {shown(self.ramp_time)}")
         object.__setattr__(self, "ramp_time", ramp_time)
 
     def turning_times(self, end_time: float) -> np.ndarray:
@@ -317,7 +329,7 @@ class PointToPointTrajectory(PointToPointMotion, Trajectory):
         object.__setattr__(self, "end", _finite_tuple("trajectory.end", self.end, 3))
         duration = _finite_float("trajectory.duration", self.duration)
         if duration <= 0.0:
-            raise SceneError(f"trajectory.duration must be > 0 [s], got {self.duration!r}")
+            raise SceneError(f"trajectory.duration must be > 0 [s], got {shown(self.duration)}")
         object.__setattr__(self, "duration", duration)
         object.__setattr__(self, "start_time", _finite_float("trajectory.start_time", self.start_time))
 
@@ -352,11 +364,11 @@ def trajectory_from_dict(data):
         value is invalid.
     """
     if not hasattr(data, "keys"):
-        raise SceneError(f"trajectory must be a table (dict), got {data!r}")
+        raise SceneError(f"trajectory must be a table (dict), got {shown(data)}")
     values = dict(data)
     kind = values.pop("kind", None)
     if not isinstance(kind, str) or kind not in _KINDS:
-        raise SceneError(f"trajectory.kind must be one of {sorted(_KINDS)}, got {kind!r}")
+        raise SceneError(f"trajectory.kind must be one of {sorted(_KINDS)}, got {shown(kind)}")
     cls = _KINDS[kind]
     missing = [name for name in REQUIRED_FIELDS.get(kind, ()) if name not in values]
     if cls is HoldTrajectory and "pose" in values:
@@ -364,10 +376,10 @@ def trajectory_from_dict(data):
     allowed = {field.name for field in dataclass_fields(cls)}
     unknown = sorted(set(values) - allowed)
     if unknown:
-        shown = ["pose" if name == "held_pose" else name for name in sorted(allowed)]
-        raise SceneError(f"trajectory of kind {kind!r} has unknown key(s) {unknown}; allowed: {shown}")
+        names = ["pose" if name == "held_pose" else name for name in sorted(allowed)]
+        raise SceneError(f"trajectory of kind {shown(kind)} has unknown key(s) {unknown}; allowed: {names}")
     trajectory = cls(**values)  # the values given are checked first
     if missing:
-        raise SceneError(f"trajectory.{missing[0]} is required for kind {kind!r} (a pose x [m], z [m], "
+        raise SceneError(f"trajectory.{missing[0]} is required for kind {shown(kind)} (a pose x [m], z [m], "
                          f"rotation [rad]); it has no sensible default")
     return trajectory

@@ -43,7 +43,7 @@ from cdpr_exu.scenes.contact_models import CONTACT_MODELS
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import Pulley, rotation_matrix
 from cdpr_exu.statics.kinematics import initial_cable_nodes, straight_cable_nodes
-from cdpr_exu.core.validation import finite, vector
+from cdpr_exu.core.validation import finite, shown, vector
 
 __all__ = ["ChainCable", "ChainRobot", "ChainEquilibrium", "chain_robot", "solve_chain_statics",
            "chain_forces"]
@@ -88,14 +88,14 @@ class ChainCable:
         for name in ("element_length", "axial_stiffness"):
             value = finite(name, getattr(self, name))
             if value <= 0:
-                raise SceneError(f"{name} must be positive and finite, got {value!r}")
+                raise SceneError(f"{name} must be positive and finite, got {shown(value)}")
         for name in ("bending_stiffness", "contact_stiffness"):
             if finite(name, getattr(self, name)) < 0:
-                raise SceneError(f"{name} must be zero or positive, got {getattr(self, name)!r}")
+                raise SceneError(f"{name} must be zero or positive, got {shown(getattr(self, name))}")
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
-            raise SceneError(f"node_masses must be finite and non-negative, got {self.node_masses!r}")
+            raise SceneError(f"node_masses must be finite and non-negative, got {shown(self.node_masses)}")
         if not isinstance(self.pulley, Pulley):
-            raise SceneError(f"pulley must be a Pulley, got {self.pulley!r}")
+            raise SceneError(f"pulley must be a Pulley, got {shown(self.pulley)}")
         vector("anchor", self.anchor, 2)
 
     @property
@@ -145,13 +145,13 @@ def chain_robot(scene) -> ChainRobot:
     effects = scene.effects
     if not effects.cable_mass or not effects.axial_elasticity:
         raise SceneError("chain statics needs effects.cable_mass and effects.axial_elasticity "
-                         f"(the scene's preset is {effects.preset!r}); use the catenary statics instead")
+                         f"(the scene's preset is {shown(effects.preset)}); use the catenary statics instead")
     if effects.bending and effects.bending_model != "exact":
         raise SceneError("chain statics models the exact-angle bending only, "
-                         f"got effects.bending_model = {effects.bending_model!r}")
+                         f"got effects.bending_model = {shown(effects.bending_model)}")
     if scene.contact_model not in (None, CONTACT_MODELS["node"]):
         raise SceneError("chain statics models the node contact on pulleys only, got "
-                         f"effects.pulley_contact_model = {effects.pulley_contact_model!r}")
+                         f"effects.pulley_contact_model = {shown(effects.pulley_contact_model)}")
     gravity = scene.gravity if effects.gravity else 0.0
     cables = []
     for cable, pulley, exit_, anchor in zip(scene.cables, scene.pulleys, scene.exits, scene.platform.anchors):
@@ -711,7 +711,7 @@ def _solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rota
             raise SceneError("solve_chain_statics needs a guess or tension_guess")
         tension_guess = np.asarray(tension_guess, dtype=float)
         if tension_guess.shape != (m,) or not np.all(np.isfinite(tension_guess)) or np.any(tension_guess < 0):
-            raise SceneError(f"tension_guess must be {m} finite tensions >= 0 [N], got {tension_guess!r}")
+            raise SceneError(f"tension_guess must be {m} finite tensions >= 0 [N], got {shown(tension_guess)}")
         interior, paid_out = _straight_guess(robot, position, rotation, tension_guess)
     v = np.concatenate([interior, [rotation] if free_rotation else []])
     inner_iterations = 0

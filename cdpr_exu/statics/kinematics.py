@@ -12,7 +12,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import per_item
+from cdpr_exu.core.validation import per_item, shown
 from cdpr_exu.core.geometry import (
     PulleyExit,
     Pulley,
@@ -54,7 +54,7 @@ def _check_pulleys(n_cables, pulley_centers, pulley_radii, sides):
     radii = per_item("pulley_radii", pulley_radii, n_cables)
     sides_array = np.broadcast_to(np.asarray(sides), (n_cables,)) if np.ndim(sides) == 0 else np.asarray(sides)
     if sides_array.shape != (n_cables,):
-        raise SceneError(f"sides must have shape ({n_cables},), got {sides!r}")
+        raise SceneError(f"sides must have shape ({n_cables},), got {shown(sides)}")
     side_list = [check_side(f"sides[{i}]", value) for i, value in enumerate(sides_array)]
     return centers, radii, side_list
 
@@ -235,7 +235,7 @@ def straight_cable_nodes(start, end, n_elements):
 
 def _check_n_elements(n_elements):
     if isinstance(n_elements, bool) or not isinstance(n_elements, (int, np.integer)) or n_elements < 1:
-        raise SceneError(f"n_elements must be an integer >= 1, got {n_elements!r}")
+        raise SceneError(f"n_elements must be an integer >= 1, got {shown(n_elements)}")
     return int(n_elements)
 
 
@@ -290,7 +290,7 @@ def initial_cable_nodes(center, radius, side, anchor, element_length, n_elements
         raise SceneError(f"anchor must have shape (2,), got shape {anchor.shape}")
     element_length = finite_array("element_length", element_length)
     if element_length.ndim != 0 or element_length <= 0.0:
-        raise SceneError(f"element_length must be a scalar > 0 [m], got {element_length!r}")
+        raise SceneError(f"element_length must be a scalar > 0 [m], got {shown(element_length)}")
     element_length = float(element_length)
     n_elements = _check_n_elements(n_elements)
 

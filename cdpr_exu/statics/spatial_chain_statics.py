@@ -47,7 +47,7 @@ import scipy.sparse as sparse
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector, skew
-from cdpr_exu.core.validation import finite, vector
+from cdpr_exu.core.validation import finite, shown, vector
 from cdpr_exu.physics import axial_3d, bending_3d
 from cdpr_exu.physics import swivel_pulley as sp
 from cdpr_exu.statics.chain_statics import descent_step
@@ -113,19 +113,19 @@ class SpatialChainCable:
         for name in ("element_length", "axial_stiffness"):
             value = finite(name, getattr(self, name))
             if value <= 0:
-                raise SceneError(f"{name} must be positive and finite, got {value!r}")
+                raise SceneError(f"{name} must be positive and finite, got {shown(value)}")
         if finite("bending_stiffness", self.bending_stiffness) < 0:
-            raise SceneError(f"bending_stiffness must be zero or positive, got {self.bending_stiffness!r}")
+            raise SceneError(f"bending_stiffness must be zero or positive, got {shown(self.bending_stiffness)}")
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
-            raise SceneError(f"node_masses must be finite and non-negative, got {self.node_masses!r}")
+            raise SceneError(f"node_masses must be finite and non-negative, got {shown(self.node_masses)}")
         if self.swivel is not None and not isinstance(self.swivel, sp.SwivelPulley):
-            raise SceneError(f"swivel must be a SwivelPulley or None, got {self.swivel!r}")
+            raise SceneError(f"swivel must be a SwivelPulley or None, got {shown(self.swivel)}")
         if not 0 <= int(self.winch_elements) <= len(self.node_masses) - 3 or (self.swivel is None) != (
                 self.winch_elements == 0):
             raise SceneError(f"winch_elements must be 0 for a point exit and leave 2 elements above the inlet "
-                             f"over a swivel pulley, got {self.winch_elements!r}")
+                             f"over a swivel pulley, got {shown(self.winch_elements)}")
         if finite("winch_travel", self.winch_travel) != 0.0 and self.swivel is None:
-            raise SceneError(f"winch_travel must be 0 for a point exit, got {self.winch_travel!r}")
+            raise SceneError(f"winch_travel must be 0 for a point exit, got {shown(self.winch_travel)}")
 
     @property
     def n_elements(self) -> int:
@@ -171,12 +171,12 @@ class SpatialChainRobot:
 
     def __post_init__(self):
         if not self.cables or not all(isinstance(c, SpatialChainCable) for c in self.cables):
-            raise SceneError(f"cables must be a non-empty tuple of SpatialChainCable, got {self.cables!r}")
+            raise SceneError(f"cables must be a non-empty tuple of SpatialChainCable, got {shown(self.cables)}")
         object.__setattr__(self, "cables", tuple(self.cables))
         if finite("mass", self.mass) < 0 or finite("gravity", self.gravity) < 0:
-            raise SceneError(f"mass and gravity must be zero or positive, got {self.mass!r}, {self.gravity!r}")
+            raise SceneError(f"mass and gravity must be zero or positive, got {shown(self.mass)}, {shown(self.gravity)}")
         if self.anchor_spring_factor is not None and not finite("anchor_spring_factor", self.anchor_spring_factor) > 0:
-            raise SceneError(f"anchor_spring_factor must be positive or None, got {self.anchor_spring_factor!r}")
+            raise SceneError(f"anchor_spring_factor must be positive or None, got {shown(self.anchor_spring_factor)}")
 
     @property
     def is_point_mass(self) -> bool:
@@ -277,7 +277,7 @@ def spatial_chain_robot(scene, anchor_spring_factor: float | None = None, tensio
     effects = scene.effects
     if effects.bending and effects.bending_model != "exact":
         raise SceneError("spatial chain statics models the exact-angle bending only, "
-                         f"got effects.bending_model = {effects.bending_model!r}")
+                         f"got effects.bending_model = {shown(effects.bending_model)}")
     platform = scene.catenary_platform()  # what the builder builds from: weights, EA, gravity
     gravity = platform.gravity
     swivels = scene.swivel_exits
@@ -653,7 +653,7 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
     x = vector("position", position, 3)
     R = np.eye(3) if rotation is None or not model.rigid else np.asarray(rotation, float)
     if R.shape != (3, 3) or not np.allclose(R.T @ R, np.eye(3), atol=1e-9):
-        raise SceneError(f"rotation must be a 3 x 3 rotation matrix, got {rotation!r}")
+        raise SceneError(f"rotation must be a 3 x 3 rotation matrix, got {shown(rotation)}")
     if len(nodes) != len(robot.cables):
         raise SceneError(f"nodes must give one array per cable ({len(robot.cables)}), got {len(nodes)}")
     start = np.zeros((model.n_points, 3))
@@ -672,7 +672,7 @@ def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotat
         angles = np.asarray(swivel_angles, dtype=float)
         if angles.shape != (len(robot.cables),) or not np.all(np.isfinite(angles[model.swivel_cables])):
             raise SceneError(f"swivel_angles must give one finite angle per cable ({len(robot.cables)}, NaN "
-                             f"allowed at point exits), got {swivel_angles!r}")
+                             f"allowed at point exits), got {shown(swivel_angles)}")
         psi = angles[model.swivel_cables].copy()
     state = (start[model.free].ravel(), x, R, psi)
     energy = model.energy(*state)
@@ -770,7 +770,7 @@ def cable_paid_out(cable: SpatialChainCable, length: float) -> SpatialChainCable
     length (``winch_travel``, :attr:`SpatialChainCable.paid_out_length`), the cable running over the disc."""
     length = finite("length", length)
     if length <= 0:
-        raise SceneError(f"length must be positive [m], got {length!r}")
+        raise SceneError(f"length must be positive [m], got {shown(length)}")
     if cable.swivel is not None:
         return replace(cable, winch_travel=cable.winch_travel + length - cable.paid_out_length)
     scale = length / cable.unstrained_length
@@ -1189,19 +1189,19 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
     pose = real_array("pose", pose)
     rigid = not robot.is_point_mass
     if pose.shape != (6,) and not (not rigid and pose.shape == (3,)):
-        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {pose.tolist()!r}")
+        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {shown(pose.tolist())}")
     guess = real_array("tension_guess", tension_guess)
     if guess.shape != (m,) or np.any(guess <= 0.0):
-        raise SceneError(f"tension_guess must be one positive tension per cable, got {tension_guess!r}")
+        raise SceneError(f"tension_guess must be one positive tension per cable, got {shown(tension_guess)}")
     lengths = real_array("lengths", lengths)
     if lengths.shape != (m,) or np.any(lengths <= 0.0):
-        raise SceneError(f"lengths must be one positive length per cable, got {lengths!r}")
+        raise SceneError(f"lengths must be one positive length per cable, got {shown(lengths)}")
     if len(nodes) != m:
         raise SceneError(f"nodes must give one array per cable ({m}), got {len(nodes)}")
     angles = np.full(m, np.nan) if swivel_angles is None else real_array("swivel_angles", swivel_angles, require_finite=False)
     if angles.shape != (m,):
         raise SceneError(f"swivel_angles must give one angle per cable ({m}, NaN: the anchor's azimuth), "
-                         f"got {swivel_angles!r}")
+                         f"got {shown(swivel_angles)}")
     wrench = np.zeros(6) if external_wrench is None else vector("external_wrench", external_wrench, 6)
     rotation = rotation_from_vector(pose[3:6]) if rigid else np.eye(3)
     arms = np.array([c.anchor for c in robot.cables]) @ rotation.T

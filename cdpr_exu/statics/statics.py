@@ -79,7 +79,7 @@ from cdpr_exu.physics.catenary import (
 )
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import Pulley, perpendicular, planar_cross, rotation_matrix
-from cdpr_exu.core.validation import finite, non_negative, positive, real_array, vector
+from cdpr_exu.core.validation import finite, non_negative, positive, real_array, shown, vector
 
 _RELATIVE_TOLERANCE = 1e-12
 
@@ -136,13 +136,13 @@ class SuspendedCable:
         object.__setattr__(self, "anchor", _point("anchor", self.anchor))
         if (self.exit_point is None) == (self.pulley is None):
             raise SceneError(
-                f"give exactly one of exit_point and pulley, got exit_point={self.exit_point!r}, "
-                f"pulley={self.pulley!r}"
+                f"give exactly one of exit_point and pulley, got exit_point={shown(self.exit_point)}, "
+                f"pulley={shown(self.pulley)}"
             )
         if self.exit_point is not None:
             object.__setattr__(self, "exit_point", _point("exit_point", self.exit_point))
         elif not isinstance(self.pulley, Pulley):
-            raise SceneError(f"pulley must be a Pulley, got {self.pulley!r}")
+            raise SceneError(f"pulley must be a Pulley, got {shown(self.pulley)}")
         elif self.pulley.is_point_exit:  # a pulley of radius 0 is a fixed exit point
             object.__setattr__(self, "exit_point", self.pulley.center)
             object.__setattr__(self, "pulley", None)
@@ -186,9 +186,9 @@ class SuspendedPlatform:
         try:
             cables = tuple(self.cables)
         except TypeError:
-            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {self.cables!r}") from None
+            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {shown(self.cables)}") from None
         if not cables or not all(isinstance(c, SuspendedCable) for c in cables):
-            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {self.cables!r}")
+            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {shown(self.cables)}")
         object.__setattr__(self, "cables", cables)
         object.__setattr__(self, "mass", non_negative("mass", self.mass))
         object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
@@ -750,14 +750,14 @@ def _lengths(platform, unstrained_lengths):
     try:
         lengths = np.asarray(unstrained_lengths, dtype=float)
     except (TypeError, ValueError):
-        raise SceneError(f"unstrained_lengths must be numbers [m], got {unstrained_lengths!r}") from None
+        raise SceneError(f"unstrained_lengths must be numbers [m], got {shown(unstrained_lengths)}") from None
     if lengths.shape != (len(platform.cables),):
         raise SceneError(
             f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
-            f"got {unstrained_lengths!r}"
+            f"got {shown(unstrained_lengths)}"
         )
     if not np.all(np.isfinite(lengths)) or np.any(lengths <= 0.0):
-        raise SceneError(f"unstrained_lengths must be positive and finite, got {unstrained_lengths!r}")
+        raise SceneError(f"unstrained_lengths must be positive and finite, got {shown(unstrained_lengths)}")
     return lengths
 
 
@@ -888,7 +888,7 @@ def solve_forward_statics(
         If an argument is invalid.
     """
     if not isinstance(platform, SuspendedPlatform):
-        raise SceneError(f"platform must be a SuspendedPlatform, got {platform!r}")
+        raise SceneError(f"platform must be a SuspendedPlatform, got {shown(platform)}")
     lengths = _lengths(platform, unstrained_lengths)
     wrench = _wrench(external_wrench)
     dof = platform.degrees_of_freedom
@@ -897,7 +897,7 @@ def solve_forward_statics(
     else:
         pose = real_array("initial_pose", initial_pose)
         if pose.shape not in ((2,), (3,)) or not np.all(np.isfinite(pose)):
-            raise SceneError(f"initial_pose must be (x, z) or (x, z, phi), got {initial_pose!r}")
+            raise SceneError(f"initial_pose must be (x, z) or (x, z, phi), got {shown(initial_pose)}")
         position, rotation = pose[:2], (float(pose[2]) if pose.size == 3 else 0.0)
     if dof == 2:
         rotation = 0.0
@@ -1064,7 +1064,7 @@ def solve_inverse_statics(
     n = len(platform.cables)
     if dof == 2:
         if rotation not in (None, 0, 0.0):
-            raise SceneError(f"a point-mass platform has no rotation, got rotation={rotation!r}")
+            raise SceneError(f"a point-mass platform has no rotation, got rotation={shown(rotation)}")
         free_rotation = False
         rotation = 0.0
     else:
@@ -1129,7 +1129,7 @@ def solve_inverse_statics(
     # cannot parametrise it) or far from the answer is retried at other rotations.
     if initial_guess is not None:
         if not isinstance(initial_guess, PlatformEquilibrium) or len(initial_guess.cables) != n:
-            raise SceneError(f"initial_guess must be a PlatformEquilibrium of this platform, got {initial_guess!r}")
+            raise SceneError(f"initial_guess must be a PlatformEquilibrium of this platform, got {shown(initial_guess)}")
         guessed = np.array([c.catenary.horizontal_tension for c in initial_guess.cables])
         if np.all(guessed > 0.0):
             horizontal = guessed

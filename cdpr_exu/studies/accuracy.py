@@ -702,12 +702,12 @@ def _cell(value: Any) -> str:
 
 def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> dict[str, Path]:
     """Write the CSV, JSON, tables, Pareto plot and the reference's series into ``out``."""
-    from cdpr_exu.core.output import write_npz, write_summary
+    from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
     from cdpr_exu.results.result import provenance
     from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_output_folder(out, command="study accuracy")
+    clear_outputs(out, "study accuracy")  # no file of an earlier accuracy study stays
     paths = {"scene": save_scene(base_scene, out / ACCURACY_FILES["scene"])}
     with open(out / ACCURACY_FILES["csv"], "w", newline="") as handle:
         writer = csv.writer(handle)
@@ -734,7 +734,9 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
                  for row in study.rows],
         **provenance(),
     }
-    write_summary(out, info, name=ACCURACY_FILES["json"])  # the date goes to timing.json
+    # The date goes to timing.json; the measured times stay: error against CPU time is what the study is about,
+    # so accuracy.csv / .json, tables.md and pareto.png change with every rerun (README, "Outputs").
+    write_summary(out, info, name=ACCURACY_FILES["json"], keep=("cpu_time_s", "wall_time_s", "real_time_factor"))
     paths["json"] = out / ACCURACY_FILES["json"]
     reference = study.series[reference_row["run"]]
     write_npz(out / ACCURACY_FILES["reference"], **reference)
@@ -971,7 +973,7 @@ def _cmd_accuracy(args: argparse.Namespace) -> int:
         grid = replace(grid, end_time=args.end_time)
     from cdpr_exu.core.output import check_output_folder
 
-    out = check_output_folder(args.out)
+    out = check_output_folder(args.out, command="study accuracy")
     start = time.perf_counter()
     study = run_accuracy_study(scene, grid, out=out, workers=args.workers, progress=not args.quiet,
                                comparison=args.compare)

@@ -3,7 +3,8 @@
 ``cdpr compare paper-circle --out results/controllers`` runs the scene under each
 controller of :data:`CONTROLLERS`, writes ``summary.json`` (keyed by controller name),
 ``comparison.md`` (a Markdown table), a ``pose.csv`` per controller and the figures
-``comparison_paths.png`` and ``comparison_errors.png``. Errors are actual - reference,
+``comparison_paths.png`` and ``comparison_errors.png``; each controller's wall time and
+real-time factor go to ``timing.json``, so that the other files are the same from run to run. Errors are actual - reference,
 measured after the start-up (``--after``, default 1 s).
 
 By default the comparison starts a circle reference smoothly from rest
@@ -28,7 +29,7 @@ from controllers.tension_aware import ClosedLoopTensionAwareController, TensionA
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import fixed
-from cdpr_exu.results.result import Result, provenance
+from cdpr_exu.results.result import Result, provenance, raise_warnings, warning_flags
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
                                       ilc_controller, model_feed_forward_controller)
@@ -84,8 +85,7 @@ _COLUMNS = (
     ("max_abs_rotation_deg", "max \\|rotation\\| [deg]", 1.0),
     ("min_element_tension_N", "min tension [N]", 1.0),
     ("slack_time_s", "slack time [s]", 1.0),
-    ("wall_time_s", "wall time [s]", 1.0),
-)
+)  # no wall time: it changes from run to run, and the table is tracked (issue 23.18); it is in timing.json
 
 
 def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: str | Path | None = None,
@@ -168,18 +168,18 @@ def markdown_table(summaries: dict[str, dict]) -> str:
             value = summary.get(key)
             cells.append("" if value is None else (str(value) if isinstance(value, int) else fixed(scale * value, 2)))
         ratio = summary.get("error_reduction_vs_ideal_ik")
-        flag = "; cables pushed" if summary.get("elements_pushed") else ""  # a real cable cannot
+        flags = "".join(f"; {flag}" for flag in warning_flags(summary))  # what a real robot cannot do
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {'' if ratio is None else f'{ratio:.1f}x'} | "
-                     f"{summary.get('status', '')}{flag} |")
+                     f"{summary.get('status', '')}{flags} |")
     return "\n".join(lines) + "\n"
 
 
 def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    from cdpr_exu.core.output import write_summary
+    from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, check_output_folder, clear_outputs, write_pose_csv, write_summary
     from cdpr_exu.post.plots import plot_comparison
     from cdpr_exu.scenes.scene import save_scene
 
-    out.mkdir(parents=True, exist_ok=True)
+    clear_outputs(check_output_folder(out, command="compare"), "compare")  # no file of an earlier comparison stays
     save_scene(scene, out / "scene.toml")
     document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
                 "controllers": summaries, **provenance()}
@@ -187,9 +187,8 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
     (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
                                        + markdown_table(summaries))
     for name, result in results.items():
-        header = "time_s,x_m,z_m,rotation_rad,x_ref_m,z_ref_m,rotation_ref_rad"
-        table = np.column_stack([result.time, result.platform_pose, result.reference_pose])
-        np.savetxt(out / f"pose_{name}.csv", table, delimiter=",", header=header, comments="", fmt="%.9g")
+        write_pose_csv(out / f"pose_{name}.csv", result.time, result.platform_pose, result.reference_pose,
+                       PLANAR_POSE_COLUMNS)
     if results:
         plot_comparison(scene, results, out)
 
@@ -209,6 +208,8 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
     if not args.quiet:
         print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
     summaries = compare_spatial(scene, names, args.out, args.after, quiet=args.quiet)
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
     if not args.quiet:
         print()
         print(spatial_comparison_table(summaries))
@@ -218,13 +219,23 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
     return EXIT_RUN_FAILED if failed else EXIT_OK
 
 
+def _check_time_options(args: argparse.Namespace) -> None:
+    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
+    on planar and spatial scenes alike)."""
+    from cdpr_exu.core.validation import non_negative
+
+    non_negative("--after", args.after)
+    non_negative("--ramp-time", args.ramp_time)
+
+
 def _cmd_compare(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from cdpr_exu.core.output import check_output_folder
     from cdpr_exu.statics.workspace import check_reference
 
-    check_output_folder(args.out)
+    _check_time_options(args)
+    check_output_folder(args.out, command="compare")
     from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
     scene = load_any_scene(args.scene)
@@ -248,6 +259,8 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
     summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet,
                                     learning_rule=rule)
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
     if not args.quiet:
         print()
         print(markdown_table(summaries))

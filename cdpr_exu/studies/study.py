@@ -599,10 +599,13 @@ def _json_value(value: Any) -> Any:
 
 
 def study_columns(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation]) -> list[str]:
-    """CSV columns: the parameters first, then run, status and the figures."""
-    columns = [v.path for v in variations] + ["run", "status", *FIGURES]
+    """CSV columns: the parameters first, then run, status and the figures; not the wall-clock figures
+    (:data:`cdpr_exu.core.output.TIMING_KEYS`), which go to ``timing.json`` (issue 23.18)."""
+    from cdpr_exu.core.output import TIMING_KEYS
+
+    columns = [v.path for v in variations] + ["run", "status", *(f for f in FIGURES if f not in TIMING_KEYS)]
     for row in rows:
-        columns.extend(k for k in row if k not in columns)
+        columns.extend(k for k in row if k not in columns and k not in TIMING_KEYS)
     return columns
 
 
@@ -610,12 +613,12 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
                 variations: Sequence[Variation], *, mode: str = "grid", after: float = 1.0,
                 plots: bool = True) -> dict[str, Path]:
     """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
-    from cdpr_exu.core.output import write_summary
+    from cdpr_exu.core.output import check_output_folder, clear_outputs, write_summary
     from cdpr_exu.results.result import provenance
     from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_output_folder(out, command="study sweep")
+    clear_outputs(out, "study sweep")  # no figure of an earlier study's parameters stays
     paths = {"scene": save_scene(base_scene, out / STUDY_FILES["scene"])}
     columns = study_columns(rows, variations)
     with open(out / STUDY_FILES["csv"], "w", newline="") as handle:
@@ -633,7 +636,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
         "base_scene": base_scene.to_dict(),
         **provenance(),
     }
-    write_summary(out, data, name=STUDY_FILES["json"])  # the date goes to timing.json
+    write_summary(out, data, name=STUDY_FILES["json"])  # the date and each row's wall time go to timing.json
     paths["json"] = out / STUDY_FILES["json"]
     if plots and variations:
         paths.update(plot_study(rows, variations, out, mode=mode))
@@ -665,7 +668,7 @@ def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation
     """Summary figures of a study; returns their paths by name.
 
     For each varied parameter, ``vs_<path>.png``: the maximum position error and the
-    wall time against that parameter (one line per value of the other parameter in a
+    Newton iterations (the run's cost, the same from run to run, unlike its wall time) against that parameter (one line per value of the other parameter in a
     2-parameter grid, per combination of the others beyond). A 2-parameter grid also
     gets ``heatmap.png``. Failed and refused runs are marked with red crosses at the
     bottom of the axes.
@@ -684,7 +687,7 @@ def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation
         for row in rows:
             groups.setdefault(tuple(row[o.path] for o in others), []).append(row)
         for quantity, axis, scale, label in (("max_position_error_m", axes[0], 1000.0, "max position error [mm]"),
-                                             ("wall_time_s", axes[1], 1.0, "wall time [s]")):
+                                             ("newton_iterations", axes[1], 1.0, "Newton iterations")):
             failed_label = "failed / refused"
             for key, members in groups.items():
                 members = sorted(members, key=lambda r: position[r[variation.path]])
@@ -722,7 +725,7 @@ def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation
 
 
 def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation], path: Path) -> Path:
-    """Maximum position error and wall time over a 2-parameter grid, failed cells marked."""
+    """Maximum position error and Newton iterations over a 2-parameter grid, failed cells marked."""
     import matplotlib
     import numpy as np
 
@@ -733,7 +736,7 @@ def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variat
     axes = figure.subplots(1, 2)
     index = {(row[first.path], row[second.path]): row for row in rows}
     for axis, quantity, scale, label in ((axes[0], "max_position_error_m", 1000.0, "max position error [mm]"),
-                                         (axes[1], "wall_time_s", 1.0, "wall time [s]")):
+                                         (axes[1], "newton_iterations", 1.0, "Newton iterations")):
         grid = np.full((len(first.values), len(second.values)), np.nan)
         for i, a in enumerate(first.values):
             for j, b in enumerate(second.values):
@@ -850,7 +853,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         print("cdpr study: --workers is ignored with a remote --scheduler (its workers run the study)",
               file=sys.stderr)
     variations = _as_variations(args.param)
-    out = check_output_folder(args.out)
+    out = check_output_folder(args.out, command="study sweep")
     rows = run_study(scene, variations, out=out, progress=not args.quiet, after=args.after,
                      mode="zip" if args.zip else "grid", workers=args.workers, scheduler=args.scheduler)
     if not args.quiet:
