@@ -41,12 +41,10 @@ Command line: ``cdpr study accuracy SCENE --out DIR [--quick]``.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import math
 import os
-import sys
 import time
 import warnings
 from concurrent.futures import Executor, Future, as_completed
@@ -56,8 +54,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from cdpr_exu.core.errors import EXIT_CODES, CoarseOutputWarning, SceneError
-from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, apply_parameters, study_subparsers
+from cdpr_exu.core.errors import CoarseOutputWarning, SceneError
+from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, apply_parameters
 
 # --------------------------------------------------------------------------- configurations
 
@@ -939,70 +937,3 @@ def _short_label(row: Mapping[str, Any]) -> str:
     """``full 20, 5e-03`` (model, elements, step) for annotations."""
     n = "" if row.get("n_elements") is None else f" {row['n_elements']}"
     return f"{row['model']}{n}, {row['step_size_s']:.0e}"
-
-
-# --------------------------------------------------------------------------- command line
-
-EPILOG_ACCURACY = """examples:
-  cdpr study accuracy paper-circle --out results/accuracy/paper_circle
-  cdpr study accuracy paper-catenary --out results/accuracy/paper_catenary
-  cdpr study accuracy paper-circle --out /tmp/quick --quick
-  cdpr study accuracy spatial-ipanema --out /tmp/ipanema --quick
-
-runs the scene on every preset (ideal, elastic, catenary, full) and the full model
-with linear bending, over elements per cable (8..60) and step sizes (5e-4..1e-2 s),
-against a reference (full, 90 elements, 5e-4 s); --quick: a small grid, 1.5 s.
-A static scene (held pose, fixed winches) compares final states, others the path.
-
-spatial scenes (dimension = 3, with a [trajectory]) run under ideal inverse kinematics on
-the catenary and full presets over 4..16 elements and 5e-3..2e-2 s against (full, 32
-elements, 2e-3 s); --quick: full at 4 and 8 elements, 1e-2 s, against 16, 1.5 s.
-Errors: the platform centre's 3-D path and the angle between the orientations.
-writes accuracy.csv, accuracy.json, tables.md (tolerance table, effects table),
-pareto.png and reference.npz into --out.
-"""
-
-
-def _cmd_accuracy(args: argparse.Namespace) -> int:
-    from cdpr_exu.scenes.spatial_scene import load_any_scene
-
-    scene = load_any_scene(args.scene)  # planar or spatial
-    check_study_scene(scene)  # before the output folder is made
-    grid = grid_for(scene, args.quick)
-    if args.end_time is not None:
-        grid = replace(grid, end_time=args.end_time)
-    from cdpr_exu.core.output import check_output_folder
-
-    out = check_output_folder(args.out, command="study accuracy")
-    start = time.perf_counter()
-    study = run_accuracy_study(scene, grid, out=out, workers=args.workers, progress=not args.quiet,
-                               comparison=args.compare)
-    if not args.quiet:
-        print(format_tables(study))
-        print(f"\n{len(study.rows)} runs in {time.perf_counter() - start:.0f} s; written to {out}/")
-    return 0
-
-
-def add_commands(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cdpr study accuracy`` to the ``cdpr`` command."""
-    accuracy = study_subparsers(subparsers).add_parser(
-        "accuracy", help="error against run time over the model ladder, elements and step sizes",
-        description="Run a scene on every model of the ladder over elements per cable and step sizes, "
-        "compare each run with a reference (the full model, finest discretisation), and write the "
-        "Pareto front of error against run time (CPU time) and the cheapest configuration per tolerance.",
-        epilog=EPILOG_ACCURACY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    accuracy.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
-    accuracy.add_argument("--out", required=True, help="output folder (created)")
-    accuracy.add_argument("--quick", action="store_true", help="a small grid over 1.5 s (a minute or less)")
-    accuracy.add_argument("--workers", type=int, help="worker processes (default: one per core)")
-    accuracy.add_argument("--end-time", type=float, help="override the end time of every run [s]")
-    accuracy.add_argument("--compare", choices=("path", "final"),
-                          help="compare the path after 1 s or the final state (default: final for static scenes)")
-    accuracy.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no tables")
-    accuracy.set_defaults(func=_cmd_accuracy)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from cdpr_exu.cli import main
-
-    sys.exit(main(["study", "accuracy", *sys.argv[1:]]))

@@ -22,21 +22,12 @@ fatal. Runs go to any :class:`concurrent.futures.Executor`: by default a process
 with one single-threaded process per core; a Dask cluster through
 ``scheduler="tcp://host:8786"`` (or ``"local"``).
 
-Adding a ``cdpr study`` sub-command from another module::
-
-    from cdpr_exu.studies.study import study_subparsers
-
-    def add_commands(subparsers):
-        accuracy = study_subparsers(subparsers).add_parser("accuracy", ...)
-        accuracy.set_defaults(func=...)
-
 This module imports only the standard library at its top, so that a spawned worker
 process can set its thread limits before NumPy, Numba or Exudyn load.
 """
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import copy
 import csv
@@ -47,7 +38,6 @@ import math
 import multiprocessing
 import os
 import re
-import sys
 import time
 import tomllib
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
@@ -55,7 +45,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
-from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, SceneError
+from cdpr_exu.core.errors import CdprError, SceneError
 
 if TYPE_CHECKING:  # pragma: no cover
     from cdpr_exu.scenes.scene import Scene
@@ -795,98 +785,3 @@ def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variati
     for cause, runs in causes.items():
         out.append(f"run{'s' if len(runs) > 1 else ''} {', '.join(runs)}: {cause}")
     return "\n".join(out)
-
-
-# --------------------------------------------------------------------------- command line
-
-EPILOG_STUDY = """examples:
-  cdpr study sweep paper-circle --param cables.n_elements=10,15 --param platform.mass=1,2.5 --out results/study
-  cdpr study sweep --help
-"""
-
-EPILOG_SWEEP = """examples:
-  cdpr study sweep paper-circle --param cables.n_elements=8,10,15 --param platform.mass=1,2.5,5 --out out/grid
-  cdpr study sweep paper-circle --param effects.preset=full,catenary --end-time 2 --out out/presets
-  cdpr study sweep scene.toml --param 'cables[1].radius=0.004,0.006' --param solver.step_size=1e-3,2e-3 \\
-      --zip --out out/zipped --workers 2
-  cdpr study sweep paper-circle --param platform.mass=1,2.5,5 --out out/local-dask --scheduler local
-  cdpr study sweep paper-circle --param platform.mass=1,2.5,5 --out out/cluster --scheduler tcp://10.0.0.1:8786
-
-parameter paths name fields of the scene's TOML form: cables.n_elements (every cable),
-cables[1].radius (one cable), platform.mass, solver.step_size, effects.bending,
-effects.preset, trajectory.angular_rate, platform.initial_pose[1], ...
-values are TOML scalars: 5, 2.5, 1e-3, true, false, "full" (or a bare word: full).
-
-writes study.csv, study.json, base_scene.toml and vs_<parameter>.png (+ heatmap.png
-for a 2-parameter grid) into --out. Failed and refused runs are recorded as rows.
-"""
-
-
-def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubParsersAction:
-    """The sub-parsers of ``cdpr study`` (made on first call; the same object after).
-
-    Other modules add ``cdpr study <name>`` commands with
-    ``study_subparsers(subparsers).add_parser(name, ...)`` in their ``add_commands``.
-    """
-    existing = getattr(subparsers, "_cdpr_study_subparsers", None)
-    if existing is not None:
-        return existing
-    study = subparsers.add_parser("study", help="parameter studies over a scene, in parallel",
-                                  description="Parameter studies: run a scene over many parameter values "
-                                  "on all cores or on a Dask cluster, and tabulate and plot the results.",
-                                  epilog=EPILOG_STUDY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    study_sub = study.add_subparsers(dest="study_command", required=True, metavar="COMMAND")
-    subparsers._cdpr_study_subparsers = study_sub
-    return study_sub
-
-
-def _cmd_sweep(args: argparse.Namespace) -> int:
-    from dataclasses import replace
-
-    from cdpr_exu.core.output import check_output_folder
-    from cdpr_exu.scenes.spatial_scene import load_any_scene
-
-    scene = load_any_scene(args.scene)  # planar or spatial
-    if args.end_time is not None:
-        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
-    if args.scheduler and args.scheduler != "local" and args.workers and not args.quiet:
-        print("cdpr study: --workers is ignored with a remote --scheduler (its workers run the study)",
-              file=sys.stderr)
-    variations = _as_variations(args.param)
-    out = check_output_folder(args.out, command="study sweep")
-    rows = run_study(scene, variations, out=out, progress=not args.quiet, after=args.after,
-                     mode="zip" if args.zip else "grid", workers=args.workers, scheduler=args.scheduler)
-    if not args.quiet:
-        print(format_table(rows, variations))
-        done = sum(row["status"] == "completed" for row in rows)
-        print(f"{done} of {len(rows)} runs completed; written to {out}/")
-    failed = sum(row["status"] != "completed" for row in rows)
-    if failed:
-        print(f"cdpr study sweep: {failed} of {len(rows)} runs did not complete (see the status column)",
-              file=sys.stderr)
-        return EXIT_RUN_FAILED
-    return EXIT_OK
-
-
-def add_commands(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cdpr study sweep`` (and the ``study`` group) to the ``cdpr`` command."""
-    sweep = study_subparsers(subparsers).add_parser(
-        "sweep", help="run a scene over a grid of parameter values",
-        description="Run a scene once per combination of parameter values (a grid, or --zip), in "
-        "parallel, and write a CSV/JSON table and summary plots. Failed and refused runs are recorded, "
-        "not fatal.", epilog=EPILOG_SWEEP + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    sweep.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
-    sweep.add_argument("--param", action="append", required=True, metavar="PATH=V1,V2,...",
-                       help="a parameter and its values; repeat for more parameters")
-    sweep.add_argument("--zip", action="store_true",
-                       help="run the i-th values of all parameters together instead of the grid")
-    sweep.add_argument("--out", required=True, help="output folder (created)")
-    sweep.add_argument("--workers", type=int, help="worker processes (default: one per core)")
-    sweep.add_argument("--scheduler", metavar="ADDRESS|local",
-                       help="run on a Dask cluster: its scheduler's address (tcp://host:8786), or 'local' "
-                       "to start one on this machine")
-    sweep.add_argument("--end-time", type=float, help="override solver.end_time of every run [s]")
-    sweep.add_argument("--after", type=float, default=1.0,
-                       help="measure errors from this time on [s] (default 1; 0 for runs not longer)")
-    sweep.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table")
-    sweep.set_defaults(func=_cmd_sweep)

@@ -1,32 +1,22 @@
-"""The ``cdpr`` command: run scenes, and write what people want to look at.
+"""``cdpr run``: run a scene, write its files and print its summary.
 
 Examples::
 
     cdpr run paper-circle --out results/paper_circle
     cdpr run my_robot.toml --out out/my_robot --end-time 5 --step-size 1e-3
-    cdpr scenes
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
-import sys
-import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
-                     RunInterrupted, SceneError, SolverFailure)
-from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text,  # noqa: F401
-                                  undate_solution_file, write_summary)
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, CdprError, RunInterrupted, SolverFailure
+from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text, undate_solution_file,
+                                  write_summary)
 from cdpr_exu.results.result import status_text
-from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
-
-#: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
-#: parsers whose ``func`` takes the parsed arguments and returns an exit code.
-COMMAND_MODULES: tuple[str, ...] = ("cdpr_exu.studies.comparison", "cdpr_exu.studies.study", "cdpr_exu.post.viewer", "cdpr_exu.studies.accuracy",
-                                   "cdpr_exu.run.rest")
+from cdpr_exu.scenes.scene import Scene, load_scene, save_scene
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
 SETTLED_AFTER = 1.0
@@ -219,31 +209,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _cmd_scenes(args: argparse.Namespace) -> int:  # noqa: ARG001
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene, shipped_spatial_scenes
-
-    for name in shipped_scenes():
-        scene = load_scene(name)
-        print(f"{name:24s} {scene.description}")
-    for name in shipped_spatial_scenes():
-        print(f"{name:24s} {load_spatial_scene(name).description}")
-    return 0
-
-
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``cdpr`` (every sub-command's ``--help`` has examples)."""
-    parser = argparse.ArgumentParser(
-        prog="cdpr", description="Simulate cable-driven parallel robots with massive, elastic, bending cables "
-        "over pulleys (Exudyn, implicit solver). Units: SI.",
-        epilog="examples:\n  cdpr run paper-circle --out results/paper_circle\n  cdpr scenes\n\n" + EXIT_CODES,
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = parser.add_subparsers(dest="command", required=True)
-
-    run = sub.add_parser("run", help="run a scene and write result, summary and figures",
-                         description="Run a scene (a shipped name or a TOML file) under ideal "
-                         "inverse-kinematics control and write its result, summary, Exudyn solution "
-                         "file and figures.", epilog=EPILOG_RUN,
-                         formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_commands(subparsers) -> None:
+    """Register ``cdpr run``."""
+    run = subparsers.add_parser("run", help="run a scene and write result, summary and figures",
+                                description="Run a scene (a shipped name or a TOML file) under ideal "
+                                "inverse-kinematics control and write its result, summary, Exudyn solution "
+                                "file and figures.", epilog=EPILOG_RUN,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     run.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
     run.add_argument("--out", help="output folder (created); nothing is written without it")
     run.add_argument("--end-time", type=float, help="override solver.end_time [s]")
@@ -257,47 +229,3 @@ def build_parser() -> argparse.ArgumentParser:
                      "that the error model says meet it (printed)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     run.set_defaults(func=_cmd_run)
-
-    scenes = sub.add_parser("scenes", help="list the shipped scenes",
-                            epilog="example:\n  cdpr scenes\n\n" + EXIT_CODES,
-                            formatter_class=argparse.RawDescriptionHelpFormatter)
-    scenes.set_defaults(func=_cmd_scenes)
-    for module_name in COMMAND_MODULES:
-        module = importlib.import_module(module_name)
-        module.add_commands(sub)
-    return parser
-
-
-def _show_warning(message, category, filename, lineno, file=None, line=None):  # noqa: ARG001
-    """Print the project's warnings as one line each, without source locations."""
-    print(f"cdpr: warning: {message}", file=sys.stderr)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``cdpr`` console script; returns the exit code (see ``cdpr --help``)."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    shown = warnings.showwarning
-    warnings.showwarning = _show_warning
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("always", CdprWarning)
-            return args.func(args)
-    except RunInterrupted as err:
-        print(f"cdpr: {err}; the partial result is written", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except KeyboardInterrupt:
-        print("cdpr: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except SolverFailure as err:
-        print(f"cdpr: solver failure: {err}", file=sys.stderr)
-        return EXIT_RUN_FAILED
-    except CdprError as err:
-        print(f"cdpr: error: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    finally:
-        warnings.showwarning = shown
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -1,0 +1,125 @@
+"""``cdpr compare``: a scene under every controller, tabulated (:mod:`cdpr_exu.studies.comparison`).
+
+Examples::
+
+    cdpr compare paper-circle --out results/controllers
+    cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, SceneError
+from cdpr_exu.results.result import raise_warnings
+from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, markdown_table,
+                                         smooth_start)
+from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule
+
+
+def _compare_spatial(scene, args: argparse.Namespace) -> int:
+    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.run.spatial_run.compare_spatial`)."""
+    from dataclasses import replace
+
+    from cdpr_exu.run.spatial_run import check_spatial_reference, compare_spatial, spatial_comparison_table
+
+    if args.end_time is not None:
+        scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr compare` needs one")
+    check_spatial_reference(scene)
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
+    summaries = compare_spatial(scene, names, args.out, args.after, quiet=args.quiet)
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
+    if not args.quiet:
+        print()
+        print(spatial_comparison_table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    return EXIT_RUN_FAILED if failed else EXIT_OK
+
+
+def _check_time_options(args: argparse.Namespace) -> None:
+    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
+    on planar and spatial scenes alike)."""
+    from cdpr_exu.core.validation import non_negative
+
+    non_negative("--after", args.after)
+    non_negative("--ramp-time", args.ramp_time)
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from cdpr_exu.core.output import check_output_folder
+    from cdpr_exu.statics.workspace import check_reference
+
+    _check_time_options(args)
+    check_output_folder(args.out, command="compare")
+    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+
+    scene = load_any_scene(args.scene)
+    if is_spatial(scene):
+        return _compare_spatial(scene, args)
+    if args.end_time is not None:
+        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
+    started = smooth_start(scene, args.ramp_time)
+    if started is not scene and not args.quiet:
+        print(f"{scene.name}: the circle starts smoothly from rest over {args.ramp_time} s "
+              "(--ramp-time 0 keeps the scene's start at full speed)")
+    scene = started
+    # A reference no controller can follow is bad input (exit 2), not six failed runs.
+    check_reference(scene)
+    try:
+        rule = StoppingRule(max_trials=args.trials, min_improvement=args.min_improvement)
+    except SceneError as err:
+        raise SceneError(f"--trials / --min-improvement: {err}") from None
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
+    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet,
+                                    learning_rule=rule)
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
+    if not args.quiet:
+        print()
+        print(markdown_table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    if failed:
+        print(f"cdpr compare: {len(failed)} of {len(summaries)} controllers did not complete: {', '.join(failed)}",
+              file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return EXIT_OK
+
+
+def add_commands(subparsers) -> None:
+    """Register ``cdpr compare``."""
+    parser = subparsers.add_parser(
+        "compare", help="run a scene under every controller and compare their errors",
+        description="Run a scene under each controller (ideal inverse kinematics, tension-aware variants, "
+        "closed loop) and write a table and figures of their errors.",
+        epilog="examples:\n  cdpr compare paper-circle --out results/controllers\n"
+               "  cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal\n\n" + EXIT_CODES,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scene", help="shipped scene name or path to a .toml file")
+    parser.add_argument("--out", help="output folder (summary.json, comparison.md, figures)")
+    parser.add_argument("--controllers", help=f"comma-separated subset of: {', '.join(CONTROLLERS)}")
+    parser.add_argument("--after", type=float, default=1.0, help="measure errors after this time [s] (default 1)")
+    parser.add_argument("--end-time", type=float, help="override solver.end_time [s]")
+    parser.add_argument("--ramp-time", type=float, default=COMPARISON_RAMP_TIME,
+                        help="start a circle that starts at full speed smoothly from rest over this time [s] "
+                             f"(default {COMPARISON_RAMP_TIME}; 0 keeps the scene's own start)")
+    parser.add_argument("--trials", type=int, default=DEFAULT_RULE.max_trials,
+                        help=f"most learning trials of ilc and model_feed_forward (default {DEFAULT_RULE.max_trials})")
+    parser.add_argument("--min-improvement", type=float, default=DEFAULT_RULE.min_improvement,
+                        help="stop learning when a trial's max error falls by less than this fraction "
+                             f"(default {DEFAULT_RULE.min_improvement})")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+    parser.set_defaults(func=_cmd_compare)
