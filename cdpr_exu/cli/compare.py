@@ -12,10 +12,31 @@ import argparse
 import sys
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, SceneError
-from cdpr_exu.results.result import raise_warnings
+from cdpr_exu.results.result import raise_warnings, status_text
 from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, markdown_table,
                                          smooth_start)
 from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule
+
+
+def print_controller_row(name: str, summary: dict) -> None:
+    """The line ``cdpr compare`` prints as a controller's run on a planar scene ends: its max and RMS
+    position error [mm] and its status."""
+    def mm(value):
+        return "     n/a" if value is None else f"{1000 * value:8.2f}"
+    print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
+          f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+
+
+def print_spatial_controller_row(name: str, summary: dict) -> None:
+    """The line ``cdpr compare`` prints as a controller's run on a spatial scene ends: its max position
+    error [mm] and its status."""
+    worst = summary["max_position_error_m"]
+    print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   {status_text(summary)}")
+
+
+def print_progress(line: str) -> None:
+    """Print a line of the learning controllers' progress at once (the trials take a while)."""
+    print(line, flush=True)
 
 
 def _compare_spatial(scene, args: argparse.Namespace) -> int:
@@ -32,7 +53,8 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
     names = args.controllers.split(",") if args.controllers else None
     if not args.quiet:
         print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
-    summaries = compare_spatial(scene, names, args.out, args.after, quiet=args.quiet)
+    summaries = compare_spatial(scene, names, args.out, args.after,
+                                report=None if args.quiet else print_spatial_controller_row)
     for name, summary in summaries.items():
         raise_warnings(summary, f"{scene.name} under {name}: ")
     if not args.quiet:
@@ -82,8 +104,9 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     names = args.controllers.split(",") if args.controllers else None
     if not args.quiet:
         print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
-    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet,
-                                    learning_rule=rule)
+    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, learning_rule=rule,
+                                    report=None if args.quiet else print_controller_row,
+                                    learning_report=None if args.quiet else print_progress)
     for name, summary in summaries.items():
         raise_warnings(summary, f"{scene.name} under {name}: ")
     if not args.quiet:

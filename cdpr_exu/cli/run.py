@@ -1,4 +1,4 @@
-"""``cdpr run``: run a scene, write its files and print its summary.
+"""``cdpr run``: run a planar or spatial scene, write its files and print its summary.
 
 Examples::
 
@@ -11,12 +11,17 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, CdprError, RunInterrupted, SolverFailure
 from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text, undate_solution_file,
                                   write_summary)
-from cdpr_exu.results.result import status_text
+from cdpr_exu.results.result import raise_warnings, status_text
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene
+
+if TYPE_CHECKING:  # pragma: no cover
+    from cdpr_exu.run.spatial_run import SpatialResult
+    from cdpr_exu.scenes.spatial_scene import SpatialScene
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
 SETTLED_AFTER = 1.0
@@ -166,6 +171,100 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     return summary
 
 
+def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> None:
+    """Print a spatial run's :meth:`SpatialResult.run_summary`: errors over the whole run and after ``after`` [s],
+    each cable's lowest tension and slack time (whole run), its tension-limit violations and notes."""
+    settled = summary["after_start_up"]
+
+    def errors(s):
+        return f"{length_text(s['max_position_error_m'])} / {length_text(s['rms_position_error_m'])}"
+
+    def degrees(s):
+        return "n/a" if s["max_rotation_error_deg"] is None else f"{s['max_rotation_error_deg']:.4f} deg"
+
+    def per_cable(values, unit, digits):
+        return " / ".join("n/a" if v is None else f"{fixed(v, digits)} {unit}" for v in values)
+
+    factor = summary["real_time_factor"]
+    print(f"{summary['scene']} under {summary['controller']} (spatial; error = actual - reference)")
+    print(f"  {'':26s} {'whole run':>22s}   {'after ' + f'{after:g}' + ' s':>22s}")
+    print(f"  {'status':26s} {status_text(summary)}")
+    print(f"  {'max / RMS position error':26s} {errors(summary):>22s}   {errors(settled):>22s}")
+    print(f"  {'max rotation error':26s} {degrees(summary):>22s}   {degrees(settled):>22s}")
+    print(f"  {'min tension per cable':26s} {per_cable(summary['min_tension_per_cable_N'], 'N', 1)}")
+    print(f"  {'slack time per cable':26s} {per_cable(summary['slack_time_per_cable_s'], 's', 3)}")
+    print(f"  {'simulated / wall time':26s} {summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s"
+          + ("" if factor is None else f" ({factor:.1f}x real time)")
+          + f", {summary['steps']} steps, {summary['newton_iterations']} Newton iterations")
+    if "tension_limit_violations" in summary:
+        count = len(summary["tension_limit_violations"])
+        print(f"  {'tension limits':26s} {f'{count} violation(s)' if count else 'none'}")
+    for v in summary.get("tension_limit_violations", []):
+        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
+              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
+    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
+        print(f"  note: {note}")
+    if out is not None:
+        print(f"  written to {out}/")
+
+
+def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
+                      after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
+    """``cdpr run`` on a spatial scene: run, write into ``out``, print a summary.
+
+    Writes what ``cdpr run`` writes for every scene: ``scene.toml`` (the scene as run: a
+    rerun from it gives the same result), ``result.npz``, ``pose.csv``, ``summary.json``
+    (wall-clock figures in ``timing.json``), ``solution.sol`` (Exudyn's solution file, its
+    date blanked, for ``cdpr view``) and (``figures``) ``overview.png``. The scene and its
+    reference are checked before anything is written. On a solver failure or Ctrl-C the
+    partial result is written before the error propagates. With ``error_estimate`` a
+    companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`):
+    ``error_estimate`` in summary.json and a printed line.
+    """
+    from cdpr_exu.run.error_estimate import estimate_error, estimate_line, summary_entry
+    from cdpr_exu.run.spatial_run import check_runnable, simulate_spatial
+    from cdpr_exu.scenes.spatial_scene import save_any_scene
+
+    check_runnable(scene)  # before scene.toml is in the folder
+    solution_file = None
+    if out is not None:
+        out = check_output_folder(out, command="run")
+        clear_outputs(out, "run")  # none of the run this one replaces stays beside it (a planar one's figures)
+        save_any_scene(scene, out / "scene.toml")
+        solution_file = out / "solution.sol"
+
+    def write(result: SpatialResult, extra: dict | None = None) -> None:
+        if out is not None:
+            result.save(out, after, figures, extra)
+            if solution_file.is_file():
+                undate_solution_file(solution_file)
+
+    try:
+        result = simulate_spatial(scene, progress=not quiet, solution_file=solution_file)
+    except (SolverFailure, RunInterrupted) as err:  # keep what was computed
+        if err.partial_result is not None:
+            write(err.partial_result)
+        raise
+    estimate, interrupt = None, None
+    if error_estimate:
+        if not quiet:
+            print("estimating the discretisation error (a companion run) ...", flush=True)
+        try:
+            estimate = estimate_error(scene, result, after=after)
+        except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
+            interrupt = err
+    write(result, None if estimate is None else summary_entry(estimate))
+    summary = result.run_summary(after)
+    raise_warnings(summary, f"{scene.name} under {result.controller}: ")  # not clean: said once, quiet or not
+    if not quiet:
+        _print_spatial_summary(summary, after, out)
+        if estimate is not None:
+            print(estimate_line(estimate))
+    if interrupt is not None:
+        raise interrupt
+    return result
+
+
 def _elements_for(scene, tolerance: float, quiet: bool):
     """The scene (planar or spatial) with the fewest elements per cable, never fewer than it has, that the error
     model says meet ``tolerance`` [m] (:func:`cdpr_exu.run.error_estimate.elements_for_tolerance` says why not fewer)."""
@@ -192,8 +291,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     scene = load_any_scene(args.scene)  # loaded once: a warning of the scene file is printed once
     if is_spatial(scene):
-        from cdpr_exu.run.spatial_run import run_spatial_scene
-
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
         scene = replace(scene, solver=replace(scene.solver, **changes))
         if tolerance is not None:

@@ -12,6 +12,7 @@ import argparse
 import sys
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +22,9 @@ from cdpr_exu.results.result import provenance
 from cdpr_exu.run.rest import DEFAULT_MAX_TIME, DEFAULT_TOLERANCE, plot_rest, solve_rest
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+
+if TYPE_CHECKING:  # pragma: no cover
+    from cdpr_exu.run.spatial_rest import SpatialRest
 
 EPILOG = """examples:
   cdpr static paper-catenary-fixed --out results/static_fixed
@@ -49,7 +53,7 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
 def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
     """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`); its warnings go to the console
     (and are in summary.json), a failure writes the scene, the cause and the last state."""
-    from cdpr_exu.run.spatial_rest import print_spatial_rest, solve_spatial_rest
+    from cdpr_exu.run.spatial_rest import solve_spatial_rest
 
     try:
         rest = solve_spatial_rest(scene)
@@ -66,6 +70,34 @@ def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
     for text in rest.warnings:
         warnings.warn(text, SuspectAnswerWarning, stacklevel=2)
     return EXIT_OK
+
+
+def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
+    """The static mode's summary on the terminal (its :attr:`SpatialRest.warnings` are the caller's to issue)."""
+    from cdpr_exu.run.spatial_rest import rotation_angles_deg
+
+    x, y, z = rest.position
+    roll, pitch, yaw = rotation_angles_deg(rest.rotation)
+    catenary = rest.catenary
+    print(f"{rest.scene.name} at rest (Exudyn's static solver, {rest.scene.cables[0].n_elements} elements per cable, "
+          f"{rest.anchor_joint}; {rest.wall_time:.2f} s)")
+    print(f"  platform at x = {x:.6f} m, y = {y:.6f} m, z = {z:.6f} m; rotation vector "
+          f"{np.round(rest.rotation_vector, 6).tolist()} rad (roll {roll:.4f}, pitch {pitch:.4f}, yaw {yaw:.4f} deg)")
+    for i, (tension, force) in enumerate(zip(rest.tensions_at_anchor, rest.forces_on_platform)):
+        print(f"  cable {i + 1}: {tension:.4f} N at the anchor (catenary {catenary.tensions_at_anchor[i]:.4f} N), "
+              f"force on platform {np.round(force, 4).tolist()} N")
+    print(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
+          f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
+          f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation_vector)):.4f} deg from the lumped robot")
+    if rest.swivel_angles is not None:
+        azimuths = [np.degrees(np.arctan2(*(c.anchor_point - c.inlet)[1::-1])) if c.inlet is not None else None
+                    for c in catenary.cables]
+        for i, (psi, azimuth) in enumerate(zip(rest.swivel_angles, azimuths)):
+            if azimuth is not None:
+                print(f"  swivel pulley {i + 1}: psi = {np.degrees(psi):.4f} deg (anchor azimuth {azimuth:.4f} deg), "
+                      f"wrap {np.degrees(catenary.cables[i].wrap_angle):.2f} deg")
+    if out is not None:
+        print(f"  written to {out}/")
 
 
 def _cmd_static(args: argparse.Namespace) -> int:

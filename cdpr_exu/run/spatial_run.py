@@ -33,7 +33,7 @@ from __future__ import annotations
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import exudyn as exu
 import numpy as np
@@ -42,8 +42,8 @@ from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import (SPATIAL_POSE_COLUMNS, check_output_folder, clear_outputs, fixed, length_text,
-                                  undate_solution_file, write_npz, write_pose_csv, write_summary)
+from cdpr_exu.core.output import (SPATIAL_POSE_COLUMNS, check_output_folder, clear_outputs, write_npz, write_pose_csv,
+                                  write_summary)
 from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
@@ -53,15 +53,14 @@ from controllers.ideal_ik import IdealIKController, ideal_paid_out
 from controllers.spatial_feedback import spatial_closed_loop_tension_aware
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.results.result import (after_start_up, provenance, raise_warnings, safety_figures, status_text,
-                                     warning_flags)
+from cdpr_exu.results.result import after_start_up, provenance, safety_figures, warning_flags
 from cdpr_exu.run.simulate import (_progress_reporter, _solver_report, interrupt_flag, output_times, quiet_exudyn,
                                    solver_settings)
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
 
-__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference", "run_spatial_scene"]
+__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference"]
 
 
 #: Samples of the reference checked before a run.
@@ -691,99 +690,6 @@ def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0
     return path
 
 
-def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> None:
-    """Print a spatial run's :meth:`SpatialResult.run_summary`: errors over the whole run and after ``after`` [s],
-    each cable's lowest tension and slack time (whole run), its tension-limit violations and notes."""
-    settled = summary["after_start_up"]
-
-    def errors(s):
-        return f"{length_text(s['max_position_error_m'])} / {length_text(s['rms_position_error_m'])}"
-
-    def degrees(s):
-        return "n/a" if s["max_rotation_error_deg"] is None else f"{s['max_rotation_error_deg']:.4f} deg"
-
-    def per_cable(values, unit, digits):
-        return " / ".join("n/a" if v is None else f"{fixed(v, digits)} {unit}" for v in values)
-
-    factor = summary["real_time_factor"]
-    print(f"{summary['scene']} under {summary['controller']} (spatial; error = actual - reference)")
-    print(f"  {'':26s} {'whole run':>22s}   {'after ' + f'{after:g}' + ' s':>22s}")
-    print(f"  {'status':26s} {status_text(summary)}")
-    print(f"  {'max / RMS position error':26s} {errors(summary):>22s}   {errors(settled):>22s}")
-    print(f"  {'max rotation error':26s} {degrees(summary):>22s}   {degrees(settled):>22s}")
-    print(f"  {'min tension per cable':26s} {per_cable(summary['min_tension_per_cable_N'], 'N', 1)}")
-    print(f"  {'slack time per cable':26s} {per_cable(summary['slack_time_per_cable_s'], 's', 3)}")
-    print(f"  {'simulated / wall time':26s} {summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s"
-          + ("" if factor is None else f" ({factor:.1f}x real time)")
-          + f", {summary['steps']} steps, {summary['newton_iterations']} Newton iterations")
-    if "tension_limit_violations" in summary:
-        count = len(summary["tension_limit_violations"])
-        print(f"  {'tension limits':26s} {f'{count} violation(s)' if count else 'none'}")
-    for v in summary.get("tension_limit_violations", []):
-        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
-              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
-    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
-        print(f"  note: {note}")
-    if out is not None:
-        print(f"  written to {out}/")
-
-
-def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
-                      after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
-    """``cdpr run`` on a spatial scene: run, write into ``out``, print a summary.
-
-    Writes what ``cdpr run`` writes for every scene: ``scene.toml`` (the scene as run: a
-    rerun from it gives the same result), ``result.npz``, ``pose.csv``, ``summary.json``
-    (wall-clock figures in ``timing.json``), ``solution.sol`` (Exudyn's solution file, its
-    date blanked, for ``cdpr view``) and (``figures``) ``overview.png``. The scene and its
-    reference are checked before anything is written. On a solver failure or Ctrl-C the
-    partial result is written before the error propagates. With ``error_estimate`` a
-    companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`):
-    ``error_estimate`` in summary.json and a printed line.
-    """
-    from cdpr_exu.run.error_estimate import estimate_error, estimate_line, summary_entry
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
-
-    check_runnable(scene)  # before scene.toml is in the folder
-    solution_file = None
-    if out is not None:
-        out = check_output_folder(out, command="run")
-        clear_outputs(out, "run")  # none of the run this one replaces stays beside it (a planar one's figures)
-        save_any_scene(scene, out / "scene.toml")
-        solution_file = out / "solution.sol"
-
-    def write(result: SpatialResult, extra: dict | None = None) -> None:
-        if out is not None:
-            result.save(out, after, figures, extra)
-            if solution_file.is_file():
-                undate_solution_file(solution_file)
-
-    try:
-        result = simulate_spatial(scene, progress=not quiet, solution_file=solution_file)
-    except (SolverFailure, RunInterrupted) as err:  # keep what was computed
-        if err.partial_result is not None:
-            write(err.partial_result)
-        raise
-    estimate, interrupt = None, None
-    if error_estimate:
-        if not quiet:
-            print("estimating the discretisation error (a companion run) ...", flush=True)
-        try:
-            estimate = estimate_error(scene, result, after=after)
-        except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
-            interrupt = err
-    write(result, None if estimate is None else summary_entry(estimate))
-    summary = result.run_summary(after)
-    raise_warnings(summary, f"{scene.name} under {result.controller}: ")  # not clean: said once, quiet or not
-    if not quiet:
-        _print_spatial_summary(summary, after, out)
-        if estimate is not None:
-            print(estimate_line(estimate))
-    if interrupt is not None:
-        raise interrupt
-    return result
-
-
 #: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
 SPATIAL_CONTROLLERS = {
     "ideal_ik": IdealIKController,
@@ -824,9 +730,10 @@ def spatial_comparison_table(summaries: dict) -> str:
 
 
 def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
-                    after: float = 1.0, quiet: bool = True) -> dict[str, dict]:
+                    after: float = 1.0, report: Callable[[str, dict], None] | None = None) -> dict[str, dict]:
     """Run a spatial scene under each named controller; write summary.json, comparison.md and each
-    controller's overview figure to ``out``. Returns the summaries by name.
+    controller's overview figure to ``out``. Returns the summaries by name; ``report(name, summary)``
+    is called as each run ends (``cdpr compare`` prints it).
 
     As the planar comparison: a run that fails is recorded with its status and partial
     figures, a controller that refuses the scene with ``refused: ...``, and the others still
@@ -857,10 +764,8 @@ def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: st
                 summaries[name] = {"controller": name, "status": f"refused: {err}"}
                 continue
             results[name], summaries[name] = result, result.summary(after)
-            if not quiet:
-                worst = summaries[name]["max_position_error_m"]
-                print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   "
-                      f"{status_text(summaries[name])}")
+            if report is not None:
+                report(name, summaries[name])
     except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
         if out is not None and summaries:
             _write_spatial_comparison(scene, summaries, results, Path(out), after)

@@ -45,7 +45,7 @@ CONTROLLERS: dict[str, Callable[[], object]] = {
     "ilc": ilc_controller,
 }
 #: Controllers that learn over trials before their run (cdpr_exu.studies.learning), made with the
-#: comparison's stopping rule and progress setting.
+#: comparison's stopping rule and progress report.
 LEARNING_CONTROLLERS: dict[str, Callable[..., object]] = {
     "model_feed_forward": model_feed_forward_controller,
     "closed_loop_model_feed_forward": closed_loop_model_feed_forward_controller,
@@ -87,14 +87,19 @@ _COLUMNS = (
 
 
 def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: str | Path | None = None,
-                        after: float = 1.0, progress: bool = False, quiet: bool = True,
-                        learning_rule: StoppingRule = DEFAULT_RULE) -> dict[str, dict]:
+                        after: float = 1.0, progress: bool = False,
+                        learning_rule: StoppingRule = DEFAULT_RULE,
+                        report: Callable[[str, dict], None] | None = None,
+                        learning_report: Callable[[str], None] | None = None) -> dict[str, dict]:
     """Run ``scene`` under each named controller; returns their summaries by name.
 
     A controller that refuses the reference (e.g. a pose that needs a pushing cable)
     or whose run fails is recorded with its status; the others still run. The
     learning controllers (:data:`LEARNING_CONTROLLERS`) run their trials first, as
     ``learning_rule`` says (their per-trial errors go into the summary as ``trials``).
+    ``report(name, summary)`` is called as each controller's run ends (not for a refused
+    one), ``learning_report`` with each line of the learning controllers' progress
+    (:class:`cdpr_exu.studies.learning.Learner`); ``cdpr compare`` prints both.
     """
     from cdpr_exu.run.simulate import simulate
 
@@ -109,7 +114,7 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
     try:
         for name in names:
             if name in LEARNING_CONTROLLERS:
-                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, progress=not quiet, plant=scene)
+                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, report=learning_report, plant=scene)
             else:
                 controller = CONTROLLERS[name]()
             try:
@@ -134,11 +139,8 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
             if "tension_limit_violations" in summary:
                 summary["tension_limit_violation_count"] = len(summary["tension_limit_violations"])
             summaries[name] = summary
-            if not quiet:
-                def mm(value):
-                    return "     n/a" if value is None else f"{1000 * value:8.2f}"
-                print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
-                      f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+            if report is not None:
+                report(name, summary)
     except KeyboardInterrupt:  # Ctrl-C, inside a run or between two: keep the controllers done so far
         if out is not None and summaries:
             _write(scene, summaries, {k: r for k, r in results.items() if k in summaries}, Path(out), after)
