@@ -13,8 +13,8 @@ import sys
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, SceneError
 from cdpr_exu.results.result import raise_warnings, status_text
-from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, markdown_table,
-                                         smooth_start)
+from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, compare_spatial,
+                                         markdown_table, smooth_start, spatial_comparison_table)
 from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule
 
 
@@ -40,10 +40,10 @@ def print_progress(line: str) -> None:
 
 
 def _compare_spatial(scene, args: argparse.Namespace) -> int:
-    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.run.spatial_run.compare_spatial`)."""
+    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.studies.comparison.compare_spatial`)."""
     from dataclasses import replace
 
-    from cdpr_exu.run.spatial_run import check_spatial_reference, compare_spatial, spatial_comparison_table
+    from cdpr_exu.run.spatial_run import check_spatial_reference
 
     if args.end_time is not None:
         scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))

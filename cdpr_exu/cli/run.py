@@ -235,7 +235,11 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
 
     def write(result: SpatialResult, extra: dict | None = None) -> None:
         if out is not None:
-            result.save(out, after, figures, extra)
+            result.save(out, after, extra)
+            if figures:
+                from cdpr_exu.post.plots import plot_spatial_run  # matplotlib only where a figure is drawn
+
+                plot_spatial_run(result, out / "overview.png", after)
             if solution_file.is_file():
                 undate_solution_file(solution_file)
 

@@ -19,7 +19,7 @@ import numpy as np
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SolverFailure, SuspectAnswerWarning
 from cdpr_exu.core.output import clear_outputs, write_summary
 from cdpr_exu.results.result import provenance
-from cdpr_exu.run.rest import DEFAULT_MAX_TIME, DEFAULT_TOLERANCE, plot_rest, solve_rest
+from cdpr_exu.run.rest import DEFAULT_MAX_TIME, DEFAULT_TOLERANCE, solve_rest
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
@@ -64,7 +64,10 @@ def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
         raise
     if out is not None:
         clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
+        from cdpr_exu.post.plots import plot_spatial_rest  # matplotlib only where a figure is drawn
+
         rest.save(out)
+        plot_spatial_rest(rest, out / "rest_profile.png")
     if not quiet:
         print_spatial_rest(rest, out)
     for text in rest.warnings:
@@ -116,6 +119,8 @@ def _cmd_static(args: argparse.Namespace) -> int:
         raise
     if out is not None:
         clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
+        from cdpr_exu.post.plots import plot_rest  # matplotlib only where a figure is drawn
+
         rest.save(out)
         plot_rest(scene, rest, out / "rest_profile.png")
     if not args.quiet:

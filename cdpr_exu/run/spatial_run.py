@@ -33,27 +33,22 @@ from __future__ import annotations
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import exudyn as exu
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
-from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import (SPATIAL_POSE_COLUMNS, check_output_folder, clear_outputs, write_npz, write_pose_csv,
-                                  write_summary)
+from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, write_npz, write_pose_csv, write_summary
 from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
-from controllers.spatial_feedback import spatial_closed_loop_tension_aware
-from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.results.result import after_start_up, provenance, safety_figures, warning_flags
+from cdpr_exu.results.result import after_start_up, provenance, safety_figures
 from cdpr_exu.run.simulate import (_progress_reporter, _solver_report, interrupt_flag, output_times, quiet_exudyn,
                                    solver_settings)
 from cdpr_exu.scenes.scene import tension_limits
@@ -293,11 +288,10 @@ class SpatialResult:
         errors from ``after`` [s] on under ``after_start_up``."""
         return {**self.summary(0.0), "after_start_up": after_start_up(self.summary(after), self.ERROR_FIGURES)}
 
-    def save(self, folder: str | Path, after: float = 1.0, figures: bool = True,
-             extra: dict | None = None) -> list[Path]:
-        """Write result.npz, pose.csv (time, pose and reference: x, y, z [m] and the rotation vector [rad]),
-        summary.json (:meth:`run_summary`, with ``extra``'s entries) and (``figures``) overview.png into
-        ``folder``; returns the paths."""
+    def save(self, folder: str | Path, after: float = 1.0, extra: dict | None = None) -> list[Path]:
+        """Write result.npz, pose.csv (time, pose and reference: x, y, z [m] and the rotation vector [rad])
+        and summary.json (:meth:`run_summary`, with ``extra``'s entries) into ``folder``; returns the paths.
+        The figure (``overview.png``) is :func:`cdpr_exu.post.plots.plot_spatial_run`'s."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
@@ -306,8 +300,6 @@ class SpatialResult:
         written = [write_npz(folder / "result.npz", **arrays),
                    write_pose_csv(folder / "pose.csv", self.time, self.pose, self.reference, SPATIAL_POSE_COLUMNS),
                    write_summary(folder, {**self.run_summary(after), **provenance(), **(extra or {})})]
-        if figures:
-            written.append(plot_spatial_run(self, folder / "overview.png", after))
         return written
 
 
@@ -647,139 +639,3 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         raise SolverFailure(f"the spatial run failed at t = {reached:.4f} s of {solver.end_time} s: {cause}",
                             time=reached, partial_result=result)
     return result
-
-
-def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0) -> Path:
-    """Overview figure: the path from above and from the side, against the reference; the position
-    error over time; the lowest element tension of each cable over time."""
-    figure = Figure(figsize=(11.0, 8.0))
-    FigureCanvasAgg(figure)
-    axes = figure.subplots(2, 2)
-    top, side, error, tension = axes[0, 0], axes[0, 1], axes[1, 0], axes[1, 1]
-    for ax, (a, b), names in ((top, (0, 1), ("x [m]", "y [m]")), (side, (0, 2), ("x [m]", "z [m]"))):
-        ax.plot(result.reference[:, a], result.reference[:, b], "k--", linewidth=1.0, label="reference")
-        ax.plot(result.pose[:, a], result.pose[:, b], "tab:blue", linewidth=1.2, label="platform")
-        ax.set_xlabel(names[0])
-        ax.set_ylabel(names[1])
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.grid(True, linewidth=0.3)
-        ax.legend(fontsize=8)
-    top.set_title("path from above", fontsize=9)
-    side.set_title("path from the side", fontsize=9)
-    for k, name in enumerate("xyz"):
-        error.plot(result.time, 1000.0 * result.position_error[:, k], label=f"error {name}")
-    error.axvline(after, color="0.6", linewidth=0.8, linestyle=":")
-    error.set_xlabel("t [s]")
-    error.set_ylabel("actual - reference [mm]")
-    error.grid(True, linewidth=0.3)
-    error.legend(fontsize=8)
-    for i, series in enumerate(result.tensions):
-        tension.plot(result.time, series.min(axis=1), label=f"cable {i + 1}")
-    tension.axhline(0.0, color="k", linewidth=0.8)
-    tension.set_xlabel("t [s]")
-    tension.set_ylabel("lowest element tension [N]")
-    tension.grid(True, linewidth=0.3)
-    tension.legend(fontsize=7, ncol=2)
-    summary = result.summary(after)
-    worst = summary["max_position_error_m"]
-    figure.suptitle(f"{result.scene_name} under {result.controller}: max position error after {after:g} s "
-                    f"{'n/a' if worst is None else f'{1000 * worst:.2f} mm'} ({result.status})", fontsize=10)
-    figure.tight_layout()
-    path = Path(path)
-    figure.savefig(path, dpi=100, format="png")
-    return path
-
-
-#: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
-SPATIAL_CONTROLLERS = {
-    "ideal_ik": IdealIKController,
-    "tension_aware": SpatialTensionAwareController,
-    "tension_aware_chain": lambda: SpatialTensionAwareController(statics="chain"),
-    "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
-}
-
-def spatial_controller_names(scene: SpatialScene) -> list[str]:
-    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS` (over
-    swivel pulleys too: the chain version's held chains run over the disc, their winch ends moved as the run's)."""
-    return list(SPATIAL_CONTROLLERS)
-
-
-_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
-            ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
-            ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
-
-
-def spatial_comparison_table(summaries: dict) -> str:
-    """The spatial comparison as a Markdown table (errors after the summaries' ``after``); a scene
-    with tension limits gets a column counting the violations, as the planar table does."""
-    columns = _COLUMNS
-    if any("tension_limit_violations" in s for s in summaries.values()):
-        columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
-        summaries = {name: {**s, "tension_limit_violation_count": len(s.get("tension_limit_violations", []))}
-                     for name, s in summaries.items()}
-    lines = ["| controller | " + " | ".join(title for _, title, _ in columns) + " | vs ideal IK | status |",
-             "|" + "---|" * (len(columns) + 3)]
-    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
-    for name, s in summaries.items():
-        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in columns]
-        worst = s.get("max_position_error_m")
-        ratio = f"{base / worst:.1f}x" if base and worst else ""
-        flags = "".join(f"; {flag}" for flag in warning_flags(s))  # what a real robot cannot do
-        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{flags} |")
-    return "\n".join(lines) + "\n"
-
-
-def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
-                    after: float = 1.0, report: Callable[[str, dict], None] | None = None) -> dict[str, dict]:
-    """Run a spatial scene under each named controller; write summary.json, comparison.md and each
-    controller's overview figure to ``out``. Returns the summaries by name; ``report(name, summary)``
-    is called as each run ends (``cdpr compare`` prints it).
-
-    As the planar comparison: a run that fails is recorded with its status and partial
-    figures, a controller that refuses the scene with ``refused: ...``, and the others still
-    run; on Ctrl-C (inside a run or between two) the controllers done so far and the
-    interrupted one's partial run are written before the interrupt goes on.
-    """
-    names = list(names or spatial_controller_names(scene))
-    unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
-    if unknown:
-        raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
-    if out is not None:  # an earlier comparison's files go before the first of this one is written
-        clear_outputs(check_output_folder(out, command="compare"), "compare")
-    summaries, results = {}, {}
-    try:
-        for name in names:
-            try:
-                result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
-            except SolverFailure as err:
-                result = err.partial_result
-                if result is None:  # it failed before its first step (settling the robot)
-                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
-                    continue
-            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
-                results[name] = err.partial_result
-                summaries[name] = err.partial_result.summary(after)
-                raise
-            except CdprError as err:  # a controller that refuses the scene is a result of the comparison too
-                summaries[name] = {"controller": name, "status": f"refused: {err}"}
-                continue
-            results[name], summaries[name] = result, result.summary(after)
-            if report is not None:
-                report(name, summaries[name])
-    except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
-        if out is not None and summaries:
-            _write_spatial_comparison(scene, summaries, results, Path(out), after)
-        raise
-    if out is not None:
-        _write_spatial_comparison(scene, summaries, results, Path(out), after)
-    return summaries
-
-
-def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
-    out.mkdir(parents=True, exist_ok=True)
-    write_summary(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
-                        "error_convention": "actual - reference", "controllers": summaries, **provenance()})
-    (out / "comparison.md").write_text(spatial_comparison_table(summaries))
-    for name, result in results.items():
-        plot_spatial_run(result, out / f"overview_{name}.png", after)

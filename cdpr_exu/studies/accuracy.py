@@ -525,9 +525,22 @@ class AccuracyStudy:
     grid: AccuracyGrid
     series: dict[int, dict[str, Any]] = field(default_factory=dict, repr=False)
 
+    #: The cost runs are judged by and the position tolerances of the tables (for the figure,
+    #: :func:`cdpr_exu.post.study_plots.plot_pareto`).
+    COST = COST
+    TOLERANCES = TOLERANCES
+
     @property
     def reference_row(self) -> dict[str, Any]:
         return next(r for r in self.rows if r["is_reference"])
+
+    def compared(self, error: str) -> list[dict[str, Any]]:
+        """The completed, compared runs other than the reference, with a finite ``error`` and cost."""
+        return [r for r in self.rows if _usable(r, error)]
+
+    def front(self, error: str) -> list[Mapping[str, Any]]:
+        """:func:`pareto_front` of the runs for ``error``."""
+        return pareto_front(self.rows, error)
 
 
 def check_study_scene(scene) -> None:
@@ -699,7 +712,8 @@ def _cell(value: Any) -> str:
 
 
 def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> dict[str, Path]:
-    """Write the CSV, JSON, tables, Pareto plot and the reference's series into ``out``."""
+    """Write the CSV, JSON, tables, Pareto plot (:func:`cdpr_exu.post.study_plots.plot_pareto`) and the
+    reference's series into ``out``."""
     from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
     from cdpr_exu.results.result import provenance
     from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
@@ -741,6 +755,8 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
     paths["reference"] = out / ACCURACY_FILES["reference"]
     (out / ACCURACY_FILES["tables"]).write_text(format_tables(study) + "\n")
     paths["tables"] = out / ACCURACY_FILES["tables"]
+    from cdpr_exu.post.study_plots import plot_pareto
+
     paths["pareto"] = plot_pareto(study, out / ACCURACY_FILES["pareto"])
     return paths
 
@@ -859,81 +875,3 @@ def format_tables(study: AccuracyStudy) -> str:
             lines.append([*_configuration_cell(r).split(" | "), kind, when, cause.replace("|", "/")])
         parts.append(_markdown(["model", "n", "step [s]", "status", "stopped at [s]", "cause"], lines))
     return "\n".join(parts)
-
-
-# --------------------------------------------------------------------------- figure
-
-#: Colours of the ladder's models; other models take the spare colours in turn.
-_MODEL_COLORS = {"ideal": "tab:gray", "elastic": "tab:green", "catenary": "tab:orange", "full": "tab:blue",
-                 model_name("full", LINEAR_BENDING): "tab:purple"}
-_SPARE_COLORS = ("tab:red", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
-_STEP_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
-
-
-def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
-    """Error against cost (CPU time), log-log: one marker per run, coloured by model, Pareto front drawn.
-
-    Left: the platform position error; right: the RMS error of the platform-end
-    tensions. Marker shapes give the step size; tolerance lines at 1 mm, 1 cm, 5 cm.
-    """
-    from matplotlib.lines import Line2D
-    from matplotlib.ticker import NullFormatter
-
-    from cdpr_exu.post.plots import _figure, _save
-
-    rows = study.rows
-    models = list(dict.fromkeys(r["model"] for r in rows))
-    spare = [m for m in models if m not in _MODEL_COLORS]
-    colors = {m: _MODEL_COLORS.get(m) or _SPARE_COLORS[spare.index(m) % len(_SPARE_COLORS)] for m in models}
-    steps = sorted({r["step_size_s"] for r in rows})
-    markers = {h: _STEP_MARKERS[i % len(_STEP_MARKERS)] for i, h in enumerate(steps)}
-    figure = _figure(12.0, 5.2, left=0.8, right=0.2, bottom=1.3, top=0.55, wspace=0.85, columns=2)
-    axes = figure.subplots(1, 2)
-    quantities = (("position_error_max_m", 1000.0, "max platform position error [mm]" if study.comparison == "path"
-                   else "final platform position error [mm]"),
-                  ("tension_error_rms_N", 1.0, "RMS error of platform-end tensions [N]" if study.comparison == "path"
-                   else "final platform-end tension error [N]"))
-    for axis, (quantity, scale, label) in zip(axes, quantities):
-        for r in rows:
-            if not _usable(r, quantity) or r[quantity] <= 0:
-                continue
-            axis.plot(r[COST], scale * r[quantity], linestyle="none", marker=markers[r["step_size_s"]],
-                      color=colors[r["model"]], markersize=6, alpha=0.8, markeredgecolor="black", markeredgewidth=0.4)
-        front = [r for r in pareto_front(rows, quantity) if r[quantity] > 0]
-        if front:
-            x = [r[COST] for r in front]
-            y = [scale * r[quantity] for r in front]
-            axis.step(x, y, where="post", color="black", linewidth=1.0, alpha=0.7, zorder=0)
-            for r, xi, yi in zip(front, x, y):
-                axis.annotate(_short_label(r), (xi, yi), fontsize=6, xytext=(3, 3), textcoords="offset points",
-                              color="0.25")
-        if quantity == "position_error_max_m":
-            for tolerance in TOLERANCES:
-                axis.axhline(1000 * tolerance, color="0.5", linestyle=":", linewidth=0.8)
-                axis.annotate(f"{1000 * tolerance:g} mm", (1.0, 1000 * tolerance), xycoords=("axes fraction", "data"),
-                              fontsize=7, color="0.4", ha="right", va="bottom")
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        axis.xaxis.set_minor_formatter(NullFormatter())
-        axis.yaxis.set_minor_formatter(NullFormatter())
-        axis.set_xlabel("CPU time of the run [s] (one core)")
-        axis.set_ylabel(label)
-        axis.grid(True, which="both", alpha=0.25)
-    done = sum(r["status"] == "completed" for r in rows) - 1
-    failed = sum(r["status"].startswith("failed") for r in rows)
-    refused = sum(r["status"].startswith("refused") for r in rows)
-    ref = study.reference_row
-    figure.suptitle(f"{study.scene_name}, {study.end_time:g} s: error against the reference ({study.reference.label}, "
-                    f"{ref[COST]:.0f} s) vs CPU time; {done} runs compared, {failed} failed, "
-                    f"{refused} refused (see accuracy.csv); black: Pareto front", fontsize=9)
-    handles = [Line2D([], [], linestyle="none", marker="o", color=colors[m], label=m) for m in models]
-    handles += [Line2D([], [], linestyle="none", marker=markers[h], color="black", markerfacecolor="none",
-                       label=f"h = {h:g} s") for h in steps]
-    figure.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
-    return _save(figure, path)
-
-
-def _short_label(row: Mapping[str, Any]) -> str:
-    """``full 20, 5e-03`` (model, elements, step) for annotations."""
-    n = "" if row.get("n_elements") is None else f" {row['n_elements']}"
-    return f"{row['model']}{n}, {row['step_size_s']:.0e}"

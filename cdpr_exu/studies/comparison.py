@@ -13,6 +13,9 @@ paper's circle starts at full speed, a jolt that no real robot would be commande
 that throws the cables slack (0.12 s on ideal IK with tension-only cables, 299 N peaks)
 without saying anything about how well a controller tracks. The scene written with the
 results (``scene.toml``) records the start used.
+
+A spatial scene runs under :data:`SPATIAL_CONTROLLERS` (:func:`compare_spatial`): ``summary.json``,
+``comparison.md`` (:func:`spatial_comparison_table`) and an ``overview_<controller>.png`` each.
 """
 
 from __future__ import annotations
@@ -24,11 +27,14 @@ import numpy as np
 
 from controllers.ideal_ik import IdealIKController
 from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
+from controllers.spatial_feedback import spatial_closed_loop_tension_aware
+from controllers.spatial_tension_aware import SpatialTensionAwareController
 
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import fixed
 from cdpr_exu.results.result import Result, provenance, warning_flags
 from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
                                       ilc_controller, model_feed_forward_controller)
 
@@ -191,3 +197,108 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
                        PLANAR_POSE_COLUMNS)
     if results:
         plot_comparison(scene, results, out)
+
+
+# --------------------------------------------------------------------------- spatial scenes
+
+#: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
+SPATIAL_CONTROLLERS = {
+    "ideal_ik": IdealIKController,
+    "tension_aware": SpatialTensionAwareController,
+    "tension_aware_chain": lambda: SpatialTensionAwareController(statics="chain"),
+    "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
+}
+
+
+def spatial_controller_names(scene: SpatialScene) -> list[str]:
+    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS` (over
+    swivel pulleys too: the chain version's held chains run over the disc, their winch ends moved as the run's)."""
+    return list(SPATIAL_CONTROLLERS)
+
+
+_SPATIAL_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
+            ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
+            ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
+
+
+def spatial_comparison_table(summaries: dict) -> str:
+    """The spatial comparison as a Markdown table (errors after the summaries' ``after``); a scene
+    with tension limits gets a column counting the violations, as the planar table does."""
+    columns = _SPATIAL_COLUMNS
+    if any("tension_limit_violations" in s for s in summaries.values()):
+        columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
+        summaries = {name: {**s, "tension_limit_violation_count": len(s.get("tension_limit_violations", []))}
+                     for name, s in summaries.items()}
+    lines = ["| controller | " + " | ".join(title for _, title, _ in columns) + " | vs ideal IK | status |",
+             "|" + "---|" * (len(columns) + 3)]
+    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
+    for name, s in summaries.items():
+        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in columns]
+        worst = s.get("max_position_error_m")
+        ratio = f"{base / worst:.1f}x" if base and worst else ""
+        flags = "".join(f"; {flag}" for flag in warning_flags(s))  # what a real robot cannot do
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{flags} |")
+    return "\n".join(lines) + "\n"
+
+
+def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
+                    after: float = 1.0, report: Callable[[str, dict], None] | None = None) -> dict[str, dict]:
+    """Run a spatial scene under each named controller; write summary.json, comparison.md and each
+    controller's overview figure to ``out``. Returns the summaries by name; ``report(name, summary)``
+    is called as each run ends (``cdpr compare`` prints it).
+
+    As the planar comparison: a run that fails is recorded with its status and partial
+    figures, a controller that refuses the scene with ``refused: ...``, and the others still
+    run; on Ctrl-C (inside a run or between two) the controllers done so far and the
+    interrupted one's partial run are written before the interrupt goes on.
+    """
+    from cdpr_exu.run.spatial_run import simulate_spatial
+
+    names = list(names or spatial_controller_names(scene))
+    unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
+    if unknown:
+        raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
+    if out is not None:  # an earlier comparison's files go before the first of this one is written
+        from cdpr_exu.core.output import check_output_folder, clear_outputs
+
+        clear_outputs(check_output_folder(out, command="compare"), "compare")
+    summaries, results = {}, {}
+    try:
+        for name in names:
+            try:
+                result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
+            except SolverFailure as err:
+                result = err.partial_result
+                if result is None:  # it failed before its first step (settling the robot)
+                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
+                    continue
+            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
+                results[name] = err.partial_result
+                summaries[name] = err.partial_result.summary(after)
+                raise
+            except CdprError as err:  # a controller that refuses the scene is a result of the comparison too
+                summaries[name] = {"controller": name, "status": f"refused: {err}"}
+                continue
+            results[name], summaries[name] = result, result.summary(after)
+            if report is not None:
+                report(name, summaries[name])
+    except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
+        if out is not None and summaries:
+            _write_spatial_comparison(scene, summaries, results, Path(out), after)
+        raise
+    if out is not None:
+        _write_spatial_comparison(scene, summaries, results, Path(out), after)
+    return summaries
+
+
+def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
+    """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
+    from cdpr_exu.core.output import write_summary
+    from cdpr_exu.post.plots import plot_spatial_run
+
+    out.mkdir(parents=True, exist_ok=True)
+    write_summary(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
+                        "error_convention": "actual - reference", "controllers": summaries, **provenance()})
+    (out / "comparison.md").write_text(spatial_comparison_table(summaries))
+    for name, result in results.items():
+        plot_spatial_run(result, out / f"overview_{name}.png", after)

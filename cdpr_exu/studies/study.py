@@ -574,14 +574,6 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
 # --------------------------------------------------------------------------- files
 
 
-def _cell(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        return repr(value) if math.isfinite(value) else ""  # empty: "not applicable", never "nan"
-    return "" if value is None else str(value)
-
-
 def _json_value(value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None
@@ -602,8 +594,9 @@ def study_columns(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variat
 def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: "Scene",
                 variations: Sequence[Variation], *, mode: str = "grid", after: float = 1.0,
                 plots: bool = True) -> dict[str, Path]:
-    """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
-    from cdpr_exu.core.output import check_output_folder, clear_outputs, write_summary
+    """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures
+    (:func:`cdpr_exu.post.study_plots.plot_study`); return the paths."""
+    from cdpr_exu.core.output import check_output_folder, clear_outputs, value_text, write_summary
     from cdpr_exu.results.result import provenance
     from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
 
@@ -615,7 +608,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
         writer = csv.writer(handle)
         writer.writerow(columns)
         for row in rows:
-            writer.writerow([_cell(row.get(c)) for c in columns])
+            writer.writerow([value_text(row.get(c)) for c in columns])
     paths["csv"] = out / STUDY_FILES["csv"]
     data = {
         "variations": [{"path": v.path, "values": list(v.values)} for v in variations],
@@ -629,6 +622,8 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
     write_summary(out, data, name=STUDY_FILES["json"])  # the date and each row's wall time go to timing.json
     paths["json"] = out / STUDY_FILES["json"]
     if plots and variations:
+        from cdpr_exu.post.study_plots import plot_study
+
         paths.update(plot_study(rows, variations, out, mode=mode))
     return paths
 
@@ -636,125 +631,6 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
 def load_study(out: str | Path) -> dict[str, Any]:
     """Read a study's ``study.json`` back (rows, variations, base scene, provenance)."""
     return json.loads((Path(out) / STUDY_FILES["json"]).read_text())
-
-
-# --------------------------------------------------------------------------- figures
-
-
-def _file_stem(path: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_]+", "_", path).strip("_")
-
-
-def _is_numeric(values: Sequence[Any]) -> bool:
-    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
-
-
-def _finite(value: Any) -> bool:
-    return isinstance(value, (int, float)) and math.isfinite(value)
-
-
-def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation], out: str | Path,
-               mode: str = "grid") -> dict[str, Path]:
-    """Summary figures of a study; returns their paths by name.
-
-    For each varied parameter, ``vs_<path>.png``: the maximum position error and the
-    Newton iterations (the run's cost, the same from run to run, unlike its wall time) against that parameter (one line per value of the other parameter in a
-    2-parameter grid, per combination of the others beyond). A 2-parameter grid also
-    gets ``heatmap.png``. Failed and refused runs are marked with red crosses at the
-    bottom of the axes.
-    """
-    from cdpr_exu.post.plots import DPI, _figure
-
-    out = Path(out)
-    written: dict[str, Path] = {}
-    for variation in variations:
-        others = [v for v in variations if v.path != variation.path] if mode == "grid" else []
-        figure = _figure(10.0, 4.0, left=0.9, right=0.25, bottom=0.8, top=0.5, wspace=0.9, columns=2)
-        axes = figure.subplots(1, 2)
-        numeric = _is_numeric(variation.values)
-        position = {v: (v if numeric else i) for i, v in enumerate(variation.values)}
-        groups: dict[tuple, list[Mapping[str, Any]]] = {}
-        for row in rows:
-            groups.setdefault(tuple(row[o.path] for o in others), []).append(row)
-        for quantity, axis, scale, label in (("max_position_error_m", axes[0], 1000.0, "max position error [mm]"),
-                                             ("newton_iterations", axes[1], 1.0, "Newton iterations")):
-            failed_label = "failed / refused"
-            for key, members in groups.items():
-                members = sorted(members, key=lambda r: position[r[variation.path]])
-                name = ", ".join(f"{o.path} = {_cell(v)}" for o, v in zip(others, key)) or None
-                ok = [r for r in members if r["status"] == "completed" and _finite(r.get(quantity))]
-                bad = [r for r in members if r["status"] != "completed"]
-                if ok:
-                    axis.plot([position[r[variation.path]] for r in ok], [scale * r[quantity] for r in ok],
-                              marker="o", label=name)
-                elif name:
-                    failed_label = None
-                if bad:  # at the foot of the axes: their figures are partial or missing
-                    label_bad = failed_label if ok or not name else f"{name}: failed / refused"
-                    axis.plot([position[r[variation.path]] for r in bad], [0.03] * len(bad), linestyle="none",
-                              marker="x", color="tab:red", markersize=9, markeredgewidth=2,
-                              transform=axis.get_xaxis_transform(), label=label_bad, clip_on=False)
-                    if ok or not name:
-                        failed_label = None
-            axis.set_xlabel(variation.path)
-            axis.set_ylabel(label)
-            axis.grid(True, alpha=0.3)
-            if not numeric:
-                axis.set_xticks(range(len(variation.values)), [_cell(v) for v in variation.values])
-            if others or failed_label is None:
-                axis.legend(fontsize=7)
-        after = next((r["errors_measured_after_s"] for r in rows if _finite(r.get("errors_measured_after_s"))), None)
-        figure.suptitle(f"study over {variation.path}" + (f" (errors after {after:g} s)" if _finite(after) else ""),
-                        fontsize=10)
-        path = out / f"vs_{_file_stem(variation.path)}.png"
-        figure.savefig(path, dpi=DPI, format="png")
-        written[f"vs_{variation.path}"] = path
-    if mode == "grid" and len(variations) == 2:
-        written["heatmap"] = _plot_heatmap(rows, variations, out / "heatmap.png")
-    return written
-
-
-def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation], path: Path) -> Path:
-    """Maximum position error and Newton iterations over a 2-parameter grid, failed cells marked."""
-    import matplotlib
-    import numpy as np
-
-    from cdpr_exu.post.plots import DPI, _figure
-
-    first, second = variations
-    figure = _figure(11.0, 4.5, left=1.0, right=0.3, bottom=0.8, top=0.5, wspace=1.6, columns=2)
-    axes = figure.subplots(1, 2)
-    index = {(row[first.path], row[second.path]): row for row in rows}
-    for axis, quantity, scale, label in ((axes[0], "max_position_error_m", 1000.0, "max position error [mm]"),
-                                         (axes[1], "newton_iterations", 1.0, "Newton iterations")):
-        grid = np.full((len(first.values), len(second.values)), np.nan)
-        for i, a in enumerate(first.values):
-            for j, b in enumerate(second.values):
-                row = index.get((a, b))
-                if row is not None and row["status"] == "completed" and _finite(row.get(quantity)):
-                    grid[i, j] = scale * row[quantity]
-        colormap = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
-        image = axis.imshow(grid, origin="lower", aspect="auto", cmap=colormap)
-        figure.colorbar(image, ax=axis, label=label)
-        finite = grid[np.isfinite(grid)]
-        middle = 0.5 * (finite.min() + finite.max()) if finite.size else 0.0
-        for i, a in enumerate(first.values):
-            for j, b in enumerate(second.values):
-                row = index.get((a, b))
-                if row is None:
-                    continue
-                if row["status"] != "completed":
-                    text, color = row["status"].split(":")[0], "tab:red"
-                else:
-                    text, color = f"{grid[i, j]:.3g}", ("black" if grid[i, j] > middle else "white")
-                axis.text(j, i, text, ha="center", va="center", fontsize=8, color=color)
-        axis.set_xticks(range(len(second.values)), [_cell(v) for v in second.values])
-        axis.set_yticks(range(len(first.values)), [_cell(v) for v in first.values])
-        axis.set_xlabel(second.path)
-        axis.set_ylabel(first.path)
-    figure.suptitle("study grid (grey, red text: failed or refused run)", fontsize=10)
-    figure.savefig(path, dpi=DPI, format="png")
-    return path
 
 
 # --------------------------------------------------------------------------- table
@@ -765,6 +641,8 @@ def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variati
 
     The causes of failed and refused runs follow the table, once each.
     """
+    from cdpr_exu.core.output import finite_number, value_text
+
     head = [v.path for v in variations] + ["run", "status", "max err [mm]", "rms err [mm]", "wall [s]",
                                            "x real time"]
     lines, causes = [], {}
@@ -773,11 +651,11 @@ def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variati
         kind, _, cause = status.partition(": ")
         if cause:
             causes.setdefault(cause, []).append(str(row.get("run", "")))
-        cells = [_cell(row.get(v.path)) for v in variations] + [_cell(row.get("run")), kind]
+        cells = [value_text(row.get(v.path)) for v in variations] + [value_text(row.get("run")), kind]
         for name, scale, fmt in (("max_position_error_m", 1000.0, "{:.2f}"), ("rms_position_error_m", 1000.0, "{:.2f}"),
                                  ("wall_time_s", 1.0, "{:.2f}"), ("real_time_factor", 1.0, "{:.2f}")):
             value = row.get(name)
-            cells.append(fmt.format(scale * value) if _finite(value) else "-")
+            cells.append(fmt.format(scale * value) if finite_number(value) else "-")
         lines.append(cells)
     widths = [max(len(str(c)) for c in column) for column in zip(head, *lines)]
     out = ["  ".join(str(c).ljust(w) for c, w in zip(head, widths)).rstrip()]
