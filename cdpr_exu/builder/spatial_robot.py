@@ -767,30 +767,6 @@ def solve_static(mbs, items, settings=None):
                                np.linalg.norm(forces, axis=1), wall_time)
 
 
-@dataclass(frozen=True, eq=False)
-class SpatialRunResult:
-    """A dynamic run: platform trajectory and, when asked, the energy.
-
-    Attributes
-    ----------
-    time : ndarray, shape (k,) [s]
-        Start of each step, and the end time.
-    position : ndarray, shape (k, 3) [m]
-    rotation_vector : ndarray, shape (k, 3) [rad]
-    energy : ndarray, shape (k,) [J] or None
-    wall_time : float [s]
-        Of ``SolveDynamic`` (with the recording).
-    newton_iterations : int
-    """
-
-    time: np.ndarray
-    position: np.ndarray
-    rotation_vector: np.ndarray
-    energy: np.ndarray | None
-    wall_time: float
-    newton_iterations: int
-
-
 def dynamic_settings(end_time, step_size, spectral_radius=0.9, tolerance=1e-8):
     """Settings of the implicit generalised-alpha integrator at a fixed step, full Newton."""
     settings = exu.SimulationSettings()
@@ -807,56 +783,3 @@ def dynamic_settings(end_time, step_size, spectral_radius=0.9, tolerance=1e-8):
     ti.newton.absoluteTolerance = tolerance
     ti.newton.maxIterations = 25
     return settings
-
-
-def run_dynamic(mbs, items, end_time, step_size, spectral_radius=0.9, record_energy=False, settings=None):
-    """Integrate the assembled robot from its initial configuration (at rest) over ``end_time`` [s].
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-        Assembled.
-    items : SpatialRobotItems
-    end_time, step_size : float [s]
-    spectral_radius : float, optional
-        Of the generalised-alpha integrator (1: no numerical damping).
-    record_energy : bool, optional
-        Record :func:`robot_energy` at every step (a Python call per step).
-    settings : exudyn.SimulationSettings, optional
-        Default :func:`dynamic_settings`.
-
-    Returns
-    -------
-    SpatialRunResult
-
-    Raises
-    ------
-    SolverFailure
-        If the integration fails.
-    """
-    end_time, step_size = positive("end_time", end_time), positive("step_size", step_size)
-    settings = dynamic_settings(end_time, step_size, spectral_radius) if settings is None else settings
-    times, positions, rotations, energies = [], [], [], []
-
-    def record(mbs_, t):
-        position, rotation = platform_pose(mbs_, items)
-        times.append(t)
-        positions.append(position)
-        rotations.append(rotation_vector(rotation))
-        if record_energy:
-            energies.append(robot_energy(mbs_, items))
-        return True
-
-    mbs.SetPreStepUserFunction(record)
-    start = time.perf_counter()
-    try:
-        mbs.SolveDynamic(settings)
-    except (exu.SolverError, RuntimeError, SystemError) as error:
-        raise SolverFailure(f"Exudyn's dynamic solver failed: {error}") from None
-    finally:
-        mbs.SetPreStepUserFunction(0)
-    wall_time = time.perf_counter() - start
-    record(mbs, float(mbs.systemData.GetTime()))
-    iterations = int(mbs.sys["dynamicSolver"].it.newtonStepsCount) if "dynamicSolver" in mbs.sys else -1
-    return SpatialRunResult(np.array(times), np.array(positions), np.array(rotations),
-                            np.array(energies) if record_energy else None, wall_time, iterations)
