@@ -81,8 +81,8 @@ from cdpr_exu.core.validation import non_negative, positive, shown
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
 from cdpr_exu.core.geometry import rotation_vector
-from cdpr_exu.physics.spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, chain_element_mass, \
-    node_masses_along, solve_spatial_statics
+from cdpr_exu.physics.spatial_statics import (SpatialEquilibrium, SpatialPlatform, chain_element_mass,
+                                              checked_unstrained_lengths, node_masses_along, solve_spatial_statics)
 from cdpr_exu.statics.spatial_chain_statics import SpatialChainCable, SpatialChainRobot, solve_spatial_chain_statics, \
     swivel_chain_start, winch_line_elements
 
@@ -258,7 +258,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     """
     if not isinstance(platform, SpatialPlatform):
         raise SceneError(f"platform must be a SpatialPlatform, got {shown(platform)}")
-    lengths = _lengths(platform, unstrained_lengths)
+    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
     chain = SpatialChainSpec() if chain is None else chain
     if not isinstance(chain, SpatialChainSpec):
         raise SceneError(f"chain must be a SpatialChainSpec, got {shown(chain)}")

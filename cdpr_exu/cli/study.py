@@ -22,7 +22,7 @@ from dataclasses import replace
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED
 from cdpr_exu.studies.accuracy import check_study_scene, format_tables, grid_for, run_accuracy_study
-from cdpr_exu.studies.study import _as_variations, format_table, run_study
+from cdpr_exu.studies.study import as_variations, format_table, run_study
 
 EPILOG_STUDY = """examples:
   cdpr study sweep paper-circle --param cables.n_elements=10,15 --param platform.mass=1,2.5 --out results/study
@@ -77,7 +77,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.scheduler and args.scheduler != "local" and args.workers and not args.quiet:
         print("cdpr study: --workers is ignored with a remote --scheduler (its workers run the study)",
               file=sys.stderr)
-    variations = _as_variations(args.param)
+    variations = as_variations(args.param)
     out = check_output_folder(args.out, command="study sweep")
     rows = run_study(scene, variations, out=out, progress=not args.quiet, after=args.after,
                      mode="zip" if args.zip else "grid", workers=args.workers, scheduler=args.scheduler)

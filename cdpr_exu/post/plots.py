@@ -60,9 +60,9 @@ _PULLEY_COLOR = "0.55"
 # --------------------------------------------------------------------------- helpers
 
 
-def _figure(width: float, height: float, left: float = 0.85, right: float = 0.2, bottom: float = 0.6,
-            top: float = 0.4, wspace: float = 0.0, hspace: float = 0.0, columns: int = 1,
-            lines: int = 1) -> Figure:
+def new_figure(width: float, height: float, left: float = 0.85, right: float = 0.2, bottom: float = 0.6,
+               top: float = 0.4, wspace: float = 0.0, hspace: float = 0.0, columns: int = 1,
+               lines: int = 1) -> Figure:
     """A new figure with an Agg canvas attached (no pyplot), its subplot margins fixed.
 
     All sizes in inches: the figure's ``width`` and ``height``, the margins around the
@@ -78,7 +78,7 @@ def _figure(width: float, height: float, left: float = 0.85, right: float = 0.2,
     return figure
 
 
-def _save(figure: Figure, path: str | Path) -> Path:
+def save_figure(figure: Figure, path: str | Path) -> Path:
     """Write ``figure`` as PNG to ``path`` (parent folders made) and return the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -445,9 +445,9 @@ def plot_snapshots(scene: Scene, result: Result, path: str | Path,
     panel_width = 3.9
     panel_height = panel_width * height_m / width_m
     left, right, bottom, top, wspace, hspace = 0.65, 0.15, 0.8, 0.65, 0.12, 0.45
-    figure = _figure(left + right + columns * panel_width + (columns - 1) * wspace,
-                     bottom + top + lines * panel_height + (lines - 1) * hspace,
-                     left, right, bottom, top, wspace, hspace, columns, lines)
+    figure = new_figure(left + right + columns * panel_width + (columns - 1) * wspace,
+                        bottom + top + lines * panel_height + (lines - 1) * hspace,
+                        left, right, bottom, top, wspace, hspace, columns, lines)
     axes = figure.subplots(lines, columns, squeeze=False, sharex=True, sharey=True)
     for j, ax in enumerate(axes.flat):
         if j >= len(times):
@@ -471,7 +471,7 @@ def plot_snapshots(scene: Scene, result: Result, path: str | Path,
     figure.suptitle(textwrap.fill(title + (f" — {note}" if note else ""), width=110), fontsize=11,
                     y=1.0 - 0.12 / figure.get_figheight(),
                     va="top")
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_path(scene: Scene, result: Result, path: str | Path) -> Path:
@@ -482,9 +482,9 @@ def plot_path(scene: Scene, result: Result, path: str | Path) -> Path:
     Path
         The file written.
     """
-    figure = _figure(5.5, 5.6, left=0.8, bottom=1.0)
+    figure = new_figure(5.5, 5.6, left=0.8, bottom=1.0)
     _path_axes(figure.add_subplot(), scene, result)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_rotation(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
@@ -497,9 +497,9 @@ def plot_rotation(result: Result, path: str | Path, scene: Scene | None = None) 
     Path
         The file written.
     """
-    figure = _figure(6.0, 3.8)
+    figure = new_figure(6.0, 3.8)
     _rotation_axes(figure.add_subplot(), scene, result)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_errors(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
@@ -512,9 +512,9 @@ def plot_errors(result: Result, path: str | Path, scene: Scene | None = None) ->
     Path
         The file written.
     """
-    figure = _figure(6.0, 3.8)
+    figure = new_figure(6.0, 3.8)
     _errors_axes(figure.add_subplot(), scene, result)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
@@ -531,7 +531,7 @@ def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
     """
     m = len(result.tensions)
     lines = max(1, m)
-    figure = _figure(6.5, 0.95 + 2.3 * lines + 0.4 * (lines - 1), top=0.35, hspace=0.4, lines=lines)
+    figure = new_figure(6.5, 0.95 + 2.3 * lines + 0.4 * (lines - 1), top=0.35, hspace=0.4, lines=lines)
     axes = figure.subplots(lines, 1, sharex=True, squeeze=False)[:, 0]
     rows = _valid_rows(result)
     time = np.asarray(result.time, dtype=float)[rows]
@@ -556,7 +556,7 @@ def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
         _legend(ax, fontsize=8, loc="upper right", ncol=3)
         _mark_end(ax, result)
     axes[-1].set_xlabel("time t [s]")
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_overview(scene: Scene, result: Result, folder: str | Path,
@@ -589,8 +589,8 @@ def plot_overview(scene: Scene, result: Result, folder: str | Path,
         plot_errors(result, folder / OVERVIEW_FILES["errors"], scene=scene),
         plot_tensions(scene, result, folder / OVERVIEW_FILES["tensions"]),
     ]
-    figure = _figure(11.0, 9.0, left=0.8, right=0.25, bottom=0.6, top=0.65, wspace=0.95, hspace=1.15,
-                     columns=2, lines=2)
+    figure = new_figure(11.0, 9.0, left=0.8, right=0.25, bottom=0.6, top=0.65, wspace=0.95, hspace=1.15,
+                        columns=2, lines=2)
     axes = figure.subplots(2, 2)
     _path_axes(axes[0, 0], scene, result)
     _rotation_axes(axes[0, 1], scene, result)
@@ -601,7 +601,7 @@ def plot_overview(scene: Scene, result: Result, folder: str | Path,
     title = f"{scene.name} ({result.controller})" + (f" — {note}" if note else "")
     figure.suptitle(textwrap.fill(title, width=int(11.0 * 72 / 12 * 1.6)), fontsize=12,
                     y=1.0 - 0.12 / figure.get_figheight(), va="top")
-    paths.append(_save(figure, folder / OVERVIEW_FILES["overview"]))
+    paths.append(save_figure(figure, folder / OVERVIEW_FILES["overview"]))
     return paths
 
 
@@ -629,7 +629,7 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     folder.mkdir(parents=True, exist_ok=True)
     colors = [f"C{j % 10}" for j in range(len(results))]
 
-    figure = _figure(5.5, 5.6, left=0.8, bottom=1.0 + 0.2 * ((len(results) + 1) // 4))
+    figure = new_figure(5.5, 5.6, left=0.8, bottom=1.0 + 0.2 * ((len(results) + 1) // 4))
     ax = figure.add_subplot()
     reference = _reference_path(scene, None)
     ax.plot(reference[:, 0], reference[:, 1], label="reference", **_REFERENCE_STYLE)
@@ -646,9 +646,9 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     ax.set_title(f"{scene.name}: path of the platform centre", fontsize=10)
     ax.grid(True, linewidth=0.4, alpha=0.6)
     _legend_below(ax)
-    paths = [_save(figure, folder / "comparison_paths.png")]
+    paths = [save_figure(figure, folder / "comparison_paths.png")]
 
-    figure = _figure(6.5, 3.8)
+    figure = new_figure(6.5, 3.8)
     ax = figure.add_subplot()
     for color, (label, result) in zip(colors, results.items()):
         rows = _valid_rows(result)
@@ -665,7 +665,7 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     ax.set_title(f"{scene.name}: position error of the platform centre", fontsize=10)
     ax.grid(True, linewidth=0.4, alpha=0.6)
     _legend(ax, fontsize=8, loc="best")
-    paths.append(_save(figure, folder / "comparison_errors.png"))
+    paths.append(save_figure(figure, folder / "comparison_errors.png"))
     return paths
 
 

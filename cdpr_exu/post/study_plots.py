@@ -18,7 +18,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import NullFormatter
 
 from cdpr_exu.core.output import finite_number, value_text
-from cdpr_exu.post.plots import DPI, _figure, _save
+from cdpr_exu.post.plots import DPI, new_figure, save_figure
 
 
 # --------------------------------------------------------------------------- parameter studies
@@ -47,7 +47,7 @@ def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], out
     written: dict[str, Path] = {}
     for variation in variations:
         others = [v for v in variations if v.path != variation.path] if mode == "grid" else []
-        figure = _figure(10.0, 4.0, left=0.9, right=0.25, bottom=0.8, top=0.5, wspace=0.9, columns=2)
+        figure = new_figure(10.0, 4.0, left=0.9, right=0.25, bottom=0.8, top=0.5, wspace=0.9, columns=2)
         axes = figure.subplots(1, 2)
         numeric = _is_numeric(variation.values)
         position = {v: (v if numeric else i) for i, v in enumerate(variation.values)}
@@ -95,7 +95,7 @@ def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], out
 def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], path: Path) -> Path:
     """Maximum position error and Newton iterations over a 2-parameter grid, failed cells marked."""
     first, second = variations
-    figure = _figure(11.0, 4.5, left=1.0, right=0.3, bottom=0.8, top=0.5, wspace=1.6, columns=2)
+    figure = new_figure(11.0, 4.5, left=1.0, right=0.3, bottom=0.8, top=0.5, wspace=1.6, columns=2)
     axes = figure.subplots(1, 2)
     index = {(row[first.path], row[second.path]): row for row in rows}
     for axis, quantity, scale, label in ((axes[0], "max_position_error_m", 1000.0, "max position error [mm]"),
@@ -152,7 +152,7 @@ def plot_pareto(study, path: str | Path) -> Path:
     colors = {m: _MODEL_COLORS.get(m) or _SPARE_COLORS[spare.index(m) % len(_SPARE_COLORS)] for m in models}
     steps = sorted({r["step_size_s"] for r in rows})
     markers = {h: _STEP_MARKERS[i % len(_STEP_MARKERS)] for i, h in enumerate(steps)}
-    figure = _figure(12.0, 5.2, left=0.8, right=0.2, bottom=1.3, top=0.55, wspace=0.85, columns=2)
+    figure = new_figure(12.0, 5.2, left=0.8, right=0.2, bottom=1.3, top=0.55, wspace=0.85, columns=2)
     axes = figure.subplots(1, 2)
     quantities = (("position_error_max_m", 1000.0, "max platform position error [mm]" if study.comparison == "path"
                    else "final platform position error [mm]"),
@@ -195,7 +195,7 @@ def plot_pareto(study, path: str | Path) -> Path:
     handles += [Line2D([], [], linestyle="none", marker=markers[h], color="black", markerfacecolor="none",
                        label=f"h = {h:g} s") for h in steps]
     figure.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def _short_label(row: Mapping[str, Any]) -> str:

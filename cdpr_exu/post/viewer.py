@@ -41,7 +41,7 @@ import exudyn as exu
 import exudyn.graphics as graphics
 import numpy as np
 
-from cdpr_exu.core.errors import CdprError
+from cdpr_exu.core.errors import CdprError, OutputError
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.scenes.scene import Scene, load_scene
 
@@ -881,13 +881,31 @@ def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *,
     CdprError
         Unknown file type, bad arguments, or MP4 without imageio-ffmpeg.
     """
-    path, _, _ = _render_animation(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir,
-                                   progress=progress, multi_sampling=multi_sampling)
+    path, _, _ = render_animation_timed(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir,
+                                        progress=progress, multi_sampling=multi_sampling)
     return path
 
 
-def _render_animation(run_dir, out_file, *, fps, every, size, frames_dir, progress,
-                      multi_sampling) -> tuple[Path, int, float]:
+def render_spatial_animation(run_dir: str | Path, out: str | Path | None = None, fps: float = 25.0,
+                             every: int | None = None, size: tuple[int, int] = (640, 480),
+                             frames_dir: str | Path | None = None) -> tuple[Path, int]:
+    """Render the spatial run in ``run_dir`` to a GIF (or MP4); returns (the file, the number of frames).
+
+    :func:`render_animation` on a spatial folder, with its checks
+    (a folder without a spatial run is refused, as every bad option).
+    """
+    from cdpr_exu.post.spatial_animation import is_spatial_run
+
+    if not is_spatial_run(run_dir):
+        raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
+                          "write one with `cdpr run SPATIAL-SCENE --out DIR`")
+    path, frames, _ = render_animation_timed(run_dir, out, fps=fps, every=every, size=size, frames_dir=frames_dir,
+                                             progress=False, multi_sampling=2)
+    return path, frames
+
+
+def render_animation_timed(run_dir, out_file, *, fps, every, size, frames_dir, progress,
+                           multi_sampling) -> tuple[Path, int, float]:
     """:func:`render_animation`, also returning the frame count and seconds per frame."""
     from tqdm import tqdm
 

@@ -361,7 +361,7 @@ def _speed_indices(model: Model) -> np.ndarray:
 def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time: float,
                           chunk_time: float) -> tuple[float, float]:
     """Integrate from the model's initial state until at rest; returns (time, speed) [s, m/s]."""
-    from cdpr_exu.run.simulate import _solver_report, likely_cause, quiet_exudyn, solver_settings  # late: imports controllers
+    from cdpr_exu.run.simulate import solver_report, likely_cause, quiet_exudyn, solver_settings  # late: imports controllers
 
     mbs = model.mbs
     data = mbs.systemData
@@ -391,7 +391,7 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
                 with quiet_exudyn():
                     mbs.SolveDynamic(settings)
             except (exu.SolverError, RuntimeError, SystemError) as err:
-                cause = _solver_report(mbs, " ".join(str(err).split()))
+                cause = solver_report(mbs, " ".join(str(err).split()))
                 reached = float(mbs.sys["dynamicSolver"].it.currentTime) if "dynamicSolver" in mbs.sys else t
                 raise SolverFailure(f"the run of scene {scene.name!r} to rest failed at t = {reached:.4f} s "
                                     f"(between {t:.3f} s and {end:.3f} s): {cause}. {likely_cause(scene, cause, reached)}",

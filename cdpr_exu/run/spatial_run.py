@@ -49,7 +49,7 @@ from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
 
 from cdpr_exu.results.result import after_start_up, provenance, safety_figures
-from cdpr_exu.run.simulate import (_progress_reporter, _solver_report, interrupt_flag, output_times, quiet_exudyn,
+from cdpr_exu.run.simulate import (progress_reporter, solver_report, interrupt_flag, output_times, quiet_exudyn,
                                    solver_settings)
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
@@ -502,7 +502,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         except SolverFailure as failure:  # the settle's solver knows why it stopped
             exudyn_said = str(failure).split(": ", 1)[-1]  # "SolveDynamic terminated", and no more
             raise SolverFailure(f"settling the robot over its swivel pulleys before the run failed: "
-                                f"{_solver_report(mbs, exudyn_said)}", time=0.0) from None
+                                f"{solver_report(mbs, exudyn_said)}", time=0.0) from None
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = output_times(solver.end_time, solver.output_period)
@@ -596,7 +596,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
             report(t, _time.perf_counter() - wall_start)
         return True
 
-    report = _progress_reporter(progress, scene)
+    report = progress_reporter(progress, scene)
     monitor = _SpatialMonitor(scene)
     record(0.0)
     state["next"] = 1
@@ -611,7 +611,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
             if state["failure"] is None:
                 mbs.SolveDynamic(solver_settings(scene, solution_file))
         except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn's own cause, not only "terminated"
-            state["failure"] = state["failure"] or _solver_report(mbs, " ".join(str(err).split()))
+            state["failure"] = state["failure"] or solver_report(mbs, " ".join(str(err).split()))
     wall = _time.perf_counter() - wall_start
     if report is not None:
         report(None, wall)

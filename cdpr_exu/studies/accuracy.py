@@ -326,7 +326,7 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
         os.environ.setdefault(name, value)
     from cdpr_exu.core.errors import SolverFailure, UnreachableError
     from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial
-    from cdpr_exu.studies.study import _warm_up
+    from cdpr_exu.studies.study import warm_up
 
     empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
              "newton_iterations": 0, "failure_time_s": math.nan}
@@ -339,7 +339,7 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
             from cdpr_exu.run.spatial_run import simulate_spatial as simulate
         else:
             from cdpr_exu.run.simulate import simulate
-        _warm_up(scene)
+        warm_up(scene)
         cpu = time.process_time()
         try:
             result = simulate(scene, progress=False)
@@ -594,7 +594,7 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
         If the reference run does not complete: nothing can be compared then.
     """
     from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, load_any_scene
-    from cdpr_exu.studies.study import _executor_for, _progress_bar
+    from cdpr_exu.studies.study import executor_for, progress_bar
 
     base = load_any_scene(scene) if isinstance(scene, (str, Path)) else scene
     check_study_scene(base)
@@ -624,10 +624,10 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
     pending.sort(key=lambda item: -_estimated_cost(configurations[item[0]]))
 
     series: dict[int, dict[str, Any]] = {}
-    bar = _progress_bar(len(rows), progress)
+    bar = progress_bar(len(rows), progress)
     bar.update(len(rows) - len(pending))
     try:
-        with _executor_for(executor, min(workers or os.cpu_count() or 1, max(len(pending), 1)), None) as pool:
+        with executor_for(executor, min(workers or os.cpu_count() or 1, max(len(pending), 1)), None) as pool:
             futures: dict[Future, int] = {pool.submit(run_configuration, data): index for index, data in pending}
             for future in as_completed(futures):
                 index = futures[future]

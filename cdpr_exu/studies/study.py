@@ -282,7 +282,7 @@ def combinations(variations: Sequence[Variation], mode: str = "grid") -> list[tu
     return [tuple(zip(paths, values)) for values in itertools.product(*(v.values for v in variations))]
 
 
-def _as_variations(variations: Any) -> list[Variation]:
+def as_variations(variations: Any) -> list[Variation]:
     """Variations from strings ``"PATH=V1,V2"``, ``(path, values)`` pairs, a dict or Variations."""
     if isinstance(variations, (str, Variation)):
         variations = [variations]
@@ -314,11 +314,11 @@ def _nan_figures() -> dict[str, Any]:
     return {name: float("nan") for name in FIGURES}
 
 
-#: Model configurations already run once in this process (see :func:`_warm_up`).
+#: Model configurations already run once in this process (see :func:`warm_up`).
 _WARMED: set[str] = set()
 
 
-def _warm_up(scene) -> None:
+def warm_up(scene) -> None:
     """Run two steps of a planar or spatial ``scene`` once per process and model configuration, untimed.
 
     The first run in a process loads Numba's compiled kernels and Exudyn's code
@@ -376,7 +376,7 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
         else:
             from cdpr_exu.run.simulate import simulate
 
-            _warm_up(scene)
+            warm_up(scene)
         after = after if after < scene.solver.end_time else 0.0
         try:
             result = simulate(scene, progress=False)
@@ -429,7 +429,7 @@ def local_dask_cluster(n_workers: int | None = None):
 
 
 @contextlib.contextmanager
-def _executor_for(executor: Executor | None, workers: int | None, scheduler: str | None):
+def executor_for(executor: Executor | None, workers: int | None, scheduler: str | None):
     """The executor to use; the ones made here are shut down afterwards."""
     if executor is not None:
         yield executor
@@ -461,7 +461,8 @@ def _executor_for(executor: Executor | None, workers: int | None, scheduler: str
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _progress_bar(total: int, enabled: bool):
+def progress_bar(total: int, enabled: bool):
+    """A tqdm bar over ``total`` runs, shown when ``enabled`` and the output is a terminal."""
     from tqdm import tqdm
 
     # disable=None: no bar when the output is not a terminal (logs, CI).
@@ -519,7 +520,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         raise SceneError(f"workers must be a whole number of at least 1, got {workers!r}")
     scene = base_scene if isinstance(base_scene, (Scene, SpatialScene)) else load_any_scene(base_scene)
     after = float(after)
-    variations = _as_variations(variations)
+    variations = as_variations(variations)
     base_data = scene.to_dict()
     for variation in variations:
         check_parameter_path(base_data, variation.path)
@@ -539,7 +540,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
             pending.append((index, data))
         rows.append(row)
 
-    bar = _progress_bar(len(rows), progress)
+    bar = progress_bar(len(rows), progress)
     bar.update(len(rows) - len(pending))
     start = time.perf_counter()
     simulated = 0.0
@@ -547,7 +548,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         if pending:
             if executor is None and scheduler is None:
                 workers = min(workers or os.cpu_count() or 1, len(pending))
-            with _executor_for(executor, workers, scheduler) as pool:
+            with executor_for(executor, workers, scheduler) as pool:
                 futures: dict[Future, int] = {pool.submit(run_variation, data, after): index
                                               for index, data in pending}
                 for future in as_completed(futures):
