@@ -80,6 +80,7 @@ from cdpr_exu.core.validation import non_negative, positive, shown
 
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
+from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # the disc and its angle psi
 from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.physics.spatial_statics import (SpatialEquilibrium, SpatialPlatform, chain_element_mass,
                                               checked_unstrained_lengths, node_masses_along, solve_spatial_statics)
@@ -290,8 +291,6 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     bending_stiffnesses = chain.flexural_rigidity / element_lengths
     bending_dampings = chain.bending_damping_constant / element_lengths
 
-    from cdpr_exu.builder.swivel_chain import add_swivel_pulley  # Exudyn items of the disc and psi
-
     chains, node_masses, swivel_items, swivel_pulleys, winch_elements = [], [], [], [], []
     for cable, length, equilibrium_cable, k, c, k_theta, c_theta, swivel in zip(
             platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses,
@@ -464,8 +463,6 @@ def robot_energy(mbs, items, current=True):
 
 def _swivel_energy(mbs, items, swivel, pulley, configuration):
     """Contact potential and J_s psi_dot^2 / 2 of one swivel pulley [J]."""
-    from cdpr_exu.builder.swivel_chain import swivel_energy
-
     cable = items.swivels.index(swivel)
     chain = items.chains[cable]
     q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)

@@ -10,9 +10,15 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, SceneError
+from cdpr_exu.core.output import check_output_folder
+from cdpr_exu.core.validation import non_negative
 from cdpr_exu.results.result import raise_warnings, status_text
+from cdpr_exu.run.spatial_run import check_spatial_reference
+from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, compare_spatial,
                                          markdown_table, smooth_start, spatial_comparison_table)
 from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule
@@ -41,10 +47,6 @@ def print_progress(line: str) -> None:
 
 def _compare_spatial(scene, args: argparse.Namespace) -> int:
     """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.studies.comparison.compare_spatial`)."""
-    from dataclasses import replace
-
-    from cdpr_exu.run.spatial_run import check_spatial_reference
-
     if args.end_time is not None:
         scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
     if scene.trajectory is None:
@@ -69,22 +71,13 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
 def _check_time_options(args: argparse.Namespace) -> None:
     """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
     on planar and spatial scenes alike)."""
-    from cdpr_exu.core.validation import non_negative
-
     non_negative("--after", args.after)
     non_negative("--ramp-time", args.ramp_time)
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from dataclasses import replace
-
-    from cdpr_exu.core.output import check_output_folder
-    from cdpr_exu.statics.workspace import check_reference
-
     _check_time_options(args)
     check_output_folder(args.out, command="compare")
-    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
-
     scene = load_any_scene(args.scene)
     if is_spatial(scene):
         return _compare_spatial(scene, args)

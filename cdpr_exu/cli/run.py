@@ -11,17 +11,18 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, CdprError, RunInterrupted, SolverFailure
 from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text, undate_solution_file,
                                   write_summary)
-from cdpr_exu.results.result import raise_warnings, status_text
+from cdpr_exu.results.result import Result, after_start_up, provenance, raise_warnings, status_text
+from cdpr_exu.run.error_estimate import (elements_for_tolerance, estimate_error, estimate_line, parse_length,
+                                         simulate_any, summary_entry)
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.run.spatial_run import SpatialResult, check_runnable, simulate_spatial
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene
-
-if TYPE_CHECKING:  # pragma: no cover
-    from cdpr_exu.run.spatial_run import SpatialResult
-    from cdpr_exu.scenes.spatial_scene import SpatialScene
+from cdpr_exu.scenes.spatial_scene import SpatialScene, is_spatial, load_any_scene, save_any_scene
+from cdpr_exu.statics.workspace import check_reference
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
 SETTLED_AFTER = 1.0
@@ -110,10 +111,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     are checked before anything is written. With ``error_estimate``
     a companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`).
     """
-    from cdpr_exu.results.result import Result, after_start_up, provenance, raise_warnings
-    from cdpr_exu.run.simulate import simulate
-    from cdpr_exu.statics.workspace import check_reference
-
     # A reference the cables cannot reach or hold is refused before anything is written
     # (simulate checks it too, but only after scene.toml would be in the folder).
     check_reference(scene)
@@ -132,8 +129,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     settled = result.summary(after=SETTLED_AFTER)
     estimate = None
     if error_estimate and failure is None:
-        from cdpr_exu.run.error_estimate import estimate_error
-
         if not quiet:
             print("estimating the discretisation error (a companion run) ...", flush=True)
         try:
@@ -145,8 +140,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         result.save(out)
         data = {**summary, **provenance()}
         if estimate is not None:
-            from cdpr_exu.run.error_estimate import summary_entry
-
             data.update(summary_entry(estimate))
         data.update({k: v for k, v in result.metadata.items() if k not in data})
         data["after_start_up"] = after_start_up(settled, Result.ERROR_FIGURES)
@@ -155,7 +148,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         if solution_file is not None and solution_file.is_file():
             undate_solution_file(solution_file)
         if figures and len(result.time) > 1:
-            from cdpr_exu.post.plots import plot_overview
+            from cdpr_exu.post.plots import plot_overview  # matplotlib only where a figure is drawn
 
             plot_overview(scene, result, out)
     if failure is None:  # a completed run that pushed is not clean: say so once, quiet or not
@@ -163,8 +156,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     if not quiet:
         _print_summary(summary, settled, out)
         if estimate is not None:
-            from cdpr_exu.run.error_estimate import estimate_line
-
             print(estimate_line(estimate))
     if failure is not None:
         raise failure
@@ -221,10 +212,6 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
     companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`):
     ``error_estimate`` in summary.json and a printed line.
     """
-    from cdpr_exu.run.error_estimate import estimate_error, estimate_line, summary_entry
-    from cdpr_exu.run.spatial_run import check_runnable, simulate_spatial
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
-
     check_runnable(scene)  # before scene.toml is in the folder
     solution_file = None
     if out is not None:
@@ -272,8 +259,6 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
 def _elements_for(scene, tolerance: float, quiet: bool):
     """The scene (planar or spatial) with the fewest elements per cable, never fewer than it has, that the error
     model says meet ``tolerance`` [m] (:func:`cdpr_exu.run.error_estimate.elements_for_tolerance` says why not fewer)."""
-    from cdpr_exu.run.error_estimate import elements_for_tolerance, estimate_error, simulate_any
-
     n = max(c.n_elements for c in scene.cables)
     pilot = estimate_error(scene, simulate_any(scene), after=SETTLED_AFTER)
     if pilot.max_position_error_m is None:
@@ -287,12 +272,8 @@ def _elements_for(scene, tolerance: float, quiet: bool):
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from cdpr_exu.run.error_estimate import parse_length
-
     out = check_output_folder(args.out, command="run")
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
-    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
-
     scene = load_any_scene(args.scene)  # loaded once: a warning of the scene file is printed once
     if is_spatial(scene):
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}

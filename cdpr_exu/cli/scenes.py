@@ -11,10 +11,10 @@ import argparse
 
 from cdpr_exu.core.errors import EXIT_CODES
 from cdpr_exu.scenes.scene import load_scene, shipped_scenes
+from cdpr_exu.scenes.spatial_scene import load_spatial_scene, shipped_spatial_scenes
 
 
 def _cmd_scenes(args: argparse.Namespace) -> int:  # noqa: ARG001
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene, shipped_spatial_scenes
 
     for name in shipped_scenes():
         scene = load_scene(name)

@@ -12,19 +12,17 @@ import argparse
 import sys
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SolverFailure, SuspectAnswerWarning
-from cdpr_exu.core.output import clear_outputs, write_summary
+from cdpr_exu.core.geometry import rotation_angles_deg
+from cdpr_exu.core.output import check_output_folder, clear_outputs, fixed, write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.run.rest import DEFAULT_MAX_TIME, DEFAULT_TOLERANCE, solve_rest
-from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.run.spatial_rest import SpatialRest, solve_spatial_rest
+from cdpr_exu.scenes.scene import Scene, save_scene
 from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
-
-if TYPE_CHECKING:  # pragma: no cover
-    from cdpr_exu.run.spatial_rest import SpatialRest
 
 EPILOG = """examples:
   cdpr static paper-catenary-fixed --out results/static_fixed
@@ -41,8 +39,6 @@ two lie more than 5 % of the shortest cable apart or an element is compressed, a
 
 def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
     """Write what a failed ``cdpr static`` knows: the scene, the cause and the last state."""
-    from cdpr_exu.scenes.scene import save_scene
-
     clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
     save_scene(scene, out / "scene.toml")
     partial = err.partial_result if isinstance(err.partial_result, dict) else {}
@@ -53,8 +49,6 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
 def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
     """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`); its warnings go to the console
     (and are in summary.json), a failure writes the scene, the cause and the last state."""
-    from cdpr_exu.run.spatial_rest import solve_spatial_rest
-
     try:
         rest = solve_spatial_rest(scene)
     except SolverFailure as err:
@@ -63,9 +57,9 @@ def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
             print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
         raise
     if out is not None:
-        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         from cdpr_exu.post.plots import plot_spatial_rest  # matplotlib only where a figure is drawn
 
+        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         rest.save(out)
         plot_spatial_rest(rest, out / "rest_profile.png")
     if not quiet:
@@ -77,8 +71,6 @@ def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
 
 def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
     """The static mode's summary on the terminal (its :attr:`SpatialRest.warnings` are the caller's to issue)."""
-    from cdpr_exu.run.spatial_rest import rotation_angles_deg
-
     x, y, z = rest.position
     roll, pitch, yaw = rotation_angles_deg(rest.rotation)
     catenary = rest.catenary
@@ -104,8 +96,6 @@ def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
 
 
 def _cmd_static(args: argparse.Namespace) -> int:
-    from cdpr_exu.core.output import check_output_folder, fixed
-
     out = check_output_folder(args.out, command="static")
     scene = load_any_scene(args.scene)
     if is_spatial(scene):
@@ -118,9 +108,9 @@ def _cmd_static(args: argparse.Namespace) -> int:
             print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
         raise
     if out is not None:
-        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         from cdpr_exu.post.plots import plot_rest  # matplotlib only where a figure is drawn
 
+        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
         rest.save(out)
         plot_rest(scene, rest, out / "rest_profile.png")
     if not args.quiet:

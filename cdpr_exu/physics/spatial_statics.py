@@ -68,8 +68,11 @@ from scipy.optimize import minimize
 from cdpr_exu.physics.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
     profile, solve_forward, solve_inverse
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
-from cdpr_exu.statics.statics import PlatformEquilibriumViews, minimise_energy  # the planar statics' line search, reused
+from cdpr_exu.core.geometry import Pulley, left_jacobian, rotation_from_vector, rotation_vector, skew
+from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+# the planar statics' line search, and its cable over a pulley in the swivel's vertical plane, reused
+from cdpr_exu.statics.statics import PlatformEquilibriumViews, SuspendedCable, forward_cable, minimise_energy
+from cdpr_exu.statics.statics import inverse_cable as planar_inverse_cable
 from cdpr_exu.core.validation import non_negative, positive, real_array, shown, vector
 
 _RELATIVE_TOLERANCE = 1e-12
@@ -435,9 +438,6 @@ def _swivel_plane(cable, anchor_point):
     UnreachableError
         If the anchor lies on the axis (its azimuth, and so the plane, is undefined).
     """
-    from cdpr_exu.core.geometry import Pulley
-    from cdpr_exu.statics.statics import SuspendedCable
-
     inlet = np.array(cable.exit_point)
     offset = np.asarray(anchor_point, dtype=float) - inlet
     rho = float(math.hypot(offset[0], offset[1]))
@@ -453,8 +453,6 @@ def _swivel_plane(cable, anchor_point):
 
 def _solve_swivel_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
     """:func:`solve_cable` over a swivel pulley: the planar pulley cable in the plane through the axis and the anchor."""
-    from cdpr_exu.statics.statics import forward_cable
-
     inlet, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
     rho = span[0]
     radius = cable.pulley_radius
@@ -547,8 +545,6 @@ def _straight_path(cable, exit_point, point):
     span = point - exit_point
     distance = float(np.linalg.norm(span))
     if cable.pulley_radius > 0.0:
-        from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
-
         try:
             path = swivel_pulley_exit(exit_point, cable.pulley_radius, point)
         except UnreachableError:
@@ -773,8 +769,6 @@ def _inverse_swivel_cable(cable, anchor_point, horizontal_tension):
     """:func:`_inverse_cable` over a swivel pulley: the planar pulley cable's inverse (``statics.inverse_cable``)
     in the vertical plane through the axis and the anchor, as :func:`_solve_swivel_cable` solves it forward.
     The length counts from the inlet, the wrap included."""
-    from cdpr_exu.statics.statics import inverse_cable as planar_inverse_cable
-
     _, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
     planar, _, _, _ = planar_inverse_cable(planar_cable, float(horizontal_tension), span, None,
                                            DEFAULT_MAX_STRAIN, None)

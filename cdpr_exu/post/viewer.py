@@ -40,10 +40,17 @@ from pathlib import Path
 import exudyn as exu
 import exudyn.graphics as graphics
 import numpy as np
+from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
+from exudyn.utilities import LoadSolutionFile, SetSolutionState
 
-from cdpr_exu.core.errors import CdprError, OutputError
+from cdpr_exu.builder import spatial_robot
 from cdpr_exu.builder.model import Model, build_model
+from cdpr_exu.core.errors import CdprError, OutputError
+from cdpr_exu.core.geometry import rotation_vector
+from cdpr_exu.core.output import check_output_folder, clear_outputs
+from cdpr_exu.run.spatial_run import build_spatial_model
 from cdpr_exu.scenes.scene import Scene, load_scene
+from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
 #: File names inside a run folder (written by ``cdpr run --out``).
 SCENE_FILE = "scene.toml"
@@ -167,8 +174,6 @@ def load_solution(path: str | Path) -> dict:
     RunFolderError
         If the file is missing, unreadable or holds no row.
     """
-    from exudyn.utilities import LoadSolutionFile
-
     path = Path(path)
     _require_file(path, "solution file")
     try:
@@ -233,15 +238,10 @@ class SpatialReplay:
 
     def platform_pose(self) -> np.ndarray:
         """The platform's pose in each row: centre of mass [m] and rotation vector [rad], shape (n_rows, 6)."""
-        from exudyn.utilities import SetSolutionState
-
-        from cdpr_exu.builder.spatial_robot import platform_pose
-        from cdpr_exu.core.geometry import rotation_vector
-
         poses = []
         for row in range(self.n_rows):
             SetSolutionState(self.mbs, self.solution, row, exu.ConfigurationType.Current)
-            position, rotation = platform_pose(self.mbs, self.items)
+            position, rotation = spatial_robot.platform_pose(self.mbs, self.items)
             poses.append(np.concatenate([position, rotation_vector(rotation)]))
         return np.asarray(poses)
 
@@ -265,14 +265,10 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | Spati
     ------
     RunFolderError, SolutionMismatchError, SceneError
     """
-    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
-
     scene_file, solution_file = run_files(run_dir)
     scene = load_any_scene(scene_file)
     solution = load_solution(solution_file)
     if is_spatial(scene):
-        from cdpr_exu.run.spatial_run import build_spatial_model
-
         mbs, items = build_spatial_model(scene)
         check_solution_fits(mbs, solution, f"solution file {str(solution_file)!r}")
         return SpatialReplay(Path(run_dir), scene, mbs, items, solution)
@@ -415,8 +411,6 @@ def _style(model: Model) -> None:
 def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768)) -> None:
     """Visualization settings of a spatial replay: small nodes, no load arrows or markers, and a view
     from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
-    from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
-
     settings = replay.mbs.GetSystemContainer().visualizationSettings
     points = np.vstack([np.asarray(replay.scene.exits, dtype=float), replay.platform_pose()[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
@@ -777,8 +771,7 @@ def check_animation_request(run_dir: str | Path, out_file: str | Path | None = N
     RunFolderError
         A folder that holds no run.
     """
-    from cdpr_exu.core.output import check_output_folder
-    from cdpr_exu.post.spatial_animation import is_spatial_run
+    from cdpr_exu.post.spatial_animation import is_spatial_run  # matplotlib: only where a run is drawn
 
     if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
             or not (np.isfinite(fps) and fps > 0):
@@ -825,7 +818,6 @@ class _PlanarFrames:
 
     def frame(self, row: int):
         """Row ``row`` as a PIL RGB image."""
-        from exudyn.utilities import SetSolutionState
         from PIL import Image
 
         model, solution = self.replay.model, self.replay.solution
@@ -894,7 +886,7 @@ def render_spatial_animation(run_dir: str | Path, out: str | Path | None = None,
     :func:`render_animation` on a spatial folder, with its checks
     (a folder without a spatial run is refused, as every bad option).
     """
-    from cdpr_exu.post.spatial_animation import is_spatial_run
+    from cdpr_exu.post.spatial_animation import is_spatial_run  # matplotlib: only where a run is drawn
 
     if not is_spatial_run(run_dir):
         raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
@@ -919,8 +911,6 @@ def render_animation_timed(run_dir, out_file, *, fps, every, size, frames_dir, p
     step = request.every if request.every is not None else _rows_per_frame(source.times, request.fps)
     rows = range(0, len(source.times), step)
     if request.frames_dir is not None:
-        from cdpr_exu.core.output import clear_outputs
-
         clear_outputs(request.frames_dir, "animate --frames-dir")  # no frame of a longer, older animation stays
 
     start = _time.perf_counter()

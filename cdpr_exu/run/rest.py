@@ -75,7 +75,9 @@ from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
 from cdpr_exu.core.output import write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import static_settings
+from cdpr_exu.physics import bending
 from cdpr_exu.results.result import provenance
+from cdpr_exu.run.simulate import likely_cause, quiet_exudyn, solver_report, solver_settings
 from cdpr_exu.scenes.scene import Scene
 
 #: Default tolerance on the largest node speed at rest [m/s].
@@ -361,8 +363,6 @@ def _speed_indices(model: Model) -> np.ndarray:
 def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time: float,
                           chunk_time: float) -> tuple[float, float]:
     """Integrate from the model's initial state until at rest; returns (time, speed) [s, m/s]."""
-    from cdpr_exu.run.simulate import solver_report, likely_cause, quiet_exudyn, solver_settings  # late: imports controllers
-
     mbs = model.mbs
     data = mbs.systemData
     settings = solver_settings(scene)
@@ -543,8 +543,6 @@ def leave_point(center: np.ndarray, radius: float, outside: np.ndarray, near: np
 def _bending_cut_force(scene: Scene, cable_index: int, positions: np.ndarray, velocities: np.ndarray,
                        cut: int) -> np.ndarray:
     """Force (x, z) [N] the bending joints straddling element (cut, cut + 1) exert on nodes > cut."""
-    from cdpr_exu.physics import bending
-
     effects, cable = scene.effects, scene.cables[cable_index]
     n = len(positions) - 1
     joints = np.array([[b - 1, b, b + 1] for b in (cut, cut + 1) if 1 <= b <= n - 1], dtype=np.int64)

@@ -31,6 +31,7 @@ rotation vector.
 from __future__ import annotations
 
 import time as _time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,18 +40,21 @@ import exudyn as exu
 import numpy as np
 
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
-from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
+from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, write_npz, write_pose_csv, write_summary
 from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
+from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
 
 from cdpr_exu.results.result import after_start_up, provenance, safety_figures
-from cdpr_exu.run.simulate import (progress_reporter, solver_report, interrupt_flag, output_times, quiet_exudyn,
+from cdpr_exu.run.simulate import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
                                    solver_settings)
+from cdpr_exu.run.spatial_rest import rest_above_exits
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
@@ -116,7 +120,6 @@ def check_spatial_reference(scene: SpatialScene) -> None:
                 f"exits[{i}].winch_line = {1000 * swivel.winch_line:.3g} mm less two elements (2 x "
                 f"{1000 * margin / 2:.3g} mm, the winch end's margin below the inlet) leaves {1000 * room:.3g} mm; give "
                 f"exits[{i}].winch_line = {1000 * (margin + max(gain[k], 0.0)):.3g} mm or more")
-    from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 
     anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
     points = poses[:, :3] if anchors is None else poses
@@ -165,8 +168,6 @@ def reference_wrenches(scene: SpatialScene, times: np.ndarray) -> np.ndarray:
     ``w = J_l(theta) theta'``; its rate comes from a central difference over 1e-6 s
     (one-sided at t = 0, where the reference starts).
     """
-    from cdpr_exu.core.geometry import left_jacobian
-
     times = np.asarray(times, dtype=float)
     gravity = scene.gravity if scene.effects.gravity else 0.0
     acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
@@ -401,10 +402,6 @@ class _SpatialMonitor:
 def _warn_outside_measured_region(scene: SpatialScene) -> None:
     """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
     outside the region where runs over a swivel pulley were measured to keep their energy."""
-    import warnings
-
-    from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
-
     solver = scene.solver
     for swivel, cable in zip(scene.swivel_exits, scene.cables):
         if swivel is None:
@@ -418,8 +415,6 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
 def _rest_above_exits(scene: SpatialScene, mbs, items) -> str | None:
     """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
     above its exits (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: its bending or pushing elements do)."""
-    from cdpr_exu.run.spatial_rest import rest_above_exits
-
     position, rotation = platform_pose(mbs, items, current=False)
     lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
     above = rest_above_exits(scene, position, rotation, lowest, items.initial)

@@ -54,8 +54,15 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from cdpr_exu.core.errors import CoarseOutputWarning, SceneError
-from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, apply_parameters
+from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
+from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
+from cdpr_exu.results.result import provenance
+from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial, load_any_scene, save_any_scene
+from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
+from cdpr_exu.scenes.trajectories import HoldTrajectory
+from cdpr_exu.studies.study import (SINGLE_THREAD_ENVIRONMENT, apply_parameters, executor_for, progress_bar,
+                                    warm_up)
 
 # --------------------------------------------------------------------------- configurations
 
@@ -276,8 +283,6 @@ def grid_for(scene, quick: bool = False) -> AccuracyGrid:
     factor that brings its coarsest cable to the fewest elements the scene takes
     (:func:`fewest_spatial_elements`), e.g. 4, 8 and 16 to 48, 96 and 192.
     """
-    from cdpr_exu.scenes.spatial_scene import is_spatial
-
     if not is_spatial(scene):
         return QUICK_GRID if quick else FULL_GRID
     grid = SPATIAL_QUICK_GRID if quick else SPATIAL_FULL_GRID
@@ -324,9 +329,6 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     """
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)
-    from cdpr_exu.core.errors import SolverFailure, UnreachableError
-    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial
-    from cdpr_exu.studies.study import warm_up
 
     empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
              "newton_iterations": 0, "failure_time_s": math.nan}
@@ -335,7 +337,7 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
             warnings.simplefilter("ignore", CoarseOutputWarning)
             scene = any_scene_from_dict(scene_data)
         spatial = is_spatial(scene)
-        if spatial:
+        if spatial:  # the runners load Numba and Exudyn: here, after the thread limits above
             from cdpr_exu.run.spatial_run import simulate_spatial as simulate
         else:
             from cdpr_exu.run.simulate import simulate
@@ -451,17 +453,12 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
 def rotation_angles_deg(rotation_vectors: np.ndarray, reference_vectors: np.ndarray) -> np.ndarray:
     """Angle [deg] of the rotation from each reference orientation to the run's, both given as
     rotation vectors [rad], shapes (N, 3); returns shape (N,)."""
-    from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-
     return np.degrees([np.linalg.norm(rotation_vector(rotation_from_vector(r).T @ rotation_from_vector(v)))
                        for v, r in zip(rotation_vectors, reference_vectors)])
 
 
 def comparison_for(scene) -> str:
     """``"final"`` for a static scene (held pose, fixed winches), else ``"path"``."""
-    from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
-    from cdpr_exu.scenes.trajectories import HoldTrajectory
-
     static = isinstance(scene.trajectory, (HoldTrajectory, SpatialHoldTrajectory)) and scene.winch.kind == "fixed"
     return "final" if static else "path"
 
@@ -550,8 +547,6 @@ def check_study_scene(scene) -> None:
     ------
     SceneError
     """
-    from cdpr_exu.scenes.spatial_scene import is_spatial
-
     if is_spatial(scene) and scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr study accuracy` runs the scene's "
                          "reference (`cdpr static` gives a spatial scene's static mode)")
@@ -593,9 +588,6 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
     SceneError
         If the reference run does not complete: nothing can be compared then.
     """
-    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, load_any_scene
-    from cdpr_exu.studies.study import executor_for, progress_bar
-
     base = load_any_scene(scene) if isinstance(scene, (str, Path)) else scene
     check_study_scene(base)
     grid = grid or grid_for(base)
@@ -714,13 +706,9 @@ def _cell(value: Any) -> str:
 def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> dict[str, Path]:
     """Write the CSV, JSON, tables, Pareto plot (:func:`cdpr_exu.post.study_plots.plot_pareto`) and the
     reference's series into ``out``."""
-    from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
-    from cdpr_exu.results.result import provenance
-    from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
-
     out = check_output_folder(out, command="study accuracy")
     clear_outputs(out, "study accuracy")  # no file of an earlier accuracy study stays
-    paths = {"scene": save_scene(base_scene, out / ACCURACY_FILES["scene"])}
+    paths = {"scene": save_any_scene(base_scene, out / ACCURACY_FILES["scene"])}
     with open(out / ACCURACY_FILES["csv"], "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(COLUMNS)

@@ -20,6 +20,7 @@ A spatial scene runs under :data:`SPATIAL_CONTROLLERS` (:func:`compare_spatial`)
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
@@ -31,10 +32,14 @@ from controllers.spatial_feedback import spatial_closed_loop_tension_aware
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
-from cdpr_exu.core.output import fixed
+from cdpr_exu.core.output import (PLANAR_POSE_COLUMNS, check_output_folder, clear_outputs, fixed, write_pose_csv,
+                                  write_summary)
 from cdpr_exu.results.result import Result, provenance, warning_flags
-from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.scenes.scene import Scene, save_scene
 from cdpr_exu.scenes.spatial_scene import SpatialScene
+from cdpr_exu.scenes.trajectories import CircleTrajectory
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
                                       ilc_controller, model_feed_forward_controller)
 
@@ -69,10 +74,6 @@ def smooth_start(scene: Scene, ramp_time: float = COMPARISON_RAMP_TIME) -> Scene
     references (hold, point-to-point) already start from rest, and a circle with its own
     ramp keeps it. ``ramp_time = 0`` returns the scene unchanged.
     """
-    from dataclasses import replace
-
-    from cdpr_exu.scenes.trajectories import CircleTrajectory
-
     if ramp_time < 0 or not np.isfinite(ramp_time):
         raise SceneError(f"ramp_time must be zero or positive [s], got {ramp_time!r}")
     trajectory = scene.trajectory
@@ -107,13 +108,9 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
     one), ``learning_report`` with each line of the learning controllers' progress
     (:class:`cdpr_exu.studies.learning.Learner`); ``cdpr compare`` prints both.
     """
-    from cdpr_exu.run.simulate import simulate
-
     names = list(names or CONTROLLERS)
     unknown = [n for n in names if n not in CONTROLLERS]
     if unknown:
-        from cdpr_exu.core.errors import SceneError
-
         raise SceneError(f"unknown controller(s) {unknown}; known: {list(CONTROLLERS)}")
     summaries: dict[str, dict] = {}
     results: dict[str, Result] = {}
@@ -181,9 +178,7 @@ def markdown_table(summaries: dict[str, dict]) -> str:
 
 
 def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, check_output_folder, clear_outputs, write_pose_csv, write_summary
     from cdpr_exu.post.plots import plot_comparison
-    from cdpr_exu.scenes.scene import save_scene
 
     clear_outputs(check_output_folder(out, command="compare"), "compare")  # no file of an earlier comparison stays
     save_scene(scene, out / "scene.toml")
@@ -252,14 +247,11 @@ def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: st
     run; on Ctrl-C (inside a run or between two) the controllers done so far and the
     interrupted one's partial run are written before the interrupt goes on.
     """
-    from cdpr_exu.run.spatial_run import simulate_spatial
-
     names = list(names or spatial_controller_names(scene))
     unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
     if unknown:
         raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
     if out is not None:  # an earlier comparison's files go before the first of this one is written
-        from cdpr_exu.core.output import check_output_folder, clear_outputs
 
         clear_outputs(check_output_folder(out, command="compare"), "compare")
     summaries, results = {}, {}
@@ -293,7 +285,6 @@ def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: st
 
 def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
     """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
-    from cdpr_exu.core.output import write_summary
     from cdpr_exu.post.plots import plot_spatial_run
 
     out.mkdir(parents=True, exist_ok=True)

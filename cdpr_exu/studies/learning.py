@@ -58,6 +58,7 @@ from controllers.feedback import ClosedLoopController, FilteredPositionPI
 
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.results.result import Result
+from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import Scene
 
 #: The learning law designed from the measured response of the paper-circle model (module notes).
@@ -180,8 +181,6 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
     SolverFailure
         If the very first trial fails (a later failure ends the learning instead).
     """
-    from cdpr_exu.run.simulate import simulate
-
     if not isinstance(law, LearningLaw):
         raise SceneError(f"law must be a LearningLaw, got {law!r}")
     if not isinstance(rule, StoppingRule):
@@ -261,8 +260,6 @@ def measure_response(model: Scene, amplitude: float = 4e-3, max_frequency: float
     -------
     PositionResponse
     """
-    from cdpr_exu.run.simulate import simulate
-
     times = command_grid(model)
     window = times >= after - 1e-9
     window[np.flatnonzero(window)[-1]] = False  # an even period: t in [after, end)
@@ -308,8 +305,6 @@ def model_feed_forward(model: Scene, plant: Scene, law: LearningLaw = DEFAULT_LA
     SceneError
         If the model and the plant differ in their cables' number or their end time.
     """
-    from cdpr_exu.run.simulate import simulate
-
     if model.n_cables != plant.n_cables or model.solver.end_time != plant.solver.end_time:
         raise SceneError("model and plant must have the same number of cables and solver.end_time")
     learning = learn_lengths(model, law, rule, after=after, on_trial=on_trial)

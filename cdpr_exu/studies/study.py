@@ -41,7 +41,7 @@ import re
 import time
 import tomllib
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
@@ -335,7 +335,6 @@ def warm_up(scene) -> None:
     if key in _WARMED:
         return
     _WARMED.add(key)
-    from dataclasses import replace
 
     solver = scene.solver
     short = replace(solver, end_time=2 * solver.step_size, output_period=solver.step_size)
