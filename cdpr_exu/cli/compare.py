@@ -45,6 +45,19 @@ def print_progress(line: str) -> None:
     print(line, flush=True)
 
 
+def _show(scene, summaries: dict, table, args: argparse.Namespace) -> list[str]:
+    """Issue each controller's warnings and (unless ``--quiet``) print ``table(summaries)`` and the output
+    folder; returns the controllers whose run did not complete."""
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
+    if not args.quiet:
+        print()
+        print(table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    return [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+
+
 def _compare_spatial(scene, args: argparse.Namespace) -> int:
     """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.studies.comparison.compare_spatial`)."""
     if args.end_time is not None:
@@ -57,14 +70,7 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
         print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
     summaries = compare_spatial(scene, names, args.out, args.after,
                                 report=None if args.quiet else print_spatial_controller_row)
-    for name, summary in summaries.items():
-        raise_warnings(summary, f"{scene.name} under {name}: ")
-    if not args.quiet:
-        print()
-        print(spatial_comparison_table(summaries))
-        if args.out:
-            print(f"written to {args.out}/")
-    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    failed = _show(scene, summaries, spatial_comparison_table, args)
     return EXIT_RUN_FAILED if failed else EXIT_OK
 
 
@@ -100,14 +106,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, learning_rule=rule,
                                     report=None if args.quiet else print_controller_row,
                                     learning_report=None if args.quiet else print_progress)
-    for name, summary in summaries.items():
-        raise_warnings(summary, f"{scene.name} under {name}: ")
-    if not args.quiet:
-        print()
-        print(markdown_table(summaries))
-        if args.out:
-            print(f"written to {args.out}/")
-    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+    failed = _show(scene, summaries, markdown_table, args)
     if failed:
         print(f"cdpr compare: {len(failed)} of {len(summaries)} controllers did not complete: {', '.join(failed)}",
               file=sys.stderr)

@@ -57,6 +57,18 @@ def _figure(value, scale: float = 1.0, unit: str = "", digits: int = 2, sign: bo
     return f"{text} {unit}".rstrip()
 
 
+def _print_violations_and_notes(summary: dict, settled: dict, out: Path | None) -> None:
+    """The end of a run's printed summary, planar or spatial: each tension-limit violation, the notes of
+    the whole run and of the settled part (once each), and the output folder."""
+    for v in summary.get("tension_limit_violations", []):
+        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
+              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
+    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
+        print(f"  note: {note}")
+    if out is not None:
+        print(f"  written to {out}/")
+
+
 def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
     def pair(key, scale, unit, digits=2):
         return _figure(summary[key], scale, unit, digits), _figure(settled[key], scale, unit, digits)
@@ -89,13 +101,7 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
     print(f"  {'':26s} {'whole run':>22s}   {'after ' + str(SETTLED_AFTER) + ' s':>18s}")
     for name, whole, after in rows:
         print(f"  {name:26s} {whole:>22s}   {after:>18s}")
-    for v in summary.get("tension_limit_violations", []):
-        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
-              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
-    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
-        print(f"  note: {note}")
-    if out is not None:
-        print(f"  written to {out}/")
+    _print_violations_and_notes(summary, settled, out)
 
 
 def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: bool = True,
@@ -190,13 +196,7 @@ def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> Non
     if "tension_limit_violations" in summary:
         count = len(summary["tension_limit_violations"])
         print(f"  {'tension limits':26s} {f'{count} violation(s)' if count else 'none'}")
-    for v in summary.get("tension_limit_violations", []):
-        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
-              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
-    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
-        print(f"  note: {note}")
-    if out is not None:
-        print(f"  written to {out}/")
+    _print_violations_and_notes(summary, settled, out)
 
 
 def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,

@@ -46,16 +46,22 @@ def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
                         "last_state": partial, **provenance()})
 
 
-def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
-    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`); its warnings go to the console
-    (and are in summary.json), a failure writes the scene, the cause and the last state."""
+def _solved(scene, out: Path | None, solve):
+    """``solve()``, the rest of ``scene``; on a solver failure the scene, the cause and the last state
+    are written to ``out`` (and the console says so) before the failure goes on."""
     try:
-        rest = solve_spatial_rest(scene)
+        return solve()
     except SolverFailure as err:
         if out is not None:
             _write_static_failure(scene, err, out)
             print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
         raise
+
+
+def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
+    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`); its warnings go to the console
+    (and are in summary.json), a failure writes the scene, the cause and the last state."""
+    rest = _solved(scene, out, lambda: solve_spatial_rest(scene))
     if out is not None:
         from cdpr_exu.post.plots import plot_spatial_rest  # matplotlib only where a figure is drawn
 
@@ -100,13 +106,8 @@ def _cmd_static(args: argparse.Namespace) -> int:
     scene = load_any_scene(args.scene)
     if is_spatial(scene):
         return _static_spatial(scene, out, args.quiet)
-    try:
-        rest = solve_rest(scene, tolerance=args.tolerance, max_time=args.max_time, polish=not args.no_polish)
-    except SolverFailure as err:
-        if out is not None:
-            _write_static_failure(scene, err, out)
-            print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
-        raise
+    rest = _solved(scene, out, lambda: solve_rest(scene, tolerance=args.tolerance, max_time=args.max_time,
+                                                  polish=not args.no_polish))
     if out is not None:
         from cdpr_exu.post.plots import plot_rest  # matplotlib only where a figure is drawn
 
