@@ -1,7 +1,7 @@
 """Swivel pulley stability map (issue 15, item 2): which swivel inertia J_s and bearing
 damping d_s hold, measured on a pendulum swinging around the swivel axis.
 
-Scene (:func:`cdpr_exu.builder.swivel_chain.run_swivel_pendulum`): a 2 kg mass on a
+Scene (:func:`cdpr_exu.run.dynamics.run_swivel_pendulum`): a 2 kg mass on a
 1.56 m cable (radius 2 mm, E = 1e9 Pa, 0.05 kg/m, 0.05 m elements, no axial damping)
 that comes up the axis from 0.3 m below the inlet, wraps the r_p = 0.1 m swivel pulley
 (r_g = h = 0.01 m, k_p = 1e6 N/m, no contact damping) and leaves it at 30 degrees from
@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cdpr_exu.builder.swivel_chain import run_swivel_pendulum
+from cdpr_exu.run.dynamics import run_swivel_pendulum
 from cdpr_exu.physics.swivel_pulley import SwivelPulley
 
 INERTIAS = (1e-6, 1e-4, 1e-2, 1.0)  # kg m^2

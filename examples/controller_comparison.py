@@ -18,6 +18,7 @@ Equivalent to ``cdpr compare paper-circle --out results/controllers`` and
 
 from dataclasses import replace
 
+from cdpr_exu.cli.compare import print_controller_row, print_progress
 from cdpr_exu.studies.comparison import compare_controllers, markdown_table, smooth_start
 from cdpr_exu.scenes.scene import ControllerModel, load_scene
 
@@ -43,7 +44,8 @@ def scenes():
 def main() -> None:
     for scene, folder in scenes():
         print(f"{scene.name} -> {folder}")
-        summaries = compare_controllers(smooth_start(scene), out=folder, quiet=False)
+        summaries = compare_controllers(smooth_start(scene), out=folder, report=print_controller_row,
+                                        learning_report=print_progress)
         print(markdown_table(summaries))
 
 

@@ -27,7 +27,8 @@ from matplotlib.figure import Figure
 from cdpr_exu.core.output import write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import load_scene
-from cdpr_exu.studies.learning import DEFAULT_LAW, DEFAULT_RULE, learn_lengths, measure_response, model_feed_forward
+from cdpr_exu.studies.learning import (DEFAULT_LAW, DEFAULT_RULE, learn_lengths, measure_response, model_feed_forward,
+                                      trial_line)
 
 OUT = Path("results/learning_control")
 AFTER = 1.0  # s, the start-up excluded from the errors
@@ -112,6 +113,10 @@ def response_table(response) -> tuple[str, list[dict]]:
     return text, data
 
 
+def print_trial(trial) -> None:
+    print(trial_line(trial), flush=True)
+
+
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     model, plant = mismatch_pair()
@@ -122,11 +127,11 @@ def main() -> None:
     print(response_md)
 
     print(f"ILC on the plant (law {DEFAULT_LAW}, rule {DEFAULT_RULE})")
-    ilc = learn_lengths(plant, after=AFTER, progress=True)
+    ilc = learn_lengths(plant, after=AFTER, on_trial=print_trial)
     print(f"  kept trial {ilc.best_trial}: {ilc.stop_reason}")
     ideal_on_plant = ilc.trials[0].max_position_error_m  # trial 1 is the ideal IK
     print("learning on the model, then its commands open loop on the plant")
-    on_model, feed_forward = model_feed_forward(model, plant, after=AFTER, progress=True)
+    on_model, feed_forward = model_feed_forward(model, plant, after=AFTER, on_trial=print_trial)
     print(f"  kept trial {on_model.best_trial}: {on_model.stop_reason}")
     ff = feed_forward.summary(after=AFTER)
     ff_slack = max(s for s in ff["slack_time_per_cable_s"] if s is not None)

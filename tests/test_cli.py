@@ -310,6 +310,7 @@ def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, m
     import os
     import signal
 
+    from cdpr_exu.cli.compare import print_controller_row
     from cdpr_exu.studies.comparison import compare_controllers
 
     class InterruptAfterFirstRow(io.StringIO):
@@ -323,7 +324,8 @@ def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, m
     out = tmp_path / "compare"
     monkeypatch.setattr("sys.stdout", InterruptAfterFirstRow())
     with pytest.raises(KeyboardInterrupt):
-        compare_controllers(scene, ["ideal_ik", "tension_aware"], out=out, after=0.0, progress=False, quiet=False)
+        compare_controllers(scene, ["ideal_ik", "tension_aware"], out=out, after=0.0, progress=False,
+                            report=print_controller_row)
     summary = _strict_json(out / "summary.json")
     assert list(summary["controllers"]) == ["ideal_ik"]
     assert summary["controllers"]["ideal_ik"]["status"] == "completed"

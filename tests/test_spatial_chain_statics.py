@@ -150,7 +150,8 @@ def test_over_swivel_pulleys_exudyns_static_solver_accepts_the_chain_statics_equ
 def test_a_rigid_platform_on_exact_joints_over_swivel_pulleys_starts_at_rest_and_stays_there():
     import warnings
 
-    from cdpr_exu.builder.spatial_robot import platform_pose, run_dynamic, start_at_rest
+    from cdpr_exu.builder.spatial_robot import platform_pose, start_at_rest
+    from cdpr_exu.run.dynamics import run_dynamic
 
     # Exudyn's static solver diverges on exact spherical joints holding a turning rigid body
     # (builder/spatial_robot.py), so it cannot check this start; its dynamic solver can: started

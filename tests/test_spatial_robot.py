@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError, SolverFailure
-from cdpr_exu.builder.spatial_robot import SpatialChainSpec, build_spatial_robot, run_dynamic, solve_static
+from cdpr_exu.builder.spatial_robot import SpatialChainSpec, build_spatial_robot, solve_static
+from cdpr_exu.run.dynamics import run_dynamic
 from cdpr_exu.physics.spatial_statics import SpatialPlatform, solve_spatial_statics
 from conftest import ASYMMETRIC_LENGTHS, PENALTY, four_cable_robot
 

@@ -12,7 +12,8 @@ import pytest
 from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.results.result import slack_time
-from cdpr_exu.run.spatial_run import simulate_spatial, spatial_comparison_table
+from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.studies.comparison import spatial_comparison_table
 from cdpr_exu.scenes.spatial_scene import load_spatial_scene
 from cdpr_exu.scenes.spatial_trajectories import (SpatialCircleTrajectory, SpatialHoldTrajectory,
                                                    SpatialPointToPointTrajectory)
@@ -185,7 +186,7 @@ def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_idea
 
 
 def test_the_chain_version_runs_over_swivel_pulleys_and_follows_the_ramp_closer_than_ideal_ik():
-    from cdpr_exu.run.spatial_run import spatial_controller_names
+    from cdpr_exu.studies.comparison import spatial_controller_names
     from controllers.ideal_ik import IdealIKController
     from controllers.spatial_tension_aware import SpatialTensionAwareController
 
@@ -255,8 +256,6 @@ def test_a_study_sweeps_a_spatial_scene_and_keeps_its_base_scene(tmp_path):
 
 
 def test_a_spatial_run_reports_each_tension_limit_crossed_as_the_planar_run_does():
-    from cdpr_exu.run.spatial_run import spatial_comparison_table
-
     scene = four_cable(end_time=0.5)
     scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))),
                     cables=tuple(replace(c, min_tension=5.0, max_tension=25.0) for c in scene.cables))
@@ -427,7 +426,7 @@ def test_ctrl_c_in_a_spatial_comparison_keeps_the_controllers_done_and_the_parti
 
     from controllers.ideal_ik import IdealIKController
     from cdpr_exu.core.errors import RunInterrupted
-    from cdpr_exu.run import spatial_run
+    from cdpr_exu.studies import comparison
 
     class CtrlC(IdealIKController):
         name = "ctrl_c"
@@ -438,12 +437,12 @@ def test_ctrl_c_in_a_spatial_comparison_keeps_the_controllers_done_and_the_parti
                 os.kill(os.getpid(), signal.SIGINT)  # the run's handler stops the integration after this step
             return super().command(measurement)
 
-    monkeypatch.setitem(spatial_run.SPATIAL_CONTROLLERS, "ctrl_c", CtrlC)
+    monkeypatch.setitem(comparison.SPATIAL_CONTROLLERS, "ctrl_c", CtrlC)
     scene = four_cable(end_time=0.3)
     scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
     out = tmp_path / "compare"
     with pytest.raises(RunInterrupted):
-        spatial_run.compare_spatial(scene, ["ideal_ik", "ctrl_c"], out, after=0.0)
+        comparison.compare_spatial(scene, ["ideal_ik", "ctrl_c"], out, after=0.0)
     summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
     assert list(summary["controllers"]) == ["ideal_ik", "ctrl_c"]
     assert summary["controllers"]["ideal_ik"]["status"] == "completed"

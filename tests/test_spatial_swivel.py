@@ -142,7 +142,8 @@ def pushed_swivel_robot():
 
 
 def _pushed_run(pushed, step, spectral_radius, modified_newton, end_time=0.05):
-    from cdpr_exu.builder.spatial_robot import dynamic_settings, run_dynamic
+    from cdpr_exu.builder.spatial_robot import dynamic_settings
+    from cdpr_exu.run.dynamics import run_dynamic
 
     mbs, items, _, _ = pushed
     settings = dynamic_settings(end_time, step, spectral_radius, tolerance=1e-6 if modified_newton else 1e-8)

@@ -9,7 +9,7 @@ from scipy.optimize import root
 from cdpr_exu.physics.bending import bending_force_kernel, cable_joints
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.physics.node_contact import node_contact_force_kernel
-from cdpr_exu.builder.swivel_chain import run_swivel_pendulum
+from cdpr_exu.run.dynamics import run_swivel_pendulum
 from cdpr_exu.physics.swivel_pulley import (SwivelPulley, SwivelStabilityWarning, cable_path_over_swivel,
                                             stability_concerns, swivel_contact_energy,
                                             swivel_contact_force, swivel_contact_pattern, swivel_contact_values,

@@ -55,7 +55,7 @@ def spatial_run_dir(tmp_path_factory) -> Path:
     """A run folder of a small spatial scene over 0.3 s (31 samples), as `cdpr run --out` writes it."""
     from conftest import small_spatial_scene
 
-    from cdpr_exu.run.spatial_run import run_spatial_scene
+    from cdpr_exu.cli.run import run_spatial_scene
 
     out = tmp_path_factory.mktemp("spatial") / "small_spatial"
     run_spatial_scene(small_spatial_scene(END_TIME), out, quiet=True, figures=False)

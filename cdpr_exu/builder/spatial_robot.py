@@ -80,9 +80,10 @@ from cdpr_exu.core.validation import non_negative, positive, shown
 
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
+from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # the disc and its angle psi
 from cdpr_exu.core.geometry import rotation_vector
-from cdpr_exu.physics.spatial_statics import SpatialEquilibrium, SpatialPlatform, _lengths, chain_element_mass, \
-    node_masses_along, solve_spatial_statics
+from cdpr_exu.physics.spatial_statics import (SpatialEquilibrium, SpatialPlatform, chain_element_mass,
+                                              checked_unstrained_lengths, node_masses_along, solve_spatial_statics)
 from cdpr_exu.statics.spatial_chain_statics import SpatialChainCable, SpatialChainRobot, solve_spatial_chain_statics, \
     swivel_chain_start, winch_line_elements
 
@@ -258,7 +259,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     """
     if not isinstance(platform, SpatialPlatform):
         raise SceneError(f"platform must be a SpatialPlatform, got {shown(platform)}")
-    lengths = _lengths(platform, unstrained_lengths)
+    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
     chain = SpatialChainSpec() if chain is None else chain
     if not isinstance(chain, SpatialChainSpec):
         raise SceneError(f"chain must be a SpatialChainSpec, got {shown(chain)}")
@@ -289,8 +290,6 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     axial_dampings = chain.axial_damping_constant / element_lengths
     bending_stiffnesses = chain.flexural_rigidity / element_lengths
     bending_dampings = chain.bending_damping_constant / element_lengths
-
-    from cdpr_exu.builder.swivel_chain import add_swivel_pulley  # Exudyn items of the disc and psi
 
     chains, node_masses, swivel_items, swivel_pulleys, winch_elements = [], [], [], [], []
     for cable, length, equilibrium_cable, k, c, k_theta, c_theta, swivel in zip(
@@ -464,8 +463,6 @@ def robot_energy(mbs, items, current=True):
 
 def _swivel_energy(mbs, items, swivel, pulley, configuration):
     """Contact potential and J_s psi_dot^2 / 2 of one swivel pulley [J]."""
-    from cdpr_exu.builder.swivel_chain import swivel_energy
-
     cable = items.swivels.index(swivel)
     chain = items.chains[cable]
     q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
@@ -767,30 +764,6 @@ def solve_static(mbs, items, settings=None):
                                np.linalg.norm(forces, axis=1), wall_time)
 
 
-@dataclass(frozen=True, eq=False)
-class SpatialRunResult:
-    """A dynamic run: platform trajectory and, when asked, the energy.
-
-    Attributes
-    ----------
-    time : ndarray, shape (k,) [s]
-        Start of each step, and the end time.
-    position : ndarray, shape (k, 3) [m]
-    rotation_vector : ndarray, shape (k, 3) [rad]
-    energy : ndarray, shape (k,) [J] or None
-    wall_time : float [s]
-        Of ``SolveDynamic`` (with the recording).
-    newton_iterations : int
-    """
-
-    time: np.ndarray
-    position: np.ndarray
-    rotation_vector: np.ndarray
-    energy: np.ndarray | None
-    wall_time: float
-    newton_iterations: int
-
-
 def dynamic_settings(end_time, step_size, spectral_radius=0.9, tolerance=1e-8):
     """Settings of the implicit generalised-alpha integrator at a fixed step, full Newton."""
     settings = exu.SimulationSettings()
@@ -807,56 +780,3 @@ def dynamic_settings(end_time, step_size, spectral_radius=0.9, tolerance=1e-8):
     ti.newton.absoluteTolerance = tolerance
     ti.newton.maxIterations = 25
     return settings
-
-
-def run_dynamic(mbs, items, end_time, step_size, spectral_radius=0.9, record_energy=False, settings=None):
-    """Integrate the assembled robot from its initial configuration (at rest) over ``end_time`` [s].
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-        Assembled.
-    items : SpatialRobotItems
-    end_time, step_size : float [s]
-    spectral_radius : float, optional
-        Of the generalised-alpha integrator (1: no numerical damping).
-    record_energy : bool, optional
-        Record :func:`robot_energy` at every step (a Python call per step).
-    settings : exudyn.SimulationSettings, optional
-        Default :func:`dynamic_settings`.
-
-    Returns
-    -------
-    SpatialRunResult
-
-    Raises
-    ------
-    SolverFailure
-        If the integration fails.
-    """
-    end_time, step_size = positive("end_time", end_time), positive("step_size", step_size)
-    settings = dynamic_settings(end_time, step_size, spectral_radius) if settings is None else settings
-    times, positions, rotations, energies = [], [], [], []
-
-    def record(mbs_, t):
-        position, rotation = platform_pose(mbs_, items)
-        times.append(t)
-        positions.append(position)
-        rotations.append(rotation_vector(rotation))
-        if record_energy:
-            energies.append(robot_energy(mbs_, items))
-        return True
-
-    mbs.SetPreStepUserFunction(record)
-    start = time.perf_counter()
-    try:
-        mbs.SolveDynamic(settings)
-    except (exu.SolverError, RuntimeError, SystemError) as error:
-        raise SolverFailure(f"Exudyn's dynamic solver failed: {error}") from None
-    finally:
-        mbs.SetPreStepUserFunction(0)
-    wall_time = time.perf_counter() - start
-    record(mbs, float(mbs.systemData.GetTime()))
-    iterations = int(mbs.sys["dynamicSolver"].it.newtonStepsCount) if "dynamicSolver" in mbs.sys else -1
-    return SpatialRunResult(np.array(times), np.array(positions), np.array(rotations),
-                            np.array(energies) if record_energy else None, wall_time, iterations)

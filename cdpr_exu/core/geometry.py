@@ -459,6 +459,14 @@ def left_jacobian(rotation_vector_):
             + (angle - math.sin(angle)) / angle**3 * (k @ k))
 
 
+def rotation_angles_deg(rotation: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw [deg] of a rotation matrix, R = Rz(yaw) Ry(pitch) Rx(roll) (for reading only)."""
+    pitch = np.arcsin(np.clip(-rotation[2, 0], -1.0, 1.0))
+    roll = np.arctan2(rotation[2, 1], rotation[2, 2])
+    yaw = np.arctan2(rotation[1, 0], rotation[0, 0])
+    return np.degrees([roll, pitch, yaw])
+
+
 # ----------------------------------------------------------------------------------
 # the one pulley description
 # ----------------------------------------------------------------------------------

@@ -70,6 +70,21 @@ def csv_cell(value: Any) -> str:
     return str(value)
 
 
+def value_text(value: Any) -> str:
+    """A value as a study's table, CSV and figures show it: ``true``/``false``, a float with all its
+    digits (empty when not finite: "not applicable", never "nan"), empty for None, else ``str``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ""  # empty: "not applicable", never "nan"
+    return "" if value is None else str(value)
+
+
+def finite_number(value: Any) -> bool:
+    """True for an int or a float that is finite (a study's figure that exists; None and NaN do not)."""
+    return isinstance(value, (int, float)) and math.isfinite(value)
+
+
 def fixed(value: float, digits: int = 2) -> str:
     """``value`` with ``digits`` decimals, never printed as ``-0.00``."""
     text = f"{value:.{digits}f}"

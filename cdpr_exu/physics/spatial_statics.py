@@ -68,8 +68,11 @@ from scipy.optimize import minimize
 from cdpr_exu.physics.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
     profile, solve_forward, solve_inverse
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
-from cdpr_exu.statics.statics import PlatformEquilibriumViews, _minimise_energy  # the planar statics' line search, reused
+from cdpr_exu.core.geometry import Pulley, left_jacobian, rotation_from_vector, rotation_vector, skew
+from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+# the planar statics' line search, and its cable over a pulley in the swivel's vertical plane, reused
+from cdpr_exu.statics.statics import PlatformEquilibriumViews, SuspendedCable, forward_cable, minimise_energy
+from cdpr_exu.statics.statics import inverse_cable as planar_inverse_cable
 from cdpr_exu.core.validation import non_negative, positive, real_array, shown, vector
 
 _RELATIVE_TOLERANCE = 1e-12
@@ -435,9 +438,6 @@ def _swivel_plane(cable, anchor_point):
     UnreachableError
         If the anchor lies on the axis (its azimuth, and so the plane, is undefined).
     """
-    from cdpr_exu.core.geometry import Pulley
-    from cdpr_exu.statics.statics import SuspendedCable
-
     inlet = np.array(cable.exit_point)
     offset = np.asarray(anchor_point, dtype=float) - inlet
     rho = float(math.hypot(offset[0], offset[1]))
@@ -453,13 +453,11 @@ def _swivel_plane(cable, anchor_point):
 
 def _solve_swivel_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
     """:func:`solve_cable` over a swivel pulley: the planar pulley cable in the plane through the axis and the anchor."""
-    from cdpr_exu.statics.statics import _forward_cable
-
     inlet, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
     rho = span[0]
     radius = cable.pulley_radius
-    planar, planar_stiffness, new_guess = _forward_cable(planar_cable, float(unstrained_length), span, guess,
-                                                         max_strain, max_tension)
+    planar, planar_stiffness, new_guess = forward_cable(planar_cable, float(unstrained_length), span, guess,
+                                                        max_strain, max_tension)
     basis = np.column_stack([e_rho, _E_Z])
     force = planar.force_on_platform
     stiffness = basis @ planar_stiffness @ basis.T + force[0] / rho * (_HORIZONTAL - np.outer(e_rho, e_rho))
@@ -485,7 +483,14 @@ def _solve_swivel_cable(cable, unstrained_length, anchor_point, guess, max_strai
 # ---------------------------------------------------------------------------
 # the platform
 # ---------------------------------------------------------------------------
-def _lengths(platform, unstrained_lengths):
+def checked_unstrained_lengths(platform, unstrained_lengths):
+    """The cables' unstrained lengths [m] as a float array, one per cable of ``platform``, each positive.
+
+    Raises
+    ------
+    SceneError
+        Naming ``unstrained_lengths``, if they are not numbers, not one per cable or not positive.
+    """
     lengths = real_array("unstrained_lengths", unstrained_lengths)
     if lengths.shape != (len(platform.cables),):
         raise SceneError(f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
@@ -540,8 +545,6 @@ def _straight_path(cable, exit_point, point):
     span = point - exit_point
     distance = float(np.linalg.norm(span))
     if cable.pulley_radius > 0.0:
-        from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
-
         try:
             path = swivel_pulley_exit(exit_point, cable.pulley_radius, point)
         except UnreachableError:
@@ -570,7 +573,7 @@ def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
     ndarray, shape (3,) or (6,)
         ``r`` [m] (and the rotation vector ``theta`` [rad] for a rigid body).
     """
-    lengths = _lengths(platform, unstrained_lengths)
+    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
     wrench = _wrench(external_wrench)
     dof = platform.degrees_of_freedom
     stiffness = np.array([c.axial_stiffness for c in platform.cables]) / lengths
@@ -647,7 +650,7 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
     """
     if not isinstance(platform, SpatialPlatform):
         raise SceneError(f"platform must be a SpatialPlatform, got {shown(platform)}")
-    lengths = _lengths(platform, unstrained_lengths)
+    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
     wrench = _wrench(external_wrench)
     max_strain = positive("max_strain", max_strain)
     if max_tension is not None:
@@ -707,8 +710,8 @@ def solve_spatial_statics(platform, unstrained_lengths, initial_pose=None, exter
         return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
 
     try:
-        scaled, _, _ = _minimise_energy(function, start * pose_scale, _RELATIVE_TOLERANCE, noise,
-                                        what="spatial statics")
+        scaled, _, _ = minimise_energy(function, start * pose_scale, _RELATIVE_TOLERANCE, noise,
+                                       what="spatial statics")
     except UnreachableError as error:
         raise UnreachableError(f"no equilibrium found for unstrained_lengths {lengths.tolist()} m: {error}") from None
     coordinates = scaled / pose_scale
@@ -763,14 +766,12 @@ def _inverse_cable(cable, anchor_point, horizontal_tension):
 
 
 def _inverse_swivel_cable(cable, anchor_point, horizontal_tension):
-    """:func:`_inverse_cable` over a swivel pulley: the planar pulley cable's inverse (``statics._inverse_cable``)
+    """:func:`_inverse_cable` over a swivel pulley: the planar pulley cable's inverse (``statics.inverse_cable``)
     in the vertical plane through the axis and the anchor, as :func:`_solve_swivel_cable` solves it forward.
     The length counts from the inlet, the wrap included."""
-    from cdpr_exu.statics.statics import _inverse_cable as _planar_inverse_cable
-
     _, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
-    planar, _, _, _ = _planar_inverse_cable(planar_cable, float(horizontal_tension), span, None,
-                                            DEFAULT_MAX_STRAIN, None)
+    planar, _, _, _ = planar_inverse_cable(planar_cable, float(horizontal_tension), span, None,
+                                           DEFAULT_MAX_STRAIN, None)
     force = planar.force_on_platform
     return planar.unstrained_length, force[0] * e_rho + force[1] * _E_Z
 

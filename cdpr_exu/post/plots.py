@@ -1,5 +1,7 @@
 """Figures of a run: the robot at several instants, the platform's path, rotation,
-errors and cable tensions (the paper's Figs. 6 and 7), and controller comparisons.
+errors and cable tensions (the paper's Figs. 6 and 7), and controller comparisons; the
+rest profile of the static mode (:func:`plot_rest`); a spatial run's overview
+(:func:`plot_spatial_run`) and a spatial robot at rest (:func:`plot_spatial_rest`).
 
 Every function takes a :class:`~cdpr_exu.scenes.scene.Scene` and/or a
 :class:`~cdpr_exu.results.result.Result`, writes one PNG and returns its path. Figures are
@@ -16,7 +18,7 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -27,9 +29,14 @@ from matplotlib.patches import Circle, Polygon
 from matplotlib.transforms import ScaledTranslation
 
 from cdpr_exu.core.errors import CdprError
-from cdpr_exu.core.geometry import anchor_points
+from cdpr_exu.core.geometry import anchor_points, rotation_angles_deg
 from cdpr_exu.results.result import Result
 from cdpr_exu.scenes.scene import Scene
+
+if TYPE_CHECKING:  # pragma: no cover
+    from cdpr_exu.run.rest import RestState
+    from cdpr_exu.run.spatial_rest import SpatialRest
+    from cdpr_exu.run.spatial_run import SpatialResult
 
 #: Resolution of the written PNGs [dots per inch].
 DPI = 150
@@ -53,9 +60,9 @@ _PULLEY_COLOR = "0.55"
 # --------------------------------------------------------------------------- helpers
 
 
-def _figure(width: float, height: float, left: float = 0.85, right: float = 0.2, bottom: float = 0.6,
-            top: float = 0.4, wspace: float = 0.0, hspace: float = 0.0, columns: int = 1,
-            lines: int = 1) -> Figure:
+def new_figure(width: float, height: float, left: float = 0.85, right: float = 0.2, bottom: float = 0.6,
+               top: float = 0.4, wspace: float = 0.0, hspace: float = 0.0, columns: int = 1,
+               lines: int = 1) -> Figure:
     """A new figure with an Agg canvas attached (no pyplot), its subplot margins fixed.
 
     All sizes in inches: the figure's ``width`` and ``height``, the margins around the
@@ -71,7 +78,7 @@ def _figure(width: float, height: float, left: float = 0.85, right: float = 0.2,
     return figure
 
 
-def _save(figure: Figure, path: str | Path) -> Path:
+def save_figure(figure: Figure, path: str | Path) -> Path:
     """Write ``figure`` as PNG to ``path`` (parent folders made) and return the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -438,9 +445,9 @@ def plot_snapshots(scene: Scene, result: Result, path: str | Path,
     panel_width = 3.9
     panel_height = panel_width * height_m / width_m
     left, right, bottom, top, wspace, hspace = 0.65, 0.15, 0.8, 0.65, 0.12, 0.45
-    figure = _figure(left + right + columns * panel_width + (columns - 1) * wspace,
-                     bottom + top + lines * panel_height + (lines - 1) * hspace,
-                     left, right, bottom, top, wspace, hspace, columns, lines)
+    figure = new_figure(left + right + columns * panel_width + (columns - 1) * wspace,
+                        bottom + top + lines * panel_height + (lines - 1) * hspace,
+                        left, right, bottom, top, wspace, hspace, columns, lines)
     axes = figure.subplots(lines, columns, squeeze=False, sharex=True, sharey=True)
     for j, ax in enumerate(axes.flat):
         if j >= len(times):
@@ -464,7 +471,7 @@ def plot_snapshots(scene: Scene, result: Result, path: str | Path,
     figure.suptitle(textwrap.fill(title + (f" — {note}" if note else ""), width=110), fontsize=11,
                     y=1.0 - 0.12 / figure.get_figheight(),
                     va="top")
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_path(scene: Scene, result: Result, path: str | Path) -> Path:
@@ -475,9 +482,9 @@ def plot_path(scene: Scene, result: Result, path: str | Path) -> Path:
     Path
         The file written.
     """
-    figure = _figure(5.5, 5.6, left=0.8, bottom=1.0)
+    figure = new_figure(5.5, 5.6, left=0.8, bottom=1.0)
     _path_axes(figure.add_subplot(), scene, result)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_rotation(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
@@ -490,9 +497,9 @@ def plot_rotation(result: Result, path: str | Path, scene: Scene | None = None) 
     Path
         The file written.
     """
-    figure = _figure(6.0, 3.8)
+    figure = new_figure(6.0, 3.8)
     _rotation_axes(figure.add_subplot(), scene, result)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_errors(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
@@ -505,9 +512,9 @@ def plot_errors(result: Result, path: str | Path, scene: Scene | None = None) ->
     Path
         The file written.
     """
-    figure = _figure(6.0, 3.8)
+    figure = new_figure(6.0, 3.8)
     _errors_axes(figure.add_subplot(), scene, result)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
@@ -524,7 +531,7 @@ def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
     """
     m = len(result.tensions)
     lines = max(1, m)
-    figure = _figure(6.5, 0.95 + 2.3 * lines + 0.4 * (lines - 1), top=0.35, hspace=0.4, lines=lines)
+    figure = new_figure(6.5, 0.95 + 2.3 * lines + 0.4 * (lines - 1), top=0.35, hspace=0.4, lines=lines)
     axes = figure.subplots(lines, 1, sharex=True, squeeze=False)[:, 0]
     rows = _valid_rows(result)
     time = np.asarray(result.time, dtype=float)[rows]
@@ -549,7 +556,7 @@ def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
         _legend(ax, fontsize=8, loc="upper right", ncol=3)
         _mark_end(ax, result)
     axes[-1].set_xlabel("time t [s]")
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_overview(scene: Scene, result: Result, folder: str | Path,
@@ -582,8 +589,8 @@ def plot_overview(scene: Scene, result: Result, folder: str | Path,
         plot_errors(result, folder / OVERVIEW_FILES["errors"], scene=scene),
         plot_tensions(scene, result, folder / OVERVIEW_FILES["tensions"]),
     ]
-    figure = _figure(11.0, 9.0, left=0.8, right=0.25, bottom=0.6, top=0.65, wspace=0.95, hspace=1.15,
-                     columns=2, lines=2)
+    figure = new_figure(11.0, 9.0, left=0.8, right=0.25, bottom=0.6, top=0.65, wspace=0.95, hspace=1.15,
+                        columns=2, lines=2)
     axes = figure.subplots(2, 2)
     _path_axes(axes[0, 0], scene, result)
     _rotation_axes(axes[0, 1], scene, result)
@@ -594,7 +601,7 @@ def plot_overview(scene: Scene, result: Result, folder: str | Path,
     title = f"{scene.name} ({result.controller})" + (f" — {note}" if note else "")
     figure.suptitle(textwrap.fill(title, width=int(11.0 * 72 / 12 * 1.6)), fontsize=12,
                     y=1.0 - 0.12 / figure.get_figheight(), va="top")
-    paths.append(_save(figure, folder / OVERVIEW_FILES["overview"]))
+    paths.append(save_figure(figure, folder / OVERVIEW_FILES["overview"]))
     return paths
 
 
@@ -622,7 +629,7 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     folder.mkdir(parents=True, exist_ok=True)
     colors = [f"C{j % 10}" for j in range(len(results))]
 
-    figure = _figure(5.5, 5.6, left=0.8, bottom=1.0 + 0.2 * ((len(results) + 1) // 4))
+    figure = new_figure(5.5, 5.6, left=0.8, bottom=1.0 + 0.2 * ((len(results) + 1) // 4))
     ax = figure.add_subplot()
     reference = _reference_path(scene, None)
     ax.plot(reference[:, 0], reference[:, 1], label="reference", **_REFERENCE_STYLE)
@@ -639,9 +646,9 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     ax.set_title(f"{scene.name}: path of the platform centre", fontsize=10)
     ax.grid(True, linewidth=0.4, alpha=0.6)
     _legend_below(ax)
-    paths = [_save(figure, folder / "comparison_paths.png")]
+    paths = [save_figure(figure, folder / "comparison_paths.png")]
 
-    figure = _figure(6.5, 3.8)
+    figure = new_figure(6.5, 3.8)
     ax = figure.add_subplot()
     for color, (label, result) in zip(colors, results.items()):
         rows = _valid_rows(result)
@@ -658,5 +665,136 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     ax.set_title(f"{scene.name}: position error of the platform centre", fontsize=10)
     ax.grid(True, linewidth=0.4, alpha=0.6)
     _legend(ax, fontsize=8, loc="best")
-    paths.append(_save(figure, folder / "comparison_errors.png"))
+    paths.append(save_figure(figure, folder / "comparison_errors.png"))
     return paths
+
+
+# --------------------------------------------------------------------------- rest states and spatial runs
+
+
+def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None = None) -> Path:
+    """Figure of the rest profile: nodes, pulleys, leave points and the platform; writes a PNG.
+
+    Returns the path written.
+    """
+    figure = Figure(figsize=(7.0, 5.0))
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot(1, 1, 1)
+    colors = ("tab:blue", "tab:red", "tab:green", "tab:purple")
+    for pulley in scene.exits:
+        if not pulley.is_point_exit:
+            ax.add_patch(Circle(pulley.center, pulley.radius, facecolor="0.92", edgecolor="0.55", zorder=1))
+        ax.plot(*pulley.center, marker="+", color="0.55", zorder=1)
+    for i, nodes in enumerate(rest.nodes):
+        color = colors[i % len(colors)]
+        ax.plot(nodes[:, 0], nodes[:, 1], "-o", color=color, markersize=3, linewidth=1.0, zorder=3,
+                label=f"cable {i + 1}: free span {rest.cable_stretched_length_m[i]:.4f} m, "
+                      f"upper force |F| = {np.hypot(*rest.upper_forces_N[i]):.2f} N")
+        ax.plot(*rest.upper_points_m[i], marker="x", color=color, markersize=8, zorder=4)
+    x, z = rest.platform_position_m
+    ax.plot(x, z, marker="s", color="0.2", markersize=7, zorder=5,
+            label=f"platform ({x:.4f}, {z:.4f}) m, {rest.platform_rotation_deg:.2f} deg")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    ax.grid(True, linewidth=0.4, alpha=0.5)
+    ax.legend(loc="upper center", fontsize=7, framealpha=0.9)
+    ax.set_title(title or f"{rest.scene_name} at rest ({rest.method}; x: leave points)", fontsize=9)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path, dpi=DPI, format="png", bbox_inches="tight")
+    return path
+
+
+#: Points per catenary curve in :func:`plot_spatial_rest`.
+CURVE_SAMPLES = 60
+
+
+def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
+    """Figure of the robot at rest, in 3-D and from above: lumped cables (dots), catenaries (dashed), platform."""
+    figure = Figure(figsize=(11.0, 5.2))
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot(1, 2, 1, projection="3d")
+    top = figure.add_subplot(1, 2, 2)
+    figure.subplots_adjust(wspace=0.35)
+    colors = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive")
+    anchors = rest.position + np.asarray(rest.scene.platform.anchors) @ rest.rotation.T
+    outline = np.vstack([anchors, anchors[:1]])
+    exits = np.asarray(rest.scene.exits)
+    for i, (nodes, cable) in enumerate(zip(rest.nodes, rest.catenary.cables)):
+        color = colors[i % len(colors)]
+        curve = cable.points(np.linspace(0.0, cable.unstrained_length, CURVE_SAMPLES))
+        label = f"cable {i + 1}: {rest.tensions_at_anchor[i]:.1f} N at the anchor"
+        ax.plot(nodes[:, 0], nodes[:, 1], nodes[:, 2], "o-", color=color, markersize=2, linewidth=1.0, label=label)
+        ax.plot(curve[:, 0], curve[:, 1], curve[:, 2], "--", color="0.3", linewidth=0.7)
+        top.plot(nodes[:, 0], nodes[:, 1], "o-", color=color, markersize=2, linewidth=1.0)
+        top.annotate(f"{i + 1}", exits[i, :2], textcoords="offset points", xytext=(4, 4), fontsize=8, color=color)
+    for axes, coordinates in ((ax, (outline[:, 0], outline[:, 1], outline[:, 2])), (top, (outline[:, 0], outline[:, 1]))):
+        axes.plot(*coordinates, "k-", linewidth=1.5)
+    ax.plot(*rest.position, "ks", markersize=4)
+    ax.plot(exits[:, 0], exits[:, 1], exits[:, 2], "k^", markersize=5)
+    top.plot(exits[:, 0], exits[:, 1], "k^", markersize=5)
+    top.plot(*rest.position[:2], "ks", markersize=4)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    top.set_xlabel("x [m]")
+    top.set_ylabel("y [m]")
+    top.set_aspect("equal")
+    top.grid(True, linewidth=0.3)
+    top.set_title("from above (exits: triangles)", fontsize=9)
+    x, y, z = rest.position
+    roll, pitch, yaw = rotation_angles_deg(rest.rotation)
+    figure.suptitle(f"{rest.scene.name} at rest: platform at ({x:.4f}, {y:.4f}, {z:.4f}) m, roll {roll:.2f}, "
+                    f"pitch {pitch:.2f}, yaw {yaw:.2f} deg\nlumped cables (dots) and elastic catenaries (dashed)",
+                    fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    span = np.vstack([exits, *rest.nodes])
+    centre, half = span.mean(axis=0), 0.55 * np.ptp(span, axis=0).max()
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    path = Path(path)
+    figure.savefig(path, dpi=110, format="png")
+    return path
+
+
+def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0) -> Path:
+    """Overview figure: the path from above and from the side, against the reference; the position
+    error over time; the lowest element tension of each cable over time."""
+    figure = Figure(figsize=(11.0, 8.0))
+    FigureCanvasAgg(figure)
+    axes = figure.subplots(2, 2)
+    top, side, error, tension = axes[0, 0], axes[0, 1], axes[1, 0], axes[1, 1]
+    for ax, (a, b), names in ((top, (0, 1), ("x [m]", "y [m]")), (side, (0, 2), ("x [m]", "z [m]"))):
+        ax.plot(result.reference[:, a], result.reference[:, b], "k--", linewidth=1.0, label="reference")
+        ax.plot(result.pose[:, a], result.pose[:, b], "tab:blue", linewidth=1.2, label="platform")
+        ax.set_xlabel(names[0])
+        ax.set_ylabel(names[1])
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, linewidth=0.3)
+        ax.legend(fontsize=8)
+    top.set_title("path from above", fontsize=9)
+    side.set_title("path from the side", fontsize=9)
+    for k, name in enumerate("xyz"):
+        error.plot(result.time, 1000.0 * result.position_error[:, k], label=f"error {name}")
+    error.axvline(after, color="0.6", linewidth=0.8, linestyle=":")
+    error.set_xlabel("t [s]")
+    error.set_ylabel("actual - reference [mm]")
+    error.grid(True, linewidth=0.3)
+    error.legend(fontsize=8)
+    for i, series in enumerate(result.tensions):
+        tension.plot(result.time, series.min(axis=1), label=f"cable {i + 1}")
+    tension.axhline(0.0, color="k", linewidth=0.8)
+    tension.set_xlabel("t [s]")
+    tension.set_ylabel("lowest element tension [N]")
+    tension.grid(True, linewidth=0.3)
+    tension.legend(fontsize=7, ncol=2)
+    summary = result.summary(after)
+    worst = summary["max_position_error_m"]
+    figure.suptitle(f"{result.scene_name} under {result.controller}: max position error after {after:g} s "
+                    f"{'n/a' if worst is None else f'{1000 * worst:.2f} mm'} ({result.status})", fontsize=10)
+    figure.tight_layout()
+    path = Path(path)
+    figure.savefig(path, dpi=100, format="png")
+    return path

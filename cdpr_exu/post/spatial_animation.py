@@ -3,7 +3,8 @@
 Reads the run folder that ``cdpr run SPATIAL-SCENE --out DIR`` writes (``result.npz``:
 time, pose, reference and the cables' nodes) and draws each frame with matplotlib's 3-D
 axes (no display, no Exudyn renderer). ``cdpr animate DIR`` renders it through
-:func:`cdpr_exu.post.viewer.render_animation`, as planar runs: the same option checks,
+:func:`cdpr_exu.post.viewer.render_animation` (or
+:func:`cdpr_exu.post.viewer.render_spatial_animation`), as planar runs: the same option checks,
 ``--frames-dir`` and GIF or MP4 writer. Units SI.
 """
 
@@ -18,7 +19,7 @@ from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import OutputError
 
-__all__ = ["is_spatial_run", "SpatialFrames", "render_spatial_animation"]
+__all__ = ["is_spatial_run", "SpatialFrames"]
 
 
 def is_spatial_run(run_dir: str | Path) -> bool:
@@ -90,21 +91,3 @@ class SpatialFrames:
         self.canvas.draw()
         image = Image.fromarray(np.asarray(self.canvas.buffer_rgba())[:, :, :3].copy())
         return image if image.size == self.size else image.resize(self.size)
-
-
-def render_spatial_animation(run_dir: str | Path, out: str | Path | None = None, fps: float = 25.0,
-                             every: int | None = None, size: tuple[int, int] = (640, 480),
-                             frames_dir: str | Path | None = None) -> tuple[Path, int]:
-    """Render the spatial run in ``run_dir`` to a GIF (or MP4); returns (the file, the number of frames).
-
-    :func:`cdpr_exu.post.viewer.render_animation` on a spatial folder, with its checks
-    (a folder without a spatial run is refused, as every bad option).
-    """
-    from cdpr_exu.post.viewer import _render_animation
-
-    if not is_spatial_run(run_dir):
-        raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
-                          "write one with `cdpr run SPATIAL-SCENE --out DIR`")
-    path, frames, _ = _render_animation(run_dir, out, fps=fps, every=every, size=size, frames_dir=frames_dir,
-                                        progress=False, multi_sampling=2)
-    return path, frames

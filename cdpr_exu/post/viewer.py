@@ -31,7 +31,6 @@ Examples::
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 import time as _time
@@ -41,10 +40,17 @@ from pathlib import Path
 import exudyn as exu
 import exudyn.graphics as graphics
 import numpy as np
+from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
+from exudyn.utilities import LoadSolutionFile, SetSolutionState
 
-from cdpr_exu.core.errors import EXIT_CODES, CdprError
+from cdpr_exu.builder import spatial_robot
 from cdpr_exu.builder.model import Model, build_model
+from cdpr_exu.core.errors import CdprError, OutputError
+from cdpr_exu.core.geometry import rotation_vector
+from cdpr_exu.core.output import check_output_folder, clear_outputs
+from cdpr_exu.run.spatial_run import build_spatial_model
 from cdpr_exu.scenes.scene import Scene, load_scene
+from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
 #: File names inside a run folder (written by ``cdpr run --out``).
 SCENE_FILE = "scene.toml"
@@ -168,8 +174,6 @@ def load_solution(path: str | Path) -> dict:
     RunFolderError
         If the file is missing, unreadable or holds no row.
     """
-    from exudyn.utilities import LoadSolutionFile
-
     path = Path(path)
     _require_file(path, "solution file")
     try:
@@ -234,15 +238,10 @@ class SpatialReplay:
 
     def platform_pose(self) -> np.ndarray:
         """The platform's pose in each row: centre of mass [m] and rotation vector [rad], shape (n_rows, 6)."""
-        from exudyn.utilities import SetSolutionState
-
-        from cdpr_exu.builder.spatial_robot import platform_pose
-        from cdpr_exu.core.geometry import rotation_vector
-
         poses = []
         for row in range(self.n_rows):
             SetSolutionState(self.mbs, self.solution, row, exu.ConfigurationType.Current)
-            position, rotation = platform_pose(self.mbs, self.items)
+            position, rotation = spatial_robot.platform_pose(self.mbs, self.items)
             poses.append(np.concatenate([position, rotation_vector(rotation)]))
         return np.asarray(poses)
 
@@ -266,14 +265,10 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | Spati
     ------
     RunFolderError, SolutionMismatchError, SceneError
     """
-    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
-
     scene_file, solution_file = run_files(run_dir)
     scene = load_any_scene(scene_file)
     solution = load_solution(solution_file)
     if is_spatial(scene):
-        from cdpr_exu.run.spatial_run import build_spatial_model
-
         mbs, items = build_spatial_model(scene)
         check_solution_fits(mbs, solution, f"solution file {str(solution_file)!r}")
         return SpatialReplay(Path(run_dir), scene, mbs, items, solution)
@@ -416,8 +411,6 @@ def _style(model: Model) -> None:
 def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768)) -> None:
     """Visualization settings of a spatial replay: small nodes, no load arrows or markers, and a view
     from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
-    from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
-
     settings = replay.mbs.GetSystemContainer().visualizationSettings
     points = np.vstack([np.asarray(replay.scene.exits, dtype=float), replay.platform_pose()[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
@@ -778,8 +771,7 @@ def check_animation_request(run_dir: str | Path, out_file: str | Path | None = N
     RunFolderError
         A folder that holds no run.
     """
-    from cdpr_exu.core.output import check_output_folder
-    from cdpr_exu.post.spatial_animation import is_spatial_run
+    from cdpr_exu.post.spatial_animation import is_spatial_run  # matplotlib: only where a run is drawn
 
     if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
             or not (np.isfinite(fps) and fps > 0):
@@ -826,7 +818,6 @@ class _PlanarFrames:
 
     def frame(self, row: int):
         """Row ``row`` as a PIL RGB image."""
-        from exudyn.utilities import SetSolutionState
         from PIL import Image
 
         model, solution = self.replay.model, self.replay.solution
@@ -882,13 +873,31 @@ def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *,
     CdprError
         Unknown file type, bad arguments, or MP4 without imageio-ffmpeg.
     """
-    path, _, _ = _render_animation(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir,
-                                   progress=progress, multi_sampling=multi_sampling)
+    path, _, _ = render_animation_timed(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir,
+                                        progress=progress, multi_sampling=multi_sampling)
     return path
 
 
-def _render_animation(run_dir, out_file, *, fps, every, size, frames_dir, progress,
-                      multi_sampling) -> tuple[Path, int, float]:
+def render_spatial_animation(run_dir: str | Path, out: str | Path | None = None, fps: float = 25.0,
+                             every: int | None = None, size: tuple[int, int] = (640, 480),
+                             frames_dir: str | Path | None = None) -> tuple[Path, int]:
+    """Render the spatial run in ``run_dir`` to a GIF (or MP4); returns (the file, the number of frames).
+
+    :func:`render_animation` on a spatial folder, with its checks
+    (a folder without a spatial run is refused, as every bad option).
+    """
+    from cdpr_exu.post.spatial_animation import is_spatial_run  # matplotlib: only where a run is drawn
+
+    if not is_spatial_run(run_dir):
+        raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
+                          "write one with `cdpr run SPATIAL-SCENE --out DIR`")
+    path, frames, _ = render_animation_timed(run_dir, out, fps=fps, every=every, size=size, frames_dir=frames_dir,
+                                             progress=False, multi_sampling=2)
+    return path, frames
+
+
+def render_animation_timed(run_dir, out_file, *, fps, every, size, frames_dir, progress,
+                           multi_sampling) -> tuple[Path, int, float]:
     """:func:`render_animation`, also returning the frame count and seconds per frame."""
     from tqdm import tqdm
 
@@ -902,8 +911,6 @@ def _render_animation(run_dir, out_file, *, fps, every, size, frames_dir, progre
     step = request.every if request.every is not None else _rows_per_frame(source.times, request.fps)
     rows = range(0, len(source.times), step)
     if request.frames_dir is not None:
-        from cdpr_exu.core.output import clear_outputs
-
         clear_outputs(request.frames_dir, "animate --frames-dir")  # no frame of a longer, older animation stays
 
     start = _time.perf_counter()
@@ -920,81 +927,3 @@ def _render_animation(run_dir, out_file, *, fps, every, size, frames_dir, progre
         raise
     writer.close()
     return request.out_file, len(rows), (_time.perf_counter() - start) / max(1, len(rows))
-
-
-# --------------------------------------------------------------------------- CLI
-
-EPILOG_VIEW = """examples:
-  cdpr run paper-circle --out results/paper_circle
-  cdpr view results/paper_circle
-  cdpr view results/paper_circle --every 10
-Needs a display; without one, use `cdpr animate`.
-"""
-
-EPILOG_ANIMATE = """examples:
-  cdpr animate results/paper_circle                    # results/paper_circle/animation.gif
-  cdpr animate results/paper_circle --out circle.mp4   # needs: pip install imageio-ffmpeg
-  cdpr animate results/paper_circle --fps 20 --every 10 --size 480x360 --frames-dir frames/
-"""
-
-
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
-    return value
-
-
-def _size_argument(text: str) -> tuple[int, int]:
-    try:
-        return parse_size(text)
-    except ValueError as err:
-        raise argparse.ArgumentTypeError(str(err)) from None
-
-
-def _cmd_view(args: argparse.Namespace) -> int:
-    try:
-        view_solution(args.run_dir, every=args.every)
-    except NoDisplayError as err:
-        print(f"cdpr view: {err}", file=sys.stderr)
-        return 1
-    return 0
-
-
-def _cmd_animate(args: argparse.Namespace) -> int:
-    out, frames, seconds = _render_animation(args.run_dir, args.out, fps=args.fps, every=args.every,
-                                             size=args.size, frames_dir=args.frames_dir,
-                                             progress=not args.quiet, multi_sampling=2)
-    if not args.quiet:
-        print(f"wrote {out}: {frames} frames of {args.size[0]}x{args.size[1]} at {args.fps:g} frames/s "
-              f"({seconds:.3f} s per frame)")
-    return 0
-
-
-def add_commands(subparsers) -> None:
-    """Add ``view`` and ``animate`` to the ``cdpr`` command."""
-    view = subparsers.add_parser(
-        "view", help="replay a run in Exudyn's interactive SolutionViewer (needs a display)",
-        description="Replay a run folder (written by `cdpr run SCENE --out DIR`) in Exudyn's interactive "
-        "SolutionViewer, with pulleys, platform and reference path drawn. Exits with code 1 when no "
-        "window can be opened here.", epilog=EPILOG_VIEW + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    view.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
-    view.add_argument("--every", type=_positive_int, help="show every K-th stored row (default: about real time)")
-    view.set_defaults(func=_cmd_view)
-
-    animate = subparsers.add_parser(
-        "animate", help="render a run to a GIF or MP4 without a display",
-        description="Render a run folder (written by `cdpr run SCENE --out DIR`) with Exudyn's software "
-        "raytracer, no display needed, into a GIF (or an MP4 with imageio-ffmpeg installed); a spatial run "
-        "folder is drawn with matplotlib's 3-D axes. The options are checked before any rendering.",
-        epilog=EPILOG_ANIMATE + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    animate.add_argument("run_dir", help="run folder with scene.toml and solution.sol")
-    animate.add_argument("--out", help="animation file, .gif or .mp4 (default: RUN_DIR/animation.gif)")
-    animate.add_argument("--fps", type=float, default=DEFAULT_FPS, help="frames per second (default: 25)")
-    animate.add_argument("--every", type=_positive_int,
-                         help="use every K-th stored row (default: real-time playback at --fps)")
-    animate.add_argument("--size", type=_size_argument, default=DEFAULT_SIZE, metavar="WxH",
-                         help="image size in pixels (default: 640x480)")
-    animate.add_argument("--frames-dir", help="also write each frame as a PNG into this folder")
-    animate.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no message")
-    animate.set_defaults(func=_cmd_animate)

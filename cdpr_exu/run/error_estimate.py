@@ -40,8 +40,14 @@ from typing import Callable
 
 import numpy as np
 
+from controllers.ideal_ik import IdealIKController
+
+from cdpr_exu.builder.model import build_model
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import length_text
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.scenes.spatial_scene import is_spatial
 
 #: Order of the error in the number of elements assumed by the estimate (see above).
 ORDER = 2.0
@@ -102,9 +108,7 @@ def companion_elements(scene) -> int:
     if n >= 30:
         try:
             half = _with_elements(scene, n // 2)  # a spatial scene checks its swivel pulleys here
-            if not _is_spatial(scene):
-                from cdpr_exu.builder.model import build_model
-
+            if not is_spatial(scene):
                 build_model(half)
             return n // 2
         except CdprError:
@@ -117,20 +121,11 @@ def _with_elements(scene, n: int):
     return scene.with_changes(cables=tuple(replace(c, n_elements=int(n)) for c in scene.cables))
 
 
-def _is_spatial(scene) -> bool:
-    from cdpr_exu.scenes.spatial_scene import is_spatial
-
-    return is_spatial(scene)
-
-
 def simulate_any(scene, controller=None):
     """Run a planar (:func:`~cdpr_exu.run.simulate.simulate`) or spatial
     (:func:`~cdpr_exu.run.spatial_run.simulate_spatial`) scene under ``controller``."""
-    if _is_spatial(scene):
-        from cdpr_exu.run.spatial_run import simulate_spatial
-
+    if is_spatial(scene):
         return simulate_spatial(scene, controller)
-    from cdpr_exu.run.simulate import simulate
 
     return simulate(scene, controller)
 
@@ -172,8 +167,6 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     after : float [s]
         Compare the paths from this time on.
     """
-    from controllers.ideal_ik import IdealIKController
-
     if not scene.effects.cable_mass:
         return _not_applicable("massless ropes have no elements: the estimate in the number of elements does not apply")
     if result.status != "completed":

@@ -59,10 +59,7 @@ equilibria of pushing elements instead). ``RestState.method`` says which path wa
 
 from __future__ import annotations
 
-import argparse
-import sys
 import math
-import warnings
 import time as _time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -73,14 +70,15 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
-from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, SceneError, SolverFailure, SuspectAnswerWarning
+from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
-from cdpr_exu.core.output import clear_outputs, write_npz, write_summary
+from cdpr_exu.core.output import write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import static_settings
+from cdpr_exu.physics import bending
 from cdpr_exu.results.result import provenance
+from cdpr_exu.run.simulate import likely_cause, quiet_exudyn, solver_report, solver_settings
 from cdpr_exu.scenes.scene import Scene
-from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
 #: Default tolerance on the largest node speed at rest [m/s].
 DEFAULT_TOLERANCE = 1.0e-6
@@ -365,8 +363,6 @@ def _speed_indices(model: Model) -> np.ndarray:
 def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time: float,
                           chunk_time: float) -> tuple[float, float]:
     """Integrate from the model's initial state until at rest; returns (time, speed) [s, m/s]."""
-    from cdpr_exu.run.simulate import _solver_report, likely_cause, quiet_exudyn, solver_settings  # late: imports controllers
-
     mbs = model.mbs
     data = mbs.systemData
     settings = solver_settings(scene)
@@ -395,7 +391,7 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
                 with quiet_exudyn():
                     mbs.SolveDynamic(settings)
             except (exu.SolverError, RuntimeError, SystemError) as err:
-                cause = _solver_report(mbs, " ".join(str(err).split()))
+                cause = solver_report(mbs, " ".join(str(err).split()))
                 reached = float(mbs.sys["dynamicSolver"].it.currentTime) if "dynamicSolver" in mbs.sys else t
                 raise SolverFailure(f"the run of scene {scene.name!r} to rest failed at t = {reached:.4f} s "
                                     f"(between {t:.3f} s and {end:.3f} s): {cause}. {likely_cause(scene, cause, reached)}",
@@ -547,8 +543,6 @@ def leave_point(center: np.ndarray, radius: float, outside: np.ndarray, near: np
 def _bending_cut_force(scene: Scene, cable_index: int, positions: np.ndarray, velocities: np.ndarray,
                        cut: int) -> np.ndarray:
     """Force (x, z) [N] the bending joints straddling element (cut, cut + 1) exert on nodes > cut."""
-    from cdpr_exu.physics import bending
-
     effects, cable = scene.effects, scene.cables[cable_index]
     n = len(positions) - 1
     joints = np.array([[b - 1, b, b + 1] for b in (cut, cut + 1) if 1 <= b <= n - 1], dtype=np.int64)
@@ -629,147 +623,3 @@ def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method
         anchor_tensions_N=np.array(anchor_tensions), span_weights_N=np.array(weights),
         max_node_speed_m_s=float(speed), time_s=float(elapsed), method=method, static_shift_m=shift, notes=notes,
     )
-
-
-# --------------------------------------------------------------------------- figure
-
-
-def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None = None) -> Path:
-    """Figure of the rest profile: nodes, pulleys, leave points and the platform; writes a PNG.
-
-    Returns the path written.
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-    from matplotlib.patches import Circle
-
-    from cdpr_exu.post.plots import DPI
-
-    figure = Figure(figsize=(7.0, 5.0))
-    FigureCanvasAgg(figure)
-    ax = figure.add_subplot(1, 1, 1)
-    colors = ("tab:blue", "tab:red", "tab:green", "tab:purple")
-    for pulley in scene.exits:
-        if not pulley.is_point_exit:
-            ax.add_patch(Circle(pulley.center, pulley.radius, facecolor="0.92", edgecolor="0.55", zorder=1))
-        ax.plot(*pulley.center, marker="+", color="0.55", zorder=1)
-    for i, nodes in enumerate(rest.nodes):
-        color = colors[i % len(colors)]
-        ax.plot(nodes[:, 0], nodes[:, 1], "-o", color=color, markersize=3, linewidth=1.0, zorder=3,
-                label=f"cable {i + 1}: free span {rest.cable_stretched_length_m[i]:.4f} m, "
-                      f"upper force |F| = {np.hypot(*rest.upper_forces_N[i]):.2f} N")
-        ax.plot(*rest.upper_points_m[i], marker="x", color=color, markersize=8, zorder=4)
-    x, z = rest.platform_position_m
-    ax.plot(x, z, marker="s", color="0.2", markersize=7, zorder=5,
-            label=f"platform ({x:.4f}, {z:.4f}) m, {rest.platform_rotation_deg:.2f} deg")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("z [m]")
-    ax.grid(True, linewidth=0.4, alpha=0.5)
-    ax.legend(loc="upper center", fontsize=7, framealpha=0.9)
-    ax.set_title(title or f"{rest.scene_name} at rest ({rest.method}; x: leave points)", fontsize=9)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=DPI, format="png", bbox_inches="tight")
-    return path
-
-
-# --------------------------------------------------------------------------- command line
-
-EPILOG = """examples:
-  cdpr static paper-catenary-fixed --out results/static_fixed
-  cdpr static paper-catenary --out results/static_pulleys --tolerance 1e-7
-  cdpr static spatial-four-cable --out results/static_spatial
-
-A spatial scene (dimension = 3) is solved directly by Exudyn's static solver, started on
-its elastic-catenary statics (--tolerance, --max-time and --no-polish do not apply), and
-reports the platform's position and rotation beside the catenary answer; it warns when the
-two lie more than 5 % of the shortest cable apart or an element is compressed, and fails
-(exit 3, with the cause) on an equilibrium that holds the platform above its exits.
-"""
-
-
-def _write_static_failure(scene: Scene, err: SolverFailure, out: Path) -> None:
-    """Write what a failed ``cdpr static`` knows: the scene, the cause and the last state."""
-    from cdpr_exu.scenes.scene import save_scene
-
-    clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
-    save_scene(scene, out / "scene.toml")
-    partial = err.partial_result if isinstance(err.partial_result, dict) else {}
-    write_summary(out, {"scene": scene.name, "status": f"failed: {err}", "failure_time_s": err.time,
-                        "last_state": partial, **provenance()})
-
-
-def _static_spatial(scene, out: Path | None, quiet: bool) -> int:
-    """``cdpr static`` on a spatial scene (:mod:`cdpr_exu.run.spatial_rest`); its warnings go to the console
-    (and are in summary.json), a failure writes the scene, the cause and the last state."""
-    from cdpr_exu.run.spatial_rest import print_spatial_rest, solve_spatial_rest
-
-    try:
-        rest = solve_spatial_rest(scene)
-    except SolverFailure as err:
-        if out is not None:
-            _write_static_failure(scene, err, out)
-            print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
-        raise
-    if out is not None:
-        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
-        rest.save(out)
-    if not quiet:
-        print_spatial_rest(rest, out)
-    for text in rest.warnings:
-        warnings.warn(text, SuspectAnswerWarning, stacklevel=2)
-    return EXIT_OK
-
-
-def _cmd_static(args: argparse.Namespace) -> int:
-    from cdpr_exu.core.output import check_output_folder, fixed
-
-    out = check_output_folder(args.out, command="static")
-    scene = load_any_scene(args.scene)
-    if is_spatial(scene):
-        return _static_spatial(scene, out, args.quiet)
-    try:
-        rest = solve_rest(scene, tolerance=args.tolerance, max_time=args.max_time, polish=not args.no_polish)
-    except SolverFailure as err:
-        if out is not None:
-            _write_static_failure(scene, err, out)
-            print(f"cdpr static: the scene, the cause and the last state are written to {out}/", file=sys.stderr)
-        raise
-    if out is not None:
-        clear_outputs(out, "static")  # no file of an earlier `cdpr static` there stays beside these
-        rest.save(out)
-        plot_rest(scene, rest, out / "rest_profile.png")
-    if not args.quiet:
-        x, z = rest.platform_position_m
-        print(f"{scene.name} at rest after {rest.time_s:.2f} s simulated ({rest.method}), "
-              f"largest node speed {rest.max_node_speed_m_s:.2g} m/s")
-        print(f"  platform at x = {fixed(x, 6)} m, z = {fixed(z, 6)} m, rotation {fixed(rest.platform_rotation_deg, 4)} deg")
-        for i in range(len(rest.nodes)):
-            print(f"  cable {i + 1}: free span {rest.cable_stretched_length_m[i]:.6f} m "
-                  f"(unstrained {rest.cable_unstrained_length_m[i]:.6f} m), force on platform "
-                  f"{np.round(rest.platform_forces_N[i], 4).tolist()} N, on upper support "
-                  f"{np.round(rest.upper_forces_N[i], 4).tolist()} N")
-        for note in rest.notes:
-            print(f"  note: {note}")
-        if out is not None:
-            print(f"  written to {out}/")
-    return EXIT_OK
-
-
-def add_commands(subparsers) -> None:
-    """Register ``cdpr static``."""
-    parser = subparsers.add_parser(
-        "static", help="bring a scene to rest and write its static state",
-        description="Bring a scene to rest (dynamics with its own damping, then Exudyn's static solver) with the "
-        "winches held, and write summary.json (platform pose, free-span lengths, end forces, nodes), rest.npz and "
-        "rest_profile.png.", epilog=EPILOG + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
-    parser.add_argument("--out", help="output folder (created); nothing is written without it")
-    parser.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCE,
-                        help=f"largest node speed counted as rest [m/s] (default {DEFAULT_TOLERANCE:g})")
-    parser.add_argument("--max-time", type=float, default=DEFAULT_MAX_TIME,
-                        help=f"give up after this much simulated time [s] (default {DEFAULT_MAX_TIME:g})")
-    parser.add_argument("--no-polish", action="store_true", help="skip Exudyn's static solver after the dynamics")
-    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
-    parser.set_defaults(func=_cmd_static)

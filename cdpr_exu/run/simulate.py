@@ -521,7 +521,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     solver = scene.solver
     recorder = _Recorder(model, solver.output_period, solver.end_time)
     ref_q = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
-    report = _progress_reporter(progress, scene)
+    report = progress_reporter(progress, scene)
     stepper = _Stepper(scene, model, controller, recorder, _Monitor(scene, recorder.indices, ref_q), report, ref_q)
     start = stepper.start
     mbs.SetPreStepUserFunction(stepper.pre_step)
@@ -534,7 +534,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         try:
             mbs.SolveDynamic(settings)
         except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
-            failure = _solver_report(mbs, " ".join(str(err).split()))
+            failure = solver_report(mbs, " ".join(str(err).split()))
     if interrupted["interrupted"]:
         wall = _time.perf_counter() - start
         if report is not None:
@@ -600,7 +600,7 @@ def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
         surplus=np.zeros(m), node_offset=np.zeros(m), max_surplus=np.zeros(m))
 
 
-def _solver_report(mbs: exu.MainSystem, message: str) -> str:
+def solver_report(mbs: exu.MainSystem, message: str) -> str:
     """What Exudyn's solver said when it stopped: its error string, time, step and residual.
 
     Exudyn's exception text is only "SolveDynamic terminated"; the stored solver
@@ -751,7 +751,7 @@ def _steepest_downward_acceleration(scene: Scene) -> float:
         return 0.0
 
 
-def _progress_reporter(progress, scene: Scene):
+def progress_reporter(progress, scene: Scene):
     """A per-step callback that updates a tqdm bar or a user callable ~100 times."""
     if not progress:
         return None

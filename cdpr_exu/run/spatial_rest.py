@@ -34,10 +34,9 @@ from pathlib import Path
 
 import exudyn as exu
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import SolverFailure
+from cdpr_exu.core.geometry import rotation_angles_deg
 from cdpr_exu.core.output import write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static, \
     start_at_rest, swivel_angles
@@ -52,9 +51,6 @@ __all__ = ["SpatialRest", "solve_spatial_rest", "PENALTY"]
 #: four-cable robot, measured in tests/test_spatial_robot.py).
 PENALTY = 100.0
 
-#: Points per catenary curve in the figure.
-CURVE_SAMPLES = 60
-
 #: A static answer farther than this fraction of the shortest cable's unstrained length from
 #: its own elastic-catenary answer is flagged (``warnings`` in the summary, and on the console).
 #: The two differ by the discretisation (n^-2: at most 0.5 mm on the shipped point-exit
@@ -63,14 +59,6 @@ CURVE_SAMPLES = 60
 #: 5 % is over five times that; beyond it the answer is the bending model's more than a
 #: hanging cable's (E = 1e10 Pa on the same robot: 132 mm, 5.5 %; 1e11 Pa: above its pulleys).
 FAR_FROM_CATENARY = 0.05
-
-
-def rotation_angles_deg(rotation: np.ndarray) -> np.ndarray:
-    """Roll, pitch, yaw [deg] of a rotation matrix, R = Rz(yaw) Ry(pitch) Rx(roll) (for reading only)."""
-    pitch = np.arcsin(np.clip(-rotation[2, 0], -1.0, 1.0))
-    roll = np.arctan2(rotation[2, 1], rotation[2, 2])
-    yaw = np.arctan2(rotation[1, 0], rotation[0, 0])
-    return np.degrees([roll, pitch, yaw])
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,10 +162,11 @@ class SpatialRest:
         }
 
     def save(self, out: str | Path) -> list[Path]:
-        """Write summary.json and rest_profile.png to the folder ``out``; returns the paths."""
+        """Write summary.json to the folder ``out``; returns its path in a list. The figure
+        (``rest_profile.png``) is :func:`cdpr_exu.post.plots.plot_spatial_rest`'s."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        return [write_summary(out, self.summary()), plot_spatial_rest(self, out / "rest_profile.png")]
+        return [write_summary(out, self.summary())]
 
 
 def bending_text(scene: SpatialScene, catenary, what: str) -> str:
@@ -263,79 +252,3 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     if above is not None:
         raise SolverFailure(f"no rest of a cable robot: {above}", partial_result=rest.summary())
     return rest
-
-
-def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
-    """Figure of the robot at rest, in 3-D and from above: lumped cables (dots), catenaries (dashed), platform."""
-    figure = Figure(figsize=(11.0, 5.2))
-    FigureCanvasAgg(figure)
-    ax = figure.add_subplot(1, 2, 1, projection="3d")
-    top = figure.add_subplot(1, 2, 2)
-    figure.subplots_adjust(wspace=0.35)
-    colors = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive")
-    anchors = rest.position + np.asarray(rest.scene.platform.anchors) @ rest.rotation.T
-    outline = np.vstack([anchors, anchors[:1]])
-    exits = np.asarray(rest.scene.exits)
-    for i, (nodes, cable) in enumerate(zip(rest.nodes, rest.catenary.cables)):
-        color = colors[i % len(colors)]
-        curve = cable.points(np.linspace(0.0, cable.unstrained_length, CURVE_SAMPLES))
-        label = f"cable {i + 1}: {rest.tensions_at_anchor[i]:.1f} N at the anchor"
-        ax.plot(nodes[:, 0], nodes[:, 1], nodes[:, 2], "o-", color=color, markersize=2, linewidth=1.0, label=label)
-        ax.plot(curve[:, 0], curve[:, 1], curve[:, 2], "--", color="0.3", linewidth=0.7)
-        top.plot(nodes[:, 0], nodes[:, 1], "o-", color=color, markersize=2, linewidth=1.0)
-        top.annotate(f"{i + 1}", exits[i, :2], textcoords="offset points", xytext=(4, 4), fontsize=8, color=color)
-    for axes, coordinates in ((ax, (outline[:, 0], outline[:, 1], outline[:, 2])), (top, (outline[:, 0], outline[:, 1]))):
-        axes.plot(*coordinates, "k-", linewidth=1.5)
-    ax.plot(*rest.position, "ks", markersize=4)
-    ax.plot(exits[:, 0], exits[:, 1], exits[:, 2], "k^", markersize=5)
-    top.plot(exits[:, 0], exits[:, 1], "k^", markersize=5)
-    top.plot(*rest.position[:2], "ks", markersize=4)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
-    top.set_xlabel("x [m]")
-    top.set_ylabel("y [m]")
-    top.set_aspect("equal")
-    top.grid(True, linewidth=0.3)
-    top.set_title("from above (exits: triangles)", fontsize=9)
-    x, y, z = rest.position
-    roll, pitch, yaw = rotation_angles_deg(rest.rotation)
-    figure.suptitle(f"{rest.scene.name} at rest: platform at ({x:.4f}, {y:.4f}, {z:.4f}) m, roll {roll:.2f}, "
-                    f"pitch {pitch:.2f}, yaw {yaw:.2f} deg\nlumped cables (dots) and elastic catenaries (dashed)",
-                    fontsize=9)
-    ax.legend(fontsize=7, loc="upper left")
-    span = np.vstack([exits, *rest.nodes])
-    centre, half = span.mean(axis=0), 0.55 * np.ptp(span, axis=0).max()
-    ax.set_xlim(centre[0] - half, centre[0] + half)
-    ax.set_ylim(centre[1] - half, centre[1] + half)
-    ax.set_zlim(centre[2] - half, centre[2] + half)
-    path = Path(path)
-    figure.savefig(path, dpi=110, format="png")
-    return path
-
-
-def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
-    """The static mode's summary on the terminal (its :attr:`SpatialRest.warnings` are the caller's to issue)."""
-    x, y, z = rest.position
-    roll, pitch, yaw = rotation_angles_deg(rest.rotation)
-    catenary = rest.catenary
-    print(f"{rest.scene.name} at rest (Exudyn's static solver, {rest.scene.cables[0].n_elements} elements per cable, "
-          f"{rest.anchor_joint}; {rest.wall_time:.2f} s)")
-    print(f"  platform at x = {x:.6f} m, y = {y:.6f} m, z = {z:.6f} m; rotation vector "
-          f"{np.round(rest.rotation_vector, 6).tolist()} rad (roll {roll:.4f}, pitch {pitch:.4f}, yaw {yaw:.4f} deg)")
-    for i, (tension, force) in enumerate(zip(rest.tensions_at_anchor, rest.forces_on_platform)):
-        print(f"  cable {i + 1}: {tension:.4f} N at the anchor (catenary {catenary.tensions_at_anchor[i]:.4f} N), "
-              f"force on platform {np.round(force, 4).tolist()} N")
-    print(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
-          f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
-          f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation_vector)):.4f} deg from the lumped robot")
-    if rest.swivel_angles is not None:
-        azimuths = [np.degrees(np.arctan2(*(c.anchor_point - c.inlet)[1::-1])) if c.inlet is not None else None
-                    for c in catenary.cables]
-        for i, (psi, azimuth) in enumerate(zip(rest.swivel_angles, azimuths)):
-            if azimuth is not None:
-                print(f"  swivel pulley {i + 1}: psi = {np.degrees(psi):.4f} deg (anchor azimuth {azimuth:.4f} deg), "
-                      f"wrap {np.degrees(catenary.cables[i].wrap_angle):.2f} deg")
-    if out is not None:
-        print(f"  written to {out}/")
-

@@ -31,37 +31,35 @@ rotation vector.
 from __future__ import annotations
 
 import time as _time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import exudyn as exu
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
-from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure, UnreachableError
-from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import (SPATIAL_POSE_COLUMNS, check_output_folder, clear_outputs, fixed, length_text,
-                                  undate_solution_file, write_npz, write_pose_csv, write_summary)
+from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector
+from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, write_npz, write_pose_csv, write_summary
 from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     start_at_rest
+from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController, ideal_paid_out
-from controllers.spatial_feedback import spatial_closed_loop_tension_aware
-from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.results.result import (after_start_up, provenance, raise_warnings, safety_figures, status_text,
-                                     warning_flags)
-from cdpr_exu.run.simulate import (_progress_reporter, _solver_report, interrupt_flag, output_times, quiet_exudyn,
+from cdpr_exu.results.result import after_start_up, provenance, safety_figures
+from cdpr_exu.run.simulate import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
                                    solver_settings)
+from cdpr_exu.run.spatial_rest import rest_above_exits
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.statics.workspace import first_unheld, limits_text
 
-__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference", "run_spatial_scene"]
+__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference"]
 
 
 #: Samples of the reference checked before a run.
@@ -122,7 +120,6 @@ def check_spatial_reference(scene: SpatialScene) -> None:
                 f"exits[{i}].winch_line = {1000 * swivel.winch_line:.3g} mm less two elements (2 x "
                 f"{1000 * margin / 2:.3g} mm, the winch end's margin below the inlet) leaves {1000 * room:.3g} mm; give "
                 f"exits[{i}].winch_line = {1000 * (margin + max(gain[k], 0.0)):.3g} mm or more")
-    from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 
     anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
     points = poses[:, :3] if anchors is None else poses
@@ -171,8 +168,6 @@ def reference_wrenches(scene: SpatialScene, times: np.ndarray) -> np.ndarray:
     ``w = J_l(theta) theta'``; its rate comes from a central difference over 1e-6 s
     (one-sided at t = 0, where the reference starts).
     """
-    from cdpr_exu.core.geometry import left_jacobian
-
     times = np.asarray(times, dtype=float)
     gravity = scene.gravity if scene.effects.gravity else 0.0
     acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
@@ -294,11 +289,10 @@ class SpatialResult:
         errors from ``after`` [s] on under ``after_start_up``."""
         return {**self.summary(0.0), "after_start_up": after_start_up(self.summary(after), self.ERROR_FIGURES)}
 
-    def save(self, folder: str | Path, after: float = 1.0, figures: bool = True,
-             extra: dict | None = None) -> list[Path]:
-        """Write result.npz, pose.csv (time, pose and reference: x, y, z [m] and the rotation vector [rad]),
-        summary.json (:meth:`run_summary`, with ``extra``'s entries) and (``figures``) overview.png into
-        ``folder``; returns the paths."""
+    def save(self, folder: str | Path, after: float = 1.0, extra: dict | None = None) -> list[Path]:
+        """Write result.npz, pose.csv (time, pose and reference: x, y, z [m] and the rotation vector [rad])
+        and summary.json (:meth:`run_summary`, with ``extra``'s entries) into ``folder``; returns the paths.
+        The figure (``overview.png``) is :func:`cdpr_exu.post.plots.plot_spatial_run`'s."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
@@ -307,8 +301,6 @@ class SpatialResult:
         written = [write_npz(folder / "result.npz", **arrays),
                    write_pose_csv(folder / "pose.csv", self.time, self.pose, self.reference, SPATIAL_POSE_COLUMNS),
                    write_summary(folder, {**self.run_summary(after), **provenance(), **(extra or {})})]
-        if figures:
-            written.append(plot_spatial_run(self, folder / "overview.png", after))
         return written
 
 
@@ -410,10 +402,6 @@ class _SpatialMonitor:
 def _warn_outside_measured_region(scene: SpatialScene) -> None:
     """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
     outside the region where runs over a swivel pulley were measured to keep their energy."""
-    import warnings
-
-    from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
-
     solver = scene.solver
     for swivel, cable in zip(scene.swivel_exits, scene.cables):
         if swivel is None:
@@ -427,8 +415,6 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
 def _rest_above_exits(scene: SpatialScene, mbs, items) -> str | None:
     """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
     above its exits (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: its bending or pushing elements do)."""
-    from cdpr_exu.run.spatial_rest import rest_above_exits
-
     position, rotation = platform_pose(mbs, items, current=False)
     lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
     above = rest_above_exits(scene, position, rotation, lowest, items.initial)
@@ -511,7 +497,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         except SolverFailure as failure:  # the settle's solver knows why it stopped
             exudyn_said = str(failure).split(": ", 1)[-1]  # "SolveDynamic terminated", and no more
             raise SolverFailure(f"settling the robot over its swivel pulleys before the run failed: "
-                                f"{_solver_report(mbs, exudyn_said)}", time=0.0) from None
+                                f"{solver_report(mbs, exudyn_said)}", time=0.0) from None
     winches = _SpatialWinches(mbs, scene, items, lengths)
     solver = scene.solver
     outputs = output_times(solver.end_time, solver.output_period)
@@ -605,7 +591,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
             report(t, _time.perf_counter() - wall_start)
         return True
 
-    report = _progress_reporter(progress, scene)
+    report = progress_reporter(progress, scene)
     monitor = _SpatialMonitor(scene)
     record(0.0)
     state["next"] = 1
@@ -620,7 +606,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
             if state["failure"] is None:
                 mbs.SolveDynamic(solver_settings(scene, solution_file))
         except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn's own cause, not only "terminated"
-            state["failure"] = state["failure"] or _solver_report(mbs, " ".join(str(err).split()))
+            state["failure"] = state["failure"] or solver_report(mbs, " ".join(str(err).split()))
     wall = _time.perf_counter() - wall_start
     if report is not None:
         report(None, wall)
@@ -648,233 +634,3 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
         raise SolverFailure(f"the spatial run failed at t = {reached:.4f} s of {solver.end_time} s: {cause}",
                             time=reached, partial_result=result)
     return result
-
-
-def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0) -> Path:
-    """Overview figure: the path from above and from the side, against the reference; the position
-    error over time; the lowest element tension of each cable over time."""
-    figure = Figure(figsize=(11.0, 8.0))
-    FigureCanvasAgg(figure)
-    axes = figure.subplots(2, 2)
-    top, side, error, tension = axes[0, 0], axes[0, 1], axes[1, 0], axes[1, 1]
-    for ax, (a, b), names in ((top, (0, 1), ("x [m]", "y [m]")), (side, (0, 2), ("x [m]", "z [m]"))):
-        ax.plot(result.reference[:, a], result.reference[:, b], "k--", linewidth=1.0, label="reference")
-        ax.plot(result.pose[:, a], result.pose[:, b], "tab:blue", linewidth=1.2, label="platform")
-        ax.set_xlabel(names[0])
-        ax.set_ylabel(names[1])
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.grid(True, linewidth=0.3)
-        ax.legend(fontsize=8)
-    top.set_title("path from above", fontsize=9)
-    side.set_title("path from the side", fontsize=9)
-    for k, name in enumerate("xyz"):
-        error.plot(result.time, 1000.0 * result.position_error[:, k], label=f"error {name}")
-    error.axvline(after, color="0.6", linewidth=0.8, linestyle=":")
-    error.set_xlabel("t [s]")
-    error.set_ylabel("actual - reference [mm]")
-    error.grid(True, linewidth=0.3)
-    error.legend(fontsize=8)
-    for i, series in enumerate(result.tensions):
-        tension.plot(result.time, series.min(axis=1), label=f"cable {i + 1}")
-    tension.axhline(0.0, color="k", linewidth=0.8)
-    tension.set_xlabel("t [s]")
-    tension.set_ylabel("lowest element tension [N]")
-    tension.grid(True, linewidth=0.3)
-    tension.legend(fontsize=7, ncol=2)
-    summary = result.summary(after)
-    worst = summary["max_position_error_m"]
-    figure.suptitle(f"{result.scene_name} under {result.controller}: max position error after {after:g} s "
-                    f"{'n/a' if worst is None else f'{1000 * worst:.2f} mm'} ({result.status})", fontsize=10)
-    figure.tight_layout()
-    path = Path(path)
-    figure.savefig(path, dpi=100, format="png")
-    return path
-
-
-def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> None:
-    """Print a spatial run's :meth:`SpatialResult.run_summary`: errors over the whole run and after ``after`` [s],
-    each cable's lowest tension and slack time (whole run), its tension-limit violations and notes."""
-    settled = summary["after_start_up"]
-
-    def errors(s):
-        return f"{length_text(s['max_position_error_m'])} / {length_text(s['rms_position_error_m'])}"
-
-    def degrees(s):
-        return "n/a" if s["max_rotation_error_deg"] is None else f"{s['max_rotation_error_deg']:.4f} deg"
-
-    def per_cable(values, unit, digits):
-        return " / ".join("n/a" if v is None else f"{fixed(v, digits)} {unit}" for v in values)
-
-    factor = summary["real_time_factor"]
-    print(f"{summary['scene']} under {summary['controller']} (spatial; error = actual - reference)")
-    print(f"  {'':26s} {'whole run':>22s}   {'after ' + f'{after:g}' + ' s':>22s}")
-    print(f"  {'status':26s} {status_text(summary)}")
-    print(f"  {'max / RMS position error':26s} {errors(summary):>22s}   {errors(settled):>22s}")
-    print(f"  {'max rotation error':26s} {degrees(summary):>22s}   {degrees(settled):>22s}")
-    print(f"  {'min tension per cable':26s} {per_cable(summary['min_tension_per_cable_N'], 'N', 1)}")
-    print(f"  {'slack time per cable':26s} {per_cable(summary['slack_time_per_cable_s'], 's', 3)}")
-    print(f"  {'simulated / wall time':26s} {summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s"
-          + ("" if factor is None else f" ({factor:.1f}x real time)")
-          + f", {summary['steps']} steps, {summary['newton_iterations']} Newton iterations")
-    if "tension_limit_violations" in summary:
-        count = len(summary["tension_limit_violations"])
-        print(f"  {'tension limits':26s} {f'{count} violation(s)' if count else 'none'}")
-    for v in summary.get("tension_limit_violations", []):
-        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
-              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
-    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
-        print(f"  note: {note}")
-    if out is not None:
-        print(f"  written to {out}/")
-
-
-def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
-                      after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
-    """``cdpr run`` on a spatial scene: run, write into ``out``, print a summary.
-
-    Writes what ``cdpr run`` writes for every scene: ``scene.toml`` (the scene as run: a
-    rerun from it gives the same result), ``result.npz``, ``pose.csv``, ``summary.json``
-    (wall-clock figures in ``timing.json``), ``solution.sol`` (Exudyn's solution file, its
-    date blanked, for ``cdpr view``) and (``figures``) ``overview.png``. The scene and its
-    reference are checked before anything is written. On a solver failure or Ctrl-C the
-    partial result is written before the error propagates. With ``error_estimate`` a
-    companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`):
-    ``error_estimate`` in summary.json and a printed line.
-    """
-    from cdpr_exu.run.error_estimate import estimate_error, estimate_line, summary_entry
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
-
-    check_runnable(scene)  # before scene.toml is in the folder
-    solution_file = None
-    if out is not None:
-        out = check_output_folder(out, command="run")
-        clear_outputs(out, "run")  # none of the run this one replaces stays beside it (a planar one's figures)
-        save_any_scene(scene, out / "scene.toml")
-        solution_file = out / "solution.sol"
-
-    def write(result: SpatialResult, extra: dict | None = None) -> None:
-        if out is not None:
-            result.save(out, after, figures, extra)
-            if solution_file.is_file():
-                undate_solution_file(solution_file)
-
-    try:
-        result = simulate_spatial(scene, progress=not quiet, solution_file=solution_file)
-    except (SolverFailure, RunInterrupted) as err:  # keep what was computed
-        if err.partial_result is not None:
-            write(err.partial_result)
-        raise
-    estimate, interrupt = None, None
-    if error_estimate:
-        if not quiet:
-            print("estimating the discretisation error (a companion run) ...", flush=True)
-        try:
-            estimate = estimate_error(scene, result, after=after)
-        except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
-            interrupt = err
-    write(result, None if estimate is None else summary_entry(estimate))
-    summary = result.run_summary(after)
-    raise_warnings(summary, f"{scene.name} under {result.controller}: ")  # not clean: said once, quiet or not
-    if not quiet:
-        _print_spatial_summary(summary, after, out)
-        if estimate is not None:
-            print(estimate_line(estimate))
-    if interrupt is not None:
-        raise interrupt
-    return result
-
-
-#: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
-SPATIAL_CONTROLLERS = {
-    "ideal_ik": IdealIKController,
-    "tension_aware": SpatialTensionAwareController,
-    "tension_aware_chain": lambda: SpatialTensionAwareController(statics="chain"),
-    "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
-}
-
-def spatial_controller_names(scene: SpatialScene) -> list[str]:
-    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS` (over
-    swivel pulleys too: the chain version's held chains run over the disc, their winch ends moved as the run's)."""
-    return list(SPATIAL_CONTROLLERS)
-
-
-_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
-            ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
-            ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
-
-
-def spatial_comparison_table(summaries: dict) -> str:
-    """The spatial comparison as a Markdown table (errors after the summaries' ``after``); a scene
-    with tension limits gets a column counting the violations, as the planar table does."""
-    columns = _COLUMNS
-    if any("tension_limit_violations" in s for s in summaries.values()):
-        columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
-        summaries = {name: {**s, "tension_limit_violation_count": len(s.get("tension_limit_violations", []))}
-                     for name, s in summaries.items()}
-    lines = ["| controller | " + " | ".join(title for _, title, _ in columns) + " | vs ideal IK | status |",
-             "|" + "---|" * (len(columns) + 3)]
-    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
-    for name, s in summaries.items():
-        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in columns]
-        worst = s.get("max_position_error_m")
-        ratio = f"{base / worst:.1f}x" if base and worst else ""
-        flags = "".join(f"; {flag}" for flag in warning_flags(s))  # what a real robot cannot do
-        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{flags} |")
-    return "\n".join(lines) + "\n"
-
-
-def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
-                    after: float = 1.0, quiet: bool = True) -> dict[str, dict]:
-    """Run a spatial scene under each named controller; write summary.json, comparison.md and each
-    controller's overview figure to ``out``. Returns the summaries by name.
-
-    As the planar comparison: a run that fails is recorded with its status and partial
-    figures, a controller that refuses the scene with ``refused: ...``, and the others still
-    run; on Ctrl-C (inside a run or between two) the controllers done so far and the
-    interrupted one's partial run are written before the interrupt goes on.
-    """
-    names = list(names or spatial_controller_names(scene))
-    unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
-    if unknown:
-        raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
-    if out is not None:  # an earlier comparison's files go before the first of this one is written
-        clear_outputs(check_output_folder(out, command="compare"), "compare")
-    summaries, results = {}, {}
-    try:
-        for name in names:
-            try:
-                result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
-            except SolverFailure as err:
-                result = err.partial_result
-                if result is None:  # it failed before its first step (settling the robot)
-                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
-                    continue
-            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
-                results[name] = err.partial_result
-                summaries[name] = err.partial_result.summary(after)
-                raise
-            except CdprError as err:  # a controller that refuses the scene is a result of the comparison too
-                summaries[name] = {"controller": name, "status": f"refused: {err}"}
-                continue
-            results[name], summaries[name] = result, result.summary(after)
-            if not quiet:
-                worst = summaries[name]["max_position_error_m"]
-                print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   "
-                      f"{status_text(summaries[name])}")
-    except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
-        if out is not None and summaries:
-            _write_spatial_comparison(scene, summaries, results, Path(out), after)
-        raise
-    if out is not None:
-        _write_spatial_comparison(scene, summaries, results, Path(out), after)
-    return summaries
-
-
-def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
-    out.mkdir(parents=True, exist_ok=True)
-    write_summary(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
-                        "error_convention": "actual - reference", "controllers": summaries, **provenance()})
-    (out / "comparison.md").write_text(spatial_comparison_table(summaries))
-    for name, result in results.items():
-        plot_spatial_run(result, out / f"overview_{name}.png", after)

@@ -50,7 +50,7 @@ Solvers:
 Both are Newton iterations with analytic Jacobians built from the catenary end
 stiffnesses, and both accept an external wrench on the platform (eg the inertial
 load ``-M a`` for dynamic feed-forward, see `inertial_wrench`). The forward problem
-is an energy minimum: its line search follows the energy (see `_minimise_energy`)
+is an energy minimum: its line search follows the energy (see `minimise_energy`)
 and starts from `straight_cable_pose`. The inverse problem is a root search on the
 residual norm; for a rigid platform on two cables it is started at the rotations
 where straight massless cables balance the platform (up to a radian near the
@@ -393,7 +393,7 @@ def _damped_newton(
     raise UnreachableError(f"{what} did not converge (scaled residual {norm:.3g})")
 
 
-def _minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="equilibrium"):
+def minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="equilibrium"):
     """Newton's method for a conservative equilibrium, with a line search on the energy.
 
     ``function(x) -> (residual, jacobian)`` where the residual is the net generalised
@@ -527,7 +527,7 @@ def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_leng
     return residual, partial, catenary
 
 
-def _forward_cable(cable, unstrained_length, point, guess, max_strain, max_tension):
+def forward_cable(cable, unstrained_length, point, guess, max_strain, max_tension):
     """Cable of given length from an anchor point: equilibrium and ``dF_A/dp_A``.
 
     Returns ``(CableEquilibrium, d(force on A)/d(anchor point) (2, 2), guess)``.
@@ -625,7 +625,7 @@ def _tension_limit(cable, max_strain, max_tension):
     return limit if max_tension is None else min(limit, max_tension)
 
 
-def _inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
+def inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
     """Cable with given horizontal tension from an anchor point.
 
     Returns ``(CableEquilibrium, dF_A/dH (2,), dF_A/dp_A at fixed H (2, 2), guess)``.
@@ -912,7 +912,7 @@ def solve_forward_statics(
         points = platform.anchor_points(pose[:2], phi)
         equilibria, stiffnesses, new_guesses = [], [], []
         for i, (cable, point, length) in enumerate(zip(platform.cables, points, lengths)):
-            equilibrium, stiffness, guess = _forward_cable(
+            equilibrium, stiffness, guess = forward_cable(
                 cable, length, point, guesses[i], max_strain, max_tension
             )
             equilibria.append(equilibrium)
@@ -929,7 +929,7 @@ def solve_forward_statics(
         return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
 
     start = np.append(position, rotation)[:dof] * pose_scale
-    scaled, _, _ = _minimise_energy(
+    scaled, _, _ = minimise_energy(
         function, start, _RELATIVE_TOLERANCE, _platform_noise(platform, force_scale),
         what="forward statics",
     )
@@ -1102,7 +1102,7 @@ def solve_inverse_statics(
         equilibria, new_guesses = [], []
         jacobian = np.zeros((3, n + 1))
         for i, (cable, point) in enumerate(zip(platform.cables, points)):
-            equilibrium, force_dH, force_dp, guess = _inverse_cable(
+            equilibrium, force_dH, force_dp, guess = inverse_cable(
                 cable, H[i], point, guesses[i], max_strain, max_tension
             )
             equilibria.append(equilibrium)
@@ -1184,7 +1184,7 @@ def solve_inverse_statics(
                 equilibrium.catenary.vertical_tension_b,
                 _rim_angle(cable.pulley, equilibrium.upper_point),
             )
-        _, stiffness, _ = _forward_cable(
+        _, stiffness, _ = forward_cable(
             cable, equilibrium.unstrained_length, equilibrium.anchor_point, guess, max_strain, max_tension
         )
         stiffnesses.append(stiffness)

@@ -41,12 +41,10 @@ Command line: ``cdpr study accuracy SCENE --out DIR [--quick]``.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import math
 import os
-import sys
 import time
 import warnings
 from concurrent.futures import Executor, Future, as_completed
@@ -56,8 +54,15 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from cdpr_exu.core.errors import EXIT_CODES, CoarseOutputWarning, SceneError
-from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, apply_parameters, study_subparsers
+from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
+from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
+from cdpr_exu.results.result import provenance
+from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial, load_any_scene, save_any_scene
+from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
+from cdpr_exu.scenes.trajectories import HoldTrajectory
+from cdpr_exu.studies.study import (SINGLE_THREAD_ENVIRONMENT, apply_parameters, executor_for, progress_bar,
+                                    warm_up)
 
 # --------------------------------------------------------------------------- configurations
 
@@ -278,8 +283,6 @@ def grid_for(scene, quick: bool = False) -> AccuracyGrid:
     factor that brings its coarsest cable to the fewest elements the scene takes
     (:func:`fewest_spatial_elements`), e.g. 4, 8 and 16 to 48, 96 and 192.
     """
-    from cdpr_exu.scenes.spatial_scene import is_spatial
-
     if not is_spatial(scene):
         return QUICK_GRID if quick else FULL_GRID
     grid = SPATIAL_QUICK_GRID if quick else SPATIAL_FULL_GRID
@@ -326,9 +329,6 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     """
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)
-    from cdpr_exu.core.errors import SolverFailure, UnreachableError
-    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial
-    from cdpr_exu.studies.study import _warm_up
 
     empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
              "newton_iterations": 0, "failure_time_s": math.nan}
@@ -337,11 +337,11 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
             warnings.simplefilter("ignore", CoarseOutputWarning)
             scene = any_scene_from_dict(scene_data)
         spatial = is_spatial(scene)
-        if spatial:
+        if spatial:  # the runners load Numba and Exudyn: here, after the thread limits above
             from cdpr_exu.run.spatial_run import simulate_spatial as simulate
         else:
             from cdpr_exu.run.simulate import simulate
-        _warm_up(scene)
+        warm_up(scene)
         cpu = time.process_time()
         try:
             result = simulate(scene, progress=False)
@@ -453,17 +453,12 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
 def rotation_angles_deg(rotation_vectors: np.ndarray, reference_vectors: np.ndarray) -> np.ndarray:
     """Angle [deg] of the rotation from each reference orientation to the run's, both given as
     rotation vectors [rad], shapes (N, 3); returns shape (N,)."""
-    from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-
     return np.degrees([np.linalg.norm(rotation_vector(rotation_from_vector(r).T @ rotation_from_vector(v)))
                        for v, r in zip(rotation_vectors, reference_vectors)])
 
 
 def comparison_for(scene) -> str:
     """``"final"`` for a static scene (held pose, fixed winches), else ``"path"``."""
-    from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
-    from cdpr_exu.scenes.trajectories import HoldTrajectory
-
     static = isinstance(scene.trajectory, (HoldTrajectory, SpatialHoldTrajectory)) and scene.winch.kind == "fixed"
     return "final" if static else "path"
 
@@ -527,9 +522,22 @@ class AccuracyStudy:
     grid: AccuracyGrid
     series: dict[int, dict[str, Any]] = field(default_factory=dict, repr=False)
 
+    #: The cost runs are judged by and the position tolerances of the tables (for the figure,
+    #: :func:`cdpr_exu.post.study_plots.plot_pareto`).
+    COST = COST
+    TOLERANCES = TOLERANCES
+
     @property
     def reference_row(self) -> dict[str, Any]:
         return next(r for r in self.rows if r["is_reference"])
+
+    def compared(self, error: str) -> list[dict[str, Any]]:
+        """The completed, compared runs other than the reference, with a finite ``error`` and cost."""
+        return [r for r in self.rows if _usable(r, error)]
+
+    def front(self, error: str) -> list[Mapping[str, Any]]:
+        """:func:`pareto_front` of the runs for ``error``."""
+        return pareto_front(self.rows, error)
 
 
 def check_study_scene(scene) -> None:
@@ -539,8 +547,6 @@ def check_study_scene(scene) -> None:
     ------
     SceneError
     """
-    from cdpr_exu.scenes.spatial_scene import is_spatial
-
     if is_spatial(scene) and scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr study accuracy` runs the scene's "
                          "reference (`cdpr static` gives a spatial scene's static mode)")
@@ -582,9 +588,6 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
     SceneError
         If the reference run does not complete: nothing can be compared then.
     """
-    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, load_any_scene
-    from cdpr_exu.studies.study import _executor_for, _progress_bar
-
     base = load_any_scene(scene) if isinstance(scene, (str, Path)) else scene
     check_study_scene(base)
     grid = grid or grid_for(base)
@@ -613,10 +616,10 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
     pending.sort(key=lambda item: -_estimated_cost(configurations[item[0]]))
 
     series: dict[int, dict[str, Any]] = {}
-    bar = _progress_bar(len(rows), progress)
+    bar = progress_bar(len(rows), progress)
     bar.update(len(rows) - len(pending))
     try:
-        with _executor_for(executor, min(workers or os.cpu_count() or 1, max(len(pending), 1)), None) as pool:
+        with executor_for(executor, min(workers or os.cpu_count() or 1, max(len(pending), 1)), None) as pool:
             futures: dict[Future, int] = {pool.submit(run_configuration, data): index for index, data in pending}
             for future in as_completed(futures):
                 index = futures[future]
@@ -701,14 +704,11 @@ def _cell(value: Any) -> str:
 
 
 def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> dict[str, Path]:
-    """Write the CSV, JSON, tables, Pareto plot and the reference's series into ``out``."""
-    from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
-    from cdpr_exu.results.result import provenance
-    from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
-
+    """Write the CSV, JSON, tables, Pareto plot (:func:`cdpr_exu.post.study_plots.plot_pareto`) and the
+    reference's series into ``out``."""
     out = check_output_folder(out, command="study accuracy")
     clear_outputs(out, "study accuracy")  # no file of an earlier accuracy study stays
-    paths = {"scene": save_scene(base_scene, out / ACCURACY_FILES["scene"])}
+    paths = {"scene": save_any_scene(base_scene, out / ACCURACY_FILES["scene"])}
     with open(out / ACCURACY_FILES["csv"], "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(COLUMNS)
@@ -743,6 +743,8 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
     paths["reference"] = out / ACCURACY_FILES["reference"]
     (out / ACCURACY_FILES["tables"]).write_text(format_tables(study) + "\n")
     paths["tables"] = out / ACCURACY_FILES["tables"]
+    from cdpr_exu.post.study_plots import plot_pareto
+
     paths["pareto"] = plot_pareto(study, out / ACCURACY_FILES["pareto"])
     return paths
 
@@ -861,148 +863,3 @@ def format_tables(study: AccuracyStudy) -> str:
             lines.append([*_configuration_cell(r).split(" | "), kind, when, cause.replace("|", "/")])
         parts.append(_markdown(["model", "n", "step [s]", "status", "stopped at [s]", "cause"], lines))
     return "\n".join(parts)
-
-
-# --------------------------------------------------------------------------- figure
-
-#: Colours of the ladder's models; other models take the spare colours in turn.
-_MODEL_COLORS = {"ideal": "tab:gray", "elastic": "tab:green", "catenary": "tab:orange", "full": "tab:blue",
-                 model_name("full", LINEAR_BENDING): "tab:purple"}
-_SPARE_COLORS = ("tab:red", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
-_STEP_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
-
-
-def plot_pareto(study: AccuracyStudy, path: str | Path) -> Path:
-    """Error against cost (CPU time), log-log: one marker per run, coloured by model, Pareto front drawn.
-
-    Left: the platform position error; right: the RMS error of the platform-end
-    tensions. Marker shapes give the step size; tolerance lines at 1 mm, 1 cm, 5 cm.
-    """
-    from matplotlib.lines import Line2D
-    from matplotlib.ticker import NullFormatter
-
-    from cdpr_exu.post.plots import _figure, _save
-
-    rows = study.rows
-    models = list(dict.fromkeys(r["model"] for r in rows))
-    spare = [m for m in models if m not in _MODEL_COLORS]
-    colors = {m: _MODEL_COLORS.get(m) or _SPARE_COLORS[spare.index(m) % len(_SPARE_COLORS)] for m in models}
-    steps = sorted({r["step_size_s"] for r in rows})
-    markers = {h: _STEP_MARKERS[i % len(_STEP_MARKERS)] for i, h in enumerate(steps)}
-    figure = _figure(12.0, 5.2, left=0.8, right=0.2, bottom=1.3, top=0.55, wspace=0.85, columns=2)
-    axes = figure.subplots(1, 2)
-    quantities = (("position_error_max_m", 1000.0, "max platform position error [mm]" if study.comparison == "path"
-                   else "final platform position error [mm]"),
-                  ("tension_error_rms_N", 1.0, "RMS error of platform-end tensions [N]" if study.comparison == "path"
-                   else "final platform-end tension error [N]"))
-    for axis, (quantity, scale, label) in zip(axes, quantities):
-        for r in rows:
-            if not _usable(r, quantity) or r[quantity] <= 0:
-                continue
-            axis.plot(r[COST], scale * r[quantity], linestyle="none", marker=markers[r["step_size_s"]],
-                      color=colors[r["model"]], markersize=6, alpha=0.8, markeredgecolor="black", markeredgewidth=0.4)
-        front = [r for r in pareto_front(rows, quantity) if r[quantity] > 0]
-        if front:
-            x = [r[COST] for r in front]
-            y = [scale * r[quantity] for r in front]
-            axis.step(x, y, where="post", color="black", linewidth=1.0, alpha=0.7, zorder=0)
-            for r, xi, yi in zip(front, x, y):
-                axis.annotate(_short_label(r), (xi, yi), fontsize=6, xytext=(3, 3), textcoords="offset points",
-                              color="0.25")
-        if quantity == "position_error_max_m":
-            for tolerance in TOLERANCES:
-                axis.axhline(1000 * tolerance, color="0.5", linestyle=":", linewidth=0.8)
-                axis.annotate(f"{1000 * tolerance:g} mm", (1.0, 1000 * tolerance), xycoords=("axes fraction", "data"),
-                              fontsize=7, color="0.4", ha="right", va="bottom")
-        axis.set_xscale("log")
-        axis.set_yscale("log")
-        axis.xaxis.set_minor_formatter(NullFormatter())
-        axis.yaxis.set_minor_formatter(NullFormatter())
-        axis.set_xlabel("CPU time of the run [s] (one core)")
-        axis.set_ylabel(label)
-        axis.grid(True, which="both", alpha=0.25)
-    done = sum(r["status"] == "completed" for r in rows) - 1
-    failed = sum(r["status"].startswith("failed") for r in rows)
-    refused = sum(r["status"].startswith("refused") for r in rows)
-    ref = study.reference_row
-    figure.suptitle(f"{study.scene_name}, {study.end_time:g} s: error against the reference ({study.reference.label}, "
-                    f"{ref[COST]:.0f} s) vs CPU time; {done} runs compared, {failed} failed, "
-                    f"{refused} refused (see accuracy.csv); black: Pareto front", fontsize=9)
-    handles = [Line2D([], [], linestyle="none", marker="o", color=colors[m], label=m) for m in models]
-    handles += [Line2D([], [], linestyle="none", marker=markers[h], color="black", markerfacecolor="none",
-                       label=f"h = {h:g} s") for h in steps]
-    figure.legend(handles=handles, loc="lower center", ncol=min(len(handles), 6), fontsize=8, frameon=False)
-    return _save(figure, path)
-
-
-def _short_label(row: Mapping[str, Any]) -> str:
-    """``full 20, 5e-03`` (model, elements, step) for annotations."""
-    n = "" if row.get("n_elements") is None else f" {row['n_elements']}"
-    return f"{row['model']}{n}, {row['step_size_s']:.0e}"
-
-
-# --------------------------------------------------------------------------- command line
-
-EPILOG_ACCURACY = """examples:
-  cdpr study accuracy paper-circle --out results/accuracy/paper_circle
-  cdpr study accuracy paper-catenary --out results/accuracy/paper_catenary
-  cdpr study accuracy paper-circle --out /tmp/quick --quick
-  cdpr study accuracy spatial-ipanema --out /tmp/ipanema --quick
-
-runs the scene on every preset (ideal, elastic, catenary, full) and the full model
-with linear bending, over elements per cable (8..60) and step sizes (5e-4..1e-2 s),
-against a reference (full, 90 elements, 5e-4 s); --quick: a small grid, 1.5 s.
-A static scene (held pose, fixed winches) compares final states, others the path.
-
-spatial scenes (dimension = 3, with a [trajectory]) run under ideal inverse kinematics on
-the catenary and full presets over 4..16 elements and 5e-3..2e-2 s against (full, 32
-elements, 2e-3 s); --quick: full at 4 and 8 elements, 1e-2 s, against 16, 1.5 s.
-Errors: the platform centre's 3-D path and the angle between the orientations.
-writes accuracy.csv, accuracy.json, tables.md (tolerance table, effects table),
-pareto.png and reference.npz into --out.
-"""
-
-
-def _cmd_accuracy(args: argparse.Namespace) -> int:
-    from cdpr_exu.scenes.spatial_scene import load_any_scene
-
-    scene = load_any_scene(args.scene)  # planar or spatial
-    check_study_scene(scene)  # before the output folder is made
-    grid = grid_for(scene, args.quick)
-    if args.end_time is not None:
-        grid = replace(grid, end_time=args.end_time)
-    from cdpr_exu.core.output import check_output_folder
-
-    out = check_output_folder(args.out, command="study accuracy")
-    start = time.perf_counter()
-    study = run_accuracy_study(scene, grid, out=out, workers=args.workers, progress=not args.quiet,
-                               comparison=args.compare)
-    if not args.quiet:
-        print(format_tables(study))
-        print(f"\n{len(study.rows)} runs in {time.perf_counter() - start:.0f} s; written to {out}/")
-    return 0
-
-
-def add_commands(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cdpr study accuracy`` to the ``cdpr`` command."""
-    accuracy = study_subparsers(subparsers).add_parser(
-        "accuracy", help="error against run time over the model ladder, elements and step sizes",
-        description="Run a scene on every model of the ladder over elements per cable and step sizes, "
-        "compare each run with a reference (the full model, finest discretisation), and write the "
-        "Pareto front of error against run time (CPU time) and the cheapest configuration per tolerance.",
-        epilog=EPILOG_ACCURACY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    accuracy.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
-    accuracy.add_argument("--out", required=True, help="output folder (created)")
-    accuracy.add_argument("--quick", action="store_true", help="a small grid over 1.5 s (a minute or less)")
-    accuracy.add_argument("--workers", type=int, help="worker processes (default: one per core)")
-    accuracy.add_argument("--end-time", type=float, help="override the end time of every run [s]")
-    accuracy.add_argument("--compare", choices=("path", "final"),
-                          help="compare the path after 1 s or the final state (default: final for static scenes)")
-    accuracy.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no tables")
-    accuracy.set_defaults(func=_cmd_accuracy)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from cdpr_exu.cli import main
-
-    sys.exit(main(["study", "accuracy", *sys.argv[1:]]))

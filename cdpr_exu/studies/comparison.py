@@ -13,12 +13,14 @@ paper's circle starts at full speed, a jolt that no real robot would be commande
 that throws the cables slack (0.12 s on ideal IK with tension-only cables, 299 N peaks)
 without saying anything about how well a controller tracks. The scene written with the
 results (``scene.toml``) records the start used.
+
+A spatial scene runs under :data:`SPATIAL_CONTROLLERS` (:func:`compare_spatial`): ``summary.json``,
+``comparison.md`` (:func:`spatial_comparison_table`) and an ``overview_<controller>.png`` each.
 """
 
 from __future__ import annotations
 
-import argparse
-import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
@@ -26,11 +28,18 @@ import numpy as np
 
 from controllers.ideal_ik import IdealIKController
 from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
+from controllers.spatial_feedback import spatial_closed_loop_tension_aware
+from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, RunInterrupted, SceneError, SolverFailure
-from cdpr_exu.core.output import fixed
-from cdpr_exu.results.result import Result, provenance, raise_warnings, warning_flags
-from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
+from cdpr_exu.core.output import (PLANAR_POSE_COLUMNS, check_output_folder, clear_outputs, fixed, write_pose_csv,
+                                  write_summary)
+from cdpr_exu.results.result import Result, provenance, warning_flags
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.scenes.scene import Scene, save_scene
+from cdpr_exu.scenes.spatial_scene import SpatialScene
+from cdpr_exu.scenes.trajectories import CircleTrajectory
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
                                       ilc_controller, model_feed_forward_controller)
 
@@ -47,7 +56,7 @@ CONTROLLERS: dict[str, Callable[[], object]] = {
     "ilc": ilc_controller,
 }
 #: Controllers that learn over trials before their run (cdpr_exu.studies.learning), made with the
-#: comparison's stopping rule and progress setting.
+#: comparison's stopping rule and progress report.
 LEARNING_CONTROLLERS: dict[str, Callable[..., object]] = {
     "model_feed_forward": model_feed_forward_controller,
     "closed_loop_model_feed_forward": closed_loop_model_feed_forward_controller,
@@ -65,10 +74,6 @@ def smooth_start(scene: Scene, ramp_time: float = COMPARISON_RAMP_TIME) -> Scene
     references (hold, point-to-point) already start from rest, and a circle with its own
     ramp keeps it. ``ramp_time = 0`` returns the scene unchanged.
     """
-    from dataclasses import replace
-
-    from cdpr_exu.scenes.trajectories import CircleTrajectory
-
     if ramp_time < 0 or not np.isfinite(ramp_time):
         raise SceneError(f"ramp_time must be zero or positive [s], got {ramp_time!r}")
     trajectory = scene.trajectory
@@ -89,29 +94,30 @@ _COLUMNS = (
 
 
 def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: str | Path | None = None,
-                        after: float = 1.0, progress: bool = False, quiet: bool = True,
-                        learning_rule: StoppingRule = DEFAULT_RULE) -> dict[str, dict]:
+                        after: float = 1.0, progress: bool = False,
+                        learning_rule: StoppingRule = DEFAULT_RULE,
+                        report: Callable[[str, dict], None] | None = None,
+                        learning_report: Callable[[str], None] | None = None) -> dict[str, dict]:
     """Run ``scene`` under each named controller; returns their summaries by name.
 
     A controller that refuses the reference (e.g. a pose that needs a pushing cable)
     or whose run fails is recorded with its status; the others still run. The
     learning controllers (:data:`LEARNING_CONTROLLERS`) run their trials first, as
     ``learning_rule`` says (their per-trial errors go into the summary as ``trials``).
+    ``report(name, summary)`` is called as each controller's run ends (not for a refused
+    one), ``learning_report`` with each line of the learning controllers' progress
+    (:class:`cdpr_exu.studies.learning.Learner`); ``cdpr compare`` prints both.
     """
-    from cdpr_exu.run.simulate import simulate
-
     names = list(names or CONTROLLERS)
     unknown = [n for n in names if n not in CONTROLLERS]
     if unknown:
-        from cdpr_exu.core.errors import SceneError
-
         raise SceneError(f"unknown controller(s) {unknown}; known: {list(CONTROLLERS)}")
     summaries: dict[str, dict] = {}
     results: dict[str, Result] = {}
     try:
         for name in names:
             if name in LEARNING_CONTROLLERS:
-                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, progress=not quiet, plant=scene)
+                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, report=learning_report, plant=scene)
             else:
                 controller = CONTROLLERS[name]()
             try:
@@ -136,11 +142,8 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
             if "tension_limit_violations" in summary:
                 summary["tension_limit_violation_count"] = len(summary["tension_limit_violations"])
             summaries[name] = summary
-            if not quiet:
-                def mm(value):
-                    return "     n/a" if value is None else f"{1000 * value:8.2f}"
-                print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
-                      f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+            if report is not None:
+                report(name, summary)
     except KeyboardInterrupt:  # Ctrl-C, inside a run or between two: keep the controllers done so far
         if out is not None and summaries:
             _write(scene, summaries, {k: r for k, r in results.items() if k in summaries}, Path(out), after)
@@ -175,9 +178,7 @@ def markdown_table(summaries: dict[str, dict]) -> str:
 
 
 def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, check_output_folder, clear_outputs, write_pose_csv, write_summary
     from cdpr_exu.post.plots import plot_comparison
-    from cdpr_exu.scenes.scene import save_scene
 
     clear_outputs(check_output_folder(out, command="compare"), "compare")  # no file of an earlier comparison stays
     save_scene(scene, out / "scene.toml")
@@ -193,108 +194,102 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
         plot_comparison(scene, results, out)
 
 
-def _compare_spatial(scene, args: argparse.Namespace) -> int:
-    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.run.spatial_run.compare_spatial`)."""
-    from dataclasses import replace
+# --------------------------------------------------------------------------- spatial scenes
 
-    from cdpr_exu.run.spatial_run import check_spatial_reference, compare_spatial, spatial_comparison_table
-
-    if args.end_time is not None:
-        scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
-    if scene.trajectory is None:
-        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr compare` needs one")
-    check_spatial_reference(scene)
-    names = args.controllers.split(",") if args.controllers else None
-    if not args.quiet:
-        print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
-    summaries = compare_spatial(scene, names, args.out, args.after, quiet=args.quiet)
-    for name, summary in summaries.items():
-        raise_warnings(summary, f"{scene.name} under {name}: ")
-    if not args.quiet:
-        print()
-        print(spatial_comparison_table(summaries))
-        if args.out:
-            print(f"written to {args.out}/")
-    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
-    return EXIT_RUN_FAILED if failed else EXIT_OK
+#: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
+SPATIAL_CONTROLLERS = {
+    "ideal_ik": IdealIKController,
+    "tension_aware": SpatialTensionAwareController,
+    "tension_aware_chain": lambda: SpatialTensionAwareController(statics="chain"),
+    "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
+}
 
 
-def _check_time_options(args: argparse.Namespace) -> None:
-    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
-    on planar and spatial scenes alike)."""
-    from cdpr_exu.core.validation import non_negative
-
-    non_negative("--after", args.after)
-    non_negative("--ramp-time", args.ramp_time)
+def spatial_controller_names(scene: SpatialScene) -> list[str]:
+    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS` (over
+    swivel pulleys too: the chain version's held chains run over the disc, their winch ends moved as the run's)."""
+    return list(SPATIAL_CONTROLLERS)
 
 
-def _cmd_compare(args: argparse.Namespace) -> int:
-    from dataclasses import replace
+_SPATIAL_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
+            ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
+            ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
 
-    from cdpr_exu.core.output import check_output_folder
-    from cdpr_exu.statics.workspace import check_reference
 
-    _check_time_options(args)
-    check_output_folder(args.out, command="compare")
-    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+def spatial_comparison_table(summaries: dict) -> str:
+    """The spatial comparison as a Markdown table (errors after the summaries' ``after``); a scene
+    with tension limits gets a column counting the violations, as the planar table does."""
+    columns = _SPATIAL_COLUMNS
+    if any("tension_limit_violations" in s for s in summaries.values()):
+        columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
+        summaries = {name: {**s, "tension_limit_violation_count": len(s.get("tension_limit_violations", []))}
+                     for name, s in summaries.items()}
+    lines = ["| controller | " + " | ".join(title for _, title, _ in columns) + " | vs ideal IK | status |",
+             "|" + "---|" * (len(columns) + 3)]
+    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
+    for name, s in summaries.items():
+        cells = ["" if s.get(key) is None else f"{scale * s[key]:.4g}" for key, _, scale in columns]
+        worst = s.get("max_position_error_m")
+        ratio = f"{base / worst:.1f}x" if base and worst else ""
+        flags = "".join(f"; {flag}" for flag in warning_flags(s))  # what a real robot cannot do
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {ratio} | {s.get('status', '')}{flags} |")
+    return "\n".join(lines) + "\n"
 
-    scene = load_any_scene(args.scene)
-    if is_spatial(scene):
-        return _compare_spatial(scene, args)
-    if args.end_time is not None:
-        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
-    started = smooth_start(scene, args.ramp_time)
-    if started is not scene and not args.quiet:
-        print(f"{scene.name}: the circle starts smoothly from rest over {args.ramp_time} s "
-              "(--ramp-time 0 keeps the scene's start at full speed)")
-    scene = started
-    # A reference no controller can follow is bad input (exit 2), not six failed runs.
-    check_reference(scene)
+
+def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
+                    after: float = 1.0, report: Callable[[str, dict], None] | None = None) -> dict[str, dict]:
+    """Run a spatial scene under each named controller; write summary.json, comparison.md and each
+    controller's overview figure to ``out``. Returns the summaries by name; ``report(name, summary)``
+    is called as each run ends (``cdpr compare`` prints it).
+
+    As the planar comparison: a run that fails is recorded with its status and partial
+    figures, a controller that refuses the scene with ``refused: ...``, and the others still
+    run; on Ctrl-C (inside a run or between two) the controllers done so far and the
+    interrupted one's partial run are written before the interrupt goes on.
+    """
+    names = list(names or spatial_controller_names(scene))
+    unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
+    if unknown:
+        raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
+    if out is not None:  # an earlier comparison's files go before the first of this one is written
+
+        clear_outputs(check_output_folder(out, command="compare"), "compare")
+    summaries, results = {}, {}
     try:
-        rule = StoppingRule(max_trials=args.trials, min_improvement=args.min_improvement)
-    except SceneError as err:
-        raise SceneError(f"--trials / --min-improvement: {err}") from None
-    names = args.controllers.split(",") if args.controllers else None
-    if not args.quiet:
-        print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
-    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, quiet=args.quiet,
-                                    learning_rule=rule)
-    for name, summary in summaries.items():
-        raise_warnings(summary, f"{scene.name} under {name}: ")
-    if not args.quiet:
-        print()
-        print(markdown_table(summaries))
-        if args.out:
-            print(f"written to {args.out}/")
-    failed = [name for name, summary in summaries.items() if summary.get("status") != "completed"]
-    if failed:
-        print(f"cdpr compare: {len(failed)} of {len(summaries)} controllers did not complete: {', '.join(failed)}",
-              file=sys.stderr)
-        return EXIT_RUN_FAILED
-    return EXIT_OK
+        for name in names:
+            try:
+                result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
+            except SolverFailure as err:
+                result = err.partial_result
+                if result is None:  # it failed before its first step (settling the robot)
+                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
+                    continue
+            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
+                results[name] = err.partial_result
+                summaries[name] = err.partial_result.summary(after)
+                raise
+            except CdprError as err:  # a controller that refuses the scene is a result of the comparison too
+                summaries[name] = {"controller": name, "status": f"refused: {err}"}
+                continue
+            results[name], summaries[name] = result, result.summary(after)
+            if report is not None:
+                report(name, summaries[name])
+    except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
+        if out is not None and summaries:
+            _write_spatial_comparison(scene, summaries, results, Path(out), after)
+        raise
+    if out is not None:
+        _write_spatial_comparison(scene, summaries, results, Path(out), after)
+    return summaries
 
 
-def add_commands(subparsers) -> None:
-    """Register ``cdpr compare``."""
-    parser = subparsers.add_parser(
-        "compare", help="run a scene under every controller and compare their errors",
-        description="Run a scene under each controller (ideal inverse kinematics, tension-aware variants, "
-        "closed loop) and write a table and figures of their errors.",
-        epilog="examples:\n  cdpr compare paper-circle --out results/controllers\n"
-               "  cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal\n\n" + EXIT_CODES,
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("scene", help="shipped scene name or path to a .toml file")
-    parser.add_argument("--out", help="output folder (summary.json, comparison.md, figures)")
-    parser.add_argument("--controllers", help=f"comma-separated subset of: {', '.join(CONTROLLERS)}")
-    parser.add_argument("--after", type=float, default=1.0, help="measure errors after this time [s] (default 1)")
-    parser.add_argument("--end-time", type=float, help="override solver.end_time [s]")
-    parser.add_argument("--ramp-time", type=float, default=COMPARISON_RAMP_TIME,
-                        help="start a circle that starts at full speed smoothly from rest over this time [s] "
-                             f"(default {COMPARISON_RAMP_TIME}; 0 keeps the scene's own start)")
-    parser.add_argument("--trials", type=int, default=DEFAULT_RULE.max_trials,
-                        help=f"most learning trials of ilc and model_feed_forward (default {DEFAULT_RULE.max_trials})")
-    parser.add_argument("--min-improvement", type=float, default=DEFAULT_RULE.min_improvement,
-                        help="stop learning when a trial's max error falls by less than this fraction "
-                             f"(default {DEFAULT_RULE.min_improvement})")
-    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
-    parser.set_defaults(func=_cmd_compare)
+def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
+    """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
+    from cdpr_exu.post.plots import plot_spatial_run
+
+    out.mkdir(parents=True, exist_ok=True)
+    write_summary(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
+                        "error_convention": "actual - reference", "controllers": summaries, **provenance()})
+    (out / "comparison.md").write_text(spatial_comparison_table(summaries))
+    for name, result in results.items():
+        plot_spatial_run(result, out / f"overview_{name}.png", after)

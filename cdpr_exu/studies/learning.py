@@ -58,6 +58,7 @@ from controllers.feedback import ClosedLoopController, FilteredPositionPI
 
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.results.result import Result
+from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import Scene
 
 #: The learning law designed from the measured response of the paper-circle model (module notes).
@@ -144,16 +145,18 @@ def _trial(number: int, result: Result, correction: float, after: float) -> Tria
                  summary["min_element_tension_N"], max(slack) if slack else None, correction, result.status)
 
 
-def _print_trial(trial: Trial) -> None:
+def trial_line(trial: Trial) -> str:
+    """One line on a trial, as ``cdpr compare`` shows the learning's progress: its errors and
+    lowest tension, its largest correction [mm] and its status."""
     def mm(value):
         return "   n/a" if value is None else f"{1000 * value:6.2f}"
     tension = "n/a" if trial.min_element_tension_N is None else f"{trial.min_element_tension_N:.2f}"
-    print(f"  trial {trial.number:2d}: max {mm(trial.max_position_error_m)} mm, RMS {mm(trial.rms_position_error_m)} mm, "
-          f"min tension {tension} N, correction {mm(trial.max_correction_m)} mm  {trial.status}", flush=True)
+    return (f"  trial {trial.number:2d}: max {mm(trial.max_position_error_m)} mm, RMS {mm(trial.rms_position_error_m)} mm, "
+            f"min tension {tension} N, correction {mm(trial.max_correction_m)} mm  {trial.status}")
 
 
 def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRule = DEFAULT_RULE, *,
-                  after: float = 1.0, progress: bool | Callable[[Trial], None] = False) -> LearningRun:
+                  after: float = 1.0, on_trial: Callable[[Trial], None] | None = None) -> LearningRun:
     """Iterative learning control of the winch lengths on ``scene`` (trials until ``rule`` stops them).
 
     Parameters
@@ -164,8 +167,8 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
     rule : StoppingRule
     after : float [s]
         Errors judged by the stopping rule are measured from this time on.
-    progress : bool or callable
-        True prints one line per trial; a callable is called with each :class:`Trial`.
+    on_trial : callable, optional
+        Called with each :class:`Trial` as it ends (the progress; :func:`trial_line` words it).
 
     Returns
     -------
@@ -178,15 +181,12 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
     SolverFailure
         If the very first trial fails (a later failure ends the learning instead).
     """
-    from cdpr_exu.run.simulate import simulate
-
     if not isinstance(law, LearningLaw):
         raise SceneError(f"law must be a LearningLaw, got {law!r}")
     if not isinstance(rule, StoppingRule):
         raise SceneError(f"rule must be a StoppingRule, got {rule!r}")
     if not np.isfinite(after) or not 0.0 <= after < scene.solver.end_time:
         raise SceneError(f"after must lie in [0, solver.end_time = {scene.solver.end_time}) s, got {after!r}")
-    report = _print_trial if progress is True else (progress if callable(progress) else None)
     times = command_grid(scene)
     law.low_pass(np.zeros((len(times), 1)), times[1] - times[0])  # refuses a cut-off above Nyquist before any trial
     baseline = ideal_changes(scene, times)
@@ -204,14 +204,14 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
                 raise
             trial = _trial(len(trials) + 1, err.partial_result, float(np.abs(table.changes - baseline).max()), after)
             trials.append(trial)
-            if report:
-                report(trial)
+            if on_trial is not None:
+                on_trial(trial)
             stop_reason = f"trial {trial.number} failed: {err}"
             break
         trial = _trial(len(trials) + 1, result, float(np.abs(table.changes - baseline).max()), after)
         trials.append(trial)
-        if report:
-            report(trial)
+        if on_trial is not None:
+            on_trial(trial)
         if best is None or trial.max_position_error_m < best[0].max_position_error_m:
             expected = np.column_stack([np.interp(times, result.time, column) for column in result.platform_pose[:, :2].T])
             best = (trial, replace(table, expected_positions=expected), result)
@@ -260,8 +260,6 @@ def measure_response(model: Scene, amplitude: float = 4e-3, max_frequency: float
     -------
     PositionResponse
     """
-    from cdpr_exu.run.simulate import simulate
-
     times = command_grid(model)
     window = times >= after - 1e-9
     window[np.flatnonzero(window)[-1]] = False  # an even period: t in [after, end)
@@ -291,7 +289,7 @@ def measure_response(model: Scene, amplitude: float = 4e-3, max_frequency: float
 
 
 def model_feed_forward(model: Scene, plant: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRule = DEFAULT_RULE,
-                       *, after: float = 1.0, progress: bool | Callable[[Trial], None] = False
+                       *, after: float = 1.0, on_trial: Callable[[Trial], None] | None = None
                        ) -> tuple[LearningRun, Result]:
     """Learn the lengths on the controller's ``model``, then run the ``plant`` open loop with them.
 
@@ -307,11 +305,9 @@ def model_feed_forward(model: Scene, plant: Scene, law: LearningLaw = DEFAULT_LA
     SceneError
         If the model and the plant differ in their cables' number or their end time.
     """
-    from cdpr_exu.run.simulate import simulate
-
     if model.n_cables != plant.n_cables or model.solver.end_time != plant.solver.end_time:
         raise SceneError("model and plant must have the same number of cables and solver.end_time")
-    learning = learn_lengths(model, law, rule, after=after, progress=progress)
+    learning = learn_lengths(model, law, rule, after=after, on_trial=on_trial)
     return learning, simulate(plant, ReplayController(learning.table, name="model_feed_forward"))
 
 
@@ -327,8 +323,9 @@ class Learner:
     rule : StoppingRule
     after : float [s]
         Errors judged by the stopping rule are measured from this time on.
-    progress : bool
-        Print one line per trial.
+    report : callable, optional
+        Called with each line of the learning's progress (where it learns, each trial
+        (:func:`trial_line`), the trial kept); ``cdpr compare`` prints them.
 
     Attributes
     ----------
@@ -337,12 +334,12 @@ class Learner:
     """
 
     def __init__(self, on_model: bool, law: LearningLaw = DEFAULT_LAW, rule: StoppingRule = DEFAULT_RULE, *,
-                 after: float = 1.0, progress: bool = False, plant: Scene | None = None):
+                 after: float = 1.0, report: Callable[[str], None] | None = None, plant: Scene | None = None):
         if not isinstance(law, LearningLaw):
             raise SceneError(f"law must be a LearningLaw, got {law!r}")
         if not isinstance(rule, StoppingRule):
             raise SceneError(f"rule must be a StoppingRule, got {rule!r}")
-        self.on_model, self.law, self.rule, self.after, self.progress = bool(on_model), law, rule, after, progress
+        self.on_model, self.law, self.rule, self.after, self.report = bool(on_model), law, rule, after, report
         self.plant = plant
         self.learning: LearningRun | None = None
 
@@ -358,33 +355,35 @@ class Learner:
         else:
             raise SceneError("iterative learning on the robot needs the plant (Learner(plant=...)): "
                              "the run hands the controller only the controllers' model")
-        if self.progress:
+        report = self.report
+        if report is not None:
             where = "the controller's model of " if self.on_model else ""
-            print(f"  learning on {where}{scene.name} (at most {self.rule.max_trials} trials)", flush=True)
-        self.learning = learn_lengths(target, self.law, self.rule, after=self.after, progress=self.progress)
-        if self.progress:
-            print(f"  kept trial {self.learning.best_trial}: {self.learning.stop_reason}", flush=True)
+            report(f"  learning on {where}{scene.name} (at most {self.rule.max_trials} trials)")
+        self.learning = learn_lengths(target, self.law, self.rule, after=self.after,
+                                      on_trial=None if report is None else (lambda trial: report(trial_line(trial))))
+        if report is not None:
+            report(f"  kept trial {self.learning.best_trial}: {self.learning.stop_reason}")
         return self.learning.table
 
 
 def ilc_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *, after: float = 1.0,
-                   progress: bool = False, plant: Scene | None = None) -> LearnedController:
+                   report: Callable[[str], None] | None = None, plant: Scene | None = None) -> LearnedController:
     """``ilc`` for ``cdpr compare``: trials on ``plant`` (the compared scene), then a run that
     replays the best trial's commands."""
-    return LearnedController("ilc", Learner(False, law, rule, after=after, progress=progress, plant=plant))
+    return LearnedController("ilc", Learner(False, law, rule, after=after, report=report, plant=plant))
 
 
 def model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
-                                  after: float = 1.0, progress: bool = False,
+                                  after: float = 1.0, report: Callable[[str], None] | None = None,
                                   plant: Scene | None = None) -> LearnedController:
     """``model_feed_forward`` for ``cdpr compare``: trials on :meth:`Scene.controller_scene` of the compared
     scene, then the plant runs open loop with the best trial's commands."""
-    return LearnedController("model_feed_forward", Learner(True, law, rule, after=after, progress=progress,
+    return LearnedController("model_feed_forward", Learner(True, law, rule, after=after, report=report,
                                                            plant=plant))
 
 
 def closed_loop_model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
-                                              after: float = 1.0, progress: bool = False,
+                                              after: float = 1.0, report: Callable[[str], None] | None = None,
                                               feedback: FilteredPositionPI | None = None,
                                               follow: str = "expected",
                                               plant: Scene | None = None) -> ClosedLoopController:
@@ -400,6 +399,6 @@ def closed_loop_model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE,
     to the reference instead."""
     if feedback is None:
         feedback = FilteredPositionPI()
-    feed_forward = LearnedController("model_feed_forward", Learner(True, law, rule, after=after, progress=progress,
+    feed_forward = LearnedController("model_feed_forward", Learner(True, law, rule, after=after, report=report,
                                                                    plant=plant))
     return ClosedLoopController("closed_loop_model_feed_forward", feed_forward, feedback, follow)

@@ -22,21 +22,12 @@ fatal. Runs go to any :class:`concurrent.futures.Executor`: by default a process
 with one single-threaded process per core; a Dask cluster through
 ``scheduler="tcp://host:8786"`` (or ``"local"``).
 
-Adding a ``cdpr study`` sub-command from another module::
-
-    from cdpr_exu.studies.study import study_subparsers
-
-    def add_commands(subparsers):
-        accuracy = study_subparsers(subparsers).add_parser("accuracy", ...)
-        accuracy.set_defaults(func=...)
-
 This module imports only the standard library at its top, so that a spawned worker
 process can set its thread limits before NumPy, Numba or Exudyn load.
 """
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import copy
 import csv
@@ -47,15 +38,14 @@ import math
 import multiprocessing
 import os
 import re
-import sys
 import time
 import tomllib
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
-from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, CdprError, SceneError
+from cdpr_exu.core.errors import CdprError, SceneError
 
 if TYPE_CHECKING:  # pragma: no cover
     from cdpr_exu.scenes.scene import Scene
@@ -292,7 +282,7 @@ def combinations(variations: Sequence[Variation], mode: str = "grid") -> list[tu
     return [tuple(zip(paths, values)) for values in itertools.product(*(v.values for v in variations))]
 
 
-def _as_variations(variations: Any) -> list[Variation]:
+def as_variations(variations: Any) -> list[Variation]:
     """Variations from strings ``"PATH=V1,V2"``, ``(path, values)`` pairs, a dict or Variations."""
     if isinstance(variations, (str, Variation)):
         variations = [variations]
@@ -324,11 +314,11 @@ def _nan_figures() -> dict[str, Any]:
     return {name: float("nan") for name in FIGURES}
 
 
-#: Model configurations already run once in this process (see :func:`_warm_up`).
+#: Model configurations already run once in this process (see :func:`warm_up`).
 _WARMED: set[str] = set()
 
 
-def _warm_up(scene) -> None:
+def warm_up(scene) -> None:
     """Run two steps of a planar or spatial ``scene`` once per process and model configuration, untimed.
 
     The first run in a process loads Numba's compiled kernels and Exudyn's code
@@ -345,7 +335,6 @@ def _warm_up(scene) -> None:
     if key in _WARMED:
         return
     _WARMED.add(key)
-    from dataclasses import replace
 
     solver = scene.solver
     short = replace(solver, end_time=2 * solver.step_size, output_period=solver.step_size)
@@ -386,7 +375,7 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
         else:
             from cdpr_exu.run.simulate import simulate
 
-            _warm_up(scene)
+            warm_up(scene)
         after = after if after < scene.solver.end_time else 0.0
         try:
             result = simulate(scene, progress=False)
@@ -439,7 +428,7 @@ def local_dask_cluster(n_workers: int | None = None):
 
 
 @contextlib.contextmanager
-def _executor_for(executor: Executor | None, workers: int | None, scheduler: str | None):
+def executor_for(executor: Executor | None, workers: int | None, scheduler: str | None):
     """The executor to use; the ones made here are shut down afterwards."""
     if executor is not None:
         yield executor
@@ -471,7 +460,8 @@ def _executor_for(executor: Executor | None, workers: int | None, scheduler: str
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _progress_bar(total: int, enabled: bool):
+def progress_bar(total: int, enabled: bool):
+    """A tqdm bar over ``total`` runs, shown when ``enabled`` and the output is a terminal."""
     from tqdm import tqdm
 
     # disable=None: no bar when the output is not a terminal (logs, CI).
@@ -529,7 +519,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         raise SceneError(f"workers must be a whole number of at least 1, got {workers!r}")
     scene = base_scene if isinstance(base_scene, (Scene, SpatialScene)) else load_any_scene(base_scene)
     after = float(after)
-    variations = _as_variations(variations)
+    variations = as_variations(variations)
     base_data = scene.to_dict()
     for variation in variations:
         check_parameter_path(base_data, variation.path)
@@ -549,7 +539,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
             pending.append((index, data))
         rows.append(row)
 
-    bar = _progress_bar(len(rows), progress)
+    bar = progress_bar(len(rows), progress)
     bar.update(len(rows) - len(pending))
     start = time.perf_counter()
     simulated = 0.0
@@ -557,7 +547,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         if pending:
             if executor is None and scheduler is None:
                 workers = min(workers or os.cpu_count() or 1, len(pending))
-            with _executor_for(executor, workers, scheduler) as pool:
+            with executor_for(executor, workers, scheduler) as pool:
                 futures: dict[Future, int] = {pool.submit(run_variation, data, after): index
                                               for index, data in pending}
                 for future in as_completed(futures):
@@ -584,14 +574,6 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
 # --------------------------------------------------------------------------- files
 
 
-def _cell(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        return repr(value) if math.isfinite(value) else ""  # empty: "not applicable", never "nan"
-    return "" if value is None else str(value)
-
-
 def _json_value(value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None
@@ -612,8 +594,9 @@ def study_columns(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variat
 def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: "Scene",
                 variations: Sequence[Variation], *, mode: str = "grid", after: float = 1.0,
                 plots: bool = True) -> dict[str, Path]:
-    """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures; return the paths."""
-    from cdpr_exu.core.output import check_output_folder, clear_outputs, write_summary
+    """Write ``study.csv``, ``study.json``, ``base_scene.toml`` and the figures
+    (:func:`cdpr_exu.post.study_plots.plot_study`); return the paths."""
+    from cdpr_exu.core.output import check_output_folder, clear_outputs, value_text, write_summary
     from cdpr_exu.results.result import provenance
     from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
 
@@ -625,7 +608,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
         writer = csv.writer(handle)
         writer.writerow(columns)
         for row in rows:
-            writer.writerow([_cell(row.get(c)) for c in columns])
+            writer.writerow([value_text(row.get(c)) for c in columns])
     paths["csv"] = out / STUDY_FILES["csv"]
     data = {
         "variations": [{"path": v.path, "values": list(v.values)} for v in variations],
@@ -639,6 +622,8 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
     write_summary(out, data, name=STUDY_FILES["json"])  # the date and each row's wall time go to timing.json
     paths["json"] = out / STUDY_FILES["json"]
     if plots and variations:
+        from cdpr_exu.post.study_plots import plot_study
+
         paths.update(plot_study(rows, variations, out, mode=mode))
     return paths
 
@@ -646,125 +631,6 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
 def load_study(out: str | Path) -> dict[str, Any]:
     """Read a study's ``study.json`` back (rows, variations, base scene, provenance)."""
     return json.loads((Path(out) / STUDY_FILES["json"]).read_text())
-
-
-# --------------------------------------------------------------------------- figures
-
-
-def _file_stem(path: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_]+", "_", path).strip("_")
-
-
-def _is_numeric(values: Sequence[Any]) -> bool:
-    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
-
-
-def _finite(value: Any) -> bool:
-    return isinstance(value, (int, float)) and math.isfinite(value)
-
-
-def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation], out: str | Path,
-               mode: str = "grid") -> dict[str, Path]:
-    """Summary figures of a study; returns their paths by name.
-
-    For each varied parameter, ``vs_<path>.png``: the maximum position error and the
-    Newton iterations (the run's cost, the same from run to run, unlike its wall time) against that parameter (one line per value of the other parameter in a
-    2-parameter grid, per combination of the others beyond). A 2-parameter grid also
-    gets ``heatmap.png``. Failed and refused runs are marked with red crosses at the
-    bottom of the axes.
-    """
-    from cdpr_exu.post.plots import DPI, _figure
-
-    out = Path(out)
-    written: dict[str, Path] = {}
-    for variation in variations:
-        others = [v for v in variations if v.path != variation.path] if mode == "grid" else []
-        figure = _figure(10.0, 4.0, left=0.9, right=0.25, bottom=0.8, top=0.5, wspace=0.9, columns=2)
-        axes = figure.subplots(1, 2)
-        numeric = _is_numeric(variation.values)
-        position = {v: (v if numeric else i) for i, v in enumerate(variation.values)}
-        groups: dict[tuple, list[Mapping[str, Any]]] = {}
-        for row in rows:
-            groups.setdefault(tuple(row[o.path] for o in others), []).append(row)
-        for quantity, axis, scale, label in (("max_position_error_m", axes[0], 1000.0, "max position error [mm]"),
-                                             ("newton_iterations", axes[1], 1.0, "Newton iterations")):
-            failed_label = "failed / refused"
-            for key, members in groups.items():
-                members = sorted(members, key=lambda r: position[r[variation.path]])
-                name = ", ".join(f"{o.path} = {_cell(v)}" for o, v in zip(others, key)) or None
-                ok = [r for r in members if r["status"] == "completed" and _finite(r.get(quantity))]
-                bad = [r for r in members if r["status"] != "completed"]
-                if ok:
-                    axis.plot([position[r[variation.path]] for r in ok], [scale * r[quantity] for r in ok],
-                              marker="o", label=name)
-                elif name:
-                    failed_label = None
-                if bad:  # at the foot of the axes: their figures are partial or missing
-                    label_bad = failed_label if ok or not name else f"{name}: failed / refused"
-                    axis.plot([position[r[variation.path]] for r in bad], [0.03] * len(bad), linestyle="none",
-                              marker="x", color="tab:red", markersize=9, markeredgewidth=2,
-                              transform=axis.get_xaxis_transform(), label=label_bad, clip_on=False)
-                    if ok or not name:
-                        failed_label = None
-            axis.set_xlabel(variation.path)
-            axis.set_ylabel(label)
-            axis.grid(True, alpha=0.3)
-            if not numeric:
-                axis.set_xticks(range(len(variation.values)), [_cell(v) for v in variation.values])
-            if others or failed_label is None:
-                axis.legend(fontsize=7)
-        after = next((r["errors_measured_after_s"] for r in rows if _finite(r.get("errors_measured_after_s"))), None)
-        figure.suptitle(f"study over {variation.path}" + (f" (errors after {after:g} s)" if _finite(after) else ""),
-                        fontsize=10)
-        path = out / f"vs_{_file_stem(variation.path)}.png"
-        figure.savefig(path, dpi=DPI, format="png")
-        written[f"vs_{variation.path}"] = path
-    if mode == "grid" and len(variations) == 2:
-        written["heatmap"] = _plot_heatmap(rows, variations, out / "heatmap.png")
-    return written
-
-
-def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation], path: Path) -> Path:
-    """Maximum position error and Newton iterations over a 2-parameter grid, failed cells marked."""
-    import matplotlib
-    import numpy as np
-
-    from cdpr_exu.post.plots import DPI, _figure
-
-    first, second = variations
-    figure = _figure(11.0, 4.5, left=1.0, right=0.3, bottom=0.8, top=0.5, wspace=1.6, columns=2)
-    axes = figure.subplots(1, 2)
-    index = {(row[first.path], row[second.path]): row for row in rows}
-    for axis, quantity, scale, label in ((axes[0], "max_position_error_m", 1000.0, "max position error [mm]"),
-                                         (axes[1], "newton_iterations", 1.0, "Newton iterations")):
-        grid = np.full((len(first.values), len(second.values)), np.nan)
-        for i, a in enumerate(first.values):
-            for j, b in enumerate(second.values):
-                row = index.get((a, b))
-                if row is not None and row["status"] == "completed" and _finite(row.get(quantity)):
-                    grid[i, j] = scale * row[quantity]
-        colormap = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
-        image = axis.imshow(grid, origin="lower", aspect="auto", cmap=colormap)
-        figure.colorbar(image, ax=axis, label=label)
-        finite = grid[np.isfinite(grid)]
-        middle = 0.5 * (finite.min() + finite.max()) if finite.size else 0.0
-        for i, a in enumerate(first.values):
-            for j, b in enumerate(second.values):
-                row = index.get((a, b))
-                if row is None:
-                    continue
-                if row["status"] != "completed":
-                    text, color = row["status"].split(":")[0], "tab:red"
-                else:
-                    text, color = f"{grid[i, j]:.3g}", ("black" if grid[i, j] > middle else "white")
-                axis.text(j, i, text, ha="center", va="center", fontsize=8, color=color)
-        axis.set_xticks(range(len(second.values)), [_cell(v) for v in second.values])
-        axis.set_yticks(range(len(first.values)), [_cell(v) for v in first.values])
-        axis.set_xlabel(second.path)
-        axis.set_ylabel(first.path)
-    figure.suptitle("study grid (grey, red text: failed or refused run)", fontsize=10)
-    figure.savefig(path, dpi=DPI, format="png")
-    return path
 
 
 # --------------------------------------------------------------------------- table
@@ -775,6 +641,8 @@ def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variati
 
     The causes of failed and refused runs follow the table, once each.
     """
+    from cdpr_exu.core.output import finite_number, value_text
+
     head = [v.path for v in variations] + ["run", "status", "max err [mm]", "rms err [mm]", "wall [s]",
                                            "x real time"]
     lines, causes = [], {}
@@ -783,11 +651,11 @@ def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variati
         kind, _, cause = status.partition(": ")
         if cause:
             causes.setdefault(cause, []).append(str(row.get("run", "")))
-        cells = [_cell(row.get(v.path)) for v in variations] + [_cell(row.get("run")), kind]
+        cells = [value_text(row.get(v.path)) for v in variations] + [value_text(row.get("run")), kind]
         for name, scale, fmt in (("max_position_error_m", 1000.0, "{:.2f}"), ("rms_position_error_m", 1000.0, "{:.2f}"),
                                  ("wall_time_s", 1.0, "{:.2f}"), ("real_time_factor", 1.0, "{:.2f}")):
             value = row.get(name)
-            cells.append(fmt.format(scale * value) if _finite(value) else "-")
+            cells.append(fmt.format(scale * value) if finite_number(value) else "-")
         lines.append(cells)
     widths = [max(len(str(c)) for c in column) for column in zip(head, *lines)]
     out = ["  ".join(str(c).ljust(w) for c, w in zip(head, widths)).rstrip()]
@@ -795,98 +663,3 @@ def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variati
     for cause, runs in causes.items():
         out.append(f"run{'s' if len(runs) > 1 else ''} {', '.join(runs)}: {cause}")
     return "\n".join(out)
-
-
-# --------------------------------------------------------------------------- command line
-
-EPILOG_STUDY = """examples:
-  cdpr study sweep paper-circle --param cables.n_elements=10,15 --param platform.mass=1,2.5 --out results/study
-  cdpr study sweep --help
-"""
-
-EPILOG_SWEEP = """examples:
-  cdpr study sweep paper-circle --param cables.n_elements=8,10,15 --param platform.mass=1,2.5,5 --out out/grid
-  cdpr study sweep paper-circle --param effects.preset=full,catenary --end-time 2 --out out/presets
-  cdpr study sweep scene.toml --param 'cables[1].radius=0.004,0.006' --param solver.step_size=1e-3,2e-3 \\
-      --zip --out out/zipped --workers 2
-  cdpr study sweep paper-circle --param platform.mass=1,2.5,5 --out out/local-dask --scheduler local
-  cdpr study sweep paper-circle --param platform.mass=1,2.5,5 --out out/cluster --scheduler tcp://10.0.0.1:8786
-
-parameter paths name fields of the scene's TOML form: cables.n_elements (every cable),
-cables[1].radius (one cable), platform.mass, solver.step_size, effects.bending,
-effects.preset, trajectory.angular_rate, platform.initial_pose[1], ...
-values are TOML scalars: 5, 2.5, 1e-3, true, false, "full" (or a bare word: full).
-
-writes study.csv, study.json, base_scene.toml and vs_<parameter>.png (+ heatmap.png
-for a 2-parameter grid) into --out. Failed and refused runs are recorded as rows.
-"""
-
-
-def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubParsersAction:
-    """The sub-parsers of ``cdpr study`` (made on first call; the same object after).
-
-    Other modules add ``cdpr study <name>`` commands with
-    ``study_subparsers(subparsers).add_parser(name, ...)`` in their ``add_commands``.
-    """
-    existing = getattr(subparsers, "_cdpr_study_subparsers", None)
-    if existing is not None:
-        return existing
-    study = subparsers.add_parser("study", help="parameter studies over a scene, in parallel",
-                                  description="Parameter studies: run a scene over many parameter values "
-                                  "on all cores or on a Dask cluster, and tabulate and plot the results.",
-                                  epilog=EPILOG_STUDY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    study_sub = study.add_subparsers(dest="study_command", required=True, metavar="COMMAND")
-    subparsers._cdpr_study_subparsers = study_sub
-    return study_sub
-
-
-def _cmd_sweep(args: argparse.Namespace) -> int:
-    from dataclasses import replace
-
-    from cdpr_exu.core.output import check_output_folder
-    from cdpr_exu.scenes.spatial_scene import load_any_scene
-
-    scene = load_any_scene(args.scene)  # planar or spatial
-    if args.end_time is not None:
-        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
-    if args.scheduler and args.scheduler != "local" and args.workers and not args.quiet:
-        print("cdpr study: --workers is ignored with a remote --scheduler (its workers run the study)",
-              file=sys.stderr)
-    variations = _as_variations(args.param)
-    out = check_output_folder(args.out, command="study sweep")
-    rows = run_study(scene, variations, out=out, progress=not args.quiet, after=args.after,
-                     mode="zip" if args.zip else "grid", workers=args.workers, scheduler=args.scheduler)
-    if not args.quiet:
-        print(format_table(rows, variations))
-        done = sum(row["status"] == "completed" for row in rows)
-        print(f"{done} of {len(rows)} runs completed; written to {out}/")
-    failed = sum(row["status"] != "completed" for row in rows)
-    if failed:
-        print(f"cdpr study sweep: {failed} of {len(rows)} runs did not complete (see the status column)",
-              file=sys.stderr)
-        return EXIT_RUN_FAILED
-    return EXIT_OK
-
-
-def add_commands(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cdpr study sweep`` (and the ``study`` group) to the ``cdpr`` command."""
-    sweep = study_subparsers(subparsers).add_parser(
-        "sweep", help="run a scene over a grid of parameter values",
-        description="Run a scene once per combination of parameter values (a grid, or --zip), in "
-        "parallel, and write a CSV/JSON table and summary plots. Failed and refused runs are recorded, "
-        "not fatal.", epilog=EPILOG_SWEEP + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    sweep.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
-    sweep.add_argument("--param", action="append", required=True, metavar="PATH=V1,V2,...",
-                       help="a parameter and its values; repeat for more parameters")
-    sweep.add_argument("--zip", action="store_true",
-                       help="run the i-th values of all parameters together instead of the grid")
-    sweep.add_argument("--out", required=True, help="output folder (created)")
-    sweep.add_argument("--workers", type=int, help="worker processes (default: one per core)")
-    sweep.add_argument("--scheduler", metavar="ADDRESS|local",
-                       help="run on a Dask cluster: its scheduler's address (tcp://host:8786), or 'local' "
-                       "to start one on this machine")
-    sweep.add_argument("--end-time", type=float, help="override solver.end_time of every run [s]")
-    sweep.add_argument("--after", type=float, default=1.0,
-                       help="measure errors from this time on [s] (default 1; 0 for runs not longer)")
-    sweep.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table")
-    sweep.set_defaults(func=_cmd_sweep)

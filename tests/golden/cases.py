@@ -308,7 +308,7 @@ def spatial_swivel_ideal_ik():
 
 
 def _spatial_controller(scene_name, name, end_time=0.6):
-    from cdpr_exu.run.spatial_run import SPATIAL_CONTROLLERS
+    from cdpr_exu.studies.comparison import SPATIAL_CONTROLLERS
 
     return _spatial_run(_spatial(scene_name, end_time), SPATIAL_CONTROLLERS[name]())
 

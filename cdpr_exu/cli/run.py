@@ -1,32 +1,28 @@
-"""The ``cdpr`` command: run scenes, and write what people want to look at.
+"""``cdpr run``: run a planar or spatial scene, write its files and print its summary.
 
 Examples::
 
     cdpr run paper-circle --out results/paper_circle
     cdpr run my_robot.toml --out out/my_robot --end-time 5 --step-size 1e-3
-    cdpr scenes
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
-import sys
-import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, CdprError, CdprWarning,
-                     RunInterrupted, SceneError, SolverFailure)
-from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text,  # noqa: F401
-                                  undate_solution_file, write_summary)
-from cdpr_exu.results.result import status_text
-from cdpr_exu.scenes.scene import Scene, load_scene, save_scene, shipped_scenes
-
-#: Modules that add sub-commands: each has ``add_commands(subparsers)``, which adds
-#: parsers whose ``func`` takes the parsed arguments and returns an exit code.
-COMMAND_MODULES: tuple[str, ...] = ("cdpr_exu.studies.comparison", "cdpr_exu.studies.study", "cdpr_exu.post.viewer", "cdpr_exu.studies.accuracy",
-                                   "cdpr_exu.run.rest")
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, CdprError, RunInterrupted, SolverFailure
+from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, length_text, undate_solution_file,
+                                  write_summary)
+from cdpr_exu.results.result import Result, after_start_up, provenance, raise_warnings, status_text
+from cdpr_exu.run.error_estimate import (elements_for_tolerance, estimate_error, estimate_line, parse_length,
+                                         simulate_any, summary_entry)
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.run.spatial_run import SpatialResult, check_runnable, simulate_spatial
+from cdpr_exu.scenes.scene import Scene, load_scene, save_scene
+from cdpr_exu.scenes.spatial_scene import SpatialScene, is_spatial, load_any_scene, save_any_scene
+from cdpr_exu.statics.workspace import check_reference
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
 SETTLED_AFTER = 1.0
@@ -61,6 +57,18 @@ def _figure(value, scale: float = 1.0, unit: str = "", digits: int = 2, sign: bo
     return f"{text} {unit}".rstrip()
 
 
+def _print_violations_and_notes(summary: dict, settled: dict, out: Path | None) -> None:
+    """The end of a run's printed summary, planar or spatial: each tension-limit violation, the notes of
+    the whole run and of the settled part (once each), and the output folder."""
+    for v in summary.get("tension_limit_violations", []):
+        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
+              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
+    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
+        print(f"  note: {note}")
+    if out is not None:
+        print(f"  written to {out}/")
+
+
 def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
     def pair(key, scale, unit, digits=2):
         return _figure(summary[key], scale, unit, digits), _figure(settled[key], scale, unit, digits)
@@ -93,13 +101,7 @@ def _print_summary(summary: dict, settled: dict, out: Path | None) -> None:
     print(f"  {'':26s} {'whole run':>22s}   {'after ' + str(SETTLED_AFTER) + ' s':>18s}")
     for name, whole, after in rows:
         print(f"  {name:26s} {whole:>22s}   {after:>18s}")
-    for v in summary.get("tension_limit_violations", []):
-        print(f"  cable {v['cable']} beyond its {v['limit']} ({v['limit_N']:g} N) from t = {v['first_time_s']:.3f} s "
-              f"for {v['duration_s']:.3f} s, reaching {v['extreme_N']:.4g} N")
-    for note in dict.fromkeys(summary["notes"] + settled["notes"]):
-        print(f"  note: {note}")
-    if out is not None:
-        print(f"  written to {out}/")
+    _print_violations_and_notes(summary, settled, out)
 
 
 def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: bool = True,
@@ -115,10 +117,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     are checked before anything is written. With ``error_estimate``
     a companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`).
     """
-    from cdpr_exu.results.result import Result, after_start_up, provenance, raise_warnings
-    from cdpr_exu.run.simulate import simulate
-    from cdpr_exu.statics.workspace import check_reference
-
     # A reference the cables cannot reach or hold is refused before anything is written
     # (simulate checks it too, but only after scene.toml would be in the folder).
     check_reference(scene)
@@ -137,8 +135,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     settled = result.summary(after=SETTLED_AFTER)
     estimate = None
     if error_estimate and failure is None:
-        from cdpr_exu.run.error_estimate import estimate_error
-
         if not quiet:
             print("estimating the discretisation error (a companion run) ...", flush=True)
         try:
@@ -150,8 +146,6 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         result.save(out)
         data = {**summary, **provenance()}
         if estimate is not None:
-            from cdpr_exu.run.error_estimate import summary_entry
-
             data.update(summary_entry(estimate))
         data.update({k: v for k, v in result.metadata.items() if k not in data})
         data["after_start_up"] = after_start_up(settled, Result.ERROR_FIGURES)
@@ -160,7 +154,7 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
         if solution_file is not None and solution_file.is_file():
             undate_solution_file(solution_file)
         if figures and len(result.time) > 1:
-            from cdpr_exu.post.plots import plot_overview
+            from cdpr_exu.post.plots import plot_overview  # matplotlib only where a figure is drawn
 
             plot_overview(scene, result, out)
     if failure is None:  # a completed run that pushed is not clean: say so once, quiet or not
@@ -168,19 +162,103 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
     if not quiet:
         _print_summary(summary, settled, out)
         if estimate is not None:
-            from cdpr_exu.run.error_estimate import estimate_line
-
             print(estimate_line(estimate))
     if failure is not None:
         raise failure
     return summary
 
 
+def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> None:
+    """Print a spatial run's :meth:`SpatialResult.run_summary`: errors over the whole run and after ``after`` [s],
+    each cable's lowest tension and slack time (whole run), its tension-limit violations and notes."""
+    settled = summary["after_start_up"]
+
+    def errors(s):
+        return f"{length_text(s['max_position_error_m'])} / {length_text(s['rms_position_error_m'])}"
+
+    def degrees(s):
+        return "n/a" if s["max_rotation_error_deg"] is None else f"{s['max_rotation_error_deg']:.4f} deg"
+
+    def per_cable(values, unit, digits):
+        return " / ".join("n/a" if v is None else f"{fixed(v, digits)} {unit}" for v in values)
+
+    factor = summary["real_time_factor"]
+    print(f"{summary['scene']} under {summary['controller']} (spatial; error = actual - reference)")
+    print(f"  {'':26s} {'whole run':>22s}   {'after ' + f'{after:g}' + ' s':>22s}")
+    print(f"  {'status':26s} {status_text(summary)}")
+    print(f"  {'max / RMS position error':26s} {errors(summary):>22s}   {errors(settled):>22s}")
+    print(f"  {'max rotation error':26s} {degrees(summary):>22s}   {degrees(settled):>22s}")
+    print(f"  {'min tension per cable':26s} {per_cable(summary['min_tension_per_cable_N'], 'N', 1)}")
+    print(f"  {'slack time per cable':26s} {per_cable(summary['slack_time_per_cable_s'], 's', 3)}")
+    print(f"  {'simulated / wall time':26s} {summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s"
+          + ("" if factor is None else f" ({factor:.1f}x real time)")
+          + f", {summary['steps']} steps, {summary['newton_iterations']} Newton iterations")
+    if "tension_limit_violations" in summary:
+        count = len(summary["tension_limit_violations"])
+        print(f"  {'tension limits':26s} {f'{count} violation(s)' if count else 'none'}")
+    _print_violations_and_notes(summary, settled, out)
+
+
+def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
+                      after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
+    """``cdpr run`` on a spatial scene: run, write into ``out``, print a summary.
+
+    Writes what ``cdpr run`` writes for every scene: ``scene.toml`` (the scene as run: a
+    rerun from it gives the same result), ``result.npz``, ``pose.csv``, ``summary.json``
+    (wall-clock figures in ``timing.json``), ``solution.sol`` (Exudyn's solution file, its
+    date blanked, for ``cdpr view``) and (``figures``) ``overview.png``. The scene and its
+    reference are checked before anything is written. On a solver failure or Ctrl-C the
+    partial result is written before the error propagates. With ``error_estimate`` a
+    companion run estimates the discretisation error (:mod:`cdpr_exu.run.error_estimate`):
+    ``error_estimate`` in summary.json and a printed line.
+    """
+    check_runnable(scene)  # before scene.toml is in the folder
+    solution_file = None
+    if out is not None:
+        out = check_output_folder(out, command="run")
+        clear_outputs(out, "run")  # none of the run this one replaces stays beside it (a planar one's figures)
+        save_any_scene(scene, out / "scene.toml")
+        solution_file = out / "solution.sol"
+
+    def write(result: SpatialResult, extra: dict | None = None) -> None:
+        if out is not None:
+            result.save(out, after, extra)
+            if figures:
+                from cdpr_exu.post.plots import plot_spatial_run  # matplotlib only where a figure is drawn
+
+                plot_spatial_run(result, out / "overview.png", after)
+            if solution_file.is_file():
+                undate_solution_file(solution_file)
+
+    try:
+        result = simulate_spatial(scene, progress=not quiet, solution_file=solution_file)
+    except (SolverFailure, RunInterrupted) as err:  # keep what was computed
+        if err.partial_result is not None:
+            write(err.partial_result)
+        raise
+    estimate, interrupt = None, None
+    if error_estimate:
+        if not quiet:
+            print("estimating the discretisation error (a companion run) ...", flush=True)
+        try:
+            estimate = estimate_error(scene, result, after=after)
+        except KeyboardInterrupt as err:  # Ctrl-C in the companion run: write this run's result, then stop
+            interrupt = err
+    write(result, None if estimate is None else summary_entry(estimate))
+    summary = result.run_summary(after)
+    raise_warnings(summary, f"{scene.name} under {result.controller}: ")  # not clean: said once, quiet or not
+    if not quiet:
+        _print_spatial_summary(summary, after, out)
+        if estimate is not None:
+            print(estimate_line(estimate))
+    if interrupt is not None:
+        raise interrupt
+    return result
+
+
 def _elements_for(scene, tolerance: float, quiet: bool):
     """The scene (planar or spatial) with the fewest elements per cable, never fewer than it has, that the error
     model says meet ``tolerance`` [m] (:func:`cdpr_exu.run.error_estimate.elements_for_tolerance` says why not fewer)."""
-    from cdpr_exu.run.error_estimate import elements_for_tolerance, estimate_error, simulate_any
-
     n = max(c.n_elements for c in scene.cables)
     pilot = estimate_error(scene, simulate_any(scene), after=SETTLED_AFTER)
     if pilot.max_position_error_m is None:
@@ -194,16 +272,10 @@ def _elements_for(scene, tolerance: float, quiet: bool):
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from cdpr_exu.run.error_estimate import parse_length
-
     out = check_output_folder(args.out, command="run")
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
-    from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
-
     scene = load_any_scene(args.scene)  # loaded once: a warning of the scene file is printed once
     if is_spatial(scene):
-        from cdpr_exu.run.spatial_run import run_spatial_scene
-
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
         scene = replace(scene, solver=replace(scene.solver, **changes))
         if tolerance is not None:
@@ -219,31 +291,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _cmd_scenes(args: argparse.Namespace) -> int:  # noqa: ARG001
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene, shipped_spatial_scenes
-
-    for name in shipped_scenes():
-        scene = load_scene(name)
-        print(f"{name:24s} {scene.description}")
-    for name in shipped_spatial_scenes():
-        print(f"{name:24s} {load_spatial_scene(name).description}")
-    return 0
-
-
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``cdpr`` (every sub-command's ``--help`` has examples)."""
-    parser = argparse.ArgumentParser(
-        prog="cdpr", description="Simulate cable-driven parallel robots with massive, elastic, bending cables "
-        "over pulleys (Exudyn, implicit solver). Units: SI.",
-        epilog="examples:\n  cdpr run paper-circle --out results/paper_circle\n  cdpr scenes\n\n" + EXIT_CODES,
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = parser.add_subparsers(dest="command", required=True)
-
-    run = sub.add_parser("run", help="run a scene and write result, summary and figures",
-                         description="Run a scene (a shipped name or a TOML file) under ideal "
-                         "inverse-kinematics control and write its result, summary, Exudyn solution "
-                         "file and figures.", epilog=EPILOG_RUN,
-                         formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_commands(subparsers) -> None:
+    """Register ``cdpr run``."""
+    run = subparsers.add_parser("run", help="run a scene and write result, summary and figures",
+                                description="Run a scene (a shipped name or a TOML file) under ideal "
+                                "inverse-kinematics control and write its result, summary, Exudyn solution "
+                                "file and figures.", epilog=EPILOG_RUN,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     run.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
     run.add_argument("--out", help="output folder (created); nothing is written without it")
     run.add_argument("--end-time", type=float, help="override solver.end_time [s]")
@@ -257,47 +311,3 @@ def build_parser() -> argparse.ArgumentParser:
                      "that the error model says meet it (printed)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no summary")
     run.set_defaults(func=_cmd_run)
-
-    scenes = sub.add_parser("scenes", help="list the shipped scenes",
-                            epilog="example:\n  cdpr scenes\n\n" + EXIT_CODES,
-                            formatter_class=argparse.RawDescriptionHelpFormatter)
-    scenes.set_defaults(func=_cmd_scenes)
-    for module_name in COMMAND_MODULES:
-        module = importlib.import_module(module_name)
-        module.add_commands(sub)
-    return parser
-
-
-def _show_warning(message, category, filename, lineno, file=None, line=None):  # noqa: ARG001
-    """Print the project's warnings as one line each, without source locations."""
-    print(f"cdpr: warning: {message}", file=sys.stderr)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``cdpr`` console script; returns the exit code (see ``cdpr --help``)."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    shown = warnings.showwarning
-    warnings.showwarning = _show_warning
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("always", CdprWarning)
-            return args.func(args)
-    except RunInterrupted as err:
-        print(f"cdpr: {err}; the partial result is written", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except KeyboardInterrupt:
-        print("cdpr: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except SolverFailure as err:
-        print(f"cdpr: solver failure: {err}", file=sys.stderr)
-        return EXIT_RUN_FAILED
-    except CdprError as err:
-        print(f"cdpr: error: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    finally:
-        warnings.showwarning = shown
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

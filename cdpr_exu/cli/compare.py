@@ -1,0 +1,140 @@
+"""``cdpr compare``: a scene under every controller, tabulated (:mod:`cdpr_exu.studies.comparison`).
+
+Examples::
+
+    cdpr compare paper-circle --out results/controllers
+    cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import replace
+
+from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, SceneError
+from cdpr_exu.core.output import check_output_folder
+from cdpr_exu.core.validation import non_negative
+from cdpr_exu.results.result import raise_warnings, status_text
+from cdpr_exu.run.spatial_run import check_spatial_reference
+from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+from cdpr_exu.statics.workspace import check_reference
+from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, compare_spatial,
+                                         markdown_table, smooth_start, spatial_comparison_table)
+from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule
+
+
+def print_controller_row(name: str, summary: dict) -> None:
+    """The line ``cdpr compare`` prints as a controller's run on a planar scene ends: its max and RMS
+    position error [mm] and its status."""
+    def mm(value):
+        return "     n/a" if value is None else f"{1000 * value:8.2f}"
+    print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
+          f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
+
+
+def print_spatial_controller_row(name: str, summary: dict) -> None:
+    """The line ``cdpr compare`` prints as a controller's run on a spatial scene ends: its max position
+    error [mm] and its status."""
+    worst = summary["max_position_error_m"]
+    print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   {status_text(summary)}")
+
+
+def print_progress(line: str) -> None:
+    """Print a line of the learning controllers' progress at once (the trials take a while)."""
+    print(line, flush=True)
+
+
+def _show(scene, summaries: dict, table, args: argparse.Namespace) -> list[str]:
+    """Issue each controller's warnings and (unless ``--quiet``) print ``table(summaries)`` and the output
+    folder; returns the controllers whose run did not complete."""
+    for name, summary in summaries.items():
+        raise_warnings(summary, f"{scene.name} under {name}: ")
+    if not args.quiet:
+        print()
+        print(table(summaries))
+        if args.out:
+            print(f"written to {args.out}/")
+    return [name for name, summary in summaries.items() if summary.get("status") != "completed"]
+
+
+def _compare_spatial(scene, args: argparse.Namespace) -> int:
+    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.studies.comparison.compare_spatial`)."""
+    if args.end_time is not None:
+        scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr compare` needs one")
+    check_spatial_reference(scene)
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
+    summaries = compare_spatial(scene, names, args.out, args.after,
+                                report=None if args.quiet else print_spatial_controller_row)
+    failed = _show(scene, summaries, spatial_comparison_table, args)
+    return EXIT_RUN_FAILED if failed else EXIT_OK
+
+
+def _check_time_options(args: argparse.Namespace) -> None:
+    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
+    on planar and spatial scenes alike)."""
+    non_negative("--after", args.after)
+    non_negative("--ramp-time", args.ramp_time)
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    _check_time_options(args)
+    check_output_folder(args.out, command="compare")
+    scene = load_any_scene(args.scene)
+    if is_spatial(scene):
+        return _compare_spatial(scene, args)
+    if args.end_time is not None:
+        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
+    started = smooth_start(scene, args.ramp_time)
+    if started is not scene and not args.quiet:
+        print(f"{scene.name}: the circle starts smoothly from rest over {args.ramp_time} s "
+              "(--ramp-time 0 keeps the scene's start at full speed)")
+    scene = started
+    # A reference no controller can follow is bad input (exit 2), not six failed runs.
+    check_reference(scene)
+    try:
+        rule = StoppingRule(max_trials=args.trials, min_improvement=args.min_improvement)
+    except SceneError as err:
+        raise SceneError(f"--trials / --min-improvement: {err}") from None
+    names = args.controllers.split(",") if args.controllers else None
+    if not args.quiet:
+        print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
+    summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, learning_rule=rule,
+                                    report=None if args.quiet else print_controller_row,
+                                    learning_report=None if args.quiet else print_progress)
+    failed = _show(scene, summaries, markdown_table, args)
+    if failed:
+        print(f"cdpr compare: {len(failed)} of {len(summaries)} controllers did not complete: {', '.join(failed)}",
+              file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return EXIT_OK
+
+
+def add_commands(subparsers) -> None:
+    """Register ``cdpr compare``."""
+    parser = subparsers.add_parser(
+        "compare", help="run a scene under every controller and compare their errors",
+        description="Run a scene under each controller (ideal inverse kinematics, tension-aware variants, "
+        "closed loop) and write a table and figures of their errors.",
+        epilog="examples:\n  cdpr compare paper-circle --out results/controllers\n"
+               "  cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal\n\n" + EXIT_CODES,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scene", help="shipped scene name or path to a .toml file")
+    parser.add_argument("--out", help="output folder (summary.json, comparison.md, figures)")
+    parser.add_argument("--controllers", help=f"comma-separated subset of: {', '.join(CONTROLLERS)}")
+    parser.add_argument("--after", type=float, default=1.0, help="measure errors after this time [s] (default 1)")
+    parser.add_argument("--end-time", type=float, help="override solver.end_time [s]")
+    parser.add_argument("--ramp-time", type=float, default=COMPARISON_RAMP_TIME,
+                        help="start a circle that starts at full speed smoothly from rest over this time [s] "
+                             f"(default {COMPARISON_RAMP_TIME}; 0 keeps the scene's own start)")
+    parser.add_argument("--trials", type=int, default=DEFAULT_RULE.max_trials,
+                        help=f"most learning trials of ilc and model_feed_forward (default {DEFAULT_RULE.max_trials})")
+    parser.add_argument("--min-improvement", type=float, default=DEFAULT_RULE.min_improvement,
+                        help="stop learning when a trial's max error falls by less than this fraction "
+                             f"(default {DEFAULT_RULE.min_improvement})")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
+    parser.set_defaults(func=_cmd_compare)
