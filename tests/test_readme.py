@@ -118,3 +118,29 @@ def test_virtual_environments_are_ignored_by_git():
     for name in (".venv", "venv"):
         done = subprocess.run(["git", "check-ignore", "-q", f"{name}/bin/python"], cwd=ROOT)
         assert done.returncode == 0, f"{name}/ is not in .gitignore"
+
+
+def _refresh_module():
+    """examples/refresh_readme.py, imported from its path (examples/ is not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("refresh_readme", ROOT / "examples" / "refresh_readme.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_figure_marker_is_filled_from_its_json(tmp_path):
+    """The marker syntax of examples/refresh_readme.py: keys, list filters, units and formats."""
+    refresh = _refresh_module()
+    (tmp_path / "r.json").write_text(json.dumps({"a": {"b": 0.018032}, "rows": [
+        {"n": 15, "step": 0.002, "e": 0.015332}, {"n": 15, "step": 0.01, "e": 0.0153}, {"n": 30, "step": 0.01, "e": 2.5}]}))
+    text = ("x <!-- value: r.json#a.b | mm:1 -->?<!-- /value --> and "
+            "<!-- value: r.json#rows.[n=15,step=2e-3].e | mm:.3g -->old<!-- /value -->, "
+            "<!-- value: r.json#rows.-1.e | 1:.0e -->1<!-- /value --> <!-- value: r.json#rows.1.n | 1:0 --><!-- /value -->\n")
+    new, tables, figures = refresh.refreshed(text, tmp_path)
+    assert (tables, figures) == (0, 4)
+    assert [m.group("body") for m in refresh.markers(new)] == ["18.0", "15.3", "2e+00", "15"]
+    assert refresh.refreshed(new, tmp_path)[0] == new
+    with pytest.raises(KeyError, match="matches 2 elements"):
+        refresh.value_at("r.json", "rows.[n=15].e", tmp_path)
