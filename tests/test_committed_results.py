@@ -39,11 +39,6 @@ MEASURED_COST = {
 #: it is regenerated with the command named here (then `python examples/refresh_readme.py`), after
 #: which its entry must go: the test then passes, and an entry left behind fails as XPASS.
 AWAITING_REGENERATION = {
-    **{f"{folder}/{name}": "python examples/controller_comparison.py"
-       for folder in ("controllers", "controllers_mismatch", "controllers_mismatch_30", "controllers_slow")
-       for name in ("summary.json", "comparison.md")},
-    "spatial/spatial-cogiro/compare/summary.json": "python examples/spatial_robots.py",
-    "spatial/spatial-ipanema/compare/summary.json": "python examples/spatial_robots.py",
     "parameter_study/study.json": "python examples/parameter_study.py",
     "parameter_study/study.csv": "python examples/parameter_study.py",
     "paper_circle/variants.json": "python examples/paper_reproduction.py",
