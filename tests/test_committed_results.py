@@ -39,8 +39,6 @@ MEASURED_COST = {
 #: it is regenerated with the command named here (then `python examples/refresh_readme.py`), after
 #: which its entry must go: the test then passes, and an entry left behind fails as XPASS.
 AWAITING_REGENERATION = {
-    "catenary_validation/summary.json": "python examples/catenary_validation.py",
-    "catenary_validation/convergence.csv": "python examples/catenary_validation.py",
     "stability/stability.csv": "python examples/stability_table.py",
     "swivel_bending_damping/summary.json": "python examples/swivel_bending_damping.py",
 }
