@@ -39,7 +39,6 @@ MEASURED_COST = {
 #: it is regenerated with the command named here (then `python examples/refresh_readme.py`), after
 #: which its entry must go: the test then passes, and an entry left behind fails as XPASS.
 AWAITING_REGENERATION = {
-    "swivel_bending_damping/summary.json": "python examples/swivel_bending_damping.py",
 }
 
 
