@@ -11,15 +11,18 @@ by the contents of PATH (a Markdown table a script wrote). ``PATH`` copies the f
 first table, ``PATH#N`` its N-th; the text around it is not copied.
 
 *Figures in the text.* Each ``<!-- value: PATH#KEYS | SPEC -->TEXT<!-- /value -->`` (on one
-line) has TEXT replaced by the number at KEYS in the JSON file PATH (or CSV file: a list of
-its rows, each a dict by column), written as SPEC says. The comment is invisible in the
-rendered Markdown; only TEXT shows.
+line) has TEXT replaced by the number at KEYS in the file PATH, written as SPEC says: a JSON
+file; a CSV file (a list of its rows, each a dict by column name); or a Markdown file (a list
+of its tables from 1, each a list of its rows, each a dict by column header and by column
+number from 0). The comment is invisible in the rendered Markdown; only TEXT shows.
 
 * ``KEYS``: dot-separated steps into the JSON: a dict key, a list index (``0``, ``-1``),
   or ``[field=value,...]``, the one element of a list of dicts whose fields have those
-  values (numbers compared as numbers): ``rows.[step=0.01,n=60].error_m``.
+  values (numbers compared as numbers; a value with a comma in double quotes):
+  ``rows.[step=0.01,n=60].error_m``, ``rows.[variant="full, step 5e-3 s"].max_abs_error_x_m``.
 * ``SPEC`` is ``UNIT:FORMAT``. UNIT scales the SI value: ``mm`` (x 1e3), ``cm`` (x 1e2),
-  ``um`` (x 1e6), ``%`` (x 100), ``1`` (as it is). FORMAT is a number of decimals
+  ``um`` (x 1e6), ``%`` (x 100), ``1`` (as it is); a leading ``-`` also flips the sign
+  (``-mm``: a length difference of -3.25e-3 m written as 3.25 mm "less"). FORMAT is a number of decimals
   (``1``: 18.0) or a Python format spec (``.2g``, ``.0e``, ``+.2f``).
   Example: ``<!-- value: results/paper_circle/summary.json#error_estimate.max_position_error_m | mm:1 -->18.0<!-- /value -->``.
 
@@ -44,10 +47,9 @@ SCALES = {"1": 1.0, "mm": 1e3, "cm": 1e2, "um": 1e6, "%": 1e2}
 FILTER = re.compile(r"\[(?P<conditions>[^\]]+)\]")
 
 
-def table_of(reference: str, root: Path) -> str:
-    """The table named by ``PATH`` (its first table) or ``PATH#N`` (its N-th, from 1)."""
-    path, _, number = reference.partition("#")
-    lines = (root / path).read_text().splitlines()
+def _tables(text: str) -> list[str]:
+    """The Markdown tables of ``text``, in order."""
+    lines = text.splitlines()
     tables, i = [], 0
     while i < len(lines):
         if lines[i].startswith("|"):
@@ -58,7 +60,28 @@ def table_of(reference: str, root: Path) -> str:
             i = j
         else:
             i += 1
-    return tables[int(number or 1) - 1]
+    return tables
+
+
+def _cells(line: str) -> list[str]:
+    return [cell.strip() for cell in re.split(r"(?<!\\)\|", line.strip().strip("|"))]
+
+
+def _table_rows(table: str) -> list[dict]:
+    """A Markdown table's rows, each a dict by header and by column number (from 0)."""
+    header, _, *rows = table.splitlines()
+    names = _cells(header)
+    out = []
+    for row in rows:
+        cells = [_number(cell) for cell in _cells(row)]
+        out.append({**dict(zip(names, cells)), **{str(k): cell for k, cell in enumerate(cells)}})
+    return out
+
+
+def table_of(reference: str, root: Path) -> str:
+    """The table named by ``PATH`` (its first table) or ``PATH#N`` (its N-th, from 1)."""
+    path, _, number = reference.partition("#")
+    return _tables((root / path).read_text())[int(number or 1) - 1]
 
 
 def _split_keys(keys: str) -> list[str]:
@@ -74,13 +97,22 @@ def _split_keys(keys: str) -> list[str]:
     return [*steps, current]
 
 
+def _conditions(conditions: str) -> list[tuple[str, str]]:
+    """``x=1.5, name="a, b"`` -> ``[('x', '1.5'), ('name', 'a, b')]``: commas inside quotes kept."""
+    parts = [part.strip() for part in re.findall(r'(?:[^,"]|"[^"]*")+', conditions)]
+    pairs = []
+    for part in parts:
+        field, _, wanted = part.partition("=")
+        wanted = wanted.strip()
+        pairs.append((field.strip(), wanted[1:-1] if len(wanted) >= 2 and wanted[0] == wanted[-1] == '"' else wanted))
+    return pairs
+
+
 def _matches(item, conditions: str) -> bool:
     if not isinstance(item, dict):
         return False
-    for condition in conditions.split(","):
-        field, _, wanted = condition.partition("=")
-        value = item.get(field.strip(), object())
-        wanted = wanted.strip()
+    for field, wanted in _conditions(conditions):
+        value = item.get(field, object())
         try:
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ValueError
@@ -108,6 +140,8 @@ def value_at(path: str, keys: str, root: Path):
     if path.endswith(".csv"):
         with open(root / path, newline="") as handle:
             value = [{key: _number(cell) for key, cell in row.items()} for row in csv.DictReader(handle)]
+    elif path.endswith(".md"):
+        value = [None, *(_table_rows(table) for table in _tables((root / path).read_text()))]
     else:
         value = json.loads((root / path).read_text())
     for step in _split_keys(keys):
@@ -129,7 +163,7 @@ def formatted(value, spec: str) -> str:
     unit, _, form = spec.partition(":")
     if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
         raise ValueError(f"not a number: {value!r}")
-    scaled = value * SCALES[unit]
+    scaled = (-1.0 if unit.startswith("-") else 1.0) * value * SCALES[unit.removeprefix("-")]
     return f"{scaled:.{int(form)}f}" if form.isdigit() else format(scaled, form)
 
 
