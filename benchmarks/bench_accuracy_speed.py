@@ -8,15 +8,22 @@ the converged reference of the accuracy study (``results/accuracy/paper_circle/r
 and says which issue-14 targets the run meets. All ratios come from one run on one
 machine; the machines are shared and noisy, so compare ratios, not seconds.
 
+It also gives the error estimate of ``cdpr run`` (:mod:`cdpr_exu.run.error_estimate`) for
+each run whose companion (twice the elements, same step) is in the table, beside its error
+against the reference: how well the estimate tells the true error.
+
 Run: ``python benchmarks/bench_accuracy_speed.py [--end-time 10]``; writes
-``benchmarks/results/accuracy_speed.md``. A shorter ``--end-time`` compares the error
-over that part of the circle only.
+``benchmarks/results/accuracy_speed.md`` and ``accuracy_speed.json`` (every number of the
+table and the text, the estimates too). A shorter ``--end-time`` compares the error over
+that part of the circle only.
 """
 
 from __future__ import annotations
 
 import argparse
 import cProfile
+import os
+import platform
 import pstats
 import time
 from dataclasses import replace
@@ -25,6 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from cdpr_exu.core.errors import SolverFailure
+from cdpr_exu.core.output import write_json
+from cdpr_exu.run.error_estimate import AFTER, path_distance, richardson_factor
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.run.simulate import simulate
 
@@ -57,7 +66,7 @@ def main() -> None:
     paper = load_scene("paper-circle")
     reference = np.load(REFERENCE)
     simulate(paper.with_changes(solver=replace(paper.solver, end_time=0.05)))  # warm-up: numba, imports
-    rows = []
+    rows, results = [], {}
     for step in STEPS:
         for n in ELEMENTS:
             scene = paper.with_changes(cables=tuple(replace(c, n_elements=n) for c in paper.cables),
@@ -70,6 +79,7 @@ def main() -> None:
                 print(f"step {step:.0e} s, n = {n:3d}: failed at t = {failure.time:.4f} s", flush=True)
                 continue
             cpu = time.process_time() - cpu
+            results[step, n] = result
             reference_pose = np.array([np.interp(result.time, reference["time"], reference["pose"][:, k])
                                        for k in range(2)]).T
             after = result.time >= min(1.0, 0.5 * args.end_time) - 1e-9  # after the start-up (half of a short run)
@@ -109,12 +119,50 @@ def main() -> None:
     lines.append("")
     lines.append("Exudyn's C++ work alone (the self time of its SolveSystem under cProfile: no Python "
                  "force, Jacobian or step function counted), the ceiling of trimming Python:")
+    floors = []
     for step, n in ((2e-3, 15), *(((step, n),) if within else ())):
         scene = paper.with_changes(cables=tuple(replace(c, n_elements=n) for c in paper.cables),
                                    solver=replace(paper.solver, end_time=args.end_time, step_size=step))
-        lines.append(f"- {n} elements, step {step:g} s: {solver_floor(scene):.1f}x real time.")
+        floors.append({"step_size_s": step, "n_elements": n, "real_time_factor": solver_floor(scene)})
+        lines.append(f"- {n} elements, step {step:g} s: {floors[-1]['real_time_factor']:.1f}x real time.")
+    # cdpr run's error estimate of each run whose companion (2n, same step) ran: the Richardson
+    # formula of cdpr_exu.run.error_estimate on the two paths, as `cdpr run` computes it
+    estimates = {}
+    for (step, n), result in results.items():
+        companion = results.get((step, 2 * n))
+        if companion is not None and args.end_time > AFTER:
+            estimates[step, n] = path_distance(result, companion, AFTER) * richardson_factor(2.0)
+    lines.append("")
+    lines.append(f"cdpr run's error estimate (Richardson from the run with twice the elements, after {AFTER:g} s) "
+                 "against the error above:")
+    for (step, n), estimate in sorted(estimates.items()):
+        error = next(row[4] for row in rows if row[:2] == (step, n))
+        lines.append(f"- {n} elements, step {step:g} s: {1000 * estimate:.2f} mm estimated, "
+                     f"{1000 * error:.2f} mm true ({estimate / error:.2f}x).")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text("\n".join(lines) + "\n")
+    fits = []
+    for step in STEPS:
+        fit = [(n, cpu) for s, n, _, _, _, cpu, _ in rows if s == step and n >= 30]
+        if len(fit) >= 2:
+            fits.append({"step_size_s": step, "from_n": fit[0][0], "to_n": fit[-1][0],
+                         "exponent": float(np.polyfit(np.log([n for n, _ in fit]), np.log([w for _, w in fit]), 1)[0])})
+    table = []
+    for step, n, speed, iterations, error, cpu, status in rows:
+        row = {"step_size_s": step, "n_elements": n, "status": status, "cpu_time_s": cpu,
+               "real_time_factor": speed, "newton_iterations_per_step": iterations, "max_position_error_m": error}
+        if (step, n) in estimates:
+            row["error_estimate_m"] = estimates[step, n]
+            row["estimate_over_error"] = estimates[step, n] / error
+        table.append(row)
+    fastest = max(within) if within else None
+    write_json(Path(args.out).with_suffix(".json"), {
+        "scene": "paper-circle", "end_time_s": args.end_time, "machine": platform.machine(),
+        "cpu_count": os.cpu_count(), "errors_measured_after_s": min(1.0, 0.5 * args.end_time),
+        "rows": table, "cost_exponents": fits,
+        "fastest_within_1mm": None if fastest is None else
+        {"real_time_factor": fastest[0], "step_size_s": fastest[1], "n_elements": fastest[2]},
+        "shipped_real_time_factor": shipped, "solver_only": floors})
     print("\n".join(lines[-8:]))
 
 

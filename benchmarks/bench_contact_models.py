@@ -11,9 +11,10 @@ fastest setting that met the 1 mm accuracy before this study, it runs:
   smoothly over a penetration band b (:mod:`cdpr_exu.physics.node_contact`), for b = 0 (sharp),
   1e-5 m (the shipped band), 1e-4 m and 1e-3 m.
 
-It prints x real time, Newton iterations, Jacobian updates and discontinuous
-iterations per step, and how far each path moves from the default's (largest platform
-position difference over the run). All from one run on one machine: compare ratios.
+It prints x real time (CPU time of the single-threaded run), Newton iterations, Jacobian
+updates and discontinuous iterations per step, and how far each path moves from the
+default's (largest platform position difference over the run). All from one run on one
+machine: compare ratios.
 
 Run: ``python benchmarks/bench_contact_models.py [--end-time 10]``; writes
 ``benchmarks/results/contact_models.md``.
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -63,7 +65,7 @@ def onset_band(band):
 
 
 def run(scene):
-    """One run: (result, Exudyn's iteration statistics)."""
+    """One run: (result, Exudyn's iteration statistics, CPU time [s])."""
     captured = {}
     build = cdpr_exu.run.simulate.build_model
 
@@ -71,11 +73,12 @@ def run(scene):
         captured["model"] = build(*args, **kwargs)
         return captured["model"]
     cdpr_exu.run.simulate.build_model = capture
+    cpu = time.process_time()
     try:
         result = cdpr_exu.run.simulate.simulate(scene)
     finally:
         cdpr_exu.run.simulate.build_model = build
-    return result, captured["model"].mbs.sys["dynamicSolver"].it
+    return result, captured["model"].mbs.sys["dynamicSolver"].it, time.process_time() - cpu
 
 
 CANDIDATES = (
@@ -106,12 +109,12 @@ def main() -> None:
     for label, model, limit, band in CANDIDATES:
         scene = base.with_changes(effects=replace(base.effects, pulley_contact_model=model))
         with discontinuous_iterations(limit), onset_band(band):
-            result, it = run(scene)
+            result, it, cpu = run(scene)
         pose = result.platform_pose[:, :2]
         reference = pose if reference is None else reference
         moved = float(np.linalg.norm(pose - reference, axis=1).max())
         steps = max(int(it.currentStepIndex), 1)
-        row = (label, result.simulated_time / result.wall_time, it.newtonStepsCount / steps,
+        row = (label, result.simulated_time / cpu, it.newtonStepsCount / steps,
                it.newtonJacobiCount / steps, it.discontinuousIterationsCount / steps, steps, 1000 * moved)
         rows.append(row)
         print("{}: {:.2f}x real time, {:.2f} Newton iterations, {:.2f} Jacobians, {:.2f} discontinuous "
@@ -119,7 +122,7 @@ def main() -> None:
     lines = [f"# Pulley contact candidates (paper circle, full model, {args.elements} elements per cable, "
              f"step {args.step:g} s, {args.end_time:g} s, one run each)", "",
              "Path moved: largest platform position difference from the default (Exudyn's contact items). "
-             "Wall-clock times of one run on a shared machine: compare ratios.", "",
+             "CPU time of one single-threaded run (the wall time of a shared machine varies with its load): compare ratios.", "",
              "| contact | x real time | Newton iterations / step | Jacobians / step | discontinuous iterations / step "
              "| steps taken | path moved [mm] |", "|---|---|---|---|---|---|---|"]
     lines += ["| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {:.3f} |".format(*row) for row in rows]

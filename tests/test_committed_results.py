@@ -34,35 +34,13 @@ MEASURED_COST = {
     "contact_models/summary.json": {"cpu_time_s"},
 }
 
-#: Committed before issue 23.18 moved the wall-clock figures of nested tables (a comparison's
-#: controllers, a study's rows, the examples' tables) into timing.json. Each is a strict xfail until
-#: it is regenerated with the command named here (then `python examples/refresh_readme.py`), after
-#: which its entry must go: the test then passes, and an entry left behind fails as XPASS.
-AWAITING_REGENERATION = {
-    **{f"{folder}/{name}": "python examples/controller_comparison.py"
-       for folder in ("controllers", "controllers_mismatch", "controllers_mismatch_30", "controllers_slow")
-       for name in ("summary.json", "comparison.md")},
-    "spatial/spatial-cogiro/compare/summary.json": "python examples/spatial_robots.py",
-    "spatial/spatial-ipanema/compare/summary.json": "python examples/spatial_robots.py",
-    "parameter_study/study.json": "python examples/parameter_study.py",
-    "parameter_study/study.csv": "python examples/parameter_study.py",
-    "paper_circle/variants.json": "python examples/paper_reproduction.py",
-    "paper_circle/variants.md": "python examples/paper_reproduction.py",
-    "catenary_validation/summary.json": "python examples/catenary_validation.py",
-    "catenary_validation/convergence.csv": "python examples/catenary_validation.py",
-    "stability/stability.csv": "python examples/stability_table.py",
-    "swivel_bending_damping/summary.json": "python examples/swivel_bending_damping.py",
-}
-
 
 def _name(path: Path) -> str:
     return str(path.relative_to(RESULTS))
 
 
 def _cases(paths):
-    return [pytest.param(p, id=_name(p), marks=pytest.mark.xfail(
-        strict=True, reason=f"committed before issue 23.18: regenerate with {AWAITING_REGENERATION[_name(p)]}"))
-            if _name(p) in AWAITING_REGENERATION else pytest.param(p, id=_name(p)) for p in paths]
+    return [pytest.param(p, id=_name(p)) for p in paths]
 
 
 def _is_timing(key: str) -> bool:

@@ -118,3 +118,65 @@ def test_virtual_environments_are_ignored_by_git():
     for name in (".venv", "venv"):
         done = subprocess.run(["git", "check-ignore", "-q", f"{name}/bin/python"], cwd=ROOT)
         assert done.returncode == 0, f"{name}/ is not in .gitignore"
+
+
+def _refresh_module():
+    """examples/refresh_readme.py, imported from its path (examples/ is not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("refresh_readme", ROOT / "examples" / "refresh_readme.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_refreshing_the_readme_and_docs_changes_nothing():
+    """Issue 23.17: figures typed by hand drifted from the files that produced them. Every table
+    and figure of README.md and docs/*.md marked with its source is what
+    ``python examples/refresh_readme.py`` writes from that source now, so a regenerated result
+    whose document was not refreshed fails here."""
+    refresh = _refresh_module()
+    stale = [str(path.relative_to(ROOT)) for path in refresh.documents(ROOT)
+             if refresh.refreshed(path.read_text(), ROOT)[0] != path.read_text()]
+    assert stale == [], f"run python examples/refresh_readme.py: {stale} differ from their sources"
+
+
+def test_every_figure_marker_names_a_number_in_an_existing_file():
+    refresh = _refresh_module()
+    count = 0
+    for path in refresh.documents(ROOT):
+        for marker in refresh.markers(path.read_text()):
+            source = ROOT / marker.group("path")
+            assert source.is_file(), f"{path.name}: {marker.group(0)}"
+            value = refresh.value_at(marker.group("path"), marker.group("keys"), ROOT)
+            assert isinstance(value, (int, float)) and not isinstance(value, bool), marker.group(0)
+            refresh.formatted(value, marker.group("spec"))
+            count += 1
+    assert count >= 20  # the README's measured figures are markers (issue 23.17)
+
+
+def test_a_figure_marker_is_filled_from_its_source(tmp_path):
+    """The marker syntax of examples/refresh_readme.py: keys, list filters (a quoted value may
+    hold commas), units, a flipped sign and formats, from JSON, CSV and Markdown tables."""
+    refresh = _refresh_module()
+    (tmp_path / "r.json").write_text(json.dumps({"a": {"b": 0.018032, "d": -0.00325}, "rows": [
+        {"n": 15, "step": 0.002, "e": 0.015332, "name": "full, step 2e-3 s"},
+        {"n": 15, "step": 0.01, "e": 0.0153, "name": "full"}, {"n": 30, "step": 0.01, "e": 2.5}]}))
+    (tmp_path / "t.csv").write_text("case,step_s\npaper,0.05\ncircle x4,0.02\n")
+    (tmp_path / "t.md").write_text("# title\n\n| case | x real time |\n|---|---|\n| shipped (full, 0.01 s) | 2.50 |\n")
+    text = ("x <!-- value: r.json#a.b | mm:1 -->?<!-- /value --> and "
+            "<!-- value: r.json#rows.[n=15,step=2e-3].e | mm:.3g -->old<!-- /value -->, "
+            "<!-- value: r.json#rows.-1.e | 1:.0e -->1<!-- /value --> <!-- value: r.json#rows.1.n | 1:0 --><!-- /value -->\n"
+            '<!-- value: r.json#rows.[name="full, step 2e-3 s"].n | 1:0 -->?<!-- /value --> '
+            "<!-- value: r.json#a.d | -mm:2 -->?<!-- /value --> "
+            "<!-- value: t.csv#[case=circle x4].step_s | 1:2 -->?<!-- /value --> "
+            '<!-- value: t.md#1.[0="shipped (full, 0.01 s)"].x real time | 1:1 -->?<!-- /value -->\n')
+    new, tables, figures = refresh.refreshed(text, tmp_path)
+    assert (tables, figures) == (0, 8)
+    assert [m.group("body") for m in refresh.markers(new)] == ["18.0", "15.3", "2e+00", "15", "15", "3.25", "0.02",
+                                                                "2.5"]
+    assert refresh.refreshed(new, tmp_path)[0] == new
+    with pytest.raises(KeyError, match="matches 2 elements"):
+        refresh.value_at("r.json", "rows.[n=15].e", tmp_path)
+    with pytest.raises(ValueError, match="not a number"):
+        refresh.formatted("full", "1:0")
