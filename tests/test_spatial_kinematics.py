@@ -10,9 +10,10 @@ from cdpr_exu.statics import kinematics as planar
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import left_jacobian
 from cdpr_exu.physics import cogiro
+from cdpr_exu.core.geometry import swivel_pulley_exit
 from cdpr_exu.physics.spatial_kinematics import (IdealSpatialRobot, SwivelPulley, cable_unit_vectors, gravity_wrench,
                                                  inverse_kinematics, inverse_kinematics_rates, structure_matrix,
-                                                 swivel_pulley_exit, tension_distribution)
+                                                 tension_distribution)
 
 # The paper's planar robot (as tests/test_kinematics.py)
 PLANAR_CENTERS = np.array([[-1.75, 0.0], [1.75, 0.0]])

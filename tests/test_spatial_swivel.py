@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+from cdpr_exu.core.geometry import swivel_pulley_exit
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.run.spatial_rest import solve_spatial_rest
 from cdpr_exu.scenes.spatial_scene import load_any_scene, load_spatial_scene, save_any_scene, spatial_scene_from_dict

@@ -69,7 +69,7 @@ from cdpr_exu.physics.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, Cate
     profile, solve_forward, solve_inverse
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import Pulley, left_jacobian, rotation_from_vector, rotation_vector, skew
-from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+from cdpr_exu.core.geometry import swivel_pulley_exit
 # the planar statics' line search, and its cable over a pulley in the swivel's vertical plane, reused
 from cdpr_exu.statics.statics import PlatformEquilibriumViews, SuspendedCable, forward_cable, minimise_energy
 from cdpr_exu.statics.statics import inverse_cable as planar_inverse_cable

@@ -57,6 +57,7 @@ from cdpr_exu.run.simulate import (interrupt_flag, output_times, progress_report
 from cdpr_exu.run.spatial_rest import rest_above_exits
 from cdpr_exu.scenes.scene import tension_limits
 from cdpr_exu.scenes.spatial_scene import SpatialScene
+from cdpr_exu.space import SPACE
 from cdpr_exu.statics.workspace import first_unheld, limits_text
 
 __all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference"]
@@ -193,15 +194,6 @@ def highest_exit(scene: SpatialScene) -> float:
     return float(np.asarray(scene.exits, dtype=float)[:, 2].max())
 
 
-def rotation_error_deg(pose: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """Angle [deg] of the rotation from the reference orientation to the actual one, shape (N,)."""
-    angles = []
-    for theta, theta_ref in zip(pose[:, 3:], reference[:, 3:]):
-        relative = rotation_from_vector(theta_ref).T @ rotation_from_vector(theta)
-        angles.append(np.linalg.norm(rotation_vector(relative)))
-    return np.degrees(np.asarray(angles))
-
-
 @dataclass
 class SpatialResult:
     """A spatial run: platform pose, reference, paid-out lengths, cable nodes and tensions.
@@ -256,7 +248,7 @@ class SpatialResult:
         as planar summaries)."""
         mask = self.time >= after
         error = np.linalg.norm(self.position_error[mask], axis=1)
-        rotation = rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
+        rotation = SPACE.rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
 
         def extreme(values, pick):
             return float(pick(values)) if values.size else None
