@@ -93,21 +93,6 @@ class Space:
     def __reduce__(self):  # one object per dimension, also across process pools and pickles
         return space_of, (self.dimension,)
 
-    # ------------------------------------------------------------------ poses
-    def position(self, pose) -> np.ndarray:
-        """The position part of pose(s) (..., pose_size) -> (..., position_size) [m]."""
-        return np.asarray(pose)[..., :self.position_size]
-
-    def rotation(self, pose) -> np.ndarray:
-        """The rotation part of pose(s) (..., pose_size) -> (..., rotation_size) [rad]."""
-        return np.asarray(pose)[..., self.position_size:]
-
-    def up(self) -> np.ndarray:
-        """The unit vector up (against gravity), shape (position_size,)."""
-        vector_ = np.zeros(self.position_size)
-        vector_[self.vertical] = 1.0
-        return vector_
-
     def rotation_matrix(self, rotation) -> np.ndarray:
         """The rotation matrix of one rotation (an angle [rad], or a rotation vector (3,) [rad]), shape (d, d)."""
         raise NotImplementedError

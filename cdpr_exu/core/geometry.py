@@ -30,8 +30,9 @@ The *ideal cable length* is the length of that path from the hang point to the a
 *paid-out length* lambda of a winch is the cable beyond the hang point: a cable of
 unstrained length ``L0`` has its winch end at ``h - (0, L0 - lambda)``.
 
-:class:`Pulley` is the one description of where a cable leaves the frame; a point exit
-is a ``Pulley`` of radius 0.
+The exits of a scene are objects (:mod:`cdpr_exu.exits`: a planar pulley, a swivel pulley,
+a point exit); the kernels here compute their ideal cables, so that every number is made
+once: :func:`planar_exit` (a planar point exit is its radius 0) and :func:`swivel_pulley_exit`.
 
 Swivel pulley
 -------------
@@ -77,7 +78,7 @@ from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.validation import non_negative, real_array, shown
 
 __all__ = [
-    "Pulley",
+    "planar_exit",
     "above_exits",
     "PulleyExit",
     "rotation_matrix",
@@ -89,10 +90,7 @@ __all__ = [
     "perpendicular",
     "anchor_points",
     "anchor_velocities",
-    "hang_point",
     "pulley_exit",
-    "ideal_cable_length",
-    "ideal_cable_length_rate",
     "penetration",
     "segment_penetration",
     "rotation_matrices",
@@ -292,25 +290,6 @@ class PulleyExit:
         return self.free_length + self.arc_length
 
 
-def hang_point(center, radius, side):
-    """Point ``h = (c_x + s r_p, c_z)`` where the cable leaves its vertical winch line.
-
-    Parameters
-    ----------
-    center : array_like, shape (2,) [m]
-        Pulley centre ``c``.
-    radius : float [m]
-        Pulley radius ``r_p >= 0``.
-    side : {-1, +1}
-        Side of the pulley on which the cable hangs (-1 left, +1 right).
-
-    Returns
-    -------
-    ndarray, shape (2,) [m]
-    """
-    return Pulley(center, radius, side).hang_point
-
-
 def exit_arrays(center, radius, side, anchor):
     """Vectorised core of :func:`pulley_exit` on checked arguments; anchor (..., 2)."""
     delta = anchor - center
@@ -351,6 +330,18 @@ def exit_arrays(center, radius, side, anchor):
     return tangent_point, wrap, free_length, unit_vector
 
 
+def planar_exit(center, radius, side, anchor) -> PulleyExit:
+    """The :class:`PulleyExit` of :func:`exit_arrays` for a checked pulley (``center`` (2,) [m], float
+    ``radius`` [m], ``side`` -1 or +1) and anchor(s) (2,) or (N, 2) [m], checked here: scalars for one
+    anchor. The one kernel of every planar exit (a point exit is radius 0)."""
+    anchor = finite_array("anchor", anchor, (2,))
+    tangent_point, wrap, free_length, unit_vector = exit_arrays(np.asarray(center), radius, side, anchor)
+    if anchor.ndim == 1:
+        wrap, free_length = float(wrap), float(free_length)
+    return PulleyExit(tangent_point=tangent_point, wrap_angle=wrap, free_length=free_length,
+                      unit_vector=unit_vector, arc_length=radius * wrap)
+
+
 def pulley_exit(center, radius, side, anchor):
     """Tangent point, wrap angle and free length of a cable running over a pulley to an anchor.
 
@@ -386,63 +377,11 @@ def pulley_exit(center, radius, side, anchor):
     ``r_p = 0.25``, ``s = -1``, ``p = (-0.15, -1.9)``) the wrap is about 145.7 degrees and
     the free length about 2.471 m.
     """
-    return Pulley(center, radius, side).exit(anchor)
-
-
-def ideal_cable_length(center, radius, side, anchor):
-    """Ideal cable length from the hang point over the pulley to the anchor.
-
-    ``L = |p - t| + r_p * wrap``: straight, massless, inextensible cable.
-
-    Parameters
-    ----------
-    center : array_like, shape (2,) [m]
-        Pulley centre.
-    radius : float [m]
-        Pulley radius (0: point exit, ``L = |p - c|``).
-    side : {-1, +1}
-        Side on which the cable hangs.
-    anchor : array_like, shape (2,) or (N, 2) [m]
-        Platform anchor(s) in the world frame.
-
-    Returns
-    -------
-    float or ndarray, shape (N,) [m]
-
-    Raises
-    ------
-    SceneError, UnreachableError
-        As :func:`pulley_exit`.
-    """
-    return pulley_exit(center, radius, side, anchor).cable_length
-
-
-def ideal_cable_length_rate(center, radius, side, anchor, anchor_velocity):
-    """Rate of the ideal cable length for an anchor moving at ``anchor_velocity``.
-
-    ``dL/dt = u . v`` with ``u`` the unit vector from the tangent point to the anchor:
-    the change of wrap exactly cancels the tangential motion of the tangent point.
-
-    Parameters
-    ----------
-    center : array_like, shape (2,) [m]
-    radius : float [m]
-    side : {-1, +1}
-    anchor : array_like, shape (2,) or (N, 2) [m]
-    anchor_velocity : array_like, same shape as ``anchor`` [m/s]
-
-    Returns
-    -------
-    float or ndarray, shape (N,) [m/s]
-    """
-    exit_ = pulley_exit(center, radius, side, anchor)
-    velocity = finite_array("anchor_velocity", anchor_velocity, (2,))
-    if velocity.shape != exit_.unit_vector.shape:
-        raise SceneError(
-            f"anchor_velocity must have the shape of anchor {exit_.unit_vector.shape}, got {velocity.shape}"
-        )
-    rate = np.sum(exit_.unit_vector * velocity, axis=-1)
-    return float(rate) if rate.ndim == 0 else rate
+    center = finite_array("center", center, (2,))
+    if center.ndim != 1:
+        raise SceneError(f"center must have shape (2,), got shape {center.shape}")
+    return planar_exit((float(center[0]), float(center[1])), check_radius("radius", radius), check_side("side", side),
+                       anchor)
 
 
 # ----------------------------------------------------------------------------------
@@ -503,105 +442,6 @@ def rotation_angles_deg(rotation: np.ndarray) -> np.ndarray:
     roll = np.arctan2(rotation[2, 1], rotation[2, 2])
     yaw = np.arctan2(rotation[1, 0], rotation[0, 0])
     return np.degrees([roll, pitch, yaw])
-
-
-# ----------------------------------------------------------------------------------
-# the one pulley description
-# ----------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Pulley:
-    """Where a cable leaves the frame: a pulley it wraps over, or a point exit.
-
-    The one description of a cable's exit used by the builder, the statics, the chain
-    statics, the controllers and the plots (the scene's ``PulleySpec`` is a ``Pulley``
-    with contact parameters).
-
-    Parameters
-    ----------
-    center : (x, z) [m]
-        Pulley centre ``c`` (the exit point of a point exit).
-    radius : float [m]
-        Rim radius ``r_p >= 0``; 0 is a point exit at ``center`` (no wrap).
-    side : {-1, +1}
-        Side on which the cable hangs to its winch: -1 on the left (it wraps clockwise
-        over the top), +1 on the right (counter-clockwise).
-
-    Raises
-    ------
-    SceneError
-        If ``center`` is not two finite numbers, ``radius`` is negative or not finite,
-        or ``side`` is not -1 or +1; the message names the field.
-    """
-
-    center: tuple = (0.0, 0.0)
-    radius: float = 0.0
-    side: int = -1
-
-    def __post_init__(self):
-        center = finite_array("center", self.center, (2,))
-        if center.ndim != 1:
-            raise SceneError(f"center must have shape (2,), got shape {center.shape}")
-        object.__setattr__(self, "center", (float(center[0]), float(center[1])))
-        object.__setattr__(self, "radius", check_radius("radius", self.radius))
-        object.__setattr__(self, "side", check_side("side", self.side))
-
-    @property
-    def is_point_exit(self) -> bool:
-        """True for a point exit (radius 0)."""
-        return self.radius == 0.0
-
-    @property
-    def hang_point(self) -> np.ndarray:
-        """Where the cable leaves its vertical winch line, ``(c_x + s r_p, c_z)``, shape (2,) [m]."""
-        return np.array([self.center[0] + self.side * self.radius, self.center[1]])
-
-    def exit(self, anchor) -> PulleyExit:
-        """Tangent point, wrap and free length of the ideal cable to ``anchor`` (2,) or (N, 2) [m].
-
-        See :func:`pulley_exit`.
-        """
-        anchor = finite_array("anchor", anchor, (2,))
-        tangent_point, wrap, free_length, unit_vector = exit_arrays(
-            np.asarray(self.center), self.radius, self.side, anchor)
-        if anchor.ndim == 1:
-            wrap, free_length = float(wrap), float(free_length)
-        return PulleyExit(tangent_point=tangent_point, wrap_angle=wrap, free_length=free_length,
-                          unit_vector=unit_vector, arc_length=self.radius * wrap)
-
-    def cable_length(self, anchor):
-        """Ideal cable length [m] from the hang point to ``anchor`` (2,) or (N, 2) [m]."""
-        return self.exit(anchor).cable_length
-
-    def rim_point(self, angle: float) -> np.ndarray:
-        """Point of the rim at polar angle ``angle`` [rad], shape (2,) [m]."""
-        return np.array(self.center) + self.radius * np.array([math.cos(angle), math.sin(angle)])
-
-    def wrap_to(self, angle: float) -> float:
-        """Angle [rad] wrapped from the hang point over the top to the rim angle ``angle``, in [0, 2 pi)."""
-        if self.side < 0:
-            return (math.pi - angle) % (2.0 * math.pi)
-        return angle % (2.0 * math.pi)
-
-    def winch_end(self, unstrained_length: float, paid_out: float) -> np.ndarray:
-        """Winch end of a cable of unstrained length ``L0`` [m] with ``paid_out`` [m] beyond the hang point.
-
-        ``h - (0, L0 - lambda)``: the cable runs straight down the winch line. Shape (2,) [m].
-        """
-        hang = self.hang_point
-        return np.array([hang[0], hang[1] - (unstrained_length - paid_out)])
-
-    @property
-    def top(self) -> float:
-        """Height [m] of the highest point the cable can leave this exit from: the top of the rim,
-        ``c_z + r_p`` (the centre of a point exit). See :func:`above_exits`."""
-        return self.center[1] + self.radius
-
-    def paid_out_length(self, unstrained_length: float, winch_end) -> float:
-        """Paid-out length lambda [m] of a cable of unstrained length ``L0`` [m] whose winch end is at ``winch_end`` (2,) [m].
-
-        The inverse of :meth:`winch_end`: all of the cable but the part hanging below the hang point.
-        """
-        return float(unstrained_length - (self.center[1] - winch_end[1]))
 
 
 # ----------------------------------------------------------------------------------
@@ -686,7 +526,8 @@ def swivel_exit_arrays(inlet, radius, anchor, azimuth_hint=None):
             raise UnreachableError(f"anchor {np.asarray(bad).tolist()} lies inside the disc of the swivel pulley "
                                    f"(inlet {inlet.tolist()}, radius {radius} m)")
     # the planar pulley in the plane (rho, z), origin at the inlet: its hang point is the inlet
-    planar = Pulley((radius, 0.0), radius, -1).exit(np.stack([rho, height], axis=-1))
+    radius = float(radius)
+    planar = planar_exit((radius, 0.0), radius, -1, np.stack([rho, height], axis=-1))
     e_rho = np.stack([np.cos(azimuth), np.sin(azimuth), np.zeros_like(azimuth)], axis=-1)
     e_z = np.array([0.0, 0.0, 1.0])
 
@@ -735,7 +576,7 @@ def swivel_pulley_exit(inlet, radius, anchor, azimuth_hint=None):
     Notes
     -----
     The cable lies in the vertical plane of azimuth ``psi`` through the axis, where
-    it is the planar cable of :class:`cdpr_exu.core.geometry.Pulley` (centre ``(r_p, 0)``,
+    it is the planar cable of :func:`planar_exit` (centre ``(r_p, 0)``,
     side -1, hang point at the inlet; Pott, "Cable-Driven Parallel Robots: Theory
     and Application", Springer 2018, pulley kinematics).
     """
@@ -844,7 +685,7 @@ def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None
     anchor_heights : array_like, shape (m,) [m]
         Height of each cable's anchor (z, the vertical axis of both dimensions).
     exit_tops : array_like, shape (m,) [m]
-        Height of the top of each cable's exit (:attr:`Pulley.top`; a swivel pulley's
+        Height of the top of each cable's exit (:attr:`cdpr_exu.exits.base.Exit.top`; a swivel pulley's
         inlet height plus its radius; an exit point's height).
     exits : str
         The scene field of the exits, for the message (``"pulleys"`` or ``"exits"``).
@@ -868,8 +709,8 @@ def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None
 # ----------------------------------------------------------------------------------
 # how deep the lumped cable cuts into a pulley
 # ----------------------------------------------------------------------------------
-def penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
-    """Depth by which each node lies inside the pulley disc (0 outside) [m].
+def penetration(pulley, positions: np.ndarray) -> np.ndarray:
+    """Depth by which each node lies inside the disc of ``pulley`` (its ``center`` and ``radius``; 0 outside) [m].
 
     Parameters
     ----------
@@ -883,8 +724,8 @@ def penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
     return np.maximum(pulley.radius - distance, 0.0)
 
 
-def segment_penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
-    """Depth by which each element (the segment between two nodes) cuts into the pulley disc [m].
+def segment_penetration(pulley, positions: np.ndarray) -> np.ndarray:
+    """Depth by which each element (the segment between two nodes) cuts into the disc of ``pulley`` [m].
 
     Parameters
     ----------

@@ -36,12 +36,11 @@ from scipy.optimize import nnls
 
 from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import (SwivelExit, check_spatial_pose, finite_array, point3, rotation_from_vector,
-                                    spatial_anchor_velocities, spatial_arms, swivel_exit_arrays, swivel_pulley_exit)
+from cdpr_exu.core.geometry import (check_spatial_pose, finite_array, point3, rotation_from_vector,
+                                    spatial_anchor_velocities, spatial_arms, swivel_exit_arrays)
 from cdpr_exu.core.validation import non_negative, per_item, shown, vector
 
 __all__ = [
-    "SwivelPulley",
     "robot_exits",
     "inverse_kinematics",
     "inverse_kinematics_rates",
@@ -57,39 +56,6 @@ _INFEASIBLE_RESIDUAL = 1e-6
 
 _BOUND_ROUNDING = 1e-9
 """A tension this fraction of the tension range outside its bounds is rounding (and is clipped)."""
-
-
-@dataclass(frozen=True)
-class SwivelPulley:
-    """A swivel pulley: a disc of radius ``radius`` turning about the vertical axis through ``inlet``.
-
-    Parameters
-    ----------
-    inlet : (x, y, z) [m]
-        Where the cable leaves the vertical axis (it hangs down the axis to its winch).
-    radius : float [m]
-        Disc radius ``r_p >= 0``; 0 is a point exit at the inlet.
-
-    Raises
-    ------
-    SceneError
-        Naming the field, if a value is not finite or ``radius`` is negative.
-    """
-
-    inlet: tuple = (0.0, 0.0, 0.0)
-    radius: float = 0.0
-
-    def __post_init__(self):
-        object.__setattr__(self, "inlet", tuple(float(x) for x in point3("inlet", self.inlet)))
-        object.__setattr__(self, "radius", non_negative("radius", self.radius))
-
-    def exit(self, anchor, azimuth_hint=None) -> SwivelExit:
-        """The cable's exit towards ``anchor`` (3,) or (N, 3) [m]; see :func:`swivel_pulley_exit`."""
-        return swivel_pulley_exit(self.inlet, self.radius, anchor, azimuth_hint)
-
-    def cable_length(self, anchor, azimuth_hint=None):
-        """Ideal cable length [m] from the inlet to ``anchor`` (3,) or (N, 3) [m]."""
-        return self.exit(anchor, azimuth_hint).cable_length
 
 
 def _check_pulleys(n_cables, inlets, pulley_radii):
@@ -109,7 +75,7 @@ def _check_hints(n_cables, azimuth_hints):
 
 
 def robot_exits(pose, anchors, inlets, pulley_radii, azimuth_hints=None):
-    """The :class:`SwivelExit` of every cable for pose(s) (6,)/(N, 6), or positions (3,)/(N, 3) with ``anchors=None``.
+    """The :class:`~cdpr_exu.core.geometry.SwivelExit` of every cable for pose(s) (6,)/(N, 6), or positions (3,)/(N, 3) with ``anchors=None``.
 
     Returns the checked pose, the checked anchors (None for a point mass) and the list of exits.
     """
@@ -181,7 +147,7 @@ def inverse_kinematics_rates(pose, pose_rate, anchors, inlets, pulley_radii, azi
     pose : array_like, shape (6,) or (N, 6) [m, rad]
         Platform pose(s); a position (3,) or (N, 3) [m] for a point mass.
     pose_rate : array_like, same shape as ``pose`` [m/s, rad/s]
-        ``(dr/dt, dtheta/dt)``, the rate of the rotation vector (see :func:`anchor_velocities`).
+        ``(dr/dt, dtheta/dt)``, the rate of the rotation vector (see :func:`cdpr_exu.core.geometry.spatial_anchor_velocities`).
     anchors, inlets, pulley_radii, azimuth_hints
         As :func:`inverse_kinematics`.
 
