@@ -155,7 +155,7 @@ def _quiet_stdout():
 def moordyn_input(scene, axial_damping_ns: float, time_step: float) -> str:
     """MoorDyn v2 input file of the scene's two lines and point mass."""
     cable = scene.cables[0]
-    (xa, za), (xb, zb) = scene.pulleys[0].center, scene.pulleys[1].center
+    (xa, za), (xb, zb) = scene.exits[0].point, scene.exits[1].point
     x0, z0, _ = scene.platform.initial_pose
     d = -DEPTH_OFFSET
     return f"""--------------------- MoorDyn Input File -------------------------------------

@@ -20,7 +20,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from cdpr_exu.run.spatial_run import simulate_spatial
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.scene import load_scene
 
 RESULTS = Path(__file__).resolve().parent / "results" / "spatial.md"
 
@@ -38,7 +38,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--end-time", type=float, default=5.0, help="simulated time per run [s]")
     args = parser.parse_args()
-    scene = load_spatial_scene("spatial-cogiro")
+    scene = load_scene("spatial-cogiro")
     scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
     rows = []
     for label, variant in variants(scene):

@@ -23,8 +23,8 @@ from pathlib import Path
 import exudyn as exu
 import numpy as np
 
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, settle, start_at_rest
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec, settle, start_at_rest
+from cdpr_exu.scenes.scene import load_scene
 
 RESULTS = Path(__file__).resolve().parent / "results" / "swivel_start.md"
 
@@ -32,7 +32,7 @@ RESULTS = Path(__file__).resolve().parent / "results" / "swivel_start.md"
 def _built(scene, tension_only):
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
-                                scene.chain_spec(tension_only=tension_only), swivels=scene.swivel_exits)
+                                scene_chain_spec(scene, tension_only=tension_only), swivels=scene.swivel_exits)
     mbs.Assemble()
     return mbs, items
 
@@ -49,7 +49,7 @@ def _timed(start, scene, tension_only):
 
 
 def main() -> None:
-    scene = load_spatial_scene("spatial-four-cable-swivel")
+    scene = load_scene("spatial-four-cable-swivel")
     no_bending = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False))
     _timed(start_at_rest, scene, True)  # numba's compilation (cached on disk) and Exudyn's first call, not timed
     rows = []

@@ -36,8 +36,8 @@ from typing import Callable
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.statics.kinematics import cable_unit_vectors, pulley_arrays
 from cdpr_exu.core.validation import shown
+from cdpr_exu.statics.kinematics import cable_exits
 
 from .base import Measurement, WinchCommand, quintic_blend
 
@@ -110,9 +110,7 @@ class FilteredPositionPI:
         Moving an anchor by d changes the ideal length by u . d, u the unit vector
         from the cable's exit point to the anchor (with the rotation held).
         """
-        scene = self._scene
-        anchors = np.asarray(scene.platform.anchors)
-        return -cable_unit_vectors(pose, anchors, *pulley_arrays(scene.exits))
+        return np.stack([exit_.unit_vector for exit_ in cable_exits(self._scene, pose)], axis=-2)
 
     def _advance(self, time: float, error: np.ndarray, weight: float):
         """The filter and integral state at ``time`` [s] from the last earlier call, and stored."""

@@ -10,56 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from cdpr_exu.statics.kinematics import inverse_kinematics, inverse_kinematics_rates, pulley_arrays
+from cdpr_exu.statics.kinematics import ideal_paid_out
 
 from .base import Measurement, WinchCommand
-
-
-def _spatial_ideal_lengths(scene, poses, pose_rates=None):
-    """:func:`ideal_paid_out` of a spatial scene: straight distances from the exit points to the
-    anchors, over the swivel pulleys where there are (wrap plus tangent length from the inlet,
-    :mod:`cdpr_exu.physics.spatial_kinematics`), poses (N, 6) (x, y, z, rotation vector); a
-    point-mass platform's rotation is ignored."""
-    from cdpr_exu.physics.spatial_kinematics import inverse_kinematics, inverse_kinematics_rates
-
-    poses = np.atleast_2d(poses)
-    exits = np.asarray(scene.exits)
-    if scene.platform.is_point_mass:
-        points, anchors = poses[:, :3], None
-        rates = None if pose_rates is None else np.atleast_2d(pose_rates)[:, :3]
-    else:
-        points, anchors = poses, np.asarray(scene.platform.anchors)
-        rates = None if pose_rates is None else np.atleast_2d(pose_rates)
-    radii = np.asarray(getattr(scene, "pulley_radii", 0.0))  # swivel pulleys (0: a point exit)
-    lengths = inverse_kinematics(points, anchors, exits, radii)
-    if rates is None:
-        return lengths, None
-    return lengths, inverse_kinematics_rates(points, rates, anchors, exits, radii)
-
-
-def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = None):
-    """Ideal paid-out lengths (and rates) of every cable for reference poses.
-
-    Parameters
-    ----------
-    scene : cdpr_exu.scenes.scene.Scene
-    poses : ndarray, shape (N, 3) [m, m, rad]
-    pose_rates : ndarray, shape (N, 3) or None [m/s, m/s, rad/s]
-
-    Returns
-    -------
-    lengths : ndarray, shape (N, m) [m]
-    rates : ndarray, shape (N, m) [m/s] or None
-    """
-    if getattr(scene, "dimension", 2) == 3:
-        return _spatial_ideal_lengths(scene, poses, pose_rates)
-    anchors = np.asarray(scene.platform.anchors)
-    centers, radii, sides = pulley_arrays(scene.exits)
-    lengths = inverse_kinematics(poses, anchors, centers, radii, sides)
-    rates = None
-    if pose_rates is not None:
-        rates = inverse_kinematics_rates(poses, pose_rates, anchors, centers, radii, sides)
-    return lengths, rates
 
 
 def table_lookup(t: float, times: np.ndarray, table: np.ndarray) -> np.ndarray:

@@ -43,11 +43,10 @@ from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.statics.kinematics import cable_unit_vectors, pulley_arrays
 from cdpr_exu.core.validation import shown
+from cdpr_exu.statics.kinematics import cable_exits, ideal_paid_out
 
 from .base import Measurement, WinchCommand
-from .ideal_ik import ideal_paid_out
 
 
 def fade_in(times: np.ndarray, fade_time: float) -> np.ndarray:
@@ -85,8 +84,7 @@ def position_jacobian(scene, poses: np.ndarray) -> np.ndarray:
     ndarray, shape (N, m, 2) [m/m]
     """
     poses = np.atleast_2d(np.asarray(poses, dtype=float))
-    anchors = np.asarray(scene.platform.anchors)
-    return -np.asarray(cable_unit_vectors(poses, anchors, *pulley_arrays(scene.exits))).reshape(len(poses), -1, 2)
+    return np.stack([exit_.unit_vector for exit_ in cable_exits(scene, poses)], axis=-2).reshape(len(poses), -1, 2)
 
 
 def ideal_changes(scene, times: np.ndarray) -> np.ndarray:

@@ -83,7 +83,7 @@ class SpatialPositionPI(FilteredPositionPI):
         pose = np.asarray(pose, dtype=float)
         anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
         point = pose[:3] if anchors is None else pose[:6]
-        units = cable_unit_vectors(point, anchors, np.asarray(scene.exits), scene.pulley_radii)
+        units = cable_unit_vectors(point, anchors, scene.exit_points, scene.pulley_radii)
         matrix = structure_matrix(point, anchors, units)
         return -matrix[:self.error_size(scene)].T
 

@@ -46,12 +46,11 @@ from scipy.interpolate import CubicSpline
 from cdpr_exu.statics import chain_statics
 from cdpr_exu.statics import statics
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes
+from cdpr_exu.statics.kinematics import anchor_points, ideal_paid_out, initial_cable_nodes
 from cdpr_exu.core.validation import shown
 
 from .base import Measurement, WinchCommand
 from .feedback import FilteredPositionPI
-from .ideal_ik import ideal_paid_out
 
 
 def suspended_platform(scene) -> statics.SuspendedPlatform:
@@ -168,7 +167,7 @@ class TensionAwareController:
                 lengths[k] = equilibrium.paid_out
                 continue
             lengths[k] = equilibrium.unstrained_lengths
-            if self.chordal_correction and scene.cable_exit == "pulley":
+            if self.chordal_correction and all(exit_.wraps for exit_ in scene.exits):
                 pose_eq = np.array([*pose[:2], equilibrium.rotation])
                 anchors = anchor_points(pose_eq, np.asarray(scene.platform.anchors))
                 lengths[k] += chain_length(scene, anchors) - ideal_paid_out(scene, pose_eq[None, :])[0][0]

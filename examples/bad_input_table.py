@@ -74,18 +74,13 @@ def _scene_text(case) -> bytes | None:
     """The bytes of the case's scene file: raw ``content``, or a shipped scene's TOML with ``changes``."""
     import tomli_w
 
-    from importlib import resources
-
-    from cdpr_exu.scenes.spatial_scene import shipped_spatial_text
+    from cdpr_exu.scenes.scene import shipped_scene_text
 
     if case.content is not None:
         return case.content
     if case.scene is None:
         return None
-    text = shipped_spatial_text(case.scene)
-    if text is None:
-        text = resources.files("cdpr_exu.scenes").joinpath(case.scene.replace("-", "_") + ".toml").read_text("utf-8")
-    data = tomllib.loads(text)
+    data = tomllib.loads(shipped_scene_text(case.scene))
     for path, value in case.changes:
         *parents, last = path
         table = data

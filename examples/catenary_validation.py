@@ -97,10 +97,15 @@ def with_elements(scene: Scene, n: int, lumping: str | None = None) -> Scene:
         replace(c, n_elements=n, **({"mass_lumping": lumping} if lumping else {})) for c in scene.cables))
 
 
+def over_pulleys(scene: Scene) -> bool:
+    """True when the cables run over their pulleys (not from fixed exit points)."""
+    return any(exit_.wraps for exit_ in scene.exits)
+
+
 def bending_off(scene: Scene) -> Scene:
     """The scene with the "catenary" preset: mass and elasticity, no bending."""
     return scene.with_changes(effects=Effects.from_preset("catenary",
-                                                          pulley_contact=scene.cable_exit == "pulley"))
+                                                          pulley_contact=over_pulleys(scene)))
 
 
 # --------------------------------------------------------------------------- catenary side
@@ -114,9 +119,9 @@ def hang_point_unstrained_length(scene: Scene, rest: RestState, i: int) -> float
     the fraction of it below (its stretch is uniform). For a point exit: the whole cable.
     """
     cable = scene.cables[i]
-    if scene.cable_exit == "point":
+    if not over_pulleys(scene):
         return cable.unstrained_length
-    nodes, height = rest.nodes[i], scene.pulleys[i].center[1]
+    nodes, height = rest.nodes[i], scene.exits[i].center[1]
     k = int(np.flatnonzero(nodes[1:, 1] >= height)[0])
     fraction = (height - nodes[k, 1]) / (nodes[k + 1, 1] - nodes[k, 1])
     return cable.unstrained_length - (k + fraction) * cable.element_length
@@ -191,7 +196,7 @@ def compare(scene: Scene, rest: RestState) -> dict:
             "lumped_platform_force_N": rest.platform_forces_N[i].tolist(),
             "inverse_platform_force_N": inverse.cables[i].force_on_platform.tolist(),
         }
-        if scene.cable_exit == "pulley":
+        if over_pulleys(scene):
             # the whole cable beyond the hang point (wrap included), which the chords shorten
             cable["chord_deficit_m"] = chord_deficit(scene, rest, i)
             cable["inverse_total_unstrained_length_m"] = inverse.cables[i].unstrained_length
@@ -220,7 +225,7 @@ def chord_deficit(scene: Scene, rest: RestState, i: int) -> float:
     (its nodes touch the rim, its elements cut inside it); a real cable follows the arc.
     Measured along the rest state: arc length minus the polygon's length.
     """
-    pulley, nodes, c = scene.pulleys[i], rest.nodes[i], int(rest.first_free_node[i]) - 1
+    pulley, nodes, c = scene.exits[i], rest.nodes[i], int(rest.first_free_node[i]) - 1
     center, radius = np.asarray(pulley.center), pulley.radius
     k = int(np.flatnonzero(nodes[1:, 1] >= center[1])[0])
     fraction = (center[1] - nodes[k, 1]) / (nodes[k + 1, 1] - nodes[k, 1])
@@ -307,8 +312,8 @@ def plot_profiles(cases: dict, path: Path) -> Path:
     for ax, on, off, title in panels:
         scene, rest, comparison = cases[on]
         _, rest_off, comparison_off = cases[off]
-        if scene.cable_exit == "pulley":
-            for pulley in scene.pulleys:
+        if over_pulleys(scene):
+            for pulley in scene.exits:
                 ax.add_patch(Circle(pulley.center, pulley.radius, facecolor="0.93", edgecolor="0.6", zorder=1))
         for i in range(scene.n_cables):
             for data, color, label in ((comparison, "red", "elastic catenary through the lumped rest position "
@@ -323,7 +328,7 @@ def plot_profiles(cases: dict, path: Path) -> Path:
                     zorder=3, markerfacecolor="none", label="lumped, bending on (paper's model)" if i == 0 else None)
             ax.plot(rest_off.nodes[i][:, 0], rest_off.nodes[i][:, 1], "x", color="tab:green", markersize=5,
                     zorder=3, label="lumped, bending off" if i == 0 else None)
-            if scene.cable_exit == "pulley":
+            if over_pulleys(scene):
                 ax.plot(*rest.upper_points_m[i], "+", color="tab:blue", markersize=9, zorder=4)
                 ax.plot(*rest_off.upper_points_m[i], "+", color="tab:green", markersize=9, zorder=4)
         x, z = rest.platform_position_m

@@ -58,7 +58,7 @@ def run(model: str, n_elements: int) -> dict:
         return {"model": model, "n_elements": n_elements, "status": f"refused: {err}"}
     cpu = time.process_time() - cpu
     depth = max(segment_penetration(pulley, frame).max()  # nodes: (samples, n + 1, 2) per cable
-                for pulley, nodes in zip(scene.pulleys, result.nodes) for frame in nodes)
+                for pulley, nodes in zip(scene.exits, result.nodes) for frame in nodes)
     return {"model": model, "n_elements": n_elements, "status": status, "cpu_time_s": cpu,
             "newton_per_step": result.newton_iterations / max(result.steps, 1),
             "deepest_element_in_pulley_mm": 1000 * float(depth),

@@ -17,21 +17,21 @@ from cdpr_exu.cli.compare import print_spatial_controller_row
 from cdpr_exu.post.plots import plot_spatial_rest
 from cdpr_exu.run.spatial_rest import solve_spatial_rest
 from cdpr_exu.studies.comparison import compare_spatial
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.scene import load_scene
 
 RESULTS = Path("results/spatial")
 
 
 def main() -> None:
     for name in ("spatial-four-cable", "spatial-cogiro", "spatial-ipanema"):
-        rest = solve_spatial_rest(load_spatial_scene(name))
+        rest = solve_spatial_rest(load_scene(name))
         rest.save(RESULTS / name / "static")
         plot_spatial_rest(rest, RESULTS / name / "static" / "rest_profile.png")
         print(f"{name}: at rest at {rest.position.round(6).tolist()} m")
     rows = ["| robot | controller | max position error [mm] | RMS position error [mm] | max rotation error [deg] "
             "| min element tension [N] |", "|---|---|---|---|---|---|"]
     for name in ("spatial-cogiro", "spatial-ipanema"):
-        summaries = compare_spatial(load_spatial_scene(name), out=RESULTS / name / "compare",
+        summaries = compare_spatial(load_scene(name), out=RESULTS / name / "compare",
                                     report=print_spatial_controller_row)
         for controller, s in summaries.items():
             rows.append(f"| {name} | {controller} | {1000 * s['max_position_error_m']:.3f} | "

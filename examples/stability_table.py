@@ -77,7 +77,7 @@ def _cables(scene: Scene, **changes) -> Scene:
 
 
 def _pulleys(scene: Scene, **changes) -> Scene:
-    return scene.with_changes(pulleys=tuple(dataclasses.replace(p, **changes) for p in scene.pulleys))
+    return scene.with_changes(exits=tuple(dataclasses.replace(p, **changes) for p in scene.exits))
 
 
 def _platform_mass(scene: Scene, mass: float) -> Scene:

@@ -35,7 +35,7 @@ from cdpr_exu.core.output import write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.run.error_estimate import path_distance
 from cdpr_exu.run.spatial_run import simulate_spatial
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.scene import load_scene
 
 NAME = "spatial-four-cable-swivel"
 COUNTS = (48, 96, 192)
@@ -44,7 +44,7 @@ AFTER = 1.0  # s: the ramp of the circle left out
 
 def scene_for(n_elements: int, damped: bool):
     """The shipped swivel scene with ``n_elements`` per cable, bending dampers on or off."""
-    scene = load_spatial_scene(NAME)
+    scene = load_scene(NAME)
     return replace(scene, effects=replace(scene.effects, bending_damping=damped),
                    cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables))
 
@@ -62,7 +62,7 @@ def tension_step_estimate(scene, result) -> dict:
     """The continuum estimate of the dampers' tension step across the wrap, d_n J v / (2 r_p^2 lambda), at the
     largest pay-out rate of the run and the smallest anchor tension after AFTER [N, m/s, m]."""
     cable = scene.cables[0]
-    radius = float(scene.swivels[0].radius)
+    radius = float(scene.exits[0].radius)
     inertia = np.pi * cable.radius**4 / 4.0
     mask = result.time >= AFTER - 1e-9
     speed = float(np.abs(np.gradient(result.paid_out, result.time, axis=0))[mask].max())

@@ -2,8 +2,8 @@
 
 Small scenes with one or two coarse cables, whose answer is known in closed form:
 a cable hanging straight down, a cable pendulum, two cables in a V holding a point
-mass. All use ``cable_exit="point"`` with fixed winches: node 0 of each cable sits at
-its pulley centre, held by the winch constraints, and there is no pulley contact.
+mass. All have point exits (:class:`~cdpr_exu.exits.point.PointExit`) with fixed winches: node 0 of
+each cable sits at its exit point, held by the winch constraints, and there is no pulley contact.
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ import pytest
 
 from cdpr_exu.physics.catenary import CatenaryCable
 from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
-from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, WinchSpec
+from cdpr_exu.exits import PointExit
+from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, Scene, SolverSpec, WinchSpec
 
 #: Gravity used by the small scenes [m/s^2].
 GRAVITY = 9.81
@@ -48,14 +49,13 @@ def hanging_cable_scene(n_elements: int = 4, length: float = 1.0, platform_mass:
     return Scene(
         name="hanging-cable",
         cables=(cable,),
-        pulleys=(PulleySpec(center=(0.0, 0.0)),),
+        exits=(PointExit((0.0, 0.0)),),
         platform=PlatformSpec(mass=platform_mass, inertia=0.01, anchors=((0.0, 0.0),),
                               initial_pose=(0.0, -length, 0.0)),
         winch=WinchSpec(kind="fixed"),
         effects=effects or Effects.from_preset("full"),
         solver=solver or settling_solver(),
         gravity=GRAVITY,
-        cable_exit="point",
     )
 
 
@@ -73,7 +73,7 @@ def pendulum_scene(step_size: float, end_time: float = 2.0, n_elements: int = 6,
     return Scene(
         name="cable-pendulum",
         cables=(CableSpec(unstrained_length=length, n_elements=n_elements),),
-        pulleys=(PulleySpec(center=(0.0, 0.0)),),
+        exits=(PointExit((0.0, 0.0)),),
         platform=PlatformSpec(mass=1.0, inertia=0.01, anchors=((0.0, offset),),
                               initial_pose=(anchor[0], anchor[1] - offset, 0.0)),
         winch=WinchSpec(kind="fixed"),
@@ -81,7 +81,6 @@ def pendulum_scene(step_size: float, end_time: float = 2.0, n_elements: int = 6,
         solver=SolverSpec(end_time=end_time, step_size=step_size, spectral_radius=spectral_radius,
                           output_period=0.01),
         gravity=GRAVITY,
-        cable_exit="point",
     )
 
 
@@ -97,14 +96,13 @@ def v_shaped_scene(effects: Effects | None = None, n_elements: int = 6, platform
     return Scene(
         name="v-shaped-cables",
         cables=(cable, cable),
-        pulleys=(PulleySpec(center=(-span, 0.0), side=-1), PulleySpec(center=(span, 0.0), side=1)),
+        exits=(PointExit((-span, 0.0)), PointExit((span, 0.0))),
         platform=PlatformSpec(mass=platform_mass, inertia=0.01, anchors=((0.0, 0.0), (0.0, 0.0)),
                               initial_pose=(0.0, -span, 0.0)),
         winch=WinchSpec(kind="fixed"),
         effects=effects or Effects.from_preset("full"),
         solver=solver or settling_solver(),
         gravity=GRAVITY,
-        cable_exit="point",
     )
 
 
@@ -160,10 +158,10 @@ def small_spatial_scene(end_time: float = 0.3, n_elements: int = 4):
     import numpy as np
 
     from cdpr_exu.physics.spatial_statics import solve_spatial_statics
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+    from cdpr_exu.scenes.scene import load_scene
     from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
 
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     scene = replace(scene, cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables),
                     effects=replace(scene.effects, slack=False),
                     solver=replace(scene.solver, end_time=end_time, step_size=1e-2, output_period=1e-2))

@@ -158,16 +158,16 @@ def _spatial_move_scene(tmp_path):
     from dataclasses import replace
 
     from cdpr_exu.physics.spatial_statics import solve_spatial_statics
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene, save_any_scene
+    from cdpr_exu.scenes.scene import load_scene, save_scene
     from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
 
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     rest = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
     start = np.concatenate([rest.position, rest.rotation_vector])
     end = start + np.array([0.15, -0.10, 0.05, 0.0, 0.0, 0.0])
     move = SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.0)
     scene = replace(scene, trajectory=move, solver=replace(scene.solver, output_period=0.01))
-    return save_any_scene(scene, tmp_path / "four_cable_move.toml")
+    return save_scene(scene, tmp_path / "four_cable_move.toml")
 
 
 @pytest.mark.slow
@@ -225,13 +225,13 @@ def test_spatial_grids_scale_their_elements_to_what_a_swivel_pulley_takes():
     elements: the quick grid's 4, 8 and 16 become 48, 96 and 192, every one a valid scene."""
     from dataclasses import replace
 
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene
-    from cdpr_exu.studies.accuracy import SPATIAL_FULL_GRID, SPATIAL_QUICK_GRID, fewest_spatial_elements, grid_for
+    from cdpr_exu.scenes.scene import load_scene
+    from cdpr_exu.studies.accuracy import SPATIAL_FULL_GRID, SPATIAL_QUICK_GRID, fewest_elements, grid_for
 
-    assert grid_for(load_spatial_scene("spatial-ipanema"), quick=True) == SPATIAL_QUICK_GRID
-    assert grid_for(load_spatial_scene("spatial-ipanema")) == SPATIAL_FULL_GRID
-    swivel = load_spatial_scene("spatial-four-cable-swivel")
-    assert fewest_spatial_elements(swivel) == 48
+    assert grid_for(load_scene("spatial-ipanema"), quick=True) == SPATIAL_QUICK_GRID
+    assert grid_for(load_scene("spatial-ipanema")) == SPATIAL_FULL_GRID
+    swivel = load_scene("spatial-four-cable-swivel")
+    assert fewest_elements(swivel) == 48
     quick = grid_for(swivel, quick=True)
     assert quick.n_elements == (48, 96) and quick.reference.n_elements == 192
     for configuration in quick.configurations():

@@ -46,7 +46,7 @@ def test_it_finds_the_rest_that_exudyn_finds_with_the_same_winch_lengths():
 
     scene = PAPER.with_changes(platform=replace(PAPER.platform, initial_pose=(0.3, -1.8, 0.0)))
     rest = solve_rest(scene)
-    held = np.array([scene.cables[i].unstrained_length - (scene.pulleys[i].center[1] - initial_nodes(scene, i)[0, 1])
+    held = np.array([scene.cables[i].unstrained_length - (scene.exits[i].center[1] - initial_nodes(scene, i)[0, 1])
                      for i in range(2)])
     solution = _solve(scene, rest.platform_position_m)
     # Exudyn's rest is an equilibrium to ~1e-11 N and its nodes to ~1e-7 m (rest.py notes);
@@ -96,11 +96,11 @@ def test_massless_straight_cables_give_hookes_law():
     position = np.array([0.2, -1.6])
     solution = solve_chain_statics(robot, position, tension_guess=[10.0, 10.0])
     for cable, nodes, tensions, paid in zip(robot.cables, solution.nodes, solution.tensions, solution.paid_out):
-        span = np.linalg.norm(position - np.asarray(cable.pulley.center))
+        span = np.linalg.norm(position - np.asarray(cable.pulley.point))
         ea = cable.axial_stiffness * cable.element_length
         assert np.ptp(tensions) < 1e-9 * tensions.max()  # no weight: one tension along the cable
         # node 0 sits on the vertical through the exit point, lambda - L0 above it
-        assert nodes[0] == pytest.approx(np.asarray(cable.pulley.center) + [0.0, paid - cable.unstrained_length],
+        assert nodes[0] == pytest.approx(np.asarray(cable.pulley.point) + [0.0, paid - cable.unstrained_length],
                                          abs=1e-12)
         straight = np.linalg.norm(nodes[-1] - nodes[0])
         assert straight / (1.0 + tensions[0] / ea) == pytest.approx(cable.unstrained_length, rel=1e-9)

@@ -130,7 +130,7 @@ def test_run_failure_exits_3_and_exudyn_banners_do_not_leak(tmp_path):
 
 def test_static_failure_says_why_and_writes_the_scene_and_the_last_state(tmp_path):
     base = load_scene("paper-catenary")
-    stiff = base.with_changes(pulleys=[replace(p, contact_stiffness=1e12) for p in base.pulleys],
+    stiff = base.with_changes(exits=[replace(p, contact_stiffness=1e12) for p in base.exits],
                               solver=replace(base.solver, step_size=2e-2))  # Newton fails within 2 s
     path = tmp_path / "stiff.toml"
     save_scene(stiff, path)
@@ -353,12 +353,12 @@ def test_two_comparisons_write_identical_files_apart_from_timing_json(tmp_path, 
     bytes in every other file (tables, pose CSVs, figures)."""
     from conftest import small_spatial_scene
 
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
+    from cdpr_exu.scenes.scene import save_scene
 
     if dimension == "planar":
         scene, controllers = _scene_file(tmp_path, "short", end_time=0.3), ["ideal_ik", "tension_aware"]
     else:  # the small robot's 5 cm in 0.2 s is beyond the catenary controllers' workspace: ideal IK only
-        scene, controllers = save_any_scene(small_spatial_scene(0.2), tmp_path / "small.toml"), ["ideal_ik"]
+        scene, controllers = save_scene(small_spatial_scene(0.2), tmp_path / "small.toml"), ["ideal_ik"]
     for name in ("a", "b"):
         _cdpr("compare", str(scene), "--controllers", ",".join(controllers), "--after", "0",
               "--out", str(tmp_path / name), "-q")

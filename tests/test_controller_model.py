@@ -23,7 +23,7 @@ def test_the_mismatch_plant_differs_from_what_its_controllers_believe():
     assert [c.linear_density for c in MISMATCH.cables] == [0.315, 0.315]
     assert [c.linear_density for c in model.cables] == [0.35, 0.35]
     # The rest is the plant's: geometry, elasticity, effects, reference, and no model of its own.
-    assert model.pulleys == MISMATCH.pulleys and model.trajectory == MISMATCH.trajectory
+    assert model.exits == MISMATCH.exits and model.trajectory == MISMATCH.trajectory
     assert model.effects == MISMATCH.effects and model.effects.slack
     assert [c.youngs_modulus for c in model.cables] == [c.youngs_modulus for c in MISMATCH.cables]
     assert model.controller_model is None
@@ -41,7 +41,7 @@ def test_a_controller_model_survives_the_toml_round_trip(tmp_path):
     assert [c.youngs_modulus for c in model.cables] == [0.9e9, 1.0e9]
     assert [c.n_elements for c in model.cables] == [15, 10]
     assert model.platform.anchors[0] == (-0.16, 0.1) and model.gravity == 9.81
-    assert {p.radius for p in model.pulleys} == {0.24}
+    assert {p.radius for p in model.exits} == {0.24}
 
 
 @pytest.mark.parametrize("table, words", [

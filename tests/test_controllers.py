@@ -9,7 +9,7 @@ from cdpr_exu.core.errors import UnreachableError
 from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, load_scene
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory
 from controllers import IdealIKController, Measurement, SmoothStart
-from controllers.ideal_ik import ideal_paid_out
+from cdpr_exu.statics.kinematics import ideal_paid_out
 from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
 
 PAPER = load_scene("paper-circle")

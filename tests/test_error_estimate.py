@@ -135,10 +135,10 @@ def _four_cable(n_elements, trajectory=None, end_time=1.5):
     """The shipped four-cable robot without bending (its continuum limit is the elastic
     catenary), coarse steps; held on its catenary pose unless ``trajectory`` is given."""
     from cdpr_exu.physics.spatial_statics import solve_spatial_statics
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+    from cdpr_exu.scenes.scene import load_scene
     from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
 
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     scene = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False),
                     cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables),
                     solver=replace(scene.solver, step_size=1e-2, output_period=0.05, end_time=end_time))
@@ -193,10 +193,10 @@ def test_cli_tolerance_on_a_spatial_scene_asks_for_more_elements_and_meets_it(tm
     """`cdpr run` on the held robot at 4 elements (0.455 mm estimated): --tolerance 0.1mm asks
     for ceil(4 sqrt(4.55)) = 9 elements, whose run's estimate (in summary.json, strict JSON)
     and true error against the catenary (0.0726 mm and 0.0715 mm measured) meet it; 1mm keeps the 4."""
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
+    from cdpr_exu.scenes.scene import save_scene
 
     scene, catenary = _four_cable(4)
-    path = save_any_scene(scene, tmp_path / "held.toml")
+    path = save_scene(scene, tmp_path / "held.toml")
     loose = _cdpr("run", str(path), "--tolerance", "1mm", "--no-error-estimate", "--no-figures")
     assert loose.returncode == 0, loose.stderr
     assert "asks for 4 elements (kept)" in loose.stdout

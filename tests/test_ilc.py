@@ -8,7 +8,7 @@ import pytest
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.scenes.scene import load_scene
 from controllers import IdealIKController, Measurement
-from controllers.ideal_ik import ideal_paid_out
+from cdpr_exu.statics.kinematics import ideal_paid_out
 from controllers.ilc import (CommandTable, LearnedController, LearningLaw, ReplayController, StoppingRule, fade_in,
                              ideal_changes, position_jacobian)
 

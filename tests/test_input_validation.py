@@ -27,20 +27,20 @@ from cdpr_exu.physics import catenary
 from cdpr_exu.statics import kinematics
 from cdpr_exu.statics import statics
 from cdpr_exu.core.errors import CdprError, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.exits import PointExit, Pulley, Swivel
 from cdpr_exu.scenes.scene import (
     MAX_ELEMENTS,
     CableSpec,
     Effects,
     PlatformSpec,
-    PulleySpec,
     Scene,
     SolverSpec,
     WinchSpec,
     load_scene,
     scene_from_dict,
+    shipped_scene_text,
 )
 from cdpr_exu.run.simulate import simulate
-from cdpr_exu.scenes.spatial_scene import load_any_scene, shipped_spatial_text, spatial_scene_from_dict
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 
 NAN, INF = float("nan"), float("inf")
@@ -58,24 +58,27 @@ def field_cases():
     """(dataclass, field, bad value) for every field of every scene dataclass."""
     positive = {
         CableSpec: ["unstrained_length", "radius", "linear_density", "youngs_modulus"],
-        PulleySpec: ["radius", "contact_stiffness"],
+        Pulley: ["radius", "contact_stiffness"],
         PlatformSpec: ["mass", "inertia"],
         SolverSpec: ["end_time", "step_size", "output_period"],
     }
-    non_negative = {CableSpec: ["damping_constant"], PulleySpec: ["contact_damping"]}
+    non_negative = {CableSpec: ["damping_constant"], Pulley: ["contact_damping"]}
     cases = []
     for cls, names in positive.items():
-        cases += [(cls, name, value) for name in names for value in NOT_POSITIVE]
+        # a platform's inertia left out (None) takes its dimension's default (PLATFORM_DEFAULTS)
+        cases += [(cls, name, value) for name in names for value in NOT_POSITIVE
+                  if not (cls is PlatformSpec and name == "inertia" and value is None)]
     for cls, names in non_negative.items():
         cases += [(cls, name, value) for name in names for value in NOT_NON_NEGATIVE]
     cases += [(CableSpec, "n_elements", v) for v in (1, 0, -15, 2.5, 15.0, "15", True, None, MAX_ELEMENTS + 1, 10**30)]
     cases += [(CableSpec, "mass_lumping", v) for v in ("lumpy", "", None, 1, ["paper"])]
-    cases += [(PulleySpec, "center", v) for v in NOT_A_PAIR]
-    cases += [(PulleySpec, "side", v) for v in (0, 2, -2, 0.5, True, "left", None, NAN)]
+    cases += [(Pulley, "center", v) for v in NOT_A_PAIR]
+    cases += [(Pulley, "side", v) for v in (0, 2, -2, 0.5, True, "left", None, NAN)]
     cases += [(PlatformSpec, "anchors", v) for v in (
-        [[0.1, 0.2, 0.3]], [0.1, 0.2], [], [[0.1]], [[NAN, 0.0]], [[0.0, INF]], [["a", 0.0]], 5.0, None, "ab")]
-    cases += [(PlatformSpec, "initial_pose", v) for v in NOT_A_TRIPLE]
-    cases += [(PlatformSpec, "size", v) for v in NOT_A_PAIR + [[-0.3, 0.2]]]
+        [[0.1, 0.2, 0.3, 0.4]], [0.1, 0.2], [], [[0.1]], [[NAN, 0.0]], [[0.0, INF]], [["a", 0.0]], 5.0, None, "ab")]
+    # None: left out, the plane's default (PLATFORM_DEFAULTS)
+    cases += [(PlatformSpec, "initial_pose", v) for v in NOT_A_TRIPLE if v is not None]
+    cases += [(PlatformSpec, "size", v) for v in NOT_A_PAIR + [[-0.3, 0.2]] if v is not None]
     cases += [(WinchSpec, "kind", v) for v in ("hydraulic", "", None, 1)]
     cases += [(SolverSpec, "spectral_radius", v) for v in (-0.1, 1.5, NAN, INF, "abc", None)]
     cases += [(SolverSpec, "newton", v) for v in ("quasi", None, 1)]
@@ -90,7 +93,7 @@ def field_cases():
 
 
 def _owner(cls) -> str:
-    return {CableSpec: "cable", PulleySpec: "pulley", PlatformSpec: "platform", WinchSpec: "winch",
+    return {CableSpec: "cable", Pulley: "pulley", PlatformSpec: "platform", WinchSpec: "winch",
             SolverSpec: "solver", Effects: "effects"}[cls]
 
 
@@ -118,12 +121,12 @@ def test_every_scene_field_refuses_bad_values_naming_field_and_value(cls, name, 
 def test_valid_edge_values_are_accepted():
     """Zero where zero is meaningful: no damping, no gravity, a point-mass platform."""
     assert CableSpec(damping_constant=0.0).axial_damping == 0.0
-    assert PulleySpec(contact_damping=0.0).contact_damping == 0.0
+    assert Pulley(contact_damping=0.0).contact_damping == 0.0
     assert SolverSpec(spectral_radius=0.0).spectral_radius == 0.0
     assert SolverSpec(spectral_radius=1.0).spectral_radius == 1.0
     assert CableSpec(n_elements=MAX_ELEMENTS).n_elements == MAX_ELEMENTS
     assert CableSpec(n_elements=np.int64(15)).n_elements == 15
-    assert PulleySpec(side=1.0).side == 1
+    assert Pulley(side=1.0).side == 1
     assert PlatformSpec(anchors=((0.0, 0.0), (0.0, 0.0))).is_point_mass
     assert SolverSpec(integrator="rk44").integrator == "rk44"
 
@@ -201,13 +204,15 @@ def test_trajectory_fields_refuse_bad_signs_and_shapes(make, field):
     (dict(gravity=-9.81), "gravity"),
     (dict(gravity=NAN), "gravity"),
     (dict(gravity="g"), "gravity"),
-    (dict(cable_exit="drum"), "cable_exit"),
     (dict(cables=()), "cables"),
     (dict(cables=5), "cables"),
     (dict(cables="ab"), "cables"),
     (dict(cables=(CableSpec(), "cable")), r"cables\[1\]"),
-    (dict(pulleys=(PulleySpec(),)), "pulleys"),
-    (dict(pulleys=(PulleySpec(), None)), r"pulleys\[1\]"),
+    (dict(exits=(Pulley(),)), "pulleys"),
+    (dict(exits=(Pulley(), None)), r"exits\[1\]"),
+    (dict(exits=(Pulley(), PointExit((1.75, 0.0)))), "exits: cable 1 leaves a point while cable 0 wraps"),
+    (dict(exits=(Pulley(), PointExit((1.75, 0.0, 0.0)))), r"exits\[1\] is a 3-D 'point' exit"),
+    (dict(dimension=4), "dimension must be 2 \\(planar\\) or 3 \\(spatial\\), got 4"),
     (dict(platform=PlatformSpec(anchors=((0.0, 0.0),))), "platform.anchors"),
     (dict(platform={"mass": 2.5}), "platform"),
     (dict(winch="kinematic"), "winch"),
@@ -215,7 +220,7 @@ def test_trajectory_fields_refuse_bad_signs_and_shapes(make, field):
     (dict(solver=None), "solver"),
     (dict(trajectory="circle"), "trajectory"),
     (dict(cables=(CableSpec(unstrained_length=2.0), CableSpec(unstrained_length=2.0))), r"cables\[0\]\.unstrained_length"),
-    (dict(cable_exit="point"), "winch.kind = 'fixed'"),
+    (dict(exits=(PointExit((-1.75, 0.0)), PointExit((1.75, 0.0)))), "winch.kind = 'fixed'"),
     (dict(solver=SolverSpec(integrator="rk44")), "winch.kind = 'fixed'"),
 ])
 def test_inconsistent_or_mistyped_scene_parts_are_refused_naming_them(changes, field):
@@ -245,6 +250,9 @@ def test_rk44_with_fixed_winches_is_accepted():
     ({"name": "x", "pulleys": [{"center": [-1.75, 0]}, {"center": [1.75, "zero"]}]}, r"pulleys\[1\]\.center\[1\]"),
     ({"name": "x", "solver": {"step_size": -1e-3}}, r"solver\.step_size"),
     ({"name": "x", "weather": "rain"}, "unknown field"),
+    ({"name": "x", "cable_exit": "drum"}, "cable_exit must be one of 'pulley', 'point', got 'drum'"),
+    ({"name": "x", "exits": [{"point": [0.0, 0.0]}], "pulleys": []}, r"unknown field\(s\) \['pulleys'\]"),
+    ({"name": "x", "dimension": 3, "exits": 5}, "exits must be an array of tables"),
 ])
 def test_malformed_plain_data_is_refused_naming_the_field(data, words):
     with pytest.raises(SceneError, match=words):
@@ -265,13 +273,13 @@ def test_malformed_toml_file_is_refused_naming_the_file(tmp_path):
 #: A scene of each kind as plain data (every field given): planar, spatial rigid, spatial over swivel pulleys.
 SCENE_DATA = {
     "planar": load_scene("paper-circle").to_dict(),
-    "spatial": tomllib.loads(shipped_spatial_text("spatial-four-cable")),
-    "swivel": tomllib.loads(shipped_spatial_text("spatial-four-cable-swivel")),
+    "spatial": tomllib.loads(shipped_scene_text("spatial-four-cable")),
+    "swivel": tomllib.loads(shipped_scene_text("spatial-four-cable-swivel")),
 }
 
 
 def _from_dict(kind, data):
-    return (scene_from_dict if kind == "planar" else spatial_scene_from_dict)(data)
+    return scene_from_dict(data)  # planar or spatial alike
 
 
 @pytest.mark.parametrize("kind, path, field", [
@@ -304,10 +312,9 @@ def test_a_point_mass_needs_no_inertia_and_a_point_exit_no_pulley_radius():
     pulley centre (cable_exit = "point") never touches the pulley."""
     spatial = copy.deepcopy(SCENE_DATA["swivel"])  # a point-mass platform
     assert "inertia" not in spatial["platform"]
-    assert spatial_scene_from_dict(spatial).platform.inertia == (0.0, 0.0, 0.0)
+    assert scene_from_dict(spatial).platform.inertia == (0.0, 0.0, 0.0)
     planar = load_scene("paper-catenary-fixed").to_dict()
-    for pulley in planar["pulleys"]:
-        del pulley["radius"], pulley["side"]
+    assert all(set(pulley) == {"center"} for pulley in planar["pulleys"])  # a point exit is its centre
     del planar["platform"]["inertia"]
     assert scene_from_dict(planar).platform.is_point_mass
 
@@ -387,20 +394,13 @@ PUBLIC_CALLS = {
     "pulley_exit radius negative": (lambda: kinematics.pulley_exit((0, 0), -1, -1, [1, -1]), SceneError, "radius must be >= 0"),
     "pulley_exit radius array": (lambda: kinematics.pulley_exit((0, 0), [1, 2], -1, [1, -1]), SceneError, "radius must be a scalar"),
     "pulley_exit center None": (lambda: kinematics.pulley_exit(None, 0.25, -1, [1, -1]), SceneError, "center"),
-    "ideal_cable_length anchor inf": (lambda: kinematics.ideal_cable_length(*PULLEY, [INF, -1]), SceneError, "anchor must be finite"),
-    "ideal_cable_length_rate shape": (lambda: kinematics.ideal_cable_length_rate(*PULLEY, [0, -2], [1, 2, 3]), SceneError, "anchor_velocity"),
-    "inverse_kinematics sides length": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, CENTERS, 0.25, [1]), SceneError, "sides"),
-    "inverse_kinematics side text": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, CENTERS, 0.25, ["a", "b"]), SceneError, r"sides\[0\]"),
-    "inverse_kinematics radii negative": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, CENTERS, -0.25, [-1, 1]), SceneError, "pulley_radii"),
-    "inverse_kinematics centers shape": (lambda: kinematics.inverse_kinematics([0, -2, 0], ANCHORS, [[0, 0]], 0.25, [-1, 1]), SceneError, "pulley_centers"),
-    "inverse_kinematics unreachable": (lambda: kinematics.inverse_kinematics([-1.6, -0.1, 0], ANCHORS, CENTERS, 0.25, [-1, 1]), UnreachableError, "inside the pulley"),
+    "pulley_exit anchor inf": (lambda: kinematics.pulley_exit(*PULLEY, [INF, -1]), SceneError, "anchor must be finite"),
     "structure_matrix units shape": (lambda: kinematics.structure_matrix([0, 0, 0], ANCHORS, [[1, 0]] * 3), SceneError, "unit_vectors"),
     "straight_cable_nodes n 0": (lambda: kinematics.straight_cable_nodes([0, 0], [1, 1], 0), SceneError, "n_elements"),
     "straight_cable_nodes n 2.5": (lambda: kinematics.straight_cable_nodes([0, 0], [1, 1], 2.5), SceneError, "n_elements"),
     "initial_cable_nodes element 0": (lambda: kinematics.initial_cable_nodes(*PULLEY, [0, -2], 0.0, 4), SceneError, "element_length"),
     "initial_cable_nodes element NaN": (lambda: kinematics.initial_cable_nodes(*PULLEY, [0, -2], NAN, 4), SceneError, "element_length"),
-    "point_exit_inverse_kinematics shape": (lambda: kinematics.point_exit_inverse_kinematics([0, 0, 0], ANCHORS, [[0, 0]]), SceneError, "pulley_centers"),
-    "hang_point side 2": (lambda: kinematics.hang_point((0, 0), 0.25, 2), SceneError, "side"),
+    "pulley_exit side 2": (lambda: kinematics.pulley_exit((0, 0), 0.25, 2, [1.0, -1.0]), SceneError, "side"),
     "CatenaryCable length negative": (lambda: catenary.CatenaryCable(-1, 1, 1), SceneError, "unstrained_length must be positive"),
     "CatenaryCable weight NaN": (lambda: catenary.CatenaryCable(1, NAN, 1), SceneError, "weight_per_length must be finite"),
     "CatenaryCable length text": (lambda: catenary.CatenaryCable("a", 1, 1), SceneError, "unstrained_length must be a real number"),
@@ -488,13 +488,13 @@ def test_former_validation_gaps_are_refused_with_scene_error(name):
 NUMPY_VALUES = {
     "PlatformSpec mass": lambda: PlatformSpec(mass=np.float64(-2.0)),
     "CableSpec n_elements": lambda: CableSpec(n_elements=np.int64(1)),
-    "PulleySpec side": lambda: PulleySpec(side=np.int64(0)),
+    "Pulley side": lambda: Pulley(side=np.int64(0)),
     "SolverSpec spectral_radius": lambda: SolverSpec(spectral_radius=np.float64(1.5)),
     "CircleTrajectory radius": lambda: CircleTrajectory(radius=np.float64(-2.0)),
     "PointToPointTrajectory end": lambda: PointToPointTrajectory(end=np.array([0.0, -1.6])),
-    "SpatialPlatformSpec mass": lambda: _spatial_platform(mass=np.float64(-2.0)),
-    "SpatialPlatformSpec inertia": lambda: _spatial_platform(inertia=np.array([-1.0, 1.0, 1.0])),
-    "SwivelSpec radius": lambda: _swivel(radius=np.float64(-0.1)),
+    "spatial PlatformSpec mass": lambda: _spatial_platform(mass=np.float64(-2.0)),
+    "spatial PlatformSpec inertia": lambda: _spatial_platform(inertia=np.array([-1.0, 1.0, 1.0])),
+    "Swivel radius": lambda: Swivel(inlet=(0.0, 0.0, 0.0), radius=np.float64(-0.1)),
     "real_array NaN": lambda: _validation().real_array("x", np.array([np.nan, 1.0])),
     "per_item negative": lambda: _validation().per_item("x", np.array([-1.0, 1.0]), 2),
     "CatenaryCable length": lambda: catenary.CatenaryCable(np.float64(-1.0), 1.0, 1.0),
@@ -505,15 +505,7 @@ NUMPY_VALUES = {
 
 
 def _spatial_platform(**changes):
-    from cdpr_exu.scenes.spatial_scene import SpatialPlatformSpec
-
-    return SpatialPlatformSpec(**{"mass": 5.0, "inertia": (1.0, 1.0, 1.0), "anchors": ((0.1, 0.0, 0.0),), **changes})
-
-
-def _swivel(**changes):
-    from cdpr_exu.scenes.spatial_scene import SwivelSpec
-
-    return SwivelSpec(**{"inlet": (0.0, 0.0, 0.0), **changes})
+    return PlatformSpec(**{"mass": 5.0, "inertia": (1.0, 1.0, 1.0), "anchors": ((0.1, 0.0, 0.0),), **changes})
 
 
 def _validation():
@@ -613,7 +605,7 @@ def malformed_scene_dicts(draw):
 
 #: Spatial scenes as plain data: a rigid platform on point exits (no trajectory), a point mass
 #: over swivel pulleys (with trajectory, solver and winch).
-SPATIAL_DICTS = [load_any_scene(name).to_dict() for name in ("spatial-four-cable", "spatial-four-cable-swivel")]
+SPATIAL_DICTS = [load_scene(name).to_dict() for name in ("spatial-four-cable", "spatial-four-cable-swivel")]
 SPATIAL_PATHS = [sorted(_paths(base), key=repr) for base in SPATIAL_DICTS]
 SPATIAL_NUMBER_PATHS = [_number_paths(base, paths) for base, paths in zip(SPATIAL_DICTS, SPATIAL_PATHS)]
 
@@ -663,7 +655,7 @@ def test_malformed_spatial_scenes_are_refused_with_the_projects_errors_only(data
     from cdpr_exu.run.spatial_run import check_spatial_reference
 
     try:
-        scene = spatial_scene_from_dict(data)
+        scene = scene_from_dict(data)
         if scene.trajectory is not None:
             check_spatial_reference(scene)
     except (SceneError, UnreachableError) as err:
@@ -678,9 +670,10 @@ FUZZ_FINDINGS = [
     (1, ("trajectory", "angular_rate"), 1e300, "trajectory is out of floating-point range: its acceleration at "
      "t = 0.010 s is [-inf, inf, 0.0]"),  # ValueError in nnls
     (1, ("cables", 0, "unstrained_length"), 1e308, "it would take inf, more than the 300 allowed"),  # OverflowError
-    (0, ("platform", "anchors"), True, "platform.anchors must be a list of (x, y, z) points, got True"),  # TypeError
+    (0, ("platform", "anchors"), True, "platform.anchors must be a list of (x, z) pairs, shape (m, 2), or of "
+     "(x, y, z) points, shape (m, 3), got True"),  # TypeError
     (0, ("exits", 1, "point"), [1.5, 1.5, 0.0], "share the exit_point [1.5, 1.5, 0.0] m"),  # np.float64(1.5)
-    (0, ("dimension",), None, "dimension must be 3 for a spatial scene, got None"),
+    (0, ("dimension",), None, "dimension must be 2 (planar) or 3 (spatial), got None"),
     (1, ("cables", 0, "linear_density"), 1e308, "give a weight per length of inf N/m"),  # 'weight_per_length'
 ]
 
@@ -692,7 +685,7 @@ def test_what_the_spatial_fuzz_found_is_refused_naming_the_field(k, path, value,
     data = copy.deepcopy(SPATIAL_DICTS[k])
     _get(data, path[:-1])[path[-1]] = value
     with pytest.raises((SceneError, UnreachableError), match=re.escape(words)):
-        scene = spatial_scene_from_dict(data)
+        scene = scene_from_dict(data)
         check_spatial_reference(scene)
 
 

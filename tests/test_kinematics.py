@@ -4,18 +4,15 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.exits import PointExit, Pulley
+from cdpr_exu.scenes.scene import PlatformSpec, Scene, WinchSpec
 from cdpr_exu.statics.kinematics import (
     anchor_points,
     anchor_velocities,
-    cable_unit_vectors,
-    hang_point,
-    ideal_cable_length,
-    ideal_cable_length_rate,
+    cable_exits,
+    ideal_paid_out,
     initial_cable_nodes,
-    inverse_kinematics,
-    inverse_kinematics_rates,
     planar_cross,
-    point_exit_inverse_kinematics,
     pulley_exit,
     rotation_matrix,
     straight_cable_nodes,
@@ -36,6 +33,22 @@ POSES = np.array([[0.0, -2.0, 0.0], [0.3, -1.4, 0.2], [-0.5, -2.5, -0.3], [0.1, 
 
 def paper_cable_1_exit():
     return pulley_exit(PULLEY_CENTERS[0], PULLEY_RADIUS, -1, PAPER_ANCHOR_1)
+
+
+def paper_robot(radius: float = PULLEY_RADIUS) -> Scene:
+    """The paper's robot over pulleys of ``radius`` (0: point exits at their centres)."""
+    exits = tuple(Pulley(c, radius, s) if radius > 0 else PointExit(c) for c, s in zip(PULLEY_CENTERS, SIDES))
+    return Scene(exits=exits, platform=PlatformSpec(anchors=ANCHORS),
+                 winch=WinchSpec(kind="kinematic" if radius > 0 else "fixed"))
+
+
+def lengths(poses, radius: float = PULLEY_RADIUS):
+    return ideal_paid_out(paper_robot(radius), poses)[0]
+
+
+def pulls(poses, radius: float = PULLEY_RADIUS):
+    """Unit vectors from each anchor towards its exit, (m, 2) or (N, m, 2): the directions of pull."""
+    return -np.stack([e.unit_vector for e in cable_exits(paper_robot(radius), poses)], axis=-2)
 
 
 # ----------------------------------------------------------------------------------
@@ -69,8 +82,8 @@ def test_rotation_matrix_rotates_counter_clockwise_and_cross_is_its_moment():
 
 
 def test_hang_point_is_on_the_side_of_the_pulley():
-    np.testing.assert_array_equal(hang_point((-1.75, 0.0), 0.25, -1), [-2.0, 0.0])
-    np.testing.assert_array_equal(hang_point((1.75, 0.0), 0.25, 1), [2.0, 0.0])
+    np.testing.assert_array_equal(Pulley((-1.75, 0.0), 0.25, -1).hang_point, [-2.0, 0.0])
+    np.testing.assert_array_equal(Pulley((1.75, 0.0), 0.25, 1).hang_point, [2.0, 0.0])
 
 
 # ----------------------------------------------------------------------------------
@@ -154,18 +167,18 @@ def test_length_rate_is_u_dot_v_by_finite_differences(radius, anchor):
     velocity, step = np.array([0.4, 0.7]), 1e-6
     anchor = np.asarray(anchor)
     numeric = (
-        ideal_cable_length(center, radius, side, anchor + step * velocity)
-        - ideal_cable_length(center, radius, side, anchor - step * velocity)
+        pulley_exit(center, radius, side, anchor + step * velocity).cable_length
+        - pulley_exit(center, radius, side, anchor - step * velocity).cable_length
     ) / (2 * step)
     # central difference: truncation ~ step^2 * curvature ~ 1e-12, rounding ~ 1e-16 / step = 1e-10
-    assert ideal_cable_length_rate(center, radius, side, anchor, velocity) == pytest.approx(numeric, abs=1e-8)
+    assert pulley_exit(center, radius, side, anchor).unit_vector @ velocity == pytest.approx(numeric, abs=1e-8)
 
 
 def test_anchor_inside_the_pulley_is_unreachable():
     with pytest.raises(UnreachableError, match="inside the pulley"):
         pulley_exit((0.0, 0.0), 0.25, -1, (0.1, 0.1))
     with pytest.raises(UnreachableError):
-        inverse_kinematics([-1.6, 0.0, 0.0], ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
+        lengths([-1.6, 0.0, 0.0])
 
 
 @pytest.mark.parametrize(
@@ -185,33 +198,31 @@ def test_bad_pulley_arguments_raise_scene_error_naming_them(args, name):
 
 
 # ----------------------------------------------------------------------------------
-# the whole robot
+# the whole robot, through its exits
 # ----------------------------------------------------------------------------------
 def test_inverse_kinematics_of_the_paper_pose_is_symmetric():
-    lengths = inverse_kinematics(PAPER_POSE, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
-    assert lengths == pytest.approx([paper_cable_1_exit().cable_length] * 2, abs=1e-14)
+    assert lengths(PAPER_POSE) == pytest.approx([paper_cable_1_exit().cable_length] * 2, abs=1e-14)
 
 
 def test_inverse_kinematics_vectorised_over_poses_matches_single_calls():
-    stacked = inverse_kinematics(POSES, ANCHORS, PULLEY_CENTERS, [0.25, 0.25], SIDES)
+    stacked = lengths(POSES)
     assert stacked.shape == (len(POSES), 2)
-    for pose, lengths in zip(POSES, stacked):
-        np.testing.assert_array_equal(lengths, inverse_kinematics(pose, ANCHORS, PULLEY_CENTERS, 0.25, SIDES))
+    for pose, single in zip(POSES, stacked):
+        np.testing.assert_array_equal(single, lengths(pose))
 
 
-def test_zero_radius_inverse_kinematics_equals_point_exit_distances():
-    with_zero_radius = inverse_kinematics(POSES, ANCHORS, PULLEY_CENTERS, 0.0, SIDES)
-    np.testing.assert_allclose(with_zero_radius, point_exit_inverse_kinematics(POSES, ANCHORS, PULLEY_CENTERS), atol=1e-15)
+def test_point_exit_inverse_kinematics_are_the_distances():
+    distances = np.linalg.norm(anchor_points(POSES, ANCHORS) - PULLEY_CENTERS, axis=-1)
+    np.testing.assert_allclose(lengths(POSES, radius=0.0), distances, atol=1e-15)
 
 
 def test_inverse_kinematics_rates_are_finite_difference_of_lengths():
-    rate, step = np.array([0.3, -0.5, 0.8]), 1e-6
+    rate, step, robot = np.array([0.3, -0.5, 0.8]), 1e-6, paper_robot()
     for pose in POSES:
-        plus = inverse_kinematics(pose + step * rate, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
-        minus = inverse_kinematics(pose - step * rate, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
-        analytic = inverse_kinematics_rates(pose, rate, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
+        analytic = ideal_paid_out(robot, pose, rate)[1]
         # truncation ~ step^2, rounding ~ 1e-16 / step = 1e-10
-        np.testing.assert_allclose(analytic, (plus - minus) / (2 * step), atol=1e-8)
+        np.testing.assert_allclose(analytic, (lengths(pose + step * rate) - lengths(pose - step * rate)) / (2 * step),
+                                   atol=1e-8)
 
 
 def test_structure_matrix_matches_a_hand_computation():
@@ -226,15 +237,13 @@ def test_structure_matrix_matches_a_hand_computation():
 def test_structure_matrix_transpose_maps_twist_to_minus_length_rates():
     rate = np.array([0.3, -0.5, 0.8])
     for pose in POSES:
-        units = cable_unit_vectors(pose, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
-        matrix = structure_matrix(pose, ANCHORS, units)
-        rates = inverse_kinematics_rates(pose, rate, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
+        matrix = structure_matrix(pose, ANCHORS, pulls(pose))
+        rates = ideal_paid_out(paper_robot(), pose, rate)[1]
         np.testing.assert_allclose(-matrix.T @ rate, rates, atol=1e-14)  # same formula, rounding only
 
 
 def test_paper_platform_at_rest_hangs_on_equal_upward_tensions():
-    units = cable_unit_vectors(PAPER_POSE, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
-    matrix = structure_matrix(PAPER_POSE, ANCHORS, units)
+    matrix = structure_matrix(PAPER_POSE, ANCHORS, pulls(PAPER_POSE))
     weight = np.array([0.0, -2.5 * 9.8, 0.0])
     tensions = np.linalg.lstsq(matrix, -weight, rcond=None)[0]
     assert np.all(tensions > 0.0)
@@ -243,7 +252,7 @@ def test_paper_platform_at_rest_hangs_on_equal_upward_tensions():
 
 
 def test_structure_matrix_vectorised_over_poses():
-    units = cable_unit_vectors(POSES, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
+    units = pulls(POSES)
     stacked = structure_matrix(POSES, ANCHORS, units)
     assert stacked.shape == (len(POSES), 3, 2)
     np.testing.assert_array_equal(stacked[1], structure_matrix(POSES[1], ANCHORS, units[1]))
@@ -251,13 +260,7 @@ def test_structure_matrix_vectorised_over_poses():
 
 def test_bad_robot_arguments_raise_scene_error_naming_them():
     with pytest.raises(SceneError, match="pose"):
-        inverse_kinematics([0.0, -2.0], ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, SIDES)
-    with pytest.raises(SceneError, match="pulley_centers"):
-        inverse_kinematics(PAPER_POSE, ANCHORS, PULLEY_CENTERS[:1], PULLEY_RADIUS, SIDES)
-    with pytest.raises(SceneError, match="pulley_radii"):
-        inverse_kinematics(PAPER_POSE, ANCHORS, PULLEY_CENTERS, [0.25, -0.25], SIDES)
-    with pytest.raises(SceneError, match=r"sides\[1\]"):
-        inverse_kinematics(PAPER_POSE, ANCHORS, PULLEY_CENTERS, PULLEY_RADIUS, [-1, 2])
+        lengths([0.0, -2.0])
     with pytest.raises(SceneError, match="unit_vectors"):
         structure_matrix(PAPER_POSE, ANCHORS, np.ones((3, 2)))
 

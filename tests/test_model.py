@@ -16,7 +16,8 @@ import pytest
 from cdpr_exu.builder.cable import element_tensions
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.builder.model import build_model, contact_candidates
-from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, load_scene
+from cdpr_exu.exits import Pulley
+from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, Scene, SolverSpec, load_scene
 from cdpr_exu.run.simulate import simulate, solver_settings
 from cdpr_exu.scenes.trajectories import CircleTrajectory
 
@@ -301,12 +302,13 @@ def test_stretch_of_a_straight_cable_is_linear_in_the_load(hanging_cable):
         (lambda: CableSpec(n_elements=1), "cable.n_elements"),
         (lambda: CableSpec(n_elements=0), "cable.n_elements"),
         (lambda: CableSpec(n_elements=2.5), "cable.n_elements"),
-        (lambda: PulleySpec(radius=0.0), "pulley.radius"),
-        (lambda: PulleySpec(radius=-0.25), "pulley.radius"),
-        (lambda: PulleySpec(contact_stiffness=0.0), "pulley.contact_stiffness"),
-        (lambda: PulleySpec(contact_stiffness=-1e7), "pulley.contact_stiffness"),
-        (lambda: PulleySpec(side=0), "pulley.side"),
-        (lambda: PlatformSpec(anchors=((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))), "platform.anchors"),
+        (lambda: Pulley(radius=0.0), "pulley.radius"),
+        (lambda: Pulley(radius=-0.25), "pulley.radius"),
+        (lambda: Pulley(contact_stiffness=0.0), "pulley.contact_stiffness"),
+        (lambda: Pulley(contact_stiffness=-1e7), "pulley.contact_stiffness"),
+        (lambda: Pulley(side=0), "pulley.side"),
+        (lambda: Scene(platform=PlatformSpec(anchors=((0.0, 0.0, 0.0), (1.0, 1.0, 1.0)), inertia=(1.0, 1.0, 1.0))),
+         "platform.anchors"),
         (lambda: PlatformSpec(anchors=(0.15, 0.1)), "platform.anchors"),
         (lambda: PlatformSpec(anchors=()), "platform.anchors"),
         (lambda: Scene(platform=PlatformSpec(anchors=((0.0, 0.0),))), "platform.anchors"),
@@ -315,7 +317,7 @@ def test_stretch_of_a_straight_cable_is_linear_in_the_load(hanging_cable):
         (lambda: PlatformSpec(mass=math.nan), "platform.mass"),
         (lambda: PlatformSpec(initial_pose=(0.0, math.nan, 0.0)), "platform.initial_pose"),
         (lambda: PlatformSpec(anchors=((0.0, math.nan), (0.1, 0.1))), "platform.anchors"),
-        (lambda: PulleySpec(center=(math.nan, 0.0)), "pulley.center"),
+        (lambda: Pulley(center=(math.nan, 0.0)), "pulley.center"),
         (lambda: Scene(gravity=math.nan), "gravity"),
         (lambda: SolverSpec(step_size=0.0), "solver.step_size"),
         (lambda: SolverSpec(step_size=math.nan), "solver.step_size"),

@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, seed, settings
 
 from cdpr_exu.core.errors import CdprError
 from cdpr_exu.scenes.scene import scene_from_dict
-from cdpr_exu.scenes.spatial_scene import spatial_scene_from_dict
+from cdpr_exu.scenes.scene import scene_from_dict
 from cdpr_exu.statics.workspace import check_reference
 from test_input_validation import malformed_scene_dicts, malformed_spatial_scene_dicts
 
@@ -59,7 +59,7 @@ def test_every_refusal_of_a_malformed_spatial_scene_names_a_field_path(data):
     from cdpr_exu.run.spatial_run import check_spatial_reference
 
     try:
-        scene = spatial_scene_from_dict(data)
+        scene = scene_from_dict(data)
         if scene.trajectory is not None:
             check_spatial_reference(scene)
     except CdprError as err:

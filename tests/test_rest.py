@@ -81,7 +81,7 @@ def test_fixed_end_free_span_is_the_whole_cable(fixed):
     for i, cable in enumerate(scene.cables):
         assert rest.first_free_node[i] == 0
         np.testing.assert_array_equal(rest.upper_points_m[i], rest.nodes[i][0])
-        np.testing.assert_allclose(rest.upper_points_m[i], scene.pulleys[i].center, atol=1e-12)
+        np.testing.assert_allclose(rest.upper_points_m[i], scene.exits[i].point, atol=1e-12)
         polygon = np.linalg.norm(np.diff(rest.nodes[i], axis=0), axis=1).sum()
         assert rest.cable_stretched_length_m[i] == pytest.approx(polygon, rel=1e-15)
         assert rest.cable_unstrained_length_m[i] == cable.unstrained_length
@@ -91,7 +91,7 @@ def test_fixed_end_free_span_is_the_whole_cable(fixed):
 
 def test_pulley_free_span_starts_where_the_cable_leaves_the_rim(pulleys):
     scene, rest = pulleys
-    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
+    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.exits)):
         first = rest.first_free_node[i]
         assert 0 < first < cable.n_elements
         center = np.asarray(pulley.center)

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.exits import Pulley
 from cdpr_exu.scenes.scene import (
-    CableSpec, Effects, PlatformSpec, PulleySpec, Scene, SolverSpec, load_scene, save_scene,
+    CableSpec, Effects, PlatformSpec, Scene, SolverSpec, load_scene, save_scene,
     scene_from_dict, shipped_scenes,
 )
 from cdpr_exu.scenes.trajectories import CircleTrajectory
@@ -24,7 +25,7 @@ def test_paper_circle_is_shipped_and_has_table_2_parameters():
     assert cable.bending_damping == pytest.approx(1.96, rel=3e-3)
     assert cable.element_mass == pytest.approx(0.0875, rel=1e-12)
     assert scene.platform.mass == 2.5 and scene.platform.inertia == 0.0271
-    assert scene.pulleys[0].center == (-1.75, 0.0) and scene.pulleys[1].center == (1.75, 0.0)
+    assert scene.exits[0].center == (-1.75, 0.0) and scene.exits[1].center == (1.75, 0.0)
     assert isinstance(scene.trajectory, CircleTrajectory)
     np.testing.assert_allclose(scene.trajectory.pose(0.0), [0.0, -2.0, 0.0], atol=1e-15)
     assert "paper-circle" in shipped_scenes()
@@ -58,14 +59,16 @@ def test_node_masses_add_up_to_the_cable_mass_or_one_half_element_more(lumping):
         (lambda: CableSpec(n_elements=0), "cable.n_elements"),
         (lambda: CableSpec(n_elements=2.5), "cable.n_elements"),
         (lambda: CableSpec(mass_lumping="lumpy"), "cable.mass_lumping"),
-        (lambda: PulleySpec(radius=0.0), "pulley.radius"),
-        (lambda: PulleySpec(contact_stiffness=-1e7), "pulley.contact_stiffness"),
-        (lambda: PulleySpec(side=0), "pulley.side"),
-        (lambda: PulleySpec(center=(0.0,)), "pulley.center"),
+        (lambda: Pulley(radius=0.0), "pulley.radius"),
+        (lambda: Pulley(contact_stiffness=-1e7), "pulley.contact_stiffness"),
+        (lambda: Pulley(side=0), "pulley.side"),
+        (lambda: Pulley(center=(0.0,)), "pulley.center"),
         (lambda: PlatformSpec(mass=-2.5), "platform.mass"),
         (lambda: PlatformSpec(mass=0.0), "platform.mass"),
         (lambda: PlatformSpec(inertia=float("inf")), "platform.inertia"),
-        (lambda: PlatformSpec(anchors=((0.1, 0.2, 0.3),)), "platform.anchors"),
+        (lambda: PlatformSpec(anchors=((0.1, 0.2, 0.3, 0.4),)), "platform.anchors"),
+        (lambda: Scene(platform=PlatformSpec(anchors=((0.1, 0.2, 0.3),) * 2, inertia=(1.0, 1.0, 1.0))),
+         "platform.anchors"),  # a spatial platform in a planar scene
         (lambda: PlatformSpec(anchors=(0.1, 0.2)), "platform.anchors"),
         (lambda: PlatformSpec(initial_pose=(0.0, float("nan"), 0.0)), "platform.initial_pose"),
         (lambda: SolverSpec(step_size=0.0), "solver.step_size"),
@@ -205,3 +208,82 @@ def test_an_initial_pose_above_the_pulleys_is_refused_naming_it_before_any_run()
     assert "cables cannot push" in message
     data["gravity"] = 0.0  # without weight nothing has to hold it up: not this refusal
     assert scene_from_dict(data).platform.initial_pose == (0.0, 0.3, 0.0)
+
+
+# --------------------------------------------------------------------------- one scene, both dimensions (issue 24)
+
+
+def test_the_public_load_scene_loads_both_dimensions_into_the_one_scene_class():
+    import cdpr_exu
+    from cdpr_exu.space import PLANE, SPACE
+
+    planar, spatial = cdpr_exu.load_scene("paper-circle"), cdpr_exu.load_scene("spatial-cogiro")
+    assert type(planar) is type(spatial) is cdpr_exu.Scene
+    assert (planar.dimension, planar.space, spatial.dimension, spatial.space) == (2, PLANE, 3, SPACE)
+    assert {"paper-circle", "spatial-cogiro"} <= set(cdpr_exu.shipped_scenes())
+    assert cdpr_exu.shipped_scenes() == sorted(cdpr_exu.shipped_scenes())
+
+
+@pytest.mark.parametrize("name", shipped_scenes())
+def test_every_shipped_scene_saves_in_its_form_and_loads_back_equal(name, tmp_path):
+    scene = load_scene(name)
+    text = save_scene(scene, tmp_path / "scene.toml").read_text()
+    planar_form = scene.dimension == 2  # the shipped planar scenes have all pulleys or all point exits
+    assert ("[[pulleys]]" in text, "cable_exit" in text, "[[exits]]" in text) == (planar_form, planar_form,
+                                                                                 not planar_form)
+    assert load_scene(tmp_path / "scene.toml") == scene
+
+
+@pytest.mark.parametrize("name, table", [
+    ("paper-circle", lambda pulley: {"kind": "pulley", **pulley}),
+    ("paper-catenary-fixed", lambda pulley: {"point": pulley["center"]}),  # kind = "point", the default
+])
+def test_a_planar_scene_in_the_exits_form_is_the_scene_of_its_planar_form(name, table):
+    planar = load_scene(name)
+    data = planar.to_dict()
+    data["exits"] = [table(pulley) for pulley in data.pop("pulleys")]
+    del data["cable_exit"]
+    assert scene_from_dict(data) == planar
+    data["dimension"] = 2
+    assert scene_from_dict(data) == planar
+
+
+def test_a_planar_scene_takes_exits_that_all_wrap_or_all_none():
+    from cdpr_exu.exits import PointExit
+
+    scene = load_scene("paper-catenary-fixed")
+    assert scene.exits_table == "pulleys"
+    # the planar builder lays every cable over its pulley, or every cable from its point, so far
+    with pytest.raises(SceneError, match="cable 1 leaves a point while cable 0 wraps"):
+        scene.with_changes(exits=(Pulley((-1.75, 0.0), 0.25, -1), PointExit((1.75, 0.0))))
+
+
+@pytest.mark.parametrize("data, words", [
+    ({"dimension": 3, "pulleys": [{"center": [0.0, 0.0]}]}, "scene has unknown field(s) ['pulleys']"),
+    ({"dimension": 3, "cable_exit": "point", "exits": []}, "scene has unknown field(s) ['cable_exit']"),
+    ({"dimension": 2, "exits": [{"kind": "swivel", "inlet": [0.0, 0.0, 0.0]}]},
+     "exits[0].kind = 'swivel': no such exit in a planar scene"),
+    ({"dimension": 3, "exits": [{"point": [0.0, 0.0]}]}, "exits[0].point must be a finite 3-vector (x, y, z) [m]"),
+    ({"dimension": 2, "exits": [{"point": [0.0, 0.0]}], "cables": [{}], "platform": {}},
+     "lacks trajectory: a scene file must give [trajectory]"),
+    ({"dimension": 3, "exits": [{"point": [0.0, 0.0, 0.0]}], "platform": {}}, "lacks cables"),
+])
+def test_each_form_takes_its_own_tables_in_its_dimension(data, words):
+    with pytest.raises(SceneError) as caught:
+        scene_from_dict({"name": "x", **data})
+    assert words in str(caught.value)
+
+
+def test_a_scene_and_its_platform_are_of_one_dimension():
+    spatial = load_scene("spatial-four-cable")
+    assert spatial.platform.space is spatial.space and spatial.platform.initial_pose is None
+    assert spatial.platform.size is None and len(spatial.platform.inertia) == 3
+    with pytest.raises(SceneError, match=r"platform.anchors must be \(x, y, z\) points in a spatial scene"):
+        spatial.with_changes(platform=PlatformSpec(mass=5.0, anchors=((0.0, 0.0),) * 4))
+    with pytest.raises(SceneError, match=r"platform.anchors must be \(x, z\) points in a planar scene"):
+        spatial.with_changes(dimension=2)
+    with pytest.raises(SceneError, match=r"exits\[0\] is a 3-D 'point' exit; a planar scene"):
+        spatial.with_changes(dimension=2, platform=PlatformSpec(mass=5.0, anchors=((0.0, 0.0),) * 4))
+    planar = load_scene("paper-circle")
+    assert planar.platform.size == (0.3, 0.2) and planar.exit_points.shape == (2, 2)
+    assert spatial.exit_points.shape == (4, 3) and spatial.exit_tops.tolist() == spatial.exit_points[:, 2].tolist()

@@ -247,13 +247,13 @@ def test_paper_circle_with_segment_contact_keeps_every_element_out_of_the_pulley
     """
     scene, result = segment_run(15)
     assert result.status == "completed"
-    worst = max(segment_penetration(p, x).max() for p, nodes in zip(scene.pulleys, result.nodes) for x in nodes)
+    worst = max(segment_penetration(p, x).max() for p, nodes in zip(scene.exits, result.nodes) for x in nodes)
     assert worst < 1.0e-3
     # Free span: elements below the pulleys, on the platform's side of the pulley centre.
     # They hang the 2.5 kg platform (about 12 N each at rest); at t = 0 every element is
     # unstrained (zero tension), so from the first output time on.
     later = result.time > 0.0
-    for i, (pulley, nodes, tensions) in enumerate(zip(scene.pulleys, result.nodes, result.tensions)):
+    for i, (pulley, nodes, tensions) in enumerate(zip(scene.exits, result.nodes, result.tensions)):
         a, b = nodes[later, :-1], nodes[later, 1:]
         free = (np.maximum(a[..., 1], b[..., 1]) < pulley.center[1]) & (
             (0.5 * (a[..., 0] + b[..., 0]) - pulley.center[0]) * pulley.side < 0)
@@ -273,7 +273,7 @@ def test_cables_node_contact_refuses_as_too_coarse_run_with_segment_contact(n_el
         build_model(node)
     scene, result = segment_run(n_elements)
     assert result.status == "completed"
-    worst = max(segment_penetration(p, x).max() for p, nodes in zip(scene.pulleys, result.nodes) for x in nodes)
+    worst = max(segment_penetration(p, x).max() for p, nodes in zip(scene.exits, result.nodes) for x in nodes)
     assert worst < 1.0e-3
     assert np.abs(result.error[:, :2]).max() < 0.2  # on the circle, not thrown off it
 
@@ -281,6 +281,6 @@ def test_cables_node_contact_refuses_as_too_coarse_run_with_segment_contact(n_el
 def test_the_monitor_still_stops_a_cable_slipping_through_a_soft_segment_contact():
     """k_p = 100 N/m cannot carry tensions of ~20 N: the cable sinks into the pulley and the
     run is stopped once an element cuts half a radius deep."""
-    scene = segment_scene().with_changes(pulleys=tuple(replace(p, contact_stiffness=100.0) for p in PAPER.pulleys))
+    scene = segment_scene().with_changes(exits=tuple(replace(p, contact_stiffness=100.0) for p in PAPER.exits))
     with pytest.raises(SolverFailure, match=r"cuts \d+ mm deep into pulley .*contact_stiffness"):
         simulate(scene)

@@ -75,7 +75,7 @@ def free_span_elements(scene, result, cable_index, rim_margin=1e-3):
     span is every element after the last such node (both its nodes off the pulley,
     on the platform side).
     """
-    pulley = scene.pulleys[cable_index]
+    pulley = scene.exits[cable_index]
     nodes = result.nodes[cable_index]
     distance = np.linalg.norm(nodes - np.asarray(pulley.center), axis=-1)
     on_pulley = distance < pulley.radius + rim_margin
@@ -103,7 +103,7 @@ def test_paper_scene_runs_ten_seconds_without_nan(paper_run):
 @pytest.mark.slow
 def test_paper_scene_nodes_stay_outside_the_pulleys_to_within_the_contact_compliance(paper_run):
     scene, result = paper_run
-    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
+    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.exits)):
         depth = result.pulley_penetration[:, i].max()
         # The rim pushes a wrapped node out with ~2 T sin(dphi / 2) <= T (the elements
         # turn by dphi ~ l0i / r_p = 1 rad there), so it sinks in by ~T / k_p: with
@@ -120,7 +120,7 @@ def test_every_node_that_reaches_a_pulley_carries_a_contact(paper_run):
     from cdpr_exu.builder.model import contact_candidates
 
     scene, result = paper_run
-    for i, pulley in enumerate(scene.pulleys):
+    for i, pulley in enumerate(scene.exits):
         distance = np.linalg.norm(result.nodes[i] - np.asarray(pulley.center), axis=-1)
         reached = np.flatnonzero((distance < pulley.radius + 0.01).any(axis=0))  # within 1 cm of the rim
         assert len(reached) > 0

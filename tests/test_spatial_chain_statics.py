@@ -6,14 +6,14 @@ import exudyn as exu
 import numpy as np
 import pytest
 
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_statics_robot, set_configuration, solve_static, \
-    swivel_angles
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_statics_robot, scene_chain_spec, set_configuration, \
+    solve_static, swivel_angles
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.run.spatial_rest import PENALTY, solve_spatial_rest
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.statics.spatial_chain_statics import spatial_chain_robot, spatial_chain_statics
 
-FOUR = load_spatial_scene("spatial-four-cable")
+FOUR = load_scene("spatial-four-cable")
 
 
 def _scene(n_elements, bending=True, point_mass=False):
@@ -68,7 +68,7 @@ def test_the_equilibrium_balances_the_platform():
 def test_the_model_is_the_builders():
     scene = _scene(10)
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths, scene.chain_spec())
+    items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths, scene_chain_spec(scene))
     robot = spatial_chain_robot(scene)
     for cable, masses, k, k_theta in zip(robot.cables, items.node_masses, items.axial_stiffnesses,
                                          items.bending_stiffnesses):
@@ -94,7 +94,7 @@ def test_without_bending_the_chains_converge_to_the_catenaries_as_n_squared():
 # ---------------------------------------------------------------------------
 # over swivel pulleys
 # ---------------------------------------------------------------------------
-SWIVEL = load_spatial_scene("spatial-four-cable-swivel")
+SWIVEL = load_scene("spatial-four-cable-swivel")
 
 
 def _swivel_scene(asymmetric=True, rigid=False):
@@ -112,7 +112,7 @@ def _swivel_scene(asymmetric=True, rigid=False):
 def _exudyn_robot(scene, anchor_spring_factor=None, tension_only=False):
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
-                                scene.chain_spec(anchor_spring_factor, tension_only), swivels=scene.swivel_exits)
+                                scene_chain_spec(scene, anchor_spring_factor, tension_only), swivels=scene.swivel_exits)
     mbs.Assemble()
     return mbs, items
 
@@ -143,7 +143,7 @@ def test_over_swivel_pulleys_exudyns_static_solver_accepts_the_chain_statics_equ
         assert np.linalg.norm(chain.rotation_vector) > 0.01
     # the wraps are on the discs: each pulley turned within 2 degrees of its anchor's azimuth
     azimuths = [np.arctan2(*(a - s.inlet)[1::-1]) for a, s in
-                zip(chain.position + np.asarray(scene.platform.anchors) @ chain.rotation.T, scene.swivels)]
+                zip(chain.position + np.asarray(scene.platform.anchors) @ chain.rotation.T, scene.exits)]
     assert np.degrees(np.abs(chain.swivel_angles - azimuths)).max() < 2.0
 
 
@@ -249,7 +249,7 @@ def sp_energy(positions, psi, nodes, pulley):
 
 # --- the inverse: lengths whose chains hold a pose -------------------------------------------------
 
-IPANEMA = load_spatial_scene("spatial-ipanema")
+IPANEMA = load_scene("spatial-ipanema")
 
 
 def _ipanema(n_elements=10):
@@ -344,7 +344,7 @@ def test_over_swivel_pulleys_the_held_chains_force_rate_is_the_derivative_of_pay
     assert np.abs(chain.force_rate - numeric).max() < 1e-4 * np.abs(numeric).max()
     # the chain hangs in the vertical plane through the axis and the anchor, and the disc turns into it
     # (measured to 1e-16 rad)
-    azimuth = np.arctan2(*(anchor - scene.swivels[1].inlet)[1::-1])
+    azimuth = np.arctan2(*(anchor - scene.exits[1].inlet)[1::-1])
     assert abs(chain.swivel_angle - azimuth) < 1e-9
 
 
@@ -364,7 +364,7 @@ def test_over_swivel_pulleys_the_inverse_chain_statics_give_back_the_rest_and_th
     # distances from the inlets (the controller's start)
     pose = rest.position + [0.01, -0.006, 0.004]
     inertial = -scene.platform.mass * np.array([1.0, -0.5, 0.0])
-    inlets = np.array([s.inlet for s in scene.swivels])
+    inlets = np.array([s.inlet for s in scene.exits])
     start = off + np.linalg.norm(inlets - pose, axis=1) - np.linalg.norm(inlets - rest.position, axis=1)
     inverse = solve_inverse_spatial_chain_statics(robot, pose, rest.tensions_at_anchor, start, rest.nodes,
                                                   np.concatenate([inertial, np.zeros(3)]))
@@ -382,7 +382,7 @@ def _swivel_jump(scene, rest, offset):
     """The pose ``offset`` [m] from the rest of the swivel scene, and the paid-out lengths changed as the straight
     distances from the inlets (the chain controller's start)."""
     pose = rest.position + np.asarray(offset, dtype=float)
-    inlets = np.array([s.inlet for s in scene.swivels])
+    inlets = np.array([s.inlet for s in scene.exits])
     lengths = np.asarray(scene.unstrained_lengths) + np.linalg.norm(inlets - pose, axis=1) \
         - np.linalg.norm(inlets - rest.position, axis=1)
     return pose, lengths
@@ -393,7 +393,7 @@ def test_over_a_swivel_pulley_a_held_chain_started_10_cm_away_converges_to_the_c
     import cdpr_exu.statics.spatial_chain_statics as statics
     from cdpr_exu.core.errors import UnreachableError
 
-    scene = load_spatial_scene("spatial-four-cable-swivel")
+    scene = load_scene("spatial-four-cable-swivel")
     robot, rest = spatial_chain_robot(scene), spatial_chain_statics(scene)
     direction = np.array([1.0, -0.6, 0.4]) / np.linalg.norm([1.0, -0.6, 0.4])  # across and up: the hardest way
     pose, lengths = _swivel_jump(scene, rest, 0.1 * direction)
@@ -428,7 +428,7 @@ def test_over_swivel_pulleys_the_inverse_chain_statics_from_the_rest_5_cm_away_h
     from cdpr_exu.statics.spatial_chain_statics import (robot_paid_out, solve_inverse_spatial_chain_statics,
                                                         solve_spatial_chain_statics)
 
-    scene = load_spatial_scene("spatial-four-cable-swivel")
+    scene = load_scene("spatial-four-cable-swivel")
     robot, rest = spatial_chain_robot(scene), spatial_chain_statics(scene)
     # 5.2 cm up and across, started from the rest's chains (without continuation a held chain stalled at 157 N)
     pose, lengths = _swivel_jump(scene, rest, [0.03, -0.03, 0.03])

@@ -7,7 +7,7 @@ import pytest
 
 from cdpr_exu.physics.spatial_kinematics import inverse_kinematics
 from cdpr_exu.run.spatial_run import simulate_spatial
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialPointToPointTrajectory
 from controllers.base import START_BLEND_TIME, WinchCommand, quintic_blend
 from controllers.feedback import ClosedLoopController
@@ -17,7 +17,7 @@ from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 
 def four_cable(n_elements=10, **solver):
     """The shipped four-cable robot, coarser, without bending, at a 10 ms step."""
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     effects = replace(scene.effects, bending=False, bending_damping=False)
     cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
     return replace(scene, cables=cables, effects=effects,
@@ -26,7 +26,7 @@ def four_cable(n_elements=10, **solver):
 
 def ipanema(n_elements=10, **solver):
     """The shipped IPAnema robot (8 taut cables from above and below), coarser, without bending."""
-    scene = load_spatial_scene("spatial-ipanema")
+    scene = load_scene("spatial-ipanema")
     effects = replace(scene.effects, bending=False, bending_damping=False)
     cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
     return replace(scene, cables=cables, effects=effects, solver=replace(scene.solver, **solver))
@@ -160,11 +160,11 @@ def test_the_spatial_loop_removes_most_of_what_ideal_ik_misses():
 
 
 def test_the_spatial_jacobian_is_the_change_of_the_straight_lengths():
-    scene = load_spatial_scene("spatial-cogiro")
+    scene = load_scene("spatial-cogiro")
     feedback = SpatialPositionPI()
     feedback.reset(scene)
     pose = np.array([0.1, -0.05, 2.3, 0.02, -0.01, 0.03])
-    anchors, exits = np.asarray(scene.platform.anchors), np.asarray(scene.exits)
+    anchors, exits = np.asarray(scene.platform.anchors), scene.exit_points
     jacobian = feedback.jacobian(pose)
     from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 
@@ -186,11 +186,11 @@ def test_the_spatial_jacobian_is_the_change_of_the_straight_lengths():
 def test_a_spatial_controller_model_round_trips_and_bad_overrides_are_named():
     from cdpr_exu.core.errors import SceneError
     from cdpr_exu.scenes.scene import ControllerModel
-    from cdpr_exu.scenes.spatial_scene import spatial_scene_from_dict
+    from cdpr_exu.scenes.scene import scene_from_dict
 
-    scene = replace(load_spatial_scene("spatial-ipanema"),
+    scene = replace(load_scene("spatial-ipanema"),
                     controller_model=ControllerModel(platform={"mass": 20.0}, cable={"youngs_modulus": 1.5e11}))
-    again = spatial_scene_from_dict(scene.to_dict())
+    again = scene_from_dict(scene.to_dict())
     assert again.controller_model == scene.controller_model
     model = again.controller_scene()
     assert model.platform.mass == 20.0 and all(c.youngs_modulus == 1.5e11 for c in model.cables)

@@ -10,9 +10,12 @@ from cdpr_exu.statics import kinematics as planar
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import left_jacobian
 from cdpr_exu.physics import cogiro
-from cdpr_exu.physics.spatial_kinematics import (IdealSpatialRobot, SwivelPulley, cable_unit_vectors, gravity_wrench,
+from cdpr_exu.core.geometry import swivel_pulley_exit
+from cdpr_exu.exits import PointExit, Pulley, Swivel
+from cdpr_exu.scenes.scene import PlatformSpec, Scene
+from cdpr_exu.physics.spatial_kinematics import (IdealSpatialRobot, cable_unit_vectors, gravity_wrench,
                                                  inverse_kinematics, inverse_kinematics_rates, structure_matrix,
-                                                 swivel_pulley_exit, tension_distribution)
+                                                 tension_distribution)
 
 # The paper's planar robot (as tests/test_kinematics.py)
 PLANAR_CENTERS = np.array([[-1.75, 0.0], [1.75, 0.0]])
@@ -54,7 +57,7 @@ def plane_embedding(azimuth, origin=(0.4, -0.3, 1.1)):
 def embedded_robot(azimuth):
     """The paper's planar robot placed in the vertical plane of the given azimuth: poses, anchors, inlets."""
     origin, e1, e3, normal = plane_embedding(azimuth)
-    hang = np.array([planar.hang_point(c, PLANAR_RADIUS, s) for c, s in zip(PLANAR_CENTERS, PLANAR_SIDES)])
+    hang = np.array([Pulley(c, PLANAR_RADIUS, s).hang_point for c, s in zip(PLANAR_CENTERS, PLANAR_SIDES)])
     inlets = origin + hang[:, :1] * e1 + hang[:, 1:] * e3
     anchors = PLANAR_ANCHORS[:, :1] * e1 + PLANAR_ANCHORS[:, 1:] * e3  # platform frame = world at theta = 0
     poses = np.hstack([origin + PLANAR_POSES[:, :1] * e1 + PLANAR_POSES[:, 1:2] * e3,
@@ -82,13 +85,14 @@ def symmetric_robot(point_mass=False):
 def test_robot_in_a_vertical_plane_reproduces_planar_kinematics(azimuth):
     poses, anchors, inlets = embedded_robot(azimuth)
     _, e1, e3, normal = plane_embedding(azimuth)
-    args = (PLANAR_ANCHORS, PLANAR_CENTERS, PLANAR_RADIUS, PLANAR_SIDES)
+    robot = Scene(exits=tuple(Pulley(c, PLANAR_RADIUS, s) for c, s in zip(PLANAR_CENTERS, PLANAR_SIDES)),
+                  platform=PlatformSpec(anchors=PLANAR_ANCHORS))  # the planar robot, its kinematics its exits'
     # Round-off: lengths of about 2 m computed in different frames (a rotation of the plane, Rodrigues'
     # formula for the platform): a few 1e-16 relative; 1e-13 leaves a hundredfold margin, far below any geometry.
     np.testing.assert_allclose(inverse_kinematics(poses, anchors, inlets, PLANAR_RADIUS),
-                               planar.inverse_kinematics(PLANAR_POSES, *args), rtol=0, atol=1e-13)
+                               planar.ideal_paid_out(robot, PLANAR_POSES)[0], rtol=0, atol=1e-13)
     units = cable_unit_vectors(poses, anchors, inlets, PLANAR_RADIUS)
-    planar_units = planar.cable_unit_vectors(PLANAR_POSES, *args)
+    planar_units = -np.stack([e.unit_vector for e in planar.cable_exits(robot, PLANAR_POSES)], axis=-2)
     np.testing.assert_allclose(units, planar_units[..., :1] * e1 + planar_units[..., 1:] * e3, rtol=0, atol=1e-13)
     matrix = structure_matrix(poses, anchors, units)
     planar_matrix = planar.structure_matrix(PLANAR_POSES, PLANAR_ANCHORS, planar_units)
@@ -142,7 +146,7 @@ def test_tangent_point_is_on_the_rim_in_the_anchors_vertical_plane_and_the_free_
 
 
 def test_anchor_on_the_swivel_axis_keeps_the_previous_azimuth_or_is_refused():
-    pulley = SwivelPulley((0.0, 0.0, 5.0), 0.2)
+    pulley = Swivel((0.0, 0.0, 5.0), 0.2)
     below = np.array([0.0, 0.0, 1.0])
     with pytest.raises(UnreachableError, match="axis of the swivel pulley"):
         pulley.exit(below)
@@ -155,7 +159,7 @@ def test_anchor_on_the_swivel_axis_keeps_the_previous_azimuth_or_is_refused():
     # its length does not depend on the azimuth: the planar cable to (0, -4) in the disc's plane
     np.testing.assert_allclose(hinted.cable_length, exit_.cable_length[1], rtol=1e-15)
     # a point exit needs no azimuth: the cable is vertical
-    np.testing.assert_allclose(SwivelPulley((0.0, 0.0, 5.0), 0.0).exit(below).unit_vector, [0, 0, -1], atol=0)
+    np.testing.assert_allclose(PointExit((0.0, 0.0, 5.0)).exit(below).unit_vector, [0, 0, -1], atol=0)
 
 
 def test_anchor_inside_the_disc_is_refused():
@@ -367,8 +371,8 @@ def test_bad_shapes_and_values_are_refused_naming_the_argument():
         IdealSpatialRobot(cogiro.EXIT_POINTS, cogiro.ANCHORS[:7], 0.0, 91.0, 100.0, 5000.0)
     with pytest.raises(SceneError, match="pulley_radii must be finite and zero or positive"):
         inverse_kinematics(cogiro.INITIAL_POSE, cogiro.ANCHORS, cogiro.EXIT_POINTS, -0.1)
-    with pytest.raises(SceneError, match="radius must be zero or positive"):
-        SwivelPulley((0.0, 0.0, 5.0), -0.1)
+    with pytest.raises(SceneError, match="swivel.radius must be positive"):
+        Swivel((0.0, 0.0, 5.0), -0.1)
     with pytest.raises(SceneError, match="pose_rate must have"):
         inverse_kinematics_rates(cogiro.INITIAL_POSE, np.zeros(3), cogiro.ANCHORS, cogiro.EXIT_POINTS, 0.0)
     with pytest.raises(SceneError, match="external_wrench"):

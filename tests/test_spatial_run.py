@@ -14,14 +14,14 @@ from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.results.result import slack_time
 from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.studies.comparison import spatial_comparison_table
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.scenes.spatial_trajectories import (SpatialCircleTrajectory, SpatialHoldTrajectory,
                                                    SpatialPointToPointTrajectory)
 
 
 def four_cable(n_elements=10, bending=False, **solver):
     """The shipped four-cable robot, coarser, without bending (so the catenary is its continuum limit)."""
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     effects = replace(scene.effects, bending=bending, bending_damping=bending)
     cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
     return replace(scene, cables=cables, effects=effects,
@@ -84,7 +84,7 @@ def test_a_spatial_run_reports_how_long_each_cable_was_slack():
 
 def ipanema(n_elements=10, **solver):
     """The shipped IPAnema robot (8 taut cables from above and below), coarser, without bending."""
-    scene = load_spatial_scene("spatial-ipanema")
+    scene = load_scene("spatial-ipanema")
     effects = replace(scene.effects, bending=False, bending_damping=False)
     cables = tuple(replace(c, n_elements=n_elements) for c in scene.cables)
     return replace(scene, cables=cables, effects=effects, solver=replace(scene.solver, **solver))
@@ -126,7 +126,7 @@ def test_paying_out_at_speed_does_not_damp_the_cable():
 
 def test_a_scene_without_trajectory_is_refused_before_the_run():
     with pytest.raises(SceneError, match=r"no \[trajectory\]"):
-        simulate_spatial(load_spatial_scene("spatial-four-cable"))
+        simulate_spatial(load_scene("spatial-four-cable"))
 
 
 def test_cdpr_run_on_a_spatial_scene_writes_its_summary_and_overview(tmp_path):
@@ -143,7 +143,7 @@ def test_cdpr_run_on_a_spatial_scene_writes_its_summary_and_overview(tmp_path):
 
 
 def test_a_reference_above_the_exits_is_refused_before_the_run_naming_the_time_and_pose():
-    scene = load_spatial_scene("spatial-cogiro")  # exits at z = 5.4 m; the platform starts at 2.265 m
+    scene = load_scene("spatial-cogiro")  # exits at z = 5.4 m; the platform starts at 2.265 m
     start = (-0.034, -0.013, 2.265, 0.0, 0.0, 0.0)
     scene = replace(scene, trajectory=SpatialPointToPointTrajectory(start, (-0.034, -0.013, 6.5, 0.0, 0.0, 0.0),
                                                                      duration=5.0))
@@ -154,7 +154,7 @@ def test_a_reference_above_the_exits_is_refused_before_the_run_naming_the_time_a
 def test_a_reference_that_starts_above_the_exits_is_refused_saying_so():
     """Issue 23.6: the swivel robot told to hold its point mass 0.4 m above the tops of its pulleys
     (inlets at z = 0, radius 0.1 m): refused before the run, the message says why."""
-    scene = load_spatial_scene("spatial-four-cable-swivel")
+    scene = load_scene("spatial-four-cable-swivel")
     scene = replace(scene, trajectory=SpatialHoldTrajectory((0.0, 0.0, 0.5, 0.0, 0.0, 0.0)))
     with pytest.raises(UnreachableError, match=r"at t = 0\.000 s is outside the workspace.*the pose is above the "
                        r"exits: .*platform\.anchors\[0\] at z = 0\.5 m, exits\[0\] up to z = 0\.1 m.*cables cannot push"):
@@ -165,7 +165,7 @@ def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_idea
     from controllers.ideal_ik import IdealIKController
     from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-    scene = load_spatial_scene("spatial-ipanema")
+    scene = load_scene("spatial-ipanema")
     scene = replace(scene, cables=tuple(replace(c, n_elements=10) for c in scene.cables),
                     solver=replace(scene.solver, end_time=4.0))
     ideal = simulate_spatial(scene, IdealIKController()).summary(1.0)
@@ -190,9 +190,9 @@ def test_the_chain_version_runs_over_swivel_pulleys_and_follows_the_ramp_closer_
     from controllers.ideal_ik import IdealIKController
     from controllers.spatial_tension_aware import SpatialTensionAwareController
 
-    swivel = load_spatial_scene("spatial-four-cable-swivel")
+    swivel = load_scene("spatial-four-cable-swivel")
     assert "tension_aware_chain" in spatial_controller_names(swivel)
-    assert "tension_aware_chain" in spatial_controller_names(load_spatial_scene("spatial-cogiro"))
+    assert "tension_aware_chain" in spatial_controller_names(load_scene("spatial-cogiro"))
     with pytest.raises(SceneError, match="statics"):
         SpatialTensionAwareController(statics="rope")
     # The circle's ramp (0.8 s of its 1 s), slow enough to be nearly static: the held chains run over the
@@ -244,15 +244,15 @@ def test_cdpr_animate_renders_a_spatial_run_headless(tmp_path):
 
 
 def test_a_study_sweeps_a_spatial_scene_and_keeps_its_base_scene(tmp_path):
-    from cdpr_exu.scenes.spatial_scene import load_any_scene
+    from cdpr_exu.scenes.scene import load_scene
     from cdpr_exu.studies.study import run_study
 
-    scene = load_spatial_scene("spatial-ipanema")
+    scene = load_scene("spatial-ipanema")
     scene = replace(scene, solver=replace(scene.solver, end_time=1.5))
     rows = run_study(scene, ["cables.n_elements=5,10"], out=tmp_path, progress=False, workers=1, plots=False)
     assert [row["status"] for row in rows] == ["completed", "completed"]
     assert all(0.0 < row["max_position_error_m"] < 5e-3 for row in rows)  # ideal IK on IPAnema: about 0.1 mm
-    assert load_any_scene(tmp_path / "base_scene.toml") == scene  # the spatial scene round-trips through TOML
+    assert load_scene(tmp_path / "base_scene.toml") == scene  # the spatial scene round-trips through TOML
 
 
 def test_a_spatial_run_reports_each_tension_limit_crossed_as_the_planar_run_does():
@@ -330,9 +330,9 @@ def test_cdpr_run_on_a_spatial_run_that_pushes_warns_once_and_prints_each_cables
     """Issues 23.1 and 23.10b: `cdpr run` wrote elements_pushed: false for such a run and printed no
     slack time per cable. Now: one console warning, the flag in summary.json (figures over the whole
     run, errors after 1 s under after_start_up), and a slack time per cable, as planar runs print."""
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
+    from cdpr_exu.scenes.scene import save_scene
 
-    path = save_any_scene(pushing_four_cable(), tmp_path / "pushing.toml")
+    path = save_scene(pushing_four_cable(), tmp_path / "pushing.toml")
     out = tmp_path / "run"
     done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "run", str(path), "--out", str(out),
                            "--no-figures", "--no-error-estimate"], capture_output=True, text=True, timeout=300)
@@ -355,13 +355,12 @@ def test_a_rotation_the_cables_cannot_hold_is_refused_before_the_run_naming_the_
     moment about the centre of mass (zero when static, plus the reference's angular acceleration
     and velocity with platform.inertia). The shipped scenes (yaw rocking of 0.05 rad at most) pass."""
     from cdpr_exu.run.spatial_run import check_spatial_reference
-    from cdpr_exu.scenes.spatial_scene import shipped_spatial_scenes
+    from cdpr_exu.scenes.scene import shipped_scenes
 
-    for name in shipped_spatial_scenes():
-        scene = load_spatial_scene(name)
-        if scene.trajectory is not None:
+    for scene in map(load_scene, shipped_scenes()):
+        if scene.dimension == 3 and scene.trajectory is not None:
             check_spatial_reference(scene)
-    scene = load_spatial_scene("spatial-ipanema")
+    scene = load_scene("spatial-ipanema")
     scene = replace(scene, trajectory=replace(scene.trajectory, tilt=(0.0, 0.0, 10.0)))
     pattern = r"the reference pose \[.*\] \(x, y, z \[m\], rotation vector \[rad\]\) at t = \d+\.\d{3} s .*moment"
     with pytest.raises(UnreachableError, match=pattern) as refusal:
@@ -458,7 +457,7 @@ def test_a_robot_that_comes_to_rest_above_its_exits_is_not_run():
     10.8 kg platform, the lumped robot's own rest over the swivel pulleys puts the platform 0.654 m
     above the inlets (measured), held up by the chains' bending; the run then "completed" there.
     No cable robot's run starts from such a state: it fails at t = 0 with the cause."""
-    base = load_spatial_scene("spatial-four-cable-swivel")
+    base = load_scene("spatial-four-cable-swivel")
     scene = replace(base, cables=tuple(replace(c, n_elements=50, youngs_modulus=1.8e11) for c in base.cables),
                     platform=replace(base.platform, mass=10.8),
                     solver=replace(base.solver, step_size=0.0057, output_period=0.0057, end_time=0.133))
@@ -499,7 +498,7 @@ def test_an_extreme_spatial_run_is_refused_fails_with_a_cause_or_completes_clean
     pushing to -14 N, flagged), a 500 kg platform refused (no equilibrium within reach), a settle
     over swivel pulleys that failed (it said only "SolveDynamic terminated" before) and a swivel robot
     resting 0.70 m above its inlets (it ran and "completed" before)."""
-    base = load_spatial_scene("spatial-four-cable-swivel" if swivel else "spatial-four-cable")
+    base = load_scene("spatial-four-cable-swivel" if swivel else "spatial-four-cable")
     try:
         scene = replace(base, cables=tuple(replace(c, n_elements=elements, youngs_modulus=modulus) for c in base.cables),
                         platform=replace(base.platform, mass=mass), effects=replace(base.effects, slack=slack),

@@ -1,4 +1,5 @@
-"""Spatial scenes in TOML and their static mode (cdpr_exu.scenes.spatial_scene, cdpr_exu.run.spatial_rest), real solver."""
+"""Spatial scenes in TOML (cdpr_exu.scenes.scene with dimension = 3) and their static mode (cdpr_exu.run.spatial_rest),
+real solver."""
 
 import json
 import subprocess
@@ -11,9 +12,8 @@ import pytest
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.physics import cogiro
 from cdpr_exu.run.rest import solve_rest
-from cdpr_exu.scenes.scene import SpatialSceneError, load_scene
 from cdpr_exu.run.spatial_rest import solve_spatial_rest
-from cdpr_exu.scenes.spatial_scene import load_any_scene, load_spatial_scene, shipped_spatial_scenes, spatial_scene_from_dict
+from cdpr_exu.scenes.scene import load_scene, scene_from_dict, shipped_scenes
 
 #: The paper's catenary scene with fixed cable ends, written as a spatial scene in the
 #: vertical x-z plane (y = 0): the same cables, elements, masses and bending.
@@ -31,12 +31,11 @@ def _cdpr(*args):
     return subprocess.run([sys.executable, "-m", "cdpr_exu.cli", *args], capture_output=True, text=True, timeout=300)
 
 
-def test_the_shipped_spatial_scene_loads_and_the_planar_loader_refuses_it_naming_the_static_mode():
-    assert "spatial-four-cable" in shipped_spatial_scenes()
-    scene = load_any_scene("spatial-four-cable")
+def test_the_one_loader_loads_the_shipped_spatial_scenes_beside_the_planar_ones():
+    assert "spatial-four-cable" in shipped_scenes() and "paper-circle" in shipped_scenes()
+    scene = load_scene("spatial-four-cable")
     assert scene.dimension == 3 and scene.n_cables == 4 and not scene.platform.is_point_mass
-    with pytest.raises(SpatialSceneError, match="cdpr static"):
-        load_scene("spatial-four-cable")
+    assert scene.space.pose_size == 6 and load_scene("paper-circle").space.pose_size == 3
 
 
 def test_run_and_the_accuracy_study_need_a_trajectory_on_a_spatial_scene(tmp_path):
@@ -49,7 +48,7 @@ def test_run_and_the_accuracy_study_need_a_trajectory_on_a_spatial_scene(tmp_pat
 
 
 def test_a_planar_robot_written_as_a_spatial_scene_rests_where_the_planar_model_rests():
-    spatial = solve_spatial_rest(spatial_scene_from_dict(PLANAR_AS_SPATIAL))
+    spatial = solve_spatial_rest(scene_from_dict(PLANAR_AS_SPATIAL))
     planar = solve_rest(load_scene("paper-catenary-fixed"))
     x, z = planar.platform_position_m
     # Both are exact static equilibria of the same discrete model (the 3-D bending force of a
@@ -65,7 +64,7 @@ def test_a_planar_robot_written_as_a_spatial_scene_rests_where_the_planar_model_
 
 
 def test_without_bending_the_lumped_robot_rests_within_its_discretisation_error_of_the_catenaries():
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     scene = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False))
     rest = solve_spatial_rest(scene)
     # tests/test_spatial_robot.py measures the lumped robot against the catenaries as n^-2,
@@ -77,7 +76,7 @@ def test_without_bending_the_lumped_robot_rests_within_its_discretisation_error_
 
 @pytest.mark.parametrize("name", ["spatial-four-cable", "spatial-cogiro", "spatial-ipanema"])
 def test_the_cables_hold_the_platform_in_force_and_moment_balance(name):
-    scene = load_spatial_scene(name)
+    scene = load_scene(name)
     rest = solve_spatial_rest(scene)
     weight = scene.platform.mass * scene.gravity
     forces = rest.forces_on_platform
@@ -90,9 +89,9 @@ def test_the_cables_hold_the_platform_in_force_and_moment_balance(name):
 
 
 def test_the_cogiro_scene_is_caspr_s_geometry_and_hangs_where_its_ideal_cables_put_it():
-    scene = load_spatial_scene("spatial-cogiro")
+    scene = load_scene("spatial-cogiro")
     # the TOML holds CASPR's numbers (cdpr_exu/physics/cogiro.py) to their 4 decimals
-    assert np.asarray(scene.exits) == pytest.approx(cogiro.EXIT_POINTS, abs=1e-12)
+    assert scene.exit_points == pytest.approx(cogiro.EXIT_POINTS, abs=1e-12)
     assert np.asarray(scene.platform.anchors) == pytest.approx(cogiro.ANCHORS - cogiro.CENTER_OF_MASS, abs=5e-5)
     rest = solve_spatial_rest(scene)
     ideal = cogiro.INITIAL_POSE[:3] + cogiro.CENTER_OF_MASS
@@ -121,6 +120,8 @@ def test_cdpr_static_on_a_spatial_scene_prints_the_pose_and_writes_a_strict_summ
     (lambda d: d.update(dimension=4), "dimension"),
     (lambda d: d.pop("exits"), "exits"),
     (lambda d: d.update(exits=[{"point": [0.0, 0.0, 0.0]}, {"point": [0.0, 0.0, 0.0]}]), "exit_point"),
+    (lambda d: d.update(exits=[{"kind": "pulley", "center": [0.0, 0.0]}] * 2), "no such exit in a spatial scene"),
+    (lambda d: d["platform"].update(initial_pose=[0.0] * 6), "platform.initial_pose"),
     (lambda d: d["platform"].update(anchors=[[0.0, 0.0, 0.0], [0.0, float("nan"), 0.0]]), "platform.anchors\\[1\\]"),
     (lambda d: d["platform"].update(mass=-1.0), "platform.mass"),
     (lambda d: d["cable"].update(radius=-0.005), "cables\\[0\\].radius"),
@@ -129,11 +130,11 @@ def test_a_bad_spatial_scene_is_refused_naming_the_field(change, field):
     data = json.loads(json.dumps(PLANAR_AS_SPATIAL))
     change(data)
     with pytest.raises(SceneError, match=field):
-        spatial_scene_from_dict(data)
+        scene_from_dict(data)
 
 
 def test_the_ipanema_scene_is_held_from_above_and_below_at_its_design_pose():
-    scene = load_spatial_scene("spatial-ipanema")
+    scene = load_scene("spatial-ipanema")
     rest = solve_spatial_rest(scene)
     # Fully constrained by 8 pretensioned cables (EA = 0.5 MN) whose lengths are the ideal ones
     # less their stretch: sag (a few mm over 4.7 m of a 0.012 kg/m rope at 300-480 N) hardly
@@ -149,7 +150,7 @@ def test_the_ipanema_scene_is_held_from_above_and_below_at_its_design_pose():
 
 def test_the_static_mode_reports_every_element_taut_on_the_shipped_robots():
     for name in ("spatial-four-cable", "spatial-cogiro", "spatial-ipanema"):
-        summary = solve_spatial_rest(load_spatial_scene(name)).summary()
+        summary = solve_spatial_rest(load_scene(name)).summary()
         # the lowest of all elements (4 x 20 or 8 x 20): the four-cable robot's slackest cable
         # still carries about 10 N; nothing is compressed
         assert summary["min_element_tension_N"] > 5.0 and not summary["elements_pushed"], name
@@ -160,13 +161,13 @@ def test_a_spatial_scene_gets_the_planar_bending_damping_constant_only_with_effe
     effects.bending_damping the chains have no dampers (and no cost for them)."""
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot
+    from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec
 
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     for damped in (True, False):
         changed = replace(scene, effects=replace(scene.effects, bending_damping=damped))
         mbs = exu.SystemContainer().AddSystem()
-        items = build_spatial_robot(mbs, changed.catenary_platform(), changed.unstrained_lengths, changed.chain_spec())
+        items = build_spatial_robot(mbs, changed.catenary_platform(), changed.unstrained_lengths, scene_chain_spec(changed))
         for cable, chain in zip(changed.cables, items.chains):
             if damped:
                 assert chain.bending_damping == pytest.approx(np.full(len(chain.joints), cable.bending_damping),
@@ -183,10 +184,10 @@ def test_a_misspelt_scene_name_lists_every_shipped_scene_and_the_likeliest_first
     assert main(["run", "spatial-cogiroo"]) == 2
     message = capsys.readouterr().err
     assert "no scene named 'spatial-cogiroo'; did you mean 'spatial-cogiro'? shipped scenes:" in message, message
-    for name in shipped_scenes() + shipped_spatial_scenes():
+    for name in shipped_scenes():
         assert name in message, name
     for misspelt, meant in (("paper-circel", "'paper-circle' or 'paper-circle-slow'"), ("ipanema", "'spatial-ipanema'")):
         with pytest.raises(SceneError, match=f"did you mean {meant}\\?"):
-            load_any_scene(misspelt)
+            load_scene(misspelt)
     with pytest.raises(SceneError, match="did you mean 'spatial-four-cable' or 'spatial-four-cable-swivel'"):
-        load_spatial_scene("spatial-four")
+        load_scene("spatial-four")

@@ -243,9 +243,9 @@ def test_no_equilibrium_within_the_tension_limit_is_a_clear_error():
 @pytest.mark.parametrize("name", ["spatial-cogiro", "spatial-ipanema"])
 def test_the_catenaries_of_the_inverse_lengths_hold_the_platform_at_the_asked_pose(name):
     from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+    from cdpr_exu.scenes.scene import load_scene
 
-    scene = load_spatial_scene(name)
+    scene = load_scene(name)
     platform = scene.catenary_platform()
     rest = solve_spatial_statics(platform, scene.unstrained_lengths)
     tensions = np.array([c.catenary.horizontal_tension for c in rest.cables])

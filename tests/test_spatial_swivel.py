@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+from cdpr_exu.core.geometry import swivel_pulley_exit
+from cdpr_exu.exits import Swivel
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.run.spatial_rest import solve_spatial_rest
-from cdpr_exu.scenes.spatial_scene import load_any_scene, load_spatial_scene, save_any_scene, spatial_scene_from_dict
+from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 
 NAME = "spatial-four-cable-swivel"
 
@@ -23,18 +24,19 @@ def without_bending(scene, n_elements=None):
 
 
 def test_the_swivel_scene_loads_and_round_trips_through_toml(tmp_path):
-    scene = load_spatial_scene(NAME)
-    assert len(scene.swivels) == 4 and all(s.radius == 0.1 for s in scene.swivels)
-    assert scene.exits[0] == scene.swivels[0].inlet and scene.pulley_radii.tolist() == [0.1] * 4
-    again = load_any_scene(save_any_scene(scene, tmp_path / "scene.toml"))
+    scene = load_scene(NAME)
+    assert all(isinstance(e, Swivel) and e.radius == 0.1 for e in scene.exits) and scene.swivel_exits == scene.exits
+    assert scene.exit_points[0].tolist() == list(scene.exits[0].inlet) and scene.pulley_radii.tolist() == [0.1] * 4
+    again = load_scene(save_scene(scene, tmp_path / "scene.toml"))
     assert again == scene
-    # a point-exit scene keeps its form: no swivels written or read
-    plain = load_spatial_scene("spatial-four-cable")
-    assert plain.swivels == () and all("kind" not in e for e in plain.to_dict()["exits"])
+    # a point-exit scene: point exits written and read, no swivels
+    plain = load_scene("spatial-four-cable")
+    assert not any(plain.swivel_exits) and all(e["kind"] == "point" for e in plain.to_dict()["exits"])
+    assert load_scene(save_scene(plain, tmp_path / "plain.toml")) == plain
 
 
 def _with_exit(change):
-    data = load_spatial_scene(NAME).to_dict()
+    data = load_scene(NAME).to_dict()
     change(data["exits"][0])
     return data
 
@@ -53,15 +55,15 @@ def _with_exit(change):
 ])
 def test_bad_swivel_fields_are_refused_naming_the_field(change, field):
     with pytest.raises(SceneError, match=field):
-        spatial_scene_from_dict(_with_exit(change))
+        scene_from_dict(_with_exit(change))
 
 
 def test_the_catenary_statics_over_swivel_pulleys_balance_and_point_each_pulley_at_its_anchor():
-    scene = load_spatial_scene(NAME)
+    scene = load_scene(NAME)
     equilibrium = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
     weight = scene.platform.mass * scene.gravity
     assert np.abs(equilibrium.net_wrench[:3]).max() < 1e-9 * weight
-    for cable, swivel in zip(equilibrium.cables, scene.swivels):
+    for cable, swivel in zip(equilibrium.cables, scene.exits):
         ideal = swivel_pulley_exit(swivel.inlet, swivel.radius, cable.anchor_point)
         # the suspended part sags (its end at the disc is 5.1 degrees steeper than the chord,
         # measured), so it leaves the disc further round than a straight cable
@@ -74,7 +76,7 @@ def test_the_catenary_statics_over_swivel_pulleys_balance_and_point_each_pulley_
 
 
 def test_exudyn_s_static_hang_converges_to_the_catenary_statics_as_the_elements_shrink():
-    rests = [solve_spatial_rest(without_bending(load_spatial_scene(NAME), n)) for n in (48, 96)]
+    rests = [solve_spatial_rest(without_bending(load_scene(NAME), n)) for n in (48, 96)]
     errors = [np.linalg.norm(r.position - r.catenary.position) for r in rests]
     # Measured 4.90 / 1.17 / 0.34 mm at 48 / 96 / 192 elements (the chords of the wrap are
     # shorter than its arc, r_p theta^3 / 24 each, and the nodes sink T l_e / (r_p k_p) into
@@ -86,7 +88,7 @@ def test_exudyn_s_static_hang_converges_to_the_catenary_statics_as_the_elements_
 
 
 def test_a_symmetric_robot_over_swivel_pulleys_hangs_symmetric():
-    scene = without_bending(load_spatial_scene(NAME))
+    scene = without_bending(load_scene(NAME))
     rest = solve_spatial_rest(scene)
     # four equal cables from the corners of a square: on the axis, equal tensions, each
     # pulley turned to its anchor (-135, -45, 45, 135 degrees)
@@ -100,13 +102,13 @@ def test_a_symmetric_robot_over_swivel_pulleys_hangs_symmetric():
 def test_spatial_scenes_honour_the_paper_mass_lumping():
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot
+    from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec
 
-    scene = load_spatial_scene("spatial-four-cable")
+    scene = load_scene("spatial-four-cable")
     paper = replace(scene, cables=tuple(replace(c, mass_lumping="paper") for c in scene.cables))
     for chosen in (scene, paper):
         mbs = exu.SystemContainer().AddSystem()
-        items = build_spatial_robot(mbs, chosen.catenary_platform(), chosen.unstrained_lengths, chosen.chain_spec())
+        items = build_spatial_robot(mbs, chosen.catenary_platform(), chosen.unstrained_lengths, scene_chain_spec(chosen))
         cable = chosen.cables[0]
         # the planar cable's own lumping (CableSpec.node_masses), exit node first
         assert items.node_masses[0] == pytest.approx(cable.node_masses(), rel=1e-12)
@@ -121,13 +123,13 @@ def pushed_swivel_robot():
     Returns (mbs, items, energy at rest [J], energy after the push [J])."""
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot, robot_energy, settle
+    from cdpr_exu.builder.spatial_robot import build_spatial_robot, robot_energy, scene_chain_spec, settle
 
-    scene = load_spatial_scene(NAME)
+    scene = load_scene(NAME)
     scene = replace(scene, effects=replace(scene.effects, bending_damping=False))
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
-                                scene.chain_spec(tension_only=False), swivels=scene.swivel_exits)
+                                scene_chain_spec(scene, tension_only=False), swivels=scene.swivel_exits)
     mbs.Assemble()
     settle(mbs, items)
     for chain in items.chains:  # axial damping off: nothing dissipates but the integrator
@@ -189,7 +191,7 @@ def test_without_damping_the_energy_over_swivel_pulleys_is_bounded_and_its_first
 def test_the_inverse_statics_over_swivel_pulleys_give_lengths_whose_catenaries_hold_the_pose():
     from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics
 
-    scene = load_spatial_scene(NAME)
+    scene = load_scene(NAME)
     platform, lengths = scene.catenary_platform(), scene.unstrained_lengths
     rest = solve_spatial_statics(platform, lengths)
     tensions = np.array([c.catenary.horizontal_tension for c in rest.cables])
@@ -208,14 +210,14 @@ def test_the_inverse_statics_over_swivel_pulleys_give_lengths_whose_catenaries_h
 def test_a_swivel_robot_starts_on_its_chain_statics_and_the_dynamic_settle_is_the_fallback():
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot, start_at_rest
+    from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec, start_at_rest
 
-    scene = load_spatial_scene(NAME)  # bending on; spring elements, as cdpr static builds it
+    scene = load_scene(NAME)  # bending on; spring elements, as cdpr static builds it
 
     def built():
         mbs = exu.SystemContainer().AddSystem()
         items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
-                                    scene.chain_spec(tension_only=False), swivels=scene.swivel_exits)
+                                    scene_chain_spec(scene, tension_only=False), swivels=scene.swivel_exits)
         mbs.Assemble()
         return mbs, items
 
@@ -238,7 +240,7 @@ def test_a_short_run_over_swivel_pulleys_starts_at_rest_and_follows_the_referenc
 
     # the shipped scene, bending on: its start, the chain statics' equilibrium, takes 0.07 s of CPU time
     # (the dynamic settle took 15 s, benchmarks/results/swivel_start.md)
-    scene = load_spatial_scene(NAME)
+    scene = load_scene(NAME)
     scene = replace(scene, solver=replace(scene.solver, end_time=0.3))
     result = simulate_spatial(scene)
     # The robot starts at rest on the axis, where the reference starts (z = -0.842 m in the scene,
@@ -258,12 +260,12 @@ def test_the_catenary_statics_find_a_small_swivel_robot_whose_straight_start_lay
     balances the weight to round-off, symmetric, where the lumped robot (48 elements, no
     bending) rests: measured 0.61 mm apart (0.17 mm at 96 elements: second order, the wrap's
     chords as above). Bound: 0.8 mm."""
-    data = without_bending(load_spatial_scene(NAME), 48).to_dict()
+    data = without_bending(load_scene(NAME), 48).to_dict()
     for exit_ in data["exits"]:
         exit_["inlet"] = [0.5 * np.sign(exit_["inlet"][0]), 0.5 * np.sign(exit_["inlet"][1]), 0.0]
     for cable in data["cables"]:
         cable["unstrained_length"] = 1.0
-    scene = spatial_scene_from_dict(data)
+    scene = scene_from_dict(data)
     equilibrium = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
     weight = scene.platform.mass * scene.gravity
     assert np.abs(equilibrium.net_wrench[:3]).max() < 1e-9 * weight
@@ -274,7 +276,7 @@ def test_the_catenary_statics_find_a_small_swivel_robot_whose_straight_start_lay
 
 def stiff_swivel(youngs_modulus, mass=16.8):
     """The shipped swivel robot with stiffer cables and a heavier platform (issue 23.3's scene at 2.4e11 Pa)."""
-    scene = load_spatial_scene(NAME)
+    scene = load_scene(NAME)
     return replace(scene, cables=tuple(replace(c, youngs_modulus=youngs_modulus) for c in scene.cables),
                    platform=replace(scene.platform, mass=mass))
 
@@ -294,9 +296,9 @@ def test_a_static_answer_above_the_pulleys_fails_with_its_cause_instead_of_exiti
     (tension-only chain statics give 0.63 m too): refused, exit 3, with the cause and the state."""
     import json
 
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
+    from cdpr_exu.scenes.scene import save_scene
 
-    path = save_any_scene(stiff_swivel(2.4e11), tmp_path / "stiff.toml")
+    path = save_scene(stiff_swivel(2.4e11), tmp_path / "stiff.toml")
     out = tmp_path / "static"
     done = _cdpr("static", str(path), "--out", str(out))
     assert done.returncode == 3, done.stderr
@@ -316,11 +318,11 @@ def test_a_static_answer_far_from_its_catenaries_warns_in_the_summary_and_on_the
     import json
 
     from cdpr_exu.run.spatial_rest import FAR_FROM_CATENARY
-    from cdpr_exu.scenes.spatial_scene import save_any_scene
+    from cdpr_exu.scenes.scene import save_scene
 
-    shipped = solve_spatial_rest(load_spatial_scene(NAME))
+    shipped = solve_spatial_rest(load_scene(NAME))
     assert shipped.catenary_distance < 0.2 * FAR_FROM_CATENARY * 2.4 and shipped.warnings == []  # 22 mm of 120
-    path = save_any_scene(stiff_swivel(1e10), tmp_path / "stiffer.toml")
+    path = save_scene(stiff_swivel(1e10), tmp_path / "stiffer.toml")
     out = tmp_path / "static"
     done = _cdpr("static", str(path), "--out", str(out))
     assert done.returncode == 0, done.stderr
@@ -348,11 +350,11 @@ def test_a_winch_line_shorter_than_its_margin_is_refused_in_millimetres_with_wha
     from cdpr_exu.core.errors import UnreachableError
     from cdpr_exu.run.spatial_run import check_spatial_reference
 
-    data = load_spatial_scene(NAME).to_dict()
+    data = load_scene(NAME).to_dict()
     for entry in data["exits"]:
         entry["winch_line"] = 1e-4
     with pytest.raises(UnreachableError) as caught:
-        check_spatial_reference(spatial_scene_from_dict(data))
+        check_spatial_reference(scene_from_dict(data))
     message = str(caught.value)
     for words in ("exits[0].winch_line = 0.1 mm less two elements (2 x 50 mm", "leaves -99.9 mm",
                   "give exits[0].winch_line = 100 mm or more"):
@@ -365,10 +367,10 @@ def test_an_anchor_on_a_swivel_axis_says_what_to_change_in_the_scene():
     from cdpr_exu.core.errors import UnreachableError
     from cdpr_exu.run.spatial_run import check_spatial_reference
 
-    data = load_spatial_scene(NAME).to_dict()
+    data = load_scene(NAME).to_dict()
     data["trajectory"] = {"kind": "hold", "pose": [1.5, 1.5, -0.5, 0.0, 0.0, 0.0]}  # below the first inlet
     with pytest.raises(UnreachableError) as caught:
-        check_spatial_reference(spatial_scene_from_dict(data))
+        check_spatial_reference(scene_from_dict(data))
     message = str(caught.value)
     assert "start the reference (the scene's trajectory) with every anchor off the vertical axis" in message, message
     assert "give azimuth_hint" not in message

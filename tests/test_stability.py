@@ -63,7 +63,7 @@ def with_cables(scene: Scene, **changes) -> Scene:
 
 
 def with_pulleys(scene: Scene, **changes) -> Scene:
-    return scene.with_changes(pulleys=tuple(dataclasses.replace(p, **changes) for p in scene.pulleys))
+    return scene.with_changes(exits=tuple(dataclasses.replace(p, **changes) for p in scene.exits))
 
 
 def with_platform_mass(scene: Scene, mass: float) -> Scene:
@@ -108,7 +108,7 @@ def assert_plausible(scene: Scene, result: Result, max_position_error: float | N
     assert result.status == "completed"
     assert result.time[-1] == pytest.approx(scene.solver.end_time)
     assert_finite(result)
-    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.pulleys)):
+    for i, (cable, pulley) in enumerate(zip(scene.cables, scene.exits)):
         tensions = result.tensions[i]
         # Tension-only elements never push (they are clipped at 0 by construction).
         if scene.effects.slack:
@@ -390,7 +390,7 @@ def test_platform_flung_upwards_falls_slack_and_snaps_taut_without_pushing_or_na
 
 def crossed_the_pulley(scene: Scene, result: Result, cable_index: int) -> np.ndarray:
     """Nodes that start on the winch's vertical line and end past the top of the pulley."""
-    pulley = scene.pulleys[cable_index]
+    pulley = scene.exits[cable_index]
     (cx, cz), r, side = pulley.center, pulley.radius, pulley.side
     nodes = result.nodes[cable_index]
     on_winch_line = (np.abs(nodes[0, :, 0] - (cx + side * r)) < 1e-3 * r) & (nodes[0, :, 1] < cz)

@@ -131,11 +131,11 @@ def test_a_spatial_run_writes_scene_pose_csv_and_solution_file_as_every_run(spat
     the numbers of result.npz to its 9 significant digits."""
     from conftest import small_spatial_scene
 
-    from cdpr_exu.scenes.spatial_scene import load_any_scene
+    from cdpr_exu.scenes.scene import load_scene
 
     for name in ("scene.toml", "result.npz", "pose.csv", "summary.json", "solution.sol"):
         assert (spatial_run_dir / name).stat().st_size > 0, name
-    assert load_any_scene(spatial_run_dir / "scene.toml") == small_spatial_scene(END_TIME)
+    assert load_scene(spatial_run_dir / "scene.toml") == small_spatial_scene(END_TIME)
     header = (spatial_run_dir / "pose.csv").read_text().splitlines()[0].split(",")
     assert header == ["time_s", "x_m", "y_m", "z_m", "rotation_x_rad", "rotation_y_rad", "rotation_z_rad",
                       "x_ref_m", "y_ref_m", "z_ref_m", "rotation_x_ref_rad", "rotation_y_ref_rad", "rotation_z_ref_rad"]
@@ -239,7 +239,7 @@ def test_animation_frames_show_the_pulleys_where_the_camera_puts_them(run_dir, t
     frame = np.asarray(Image.open(tmp_path / "frame_00000.png").convert("RGB"), dtype=int)
     replay = viewer.load_replay(run_dir)
     camera = viewer.fit_camera(viewer._view_points(replay), size)
-    for pulley in replay.scene.pulleys:
+    for pulley in replay.scene.exits:
         inside = camera.to_pixels(np.array(pulley.center) + [0.0, -0.5 * pulley.radius]).round().astype(int)
         outside = camera.to_pixels(np.array(pulley.center) + [0.0, -1.4 * pulley.radius]).round().astype(int)
         # disc: shaded grey (measured about 225); background: white

@@ -24,7 +24,8 @@ import numpy as np
 from cdpr_exu.physics import axial
 from cdpr_exu.physics import bending
 from cdpr_exu.physics import cable_forces
-from cdpr_exu.scenes.scene import CableSpec, Effects, PulleySpec
+from cdpr_exu.exits import Pulley
+from cdpr_exu.scenes.scene import CableSpec, Effects
 from cdpr_exu.physics import node_contact as node_contact_module
 from cdpr_exu.physics.node_contact import NodePulleyContact
 from cdpr_exu.physics.segment_contact import SegmentPulleyContact
@@ -152,7 +153,7 @@ def arm_first_step_kink(forces: CableForceItems | None) -> np.ndarray:
 
 
 def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[CableItems],
-                     effects: Effects, pulleys: list[PulleySpec] | None = None,
+                     effects: Effects, pulleys: list[Pulley] | None = None,
                      contact_elements: list[np.ndarray] | None = None,
                      sparse_jacobian: bool = True,
                      contact_nodes: list[np.ndarray] | None = None) -> CableForceItems | None:
@@ -165,7 +166,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     items : list of CableItems
         The cables' nodes, in the same order.
     effects : Effects
-    pulleys : list of PulleySpec, optional
+    pulleys : list of Pulley, optional
         Pulley of each cable; needed with ``contact_elements``.
     contact_elements : list of ndarray of int, optional
         Cable-local indices of the elements (element j joins nodes j and j + 1) that get
@@ -331,7 +332,7 @@ def _sparse_jacobian_function(blocks, reference, positions):
     return jacobian_function
 
 
-def _node_contact(counts: list[int], pulleys: list[PulleySpec] | None,
+def _node_contact(counts: list[int], pulleys: list[Pulley] | None,
                   contact_nodes: list[np.ndarray] | None) -> NodePulleyContact | None:
     """The node rim contacts of the listed nodes with their cables' pulleys (None if none)."""
     if contact_nodes is None or not any(len(n) for n in contact_nodes):
@@ -346,7 +347,7 @@ def _node_contact(counts: list[int], pulleys: list[PulleySpec] | None,
     return NodePulleyContact(sum(counts), nodes, *per_node, band=node_contact_module.CONTACT_ONSET_DEPTH)
 
 
-def _segment_contact(counts: list[int], pulleys: list[PulleySpec] | None,
+def _segment_contact(counts: list[int], pulleys: list[Pulley] | None,
                      contact_elements: list[np.ndarray] | None) -> SegmentPulleyContact | None:
     """The segment rim contacts of the listed elements with their cables' pulleys (None if none)."""
     if contact_elements is None or not any(len(e) for e in contact_elements):

@@ -122,10 +122,10 @@ def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
     the polygon circumscribed about the pulley, every chord touching the rim, and the
     winch line moves out by the difference (30 mm for the paper's cable).
     """
-    cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
+    cable, pulley = scene.cables[cable_index], scene.exits[cable_index]
     anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
-    if scene.exits[cable_index].is_point_exit:
-        return straight_cable_nodes(np.asarray(pulley.center), anchor, cable.n_elements)
+    if not pulley.wraps:
+        return straight_cable_nodes(np.asarray(pulley.point), anchor, cable.n_elements)
     contact = scene.contact_model
     radius = pulley.radius if contact is None else contact.wrap_radius(pulley.radius, cable.element_length)
     return initial_cable_nodes(np.asarray(pulley.center), radius, pulley.side, anchor,
@@ -145,7 +145,7 @@ def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 
     -------
     ndarray of int
     """
-    cable, pulley = scene.cables[cable_index], scene.pulleys[cable_index]
+    cable, pulley = scene.cables[cable_index], scene.exits[cable_index]
     times = np.linspace(0.0, scene.solver.end_time, 200)
     anchors = anchor_points(scene.trajectory.pose(times), np.asarray(scene.platform.anchors))[:, cable_index]
     exits = pulley.exit(anchors)  # all times at once
@@ -181,7 +181,7 @@ def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.
 
     if scene.contact_model is not None and not scene.contact_model.limits_element_length:
         return
-    pulley, cable = scene.pulleys[cable_index], scene.cables[cable_index]
+    pulley, cable = scene.exits[cable_index], scene.cables[cable_index]
     depth = segment_penetration(pulley, nodes_xz).max()
     if depth > 0.5 * pulley.radius:
         raise SceneError(
@@ -224,9 +224,9 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
     on_segments = contact is not None and contact.on_segments
     cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
     contact_elements = []  # cable-local element indices per cable (segment contact only)
-    for i, (cable, pulley, exit_) in enumerate(zip(scene.cables, scene.pulleys, scene.exits)):
+    for i, (cable, exit_) in enumerate(zip(scene.cables, scene.exits)):
         nodes_xz = initial_nodes(scene, i)
-        if not exit_.is_point_exit:
+        if exit_.wraps:
             _check_elements_fit_the_pulley(scene, i, nodes_xz)
         items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
         attach_cable(mbs, platform, i, items.markers[-1], cable, explicit=scene.solver.integrator != "generalized_alpha")
@@ -242,8 +242,8 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
             contact_elements.append(np.zeros(0, dtype=np.int64))
             candidates = contact_candidates(scene, i)
             if contact.exudyn_items:
-                pulley_marker = add_pulley_ground(mbs, pulley)
-                contacts.append(add_pulley_contact(mbs, pulley, pulley_marker,
+                pulley_marker = add_pulley_ground(mbs, exit_)
+                contacts.append(add_pulley_contact(mbs, exit_, pulley_marker,
                                                    [items.markers[j] for j in candidates], nodes_xz[candidates]))
             else:  # forces in the cables' generic object (add_cable_forces)
                 contacts.append([])
@@ -257,7 +257,7 @@ def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
     if sparse_jacobian is None:
         sparse_jacobian = sum(c.n_elements + 1 for c in scene.cables) > SPARSE_JACOBIAN_MIN_NODES
     on_nodes = contact is not None and contact.smooth_nodes
-    cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.pulleys),
+    cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.exits),
                                     contact_elements if on_segments else None, sparse_jacobian=sparse_jacobian,
                                     contact_nodes=contact_nodes if on_nodes else None)
     mbs.Assemble()
@@ -301,7 +301,9 @@ def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems
         rope_cable = _replace(cable, unstrained_length=cable.unstrained_length + segment - hanging)
         bx, bz = scene.platform.anchors[i]
         anchor_marker = mbs.AddMarker(_eii.MarkerBodyRigid(bodyNumber=platform.body, localPosition=[bx, bz, 0.0]))
-        rope = add_rope(mbs, rope_cable, scene.pulleys[i].center, radius, scene.pulleys[i].side, anchor_marker,
+        exit_ = scene.exits[i]
+        side = getattr(exit_, "side", -1)  # a point exit has no side: its sheave has no radius
+        rope = add_rope(mbs, rope_cable, exit_.point, radius, side, anchor_marker,
                         hang - np.array([0.0, segment]), ground_coordinate, scene.effects)
         drive = mbs.AddObject(_eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
                                                             offset=0.0))

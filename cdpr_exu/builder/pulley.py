@@ -18,26 +18,26 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from cdpr_exu.scenes.scene import PulleySpec
+from cdpr_exu.exits import Pulley
 
 #: Radius given to the node "sphere" [m]; Exudyn needs a positive radius.
 NODE_CONTACT_RADIUS = 1.0e-9
 
 
-def add_pulley_ground(mbs: exu.MainSystem, pulley: PulleySpec) -> int:
+def add_pulley_ground(mbs: exu.MainSystem, pulley: Pulley) -> int:
     """Add the ground marker at the pulley centre; returns the marker index."""
     ground = mbs.AddObject(eii.ObjectGround(referencePosition=[pulley.center[0], pulley.center[1], 0.0]))
     return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
 
 
-def add_pulley_contact(mbs: exu.MainSystem, pulley: PulleySpec, pulley_marker: int,
+def add_pulley_contact(mbs: exu.MainSystem, pulley: Pulley, pulley_marker: int,
                        node_markers: list[int], node_positions: np.ndarray) -> list[int]:
     """Add a rim contact between the pulley and each listed cable node.
 
     Parameters
     ----------
     mbs : exudyn.MainSystem
-    pulley : PulleySpec
+    pulley : Pulley
     pulley_marker : int
         Ground rigid marker at the pulley centre (:func:`add_pulley_ground`).
     node_markers : list of int

@@ -39,7 +39,7 @@ Platform
 Swivel pulleys
 --------------
 A cable whose exit is a swivel pulley (``swivels[i]``, a
-:class:`cdpr_exu.scenes.spatial_scene.SwivelSpec`) is a fixed-length chain that starts at
+:class:`cdpr_exu.exits.swivel.Swivel`) is a fixed-length chain that starts at
 its winch end, held on the pulley's vertical axis ``winch_line`` below the inlet, runs
 up the axis, wraps over the disc and hangs to the anchor: its elements keep their
 length ``L / n`` (``L`` the unstrained length from the inlet, the catenary statics'),
@@ -153,6 +153,24 @@ class SpatialChainSpec:
             object.__setattr__(self, "anchor_spring_factor", factor)
 
 
+def scene_chain_spec(scene, anchor_spring_factor: float | None = None,
+                     tension_only: bool | None = None) -> SpatialChainSpec:
+    """The lumped cables of a spatial scene (:class:`~cdpr_exu.scenes.scene.Scene`), with its effects.
+
+    ``tension_only`` defaults to ``effects.slack``; the static mode asks for False (Exudyn's
+    static solver needs every element's stiffness, which a slack element has not).
+    """
+    effects, cable = scene.effects, scene.cables[0]  # the cables share one discretisation (the scene checks)
+    return SpatialChainSpec(
+        tension_only=effects.slack if tension_only is None else bool(tension_only),
+        n_elements=cable.n_elements,
+        axial_damping_constant=cable.damping_constant * cable.area if effects.axial_damping else 0.0,
+        flexural_rigidity=cable.youngs_modulus * cable.second_moment if effects.bending else 0.0,
+        bending_damping_constant=(cable.damping_constant * cable.second_moment
+                                  if effects.bending and effects.bending_damping else 0.0),
+        anchor_spring_factor=anchor_spring_factor, mass_lumping=cable.mass_lumping)
+
+
 @dataclass
 class SpatialRobotItems:
     """Item indices and data of a spatial robot in an Exudyn ``MainSystem``.
@@ -243,7 +261,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     initial : SpatialEquilibrium, optional
         Start configuration: platform pose and cable shapes; default the catenary
         statics of these lengths (:func:`solve_spatial_statics`).
-    swivels : sequence of (SwivelSpec or None), optional
+    swivels : sequence of (Swivel or None), optional
         Each cable's swivel pulley (its contact, swivel inertia and bearing, winch line;
         see the module notes), None for a point exit; the platform's cable must then
         have the same ``pulley_radius`` and its ``exit_point`` at the inlet.

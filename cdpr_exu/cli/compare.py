@@ -17,7 +17,7 @@ from cdpr_exu.core.output import check_output_folder
 from cdpr_exu.core.validation import non_negative
 from cdpr_exu.results.result import raise_warnings, status_text
 from cdpr_exu.run.spatial_run import check_spatial_reference
-from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, compare_spatial,
                                          markdown_table, smooth_start, spatial_comparison_table)
@@ -84,8 +84,8 @@ def _check_time_options(args: argparse.Namespace) -> None:
 def _cmd_compare(args: argparse.Namespace) -> int:
     _check_time_options(args)
     check_output_folder(args.out, command="compare")
-    scene = load_any_scene(args.scene)
-    if is_spatial(scene):
+    scene = load_scene(args.scene)
+    if scene.dimension == 3:  # one comparison when the controllers are one (issue 24, slice 8)
         return _compare_spatial(scene, args)
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))

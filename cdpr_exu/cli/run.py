@@ -21,7 +21,6 @@ from cdpr_exu.run.error_estimate import (elements_for_tolerance, estimate_error,
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.run.spatial_run import SpatialResult, check_runnable, simulate_spatial
 from cdpr_exu.scenes.scene import Scene, load_scene, save_scene
-from cdpr_exu.scenes.spatial_scene import SpatialScene, is_spatial, load_any_scene, save_any_scene
 from cdpr_exu.statics.workspace import check_reference
 
 #: Errors are measured after this start-up time in the printed "settled" figures [s].
@@ -199,7 +198,7 @@ def _print_spatial_summary(summary: dict, after: float, out: Path | None) -> Non
     _print_violations_and_notes(summary, settled, out)
 
 
-def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = False, figures: bool = True,
+def run_spatial_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: bool = True,
                       after: float = 1.0, error_estimate: bool = False) -> SpatialResult:
     """``cdpr run`` on a spatial scene: run, write into ``out``, print a summary.
 
@@ -217,7 +216,7 @@ def run_spatial_scene(scene: SpatialScene, out: Path | None, *, quiet: bool = Fa
     if out is not None:
         out = check_output_folder(out, command="run")
         clear_outputs(out, "run")  # none of the run this one replaces stays beside it (a planar one's figures)
-        save_any_scene(scene, out / "scene.toml")
+        save_scene(scene, out / "scene.toml")
         solution_file = out / "solution.sol"
 
     def write(result: SpatialResult, extra: dict | None = None) -> None:
@@ -274,8 +273,8 @@ def _elements_for(scene, tolerance: float, quiet: bool):
 def _cmd_run(args: argparse.Namespace) -> int:
     out = check_output_folder(args.out, command="run")
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
-    scene = load_any_scene(args.scene)  # loaded once: a warning of the scene file is printed once
-    if is_spatial(scene):
+    scene = load_scene(args.scene)  # loaded once: a warning of the scene file is printed once
+    if scene.dimension == 3:  # one run command when simulate() is one (issue 24, slice 9)
         changes = {k: v for k, v in (("end_time", args.end_time), ("step_size", args.step_size)) if v is not None}
         scene = replace(scene, solver=replace(scene.solver, **changes))
         if tolerance is not None:

@@ -11,16 +11,12 @@ import argparse
 
 from cdpr_exu.core.errors import EXIT_CODES
 from cdpr_exu.scenes.scene import load_scene, shipped_scenes
-from cdpr_exu.scenes.spatial_scene import load_spatial_scene, shipped_spatial_scenes
 
 
 def _cmd_scenes(args: argparse.Namespace) -> int:  # noqa: ARG001
 
-    for name in shipped_scenes():
-        scene = load_scene(name)
-        print(f"{name:24s} {scene.description}")
-    for name in shipped_spatial_scenes():
-        print(f"{name:24s} {load_spatial_scene(name).description}")
+    for name in shipped_scenes():  # planar and spatial
+        print(f"{name:24s} {load_scene(name).description}")
     return 0
 
 

@@ -21,8 +21,7 @@ from cdpr_exu.core.output import check_output_folder, clear_outputs, fixed, writ
 from cdpr_exu.results.result import provenance
 from cdpr_exu.run.rest import DEFAULT_MAX_TIME, DEFAULT_TOLERANCE, solve_rest
 from cdpr_exu.run.spatial_rest import SpatialRest, solve_spatial_rest
-from cdpr_exu.scenes.scene import Scene, save_scene
-from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
+from cdpr_exu.scenes.scene import Scene, load_scene, save_scene
 
 EPILOG = """examples:
   cdpr static paper-catenary-fixed --out results/static_fixed
@@ -103,8 +102,8 @@ def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
 
 def _cmd_static(args: argparse.Namespace) -> int:
     out = check_output_folder(args.out, command="static")
-    scene = load_any_scene(args.scene)
-    if is_spatial(scene):
+    scene = load_scene(args.scene)
+    if scene.dimension == 3:  # one rest pipeline in issue 24, slice 9
         return _static_spatial(scene, out, args.quiet)
     rest = _solved(scene, out, lambda: solve_rest(scene, tolerance=args.tolerance, max_time=args.max_time,
                                                   polish=not args.no_polish))

@@ -22,7 +22,7 @@ from dataclasses import replace
 
 from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED
 from cdpr_exu.core.output import check_output_folder
-from cdpr_exu.scenes.spatial_scene import load_any_scene
+from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.studies.accuracy import check_study_scene, format_tables, grid_for, run_accuracy_study
 from cdpr_exu.studies.study import as_variations, format_table, run_study
 
@@ -68,7 +68,7 @@ def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubPar
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    scene = load_any_scene(args.scene)  # planar or spatial
+    scene = load_scene(args.scene)  # planar or spatial
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
     if args.scheduler and args.scheduler != "local" and args.workers and not args.quiet:
@@ -135,7 +135,7 @@ pareto.png and reference.npz into --out.
 
 
 def _cmd_accuracy(args: argparse.Namespace) -> int:
-    scene = load_any_scene(args.scene)  # planar or spatial
+    scene = load_scene(args.scene)  # planar or spatial
     check_study_scene(scene)  # before the output folder is made
     grid = grid_for(scene, args.quick)
     if args.end_time is not None:

@@ -30,8 +30,41 @@ The *ideal cable length* is the length of that path from the hang point to the a
 *paid-out length* lambda of a winch is the cable beyond the hang point: a cable of
 unstrained length ``L0`` has its winch end at ``h - (0, L0 - lambda)``.
 
-:class:`Pulley` is the one description of where a cable leaves the frame; a point exit
-is a ``Pulley`` of radius 0.
+The exits of a scene are objects (:mod:`cdpr_exu.exits`: a planar pulley, a swivel pulley,
+a point exit); the kernels here compute their ideal cables, so that every number is made
+once: :func:`planar_exit` (a planar point exit is its radius 0) and :func:`swivel_pulley_exit`.
+
+Swivel pulley
+-------------
+A swivel pulley turns about the vertical axis through its **inlet** ``e`` (3,): the
+point where the cable leaves the axis and starts to wrap on the disc. The winch side
+of the cable hangs straight down that axis to the winch, as in the planar model,
+where it hangs down the vertical winch line (above). The disc, of
+radius ``r_p``, lies in the vertical plane through the axis and the anchor ``p``; its
+centre is at ``e + r_p e_rho``, ``r_p`` from the axis towards the anchor.
+
+* The **azimuth** ``psi`` of the pulley is the direction of ``p`` seen from the axis,
+  ``atan2(p_y - e_y, p_x - e_x)``; ``e_rho = (cos psi, sin psi, 0)``.
+* In that plane, with coordinates ``(rho, z) = ((p - e) . e_rho, p_z - e_z)``, the
+  cable is exactly the planar one: the planar pulley (:func:`pulley_exit`) with centre
+  ``(r_p, 0)``, radius ``r_p`` and ``side = -1``. Its hang point ``(c_x + s r_p, c_z)
+  = (0, 0)`` is the inlet, its vertical winch line ``x = 0`` is the swivel axis, and
+  the cable wraps from the axis over the top of the disc towards the anchor. The
+  tangent point, wrap angle, free length and ideal cable length
+  ``L = r_p * wrap + |p - t|`` (from the inlet) are the planar ones, mapped back
+  with ``(rho, z) -> e + rho e_rho + z e_z``. ``r_p = 0`` gives ``L = |p - e|``.
+* Since ``rho >= 0``, the anchor is never beyond the planar pulley's outer vertical
+  line: every anchor outside the disc is reachable, above the inlet too (wrap below
+  pi / 2), and below it (wrap up to 3 pi / 2 when the anchor is under the disc).
+  Only a cable coming *down* to the pulley from a winch above is not covered: that
+  is the mirror image ``z -> -z`` of this geometry and no scene needs it yet.
+* **Anchor on the axis** (``rho`` below 1e-12 of ``|p - e| + r_p``): the azimuth is
+  undefined. The cable length does not depend on it, but for ``r_p > 0`` the
+  direction of the cable does. The azimuth is then kept from the previous pose of
+  the same call (a trajectory passing under a pulley) or taken from
+  ``azimuth_hint``; with neither, the pose is refused (``UnreachableError``). For a
+  point exit (``r_p = 0``) the cable is vertical whatever the azimuth, which is
+  then reported as the hint, the previous one, or 0.
 """
 
 from __future__ import annotations
@@ -42,10 +75,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.validation import real_array, shown
+from cdpr_exu.core.validation import non_negative, real_array, shown
 
 __all__ = [
-    "Pulley",
+    "planar_exit",
     "above_exits",
     "PulleyExit",
     "rotation_matrix",
@@ -57,12 +90,15 @@ __all__ = [
     "perpendicular",
     "anchor_points",
     "anchor_velocities",
-    "hang_point",
     "pulley_exit",
-    "ideal_cable_length",
-    "ideal_cable_length_rate",
     "penetration",
     "segment_penetration",
+    "rotation_matrices",
+    "left_jacobians",
+    "spatial_anchor_points",
+    "spatial_anchor_velocities",
+    "SwivelExit",
+    "swivel_pulley_exit",
 ]
 
 # A wrap angle this far below zero is rounding, not geometry [rad].
@@ -254,25 +290,6 @@ class PulleyExit:
         return self.free_length + self.arc_length
 
 
-def hang_point(center, radius, side):
-    """Point ``h = (c_x + s r_p, c_z)`` where the cable leaves its vertical winch line.
-
-    Parameters
-    ----------
-    center : array_like, shape (2,) [m]
-        Pulley centre ``c``.
-    radius : float [m]
-        Pulley radius ``r_p >= 0``.
-    side : {-1, +1}
-        Side of the pulley on which the cable hangs (-1 left, +1 right).
-
-    Returns
-    -------
-    ndarray, shape (2,) [m]
-    """
-    return Pulley(center, radius, side).hang_point
-
-
 def exit_arrays(center, radius, side, anchor):
     """Vectorised core of :func:`pulley_exit` on checked arguments; anchor (..., 2)."""
     delta = anchor - center
@@ -313,6 +330,18 @@ def exit_arrays(center, radius, side, anchor):
     return tangent_point, wrap, free_length, unit_vector
 
 
+def planar_exit(center, radius, side, anchor) -> PulleyExit:
+    """The :class:`PulleyExit` of :func:`exit_arrays` for a checked pulley (``center`` (2,) [m], float
+    ``radius`` [m], ``side`` -1 or +1) and anchor(s) (2,) or (N, 2) [m], checked here: scalars for one
+    anchor. The one kernel of every planar exit (a point exit is radius 0)."""
+    anchor = finite_array("anchor", anchor, (2,))
+    tangent_point, wrap, free_length, unit_vector = exit_arrays(np.asarray(center), radius, side, anchor)
+    if anchor.ndim == 1:
+        wrap, free_length = float(wrap), float(free_length)
+    return PulleyExit(tangent_point=tangent_point, wrap_angle=wrap, free_length=free_length,
+                      unit_vector=unit_vector, arc_length=radius * wrap)
+
+
 def pulley_exit(center, radius, side, anchor):
     """Tangent point, wrap angle and free length of a cable running over a pulley to an anchor.
 
@@ -348,63 +377,11 @@ def pulley_exit(center, radius, side, anchor):
     ``r_p = 0.25``, ``s = -1``, ``p = (-0.15, -1.9)``) the wrap is about 145.7 degrees and
     the free length about 2.471 m.
     """
-    return Pulley(center, radius, side).exit(anchor)
-
-
-def ideal_cable_length(center, radius, side, anchor):
-    """Ideal cable length from the hang point over the pulley to the anchor.
-
-    ``L = |p - t| + r_p * wrap``: straight, massless, inextensible cable.
-
-    Parameters
-    ----------
-    center : array_like, shape (2,) [m]
-        Pulley centre.
-    radius : float [m]
-        Pulley radius (0: point exit, ``L = |p - c|``).
-    side : {-1, +1}
-        Side on which the cable hangs.
-    anchor : array_like, shape (2,) or (N, 2) [m]
-        Platform anchor(s) in the world frame.
-
-    Returns
-    -------
-    float or ndarray, shape (N,) [m]
-
-    Raises
-    ------
-    SceneError, UnreachableError
-        As :func:`pulley_exit`.
-    """
-    return pulley_exit(center, radius, side, anchor).cable_length
-
-
-def ideal_cable_length_rate(center, radius, side, anchor, anchor_velocity):
-    """Rate of the ideal cable length for an anchor moving at ``anchor_velocity``.
-
-    ``dL/dt = u . v`` with ``u`` the unit vector from the tangent point to the anchor:
-    the change of wrap exactly cancels the tangential motion of the tangent point.
-
-    Parameters
-    ----------
-    center : array_like, shape (2,) [m]
-    radius : float [m]
-    side : {-1, +1}
-    anchor : array_like, shape (2,) or (N, 2) [m]
-    anchor_velocity : array_like, same shape as ``anchor`` [m/s]
-
-    Returns
-    -------
-    float or ndarray, shape (N,) [m/s]
-    """
-    exit_ = pulley_exit(center, radius, side, anchor)
-    velocity = finite_array("anchor_velocity", anchor_velocity, (2,))
-    if velocity.shape != exit_.unit_vector.shape:
-        raise SceneError(
-            f"anchor_velocity must have the shape of anchor {exit_.unit_vector.shape}, got {velocity.shape}"
-        )
-    rate = np.sum(exit_.unit_vector * velocity, axis=-1)
-    return float(rate) if rate.ndim == 0 else rate
+    center = finite_array("center", center, (2,))
+    if center.ndim != 1:
+        raise SceneError(f"center must have shape (2,), got shape {center.shape}")
+    return planar_exit((float(center[0]), float(center[1])), check_radius("radius", radius), check_side("side", side),
+                       anchor)
 
 
 # ----------------------------------------------------------------------------------
@@ -468,102 +445,228 @@ def rotation_angles_deg(rotation: np.ndarray) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------
-# the one pulley description
+# one cable over one swivel pulley (spatial)
 # ----------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Pulley:
-    """Where a cable leaves the frame: a pulley it wraps over, or a point exit.
+ON_AXIS = 1e-12
+"""An anchor closer to the swivel axis than this fraction of its distance (plus r_p) is on the axis."""
 
-    The one description of a cable's exit used by the builder, the statics, the chain
-    statics, the controllers and the plots (the scene's ``PulleySpec`` is a ``Pulley``
-    with contact parameters).
+
+@dataclass(frozen=True, eq=False)  # array fields
+class SwivelExit(PulleyExit):
+    """Where and how an ideal cable leaves a swivel pulley towards its anchor: a
+    :class:`~cdpr_exu.core.geometry.PulleyExit` in 3-D, with the pulley's azimuth.
+
+    Attributes
+    ----------
+    azimuth : float or ndarray, shape (N,) [rad]
+        Direction of the anchor seen from the swivel axis, ``atan2(dy, dx)``.
+    tangent_point : ndarray, shape (3,) or (N, 3) [m]
+        Where the cable leaves the rim (the inlet for a point exit).
+    wrap_angle : float or ndarray, shape (N,) [rad]
+        Arc from the inlet over the top of the disc to the tangent point, in ``[0, 3 pi / 2)``.
+    free_length : float or ndarray, shape (N,) [m]
+        Straight length ``|p - t|``.
+    unit_vector : ndarray, shape (3,) or (N, 3)
+        Unit vector from the tangent point towards the anchor (opposite to the pull on the platform).
+    arc_length : float or ndarray, shape (N,) [m]
+        Wrapped length ``r_p * wrap_angle``.
+    """
+
+    azimuth: float | np.ndarray
+
+
+def point3(name, value):
+    array = finite_array(name, value, (3,))
+    if array.ndim != 1:
+        raise SceneError(f"{name} must have shape (3,), got shape {array.shape}")
+    return array
+
+
+def _fill_azimuths(azimuth, on_axis, azimuth_hint, radius, anchor, inlet):
+    """Azimuths of on-axis anchors: the previous one in the batch, else the hint, else refuse (r_p > 0)."""
+    flat_azimuth = azimuth.reshape(-1)
+    flat_on_axis = on_axis.reshape(-1)
+    flat_anchor = anchor.reshape(-1, 3)
+    previous = azimuth_hint
+    for k in range(flat_azimuth.size):
+        if not flat_on_axis[k]:
+            previous = flat_azimuth[k]
+            continue
+        if previous is None:
+            if radius > 0.0:
+                raise UnreachableError(
+                    f"anchor {flat_anchor[k].tolist()} lies on the axis of the swivel pulley (inlet "
+                    f"{inlet.tolist()}, radius {radius} m): which way the pulley turns (its azimuth) is undefined "
+                    "there; start the reference (the scene's trajectory) with every anchor off the vertical axis "
+                    "of its swivel pulley (in Python, swivel_pulley_exit also takes the previous azimuth as "
+                    "azimuth_hint)")
+            previous = 0.0  # a point exit: the vertical cable does not depend on it
+        flat_azimuth[k] = previous
+    return flat_azimuth.reshape(azimuth.shape)
+
+
+def swivel_exit_arrays(inlet, radius, anchor, azimuth_hint=None):
+    """Vectorised core of :func:`swivel_pulley_exit` on checked arguments; anchor (..., 3)."""
+    delta = anchor - inlet
+    distance = np.linalg.norm(delta, axis=-1)
+    if radius == 0.0 and np.any(distance == 0.0):
+        bad = anchor[distance == 0.0] if anchor.ndim > 1 else anchor
+        raise UnreachableError(f"anchor {np.asarray(bad).tolist()} coincides with the point exit {inlet.tolist()}")
+    rho = np.hypot(delta[..., 0], delta[..., 1])
+    azimuth = np.arctan2(delta[..., 1], delta[..., 0])
+    on_axis = rho <= ON_AXIS * (distance + radius)
+    if np.any(on_axis):
+        azimuth = _fill_azimuths(np.array(azimuth, dtype=float), on_axis, azimuth_hint, radius, anchor, inlet)
+        rho = np.where(on_axis, 0.0, rho)
+    height = delta[..., 2]
+    if radius > 0.0:
+        inside = np.hypot(rho - radius, height) <= radius
+        if np.any(inside):
+            bad = anchor[inside] if anchor.ndim > 1 else anchor
+            raise UnreachableError(f"anchor {np.asarray(bad).tolist()} lies inside the disc of the swivel pulley "
+                                   f"(inlet {inlet.tolist()}, radius {radius} m)")
+    # the planar pulley in the plane (rho, z), origin at the inlet: its hang point is the inlet
+    radius = float(radius)
+    planar = planar_exit((radius, 0.0), radius, -1, np.stack([rho, height], axis=-1))
+    e_rho = np.stack([np.cos(azimuth), np.sin(azimuth), np.zeros_like(azimuth)], axis=-1)
+    e_z = np.array([0.0, 0.0, 1.0])
+
+    def to_world(planar_vector):
+        return planar_vector[..., :1] * e_rho + planar_vector[..., 1:] * e_z
+
+    return SwivelExit(
+        azimuth=float(azimuth) if np.ndim(azimuth) == 0 else azimuth,
+        tangent_point=inlet + to_world(planar.tangent_point),
+        wrap_angle=planar.wrap_angle,
+        free_length=planar.free_length,
+        unit_vector=to_world(planar.unit_vector),
+        arc_length=planar.arc_length,
+    )
+
+
+def swivel_pulley_exit(inlet, radius, anchor, azimuth_hint=None):
+    """Azimuth, tangent point, wrap and free length of an ideal cable over a swivel pulley to an anchor.
 
     Parameters
     ----------
-    center : (x, z) [m]
-        Pulley centre ``c`` (the exit point of a point exit).
+    inlet : array_like, shape (3,) [m]
+        Point where the cable leaves the vertical swivel axis onto the disc (it hangs
+        down the axis to its winch).
     radius : float [m]
-        Rim radius ``r_p >= 0``; 0 is a point exit at ``center`` (no wrap).
-    side : {-1, +1}
-        Side on which the cable hangs to its winch: -1 on the left (it wraps clockwise
-        over the top), +1 on the right (counter-clockwise).
+        Disc radius ``r_p >= 0``; 0 is a point exit at the inlet.
+    anchor : array_like, shape (3,) or (N, 3) [m]
+        Platform anchor(s) in the world frame.
+    azimuth_hint : float [rad], optional
+        Azimuth to use for an anchor on the swivel axis when no earlier anchor of
+        this call is off the axis (see the module notes).
+
+    Returns
+    -------
+    SwivelExit
+        Scalars and (3,) vectors, or (N,) and (N, 3) arrays for N anchors.
 
     Raises
     ------
     SceneError
-        If ``center`` is not two finite numbers, ``radius`` is negative or not finite,
-        or ``side`` is not -1 or +1; the message names the field.
+        If an argument is malformed or not finite, or ``radius`` is negative.
+    UnreachableError
+        If an anchor is inside the disc (or on a point exit), or on the axis of a
+        pulley of positive radius with no azimuth to keep.
+
+    Notes
+    -----
+    The cable lies in the vertical plane of azimuth ``psi`` through the axis, where
+    it is the planar cable of :func:`planar_exit` (centre ``(r_p, 0)``,
+    side -1, hang point at the inlet; Pott, "Cable-Driven Parallel Robots: Theory
+    and Application", Springer 2018, pulley kinematics).
     """
+    inlet = point3("inlet", inlet)
+    radius = non_negative("radius", radius)
+    anchor = finite_array("anchor", anchor, (3,))
+    if anchor.ndim > 2:
+        raise SceneError(f"anchor must have shape (3,) or (N, 3), got shape {anchor.shape}")
+    if azimuth_hint is not None:
+        azimuth_hint = float(finite_array("azimuth_hint", azimuth_hint))
+    return swivel_exit_arrays(inlet, radius, anchor, azimuth_hint)
 
-    center: tuple = (0.0, 0.0)
-    radius: float = 0.0
-    side: int = -1
 
-    def __post_init__(self):
-        center = finite_array("center", self.center, (2,))
-        if center.ndim != 1:
-            raise SceneError(f"center must have shape (2,), got shape {center.shape}")
-        object.__setattr__(self, "center", (float(center[0]), float(center[1])))
-        object.__setattr__(self, "radius", check_radius("radius", self.radius))
-        object.__setattr__(self, "side", check_side("side", self.side))
+# ----------------------------------------------------------------------------------
+# the spatial platform: anchors, their velocities (the planar ones are above)
+# ----------------------------------------------------------------------------------
+def rotation_matrices(rotation_vectors):
+    """``R = exp([theta]x)`` for rotation vectors (..., 3) [rad] -> (..., 3, 3).
 
-    @property
-    def is_point_exit(self) -> bool:
-        """True for a point exit (radius 0)."""
-        return self.radius == 0.0
+    Each is :func:`rotation_from_vector`.
+    """
+    theta = np.asarray(rotation_vectors, dtype=float)
+    flat = theta.reshape(-1, 3)
+    return np.array([rotation_from_vector(t) for t in flat]).reshape(theta.shape[:-1] + (3, 3))
 
-    @property
-    def hang_point(self) -> np.ndarray:
-        """Where the cable leaves its vertical winch line, ``(c_x + s r_p, c_z)``, shape (2,) [m]."""
-        return np.array([self.center[0] + self.side * self.radius, self.center[1]])
 
-    def exit(self, anchor) -> PulleyExit:
-        """Tangent point, wrap and free length of the ideal cable to ``anchor`` (2,) or (N, 2) [m].
+def left_jacobians(rotation_vectors):
+    """``J_l(theta)`` (:func:`left_jacobian`) for rotation vectors (..., 3) [rad] -> (..., 3, 3)."""
+    theta = np.asarray(rotation_vectors, dtype=float)
+    return np.array([left_jacobian(t) for t in theta.reshape(-1, 3)]).reshape(theta.shape[:-1] + (3, 3))
 
-        See :func:`pulley_exit`.
-        """
-        anchor = finite_array("anchor", anchor, (2,))
-        tangent_point, wrap, free_length, unit_vector = exit_arrays(
-            np.asarray(self.center), self.radius, self.side, anchor)
-        if anchor.ndim == 1:
-            wrap, free_length = float(wrap), float(free_length)
-        return PulleyExit(tangent_point=tangent_point, wrap_angle=wrap, free_length=free_length,
-                          unit_vector=unit_vector, arc_length=self.radius * wrap)
 
-    def cable_length(self, anchor):
-        """Ideal cable length [m] from the hang point to ``anchor`` (2,) or (N, 2) [m]."""
-        return self.exit(anchor).cable_length
+def check_spatial_pose(pose, anchors, pose_name="pose"):
+    """Pose (6,)/(N, 6) and anchors (m, 3), or pose (3,)/(N, 3) for a point mass (anchors None)."""
+    width = 3 if anchors is None else 6
+    pose = finite_array(pose_name, pose, (width,))
+    if pose.ndim > 2:
+        raise SceneError(f"{pose_name} must have shape ({width},) or (N, {width}), got shape {pose.shape}")
+    if anchors is not None:
+        anchors = finite_array("anchors", anchors, (3,))
+        if anchors.ndim != 2:
+            raise SceneError(f"anchors must have shape (m, 3), got shape {anchors.shape}")
+    return pose, anchors
 
-    def rim_point(self, angle: float) -> np.ndarray:
-        """Point of the rim at polar angle ``angle`` [rad], shape (2,) [m]."""
-        return np.array(self.center) + self.radius * np.array([math.cos(angle), math.sin(angle)])
 
-    def wrap_to(self, angle: float) -> float:
-        """Angle [rad] wrapped from the hang point over the top to the rim angle ``angle``, in [0, 2 pi)."""
-        if self.side < 0:
-            return (math.pi - angle) % (2.0 * math.pi)
-        return angle % (2.0 * math.pi)
+def spatial_arms(pose, anchors):
+    """``R(theta) b_i``, shape (..., m, 3)."""
+    return np.einsum("...jk,mk->...mj", rotation_matrices(pose[..., 3:6]), anchors)
 
-    def winch_end(self, unstrained_length: float, paid_out: float) -> np.ndarray:
-        """Winch end of a cable of unstrained length ``L0`` [m] with ``paid_out`` [m] beyond the hang point.
 
-        ``h - (0, L0 - lambda)``: the cable runs straight down the winch line. Shape (2,) [m].
-        """
-        hang = self.hang_point
-        return np.array([hang[0], hang[1] - (unstrained_length - paid_out)])
+def spatial_anchor_points(pose, anchors):
+    """World positions of the platform anchors, ``p_i = r + R(theta) b_i``.
 
-    @property
-    def top(self) -> float:
-        """Height [m] of the highest point the cable can leave this exit from: the top of the rim,
-        ``c_z + r_p`` (the centre of a point exit). See :func:`above_exits`."""
-        return self.center[1] + self.radius
+    Parameters
+    ----------
+    pose : array_like, shape (6,) or (N, 6) [m, rad]
+        Platform pose(s) ``(r, theta)``.
+    anchors : array_like, shape (m, 3) [m]
+        Anchor points ``b_i`` in the platform frame.
 
-    def paid_out_length(self, unstrained_length: float, winch_end) -> float:
-        """Paid-out length lambda [m] of a cable of unstrained length ``L0`` [m] whose winch end is at ``winch_end`` (2,) [m].
+    Returns
+    -------
+    ndarray, shape (m, 3) or (N, m, 3) [m]
+    """
+    pose, anchors = check_spatial_pose(pose, anchors)
+    return pose[..., None, :3] + spatial_arms(pose, anchors)
 
-        The inverse of :meth:`winch_end`: all of the cable but the part hanging below the hang point.
-        """
-        return float(unstrained_length - (self.center[1] - winch_end[1]))
+
+def spatial_anchor_velocities(pose, pose_rate, anchors):
+    """World velocities of the platform anchors, ``v_i = dr/dt + omega x (R b_i)``, ``omega = J_l(theta) dtheta/dt``.
+
+    Parameters
+    ----------
+    pose : array_like, shape (6,) or (N, 6) [m, rad]
+        Platform pose(s) ``(r, theta)``.
+    pose_rate : array_like, same shape as ``pose`` [m/s, rad/s]
+        Rate(s) of the pose, ``(dr/dt, dtheta/dt)`` (the rotation vector's rate, not
+        the angular velocity).
+    anchors : array_like, shape (m, 3) [m]
+
+    Returns
+    -------
+    ndarray, shape (m, 3) or (N, m, 3) [m/s]
+    """
+    pose, anchors = check_spatial_pose(pose, anchors)
+    pose_rate = finite_array("pose_rate", pose_rate, (6,))
+    if pose_rate.shape != pose.shape:
+        raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
+    omega = np.einsum("...jk,...k->...j", left_jacobians(pose[..., 3:6]), pose_rate[..., 3:6])
+    return pose_rate[..., None, :3] + np.cross(omega[..., None, :], spatial_arms(pose, anchors))
 
 
 # ----------------------------------------------------------------------------------
@@ -582,7 +685,7 @@ def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None
     anchor_heights : array_like, shape (m,) [m]
         Height of each cable's anchor (z, the vertical axis of both dimensions).
     exit_tops : array_like, shape (m,) [m]
-        Height of the top of each cable's exit (:attr:`Pulley.top`; a swivel pulley's
+        Height of the top of each cable's exit (:attr:`cdpr_exu.exits.base.Exit.top`; a swivel pulley's
         inlet height plus its radius; an exit point's height).
     exits : str
         The scene field of the exits, for the message (``"pulleys"`` or ``"exits"``).
@@ -606,8 +709,8 @@ def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None
 # ----------------------------------------------------------------------------------
 # how deep the lumped cable cuts into a pulley
 # ----------------------------------------------------------------------------------
-def penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
-    """Depth by which each node lies inside the pulley disc (0 outside) [m].
+def penetration(pulley, positions: np.ndarray) -> np.ndarray:
+    """Depth by which each node lies inside the disc of ``pulley`` (its ``center`` and ``radius``; 0 outside) [m].
 
     Parameters
     ----------
@@ -621,8 +724,8 @@ def penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
     return np.maximum(pulley.radius - distance, 0.0)
 
 
-def segment_penetration(pulley: Pulley, positions: np.ndarray) -> np.ndarray:
-    """Depth by which each element (the segment between two nodes) cuts into the pulley disc [m].
+def segment_penetration(pulley, positions: np.ndarray) -> np.ndarray:
+    """Depth by which each element (the segment between two nodes) cuts into the disc of ``pulley`` [m].
 
     Parameters
     ----------

@@ -8,9 +8,10 @@ expected (:func:`is_number`), in scalars and in arrays alike.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
-from typing import Any
+from typing import Any, Mapping
 
 from cdpr_exu.core.errors import SceneError
 
@@ -141,6 +142,21 @@ def flat_coordinates(name: str, value: Any, n_coordinates: int | None = None):
     return array
 
 
+def entries(path: str, value: Any, length: int, unit: str = "") -> tuple[float, ...]:
+    """``value`` as a tuple of ``length`` finite floats, or SceneError naming ``path`` (``unit`` is named in
+    the messages): a scene field such as a pulley's centre or a platform's pose."""
+    units = f" [{unit}]" if unit else ""
+    if isinstance(value, (str, bytes, Mapping)):
+        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}")
+    try:
+        items = list(value)
+    except TypeError:
+        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}") from None
+    if len(items) != length:
+        raise SceneError(f"{path} must have {length} entries{units}, got {len(items)}: {shown(value)}")
+    return tuple(finite(f"{path}[{i}]", v) for i, v in enumerate(items))
+
+
 def vector(name: str, value: Any, length: int, meaning: str = ""):
     """``value`` as a finite float ndarray of shape ``(length,)``.
 
@@ -186,3 +202,24 @@ def points_per_item(name: str, values: Any, count: int):
     if array.shape != (count, 2) or not np.isfinite(array).all():
         raise SceneError(f"{name} must be finite, shape (2,) or ({count}, 2); got shape {array.shape}")
     return np.ascontiguousarray(array)
+
+
+def from_table(cls: type, data: Any, path: str, head: str) -> Any:
+    """Make the dataclass ``cls`` from the table ``data`` (a scene file's), or SceneError naming ``path``:
+    refuses a table that is none and unknown fields, and names the fields of its own messages (which
+    name them under ``head``, e.g. ``pulley.radius``) under ``path`` (``pulleys[1].radius``)."""
+    if not isinstance(data, Mapping):
+        raise SceneError(f"{path} must be a table, got {shown(data)}")
+    known = {f.name for f in dataclasses.fields(cls)}
+    unknown = set(data) - known
+    if unknown:
+        raise SceneError(f"{path} has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
+    try:
+        return cls(**data)
+    except SceneError as err:
+        message = str(err)
+        if path != head and message.startswith(head + "."):
+            message = path + message[len(head):]
+        raise SceneError(message) from None
+    except TypeError as err:
+        raise SceneError(f"{path}: {err}") from None

@@ -9,37 +9,8 @@ the SO(3) helpers are :mod:`cdpr_exu.core.geometry`'s (``rotation_from_vector``,
 ``left_jacobian``). A
 point-mass platform (every cable on one point) has the pose ``r``, shape (3,).
 
-Swivel pulley
--------------
-A swivel pulley turns about the vertical axis through its **inlet** ``e`` (3,): the
-point where the cable leaves the axis and starts to wrap on the disc. The winch side
-of the cable hangs straight down that axis to the winch, as in the planar model,
-where it hangs down the vertical winch line (:mod:`cdpr_exu.core.geometry`). The disc, of
-radius ``r_p``, lies in the vertical plane through the axis and the anchor ``p``; its
-centre is at ``e + r_p e_rho``, ``r_p`` from the axis towards the anchor.
-
-* The **azimuth** ``psi`` of the pulley is the direction of ``p`` seen from the axis,
-  ``atan2(p_y - e_y, p_x - e_x)``; ``e_rho = (cos psi, sin psi, 0)``.
-* In that plane, with coordinates ``(rho, z) = ((p - e) . e_rho, p_z - e_z)``, the
-  cable is exactly the planar one: :class:`cdpr_exu.core.geometry.Pulley` with centre
-  ``(r_p, 0)``, radius ``r_p`` and ``side = -1``. Its hang point ``(c_x + s r_p, c_z)
-  = (0, 0)`` is the inlet, its vertical winch line ``x = 0`` is the swivel axis, and
-  the cable wraps from the axis over the top of the disc towards the anchor. The
-  tangent point, wrap angle, free length and ideal cable length
-  ``L = r_p * wrap + |p - t|`` (from the inlet) are the planar ones, mapped back
-  with ``(rho, z) -> e + rho e_rho + z e_z``. ``r_p = 0`` gives ``L = |p - e|``.
-* Since ``rho >= 0``, the anchor is never beyond the planar pulley's outer vertical
-  line: every anchor outside the disc is reachable, above the inlet too (wrap below
-  pi / 2), and below it (wrap up to 3 pi / 2 when the anchor is under the disc).
-  Only a cable coming *down* to the pulley from a winch above is not covered: that
-  is the mirror image ``z -> -z`` of this geometry and no scene needs it yet.
-* **Anchor on the axis** (``rho`` below 1e-12 of ``|p - e| + r_p``): the azimuth is
-  undefined. The cable length does not depend on it, but for ``r_p > 0`` the
-  direction of the cable does. The azimuth is then kept from the previous pose of
-  the same call (a trajectory passing under a pulley) or taken from
-  ``azimuth_hint``; with neither, the pose is refused (``UnreachableError``). For a
-  point exit (``r_p = 0``) the cable is vertical whatever the azimuth, which is
-  then reported as the hint, the previous one, or 0.
+The geometry of one cable over a swivel pulley (its azimuth, tangent point and wrap) and of the
+platform (anchor points and velocities, rotation matrices) is :mod:`cdpr_exu.core.geometry`'s.
 
 Sign conventions
 ----------------
@@ -65,17 +36,12 @@ from scipy.optimize import nnls
 
 from cdpr_exu.physics.catenary import STANDARD_GRAVITY
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import Pulley, PulleyExit, finite_array, left_jacobian, rotation_from_vector
+from cdpr_exu.core.geometry import (check_spatial_pose, finite_array, point3, rotation_from_vector,
+                                    spatial_anchor_velocities, spatial_arms, swivel_exit_arrays)
 from cdpr_exu.core.validation import non_negative, per_item, shown, vector
 
 __all__ = [
-    "SwivelExit",
-    "SwivelPulley",
-    "swivel_pulley_exit",
     "robot_exits",
-    "rotation_matrices",
-    "anchor_points",
-    "anchor_velocities",
     "inverse_kinematics",
     "inverse_kinematics_rates",
     "cable_unit_vectors",
@@ -85,266 +51,11 @@ __all__ = [
     "IdealSpatialRobot",
 ]
 
-_ON_AXIS = 1e-12
-"""An anchor closer to the swivel axis than this fraction of its distance (plus r_p) is on the axis."""
-
 _INFEASIBLE_RESIDUAL = 1e-6
 """NNLS residual below which the least-distance problem is infeasible (a feasible one has ||r|| >= 1/sqrt(1 + m/4))."""
 
 _BOUND_ROUNDING = 1e-9
 """A tension this fraction of the tension range outside its bounds is rounding (and is clipped)."""
-
-
-# ----------------------------------------------------------------------------------
-# one cable over one swivel pulley
-# ----------------------------------------------------------------------------------
-@dataclass(frozen=True, eq=False)  # array fields
-class SwivelExit(PulleyExit):
-    """Where and how an ideal cable leaves a swivel pulley towards its anchor: a
-    :class:`~cdpr_exu.core.geometry.PulleyExit` in 3-D, with the pulley's azimuth.
-
-    Attributes
-    ----------
-    azimuth : float or ndarray, shape (N,) [rad]
-        Direction of the anchor seen from the swivel axis, ``atan2(dy, dx)``.
-    tangent_point : ndarray, shape (3,) or (N, 3) [m]
-        Where the cable leaves the rim (the inlet for a point exit).
-    wrap_angle : float or ndarray, shape (N,) [rad]
-        Arc from the inlet over the top of the disc to the tangent point, in ``[0, 3 pi / 2)``.
-    free_length : float or ndarray, shape (N,) [m]
-        Straight length ``|p - t|``.
-    unit_vector : ndarray, shape (3,) or (N, 3)
-        Unit vector from the tangent point towards the anchor (opposite to the pull on the platform).
-    arc_length : float or ndarray, shape (N,) [m]
-        Wrapped length ``r_p * wrap_angle``.
-    """
-
-    azimuth: float | np.ndarray
-
-
-def _point3(name, value):
-    array = finite_array(name, value, (3,))
-    if array.ndim != 1:
-        raise SceneError(f"{name} must have shape (3,), got shape {array.shape}")
-    return array
-
-
-def _fill_azimuths(azimuth, on_axis, azimuth_hint, radius, anchor, inlet):
-    """Azimuths of on-axis anchors: the previous one in the batch, else the hint, else refuse (r_p > 0)."""
-    flat_azimuth = azimuth.reshape(-1)
-    flat_on_axis = on_axis.reshape(-1)
-    flat_anchor = anchor.reshape(-1, 3)
-    previous = azimuth_hint
-    for k in range(flat_azimuth.size):
-        if not flat_on_axis[k]:
-            previous = flat_azimuth[k]
-            continue
-        if previous is None:
-            if radius > 0.0:
-                raise UnreachableError(
-                    f"anchor {flat_anchor[k].tolist()} lies on the axis of the swivel pulley (inlet "
-                    f"{inlet.tolist()}, radius {radius} m): which way the pulley turns (its azimuth) is undefined "
-                    "there; start the reference (the scene's trajectory) with every anchor off the vertical axis "
-                    "of its swivel pulley (in Python, swivel_pulley_exit also takes the previous azimuth as "
-                    "azimuth_hint)")
-            previous = 0.0  # a point exit: the vertical cable does not depend on it
-        flat_azimuth[k] = previous
-    return flat_azimuth.reshape(azimuth.shape)
-
-
-def _swivel_exit(inlet, radius, anchor, azimuth_hint=None):
-    """Vectorised core of :func:`swivel_pulley_exit` on checked arguments; anchor (..., 3)."""
-    delta = anchor - inlet
-    distance = np.linalg.norm(delta, axis=-1)
-    if radius == 0.0 and np.any(distance == 0.0):
-        bad = anchor[distance == 0.0] if anchor.ndim > 1 else anchor
-        raise UnreachableError(f"anchor {np.asarray(bad).tolist()} coincides with the point exit {inlet.tolist()}")
-    rho = np.hypot(delta[..., 0], delta[..., 1])
-    azimuth = np.arctan2(delta[..., 1], delta[..., 0])
-    on_axis = rho <= _ON_AXIS * (distance + radius)
-    if np.any(on_axis):
-        azimuth = _fill_azimuths(np.array(azimuth, dtype=float), on_axis, azimuth_hint, radius, anchor, inlet)
-        rho = np.where(on_axis, 0.0, rho)
-    height = delta[..., 2]
-    if radius > 0.0:
-        inside = np.hypot(rho - radius, height) <= radius
-        if np.any(inside):
-            bad = anchor[inside] if anchor.ndim > 1 else anchor
-            raise UnreachableError(f"anchor {np.asarray(bad).tolist()} lies inside the disc of the swivel pulley "
-                                   f"(inlet {inlet.tolist()}, radius {radius} m)")
-    # the planar pulley in the plane (rho, z), origin at the inlet: its hang point is the inlet
-    planar = Pulley((radius, 0.0), radius, -1).exit(np.stack([rho, height], axis=-1))
-    e_rho = np.stack([np.cos(azimuth), np.sin(azimuth), np.zeros_like(azimuth)], axis=-1)
-    e_z = np.array([0.0, 0.0, 1.0])
-
-    def to_world(planar_vector):
-        return planar_vector[..., :1] * e_rho + planar_vector[..., 1:] * e_z
-
-    return SwivelExit(
-        azimuth=float(azimuth) if np.ndim(azimuth) == 0 else azimuth,
-        tangent_point=inlet + to_world(planar.tangent_point),
-        wrap_angle=planar.wrap_angle,
-        free_length=planar.free_length,
-        unit_vector=to_world(planar.unit_vector),
-        arc_length=planar.arc_length,
-    )
-
-
-def swivel_pulley_exit(inlet, radius, anchor, azimuth_hint=None):
-    """Azimuth, tangent point, wrap and free length of an ideal cable over a swivel pulley to an anchor.
-
-    Parameters
-    ----------
-    inlet : array_like, shape (3,) [m]
-        Point where the cable leaves the vertical swivel axis onto the disc (it hangs
-        down the axis to its winch).
-    radius : float [m]
-        Disc radius ``r_p >= 0``; 0 is a point exit at the inlet.
-    anchor : array_like, shape (3,) or (N, 3) [m]
-        Platform anchor(s) in the world frame.
-    azimuth_hint : float [rad], optional
-        Azimuth to use for an anchor on the swivel axis when no earlier anchor of
-        this call is off the axis (see the module notes).
-
-    Returns
-    -------
-    SwivelExit
-        Scalars and (3,) vectors, or (N,) and (N, 3) arrays for N anchors.
-
-    Raises
-    ------
-    SceneError
-        If an argument is malformed or not finite, or ``radius`` is negative.
-    UnreachableError
-        If an anchor is inside the disc (or on a point exit), or on the axis of a
-        pulley of positive radius with no azimuth to keep.
-
-    Notes
-    -----
-    The cable lies in the vertical plane of azimuth ``psi`` through the axis, where
-    it is the planar cable of :class:`cdpr_exu.core.geometry.Pulley` (centre ``(r_p, 0)``,
-    side -1, hang point at the inlet; Pott, "Cable-Driven Parallel Robots: Theory
-    and Application", Springer 2018, pulley kinematics).
-    """
-    inlet = _point3("inlet", inlet)
-    radius = non_negative("radius", radius)
-    anchor = finite_array("anchor", anchor, (3,))
-    if anchor.ndim > 2:
-        raise SceneError(f"anchor must have shape (3,) or (N, 3), got shape {anchor.shape}")
-    if azimuth_hint is not None:
-        azimuth_hint = float(finite_array("azimuth_hint", azimuth_hint))
-    return _swivel_exit(inlet, radius, anchor, azimuth_hint)
-
-
-@dataclass(frozen=True)
-class SwivelPulley:
-    """A swivel pulley: a disc of radius ``radius`` turning about the vertical axis through ``inlet``.
-
-    Parameters
-    ----------
-    inlet : (x, y, z) [m]
-        Where the cable leaves the vertical axis (it hangs down the axis to its winch).
-    radius : float [m]
-        Disc radius ``r_p >= 0``; 0 is a point exit at the inlet.
-
-    Raises
-    ------
-    SceneError
-        Naming the field, if a value is not finite or ``radius`` is negative.
-    """
-
-    inlet: tuple = (0.0, 0.0, 0.0)
-    radius: float = 0.0
-
-    def __post_init__(self):
-        object.__setattr__(self, "inlet", tuple(float(x) for x in _point3("inlet", self.inlet)))
-        object.__setattr__(self, "radius", non_negative("radius", self.radius))
-
-    def exit(self, anchor, azimuth_hint=None) -> SwivelExit:
-        """The cable's exit towards ``anchor`` (3,) or (N, 3) [m]; see :func:`swivel_pulley_exit`."""
-        return swivel_pulley_exit(self.inlet, self.radius, anchor, azimuth_hint)
-
-    def cable_length(self, anchor, azimuth_hint=None):
-        """Ideal cable length [m] from the inlet to ``anchor`` (3,) or (N, 3) [m]."""
-        return self.exit(anchor, azimuth_hint).cable_length
-
-
-# ----------------------------------------------------------------------------------
-# the platform
-# ----------------------------------------------------------------------------------
-def rotation_matrices(rotation_vectors):
-    """``R = exp([theta]x)`` for rotation vectors (..., 3) [rad] -> (..., 3, 3).
-
-    Each is :func:`cdpr_exu.core.geometry.rotation_from_vector`.
-    """
-    theta = np.asarray(rotation_vectors, dtype=float)
-    flat = theta.reshape(-1, 3)
-    return np.array([rotation_from_vector(t) for t in flat]).reshape(theta.shape[:-1] + (3, 3))
-
-
-def _left_jacobians(rotation_vectors):
-    theta = np.asarray(rotation_vectors, dtype=float)
-    return np.array([left_jacobian(t) for t in theta.reshape(-1, 3)]).reshape(theta.shape[:-1] + (3, 3))
-
-
-def _check_pose(pose, anchors, pose_name="pose"):
-    """Pose (6,)/(N, 6) and anchors (m, 3), or pose (3,)/(N, 3) for a point mass (anchors None)."""
-    width = 3 if anchors is None else 6
-    pose = finite_array(pose_name, pose, (width,))
-    if pose.ndim > 2:
-        raise SceneError(f"{pose_name} must have shape ({width},) or (N, {width}), got shape {pose.shape}")
-    if anchors is not None:
-        anchors = finite_array("anchors", anchors, (3,))
-        if anchors.ndim != 2:
-            raise SceneError(f"anchors must have shape (m, 3), got shape {anchors.shape}")
-    return pose, anchors
-
-
-def _arms(pose, anchors):
-    """``R(theta) b_i``, shape (..., m, 3)."""
-    return np.einsum("...jk,mk->...mj", rotation_matrices(pose[..., 3:6]), anchors)
-
-
-def anchor_points(pose, anchors):
-    """World positions of the platform anchors, ``p_i = r + R(theta) b_i``.
-
-    Parameters
-    ----------
-    pose : array_like, shape (6,) or (N, 6) [m, rad]
-        Platform pose(s) ``(r, theta)``.
-    anchors : array_like, shape (m, 3) [m]
-        Anchor points ``b_i`` in the platform frame.
-
-    Returns
-    -------
-    ndarray, shape (m, 3) or (N, m, 3) [m]
-    """
-    pose, anchors = _check_pose(pose, anchors)
-    return pose[..., None, :3] + _arms(pose, anchors)
-
-
-def anchor_velocities(pose, pose_rate, anchors):
-    """World velocities of the platform anchors, ``v_i = dr/dt + omega x (R b_i)``, ``omega = J_l(theta) dtheta/dt``.
-
-    Parameters
-    ----------
-    pose : array_like, shape (6,) or (N, 6) [m, rad]
-        Platform pose(s) ``(r, theta)``.
-    pose_rate : array_like, same shape as ``pose`` [m/s, rad/s]
-        Rate(s) of the pose, ``(dr/dt, dtheta/dt)`` (the rotation vector's rate, not
-        the angular velocity).
-    anchors : array_like, shape (m, 3) [m]
-
-    Returns
-    -------
-    ndarray, shape (m, 3) or (N, m, 3) [m/s]
-    """
-    pose, anchors = _check_pose(pose, anchors)
-    pose_rate = finite_array("pose_rate", pose_rate, (6,))
-    if pose_rate.shape != pose.shape:
-        raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
-    omega = np.einsum("...jk,...k->...j", _left_jacobians(pose[..., 3:6]), pose_rate[..., 3:6])
-    return pose_rate[..., None, :3] + np.cross(omega[..., None, :], _arms(pose, anchors))
 
 
 def _check_pulleys(n_cables, inlets, pulley_radii):
@@ -364,19 +75,19 @@ def _check_hints(n_cables, azimuth_hints):
 
 
 def robot_exits(pose, anchors, inlets, pulley_radii, azimuth_hints=None):
-    """The :class:`SwivelExit` of every cable for pose(s) (6,)/(N, 6), or positions (3,)/(N, 3) with ``anchors=None``.
+    """The :class:`~cdpr_exu.core.geometry.SwivelExit` of every cable for pose(s) (6,)/(N, 6), or positions (3,)/(N, 3) with ``anchors=None``.
 
     Returns the checked pose, the checked anchors (None for a point mass) and the list of exits.
     """
-    pose, anchors = _check_pose(pose, anchors)
+    pose, anchors = check_spatial_pose(pose, anchors)
     n_cables = len(finite_array("inlets", inlets, (3,)).reshape(-1, 3)) if anchors is None else len(anchors)
     inlets, radii = _check_pulleys(n_cables, inlets, pulley_radii)
     hints = _check_hints(n_cables, azimuth_hints)
     if anchors is None:
         points = np.broadcast_to(pose[..., None, :], pose.shape[:-1] + (n_cables, 3))
     else:
-        points = pose[..., None, :3] + _arms(pose, anchors)
-    exits = [_swivel_exit(inlets[i], float(radii[i]), np.ascontiguousarray(points[..., i, :]), hints[i])
+        points = pose[..., None, :3] + spatial_arms(pose, anchors)
+    exits = [swivel_exit_arrays(inlets[i], float(radii[i]), np.ascontiguousarray(points[..., i, :]), hints[i])
              for i in range(n_cables)]
     return pose, anchors, exits
 
@@ -436,7 +147,7 @@ def inverse_kinematics_rates(pose, pose_rate, anchors, inlets, pulley_radii, azi
     pose : array_like, shape (6,) or (N, 6) [m, rad]
         Platform pose(s); a position (3,) or (N, 3) [m] for a point mass.
     pose_rate : array_like, same shape as ``pose`` [m/s, rad/s]
-        ``(dr/dt, dtheta/dt)``, the rate of the rotation vector (see :func:`anchor_velocities`).
+        ``(dr/dt, dtheta/dt)``, the rate of the rotation vector (see :func:`cdpr_exu.core.geometry.spatial_anchor_velocities`).
     anchors, inlets, pulley_radii, azimuth_hints
         As :func:`inverse_kinematics`.
 
@@ -451,7 +162,7 @@ def inverse_kinematics_rates(pose, pose_rate, anchors, inlets, pulley_radii, azi
             raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
         velocities = np.broadcast_to(pose_rate[..., None, :], pose.shape[:-1] + (len(exits), 3))
     else:
-        velocities = anchor_velocities(pose, pose_rate, anchors)
+        velocities = spatial_anchor_velocities(pose, pose_rate, anchors)
     return np.stack([np.sum(e.unit_vector * velocities[..., i, :], axis=-1) for i, e in enumerate(exits)], axis=-1)
 
 
@@ -480,7 +191,7 @@ def structure_matrix(pose, anchors, unit_vectors):
     -----
     ``dL/d(r, theta) = -A^T blockdiag(I, J_l(theta))`` (module notes).
     """
-    pose, anchors = _check_pose(pose, anchors)
+    pose, anchors = check_spatial_pose(pose, anchors)
     units = finite_array("unit_vectors", unit_vectors, (3,))
     n_cables = units.shape[-2] if units.ndim >= 2 else 0
     if anchors is not None and (units.ndim < 2 or n_cables != len(anchors)):
@@ -494,7 +205,7 @@ def structure_matrix(pose, anchors, unit_vectors):
     forces = np.swapaxes(units, -1, -2)
     if anchors is None:
         return np.array(forces)
-    moments = np.swapaxes(np.cross(_arms(pose, anchors), units), -1, -2)
+    moments = np.swapaxes(np.cross(spatial_arms(pose, anchors), units), -1, -2)
     return np.concatenate([forces, moments], axis=-2)
 
 
@@ -520,7 +231,7 @@ def gravity_wrench(pose, mass, center_of_mass=(0.0, 0.0, 0.0), gravity=STANDARD_
     weight = np.array([0.0, 0.0, -non_negative("mass", mass) * non_negative("gravity", gravity)])
     if pose.shape == (3,):
         return weight
-    arm = rotation_from_vector(pose[3:]) @ _point3("center_of_mass", center_of_mass)
+    arm = rotation_from_vector(pose[3:]) @ point3("center_of_mass", center_of_mass)
     return np.concatenate([weight, np.cross(arm, weight)])
 
 

@@ -68,10 +68,10 @@ from scipy.optimize import minimize
 from cdpr_exu.physics.catenary import DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState, end_stiffness, \
     profile, solve_forward, solve_inverse
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import Pulley, left_jacobian, rotation_from_vector, rotation_vector, skew
-from cdpr_exu.physics.spatial_kinematics import swivel_pulley_exit
+from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector, skew
+from cdpr_exu.core.geometry import swivel_pulley_exit
 # the planar statics' line search, and its cable over a pulley in the swivel's vertical plane, reused
-from cdpr_exu.statics.statics import PlatformEquilibriumViews, SuspendedCable, forward_cable, minimise_energy
+from cdpr_exu.statics.statics import PlatformEquilibriumViews, forward_cable, minimise_energy, swivel_plane_cable
 from cdpr_exu.statics.statics import inverse_cable as planar_inverse_cable
 from cdpr_exu.core.validation import non_negative, positive, real_array, shown, vector
 
@@ -446,8 +446,7 @@ def _swivel_plane(cable, anchor_point):
                                f"{inlet.tolist()}: its azimuth is undefined")
     e_rho = np.array([offset[0], offset[1], 0.0]) / rho
     radius = cable.pulley_radius
-    planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
-                                  pulley=Pulley((radius, 0.0), radius, -1))
+    planar_cable = swivel_plane_cable(cable.weight_per_length, cable.axial_stiffness, radius)
     return inlet, e_rho, np.array([rho, offset[2]]), planar_cable
 
 
@@ -538,7 +537,7 @@ def _straight_path(cable, exit_point, point):
     vector (3,) along its last straight part towards ``point`` (the length's gradient in ``point``).
 
     Over a swivel pulley the path wraps the disc in the plane through the axis and ``point``
-    (:func:`cdpr_exu.physics.spatial_kinematics.swivel_pulley_exit`: arc plus free length);
+    (:func:`cdpr_exu.core.geometry.swivel_pulley_exit`: arc plus free length);
     where that is undefined (``point`` on the axis or inside the disc, only ever an iterate of
     the starting guess) the straight distance from the inlet stands in.
     """

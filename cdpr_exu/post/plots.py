@@ -137,8 +137,8 @@ def _anchor_world(scene: Scene, pose: np.ndarray) -> np.ndarray:
 
 def _robot_limits(scene: Scene, result: Result, rows: np.ndarray, margin: float = 0.12):
     """Axis limits (xmin, xmax, zmin, zmax) [m] holding pulleys, cables, platform, path."""
-    points = [np.asarray(p.center) + np.array([sx, sz]) * p.radius
-              for p in scene.pulleys for sx, sz in ((-1, -1), (1, 1))]
+    points = [np.asarray(p.point) + np.array([sx, sz]) * p.radius
+              for p in scene.exits for sx, sz in ((-1, -1), (1, 1))]
     points = [np.asarray(points)]
     for nodes in result.nodes:
         nodes = np.asarray(nodes, dtype=float)[rows].reshape(-1, 2)
@@ -166,10 +166,10 @@ def _nearest_row(result: Result, rows: np.ndarray, t: float) -> int | None:
 
 
 def _draw_pulleys(ax, scene: Scene) -> None:
-    for pulley in scene.pulleys:
-        ax.add_patch(Circle(pulley.center, pulley.radius, facecolor="0.92", edgecolor=_PULLEY_COLOR,
+    for pulley in scene.exits:
+        ax.add_patch(Circle(pulley.point, pulley.radius, facecolor="0.92", edgecolor=_PULLEY_COLOR,
                             linewidth=1.2, zorder=1))
-        ax.plot(*pulley.center, marker="+", color=_PULLEY_COLOR, markersize=5, zorder=1)
+        ax.plot(*pulley.point, marker="+", color=_PULLEY_COLOR, markersize=5, zorder=1)
 
 
 def _free_span_sag(scene: Scene, i: int, nodes: np.ndarray):
@@ -188,7 +188,7 @@ def _free_span_sag(scene: Scene, i: int, nodes: np.ndarray):
         return None
     anchor = nodes[-1]
     pulley = scene.exits[i]
-    center, radius = np.asarray(pulley.center, dtype=float), pulley.radius
+    center, radius = np.asarray(pulley.point, dtype=float), pulley.radius
     try:
         start = np.asarray(pulley.exit(anchor).tangent_point, dtype=float)
     except (CdprError, ValueError):
@@ -682,9 +682,9 @@ def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None
     ax = figure.add_subplot(1, 1, 1)
     colors = ("tab:blue", "tab:red", "tab:green", "tab:purple")
     for pulley in scene.exits:
-        if not pulley.is_point_exit:
-            ax.add_patch(Circle(pulley.center, pulley.radius, facecolor="0.92", edgecolor="0.55", zorder=1))
-        ax.plot(*pulley.center, marker="+", color="0.55", zorder=1)
+        if pulley.wraps:
+            ax.add_patch(Circle(pulley.point, pulley.radius, facecolor="0.92", edgecolor="0.55", zorder=1))
+        ax.plot(*pulley.point, marker="+", color="0.55", zorder=1)
     for i, nodes in enumerate(rest.nodes):
         color = colors[i % len(colors)]
         ax.plot(nodes[:, 0], nodes[:, 1], "-o", color=color, markersize=3, linewidth=1.0, zorder=3,
@@ -720,7 +720,7 @@ def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
     colors = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive")
     anchors = rest.position + np.asarray(rest.scene.platform.anchors) @ rest.rotation.T
     outline = np.vstack([anchors, anchors[:1]])
-    exits = np.asarray(rest.scene.exits)
+    exits = rest.scene.exit_points
     for i, (nodes, cable) in enumerate(zip(rest.nodes, rest.catenary.cables)):
         color = colors[i % len(colors)]
         curve = cable.points(np.linspace(0.0, cable.unstrained_length, CURVE_SAMPLES))

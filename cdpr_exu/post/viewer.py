@@ -50,7 +50,6 @@ from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.core.output import check_output_folder, clear_outputs
 from cdpr_exu.run.spatial_run import build_spatial_model
 from cdpr_exu.scenes.scene import Scene, load_scene
-from cdpr_exu.scenes.spatial_scene import is_spatial, load_any_scene
 
 #: File names inside a run folder (written by ``cdpr run --out``).
 SCENE_FILE = "scene.toml"
@@ -219,7 +218,7 @@ class SpatialReplay:
     Attributes
     ----------
     run_dir : Path
-    scene : SpatialScene
+    scene : Scene
     mbs : exudyn.MainSystem
         Rebuilt from ``scene.toml`` (:func:`cdpr_exu.run.spatial_run.build_spatial_model`).
     items : SpatialRobotItems
@@ -266,9 +265,9 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | Spati
     RunFolderError, SolutionMismatchError, SceneError
     """
     scene_file, solution_file = run_files(run_dir)
-    scene = load_any_scene(scene_file)
+    scene = load_scene(scene_file)
     solution = load_solution(solution_file)
-    if is_spatial(scene):
+    if scene.dimension == 3:  # one replay when the builder is one (issue 24, slice 9)
         mbs, items = build_spatial_model(scene)
         check_solution_fits(mbs, solution, f"solution file {str(solution_file)!r}")
         return SpatialReplay(Path(run_dir), scene, mbs, items, solution)
@@ -327,8 +326,8 @@ def thin_polyline(points: np.ndarray, min_segment: float) -> np.ndarray:
 
 def scene_extent(scene: Scene) -> float:
     """Size of the robot: the larger side of the box around pulleys and start pose [m]."""
-    centers = np.array([p.center for p in scene.pulleys] + [scene.platform.initial_pose[:2]], dtype=float)
-    radius = max(p.radius for p in scene.pulleys)
+    centers = np.vstack([scene.exit_points, [scene.platform.initial_pose[:2]]])
+    radius = max(scene.pulley_radii)
     return float(np.max(np.ptp(centers, axis=0)) + 2.0 * radius) or 1.0
 
 
@@ -354,9 +353,9 @@ def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
     scene, mbs = model.scene, model.mbs
     extent = scene_extent(scene)
     items = []
-    for pulley in scene.pulleys:
-        x, z = pulley.center
-        if pulley.radius > 0.0:
+    for pulley in scene.exits:
+        x, z = pulley.point
+        if pulley.wraps:
             items.append(graphics.Cylinder(pAxis=[x, z, -0.02], vAxis=[0.0, 0.0, 0.01], radius=pulley.radius,
                                            color=PULLEY_COLOR, nTiles=64))
             items.append(graphics.Circle([x, z, 0.0], pulley.radius, color=PULLEY_RIM_COLOR))
@@ -412,7 +411,7 @@ def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768))
     """Visualization settings of a spatial replay: small nodes, no load arrows or markers, and a view
     from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
     settings = replay.mbs.GetSystemContainer().visualizationSettings
-    points = np.vstack([np.asarray(replay.scene.exits, dtype=float), replay.platform_pose()[:, :3]])
+    points = np.vstack([replay.scene.exit_points, replay.platform_pose()[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
     extent = float((high - low).max()) or 1.0
     settings.loads.show = False
@@ -509,8 +508,8 @@ def _view_points(replay: Replay) -> np.ndarray:
     """Every point an animation must show: pulleys, nodes, platform, reference."""
     scene = replay.scene
     positions = replay.positions()
-    parts = [np.array([[p.center[0] + dx * p.radius, p.center[1] + dz * p.radius]
-                       for p in scene.pulleys for dx, dz in ((-1, -1), (1, 1))])]
+    parts = [np.array([[p.point[0] + dx * p.radius, p.point[1] + dz * p.radius]
+                       for p in scene.exits for dx, dz in ((-1, -1), (1, 1))])]
     parts += [value.reshape(-1, 2) for name, value in positions.items() if name != "platform"]
     platform = positions["platform"][:, :2]
     half_diagonal = 0.5 * float(np.hypot(*scene.platform.size))

@@ -61,7 +61,7 @@ def energy_parts(scene: Scene, result: Result) -> EnergyParts:
     bending = np.zeros_like(kinetic)
     contact = np.zeros_like(kinetic)
     with_contact = scene.pulley_contact
-    for cable, pulley, nodes, node_velocities in zip(scene.cables, scene.pulleys, result.nodes,
+    for cable, pulley, nodes, node_velocities in zip(scene.cables, scene.exits, result.nodes,
                                                      result.node_velocities):
         masses = cable.node_masses()
         kinetic = kinetic + 0.5 * np.einsum("j,tjk,tjk->t", masses, node_velocities, node_velocities)

@@ -47,7 +47,6 @@ from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFa
 from cdpr_exu.core.output import length_text
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.run.spatial_run import simulate_spatial
-from cdpr_exu.scenes.spatial_scene import is_spatial
 
 #: Order of the error in the number of elements assumed by the estimate (see above).
 ORDER = 2.0
@@ -108,7 +107,7 @@ def companion_elements(scene) -> int:
     if n >= 30:
         try:
             half = _with_elements(scene, n // 2)  # a spatial scene checks its swivel pulleys here
-            if not is_spatial(scene):
+            if half.dimension == 2:  # the planar builder checks its elements against the pulleys
                 build_model(half)
             return n // 2
         except CdprError:
@@ -124,7 +123,7 @@ def _with_elements(scene, n: int):
 def simulate_any(scene, controller=None):
     """Run a planar (:func:`~cdpr_exu.run.simulate.simulate`) or spatial
     (:func:`~cdpr_exu.run.spatial_run.simulate_spatial`) scene under ``controller``."""
-    if is_spatial(scene):
+    if scene.dimension == 3:  # one simulate() when the runs are one (issue 24, slice 9)
         return simulate_spatial(scene, controller)
 
     return simulate(scene, controller)
@@ -159,7 +158,7 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
 
     Parameters
     ----------
-    scene : Scene or SpatialScene
+    scene : Scene
     result : Result or SpatialResult
         The run to judge (completed).
     controller_factory : callable, optional

@@ -8,7 +8,7 @@ holds the platform pose, every node, every element's axial force, and for each c
 the length and end forces of its *free span*, the part that the elastic catenary
 (:mod:`cdpr_exu.physics.catenary`) describes:
 
-* with a point exit (``cable_exit = "point"``), or over a pulley that no node
+* with a point exit (the cable does not wrap its exit), or over a pulley that no node
   touches, the whole cable, from its upper end (node 0, held by the winch
   constraints) to the platform anchor (node n);
 * over a pulley, the cable from the point where it leaves the rim to the anchor. Let
@@ -584,8 +584,8 @@ def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method
         elements = np.linalg.norm(np.diff(nodes, axis=0), axis=1)
         platform_forces.append(reaction_sign * np.asarray(mbs.GetObjectOutput(model.platform.joints[i], force))[:2])
         anchor_tensions.append(tension[-1])
-        pulley = scene.pulleys[i]
-        touching = [] if scene.exits[i].is_point_exit else np.flatnonzero(penetration(pulley, nodes) > 0.0)
+        pulley = scene.exits[i]
+        touching = np.flatnonzero(penetration(pulley, nodes) > 0.0) if pulley.wraps else []
         if len(touching) == 0 or touching[-1] >= len(nodes) - 1:
             winch = model.winches[i]
             if int(winch.horizontal) >= 0 and int(winch.vertical) >= 0:
@@ -604,7 +604,7 @@ def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method
             weights.append(float(node_weights.sum()))
             continue
         c = int(touching[-1])
-        point = leave_point(np.asarray(pulley.center), pulley.radius, nodes[c + 1], nodes[c])
+        point = leave_point(np.asarray(pulley.point), pulley.radius, nodes[c + 1], nodes[c])
         piece = float(np.hypot(*(nodes[c + 1] - point)))
         on_span = tension[c] * (nodes[c] - nodes[c + 1]) / elements[c] + _bending_cut_force(scene, i, nodes, v, c)
         first.append(c + 1)

@@ -163,19 +163,19 @@ class _Monitor:
         self.rest = np.concatenate([np.full(scene.cables[i].n_elements, scene.cables[i].element_length)
                                     for i in lumped]) if lumped else np.zeros(0)
         if self.check_pulleys and lumped:
-            self.centers = np.array([scene.pulleys[i].center for i in lumped], dtype=float)[self.element_cable]
-            self.radii = np.array([scene.pulleys[i].radius for i in lumped], dtype=float)[self.element_cable]
+            self.centers = scene.exit_points[lumped][self.element_cable]
+            self.radii = scene.pulley_radii[lumped][self.element_cable]
         self.platform_index = indices["platform"]
         self.reference_pose = reference[self.platform_index]
         # No pose of a platform hung on these cables lies farther from every pulley
         # than the longest cable; the box of those reaches bounds every sane state.
-        centers = np.array([p.center for p in scene.pulleys])
+        centers = scene.exit_points
         reach = max(c.unstrained_length for c in scene.cables) * (1.0 + MAX_STRAIN) + max(
             np.abs(np.asarray(scene.platform.anchors)).max(), 0.0)
         self.box = (centers.min(axis=0) - reach, centers.max(axis=0) + reach)
         # A suspended platform (starting below every pulley) that rises above the
         # highest pulley rim is held there only by cables that push.
-        tops = centers[:, 1] + np.array([p.radius for p in scene.pulleys])
+        tops = scene.exit_tops
         suspended = scene.platform.initial_pose[1] < centers[:, 1].min()
         self.ceiling = tops.max() if suspended else np.inf
 
@@ -305,8 +305,8 @@ class _Recorder:
             rest = np.full((k, cable.n_elements), cable.element_length)
             rest[:, 0] += self.surplus[:k, i]  # the winch element holds the slack rope at the drum
             tensions.append(element_tensions(cable, positions, velocities, scene.effects, rest))
-            if not scene.exits[i].is_point_exit:
-                depth.append(penetration(scene.pulleys[i], positions).max(axis=1))
+            if scene.exits[i].wraps:
+                depth.append(penetration(scene.exits[i], positions).max(axis=1))
             else:
                 depth.append(np.zeros(k))
         reference = scene.trajectory.pose(times) if k else np.zeros((0, 3))
@@ -566,7 +566,7 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
                        "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts(),
                        # above the highest pulley centre every cable pulls the platform down (Result.summary)
-                       "highest_exit_z_m": max(float(p.center[1]) for p in scene.pulleys)}
+                       "highest_exit_z_m": max(float(e.point[-1]) for e in scene.exits)}
     if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     last_time = float(result.time[-1]) if len(result.time) else 0.0
@@ -637,7 +637,7 @@ def explicit_step_limit(scene: Scene) -> float:
     pulley contact adds sqrt(k_p / m_i). RK44 needs h |lambda| below about 2.8.
     """
     limits = []
-    for cable, pulley in zip(scene.cables, scene.pulleys):
+    for cable, pulley in zip(scene.cables, scene.exits):
         mass = float(cable.node_masses()[1:-1].min()) if cable.n_elements > 1 else cable.element_mass
         damping = cable.axial_damping if scene.effects.axial_damping else 0.0
         stiffness = cable.axial_stiffness if scene.effects.axial_elasticity else 0.0
@@ -684,7 +684,7 @@ def first_step_hints(scene: Scene) -> list[str]:
     cable = scene.cables[0]
     mass = cable.element_mass if scene.effects.cable_mass else scene.platform.mass
     if scene.pulley_contact:
-        worst = max(scene.pulleys, key=lambda p: p.contact_stiffness)
+        worst = max(scene.exits, key=lambda p: p.contact_stiffness)
         # The paper's pulley (1e7 N/m on 0.0875 kg nodes) runs at 2e-3 s: k h^2 / m = 457.
         ratio = worst.contact_stiffness * solver.step_size**2 / mass
         if ratio > 1e4:

@@ -38,11 +38,11 @@ import numpy as np
 from cdpr_exu.core.errors import SolverFailure
 from cdpr_exu.core.geometry import rotation_angles_deg
 from cdpr_exu.core.output import write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, solve_static, \
-    start_at_rest, swivel_angles
+from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, scene_chain_spec, \
+    solve_static, start_at_rest, swivel_angles
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.results.result import provenance
-from cdpr_exu.scenes.spatial_scene import SpatialScene
+from cdpr_exu.scenes.scene import Scene
 
 __all__ = ["SpatialRest", "solve_spatial_rest", "PENALTY"]
 
@@ -67,7 +67,7 @@ class SpatialRest:
 
     Attributes
     ----------
-    scene : SpatialScene
+    scene : Scene
     position : ndarray, shape (3,) [m]
         Platform centre of mass (lumped robot).
     rotation : ndarray, shape (3, 3)
@@ -89,7 +89,7 @@ class SpatialRest:
         Both solves together.
     """
 
-    scene: SpatialScene
+    scene: Scene
     position: np.ndarray
     rotation: np.ndarray
     rotation_vector: np.ndarray
@@ -139,7 +139,7 @@ class SpatialRest:
             "method": f"Exudyn static solver on the lumped robot ({self.scene.cables[0].n_elements} elements per "
                       f"cable, {self.anchor_joint}), started on the elastic-catenary statics"
                       + (" and, over swivel pulleys, on the chain statics' equilibrium from there"
-                         if self.scene.swivels else ""),
+                         if any(self.scene.swivel_exits) else ""),
             "platform_position_m": self.position.tolist(),
             "platform_rotation_vector_rad": self.rotation_vector.tolist(),
             "platform_roll_pitch_yaw_deg": rotation_angles_deg(self.rotation).tolist(),
@@ -169,7 +169,7 @@ class SpatialRest:
         return [write_summary(out, self.summary())]
 
 
-def bending_text(scene: SpatialScene, catenary, what: str) -> str:
+def bending_text(scene: Scene, catenary, what: str) -> str:
     """The cables' bending against their pulleys, for messages: ``what`` (e.g. "what moves it") is
     the bending E J [N m^2] whose bending length sqrt(E J / T) at the catenaries' largest tension T
     is compared with the smallest swivel radius (or the shortest cable: point exits)."""
@@ -188,11 +188,11 @@ def bending_text(scene: SpatialScene, catenary, what: str) -> str:
             f"({scale:.4g} m)")
 
 
-def rest_above_exits(scene: SpatialScene, position, rotation, lowest_tension: float, catenary) -> str | None:
+def rest_above_exits(scene: Scene, position, rotation, lowest_tension: float, catenary) -> str | None:
     """Why a rest of the lumped robot with every anchor above its exit is no cable robot's rest, or None.
 
     Such a rest is held by elements that push or by the cables' bending, not by hanging cables
-    (:meth:`SpatialScene.above_exits`): cables whose bending length sqrt(E J / T) is many
+    (:meth:`Scene.above_exits`): cables whose bending length sqrt(E J / T) is many
     times their pulleys' radius stand up like rods rather than wrap their pulleys (measured on
     the swivel robot: E = 1e11 Pa, 16.8 kg: 6.9 times, platform 0.14 m above the inlets).
 
@@ -215,7 +215,7 @@ def rest_above_exits(scene: SpatialScene, position, rotation, lowest_tension: fl
             "youngs_modulus or radius (a wire rope bends far more easily than a solid rod of its modulus)")
 
 
-def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
+def solve_spatial_rest(scene: Scene) -> SpatialRest:
     """Bring a spatial scene to rest: catenary statics, then Exudyn's static solve of the lumped robot.
 
     The answer's :attr:`SpatialRest.warnings` say what makes it suspect (far from the catenaries,
@@ -235,11 +235,11 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     lengths = scene.unstrained_lengths
     catenary = solve_spatial_statics(platform, lengths)
     rigid = not platform.is_point_mass
-    chain = scene.chain_spec(anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
+    chain = scene_chain_spec(scene, anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary, swivels=scene.swivel_exits)
     mbs.Assemble()
-    if scene.swivels:
+    if any(scene.swivel_exits):
         start_at_rest(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley
     static = solve_static(mbs, items)
     nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
@@ -247,7 +247,7 @@ def solve_spatial_rest(scene: SpatialScene) -> SpatialRest:
     joint = f"penalty spherical joints of {PENALTY:g} element stiffnesses" if rigid else "exact spherical joints"
     rest = SpatialRest(scene, static.position, static.rotation, static.rotation_vector, static.tensions_at_anchor,
                        static.forces_on_platform, nodes, tensions, catenary, joint, _time.perf_counter() - start,
-                       swivel_angles(mbs, items) if scene.swivels else None)
+                       swivel_angles(mbs, items) if any(scene.swivel_exits) else None)
     above = rest_above_exits(scene, rest.position, rest.rotation, rest.lowest_element_tension, catenary)
     if above is not None:
         raise SolverFailure(f"no rest of a cable robot: {above}", partial_result=rest.summary())

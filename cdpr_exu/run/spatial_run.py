@@ -44,19 +44,20 @@ from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation
 from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, write_npz, write_pose_csv, write_summary
 from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
-    start_at_rest
+    scene_chain_spec, start_at_rest
 from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
 from controllers.base import Controller, Measurement, SmoothStart
-from controllers.ideal_ik import IdealIKController, ideal_paid_out
+from controllers.ideal_ik import IdealIKController
 
 from cdpr_exu.results.result import after_start_up, provenance, safety_figures
 from cdpr_exu.run.simulate import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
                                    solver_settings)
 from cdpr_exu.run.spatial_rest import rest_above_exits
-from cdpr_exu.scenes.scene import tension_limits
-from cdpr_exu.scenes.spatial_scene import SpatialScene
+from cdpr_exu.scenes.scene import Scene, tension_limits
+from cdpr_exu.space import SPACE
+from cdpr_exu.statics.kinematics import ideal_paid_out
 from cdpr_exu.statics.workspace import first_unheld, limits_text
 
 __all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference"]
@@ -66,7 +67,7 @@ __all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_sp
 REFERENCE_SAMPLES = 401
 
 
-def check_spatial_reference(scene: SpatialScene) -> None:
+def check_spatial_reference(scene: Scene) -> None:
     """Refuse a reference the cables cannot follow, before the run.
 
     At 401 samples of the reference: every commanded paid-out length stays positive, and
@@ -78,7 +79,7 @@ def check_spatial_reference(scene: SpatialScene) -> None:
     tensions must also give the moment about the centre of mass that the reference's
     rotation needs (:func:`reference_wrenches`), the whole wrench-feasible workspace.
     With fewer cables the platform turns to balance the moment, and only the force is asked. A pose with every anchor above its exit is such a pose; the
-    message then says so (:meth:`SpatialScene.above_exits`).
+    message then says so (:meth:`Scene.above_exits`).
 
     Raises
     ------
@@ -123,7 +124,7 @@ def check_spatial_reference(scene: SpatialScene) -> None:
 
     anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
     points = poses[:, :3] if anchors is None else poses
-    units = cable_unit_vectors(points, anchors, np.asarray(scene.exits), scene.pulley_radii)
+    units = cable_unit_vectors(points, anchors, scene.exit_points, scene.pulley_radii)
     wrenches = reference_wrenches(scene, times)
     limits = tension_limits(scene.cables)
 
@@ -159,7 +160,7 @@ def check_spatial_reference(scene: SpatialScene) -> None:
             f"{why(free)}; {residual:.4g} (N, N m) would remain unbalanced")
 
 
-def reference_wrenches(scene: SpatialScene, times: np.ndarray) -> np.ndarray:
+def reference_wrenches(scene: Scene, times: np.ndarray) -> np.ndarray:
     """The wrench the cables must give the platform to follow the reference, shape (N, 6) [N, N m].
 
     The force ``M (a + g e_z)`` and the moment about the centre of mass ``I w' + w x I w``
@@ -186,20 +187,6 @@ def reference_wrenches(scene: SpatialScene, times: np.ndarray) -> np.ndarray:
     spin = np.einsum("nij,nj->ni", inertia, omega)
     moment = np.einsum("nij,nj->ni", inertia, omega_rate) + np.cross(omega, spin)
     return np.column_stack([force, moment])
-
-
-def highest_exit(scene: SpatialScene) -> float:
-    """Height [m] of the scene's highest exit point or swivel inlet: above it every cable pulls the platform down."""
-    return float(np.asarray(scene.exits, dtype=float)[:, 2].max())
-
-
-def rotation_error_deg(pose: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """Angle [deg] of the rotation from the reference orientation to the actual one, shape (N,)."""
-    angles = []
-    for theta, theta_ref in zip(pose[:, 3:], reference[:, 3:]):
-        relative = rotation_from_vector(theta_ref).T @ rotation_from_vector(theta)
-        angles.append(np.linalg.norm(rotation_vector(relative)))
-    return np.degrees(np.asarray(angles))
 
 
 @dataclass
@@ -256,7 +243,7 @@ class SpatialResult:
         as planar summaries)."""
         mask = self.time >= after
         error = np.linalg.norm(self.position_error[mask], axis=1)
-        rotation = rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
+        rotation = SPACE.rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
 
         def extreme(values, pick):
             return float(pick(values)) if values.size else None
@@ -307,7 +294,7 @@ class SpatialResult:
 class _SpatialWinches:
     """The variable-length cables: before each step, every cable's elements follow its paid-out length."""
 
-    def __init__(self, mbs, scene: SpatialScene, items, lengths: np.ndarray):
+    def __init__(self, mbs, scene: Scene, items, lengths: np.ndarray):
         self.mbs, self.scene, self.items = mbs, scene, items
         self.n = scene.cables[0].n_elements
         self.gravity = scene.gravity if (scene.effects.gravity and scene.effects.cable_mass) else 0.0
@@ -371,9 +358,9 @@ class _SpatialMonitor:
     its highest exit (every cable pulls it down there: only cables that push could hold it), or one
     turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference's orientation."""
 
-    def __init__(self, scene: SpatialScene):
+    def __init__(self, scene: Scene):
         self.trajectory = scene.trajectory
-        self.ceiling = highest_exit(scene)
+        self.ceiling = float(scene.exit_points[:, 2].max())  # above it every cable pulls the platform down
         self.turns = not scene.platform.is_point_mass
 
     def problem(self, t: float, position: np.ndarray, rotation: np.ndarray) -> str | None:
@@ -399,7 +386,7 @@ class _SpatialMonitor:
         return None
 
 
-def _warn_outside_measured_region(scene: SpatialScene) -> None:
+def _warn_outside_measured_region(scene: Scene) -> None:
     """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
     outside the region where runs over a swivel pulley were measured to keep their energy."""
     solver = scene.solver
@@ -412,7 +399,7 @@ def _warn_outside_measured_region(scene: SpatialScene) -> None:
         return
 
 
-def _rest_above_exits(scene: SpatialScene, mbs, items) -> str | None:
+def _rest_above_exits(scene: Scene, mbs, items) -> str | None:
     """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
     above its exits (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: its bending or pushing elements do)."""
     position, rotation = platform_pose(mbs, items, current=False)
@@ -421,7 +408,7 @@ def _rest_above_exits(scene: SpatialScene, mbs, items) -> str | None:
     return None if above is None else f"the run cannot start from the robot's rest: {above}"
 
 
-def check_runnable(scene: SpatialScene) -> None:
+def check_runnable(scene: Scene) -> None:
     """Refuse a scene ``cdpr run`` cannot run, before anything is built or written: no ``[trajectory]``,
     or a reference the cables cannot follow (:func:`check_spatial_reference`).
 
@@ -434,7 +421,7 @@ def check_runnable(scene: SpatialScene) -> None:
     check_spatial_reference(scene)
 
 
-def build_spatial_model(scene: SpatialScene):
+def build_spatial_model(scene: Scene):
     """The scene's lumped robot in a new Exudyn system, assembled in its catenary start; returns (mbs, items).
 
     What :func:`simulate_spatial` integrates and what a replay of its solution file
@@ -451,12 +438,12 @@ def build_spatial_model(scene: SpatialScene):
     lengths = scene.unstrained_lengths
     start = solve_spatial_statics(platform, lengths)
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, platform, lengths, scene.chain_spec(), initial=start, swivels=scene.swivel_exits)
+    items = build_spatial_robot(mbs, platform, lengths, scene_chain_spec(scene), initial=start, swivels=scene.swivel_exits)
     mbs.Assemble()
     return mbs, items
 
 
-def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, progress=False, *,
+def simulate_spatial(scene: Scene, controller: Controller | None = None, progress=False, *,
                      solution_file: str | Path | None = None) -> SpatialResult:
     """Run ``scene``'s reference under ``controller`` (default: ideal inverse kinematics).
 
@@ -490,7 +477,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     check_runnable(scene)
     mbs, items = build_spatial_model(scene)
     lengths = scene.unstrained_lengths
-    if scene.swivels:
+    if any(scene.swivel_exits):
         _warn_outside_measured_region(scene)
         try:
             start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
@@ -596,7 +583,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
     record(0.0)
     state["next"] = 1
     # a start no run can come back from: over swivel pulleys, a rest held up by the chains' bending (with its cause)
-    state["failure"] = (_rest_above_exits(scene, mbs, items) if scene.swivels else None) \
+    state["failure"] = (_rest_above_exits(scene, mbs, items) if any(scene.swivel_exits) else None) \
         or monitor.problem(0.0, *platform_pose(mbs, items))
     mbs.SetPreStepUserFunction(pre_step)
     mbs.SetPostStepUserFunction(post_step)
@@ -622,7 +609,7 @@ def simulate_spatial(scene: SpatialScene, controller: Controller | None = None, 
                            int(steps), int(newton))
     if tension_limits(scene.cables) is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
-    result.metadata["highest_exit_z_m"] = highest_exit(scene)
+    result.metadata["highest_exit_z_m"] = float(scene.exit_points[:, 2].max())
     reached = state["reached"]  # the solver's own time: the samples may end up to one output period before it
     if interrupted["interrupted"]:
         result.status, result.failure_time = f"interrupted at t = {reached:.4f} s", reached

@@ -1,49 +1,48 @@
-"""Scenes: the frozen, validated description of one CDPR simulation.
+"""Scenes: the frozen, validated description of one CDPR simulation, planar or spatial.
 
-A :class:`Scene` is a tree of frozen dataclasses (cables, pulleys, platform, winch,
-effects, solver settings and the reference trajectory). It is validated when it is
-made: a bad field raises :class:`~cdpr_exu.core.errors.SceneError` naming the field and
-its value, before any simulation starts. Scenes load from and save to TOML.
+A :class:`Scene` is a tree of frozen dataclasses (cables, exits, platform, winch, effects,
+solver settings and the reference trajectory) with its ``dimension``: 2, the paper's
+vertical x-z plane (positions are ``(x, z)`` pairs; only the Exudyn builder maps them onto
+Exudyn's x-y plane, paper z -> Exudyn y), or 3, space with z up. Gravity acts along -z in
+both. The scene's :class:`~cdpr_exu.space.Space` is made from its dimension once; its
+exits are objects (:mod:`cdpr_exu.exits`). It is validated when it is made: a bad field
+raises :class:`~cdpr_exu.core.errors.SceneError` naming the field and its value, before
+any simulation starts.
 
-Units are SI throughout (m, kg, s, N, rad). Planar scenes live in the paper's
-vertical x-z plane with gravity along -z; positions are given as ``(x, z)`` pairs.
-Only the Exudyn builder maps them onto Exudyn's x-y plane (paper z -> Exudyn y).
+Scenes load from and save to TOML (:func:`load_scene`, :func:`save_scene`), in either form:
+``[[exits]]``, a table per cable with its ``kind`` (the spatial scenes' form, ``dimension = 3``,
+and a planar one's), or the planar form, ``[[pulleys]]`` and ``cable_exit`` (the README's
+scene reference and docs/spatial.md show both).
+
+Units are SI throughout (m, kg, s, N, rad).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 import tomllib
 import warnings
 from dataclasses import dataclass, field, fields, replace
 from importlib import resources
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, ClassVar, Mapping
 
 import numpy as np
+import tomli_w
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, UnreachableError
+from cdpr_exu.core.geometry import above_exits
+from cdpr_exu.core.validation import entries, finite, from_table, non_negative, positive, shown
+from cdpr_exu.exits import EXIT_KINDS, Exit, PointExit, Pulley, exit_from_dict
+from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
-from cdpr_exu.core.geometry import Pulley, above_exits, anchor_points
-from cdpr_exu.core.validation import finite, non_negative, positive, shown
-from cdpr_exu.scenes.trajectories import Trajectory, trajectory_from_dict
+from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialTrajectory, spatial_trajectory_from_dict
+from cdpr_exu.scenes.trajectories import HoldTrajectory, Trajectory, trajectory_from_dict
+from cdpr_exu.space import DIMENSIONS, PLANE, Space, space_of
 
 # --------------------------------------------------------------------------- checks
-
-
-def _vector(path: str, value: Any, length: int, unit: str = "") -> tuple[float, ...]:
-    """Return ``value`` as a tuple of ``length`` finite floats; ``unit`` is named in the messages."""
-    units = f" [{unit}]" if unit else ""
-    if isinstance(value, (str, bytes, Mapping)):
-        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}")
-    try:
-        items = list(value)
-    except TypeError:
-        raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}") from None
-    if len(items) != length:
-        raise SceneError(f"{path} must have {length} entries{units}, got {len(items)}: {shown(value)}")
-    return tuple(finite(f"{path}[{i}]", v) for i, v in enumerate(items))
 
 
 def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
@@ -123,6 +122,9 @@ class CableSpec:
     mass_lumping: str = "consistent"
     min_tension: float | None = None
     max_tension: float | None = None
+
+    #: Most elements a cable may have (:data:`MAX_ELEMENTS`).
+    max_elements: ClassVar[int] = MAX_ELEMENTS
 
     def __post_init__(self) -> None:
         _set(self, "unstrained_length", positive("cable.unstrained_length", self.unstrained_length, "m"))
@@ -235,87 +237,93 @@ class CableSpec:
         return masses
 
 
-@dataclass(frozen=True)
-class PulleySpec(Pulley):
-    """A pulley the cable runs over, and on which side the cable hangs to its winch.
-
-    The cable comes up from the winch along the vertical line x = x_c + side * radius,
-    wraps over the top of the pulley and leaves it tangentially towards the anchor. A
-    :class:`~cdpr_exu.core.geometry.Pulley` (its geometry: hang point, exit, wrap) with the
-    parameters of the rim contact.
-
-    Parameters
-    ----------
-    center : (x, z) [m]
-    radius : float [m]
-        Rim radius r_p. Must be positive when the cable runs over the pulley.
-    side : {-1, +1}
-        -1: the cable hangs on the pulley's left (x < x_c), +1: on its right.
-    contact_stiffness : float [N/m]
-        Penalty stiffness k_p of the rim contact.
-    contact_damping : float [N s/m]
-        Damping c_p on the normal velocity of a node in contact.
-    """
-
-    center: tuple[float, float] = (0.0, 0.0)
-    radius: float = 0.25
-    side: int = -1
-    contact_stiffness: float = 1.0e7
-    contact_damping: float = 10.0
-
-    def __post_init__(self) -> None:
-        _set(self, "center", _vector("pulley.center", self.center, 2, "m"))
-        _set(self, "radius", positive("pulley.radius", self.radius, "m"))
-        if self.side not in (-1, 1) or isinstance(self.side, bool):
-            raise SceneError(f"pulley.side must be -1 (left) or +1 (right), got {shown(self.side)}")
-        _set(self, "side", int(self.side))
-        _set(self, "contact_stiffness", positive("pulley.contact_stiffness", self.contact_stiffness, "N/m"))
-        _set(self, "contact_damping", non_negative("pulley.contact_damping", self.contact_damping, "N s/m"))
+#: What a platform that leaves a field out gets, by its dimension. In the plane: the paper's platform
+#: (Table 2: its moment of inertia J_MP, the start of its runs, the rectangle its figures draw). In
+#: space: a point mass has no inertia (a rigid platform must give its principal moments), a spatial
+#: robot starts at its rest (``cdpr static`` finds it; no initial pose is taken), and no rectangle.
+PLATFORM_DEFAULTS: dict[int, dict[str, Any]] = {
+    2: {"inertia": 0.0271, "point_mass_inertia": 0.0271, "initial_pose": (0.0, -2.0, 0.0), "size": (0.3, 0.2)},
+    3: {"inertia": None, "point_mass_inertia": (0.0, 0.0, 0.0), "initial_pose": None, "size": None},
+}
 
 
 @dataclass(frozen=True)
 class PlatformSpec:
-    """The rigid planar platform (paper sec. 2.3).
+    """The platform (paper sec. 2.3): a rigid body the cables hold, planar or spatial.
+
+    Its dimension is that of its anchors: ``(x, z)`` pairs make a planar platform, ``(x, y, z)``
+    points a spatial one (:attr:`space`); its scene must be of that dimension. A field left out
+    (None) takes :data:`PLATFORM_DEFAULTS` of that dimension.
 
     Parameters
     ----------
     mass : float [kg]
-    inertia : float [kg m^2]
-        Moment of inertia J_MP about the centre of mass, out of the plane.
-    anchors : sequence of (x, z) [m]
-        Cable anchor points b_i in the platform frame, one per cable, shape (m, 2).
-        All zero for a point-mass platform.
-    initial_pose : (x, z, rotation) [m, m, rad]
-        Pose at t = 0; rotation positive counter-clockwise (paper eq. 17).
-    size : (width, height) [m]
-        Rectangle drawn in figures and animations (no effect on the dynamics).
+        Positive for a rigid platform; a spatial point mass may weigh nothing.
+    inertia : float, or (float, float, float) [kg m^2]
+        Planar: the moment of inertia J_MP about the centre of mass, out of the plane (positive).
+        Spatial: the principal moments about the centre of mass along the platform axes
+        (positive for a rigid platform; left out, zero for a point mass).
+    anchors : sequence of (x, z) or of (x, y, z) [m]
+        Cable anchor points b_i in the platform frame (centre of mass at 0), one per cable,
+        shape (m, d). All zero for a point-mass platform.
+    initial_pose : (x, z, rotation) [m, m, rad], or None
+        Planar: the pose at t = 0, rotation positive counter-clockwise (paper eq. 17).
+        Spatial: None, the start is the rest.
+    size : (width, height) [m], or None
+        Rectangle drawn in planar figures and animations (no effect on the dynamics).
     """
 
     mass: float = 2.5
-    inertia: float = 0.0271
-    anchors: tuple[tuple[float, float], ...] = ((-0.15, 0.1), (0.15, 0.1))
-    initial_pose: tuple[float, float, float] = (0.0, -2.0, 0.0)
-    size: tuple[float, float] = (0.3, 0.2)
+    inertia: float | tuple[float, float, float] | None = None
+    anchors: tuple = ((-0.15, 0.1), (0.15, 0.1))
+    initial_pose: tuple | None = None
+    size: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        _set(self, "mass", positive("platform.mass", self.mass, "kg"))
-        _set(self, "inertia", positive("platform.inertia", self.inertia, "kg m^2"))
         anchors = np.asarray(self.anchors, dtype=object)
-        if anchors.ndim != 2 or anchors.shape[1] != 2 or anchors.shape[0] < 1:
-            raise SceneError(
-                f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), got {shown(self.anchors)}"
-            )
-        _set(self, "anchors", tuple(_vector(f"platform.anchors[{i}]", a, 2, "m") for i, a in enumerate(self.anchors)))
-        _set(self, "initial_pose", _vector("platform.initial_pose", self.initial_pose, 3, "m, m, rad"))
-        size = _vector("platform.size", self.size, 2, "m")
-        for i, s in enumerate(size):
-            non_negative(f"platform.size[{i}]", s, "m")
+        if isinstance(self.anchors, (str, bytes, Mapping)) or anchors.ndim != 2 or anchors.shape[0] < 1 \
+                or anchors.shape[1] not in DIMENSIONS:
+            raise SceneError(f"platform.anchors must be a list of (x, z) pairs, shape (m, 2), or of (x, y, z) "
+                             f"points, shape (m, 3), got {shown(self.anchors)}")
+        space = space_of(anchors.shape[1])
+        _set(self, "anchors", tuple(entries(f"platform.anchors[{i}]", a, space.position_size, "m")
+                                    for i, a in enumerate(self.anchors)))
+        rigid = space.is_rigid(self.is_point_mass)
+        _set(self, "mass", (positive if rigid else non_negative)("platform.mass", self.mass, "kg"))
+        defaults = PLATFORM_DEFAULTS[space.dimension]
+        inertia = self.inertia
+        if inertia is None:
+            inertia = defaults["point_mass_inertia" if self.is_point_mass else "inertia"]
+            if inertia is None:  # a rigid spatial platform: its turning depends on it
+                refuse_missing(missing_fields("platform", {}, ("inertia",)))
+        _set(self, "inertia", space.inertia("platform.inertia", inertia, rigid))
+        pose = defaults["initial_pose"] if self.initial_pose is None else self.initial_pose
+        if defaults["initial_pose"] is None and pose is not None:
+            raise SceneError(f"platform.initial_pose = {shown(pose)}: a {space.name} scene starts at its rest "
+                             "(cdpr static finds it); leave platform.initial_pose out")
+        if pose is not None:
+            pose = entries("platform.initial_pose", pose, space.pose_size, ", ".join(space.pose_units))
+        _set(self, "initial_pose", pose)
+        size = defaults["size"] if self.size is None else self.size
+        if size is not None:
+            size = entries("platform.size", size, 2, "m")
+            for i, s in enumerate(size):
+                non_negative(f"platform.size[{i}]", s, "m")
         _set(self, "size", size)
+
+    @property
+    def space(self) -> Space:
+        """The :class:`~cdpr_exu.space.Space` of the platform: that of its anchors."""
+        return space_of(len(self.anchors[0]))
 
     @property
     def is_point_mass(self) -> bool:
         """True when every anchor sits at the centre of mass."""
-        return bool(np.allclose(self.anchors, 0.0))
+        return all(v == 0.0 for anchor in self.anchors for v in anchor)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (TOML-ready): the fields given or taken by default (None left out)."""
+        return {f.name: _listify(getattr(self, f.name)) for f in fields(self) if getattr(self, f.name) is not None}
 
 
 @dataclass(frozen=True)
@@ -630,7 +638,8 @@ class ControllerModel:
     cables : sequence of mappings
         Per-cable overrides (none, or one per cable), applied after ``cable``.
     pulley, pulleys : mapping, sequence of mappings
-        The same for the :class:`PulleySpec` fields.
+        The same for the fields of the scene's pulleys (:class:`~cdpr_exu.exits.pulley.Pulley`;
+        refused where the exits are not pulleys).
     platform : mapping
         Overrides of :class:`PlatformSpec` fields: mass [kg], inertia [kg m^2], anchors [m].
     gravity : float or None [m/s^2]
@@ -648,11 +657,11 @@ class ControllerModel:
         for name in ("cable", "pulley", "platform"):
             _set(self, name, _overrides(f"controller_model.{name}", getattr(self, name), name))
         for name, part in (("cables", "cable"), ("pulleys", "pulley")):
-            entries = getattr(self, name)
-            if isinstance(entries, (str, bytes, Mapping)) or not hasattr(entries, "__iter__"):
-                raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(entries)}")
+            tables = getattr(self, name)
+            if isinstance(tables, (str, bytes, Mapping)) or not hasattr(tables, "__iter__"):
+                raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(tables)}")
             _set(self, name, tuple(_overrides(f"controller_model.{name}[{i}]", e, part)
-                                   for i, e in enumerate(entries)))
+                                   for i, e in enumerate(tables)))
         if self.gravity is not None:
             _set(self, "gravity", non_negative("controller_model.gravity", self.gravity, "m/s^2"))
 
@@ -677,12 +686,18 @@ class ControllerModel:
                                  f"got {len(getattr(self, name))}")
         cables = tuple(_override(c, {**self.cable, **(self.cables[i] if self.cables else {})}, f"cables[{i}]", "cable")
                        for i, c in enumerate(scene.cables))
-        pulleys = tuple(_override(p, {**self.pulley, **(self.pulleys[i] if self.pulleys else {})}, f"pulleys[{i}]",
-                                  "pulley") for i, p in enumerate(scene.pulleys))
+        if self.pulley or self.pulleys:
+            others = [(i, exit_.kind) for i, exit_ in enumerate(scene.exits) if not isinstance(exit_, Pulley)]
+            if others:
+                raise SceneError(f"controller_model.pulley / controller_model.pulleys: this scene has exits, not pulleys "
+                                 f"({scene.exits_table}[{others[0][0]}] is a {others[0][1]!r} exit); its controller "
+                                 "model overrides cable, cables, platform and gravity")
+        exits = tuple(_override(e, {**self.pulley, **(self.pulleys[i] if self.pulleys else {})}, f"pulleys[{i}]",
+                                "pulley") for i, e in enumerate(scene.exits))
         platform = _override(scene.platform, self.platform, "platform", "platform")
         gravity = scene.gravity if self.gravity is None else self.gravity
         try:
-            return replace(scene, cables=cables, pulleys=pulleys, platform=platform, gravity=gravity,
+            return replace(scene, cables=cables, exits=exits, platform=platform, gravity=gravity,
                            controller_model=None)
         except SceneError as err:
             raise SceneError(f"controller_model: the controllers' model is not a valid robot: {err}") from None
@@ -718,17 +733,11 @@ def _override(part: Any, changes: Mapping[str, Any], path: str, head: str) -> An
 
 def controller_model_from_dict(data: Any) -> ControllerModel:
     """A :class:`ControllerModel` from its TOML table, refusing unknown keys (named)."""
-    if not isinstance(data, Mapping):
-        raise SceneError(f"controller_model must be a table, got {shown(data)}")
-    known = {f.name for f in fields(ControllerModel)}
-    unknown = sorted(set(data) - known)
-    if unknown:
-        raise SceneError(f"controller_model has unknown field(s) {unknown}; known: {sorted(known)}")
-    values = dict(data)
     for name in ("cables", "pulleys"):
-        if name in values and not (isinstance(values[name], list) and all(isinstance(e, Mapping) for e in values[name])):
-            raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(values[name])}")
-    return ControllerModel(**values)
+        if isinstance(data, Mapping) and name in data and not (
+                isinstance(data[name], list) and all(isinstance(e, Mapping) for e in data[name])):
+            raise SceneError(f"controller_model.{name} must be an array of tables, got {shown(data[name])}")
+    return from_table(ControllerModel, data, "controller_model", "controller_model")
 
 
 # --------------------------------------------------------------------------- scene
@@ -736,46 +745,54 @@ def controller_model_from_dict(data: Any) -> ControllerModel:
 
 @dataclass(frozen=True)
 class Scene:
-    """A complete CDPR simulation: robot, effects, solver settings and reference.
+    """A complete CDPR simulation, planar or spatial: robot, effects, solver settings and reference.
 
     Parameters
     ----------
     name : str
     description : str
+    dimension : {2, 3}
+        2: the paper's vertical x-z plane; 3: space, z up. Gravity acts along -z in both.
+        The scene's :attr:`space` (:func:`cdpr_exu.space.space_of`) is made from it once.
     cables : tuple of CableSpec
-        One per cable; cable i runs over ``pulleys[i]`` to ``platform.anchors[i]``.
-    pulleys : tuple of PulleySpec
+        One per cable; cable i leaves the frame at ``exits[i]`` and holds ``platform.anchors[i]``.
+    exits : tuple of Exit
+        Where each cable leaves the frame (:mod:`cdpr_exu.exits`): planar pulleys or point
+        exits in the plane, point exits or swivel pulleys in space, or any registered kind.
     platform : PlatformSpec
+        Of the scene's dimension (its anchors' size).
     winch : WinchSpec
     effects : Effects
     solver : SolverSpec
-    trajectory : Trajectory
-        Reference pose of the platform over time (x, z, rotation).
+    trajectory : Trajectory, SpatialTrajectory or None
+        Reference pose of the platform over time (default: hold a planar initial pose; a spatial
+        scene without one has a static mode only).
     gravity : float [m/s^2]
         Magnitude of the gravitational acceleration, acting along -z.
-    cable_exit : {"pulley", "point"}
-        "pulley": each cable wraps over its pulley and hangs to its winch (paper).
-        "point": the cable's winch end is fixed at the pulley centre and there is no
-        pulley contact (used to compare with the catenary's fixed end points).
     controller_model : ControllerModel or None
         What the controllers believe where it differs from this (simulated) robot;
         :meth:`controller_scene` applies it. None: the controllers know the plant.
+
+    Raises
+    ------
+    SceneError
+        Naming the field: a part of the wrong type, counts that do not match, parts of another
+        dimension, and what the dimension's builder cannot build (:data:`DIMENSION_RULES`).
+    UnreachableError
+        A planar initial pose the cables cannot reach or hold.
     """
 
     name: str = "scene"
     description: str = ""
+    dimension: int = 2
     cables: tuple[CableSpec, ...] = (CableSpec(), CableSpec())
-    pulleys: tuple[PulleySpec, ...] = (
-        PulleySpec(center=(-1.75, 0.0), side=-1),
-        PulleySpec(center=(1.75, 0.0), side=1),
-    )
+    exits: tuple[Exit, ...] = (Pulley(center=(-1.75, 0.0), side=-1), Pulley(center=(1.75, 0.0), side=1))
     platform: PlatformSpec = field(default_factory=PlatformSpec)
     winch: WinchSpec = field(default_factory=WinchSpec)
     effects: Effects = field(default_factory=Effects)
     solver: SolverSpec = field(default_factory=SolverSpec)
-    trajectory: Trajectory | None = None
+    trajectory: Any = None
     gravity: float = 9.81
-    cable_exit: str = "pulley"
     controller_model: ControllerModel | None = None
 
     def __post_init__(self) -> None:
@@ -783,7 +800,10 @@ class Scene:
             raise SceneError(f"name must be a non-empty string, got {shown(self.name)}")
         if not isinstance(self.description, str):
             raise SceneError(f"description must be a string, got {shown(self.description)}")
-        for name, kind in (("cables", CableSpec), ("pulleys", PulleySpec)):
+        space = space_of(self.dimension)
+        _set(self, "dimension", space.dimension)
+        rules = DIMENSION_RULES[space.dimension]
+        for name, kind in (("cables", CableSpec), ("exits", Exit)):
             parts = getattr(self, name)
             if isinstance(parts, (str, bytes, Mapping)) or not hasattr(parts, "__iter__"):
                 raise SceneError(f"{name} must be a sequence of {kind.__name__}, got {shown(parts)}")
@@ -796,34 +816,32 @@ class Scene:
                            ("solver", SolverSpec)):
             if not isinstance(getattr(self, name), kind):
                 raise SceneError(f"{name} must be a {kind.__name__}, got {shown(getattr(self, name))}")
-        if self.trajectory is not None and not isinstance(self.trajectory, Trajectory):
-            raise SceneError(f"trajectory must be a Trajectory, got {shown(self.trajectory)}")
+        if self.trajectory is not None and not isinstance(self.trajectory, rules.trajectory):
+            raise SceneError(f"trajectory must be a {rules.trajectory.__name__}, got {shown(self.trajectory)}")
         m = len(self.cables)
         if m < 1:
             raise SceneError("cables must list at least one cable")
-        if len(self.pulleys) != m:
-            raise SceneError(f"pulleys must list one pulley per cable ({m}), got {len(self.pulleys)}")
+        table = self.exits_table
+        if len(self.exits) != m:
+            raise SceneError(f"{table} must list one exit per cable ({m}), got {len(self.exits)}")
         if len(self.platform.anchors) != m:
-            raise SceneError(
-                f"platform.anchors must list one anchor per cable ({m}), got {len(self.platform.anchors)}"
-            )
+            raise SceneError(f"platform.anchors must list one anchor per cable ({m}), got {len(self.platform.anchors)}")
+        labels = ", ".join(space.position_labels)
+        if self.platform.space is not space:
+            raise SceneError(f"platform.anchors must be ({labels}) points in a {space.name} scene (dimension = "
+                             f"{space.dimension}), got {shown(self.platform.anchors)}")
+        for i, exit_ in enumerate(self.exits):
+            if space.dimension not in exit_.dimensions or len(exit_.point) != space.position_size:
+                raise SceneError(f"exits[{i}] is a {exit_.dimension}-D {exit_.kind!r} exit; a {space.name} scene "
+                                 f"(dimension = {space.dimension}) needs ({labels}) exits")
         _set(self, "gravity", non_negative("gravity", self.gravity, "m/s^2"))
         check_weight(self.platform.mass, self.gravity)
-        _choice("cable_exit", self.cable_exit, ("pulley", "point"))
-        if self.winch.kind == "servo" and not self.effects.cable_mass:
-            raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")
-        if self.cable_exit == "point" and self.winch.kind != "fixed":
-            raise SceneError("cable_exit = 'point' needs winch.kind = 'fixed' (the cable starts at the pulley centre)")
-        if self.solver.integrator != "generalized_alpha" and self.winch.kind != "fixed":
-            raise SceneError(
-                f"solver.integrator = {shown(self.solver.integrator)} needs winch.kind = 'fixed', got "
-                f"{shown(self.winch.kind)}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
-                "and hold them at their initial value, ignoring every winch command")
-        if self.trajectory is None:
-            from cdpr_exu.scenes.trajectories import HoldTrajectory
-
-            _set(self, "trajectory", HoldTrajectory(tuple(self.platform.initial_pose)))
-        self._check_reachable()
+        for i, (cable, exit_) in enumerate(zip(self.cables, self.exits)):
+            exit_.check(cable, i, f"{table}[{i}]")
+        rules.check(self)
+        if self.trajectory is None and self.platform.initial_pose is not None:
+            _set(self, "trajectory", rules.hold(tuple(self.platform.initial_pose)))
+        self._check_start()
         if self.controller_model is not None:
             if not isinstance(self.controller_model, ControllerModel):
                 raise SceneError(f"controller_model must be a ControllerModel, got {shown(self.controller_model)}")
@@ -831,6 +849,11 @@ class Scene:
                 _set(self, "controller_model", None)
             else:
                 self.controller_model.apply(self)  # refuse a model that is no valid robot now, not at the run
+
+    @property
+    def space(self) -> Space:
+        """The :class:`~cdpr_exu.space.Space` of the scene: what a pose, a position and a rotation are."""
+        return space_of(self.dimension)
 
     def controller_scene(self) -> "Scene":
         """The robot the controllers believe in: this scene with its controller model applied.
@@ -842,47 +865,70 @@ class Scene:
             return self
         return self.controller_model.apply(self)
 
-    def _check_reachable(self) -> None:
+    def _check_start(self) -> None:
         """Refuse an initial pose the cables cannot reach or hold (before any simulation)."""
-        anchors = anchor_points(np.asarray(self.platform.initial_pose), np.asarray(self.platform.anchors))
-        above = above_exits(anchors[:, 1], [exit_.top for exit_ in self.exits])
+        pose = self.platform.initial_pose
+        if pose is None:  # the scene starts at its rest
+            return
+        space, table = self.space, self.exits_table
+        anchors = space.anchor_points(np.asarray(pose), np.asarray(self.platform.anchors))
+        above = above_exits(anchors[:, space.vertical], self.exit_tops, exits=table)
         if above is not None and self.gravity > 0.0 and self.effects.gravity:
-            raise UnreachableError(
-                f"platform.initial_pose {list(self.platform.initial_pose)} (x [m], z [m], rotation [rad]) is above "
-                f"the pulleys: {above}; give a platform.initial_pose below them")
-        for i, (cable, pulley, exit_) in enumerate(zip(self.cables, self.pulleys, self.exits)):
-            if exit_.is_point_exit:
-                needed = float(np.linalg.norm(anchors[i] - np.asarray(exit_.center)))
-            else:
-                try:
-                    needed = exit_.cable_length(anchors[i])
-                except UnreachableError as err:
-                    raise UnreachableError(
-                        f"platform.anchors[{i}] at platform.initial_pose {list(self.platform.initial_pose)} cannot be "
-                        f"reached over pulleys[{i}] (pulleys[{i}].center {list(pulley.center)} m, "
-                        f"pulleys[{i}].radius {pulley.radius} m, pulleys[{i}].side {pulley.side}): {err}") from None
+            units = ", ".join(f"{label} [{unit}]" for label, unit in zip(space.pose_labels, space.pose_units))
+            raise UnreachableError(f"platform.initial_pose {list(pose)} ({units}) is above the {table}: {above}; "
+                                   "give a platform.initial_pose below them")
+        for i, (cable, exit_) in enumerate(zip(self.cables, self.exits)):
+            try:
+                needed = float(exit_.cable_length(anchors[i]))
+            except UnreachableError as err:
+                raise UnreachableError(
+                    f"platform.anchors[{i}] at platform.initial_pose {list(pose)} cannot be reached over "
+                    f"{table}[{i}] ({exit_.describe(f'{table}[{i}]')}): {err}") from None
             if needed > cable.unstrained_length * (1 + 1e-9):
                 raise SceneError(
                     f"cables[{i}].unstrained_length = {cable.unstrained_length} m is shorter than the "
-                    f"{needed:.4f} m needed to reach platform.initial_pose {self.platform.initial_pose}"
-                )
+                    f"{needed:.4f} m needed to reach platform.initial_pose {pose}")
 
     # Convenience -------------------------------------------------------------------
     @property
-    def exits(self) -> tuple[Pulley, ...]:
-        """Where each cable leaves the frame, decided once from ``cable_exit``.
+    def exits_table(self) -> str:
+        """The scene file's name of the exits (messages, :func:`save_scene`): ``"pulleys"`` for a planar scene
+        whose exits are all pulleys or all point exits (the planar form), else ``"exits"``."""
+        kinds = {exit_.kind for exit_ in self.exits}
+        return "pulleys" if self.space is PLANE and kinds in ({"pulley"}, {"point"}) else "exits"
 
-        The cable's pulley, or for ``cable_exit = "point"`` a point exit (a
-        :class:`~cdpr_exu.core.geometry.Pulley` of radius 0) at the pulley's centre.
-        """
-        if self.cable_exit == "point":
-            return tuple(Pulley(p.center, 0.0, p.side) for p in self.pulleys)
-        return tuple(self.pulleys)
+    @property
+    def exit_points(self) -> np.ndarray:
+        """Each exit's fixed point (a pulley's centre, a swivel's inlet, a point exit's point), shape (m, d) [m]."""
+        return np.array([exit_.point for exit_ in self.exits], dtype=float)
+
+    @property
+    def pulley_radii(self) -> np.ndarray:
+        """Each exit's radius [m], 0 where the cable leaves from a point, shape (m,) (the ideal kinematics'
+        ``pulley_radii``)."""
+        return np.array([exit_.radius for exit_ in self.exits], dtype=float)
+
+    @property
+    def exit_tops(self) -> np.ndarray:
+        """Height [m] of the highest point each cable can leave its exit from, shape (m,)
+        (:attr:`cdpr_exu.exits.base.Exit.top`)."""
+        return np.array([exit_.top for exit_ in self.exits], dtype=float)
+
+    def above_exits(self, position, rotation=None) -> str | None:
+        """Why no cable can hold the platform with its centre of mass at ``position`` (d,) [m], its frame
+        turned by the rotation matrix ``rotation`` (d, d) (default: not turned): every anchor at or above
+        its exit's top (:func:`cdpr_exu.core.geometry.above_exits`); None if one is below, or the platform
+        has no weight."""
+        if self.gravity == 0.0 or not self.effects.gravity:
+            return None
+        anchors, up = np.asarray(self.platform.anchors, dtype=float), self.space.vertical
+        turned = anchors if rotation is None else anchors @ np.asarray(rotation, dtype=float).T
+        return above_exits(float(position[up]) + turned[:, up], self.exit_tops, exits=self.exits_table)
 
     @property
     def pulley_contact(self) -> bool:
-        """True when the cables touch their pulleys: contact is on and the cables run over pulleys."""
-        return self.effects.pulley_contact and self.cable_exit == "pulley"
+        """True when the cables touch their pulleys: contact is on and a cable wraps over its exit."""
+        return self.effects.pulley_contact and any(exit_.wraps for exit_ in self.exits)
 
     @property
     def contact_model(self) -> PulleyContactModel | None:
@@ -894,6 +940,11 @@ class Scene:
         return len(self.cables)
 
     @property
+    def unstrained_lengths(self) -> np.ndarray:
+        """Unstrained length of each cable, shape (m,) [m]."""
+        return np.array([c.unstrained_length for c in self.cables])
+
+    @property
     def tension_limits(self) -> np.ndarray | None:
         """Each cable's (t_min, t_max) [N], shape (m, 2), 0 and inf where not given; None without any limit."""
         return tension_limits(self.cables)
@@ -902,24 +953,69 @@ class Scene:
         """A copy with top-level fields replaced (validated again)."""
         return replace(self, **changes)
 
+    # Transitional: the spatial twins' helpers, until their consumers are one (issue 24) ---------
+    @property
+    def swivel_exits(self) -> tuple:
+        """Each cable's exit where the cable wraps over it (a swivel pulley in space), else None, shape (m,).
+
+        Transitional: removed when the spatial builder, rest and run take the exits (issue 24, slice 9).
+        """
+        return tuple(exit_ if exit_.wraps else None for exit_ in self.exits)
+
+    def catenary_platform(self) -> SpatialPlatform:
+        """A spatial scene as elastic catenaries (:mod:`cdpr_exu.physics.spatial_statics`).
+
+        Transitional: removed when the catenary statics has one driver for both dimensions (issue 24, slice 8).
+        """
+        gravity = self.gravity if self.effects.gravity else 0.0
+        weighs = self.effects.cable_mass and self.effects.gravity
+        weights = [c.linear_density * gravity if weighs else 0.0 for c in self.cables]
+        for i, (cable, weight) in enumerate(zip(self.cables, weights)):
+            if not math.isfinite(weight):
+                raise SceneError(f"cables[{i}].linear_density = {shown(cable.linear_density)} kg/m and gravity = "
+                                 f"{shown(gravity)} m/s^2 give a weight per length of {shown(weight)} N/m, out of "
+                                 "floating-point range")
+        cables = [SpatialCable(exit_.point, w, c.axial_rigidity, anchor=a, pulley_radius=exit_.radius)
+                  for c, w, exit_, a in zip(self.cables, weights, self.exits, self.platform.anchors)]
+        return SpatialPlatform(cables, self.platform.mass, gravity, self.platform.inertia)
+
     def to_dict(self) -> dict[str, Any]:
-        """Plain-data form (TOML-ready) of the scene."""
-        data: dict[str, Any] = {
-            "name": self.name,
-            "description": self.description,
-            "gravity": self.gravity,
-            "cable_exit": self.cable_exit,
-            "cables": [{k: v for k, v in dataclasses.asdict(c).items() if v is not None} for c in self.cables],
-            "pulleys": [_listify(dataclasses.asdict(p)) for p in self.pulleys],
-            "platform": _listify(dataclasses.asdict(self.platform)),
-            "winch": dataclasses.asdict(self.winch),
-            "effects": dataclasses.asdict(self.effects),
-            "solver": dataclasses.asdict(self.solver),
-            "trajectory": self.trajectory.to_dict(),
-        }
+        """Plain-data form (TOML-ready) of the scene: the planar form for a planar scene whose exits are
+        all pulleys or all point exits (:attr:`exits_table`), else the form with ``dimension`` and
+        ``[[exits]]``; :func:`scene_from_dict` reads either back to an equal scene."""
+        cables = [{k: v for k, v in dataclasses.asdict(c).items() if v is not None} for c in self.cables]
+        if self.exits_table == "pulleys":
+            data: dict[str, Any] = {
+                "name": self.name, "description": self.description, "gravity": self.gravity,
+                "cable_exit": self.exits[0].kind, "cables": cables,
+                "pulleys": [_pulley_table(exit_) for exit_ in self.exits],
+                "platform": self.platform.to_dict(),
+                "winch": dataclasses.asdict(self.winch),
+                "effects": dataclasses.asdict(self.effects),
+                "solver": dataclasses.asdict(self.solver),
+                "trajectory": self.trajectory.to_dict(),
+            }
+        else:
+            data = {
+                "name": self.name, "description": self.description, "dimension": self.dimension,
+                "gravity": self.gravity, "cables": cables, "exits": [exit_.to_dict() for exit_ in self.exits],
+                "platform": self.platform.to_dict(),
+                "effects": dataclasses.asdict(self.effects),
+                "solver": dataclasses.asdict(self.solver),
+                "winch": dataclasses.asdict(self.winch),
+            }
+            if self.trajectory is not None:
+                data["trajectory"] = self.trajectory.to_dict()
         if self.controller_model is not None:
             data["controller_model"] = self.controller_model.to_dict()
         return data
+
+
+def _pulley_table(exit_: Exit) -> dict[str, Any]:
+    """An exit of a scene in the planar form as its ``[[pulleys]]`` table: a pulley's fields, a point exit's centre."""
+    if exit_.wraps:
+        return {name: value for name, value in exit_.to_dict().items() if name != "kind"}
+    return {"center": list(exit_.point)}
 
 
 def _listify(value: Any) -> Any:
@@ -931,28 +1027,79 @@ def _listify(value: Any) -> Any:
     return value
 
 
+# --------------------------------------------------------------------------- what each dimension takes
+
+
+def _planar_rules(scene: Scene) -> None:
+    """What the planar builder builds so far (:mod:`cdpr_exu.builder.model`)."""
+    if scene.winch.kind == "servo" and not scene.effects.cable_mass:
+        raise SceneError("winch.kind = 'servo' needs effects.cable_mass = true (a lumped cable to reel)")
+    wraps = [exit_.wraps for exit_ in scene.exits]
+    if any(wraps) and not all(wraps):
+        raise SceneError(f"exits: cable {wraps.index(False)} leaves a point while cable {wraps.index(True)} wraps over "
+                         "a pulley; the planar builder takes exits that all wrap or all none so far")
+    if not any(wraps) and scene.winch.kind != "fixed":
+        raise SceneError("point exits (cable_exit = 'point') need winch.kind = 'fixed' (the cable starts at the "
+                         "exit point)")
+    if scene.solver.integrator != "generalized_alpha" and scene.winch.kind != "fixed":
+        raise SceneError(
+            f"solver.integrator = {shown(scene.solver.integrator)} needs winch.kind = 'fixed', got "
+            f"{shown(scene.winch.kind)}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
+            "and hold them at their initial value, ignoring every winch command")
+
+
+def _spatial_rules(scene: Scene) -> None:
+    """What the spatial builder builds so far (:mod:`cdpr_exu.builder.spatial_robot`)."""
+    if not (scene.effects.cable_mass and scene.effects.axial_elasticity):
+        raise SceneError(f"effects.preset = {shown(scene.effects.preset)}: a spatial scene needs lumped, elastic "
+                         "cables (effects.cable_mass and effects.axial_elasticity); use the 'full' or 'catenary' preset")
+    first = scene.cables[0]
+    for i, cable in enumerate(scene.cables[1:], start=1):
+        for name in ("n_elements", "radius", "youngs_modulus", "damping_constant", "mass_lumping"):
+            if getattr(cable, name) != getattr(first, name):
+                raise SceneError(f"cables[{i}].{name} = {shown(getattr(cable, name))} differs from cables[0].{name} = "
+                                 f"{shown(getattr(first, name))}: the cables of a spatial scene share one "
+                                 "discretisation, damping and bending so far")
+    scene.catenary_platform()  # refuses coincident exits, too few cables, anchors on one line
+    if scene.winch.kind == "servo":
+        raise SceneError("winch.kind = 'servo': servo drums are planar only so far; use 'kinematic' or 'fixed'")
+    if scene.solver.integrator != "generalized_alpha":
+        raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
+
+
+@dataclass(frozen=True)
+class DimensionRules:
+    """What a scene of one dimension takes where the two dimensions still differ: its trajectories
+    (their base class, the maker of a ``[trajectory]`` table, the one that holds a pose), what its
+    builder builds (``check`` refuses the rest, naming the field), the platform fields a scene file
+    must give (besides a rigid platform's inertia) and whether it must give ``[trajectory]`` (a
+    spatial scene without one has a static mode only). Transitional: one trajectory registry and one
+    builder (issue 24, slices 7 and 9) remove these differences.
+    """
+
+    trajectory: type
+    trajectory_from_dict: Callable[[Any], Any]
+    hold: Callable[[tuple], Any]
+    check: Callable[[Scene], None]
+    platform_fields: tuple[str, ...]
+    trajectory_required: bool
+
+
+#: The rules of each dimension (:class:`DimensionRules`), by dimension.
+DIMENSION_RULES: dict[int, DimensionRules] = {
+    2: DimensionRules(Trajectory, trajectory_from_dict, HoldTrajectory, _planar_rules,
+                      ("mass", "anchors", "initial_pose"), trajectory_required=True),
+    3: DimensionRules(SpatialTrajectory, spatial_trajectory_from_dict, SpatialHoldTrajectory, _spatial_rules,
+                      ("mass", "anchors"), trajectory_required=False),
+}
+
+
 # --------------------------------------------------------------------------- TOML
 
 
 def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
-    """Make dataclass ``cls`` from a mapping, refusing unknown keys."""
-    if not isinstance(data, Mapping):
-        raise SceneError(f"{path} must be a table, got {shown(data)}")
-    known = {f.name for f in fields(cls)}
-    unknown = set(data) - known
-    if unknown:
-        raise SceneError(f"{path} has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
-    try:
-        return cls(**data)
-    except SceneError as err:
-        # Prefix the field path with its position in the tree, e.g. cables[1].radius.
-        message = str(err)
-        head = cls.__name__.replace("Spec", "").lower()
-        if path != head and message.startswith(head + "."):
-            message = path + message[len(head):]
-        raise SceneError(message) from None
-    except TypeError as err:
-        raise SceneError(f"{path}: {err}") from None
+    """Make the scene part ``cls`` from its table (:func:`~cdpr_exu.core.validation.from_table`), e.g. cables[1]."""
+    return from_table(cls, data, path, cls.__name__.replace("Spec", "").lower())
 
 
 def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -961,29 +1108,27 @@ def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list
     if not isinstance(shared, Mapping):
         raise SceneError(f"{single} must be a table, got {shown(shared)}")
     shared = dict(shared)
-    entries = data.get(plural, defaults)
-    if not isinstance(entries, list) or not all(isinstance(e, Mapping) for e in entries):
-        raise SceneError(f"{plural} must be an array of tables, got {shown(entries)}")
-    return [{**e, **shared} if plural not in data else {**shared, **dict(e)} for e in entries]
+    tables = data.get(plural, defaults)
+    if not isinstance(tables, list) or not all(isinstance(e, Mapping) for e in tables):
+        raise SceneError(f"{plural} must be an array of tables, got {shown(tables)}")
+    return [{**e, **shared} if plural not in data else {**shared, **dict(e)} for e in tables]
 
 
-#: The fields a scene file (or its plain data) must give, with their units: the robot's
-#: geometry, lengths and masses, for which no default would be the robot its author meant.
-#: Which of them apply depends on the scene (a pulley's radius and side only where the
-#: cables run over pulleys, a platform's inertia only where an anchor is off its centre of
-#: mass): :func:`missing_fields` is given the names that apply. Every other field keeps a
-#: documented default that is a model choice (the paper's cable material, elements, contact
-#: law, solver settings, effect flags).
+#: The fields of cables and platforms a scene file (or its plain data) must give, with their units:
+#: the robot's lengths and masses, for which no default would be the robot its author meant. Which
+#: of them apply depends on the scene (a platform's inertia only where an anchor is off its centre of
+#: mass, its initial pose only in the plane); each exit kind names its own
+#: (:attr:`cdpr_exu.exits.base.Exit.required_fields`). Every other field keeps a documented default
+#: that is a model choice (the paper's cable material, elements, contact law, solver settings, effect flags).
 REQUIRED_FIELDS: dict[str, str] = {
-    "unstrained_length": "m", "center": "m", "radius": "m", "side": "-1 or +1", "mass": "kg",
-    "inertia": "kg m^2", "anchors": "m", "initial_pose": "m, m, rad", "point": "m", "inlet": "m",
+    "unstrained_length": "m", "mass": "kg", "inertia": "kg m^2", "anchors": "m", "initial_pose": "m, m, rad",
 }
 
 
-def missing_fields(path: str, given: Mapping[str, Any], names: tuple[str, ...]) -> list[str]:
-    """The required ``names`` (keys of :data:`REQUIRED_FIELDS`) that the table ``given`` leaves
-    out, each as a field path ``path.name`` with its unit, e.g. ``"platform.mass [kg]"``."""
-    return [f"{path}.{name} [{REQUIRED_FIELDS[name]}]" for name in names if name not in given]
+def missing_fields(path: str, given: Mapping[str, Any], names, units: Mapping[str, str] = REQUIRED_FIELDS) -> list[str]:
+    """The required ``names`` (keys of ``units``, by default :data:`REQUIRED_FIELDS`) that the table
+    ``given`` leaves out, each as a field path ``path.name`` with its unit, e.g. ``"platform.mass [kg]"``."""
+    return [f"{path}.{name} [{units[name]}]" for name in names if name not in given]
 
 
 def refuse_missing(missing: list[str], source: str | None = None) -> None:
@@ -999,73 +1144,115 @@ def refuse_missing(missing: list[str], source: str | None = None) -> None:
                          "(see the scene reference in the README)")
 
 
-def _planar_missing(data: Mapping[str, Any], cable_dicts, pulley_dicts, platform: "PlatformSpec") -> list[str]:
-    """The required fields a planar scene's plain data leaves out (its tables are checked apart)."""
-    missing = [field_ for i, c in enumerate(cable_dicts)
-               for field_ in missing_fields(f"cables[{i}]", c, ("unstrained_length",))]
-    over_pulleys = data.get("cable_exit", "pulley") == "pulley"
-    for i, p in enumerate(pulley_dicts):
-        missing += missing_fields(f"pulleys[{i}]", p, ("center", "radius", "side") if over_pulleys else ("center",))
-    if isinstance(data.get("platform"), Mapping):
-        names = ("mass", "anchors", "initial_pose") + (() if platform.is_point_mass else ("inertia",))
-        missing += missing_fields("platform", data["platform"], names)
-    return missing
+def _platform_missing(platform_data: Any, platform: PlatformSpec, rules: DimensionRules) -> list[str]:
+    """The required fields the ``[platform]`` table leaves out (the inertia where an anchor is off its centre)."""
+    if not isinstance(platform_data, Mapping):
+        return []
+    names = rules.platform_fields + (() if platform.is_point_mass else ("inertia",))
+    return missing_fields("platform", platform_data, names)
+
+
+#: The top-level fields of a scene in the planar form (``[[pulleys]]``) and in the form with ``[[exits]]``.
+PLANAR_FORM_FIELDS = {"name", "description", "dimension", "gravity", "cable_exit", "cable", "cables", "pulley",
+                      "pulleys", "platform", "winch", "effects", "solver", "trajectory", "controller_model"}
+EXITS_FORM_FIELDS = PLANAR_FORM_FIELDS - {"cable_exit", "pulley", "pulleys"} | {"exits"}
 
 
 def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene:
-    """Make a validated Scene from plain data (as read from TOML).
+    """Make a validated Scene, planar or spatial, from plain data (as read from TOML).
 
-    ``[cable]`` and ``[pulley]`` tables hold values shared by every cable or pulley;
-    ``[[cables]]`` and ``[[pulleys]]`` entries override them one by one. ``[effects]``
-    may name a ``preset`` and override single effects. The values given are checked
-    first; then the tables (:data:`REQUIRED_TABLES`) and fields (:data:`REQUIRED_FIELDS`)
-    a scene must give are required. ``source`` names the file in those messages.
+    ``dimension`` (2 when absent) says which. A scene gives its exits in one of two forms:
+
+    * ``[[exits]]``, one table per cable with its ``kind`` (``"point"`` when absent; any kind
+      of :data:`cdpr_exu.exits.EXIT_KINDS` that exists in the dimension) and that kind's
+      fields, in both dimensions (the spatial scenes' form);
+    * the planar form: ``[[pulleys]]`` (centre, radius, side, contact) and ``cable_exit``
+      (``"pulley"``, the default, or ``"point"``: each cable leaves from its pulley's centre).
+
+    ``[cable]`` (and ``[pulley]``) tables hold values shared by every cable (pulley);
+    ``[[cables]]`` (``[[pulleys]]``) entries override them one by one. ``[effects]`` may
+    name a ``preset`` and override single effects. The values given are checked first; then
+    the tables and fields (:data:`REQUIRED_FIELDS`, each exit kind's) a scene must give are
+    required. ``source`` names the file in those messages.
     """
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
     data = dict(data)
-    if data.get("dimension", 2) != 2:
-        raise SceneError(f"dimension must be 2 (planar) or 3 (spatial), got {shown(data['dimension'])}")
-    data.pop("dimension", None)
-    top_known = {
-        "name", "description", "gravity", "cable_exit", "cable", "cables", "pulley", "pulleys",
-        "platform", "winch", "effects", "solver", "trajectory", "controller_model",
-    }
-    unknown = set(data) - top_known
+    space = space_of(data.get("dimension", 2))
+    rules = DIMENSION_RULES[space.dimension]
+    planar_form = space is PLANE and "exits" not in data
+    known = PLANAR_FORM_FIELDS if planar_form else EXITS_FORM_FIELDS
+    unknown = set(data) - known
     if unknown:
-        raise SceneError(f"scene has unknown field(s) {sorted(unknown)}; known: {sorted(top_known)}")
-    default = Scene.__dataclass_fields__
-    default_pulleys = [_listify(dataclasses.asdict(p)) for p in default["pulleys"].default]
-    pulley_dicts = _per_cable(data, "pulley", "pulleys", default_pulleys)
-    cable_dicts = _per_cable(data, "cable", "cables", [{} for _ in pulley_dicts])
+        raise SceneError(f"scene has unknown field(s) {sorted(unknown)}; known: {sorted(known)}")
+    exits, exits_missing, required = _planar_form_exits(data) if planar_form else _exits_form_exits(data, space)
+    cable_dicts = _per_cable(data, "cable", "cables", [{} for _ in exits] if planar_form else [])
     cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
-    pulleys = tuple(_build(PulleySpec, p, f"pulleys[{i}]") for i, p in enumerate(pulley_dicts))
-    platform = _build(PlatformSpec, data.get("platform", {}), "platform")
+    platform_data = data.get("platform", {})
+    if isinstance(platform_data, Mapping) and "anchors" not in platform_data and not planar_form:
+        # a stand-in point mass of the scene's dimension, to check the values given: refused as missing below
+        platform_data = {**platform_data, "anchors": [[0.0] * space.position_size] * max(1, len(exits))}
+    platform = _build(PlatformSpec, platform_data, "platform")
     effects_data = data.get("effects", {})
     if not isinstance(effects_data, Mapping):
         raise SceneError(f"effects must be a table, got {shown(effects_data)}")
     effects_data = dict(effects_data)
-    preset = effects_data.pop("preset", "full")
-    effects = Effects.from_preset(preset, **effects_data)
-    trajectory = None
-    if "trajectory" in data:
-        trajectory = trajectory_from_dict(data["trajectory"])
+    effects = Effects.from_preset(effects_data.pop("preset", "full"), **effects_data)
     kwargs: dict[str, Any] = dict(
-        cables=cables,
-        pulleys=pulleys,
-        platform=platform,
-        winch=_build(WinchSpec, data.get("winch", {}), "winch"),
-        effects=effects,
+        dimension=space.dimension, cables=cables, exits=exits, platform=platform,
+        winch=_build(WinchSpec, data.get("winch", {}), "winch"), effects=effects,
         solver=_build(SolverSpec, data.get("solver", {}), "solver"),
-        trajectory=trajectory,
+        trajectory=rules.trajectory_from_dict(data["trajectory"]) if "trajectory" in data else None,
         controller_model=controller_model_from_dict(data["controller_model"]) if "controller_model" in data else None,
     )
-    for key in ("name", "description", "gravity", "cable_exit"):
+    for key in ("name", "description", "gravity"):
         if key in data:
             kwargs[key] = data[key]
-    _check_required_tables(data, source)
-    refuse_missing(_planar_missing(data, cable_dicts, pulley_dicts, platform), source)
+    _check_required_tables(data, required, source)
+    missing = [field_ for i, c in enumerate(cable_dicts)
+               for field_ in missing_fields(f"cables[{i}]", c, ("unstrained_length",))]
+    refuse_missing(missing + exits_missing + _platform_missing(data.get("platform"), platform, rules), source)
     return Scene(**kwargs)
+
+
+def _planar_form_exits(data: Mapping[str, Any]) -> tuple[tuple[Exit, ...], list[str], dict[str, str]]:
+    """The exits of a scene in the planar form: its ``[[pulleys]]`` (with ``[pulley]``), each a
+    :class:`~cdpr_exu.exits.pulley.Pulley`, or for ``cable_exit = "point"`` a point exit at its centre.
+
+    Returns the exits, the required fields their tables leave out (:func:`missing_fields`) and the
+    tables the scene must give (:data:`REQUIRED_TABLES`)."""
+    cable_exit = _choice("cable_exit", data.get("cable_exit", "pulley"), ("pulley", "point"))
+    default = [_pulley_table(exit_) for exit_ in Scene.__dataclass_fields__["exits"].default]
+    tables = _per_cable(data, "pulley", "pulleys", default)
+    pulleys = [from_table(Pulley, table, f"pulleys[{i}]", Pulley.path_head) for i, table in enumerate(tables)]
+    over_pulleys = cable_exit == "pulley"
+    names = Pulley.required_fields if over_pulleys else {"center": "m"}
+    missing = [field_ for i, table in enumerate(tables) for field_ in missing_fields(f"pulleys[{i}]", table, names, names)]
+    required = dict(REQUIRED_TABLES)
+    if isinstance(data.get("pulley"), Mapping) and "center" in data["pulley"]:
+        required.pop("pulleys")
+    exits = tuple(pulleys) if over_pulleys else tuple(PointExit(pulley.center) for pulley in pulleys)
+    return exits, missing, required
+
+
+def _exits_form_exits(data: Mapping[str, Any], space: Space) -> tuple[tuple[Exit, ...], list[str], dict[str, str]]:
+    """The exits of a scene's ``[[exits]]``: one :func:`~cdpr_exu.exits.base.exit_from_dict` per table.
+
+    Returns the exits, the required fields (each kind's) their tables leave out and the tables
+    the scene must give."""
+    tables = data.get("exits", [])
+    if not isinstance(tables, list):
+        raise SceneError(f"exits must be an array of tables, each an exit with its kind ({', '.join(map(repr, EXIT_KINDS))}) "
+                         f"and fields, e.g. a point exit (point = [{', '.join(space.position_labels)}]), got {shown(tables)}")
+    exits = tuple(exit_from_dict(table, f"exits[{i}]", space) for i, table in enumerate(tables))
+    missing = [field_ for i, (table, exit_) in enumerate(zip(tables, exits))
+               for field_ in missing_fields(f"exits[{i}]", table, exit_.required_fields, exit_.required_fields)]
+    required = {"cables": "[[cables]] (one per cable, at least its unstrained_length)",
+                "exits": "[[exits]] (one per cable, each with its kind and its fields)",
+                "platform": "[platform] (its mass and anchors)"}
+    if DIMENSION_RULES[space.dimension].trajectory_required:
+        required["trajectory"] = REQUIRED_TABLES["trajectory"]
+    return exits, missing, required
 
 
 def tension_limits(cables) -> np.ndarray | None:
@@ -1073,16 +1260,6 @@ def tension_limits(cables) -> np.ndarray | None:
     if all(c.min_tension is None and c.max_tension is None for c in cables):
         return None
     return np.array([[c.min_tension or 0.0, math.inf if c.max_tension is None else c.max_tension] for c in cables])
-
-
-class SpatialSceneError(SceneError):
-    """A spatial scene (``dimension = 3``) given where only planar scenes are taken."""
-
-
-def _refuse_spatial(source: str | Path) -> None:
-    raise SpatialSceneError(
-        f"scene {shown(str(source))} is spatial (dimension = 3): `cdpr static`, `run`, `compare`, `study sweep`, "
-        "`study accuracy` and `animate` take spatial scenes; `view` takes planar scenes only (see docs/spatial.md)")
 
 
 def is_scene_file(source: str | Path) -> bool:
@@ -1126,31 +1303,26 @@ def parse_scene_text(text: str, source: str | Path) -> dict[str, Any]:
 
 
 def load_scene(source: str | Path) -> Scene:
-    """Load a planar scene by shipped name (e.g. ``"paper-circle"``) or from a TOML file path.
+    """Load a scene, planar or spatial, by shipped name (e.g. ``"paper-circle"``, ``"spatial-cogiro"``;
+    :func:`shipped_scenes`) or from a TOML file path (:func:`scene_from_dict` reads its plain data).
 
     Raises
     ------
-    SpatialSceneError
-        For a spatial scene (:func:`cdpr_exu.scenes.spatial_scene.load_spatial_scene` loads those).
     SceneError
-        For a file that cannot be read as a scene (:func:`read_scene_file`), and for a bad scene.
+        For a name no shipped scene has (:func:`unknown_scene`), for a file that cannot be read as a
+        scene (:func:`read_scene_file`), and for a bad scene.
     """
     if is_scene_file(source):
         data = read_scene_file(source)
     else:
-        name = str(source).replace("-", "_") + ".toml"
-        resource = resources.files("cdpr_exu.scenes").joinpath(name)
-        if not resource.is_file() and resources.files("cdpr_exu.scenes").joinpath("spatial", name).is_file():
-            _refuse_spatial(source)
-        if not resource.is_file():
+        text = shipped_scene_text(str(source))
+        if text is None:
             raise unknown_scene(source)
-        data = parse_scene_text(resource.read_text(encoding="utf-8"), source)
-    if isinstance(data, Mapping) and data.get("dimension") == 3:
-        _refuse_spatial(source)
+        data = parse_scene_text(text, source)
     return scene_from_dict(data, source=str(source))
 
 
-#: What a scene file must say: no default would be the robot or the motion its author meant.
+#: What a scene file in the planar form must say: no default would be the robot or the motion its author meant.
 REQUIRED_TABLES: dict[str, str] = {
     "pulleys": "[[pulleys]] with each pulley's center (where the cables run)",
     "platform": "[platform] with its anchors and mass",
@@ -1158,16 +1330,18 @@ REQUIRED_TABLES: dict[str, str] = {
 }
 
 
-def _check_required_tables(data: Mapping[str, Any], source: str | None) -> None:
-    """Refuse a planar scene file that leaves out a table it cannot sensibly do without."""
-    missing = [name for name in REQUIRED_TABLES if name not in data]
-    if "pulleys" in missing and isinstance(data.get("pulley"), Mapping) and "center" in data["pulley"]:
-        missing.remove("pulleys")
+def _check_required_tables(data: Mapping[str, Any], required: Mapping[str, str], source: str | None) -> None:
+    """Refuse a scene file that leaves out a table it cannot sensibly do without (``required``: name -> what to give)."""
+    missing = [name for name in required if name not in data]
     if missing:
         where = "scene" if source is None else f"scene {shown(source)}"
         raise SceneError(f"{where} lacks {', '.join(missing)}: a scene file must give "
-                         + "; ".join(REQUIRED_TABLES[name] for name in missing)
+                         + "; ".join(required[name] for name in missing)
                          + " (see the scene reference in the README)")
+
+
+#: Where the shipped spatial scenes live, inside the package's ``scenes`` folder.
+SPATIAL_FOLDER = "spatial"
 
 
 def shipped_names(folder: str | None = None) -> list[str]:
@@ -1178,15 +1352,23 @@ def shipped_names(folder: str | None = None) -> list[str]:
 
 
 def shipped_scenes() -> list[str]:
-    """Names of the planar scenes shipped with the package."""
-    return shipped_names()
+    """Names of the scenes shipped with the package, planar and spatial, sorted."""
+    return sorted(shipped_names() + shipped_names(SPATIAL_FOLDER))
+
+
+def shipped_scene_text(name: str) -> str | None:
+    """The TOML text of the shipped scene ``name`` (planar or spatial), or None."""
+    file_name = str(name).replace("-", "_") + ".toml"
+    for resource in (resources.files("cdpr_exu.scenes").joinpath(file_name),
+                     resources.files("cdpr_exu.scenes").joinpath(SPATIAL_FOLDER, file_name)):
+        if resource.is_file():
+            return resource.read_text(encoding="utf-8")
+    return None
 
 
 def closest_names(name: str, names: list[str]) -> list[str]:
     """The names a misspelt ``name`` most likely meant: those that contain it, else those whose
     similarity (difflib's ratio) is at least 0.6 and within 0.1 of the best, the closest first."""
-    import difflib
-
     key = name.replace("_", "-").lower()
     if len(key) >= 3 and any(key in n for n in names):
         return [n for n in names if key in n]
@@ -1198,8 +1380,6 @@ def closest_names(name: str, names: list[str]) -> list[str]:
 def unknown_scene(source: str | Path) -> SceneError:
     """The refusal of a scene name that no shipped scene has: it lists every shipped scene, planar and
     spatial (``cdpr scenes``), after the likeliest (:func:`closest_names`), e.g. "did you mean 'spatial-cogiro'?"."""
-    from cdpr_exu.scenes.spatial_scene import SPATIAL_FOLDER
-
     name = str(source)
     planar, spatial = shipped_names(), shipped_names(SPATIAL_FOLDER)
     close = closest_names(name, planar + spatial)
@@ -1209,9 +1389,8 @@ def unknown_scene(source: str | Path) -> SceneError:
 
 
 def save_scene(scene: Scene, path: str | Path) -> Path:
-    """Write the scene as TOML; :func:`load_scene` reads it back to an equal Scene."""
-    import tomli_w
-
+    """Write the scene as TOML, planar or spatial (:meth:`Scene.to_dict`); :func:`load_scene` reads it back
+    to an equal Scene."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(tomli_w.dumps(scene.to_dict()))

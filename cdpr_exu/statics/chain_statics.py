@@ -41,7 +41,8 @@ from numba import njit
 from cdpr_exu.physics import bending
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import Pulley, rotation_matrix
+from cdpr_exu.core.geometry import rotation_matrix
+from cdpr_exu.exits import Exit
 from cdpr_exu.statics.kinematics import initial_cable_nodes, straight_cable_nodes
 from cdpr_exu.core.validation import finite, shown, vector
 
@@ -65,8 +66,8 @@ class ChainCable:
         k_theta of each interior joint (0: no bending).
     slack : bool
         Tension-only elements.
-    pulley : Pulley
-        Where the cable leaves the frame (radius 0: a fixed exit point).
+    pulley : Exit
+        Where the cable leaves the frame (:mod:`cdpr_exu.exits`: a pulley, or a point exit).
     contact_stiffness : float [N/m]
         Pulley penalty k_p (0: no contact).
     anchor : (x, z) [m]
@@ -78,7 +79,7 @@ class ChainCable:
     axial_stiffness: float
     bending_stiffness: float
     slack: bool
-    pulley: Pulley
+    pulley: Exit
     contact_stiffness: float
     anchor: tuple
 
@@ -94,8 +95,8 @@ class ChainCable:
                 raise SceneError(f"{name} must be zero or positive, got {shown(getattr(self, name))}")
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
             raise SceneError(f"node_masses must be finite and non-negative, got {shown(self.node_masses)}")
-        if not isinstance(self.pulley, Pulley):
-            raise SceneError(f"pulley must be a Pulley, got {shown(self.pulley)}")
+        if not isinstance(self.pulley, Exit):
+            raise SceneError(f"pulley must be an exit (cdpr_exu.exits), got {shown(self.pulley)}")
         vector("anchor", self.anchor, 2)
 
     @property
@@ -154,15 +155,14 @@ def chain_robot(scene) -> ChainRobot:
                          f"effects.pulley_contact_model = {shown(effects.pulley_contact_model)}")
     gravity = scene.gravity if effects.gravity else 0.0
     cables = []
-    for cable, pulley, exit_, anchor in zip(scene.cables, scene.pulleys, scene.exits, scene.platform.anchors):
+    for cable, exit_, anchor in zip(scene.cables, scene.exits, scene.platform.anchors):
         masses = cable.node_masses() if gravity > 0 else np.zeros(cable.n_elements + 1)
-        contact = pulley.contact_stiffness if scene.pulley_contact else 0.0
+        contact = exit_.contact_stiffness if scene.pulley_contact else 0.0
         cables.append(ChainCable(
             node_masses=tuple(float(m) for m in masses), element_length=cable.element_length,
             axial_stiffness=cable.axial_stiffness,
             bending_stiffness=cable.bending_stiffness if effects.bending else 0.0,
-            slack=effects.slack, pulley=Pulley(exit_.center, exit_.radius, exit_.side),
-            contact_stiffness=contact, anchor=tuple(anchor)))
+            slack=effects.slack, pulley=exit_, contact_stiffness=contact, anchor=tuple(anchor)))
     return ChainRobot(tuple(cables), scene.platform.mass, gravity)
 
 
@@ -231,11 +231,11 @@ class _Layout:
             self.anchor_sum[:, 2 * j:2 * j + 2] = np.eye(2)
         self.joints, self.joint_stiffness = joints, joint_stiffness
         # per node: the pulley it may touch (stiffness 0: none)
-        self.node_center = np.concatenate([np.tile(np.asarray(c.pulley.center, float), (n, 1))
+        self.node_center = np.concatenate([np.tile(np.asarray(c.pulley.point, float), (n, 1))
                                            for c, n in zip(robot.cables, self.counts)])
         self.node_radius = np.concatenate([np.full(n, c.pulley.radius) for c, n in zip(robot.cables, self.counts)])
         self.node_contact = np.concatenate([
-            np.full(n, 0.0 if c.pulley.is_point_exit else c.contact_stiffness)
+            np.full(n, c.contact_stiffness if c.pulley.wraps else 0.0)
             for c, n in zip(robot.cables, self.counts)])
         elements = [np.stack([np.arange(f, f + n - 1), np.arange(f + 1, f + n)], axis=1)
                     for f, n in zip(self.first, self.counts)]
@@ -570,10 +570,10 @@ def _straight_guess(robot, position, rotation, tensions):
         anchor = np.asarray(position) + R @ np.asarray(cable.anchor)
         stretched = cable.element_length * (1.0 + tension / (cable.axial_stiffness * cable.element_length))
         pulley = cable.pulley
-        if not pulley.is_point_exit:
+        if pulley.wraps:
             nodes = initial_cable_nodes(pulley.center, pulley.radius, pulley.side, anchor, stretched, cable.n_elements)
         else:
-            direction = anchor - np.asarray(pulley.center)
+            direction = anchor - np.asarray(pulley.point)
             start = anchor - direction / np.linalg.norm(direction) * stretched * cable.n_elements
             nodes = straight_cable_nodes(start, anchor, cable.n_elements)
         interior.append(nodes[1:-1].ravel())

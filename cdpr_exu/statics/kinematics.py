@@ -1,9 +1,12 @@
-"""Ideal kinematics of a planar cable robot: cable lengths, rates, unit vectors, wrenches.
+"""Ideal kinematics of a cable robot: cable lengths, rates and unit vectors, the planar wrench matrix.
 
-Pure NumPy/SciPy; no Exudyn. Poses, anchors and the pulley convention (hang point,
-wrap, tangent point, ideal cable length) are defined once in :mod:`cdpr_exu.core.geometry`;
-this module applies them to the whole robot. The geometry names are re-exported here
-for code that imports them from ``cdpr_exu.statics.kinematics``.
+Pure NumPy/SciPy; no Exudyn. The ideal cables (straight, massless, inextensible) of a
+scene, planar or spatial, are its exits' (:mod:`cdpr_exu.exits`: each computes its cable
+with the kernels of :mod:`cdpr_exu.core.geometry`) at the anchors its
+:class:`~cdpr_exu.space.Space` places: :func:`cable_exits`, :func:`ideal_paid_out`. The
+planar wrench matrix and the initial node layouts of planar cables are here too (the
+spatial ones: :mod:`cdpr_exu.physics.spatial_kinematics`). The planar geometry names are
+re-exported here for code that imports them from ``cdpr_exu.statics.kinematics``.
 """
 
 from __future__ import annotations
@@ -12,32 +15,15 @@ import numpy as np
 from scipy.optimize import brentq
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import per_item, shown
-from cdpr_exu.core.geometry import (
-    PulleyExit,
-    Pulley,
-    anchor_points,
-    anchor_velocities,
-    check_pose_and_anchors,
-    check_side,
-    exit_arrays,
-    finite_array,
-    hang_point,
-    ideal_cable_length,
-    ideal_cable_length_rate,
-    planar_cross,
-    pulley_exit,
-    rotated_anchors,
-    rotation_matrix,
-)
+from cdpr_exu.core.validation import shown
+from cdpr_exu.core.geometry import (anchor_points, anchor_velocities, check_pose_and_anchors, check_radius, check_side,
+                                    exit_arrays, finite_array, planar_cross, pulley_exit, rotated_anchors,
+                                    rotation_matrix)
 
 #: The geometry names above are re-exported for code that imports them from here.
 __all__ = [
-    "inverse_kinematics",
-    "inverse_kinematics_rates",
-    "point_exit_inverse_kinematics",
-    "pulley_arrays",
-    "cable_unit_vectors",
+    "cable_exits",
+    "ideal_paid_out",
     "structure_matrix",
     "initial_cable_nodes",
     "straight_cable_nodes",
@@ -45,129 +31,42 @@ __all__ = [
 
 
 # ----------------------------------------------------------------------------------
-# the whole robot
+# the whole robot, planar or spatial: through its exits
 # ----------------------------------------------------------------------------------
-def _check_pulleys(n_cables, pulley_centers, pulley_radii, sides):
-    centers = finite_array("pulley_centers", pulley_centers, (2,))
-    if centers.shape != (n_cables, 2):
-        raise SceneError(f"pulley_centers must have shape ({n_cables}, 2), got shape {centers.shape}")
-    radii = per_item("pulley_radii", pulley_radii, n_cables)
-    sides_array = np.broadcast_to(np.asarray(sides), (n_cables,)) if np.ndim(sides) == 0 else np.asarray(sides)
-    if sides_array.shape != (n_cables,):
-        raise SceneError(f"sides must have shape ({n_cables},), got {shown(sides)}")
-    side_list = [check_side(f"sides[{i}]", value) for i, value in enumerate(sides_array)]
-    return centers, radii, side_list
+def cable_exits(scene, poses: np.ndarray) -> list:
+    """Each cable's ideal exit towards its anchor at the platform pose(s) (N, pose_size) or (pose_size,):
+    :class:`~cdpr_exu.core.geometry.PulleyExit` (tangent point, wrap, free length, unit vector ``u_i``
+    from the exit towards the anchor), one per cable, from its exit (:meth:`cdpr_exu.exits.base.Exit.exit`)."""
+    points = scene.space.anchor_points(poses, np.asarray(scene.platform.anchors, dtype=float))
+    return [exit_.exit(points[..., i, :]) for i, exit_ in enumerate(scene.exits)]
 
 
-def pulley_arrays(pulleys):
-    """Centres (m, 2) [m], radii (m,) [m] and sides (m,) of a sequence of :class:`~cdpr_exu.core.geometry.Pulley`,
-    the arguments of the robot-level functions below."""
-    centers = np.array([p.center for p in pulleys], dtype=float).reshape(-1, 2)
-    return centers, np.array([p.radius for p in pulleys], dtype=float), np.array([p.side for p in pulleys], dtype=int)
+def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = None):
+    """Ideal paid-out lengths (and rates) of every cable for reference poses, planar or spatial.
 
-
-def _robot_exits(pose, anchors, pulley_centers, pulley_radii, sides):
-    """Per-cable exits for pose (..., 3): lists of (tangent, wrap, free, unit) arrays."""
-    pose, anchors = check_pose_and_anchors(pose, anchors)
-    centers, radii, side_list = _check_pulleys(len(anchors), pulley_centers, pulley_radii, sides)
-    points = pose[..., None, :2] + rotated_anchors(pose, anchors)
-    exits = [
-        exit_arrays(centers[i], float(radii[i]), side_list[i], points[..., i, :]) for i in range(len(anchors))
-    ]
-    return pose, anchors, radii, exits
-
-
-def inverse_kinematics(pose, anchors, pulley_centers, pulley_radii, sides):
-    """Ideal cable lengths (hang point to anchor) for platform pose(s).
+    Each exit gives its ideal cable to the anchor (:func:`cable_exits`: straight from a point, over a
+    pulley's rim or a swivel pulley's disc), its length ``L_i`` and unit vector ``u_i``; the rate is
+    ``dL_i/dt = u_i . v_i``, ``v_i`` the anchor's velocity (the scene's :class:`~cdpr_exu.space.Space`).
 
     Parameters
     ----------
-    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
-        Platform pose(s) ``(x, z, phi)``.
-    anchors : array_like, shape (m, 2) [m]
-        Anchor points ``b_i`` in the platform frame.
-    pulley_centers : array_like, shape (m, 2) [m]
-        Centre of the pulley of each cable.
-    pulley_radii : float or array_like, shape (m,) [m]
-        Pulley radii; 0 is a point exit.
-    sides : array_like, shape (m,), values in {-1, +1}
-        Side on which each cable hangs towards its winch.
+    scene : cdpr_exu.scenes.scene.Scene
+    poses : ndarray, shape (N, pose_size) [m, rad]
+    pose_rates : ndarray, shape (N, pose_size) or None [m/s, rad/s]
+        The poses' time derivatives (in space, the rotation vector's rate).
 
     Returns
     -------
-    ndarray, shape (m,) or (N, m) [m]
-
-    Raises
-    ------
-    SceneError
-        If an argument is malformed.
-    UnreachableError
-        If an anchor is inside a pulley or beyond the outer vertical cable line.
+    lengths : ndarray, shape (N, m) [m]
+    rates : ndarray, shape (N, m) [m/s] or None
     """
-    _, _, radii, exits = _robot_exits(pose, anchors, pulley_centers, pulley_radii, sides)
-    return np.stack([free + radii[i] * wrap for i, (_, wrap, free, _) in enumerate(exits)], axis=-1)
-
-
-def inverse_kinematics_rates(pose, pose_rate, anchors, pulley_centers, pulley_radii, sides):
-    """Rates of the ideal cable lengths, ``dL_i/dt = u_i . v_i`` (the winch reeling rates).
-
-    Parameters
-    ----------
-    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
-        Platform pose(s).
-    pose_rate : array_like, same shape as ``pose`` [m/s, m/s, rad/s]
-        Pose rate(s) ``(xdot, zdot, phidot)``.
-    anchors, pulley_centers, pulley_radii, sides
-        As :func:`inverse_kinematics`.
-
-    Returns
-    -------
-    ndarray, shape (m,) or (N, m) [m/s]
-        Positive when the cable between pulley and platform lengthens (winch pays out).
-    """
-    pose, anchors, _, exits = _robot_exits(pose, anchors, pulley_centers, pulley_radii, sides)
-    velocities = anchor_velocities(pose, pose_rate, anchors)
-    return np.stack([np.sum(unit * velocities[..., i, :], axis=-1) for i, (_, _, _, unit) in enumerate(exits)], axis=-1)
-
-
-def point_exit_inverse_kinematics(pose, anchors, pulley_centers):
-    """Ideal cable lengths with point exits: the distances ``|p_i - c_i|``.
-
-    Parameters
-    ----------
-    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
-    anchors : array_like, shape (m, 2) [m]
-    pulley_centers : array_like, shape (m, 2) [m]
-        Cable exit points.
-
-    Returns
-    -------
-    ndarray, shape (m,) or (N, m) [m]
-    """
-    points = anchor_points(pose, anchors)
-    centers = finite_array("pulley_centers", pulley_centers, (2,))
-    if centers.shape != (points.shape[-2], 2):
-        raise SceneError(f"pulley_centers must have shape ({points.shape[-2]}, 2), got shape {centers.shape}")
-    return np.linalg.norm(points - centers, axis=-1)
-
-
-def cable_unit_vectors(pose, anchors, pulley_centers, pulley_radii, sides):
-    """Unit vectors along each cable from its platform anchor towards its pulley.
-
-    These are the directions in which the cables pull on the platform, ready for
-    :func:`structure_matrix` (``-PulleyExit.unit_vector``).
-
-    Parameters
-    ----------
-    pose, anchors, pulley_centers, pulley_radii, sides
-        As :func:`inverse_kinematics`.
-
-    Returns
-    -------
-    ndarray, shape (m, 2) or (N, m, 2)
-    """
-    _, _, _, exits = _robot_exits(pose, anchors, pulley_centers, pulley_radii, sides)
-    return np.stack([-unit for (_, _, _, unit) in exits], axis=-2)
+    exits = cable_exits(scene, poses)
+    lengths = np.stack([e.cable_length for e in exits], axis=-1)
+    if pose_rates is None:
+        return lengths, None
+    velocities = scene.space.anchor_velocities(poses, pose_rates, np.asarray(scene.platform.anchors, dtype=float))
+    return lengths, np.stack([np.sum(e.unit_vector * velocities[..., i, :], axis=-1) for i, e in enumerate(exits)],
+                             axis=-1)
 
 
 def structure_matrix(pose, anchors, unit_vectors):
@@ -184,7 +83,7 @@ def structure_matrix(pose, anchors, unit_vectors):
         Anchor points ``b_i`` in the platform frame.
     unit_vectors : array_like, shape (m, 2) or (N, m, 2)
         Unit vectors ``w_i`` from each anchor towards its cable's exit point (the
-        direction of pull, see :func:`cable_unit_vectors`). Not re-normalised.
+        direction of pull: minus the exits' unit vectors, :func:`cable_exits`). Not re-normalised.
 
     Returns
     -------
@@ -283,8 +182,10 @@ def initial_cable_nodes(center, radius, side, anchor, element_length, n_elements
     current shortfall (never less than ``element_length / 1000``) cannot jump over a
     crossing wider than that step; the bracket is then refined with Brent's method.
     """
-    pulley = Pulley(center, radius, side)
-    center, radius, side = np.asarray(pulley.center), pulley.radius, pulley.side
+    center = finite_array("center", center, (2,))
+    if center.ndim != 1:
+        raise SceneError(f"center must have shape (2,), got shape {center.shape}")
+    radius, side = check_radius("radius", radius), check_side("side", side)
     anchor = finite_array("anchor", anchor, (2,))
     if anchor.ndim != 1:
         raise SceneError(f"anchor must have shape (2,), got shape {anchor.shape}")
@@ -297,7 +198,7 @@ def initial_cable_nodes(center, radius, side, anchor, element_length, n_elements
     tangent_point, wrap, free_length, unit_vector = exit_arrays(center, radius, side, anchor)
     wrap, free_length = float(wrap), float(free_length)
     arc_end = free_length + radius * wrap
-    hang = pulley.hang_point
+    hang = np.array([center[0] + side * radius, center[1]])
     angle_t = np.arctan2(tangent_point[1] - center[1], tangent_point[0] - center[0])
 
     def path(sigma):

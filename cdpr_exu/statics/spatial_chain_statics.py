@@ -259,7 +259,7 @@ def spatial_chain_robot(scene, anchor_spring_factor: float | None = None, tensio
 
     Parameters
     ----------
-    scene : SpatialScene
+    scene : Scene
     anchor_spring_factor : float or None
         See :class:`SpatialChainRobot`.
     tension_only : bool, optional

@@ -78,8 +78,9 @@ from cdpr_exu.physics.catenary import (
     state_from_end_forces,
 )
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import Pulley, perpendicular, planar_cross, rotation_matrix
+from cdpr_exu.core.geometry import perpendicular, planar_cross, rotation_matrix
 from cdpr_exu.core.validation import finite, non_negative, positive, real_array, shown, vector
+from cdpr_exu.exits import Exit, Pulley
 
 _RELATIVE_TOLERANCE = 1e-12
 
@@ -115,16 +116,17 @@ class SuspendedCable:
         Anchor point on the platform, in the platform frame (centre of mass at 0).
     exit_point : (float, float) [m], optional
         Fixed upper end, world frame. Give exactly one of ``exit_point`` and ``pulley``.
-    pulley : Pulley, optional
-        Pulley the cable leaves from (:class:`cdpr_exu.core.geometry.Pulley`); one of radius 0
-        is taken as the fixed ``exit_point`` at its centre.
+    pulley : Exit, optional
+        The planar exit the cable leaves from (:mod:`cdpr_exu.exits`): a
+        :class:`~cdpr_exu.exits.pulley.Pulley`, or an exit the cable does not wrap (a point
+        exit), taken as the fixed ``exit_point`` at its point.
     """
 
     weight_per_length: float
     axial_stiffness: float
     anchor: tuple = (0.0, 0.0)
     exit_point: tuple | None = None
-    pulley: Pulley | None = None
+    pulley: Exit | None = None
 
     def __post_init__(self):
         object.__setattr__(
@@ -141,10 +143,10 @@ class SuspendedCable:
             )
         if self.exit_point is not None:
             object.__setattr__(self, "exit_point", _point("exit_point", self.exit_point))
-        elif not isinstance(self.pulley, Pulley):
-            raise SceneError(f"pulley must be a Pulley, got {shown(self.pulley)}")
-        elif self.pulley.is_point_exit:  # a pulley of radius 0 is a fixed exit point
-            object.__setattr__(self, "exit_point", self.pulley.center)
+        elif not isinstance(self.pulley, Exit):
+            raise SceneError(f"pulley must be a Pulley or another exit (cdpr_exu.exits), got {shown(self.pulley)}")
+        elif not self.pulley.wraps:  # the cable leaves from the exit's point
+            object.__setattr__(self, "exit_point", _point("exit_point", self.pulley.point))
             object.__setattr__(self, "pulley", None)
 
     def catenary(self, unstrained_length):
@@ -157,6 +159,15 @@ class SuspendedCable:
         if self.pulley is None:
             return np.array(self.exit_point)
         return np.array(self.pulley.center)
+
+
+def swivel_plane_cable(weight_per_length, axial_stiffness, radius) -> SuspendedCable:
+    """The planar cable of a swivel pulley of radius ``radius`` [m], in the vertical plane through its axis
+    and the anchor: over a pulley of centre (r_p, 0), hung on its left (side -1), so that its hang point
+    is the inlet at the plane's origin and its winch line the swivel axis (:mod:`cdpr_exu.core.geometry`,
+    "Swivel pulley"); the anchor at the platform's reference point."""
+    radius = float(radius)
+    return SuspendedCable(weight_per_length, axial_stiffness, anchor=(0.0, 0.0), pulley=Pulley((radius, 0.0), radius, -1))
 
 
 @dataclass(frozen=True)

@@ -56,33 +56,33 @@ def _pose_text(times: np.ndarray, poses: np.ndarray, k: int) -> str:
 
 
 def _check_anchors_outside_discs(scene, times, poses, anchors) -> None:
-    for i, pulley in enumerate(scene.exits):
-        if pulley.is_point_exit:
+    table = scene.exits_table
+    for i, exit_ in enumerate(scene.exits):
+        if not exit_.wraps:
             continue
-        distance = np.linalg.norm(anchors[:, i] - np.asarray(pulley.center), axis=1)
-        inside = np.flatnonzero(distance <= pulley.radius * (1.0 + 1e-9))
+        distance = np.linalg.norm(anchors[:, i] - np.asarray(exit_.point), axis=1)
+        inside = np.flatnonzero(distance <= exit_.radius * (1.0 + 1e-9))
         if inside.size:
             k = inside[0]
             raise UnreachableError(
-                f"platform.anchors[{i}] enters pulleys[{i}] ({_pose_text(times, poses, k)}): the anchor at "
-                f"{np.round(anchors[k, i], 4).tolist()} m lies {distance[k]:.4f} m from pulleys[{i}].center "
-                f"{list(pulley.center)} m, inside pulleys[{i}].radius = {pulley.radius} m")
+                f"platform.anchors[{i}] enters {table}[{i}] ({_pose_text(times, poses, k)}): the anchor at "
+                f"{np.round(anchors[k, i], 4).tolist()} m lies {distance[k]:.4f} m from {table}[{i}].center "
+                f"{list(exit_.point)} m, inside {table}[{i}].radius = {exit_.radius} m")
 
 
 def _exit_named(scene, i, times, poses, anchors):
     """The exit of cable i at every sample; its refusal names the fields and the time."""
-    pulley = scene.exits[i]
+    exit_, path = scene.exits[i], f"{scene.exits_table}[{i}]"
     try:
-        return pulley.exit(anchors)
+        return exit_.exit(anchors)
     except UnreachableError as err:
         for k in range(len(anchors)):
             try:
-                pulley.exit(anchors[k])
+                exit_.exit(anchors[k])
             except UnreachableError:
                 raise UnreachableError(
-                    f"platform.anchors[{i}] cannot be reached over pulleys[{i}] ({_pose_text(times, poses, k)}; "
-                    f"pulleys[{i}].center {list(pulley.center)} m, pulleys[{i}].radius {pulley.radius} m, "
-                    f"pulleys[{i}].side {pulley.side}): {err}") from None
+                    f"platform.anchors[{i}] cannot be reached over {path} ({_pose_text(times, poses, k)}; "
+                    f"{exit_.describe(path)}): {err}") from None
         raise
 
 
@@ -97,10 +97,10 @@ def _exits(scene, times, poses, anchors):
 
 
 def _check_lengths(scene, times, poses, lengths) -> None:
-    if scene.cable_exit == "point":
-        return  # a cable fixed at the exit point: its length is checked with the scene (initial pose)
     lumped = scene.effects.cable_mass
-    for i, (cable, length) in enumerate(zip(scene.cables, lengths)):
+    for i, (cable, exit_, length) in enumerate(zip(scene.cables, scene.exits, lengths)):
+        if not exit_.wraps:
+            continue  # a cable fixed at the exit point: its length is checked with the scene (initial pose)
         # A lumped cable keeps at least one element on the winch side of the pulley; a
         # massless rope has no elements, so its whole length may be paid out.
         spare = cable.element_length if lumped else 0.0
@@ -111,7 +111,7 @@ def _check_lengths(scene, times, poses, lengths) -> None:
                     if lumped else "a massless rope can pay out at most its whole length")
             raise UnreachableError(
                 f"{_pose_text(times, poses, k)} needs {length[k]:.4f} m of cable {i + 1} between "
-                f"pulleys[{i}] and platform.anchors[{i}], but cables[{i}].unstrained_length is "
+                f"{scene.exits_table}[{i}] and platform.anchors[{i}], but cables[{i}].unstrained_length is "
                 f"{cable.unstrained_length} m ({kept})")
 
 

@@ -58,7 +58,7 @@ from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure,
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
 from cdpr_exu.results.result import provenance
-from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial, load_any_scene, save_any_scene
+from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
 from cdpr_exu.scenes.trajectories import HoldTrajectory
 from cdpr_exu.studies.study import (SINGLE_THREAD_ENVIRONMENT, apply_parameters, executor_for, progress_bar,
@@ -274,19 +274,21 @@ SPATIAL_QUICK_GRID = AccuracyGrid(
 )
 
 
+#: The default grids (quick, full) of each dimension.
+GRIDS = {2: (QUICK_GRID, FULL_GRID), 3: (SPATIAL_QUICK_GRID, SPATIAL_FULL_GRID)}
+
+
 def grid_for(scene, quick: bool = False) -> AccuracyGrid:
     """The default grid of ``scene``: :data:`FULL_GRID` / :data:`QUICK_GRID` for planar scenes,
     :data:`SPATIAL_FULL_GRID` / :data:`SPATIAL_QUICK_GRID` for spatial ones.
 
     Over swivel pulleys a cable needs its elements short beside the pulley's radius (the
-    scene refuses coarser ones): there the spatial grid's element counts are scaled by the
-    factor that brings its coarsest cable to the fewest elements the scene takes
-    (:func:`fewest_spatial_elements`), e.g. 4, 8 and 16 to 48, 96 and 192.
+    scene refuses coarser ones): there the grid's element counts are scaled by the factor
+    that brings its coarsest cable to the fewest elements its exit takes
+    (:func:`fewest_elements`), e.g. 4, 8 and 16 to 48, 96 and 192.
     """
-    if not is_spatial(scene):
-        return QUICK_GRID if quick else FULL_GRID
-    grid = SPATIAL_QUICK_GRID if quick else SPATIAL_FULL_GRID
-    factor = math.ceil(fewest_spatial_elements(scene) / min(grid.n_elements))
+    grid = GRIDS[scene.dimension][0 if quick else 1]
+    factor = math.ceil(fewest_elements(scene) / min(grid.n_elements))
     if factor <= 1:
         return grid
     resolution = grid.variant_resolution
@@ -295,16 +297,10 @@ def grid_for(scene, quick: bool = False) -> AccuracyGrid:
                    variant_resolution=None if resolution is None else (factor * resolution[0], resolution[1]))
 
 
-def fewest_spatial_elements(scene) -> int:
-    """The fewest elements per cable a spatial scene takes: 1 over point exits; over a swivel
-    pulley of radius r, elements no longer than ``SAFE_ELEMENT_FRACTION`` r."""
-    from cdpr_exu.physics.swivel_pulley import SAFE_ELEMENT_FRACTION
-
-    fewest = 1
-    for cable, swivel in zip(scene.cables, scene.swivel_exits):
-        if swivel is not None:
-            fewest = max(fewest, math.ceil(cable.unstrained_length / (SAFE_ELEMENT_FRACTION * swivel.radius) - 1e-9))
-    return fewest
+def fewest_elements(scene) -> int:
+    """The fewest elements per cable the scene's exits take (:meth:`cdpr_exu.exits.base.Exit.fewest_elements`:
+    over a swivel pulley of radius r, elements no longer than ``SAFE_ELEMENT_FRACTION`` r; 1 elsewhere)."""
+    return max(exit_.fewest_elements(cable) for cable, exit_ in zip(scene.cables, scene.exits))
 
 
 # --------------------------------------------------------------------------- one run
@@ -335,16 +331,14 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     try:
         with warnings.catch_warnings():  # the study samples once per step where the step is coarser, knowingly
             warnings.simplefilter("ignore", CoarseOutputWarning)
-            scene = any_scene_from_dict(scene_data)
-        spatial = is_spatial(scene)
-        if spatial:  # the runners load Numba and Exudyn: here, after the thread limits above
-            from cdpr_exu.run.spatial_run import simulate_spatial as simulate
-        else:
-            from cdpr_exu.run.simulate import simulate
+            scene = scene_from_dict(scene_data)
+        spatial = scene.dimension == 3  # one Result in issue 24, slice 3
+        from cdpr_exu.run.error_estimate import simulate_any  # loads Numba and Exudyn: after the thread limits
+
         warm_up(scene)
         cpu = time.process_time()
         try:
-            result = simulate(scene, progress=False)
+            result = simulate_any(scene)
             status = "completed"
         except SolverFailure as err:
             result = err.partial_result
@@ -547,7 +541,7 @@ def check_study_scene(scene) -> None:
     ------
     SceneError
     """
-    if is_spatial(scene) and scene.trajectory is None:
+    if scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr study accuracy` runs the scene's "
                          "reference (`cdpr static` gives a spatial scene's static mode)")
 
@@ -565,7 +559,7 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
 
     Parameters
     ----------
-    scene : Scene or SpatialScene, or a shipped scene name or TOML path
+    scene : Scene, or a shipped scene name or TOML path
     grid : AccuracyGrid, optional
         Default: :func:`grid_for` the scene (the full planar or spatial grid).
     out : path, optional
@@ -588,7 +582,7 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
     SceneError
         If the reference run does not complete: nothing can be compared then.
     """
-    base = load_any_scene(scene) if isinstance(scene, (str, Path)) else scene
+    base = load_scene(scene) if isinstance(scene, (str, Path)) else scene
     check_study_scene(base)
     grid = grid or grid_for(base)
     if grid.end_time is not None:
@@ -608,7 +602,7 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", CoarseOutputWarning)
-                data = any_scene_from_dict(configuration.scene_data(base_data)).to_dict()
+                data = scene_from_dict(configuration.scene_data(base_data)).to_dict()
         except SceneError as err:
             row["status"] = "refused: " + " ".join(str(err).split())
         else:
@@ -708,7 +702,7 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
     reference's series into ``out``."""
     out = check_output_folder(out, command="study accuracy")
     clear_outputs(out, "study accuracy")  # no file of an earlier accuracy study stays
-    paths = {"scene": save_any_scene(base_scene, out / ACCURACY_FILES["scene"])}
+    paths = {"scene": save_scene(base_scene, out / ACCURACY_FILES["scene"])}
     with open(out / ACCURACY_FILES["csv"], "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(COLUMNS)

@@ -38,7 +38,6 @@ from cdpr_exu.results.result import Result, provenance, warning_flags
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.scenes.scene import Scene, save_scene
-from cdpr_exu.scenes.spatial_scene import SpatialScene
 from cdpr_exu.scenes.trajectories import CircleTrajectory
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
                                       ilc_controller, model_feed_forward_controller)
@@ -205,7 +204,7 @@ SPATIAL_CONTROLLERS = {
 }
 
 
-def spatial_controller_names(scene: SpatialScene) -> list[str]:
+def spatial_controller_names(scene: Scene) -> list[str]:
     """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS` (over
     swivel pulleys too: the chain version's held chains run over the disc, their winch ends moved as the run's)."""
     return list(SPATIAL_CONTROLLERS)
@@ -236,7 +235,7 @@ def spatial_comparison_table(summaries: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: str | Path | None = None,
+def compare_spatial(scene: Scene, names: list[str] | None = None, out: str | Path | None = None,
                     after: float = 1.0, report: Callable[[str, dict], None] | None = None) -> dict[str, dict]:
     """Run a spatial scene under each named controller; write summary.json, comparison.md and each
     controller's overview figure to ``out``. Returns the summaries by name; ``report(name, summary)``
@@ -283,7 +282,7 @@ def compare_spatial(scene: SpatialScene, names: list[str] | None = None, out: st
     return summaries
 
 
-def _write_spatial_comparison(scene: SpatialScene, summaries: dict, results: dict, out: Path, after: float) -> None:
+def _write_spatial_comparison(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
     """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
     from cdpr_exu.post.plots import plot_spatial_run
 

@@ -326,11 +326,9 @@ def warm_up(scene) -> None:
     run a worker takes first would report that in its time.
     """
     from cdpr_exu.run.error_estimate import simulate_any
-    from cdpr_exu.scenes.spatial_scene import is_spatial
 
     effects = scene.to_dict()["effects"]
-    configuration = (["spatial", effects, bool(scene.swivels)] if is_spatial(scene)
-                     else ["planar", effects, scene.cable_exit, scene.winch.kind])
+    configuration = [scene.dimension, effects, [exit_.kind for exit_ in scene.exits], scene.winch.kind]
     key = json.dumps(configuration, sort_keys=True)
     if key in _WARMED:
         return
@@ -366,19 +364,15 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)  # effective if the libraries are not loaded yet
     from cdpr_exu.core.errors import SolverFailure, UnreachableError
-    from cdpr_exu.scenes.spatial_scene import any_scene_from_dict, is_spatial
+    from cdpr_exu.run.error_estimate import simulate_any
+    from cdpr_exu.scenes.scene import scene_from_dict
 
     try:
-        scene = any_scene_from_dict(scene_data)
-        if is_spatial(scene):
-            from cdpr_exu.run.spatial_run import simulate_spatial as simulate
-        else:
-            from cdpr_exu.run.simulate import simulate
-
-            warm_up(scene)
+        scene = scene_from_dict(scene_data)
+        warm_up(scene)
         after = after if after < scene.solver.end_time else 0.0
         try:
-            result = simulate(scene, progress=False)
+            result = simulate_any(scene)
             status = "completed"
         except SolverFailure as err:
             result = err.partial_result
@@ -512,12 +506,11 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         Before any run, for an unknown parameter path, a malformed value or unequal
         zipped lengths. Invalid values of a known path are recorded as refused runs.
     """
-    from cdpr_exu.scenes.scene import Scene
-    from cdpr_exu.scenes.spatial_scene import SpatialScene, any_scene_from_dict, load_any_scene
+    from cdpr_exu.scenes.scene import Scene, load_scene, scene_from_dict
 
     if workers is not None and (isinstance(workers, bool) or int(workers) != workers or workers < 1):
         raise SceneError(f"workers must be a whole number of at least 1, got {workers!r}")
-    scene = base_scene if isinstance(base_scene, (Scene, SpatialScene)) else load_any_scene(base_scene)
+    scene = base_scene if isinstance(base_scene, Scene) else load_scene(base_scene)
     after = float(after)
     variations = as_variations(variations)
     base_data = scene.to_dict()
@@ -532,7 +525,7 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
         row["run"] = index
         data = apply_parameters(base_data, assignments)
         try:
-            data = any_scene_from_dict(data).to_dict()
+            data = scene_from_dict(data).to_dict()
         except SceneError as err:
             row.update({"status": "refused: " + " ".join(str(err).split()), **_nan_figures()})
         else:
@@ -598,7 +591,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
     (:func:`cdpr_exu.post.study_plots.plot_study`); return the paths."""
     from cdpr_exu.core.output import check_output_folder, clear_outputs, value_text, write_summary
     from cdpr_exu.results.result import provenance
-    from cdpr_exu.scenes.spatial_scene import save_any_scene as save_scene
+    from cdpr_exu.scenes.scene import save_scene
 
     out = check_output_folder(out, command="study sweep")
     clear_outputs(out, "study sweep")  # no figure of an earlier study's parameters stays

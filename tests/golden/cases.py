@@ -41,9 +41,9 @@ def _planar(name, end_time, **changes):
 
 
 def _spatial(name, end_time):
-    from cdpr_exu.scenes.spatial_scene import load_spatial_scene
+    from cdpr_exu.scenes.scene import load_scene
 
-    return _short(load_spatial_scene(name), end_time)
+    return _short(load_scene(name), end_time)
 
 
 def _run_arrays(result, pose, reference):

@@ -1,0 +1,221 @@
+"""The space a robot lives in: the plane of the paper or three dimensions, decided once.
+
+A scene says its dimension once (``dimension = 3`` in TOML, 2 when absent) and gets a
+:class:`Space` (:func:`space_of`): the one object that knows what a pose, a position and a
+rotation are in that dimension. A concept that is the same in both dimensions (scene,
+exits, kinematics, statics, builder, run, result, controllers) is written once and asks its
+scene's space for what differs, instead of testing the dimension itself. This module is the
+only place that branches on the dimension (:func:`space_of`).
+
+* **Planar** (:data:`PLANE`): the paper's vertical x-z plane, gravity along -z. A pose is
+  ``(x, z, phi)`` [m, m, rad], ``phi`` counter-clockwise (paper eq. 17); an anchor ``b`` sits
+  at ``r + R(phi) b``. The builder maps (x, z) onto Exudyn's x-y plane (its 2-D items).
+* **Spatial** (:data:`SPACE`): z up, gravity along -z. A pose is ``(x, y, z, theta)``
+  [m, rad], ``theta`` the platform's rotation vector, ``R = exp([theta]x)``.
+
+Each space computes with its own kernels of :mod:`cdpr_exu.core.geometry` (the planar ones
+and the spatial ones, each bit for bit what it was before the space existed): planar numbers
+never go through 3-D arithmetic.
+
+The planar robot embeds in space as ``(x, z, phi) -> (x, 0, z, 0, -phi, 0)``: its plane is
+the x-z plane, and a counter-clockwise turn seen with x to the right and z up is a turn
+about -y (:meth:`Space.embed`). Units SI.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cdpr_exu.core import geometry
+from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.validation import positive, shown, vector
+
+__all__ = ["Space", "PLANE", "SPACE", "space_of", "DIMENSIONS"]
+
+
+class Space:
+    """What a pose, a position and a rotation are in one dimension (see the module notes).
+
+    Attributes
+    ----------
+    dimension : int
+        2 (the paper's plane) or 3.
+    name : str
+        "planar" or "spatial" (for messages).
+    position_labels, rotation_labels, pose_labels : tuple of str
+        The names of a position's, a rotation's and a pose's entries, in order (for tables,
+        CSV headers and figures).
+    position_size, rotation_size, pose_size : int
+        Entries of a position (2 | 3), a rotation (1 | 3) and a pose (3 | 6).
+    wrench_size : int
+        Entries of a wrench on the platform (force and moment): the pose size.
+    pose_units : tuple of str
+    vertical : int
+        Index of the vertical (up) axis in a position: 1 (z of (x, z)) or 2 (z of (x, y, z)).
+    """
+
+    dimension: int
+    name: str
+    position_labels: tuple[str, ...]
+    rotation_labels: tuple[str, ...]
+
+    @property
+    def position_size(self) -> int:
+        return len(self.position_labels)
+
+    @property
+    def rotation_size(self) -> int:
+        return len(self.rotation_labels)
+
+    @property
+    def pose_size(self) -> int:
+        return self.position_size + self.rotation_size
+
+    @property
+    def wrench_size(self) -> int:
+        return self.pose_size
+
+    @property
+    def pose_labels(self) -> tuple[str, ...]:
+        return self.position_labels + self.rotation_labels
+
+    @property
+    def pose_units(self) -> tuple[str, ...]:
+        return ("m",) * self.position_size + ("rad",) * self.rotation_size
+
+    @property
+    def vertical(self) -> int:
+        return self.position_size - 1
+
+    def __repr__(self) -> str:
+        return f"<{self.name} space>"
+
+    def __reduce__(self):  # one object per dimension, also across process pools and pickles
+        return space_of, (self.dimension,)
+
+    def rotation_matrix(self, rotation) -> np.ndarray:
+        """The rotation matrix of one rotation (an angle [rad], or a rotation vector (3,) [rad]), shape (d, d)."""
+        raise NotImplementedError
+
+    def anchor_points(self, pose, anchors) -> np.ndarray:
+        """World positions of the platform anchors ``r + R b_i``: pose (pose_size,) or (N, pose_size),
+        anchors (m, d) in the platform frame -> (m, d) or (N, m, d) [m]."""
+        raise NotImplementedError
+
+    def anchor_velocities(self, pose, pose_rate, anchors) -> np.ndarray:
+        """World velocities of the anchors for a pose and its rate (the pose's time derivative: in space
+        the rotation vector's rate, not the angular velocity), shape as :meth:`anchor_points` [m/s]."""
+        raise NotImplementedError
+
+    def rotation_error_deg(self, pose, reference) -> np.ndarray:
+        """Angle [deg] of the rotation from the reference orientation to the actual one, poses
+        (N, pose_size) -> (N,)."""
+        raise NotImplementedError
+
+    def embed(self, pose) -> np.ndarray:
+        """Pose(s) (..., pose_size) as spatial poses (..., 6): ``(x, z, phi) -> (x, 0, z, 0, -phi, 0)``
+        in the plane (see the module notes), the identity in space."""
+        raise NotImplementedError
+
+    def is_rigid(self, point_mass: bool) -> bool:
+        """Whether a platform is simulated as a rigid body, which needs a positive mass and inertia: in
+        the plane always (Exudyn's 2-D rigid body; a point mass's rotation is locked), in space unless
+        every anchor sits at its centre of mass (then it is a mass point, which may weigh nothing)."""
+        raise NotImplementedError
+
+    def inertia(self, name: str, value, rigid: bool):
+        """A platform's inertia as this space has it, validated: the moment about the axis normal to
+        the plane [kg m^2] (a float), or the three principal moments about the platform axes [kg m^2]
+        (a tuple). ``rigid``: the platform turns, so every moment must be positive (else zero is
+        allowed). The message names ``name``."""
+        raise NotImplementedError
+
+
+class PlanarSpace(Space):
+    """The paper's vertical x-z plane (see the module notes)."""
+
+    dimension = 2
+    name = "planar"
+    position_labels = ("x", "z")
+    rotation_labels = ("rotation",)
+
+    def rotation_matrix(self, rotation) -> np.ndarray:
+        return geometry.rotation_matrix(float(np.asarray(rotation).reshape(-1)[0]))
+
+    def anchor_points(self, pose, anchors) -> np.ndarray:
+        return geometry.anchor_points(pose, anchors)
+
+    def anchor_velocities(self, pose, pose_rate, anchors) -> np.ndarray:
+        return geometry.anchor_velocities(pose, pose_rate, anchors)
+
+    def rotation_error_deg(self, pose, reference) -> np.ndarray:
+        return np.degrees(np.abs(np.asarray(pose)[:, 2] - np.asarray(reference)[:, 2]))
+
+    def embed(self, pose) -> np.ndarray:
+        pose = np.asarray(pose, dtype=float)
+        zero = np.zeros(pose.shape[:-1])
+        return np.stack([pose[..., 0], zero, pose[..., 1], zero, -pose[..., 2], zero], axis=-1)
+
+    def is_rigid(self, point_mass: bool) -> bool:
+        return True
+
+    def inertia(self, name: str, value, rigid: bool) -> float:
+        return positive(name, value, "kg m^2")
+
+
+class SpatialSpace(Space):
+    """Three dimensions, z up (see the module notes)."""
+
+    dimension = 3
+    name = "spatial"
+    position_labels = ("x", "y", "z")
+    rotation_labels = ("rx", "ry", "rz")
+
+    def rotation_matrix(self, rotation) -> np.ndarray:
+        return geometry.rotation_from_vector(rotation)
+
+    def anchor_points(self, pose, anchors) -> np.ndarray:
+        return geometry.spatial_anchor_points(pose, anchors)
+
+    def anchor_velocities(self, pose, pose_rate, anchors) -> np.ndarray:
+        return geometry.spatial_anchor_velocities(pose, pose_rate, anchors)
+
+    def rotation_error_deg(self, pose, reference) -> np.ndarray:
+        angles = []
+        for theta, theta_ref in zip(np.asarray(pose)[:, 3:], np.asarray(reference)[:, 3:]):
+            relative = geometry.rotation_from_vector(theta_ref).T @ geometry.rotation_from_vector(theta)
+            angles.append(np.linalg.norm(geometry.rotation_vector(relative)))
+        return np.degrees(np.asarray(angles))
+
+    def embed(self, pose) -> np.ndarray:
+        return np.asarray(pose, dtype=float)
+
+    def is_rigid(self, point_mass: bool) -> bool:
+        return not point_mass
+
+    def inertia(self, name: str, value, rigid: bool) -> tuple[float, float, float]:
+        moments = vector(name, value, 3, " (principal moments) [kg m^2]")
+        if np.any(moments < 0.0) or (rigid and np.any(moments <= 0.0)):
+            raise SceneError(f"{name} must be {'positive' if rigid else 'zero or positive'} (principal moments "
+                             f"[kg m^2]), got {shown(value)}")
+        return tuple(float(v) for v in moments)
+
+
+#: The two spaces, one object each.
+PLANE: Space = PlanarSpace()
+SPACE: Space = SpatialSpace()
+#: The dimensions a scene may have.
+DIMENSIONS = (2, 3)
+
+
+def space_of(dimension) -> Space:
+    """The :class:`Space` of ``dimension`` (2 or 3): the one decision on the dimension.
+
+    Raises
+    ------
+    SceneError
+        For any other value, naming ``dimension``.
+    """
+    if isinstance(dimension, bool) or dimension not in DIMENSIONS:
+        raise SceneError(f"dimension must be 2 (planar) or 3 (spatial), got {shown(dimension)}")
+    return PLANE if dimension == 2 else SPACE
