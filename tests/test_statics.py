@@ -417,7 +417,7 @@ def test_no_equilibrium_within_the_tension_limit_is_a_clear_error(dimension):
                       max_tension=_in(dimension, 2.0, 10.0))
 
 
-ROUND_TRIPS = ([pytest.param(2, p, position, id=f"planar-{p.id}-{position}") for p in ALL_PLATFORMS
+ROUND_TRIPS = ([pytest.param(2, p.values, position, id=f"planar-{p.id}-{position}") for p in ALL_PLATFORMS
                 for position in [(0.0, -1.75), (0.5, -1.5), (-0.9, -2.2), (1.2, -0.8)]]
                + [pytest.param(3, name, None, id=name) for name in ("spatial-cogiro", "spatial-ipanema")])
 
@@ -425,7 +425,7 @@ ROUND_TRIPS = ([pytest.param(2, p, position, id=f"planar-{p.id}-{position}") for
 @pytest.mark.parametrize("dimension, platform_kind, target", ROUND_TRIPS)
 def test_forward_statics_of_the_inverse_lengths_returns_the_pose(dimension, platform_kind, target):
     if dimension == 2:
-        platform, guess, start = make_platform(*platform_kind.values), None, None
+        platform, guess, start = make_platform(*platform_kind), None, None
     else:
         scene = load_scene(platform_kind)
         platform = catenary_platform(scene)
@@ -457,13 +457,15 @@ def test_the_spatial_inverse_at_the_rest_gives_back_the_lengths_and_stays_near_t
         assert np.abs(inverse.horizontal_tensions - tensions).max() < 0.5 * tensions.max()
 
 
-BALANCES = ([pytest.param(2, p, id=f"planar-{p.id}") for p in ALL_PLATFORMS]
-            + [pytest.param(3, (False, rigid), id=f"spatial-{'rigid' if rigid else 'point-mass'}") for rigid in (False, True)])
+#: The planar robot with and without pulleys, rigid or a point mass; the spatial four-cable robot, rigid or not.
+BOTH_SPACES = ([pytest.param(2, p.values, id=f"planar-{p.id}") for p in ALL_PLATFORMS]
+               + [pytest.param(3, (False, rigid), id=f"spatial-{'rigid' if rigid else 'point-mass'}")
+                  for rigid in (False, True)])
 
 
-@pytest.mark.parametrize("dimension, platform_kind", BALANCES)
+@pytest.mark.parametrize("dimension, platform_kind", BOTH_SPACES)
 def test_cable_forces_balance_the_weight_and_their_moments_cancel(dimension, platform_kind):
-    pulleys, rigid = platform_kind.values if dimension == 2 else platform_kind
+    pulleys, rigid = platform_kind
     platform = robot(dimension, rigid, pulleys)
     weight = platform.mass * platform.gravity
     if dimension == 2:
@@ -491,13 +493,9 @@ def test_cable_forces_balance_the_weight_and_their_moments_cancel(dimension, pla
         assert np.linalg.norm(solved[0].rotation) > 1e-2  # it does turn
 
 
-MASSLESS = ([pytest.param(2, p, id=f"planar-{p.id}") for p in ALL_PLATFORMS]
-            + [pytest.param(3, (False, rigid), id=f"spatial-{'rigid' if rigid else 'point-mass'}") for rigid in (False, True)])
-
-
-@pytest.mark.parametrize("dimension, platform_kind", MASSLESS)
+@pytest.mark.parametrize("dimension, platform_kind", BOTH_SPACES)
 def test_massless_cables_settle_where_straight_elastic_cables_do(dimension, platform_kind):
-    pulleys, rigid = platform_kind.values if dimension == 2 else platform_kind
+    pulleys, rigid = platform_kind
     massive = robot(dimension, rigid, pulleys)
     cables = [SuspendedCable(0.0, c.axial_stiffness, anchor=c.anchor, exit_point=c.exit_point, pulley=c.pulley)
               for c in massive.cables]

@@ -156,11 +156,6 @@ class SuspendedCable:
         """The `CatenaryCable` of this cable with the given unstrained length [m]."""
         return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
 
-    @property
-    def upper_reference(self):
-        """Exit point, or pulley centre, shape (d,) [m]."""
-        return np.array(self.point)
-
 
 def _swivel_plane_cable(weight_per_length, axial_stiffness, radius) -> SuspendedCable:
     """The planar cable of a swivel pulley of radius ``radius`` [m], in the vertical plane through its axis
@@ -765,9 +760,7 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
         )
     # d(H, V_B, angle)/d(point) = -jacobian^-1 d(residual)/d(point), d(residual)/d(point) = [I; 0]
     sensitivity = -np.linalg.solve(jacobian, np.vstack([np.eye(2), np.zeros((1, 2))]))
-    force_derivative = np.array(
-        [[sign_x, 0.0, 0.0], [-w * derivative[0], 1.0 - w * derivative[1], -w * derivative[2]]]
-    )
+    force_derivative = np.array([[sign_x, 0.0, 0.0], [-w * derivative[0], 1.0 - w * derivative[1], -w * derivative[2]]])
     stiffness = force_derivative @ sensitivity
     equilibrium = _planar_equilibrium(state, catenary_cable, unstrained_length, point, pulley.rim_point(angle),
                                       (H, V_B, angle), wrap, r)
@@ -828,9 +821,7 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
 
         x, jacobian, sign_x, tension_scale = _warm_then_cold(solve_from, guess)
         length, V_B, angle = x
-        _, partial, catenary = _pulley_residual(
-            cable, pulley, sign_x, point, H, V_B, angle, length, tension_scale
-        )
+        _, partial, catenary = _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, length, tension_scale)
         d_residual_dH = partial[:, 0]
         d_residual_dp = np.vstack([np.eye(2), np.zeros((1, 2))])
         state = state_from_end_forces(catenary, H, V_B, sign_x)
@@ -839,9 +830,7 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
         equilibrium = _planar_equilibrium(state, catenary, total, point, pulley.rim_point(angle), (length, V_B, angle),
                                           wrap, r)
     if state.max_tension > _tension_limit(cable, max_strain, max_tension):
-        raise UnreachableError(
-            f"horizontal_tension {H:g} N needs tension {state.max_tension:g} N, above the limit"
-        )
+        raise UnreachableError(f"horizontal_tension {H:g} N needs tension {state.max_tension:g} N, above the limit")
     # unknowns u = (L_c, V_B[, angle]); force on A = (sign_x H, V_B - w L_c)
     d_u_dH = -np.linalg.solve(jacobian, d_residual_dH)
     d_u_dp = -np.linalg.solve(jacobian, d_residual_dp)
@@ -1271,7 +1260,7 @@ class _PlanarStatics:
     def straight_cable_pose(self, platform, lengths, wrench):
         dof = platform.degrees_of_freedom
         stiffness = np.array([c.axial_stiffness / L for c, L in zip(platform.cables, lengths)])
-        uppers = np.array([c.upper_reference for c in platform.cables])
+        uppers = np.array([c.point for c in platform.cables])
         force_scale, length_scale = self.scales(platform, lengths, wrench)
         weight = platform.mass * platform.gravity
 
