@@ -10,14 +10,14 @@ from cdpr_exu.statics.chain_statics import ChainRobot, chain_forces, chain_robot
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.builder.model import initial_nodes
 from cdpr_exu.scenes.scene import Effects, PlatformSpec, load_scene
-from controllers.tension_aware import suspended_platform
+from cdpr_exu.statics.statics import catenary_platform
 
 PAPER = load_scene("paper-circle")
 
 
 def _solve(scene, position, **kwargs):
     """Chain statics of ``scene`` at ``position``, started from its catenary statics."""
-    start = statics.solve_inverse_statics(suspended_platform(scene), position)
+    start = statics.solve_inverse_statics(catenary_platform(scene), position)
     return solve_chain_statics(chain_robot(scene), position, start.rotation,
                                tension_guess=[c.tension_at_anchor for c in start.cables], **kwargs)
 
@@ -74,10 +74,10 @@ def test_without_bending_it_converges_to_the_elastic_catenary_at_second_order():
     for n in (10, 20, 40):
         scene = _catenary_scene(n)
         chain = _solve(scene, position)
-        platform = suspended_platform(scene)
+        platform = catenary_platform(scene)
         hung = statics.SuspendedPlatform(
             tuple(replace(c, exit_point=tuple(nodes[0])) for c, nodes in zip(platform.cables, chain.nodes)),
-            platform.mass, platform.gravity, platform.moment_of_inertia)
+            platform.mass, platform.gravity, platform.inertia)
         catenary = statics.solve_inverse_statics(hung, position)
         length = scene.cables[0].unstrained_length
         errors.append(np.abs(catenary.unstrained_lengths - length).max())
@@ -117,7 +117,7 @@ def test_a_continued_solution_equals_a_fresh_one():
 
 def test_an_inertial_load_changes_the_lengths_as_the_static_load_would():
     """d'Alembert: -M a along x is the same load as a horizontal external force."""
-    platform = suspended_platform(PAPER)
+    platform = catenary_platform(PAPER)
     wrench = statics.inertial_wrench(platform, np.array([0.5, 0.0]), 0.0)
     with_load = _solve(PAPER, (0.0, -1.8), external_wrench=wrench)
     without = _solve(PAPER, (0.0, -1.8))

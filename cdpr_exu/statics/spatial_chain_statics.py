@@ -1,6 +1,6 @@
 """Static equilibrium of the simulator's own lumped spatial cables: chains of 3-D nodes.
 
-:mod:`cdpr_exu.physics.spatial_statics` treats each cable as a continuous elastic
+:mod:`cdpr_exu.statics.statics` treats each cable as a continuous elastic
 catenary in its vertical plane, without bending. The spatial simulator does not
 (:mod:`cdpr_exu.builder.spatial_robot`): its cable is a chain of n straight elements whose
 nodes carry the mass (the scene's lumping, :meth:`CableSpec.node_masses`), with
@@ -51,7 +51,7 @@ from cdpr_exu.core.validation import finite, shown, vector
 from cdpr_exu.physics import axial_3d, bending_3d
 from cdpr_exu.physics import swivel_pulley as sp
 from cdpr_exu.statics.chain_statics import descent_step
-from cdpr_exu.physics.spatial_statics import chain_element_mass, node_masses_along, solve_spatial_statics
+from cdpr_exu.statics.statics import catenary_platform, chain_element_mass, node_masses_along, solve_statics
 
 __all__ = ["SpatialChainCable", "SpatialChainRobot", "SpatialChainEquilibrium", "spatial_chain_robot",
            "solve_spatial_chain_statics", "catenary_start", "spatial_chain_statics", "swivel_chain_start",
@@ -212,7 +212,7 @@ def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, co
     Parameters
     ----------
     equilibrium_cable : SpatialCableState
-        The cable in the catenary statics (:func:`cdpr_exu.physics.spatial_statics.solve_spatial_statics`).
+        The cable in the catenary statics (:func:`cdpr_exu.statics.statics.solve_statics`).
     length : float [m]
         Unstrained length from the inlet to the anchor (the catenary's).
     n_elements, winch_elements : int
@@ -264,7 +264,7 @@ def spatial_chain_robot(scene, anchor_spring_factor: float | None = None, tensio
         See :class:`SpatialChainRobot`.
     tension_only : bool, optional
         Default the scene's ``effects.slack`` (the static mode builds spring elements: False).
-    catenary : SpatialEquilibrium, optional
+    catenary : PlatformEquilibrium, optional
         The scene's catenary statics: a cable over a swivel pulley is held at the winch end
         its start shape puts it (:func:`swivel_chain_start`), as the builder holds it; solved
         here when not given and needed.
@@ -278,11 +278,11 @@ def spatial_chain_robot(scene, anchor_spring_factor: float | None = None, tensio
     if effects.bending and effects.bending_model != "exact":
         raise SceneError("spatial chain statics models the exact-angle bending only, "
                          f"got effects.bending_model = {shown(effects.bending_model)}")
-    platform = scene.catenary_platform()  # what the builder builds from: weights, EA, gravity
+    platform = catenary_platform(scene)  # what the builder builds from: weights, EA, gravity
     gravity = platform.gravity
     swivels = scene.swivel_exits
     if catenary is None and any(s is not None for s in swivels):
-        catenary = solve_spatial_statics(platform, scene.unstrained_lengths)
+        catenary = solve_statics(platform, scene.unstrained_lengths)
     slack = bool(effects.slack if tension_only is None else tension_only)
     cables = []
     for i, (spec, cable, swivel) in enumerate(zip(scene.cables, platform.cables, swivels)):
@@ -578,8 +578,8 @@ def catenary_start(robot: SpatialChainRobot, equilibrium):
     Parameters
     ----------
     robot : SpatialChainRobot
-    equilibrium : SpatialEquilibrium
-        Of the same cables (:func:`cdpr_exu.physics.spatial_statics.solve_spatial_statics`).
+    equilibrium : PlatformEquilibrium
+        Of the same cables (:func:`cdpr_exu.statics.statics.solve_statics`).
 
     Returns
     -------
@@ -605,7 +605,7 @@ def catenary_start(robot: SpatialChainRobot, equilibrium):
             points[0] = cable.exit_point
         points[-1] = state.anchor_point
         nodes.append(points)
-    return nodes, np.asarray(equilibrium.position, float), np.asarray(equilibrium.rotation, float), angles
+    return nodes, np.asarray(equilibrium.position, float), np.asarray(equilibrium.rotation_matrix, float), angles
 
 
 def solve_spatial_chain_statics(robot: SpatialChainRobot, nodes, position, rotation=None, swivel_angles=None, *,
@@ -743,7 +743,7 @@ def spatial_chain_statics(scene, anchor_spring_factor: float | None = None, tens
     UnreachableError
         If the catenary statics or the chains find no equilibrium.
     """
-    catenary = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    catenary = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     robot = spatial_chain_robot(scene, anchor_spring_factor, tension_only, catenary)
     return solve_spatial_chain_statics(robot, *catenary_start(robot, catenary), **kwargs)
 
@@ -1118,7 +1118,7 @@ def solve_inverse_spatial_chain_statics(robot: SpatialChainRobot, pose, tension_
     held ends (:func:`solve_held_chain`): the cables decouple, and only the platform's balance
     ties them, six equations (three for a point mass, or a rigid platform on fewer than six
     cables, whose rotation is left free as in
-    :func:`cdpr_exu.physics.spatial_statics.solve_inverse_spatial_statics`) in the m lengths.
+    :func:`cdpr_exu.statics.statics.solve_inverse_statics`) in the m lengths.
     Gauss-Newton on the lengths, each cable's force derivative from its own chain: among the
     length changes that cancel the imbalance to first order, the one whose tensions (the norm
     of each cable's force on the platform) come nearest ``tension_guess``. Continuing from the
