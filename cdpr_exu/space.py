@@ -196,7 +196,7 @@ class SpatialSpace(Space):
 
     def angular_velocity(self, rotation, rotation_rate) -> np.ndarray:
         rotation, rate = np.asarray(rotation, dtype=float), np.asarray(rotation_rate, dtype=float)
-        jacobians = np.array([geometry.left_jacobian(theta) for theta in rotation.reshape(-1, 3)])
+        jacobians = geometry.left_jacobians(rotation).reshape(-1, 3, 3)
         return np.einsum("nij,nj->ni", jacobians, rate.reshape(-1, 3)).reshape(rate.shape)
 
     def anchor_points(self, pose, anchors) -> np.ndarray:
