@@ -232,6 +232,14 @@ def test_a_non_table_or_a_non_space_is_refused():
         HoldTrajectory((0.0, -2.0, 0.0), space=3)
 
 
+@pytest.mark.parametrize("name, other", [("paper-circle", TRAJECTORIES["spatial_hold"]),
+                                         ("spatial-cogiro", TRAJECTORIES["planar_hold"])])
+def test_a_scene_refuses_a_trajectory_of_the_other_space(name, other):
+    scene = load_scene(name)
+    with pytest.raises(SceneError, match=f"trajectory must be a Trajectory of the {scene.space.name} space"):
+        scene.with_changes(trajectory=other)
+
+
 @ALL
 def test_trajectories_are_frozen(trajectory):
     with pytest.raises(AttributeError):
