@@ -28,7 +28,7 @@ import numpy as np
 
 from cdpr_exu.core import geometry
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import positive, shown, vector
+from cdpr_exu.core.validation import entries, finite, positive, shown, vector
 
 __all__ = ["Space", "PLANE", "SPACE", "space_of", "DIMENSIONS"]
 
@@ -97,6 +97,17 @@ class Space:
         """The rotation matrix of one rotation (an angle [rad], or a rotation vector (3,) [rad]), shape (d, d)."""
         raise NotImplementedError
 
+    def rotation(self, name: str, value=None):
+        """A rotation as this space has it, validated (the message names ``name``): the angle [rad] in the
+        plane (a float), a rotation vector [rad] in space (a tuple of 3); ``None`` is no rotation."""
+        raise NotImplementedError
+
+    def angular_velocity(self, rotation, rotation_rate) -> np.ndarray:
+        """The angular velocity [rad/s] in the fixed frame of a rotation (..., rotation_size) [rad] changing
+        at ``rotation_rate`` (its time derivative, same shape): the rate itself in the plane,
+        ``J_l(theta) theta'`` in space (the rotation vector's rate is not the angular velocity)."""
+        raise NotImplementedError
+
     def anchor_points(self, pose, anchors) -> np.ndarray:
         """World positions of the platform anchors ``r + R b_i``: pose (pose_size,) or (N, pose_size),
         anchors (m, d) in the platform frame -> (m, d) or (N, m, d) [m]."""
@@ -142,6 +153,12 @@ class PlanarSpace(Space):
     def rotation_matrix(self, rotation) -> np.ndarray:
         return geometry.rotation_matrix(float(np.asarray(rotation).reshape(-1)[0]))
 
+    def rotation(self, name: str, value=None) -> float:
+        return 0.0 if value is None else finite(name, value)
+
+    def angular_velocity(self, rotation, rotation_rate) -> np.ndarray:
+        return np.asarray(rotation_rate, dtype=float)
+
     def anchor_points(self, pose, anchors) -> np.ndarray:
         return geometry.anchor_points(pose, anchors)
 
@@ -173,6 +190,14 @@ class SpatialSpace(Space):
 
     def rotation_matrix(self, rotation) -> np.ndarray:
         return geometry.rotation_from_vector(rotation)
+
+    def rotation(self, name: str, value=None) -> tuple[float, float, float]:
+        return (0.0, 0.0, 0.0) if value is None else entries(name, value, 3, "rad")
+
+    def angular_velocity(self, rotation, rotation_rate) -> np.ndarray:
+        rotation, rate = np.asarray(rotation, dtype=float), np.asarray(rotation_rate, dtype=float)
+        jacobians = geometry.left_jacobians(rotation).reshape(-1, 3, 3)
+        return np.einsum("nij,nj->ni", jacobians, rate.reshape(-1, 3)).reshape(rate.shape)
 
     def anchor_points(self, pose, anchors) -> np.ndarray:
         return geometry.spatial_anchor_points(pose, anchors)

@@ -109,7 +109,7 @@ CASES = {
     "50 elements": ("50 elements per cable", lambda s: _cables(s, n_elements=50)),
     "100 elements": ("100 elements per cable", lambda s: _cables(s, n_elements=100)),
     "circle x4": ("angular rate 6 rad/s (R w^2 = 14.4 m/s^2 > g): the cables go slack",
-                  lambda s: s.with_changes(trajectory=CircleTrajectory(angular_rate=6.0))),
+                  lambda s: s.with_changes(trajectory=CircleTrajectory((0.0, -1.6), angular_rate=6.0))),
     "platform 0.1 kg": ("platform mass 0.1 kg (inertia scaled)", lambda s: _platform_mass(s, 0.1)),
     "platform 100 kg": ("platform mass 100 kg (inertia scaled)", lambda s: _platform_mass(s, 100.0)),
     "flung up": ("lift 0.4 m in 0.35 s (decelerating at 18.8 m/s^2 > g): the cables go slack",

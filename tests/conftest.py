@@ -159,7 +159,8 @@ def small_spatial_scene(end_time: float = 0.3, n_elements: int = 4):
 
     from cdpr_exu.statics.statics import catenary_platform, solve_statics
     from cdpr_exu.scenes.scene import load_scene
-    from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
+    from cdpr_exu.scenes.trajectories import PointToPointTrajectory
+    from cdpr_exu.space import SPACE
 
     scene = load_scene("spatial-four-cable")
     scene = replace(scene, cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables),
@@ -169,4 +170,4 @@ def small_spatial_scene(end_time: float = 0.3, n_elements: int = 4):
     start = np.concatenate([rest.position, rest.rotation])
     end = start + np.array([0.05, 0.0, 0.0, 0.0, 0.0, 0.0])
     return replace(scene, name="small-spatial",
-                   trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=end_time))
+                   trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=end_time, space=SPACE))

@@ -159,13 +159,14 @@ def _spatial_move_scene(tmp_path):
 
     from cdpr_exu.statics.statics import catenary_platform, solve_statics
     from cdpr_exu.scenes.scene import load_scene, save_scene
-    from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
+    from cdpr_exu.scenes.trajectories import PointToPointTrajectory
+    from cdpr_exu.space import SPACE
 
     scene = load_scene("spatial-four-cable")
     rest = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     start = np.concatenate([rest.position, rest.rotation])
     end = start + np.array([0.15, -0.10, 0.05, 0.0, 0.0, 0.0])
-    move = SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.0)
+    move = PointToPointTrajectory(tuple(start), tuple(end), duration=1.0, space=SPACE)
     scene = replace(scene, trajectory=move, solver=replace(scene.solver, output_period=0.01))
     return save_scene(scene, tmp_path / "four_cable_move.toml")
 

@@ -136,7 +136,8 @@ def _four_cable(n_elements, trajectory=None, end_time=1.5):
     catenary), coarse steps; held on its catenary pose unless ``trajectory`` is given."""
     from cdpr_exu.statics.statics import catenary_platform, solve_statics
     from cdpr_exu.scenes.scene import load_scene
-    from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
+    from cdpr_exu.scenes.trajectories import HoldTrajectory
+    from cdpr_exu.space import SPACE
 
     scene = load_scene("spatial-four-cable")
     scene = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False),
@@ -144,7 +145,7 @@ def _four_cable(n_elements, trajectory=None, end_time=1.5):
                     solver=replace(scene.solver, step_size=1e-2, output_period=0.05, end_time=end_time))
     rest = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     pose = np.concatenate([rest.position, rest.rotation])
-    return replace(scene, trajectory=trajectory or SpatialHoldTrajectory(tuple(pose))), rest.position
+    return replace(scene, trajectory=trajectory or HoldTrajectory(tuple(pose), space=SPACE)), rest.position
 
 
 @pytest.mark.parametrize("n", [4, 8])
@@ -173,12 +174,13 @@ def test_the_estimate_of_a_moving_spatial_robot_is_within_a_factor_two_of_a_four
     at 1e-2 s) is of the discretisation error's size here (docs/accuracy.md). Bound: within
     0.5 to 2 (an estimate whose order is assumed)."""
     from cdpr_exu.run.spatial_run import simulate_spatial
-    from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
+    from cdpr_exu.scenes.trajectories import PointToPointTrajectory
+    from cdpr_exu.space import SPACE
 
     held, _ = _four_cable(8)
     start = np.asarray(held.trajectory.pose(0.0)).ravel()
     end = start + np.array([0.15, -0.10, 0.05, 0.0, 0.0, 0.0])
-    move = SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.0)
+    move = PointToPointTrajectory(tuple(start), tuple(end), duration=1.0, space=SPACE)
     scene, _ = _four_cable(8, move, end_time=2.0)
     fine, _ = _four_cable(32, move, end_time=2.0)
     result, reference = simulate_spatial(scene), simulate_spatial(fine)
@@ -224,12 +226,13 @@ def test_tension_only_spatial_references_converge_at_order_two_and_keep_their_st
     (1306 steps for 401) and their paths moved by 0.30 and 0.39 mm, not converging. Bound:
     a ratio above 3 (order above 1.58)."""
     from cdpr_exu.run.spatial_run import simulate_spatial
-    from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
+    from cdpr_exu.scenes.trajectories import PointToPointTrajectory
+    from cdpr_exu.space import SPACE
 
     held, _ = _four_cable(8)
     start = np.asarray(held.trajectory.pose(0.0)).ravel()
-    move = SpatialPointToPointTrajectory(tuple(start), tuple(start + [0.15, -0.10, 0.05, 0.0, 0.0, 0.0]),
-                                         duration=1.0)
+    move = PointToPointTrajectory(tuple(start), tuple(start + [0.15, -0.10, 0.05, 0.0, 0.0, 0.0]),
+                                  duration=1.0, space=SPACE)
     paths = {}
     for n in (16, 32, 64):
         scene, _ = _four_cable(n, move, end_time=2.0)

@@ -42,6 +42,7 @@ from cdpr_exu.scenes.scene import (
 )
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
+from cdpr_exu.space import PLANE, SPACE
 
 NAN, INF = float("nan"), float("inf")
 
@@ -167,31 +168,47 @@ def test_unknown_preset_is_refused(preset):
 # ============================================================================ trajectories
 
 
+#: A good circle centre and pose of each space, beside the bad value a case gives.
+_GOOD = {PLANE: ((0.0, -1.6), (0.0, -2.0, 0.0)), SPACE: ((0.0, 0.0, 2.0), (0.0, 0.0, 2.0, 0.0, 0.0, 0.0))}
+
+
+def _circle(space, **fields):
+    return CircleTrajectory(fields.pop("center", _GOOD[space][0]), space=space, **fields)
+
+
+def _move(space, **fields):
+    pose = _GOOD[space][1]
+    return PointToPointTrajectory(fields.pop("start", pose), fields.pop("end", pose), space=space, **fields)
+
+
+@pytest.mark.parametrize("space", [PLANE, SPACE], ids=["planar", "spatial"])
 @pytest.mark.parametrize("make, field", [
-    (lambda v: CircleTrajectory(center=v), "center"),
-    (lambda v: CircleTrajectory(radius=v), "radius"),
-    (lambda v: CircleTrajectory(angular_rate=v), "angular_rate"),
-    (lambda v: CircleTrajectory(ramp_time=v), "ramp_time"),
-    (lambda v: HoldTrajectory(v), "pose"),
-    (lambda v: PointToPointTrajectory(start=v), "start"),
-    (lambda v: PointToPointTrajectory(duration=v), "duration"),
-    (lambda v: PointToPointTrajectory(start_time=v), "start_time"),
+    (lambda s, v: _circle(s, center=v), "center"),
+    (lambda s, v: _circle(s, radius=v), "radius"),
+    (lambda s, v: _circle(s, angular_rate=v), "angular_rate"),
+    (lambda s, v: _circle(s, ramp_time=v), "ramp_time"),
+    (lambda s, v: HoldTrajectory(v, space=s), "pose"),
+    (lambda s, v: _move(s, start=v), "start"),
+    (lambda s, v: _move(s, duration=v), "duration"),
+    (lambda s, v: _move(s, start_time=v), "start_time"),
 ])
 @pytest.mark.parametrize("value", [NAN, INF, "abc", None, [1.0, NAN, 0.0]])
-def test_trajectory_fields_refuse_non_finite_and_non_numeric_values(make, field, value):
+def test_trajectory_fields_refuse_non_finite_and_non_numeric_values(space, make, field, value):
     with pytest.raises(SceneError, match=field):
-        make(value)
+        make(space, value)
 
 
+@pytest.mark.parametrize("space", [PLANE, SPACE], ids=["planar", "spatial"])
 @pytest.mark.parametrize("make, field", [
-    (lambda: CircleTrajectory(radius=-0.4), "radius"),
-    (lambda: CircleTrajectory(ramp_time=-1.0), "ramp_time"),
-    (lambda: PointToPointTrajectory(duration=0.0), "duration"),
-    (lambda: PointToPointTrajectory(end=(0.0, -1.6)), "end"),
+    (lambda s: _circle(s, radius=-0.4), "radius"),
+    (lambda s: _circle(s, ramp_time=-1.0), "ramp_time"),
+    (lambda s: _move(s, duration=0.0), "duration"),
+    (lambda s: _move(s, end=(0.0, -1.6)), "end"),
+    (lambda s: _circle(s, center=(0.0, 0.0, 0.0, 0.0)), "center"),
 ])
-def test_trajectory_fields_refuse_bad_signs_and_shapes(make, field):
+def test_trajectory_fields_refuse_bad_signs_and_shapes(space, make, field):
     with pytest.raises(SceneError, match=field):
-        make()
+        make(space)
 
 
 # ============================================================================ whole scenes
@@ -490,8 +507,8 @@ NUMPY_VALUES = {
     "CableSpec n_elements": lambda: CableSpec(n_elements=np.int64(1)),
     "Pulley side": lambda: Pulley(side=np.int64(0)),
     "SolverSpec spectral_radius": lambda: SolverSpec(spectral_radius=np.float64(1.5)),
-    "CircleTrajectory radius": lambda: CircleTrajectory(radius=np.float64(-2.0)),
-    "PointToPointTrajectory end": lambda: PointToPointTrajectory(end=np.array([0.0, -1.6])),
+    "CircleTrajectory radius": lambda: CircleTrajectory((0.0, -1.6), radius=np.float64(-2.0)),
+    "PointToPointTrajectory end": lambda: PointToPointTrajectory((0.0, -2.0, 0.0), np.array([0.0, -1.6])),
     "spatial PlatformSpec mass": lambda: _spatial_platform(mass=np.float64(-2.0)),
     "spatial PlatformSpec inertia": lambda: _spatial_platform(inertia=np.array([-1.0, 1.0, 1.0])),
     "Swivel radius": lambda: Swivel(inlet=(0.0, 0.0, 0.0), radius=np.float64(-0.1)),

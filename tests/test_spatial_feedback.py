@@ -8,7 +8,8 @@ import pytest
 from cdpr_exu.physics.spatial_kinematics import inverse_kinematics
 from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.scenes.scene import load_scene
-from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialPointToPointTrajectory
+from cdpr_exu.scenes.trajectories import HoldTrajectory, PointToPointTrajectory
+from cdpr_exu.space import SPACE
 from controllers.base import START_BLEND_TIME, WinchCommand, quintic_blend
 from controllers.feedback import ClosedLoopController
 from controllers.ideal_ik import IdealIKController
@@ -60,7 +61,7 @@ class _Spy:
 @pytest.fixture(scope="module")
 def spied():
     scene = four_cable(end_time=1.0)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     spy = _Spy()
     return scene, spy, simulate_spatial(scene, spy)
 
@@ -117,7 +118,7 @@ def test_ideal_ik_under_the_smooth_start_is_unchanged_bit_for_bit():
     scene = four_cable(end_time=0.5)
     start = start_pose(scene)
     end = start + np.array([0.02, 0.0, 0.0, 0.0, 0.0, 0.0])
-    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=0.5))
+    scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=0.5, space=SPACE))
 
     class Recorded(IdealIKController):
         def reset(self, scene_, initial):
@@ -147,7 +148,7 @@ def test_the_spatial_loop_removes_most_of_what_ideal_ik_misses():
     scene = ipanema(end_time=3.0)
     start = start_pose(scene)
     end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
-    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.5))
+    scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.5, space=SPACE))
     open_loop = simulate_spatial(scene, IdealIKController()).summary(2.25)
     closed = simulate_spatial(scene, ClosedLoopController("closed", IdealIKController(), SpatialPositionPI(),
                                                           follow="reference")).summary(2.25)
@@ -213,7 +214,7 @@ def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_contr
     YOUNG = 1.3 * scene.cables[0].youngs_modulus
     start = start_pose(scene)
     end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
-    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.5),
+    scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.5, space=SPACE),
                     controller_model=ControllerModel(platform={"mass": 20.0}, cable={"youngs_modulus": YOUNG}))
     open_loop = simulate_spatial(scene, SpatialTensionAwareController()).summary(2.25)
     closed = simulate_spatial(scene, spatial_closed_loop_tension_aware()).summary(2.25)
@@ -235,7 +236,7 @@ def test_a_controller_that_uses_the_tensions_gets_tensions_that_hold_the_platfor
     from cdpr_exu.statics.spatial_chain_statics import spatial_chain_robot, spatial_chain_statics
 
     scene = ipanema(end_time=0.3, output_period=0.01)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     spy = _TensionSpy()
     result = simulate_spatial(scene, spy)
     robot = spatial_chain_robot(scene)

@@ -15,8 +15,8 @@ from cdpr_exu.results.result import slack_time
 from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.studies.comparison import spatial_comparison_table
 from cdpr_exu.scenes.scene import load_scene
-from cdpr_exu.scenes.spatial_trajectories import (SpatialCircleTrajectory, SpatialHoldTrajectory,
-                                                   SpatialPointToPointTrajectory)
+from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
+from cdpr_exu.space import SPACE
 
 
 def four_cable(n_elements=10, bending=False, **solver):
@@ -35,7 +35,7 @@ def start_pose(scene):
 
 def test_a_robot_told_to_hold_its_equilibrium_stays_there():
     scene = four_cable(end_time=2.0)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     result = simulate_spatial(scene)
     # It starts on the catenary, which the 10-element chains meet to their discretisation
     # error (6.6e-5 m measured for this robot, tests/test_spatial_robot.py); it settles there.
@@ -57,7 +57,7 @@ def test_a_spatial_run_reports_how_long_each_cable_was_slack():
     slack time is the recorded time during which one of its elements carried nothing."""
     scene = four_cable(end_time=0.6)
     pose = start_pose(scene)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(pose)))
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(pose), space=SPACE))
     from controllers.base import WinchCommand
 
     class PayOut:
@@ -94,7 +94,7 @@ def test_after_a_move_the_robot_rests_where_the_catenaries_of_the_paid_out_lengt
     scene = ipanema(end_time=3.0)
     start = start_pose(scene)
     end = start + np.array([0.2, -0.15, 0.1, 0.0, 0.0, 0.05])
-    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=2.0))
+    scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=2.0, space=SPACE))
     result = simulate_spatial(scene)
     final = result.paid_out[-1]
     assert np.abs(final - scene.unstrained_lengths).max() > 0.25  # the winches moved decimetres
@@ -117,7 +117,7 @@ def test_paying_out_at_speed_does_not_damp_the_cable():
     scene = ipanema(end_time=1.5)
     start = start_pose(scene)
     end = start + np.array([0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
-    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.0))
+    scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.0, space=SPACE))
     result = simulate_spatial(scene)
     tensions = np.concatenate([t.ravel() for t in result.tensions])
     assert 250.0 < tensions.min() and tensions.max() < 550.0
@@ -145,8 +145,8 @@ def test_cdpr_run_on_a_spatial_scene_writes_its_summary_and_overview(tmp_path):
 def test_a_reference_above_the_exits_is_refused_before_the_run_naming_the_time_and_pose():
     scene = load_scene("spatial-cogiro")  # exits at z = 5.4 m; the platform starts at 2.265 m
     start = (-0.034, -0.013, 2.265, 0.0, 0.0, 0.0)
-    scene = replace(scene, trajectory=SpatialPointToPointTrajectory(start, (-0.034, -0.013, 6.5, 0.0, 0.0, 0.0),
-                                                                     duration=5.0))
+    scene = replace(scene, trajectory=PointToPointTrajectory(start, (-0.034, -0.013, 6.5, 0.0, 0.0, 0.0),
+                                                              duration=5.0, space=SPACE))
     with pytest.raises(UnreachableError, match=r"at t = 3\.\d+ s is outside the workspace.*non-negative tensions"):
         simulate_spatial(scene)
 
@@ -155,7 +155,7 @@ def test_a_reference_that_starts_above_the_exits_is_refused_saying_so():
     """Issue 23.6: the swivel robot told to hold its point mass 0.4 m above the tops of its pulleys
     (inlets at z = 0, radius 0.1 m): refused before the run, the message says why."""
     scene = load_scene("spatial-four-cable-swivel")
-    scene = replace(scene, trajectory=SpatialHoldTrajectory((0.0, 0.0, 0.5, 0.0, 0.0, 0.0)))
+    scene = replace(scene, trajectory=HoldTrajectory((0.0, 0.0, 0.5, 0.0, 0.0, 0.0), space=SPACE))
     with pytest.raises(UnreachableError, match=r"at t = 0\.000 s is outside the workspace.*the pose is above the "
                        r"exits: .*platform\.anchors\[0\] at z = 0\.5 m, exits\[0\] up to z = 0\.1 m.*cables cannot push"):
         simulate_spatial(scene)
@@ -257,7 +257,7 @@ def test_a_study_sweeps_a_spatial_scene_and_keeps_its_base_scene(tmp_path):
 
 def test_a_spatial_run_reports_each_tension_limit_crossed_as_the_planar_run_does():
     scene = four_cable(end_time=0.5)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))),
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE),
                     cables=tuple(replace(c, min_tension=5.0, max_tension=25.0) for c in scene.cables))
     result = simulate_spatial(scene)
     summary = result.summary(after=0.0)
@@ -292,8 +292,8 @@ def test_a_run_whose_solver_shrank_its_steps_completes_and_records_its_end_time(
     base = four_cable()
     cables = tuple(replace(c, n_elements=2, youngs_modulus=5.5e11) for c in base.cables)
     scene = replace(base, cables=cables, platform=replace(base.platform, mass=328.0),
-                    trajectory=SpatialCircleTrajectory(center=(0.0, 0.1, -1.9), radius=0.1, angular_rate=1.0,
-                                                       ramp_time=0.1),
+                    trajectory=CircleTrajectory(center=(0.0, 0.1, -1.9), radius=0.1, angular_rate=1.0,
+                                                ramp_time=0.1, space=SPACE),
                     solver=replace(base.solver, step_size=0.03, output_period=0.03, end_time=0.35))
     result = simulate_spatial(scene)
     assert result.steps > 2 * scene.solver.n_steps  # the solver shrank its steps
@@ -308,7 +308,7 @@ def pushing_four_cable(end_time=0.5):
     cables 2 and 4 are compressed (-0.1 N and -4.86 N measured)."""
     scene = four_cable(end_time=end_time)
     scene = replace(scene, effects=replace(scene.effects, slack=False))
-    return replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    return replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
 
 
 def test_a_run_shorter_than_the_error_window_still_reports_its_pushing_cables():
@@ -374,7 +374,7 @@ def test_a_spatial_run_that_fails_says_what_exudyn_said():
     """Issue 23.5: a failed spatial run said only "SolveDynamic terminated"; the cause Exudyn's solver
     stored (here one Newton iteration per step: the step shrinks to its minimum) is in the message."""
     scene = four_cable(end_time=0.3, max_newton_iterations=1)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     with pytest.raises(SolverFailure, match=r"failed at t = 0\.\d{4} s of 0\.3 s: Exudyn's solver stopped "
                                             r"\(SolveDynamic terminated\): reduction of step size reached minimum"):
         simulate_spatial(scene)
@@ -405,7 +405,7 @@ def test_a_platform_thrown_above_its_exits_stops_the_run_and_its_summary_flags_i
     was reported completed. It now stops when the platform passes its highest exit, with the
     cause, keeping what was computed; that partial result's summary flags it."""
     scene = four_cable(n_elements=4, end_time=0.5)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))),
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE),
                     solver=replace(scene.solver, step_size=2e-3, output_period=0.01))
     with pytest.raises(SolverFailure, match=r"the platform rose above its highest exit at t = 0\.\d{4} s") as failure:
         simulate_spatial(scene, ReelIn(0.1, 0.05))
@@ -438,7 +438,7 @@ def test_ctrl_c_in_a_spatial_comparison_keeps_the_controllers_done_and_the_parti
 
     monkeypatch.setitem(comparison.SPATIAL_CONTROLLERS, "ctrl_c", CtrlC)
     scene = four_cable(end_time=0.3)
-    scene = replace(scene, trajectory=SpatialHoldTrajectory(tuple(start_pose(scene))))
+    scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     out = tmp_path / "compare"
     with pytest.raises(RunInterrupted):
         comparison.compare_spatial(scene, ["ideal_ik", "ctrl_c"], out, after=0.0)
@@ -502,8 +502,8 @@ def test_an_extreme_spatial_run_is_refused_fails_with_a_cause_or_completes_clean
     try:
         scene = replace(base, cables=tuple(replace(c, n_elements=elements, youngs_modulus=modulus) for c in base.cables),
                         platform=replace(base.platform, mass=mass), effects=replace(base.effects, slack=slack),
-                        trajectory=SpatialCircleTrajectory(center=(0.0, 0.1, -0.842 if swivel else -1.9), radius=0.1,
-                                                           angular_rate=1.0, ramp_time=0.1),
+                        trajectory=CircleTrajectory(center=(0.0, 0.1, -0.842 if swivel else -1.9), radius=0.1,
+                                                    angular_rate=1.0, ramp_time=0.1, space=SPACE),
                         solver=replace(base.solver, step_size=min(step, end), output_period=min(step, end),
                                        end_time=end))
         result = simulate_spatial(scene)

@@ -353,7 +353,7 @@ def test_four_times_faster_circle_with_slack_cables_snaps_taut_and_completes_wit
     and the slack rope the winches pay out piles up at the drums (winch.reservoir_split)
     instead of collapsing the winch element: the run completes, no NaN, no pushing."""
     scene = shortened(PAPER, step_size=step, output_period=max(step, 0.004)).with_changes(
-        trajectory=CircleTrajectory(angular_rate=6.0), effects=Effects.from_preset("full", slack=True))
+        trajectory=CircleTrajectory((0.0, -1.6), angular_rate=6.0), effects=Effects.from_preset("full", slack=True))
     result, failure = run(scene)
     assert failure is None, str(failure)
     assert_plausible(scene, result, max_position_error=None)

@@ -1,126 +1,393 @@
-"""Tests of cdpr_exu.scenes.trajectories: the paper's circle, holds, quintic moves, dict round-trips."""
+"""Tests of cdpr_exu.scenes.trajectories: one set of kinds for the plane and for space.
+
+What both spaces share is one test parametrised over the space (shapes, derivatives against
+finite differences, the ramp from rest, rest-to-rest moves, holds, dict round trips, field
+checks); what is a fact of one space is its own test (the paper's vertical circle, the
+horizontal spatial circle, the rotation vector's rate against the angular velocity). A toy kind
+registered at test time loads in a planar and a spatial scene.
+"""
+
+from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_matrix, rotation_vector
+from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 from cdpr_exu.scenes.trajectories import (
+    TRAJECTORY_KINDS,
     CircleTrajectory,
     HoldTrajectory,
     PointToPointTrajectory,
+    Trajectory,
     trajectory_from_dict,
 )
+from cdpr_exu.space import PLANE, SPACE
+from cdpr_exu.statics.kinematics import ideal_paid_out
 
-TRAJECTORIES = [
-    CircleTrajectory(),
-    CircleTrajectory(center=(0.1, -1.5), radius=0.3, angular_rate=-0.7, rotation=0.1, ramp_time=2.0),
-    HoldTrajectory((0.1, -2.0, 0.05)),
-    PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.3, -1.5, 0.2), duration=1.5, start_time=0.5),
-]
+PAPER_CIRCLE = CircleTrajectory((0.0, -1.6))
+RAMPED_TILTED_CIRCLE = CircleTrajectory((0.1, -0.2, 1.5), radius=0.3, angular_rate=-0.7, rotation=(0.05, 0.0, 0.2),
+                                        tilt=(0.04, -0.03, 0.0), ramp_time=2.0, space=SPACE)
+SPATIAL_MOVE = PointToPointTrajectory((0.0, 0.1, 1.0, 0.0, 0.1, 0.0), (0.3, -0.2, 1.4, 0.1, -0.1, 0.3), duration=1.5,
+                                      start_time=0.5, space=SPACE)
+PLANAR_MOVE = PointToPointTrajectory((0.0, -2.0, 0.0), (0.3, -1.5, 0.2), duration=1.5, start_time=0.5)
+TRAJECTORIES = {
+    "planar_circle": PAPER_CIRCLE,
+    "planar_circle_ramp_rotation": CircleTrajectory((0.1, -1.5), radius=0.3, angular_rate=-0.7, rotation=0.1,
+                                                    ramp_time=2.0),
+    "planar_circle_rocking": CircleTrajectory((0.1, -1.5), radius=0.3, rotation=0.1, tilt=0.05),
+    "planar_hold": HoldTrajectory((0.1, -2.0, 0.05)),
+    "planar_point_to_point": PLANAR_MOVE,
+    "spatial_circle": CircleTrajectory((0.0, 0.0, 2.0), space=SPACE),
+    "spatial_circle_ramp_tilt": RAMPED_TILTED_CIRCLE,
+    "spatial_hold": HoldTrajectory((0.1, -0.1, 2.0, 0.05, 0.0, -0.02), space=SPACE),
+    "spatial_point_to_point": SPATIAL_MOVE,
+}
+SPACES = pytest.mark.parametrize("space", [PLANE, SPACE], ids=["planar", "spatial"])
+ALL = pytest.mark.parametrize("trajectory", list(TRAJECTORIES.values()), ids=list(TRAJECTORIES))
 TIMES = np.linspace(-0.5, 6.0, 53)
 # The quintic blends have a jerk jump at their ends (0.5, 2.0); keep finite differences
 # off those points, where a central difference errs by O(step) rather than O(step^2).
 SMOOTH_TIMES = TIMES + 0.0123
 
 
-def test_default_circle_is_the_papers_reference():
-    t = np.linspace(0.0, 10.0, 41)
-    expected = np.stack([0.4 * np.sin(1.5 * t), -1.6 - 0.4 * np.cos(1.5 * t), 0.0 * t], axis=-1)
-    np.testing.assert_allclose(CircleTrajectory().pose(t), expected, atol=1e-15)
-    np.testing.assert_allclose(CircleTrajectory().pose(0.0), [0.0, -2.0, 0.0], atol=1e-15)
+def _ramped_circle(space):
+    """A ramped circle of ``space`` (rocking in space) and the same circle without its ramp."""
+    circle = PAPER_CIRCLE if space is PLANE else RAMPED_TILTED_CIRCLE
+    circle = replace(circle, angular_rate=-0.7, ramp_time=2.0)
+    return circle, replace(circle, ramp_time=0.0)
 
 
-@pytest.mark.parametrize("trajectory", TRAJECTORIES, ids=lambda tr: tr.kind)
+# ------------------------------------------------------------------ shared by both spaces
+
+
+@ALL
 def test_scalar_time_gives_a_pose_and_array_time_gives_rows(trajectory):
+    size = trajectory.space.pose_size
     for method in (trajectory.pose, trajectory.velocity, trajectory.acceleration):
-        assert method(1.0).shape == (3,)
+        assert method(1.0).shape == (size,)
         rows = method(TIMES)
-        assert rows.shape == (len(TIMES), 3)
+        assert rows.shape == (len(TIMES), size)
         np.testing.assert_allclose(rows[7], method(TIMES[7]), atol=1e-15)
+    assert trajectory.angular_velocity(TIMES).shape == (len(TIMES), trajectory.space.rotation_size)
 
 
-@pytest.mark.parametrize("trajectory", TRAJECTORIES, ids=lambda tr: tr.kind)
-def test_velocity_and_acceleration_are_finite_differences(trajectory):
+@ALL
+def test_velocity_and_acceleration_are_central_differences_of_pose_and_velocity(trajectory):
     step = 1e-5
     t = SMOOTH_TIMES
     numeric_velocity = (trajectory.pose(t + step) - trajectory.pose(t - step)) / (2 * step)
     numeric_acceleration = (trajectory.velocity(t + step) - trajectory.velocity(t - step)) / (2 * step)
-    # central differences: truncation ~ step^2 * |third derivative| (< 100) ~ 1e-8,
-    # rounding ~ 1e-16 / step ~ 1e-11
+    # central differences: truncation ~ step^2 / 6 * |third derivative| (< 100 here) ~ 2e-9,
+    # rounding ~ 1e-16 * |pose| (< 3) / step ~ 3e-11; 1e-7 leaves a wide margin
     np.testing.assert_allclose(trajectory.velocity(t), numeric_velocity, atol=1e-7)
     np.testing.assert_allclose(trajectory.acceleration(t), numeric_acceleration, atol=1e-7)
 
 
-def test_ramped_circle_starts_from_rest_and_reaches_the_steady_rate():
-    circle = CircleTrajectory(ramp_time=2.0)
-    np.testing.assert_allclose(circle.pose(0.0), [0.0, -2.0, 0.0], atol=1e-15)
+@SPACES
+def test_ramped_circle_starts_from_rest_and_is_the_steady_circle_half_a_ramp_late(space):
+    circle, steady = _ramped_circle(space)
+    np.testing.assert_array_equal(circle.pose(0.0), steady.pose(0.0))
+    # every entry, the rocking's rotation rate included, starts at rest
     np.testing.assert_allclose(circle.velocity(0.0), 0.0, atol=1e-15)
     np.testing.assert_allclose(circle.acceleration(0.0), 0.0, atol=1e-15)
-    # after the ramp: the paper's circle delayed by half the ramp time
+    _, rate, rate_change = circle.phase(np.array([2.0, 3.0, 7.5]))
+    np.testing.assert_allclose(rate, -0.7, atol=1e-15)
+    np.testing.assert_allclose(rate_change, 0.0, atol=1e-15)
+    speed = np.linalg.norm(circle.velocity(np.linspace(2.0, 8.0, 13))[:, :2], axis=1)
+    np.testing.assert_allclose(speed, circle.radius * 0.7, atol=1e-15)
     t = np.linspace(2.0, 8.0, 13)
-    np.testing.assert_allclose(circle.pose(t), CircleTrajectory().pose(t - 1.0), atol=1e-14)
-    np.testing.assert_allclose(circle.velocity(t), CircleTrajectory().velocity(t - 1.0), atol=1e-14)
+    for method in ("pose", "velocity", "acceleration"):
+        np.testing.assert_allclose(getattr(circle, method)(t), getattr(steady, method)(t - 1.0), atol=1e-14)
+    # the jerk is bounded: the acceleration jumps by ~1e-9 across the end of the ramp
+    np.testing.assert_allclose(circle.acceleration(2.0 - 1e-9), circle.acceleration(2.0 + 1e-9), atol=1e-7)
 
 
-def test_ramped_circle_acceleration_is_continuous_at_the_end_of_the_ramp():
-    circle = CircleTrajectory(ramp_time=2.0)
-    before, after = circle.acceleration(2.0 - 1e-9), circle.acceleration(2.0 + 1e-9)
-    np.testing.assert_allclose(before, after, atol=1e-7)  # jerk is bounded, so ~1e-9 jumps
+def test_both_spaces_run_a_circle_with_one_phase_law():
+    t = np.linspace(-1.0, 5.0, 61)
+    planar, spatial = _ramped_circle(PLANE)[0], _ramped_circle(SPACE)[0]
+    for flat, turning in zip(planar.phase(t), spatial.phase(t)):
+        np.testing.assert_array_equal(flat, turning)
 
 
-def test_point_to_point_is_rest_to_rest_and_holds_outside_the_motion():
-    move = PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.3, -1.5, 0.2), duration=1.5, start_time=0.5)
-    np.testing.assert_array_equal(move.pose(0.0), [0.0, -2.0, 0.0])
-    np.testing.assert_allclose(move.pose(2.0), [0.3, -1.5, 0.2], atol=1e-15)
-    np.testing.assert_allclose(move.pose(9.0), [0.3, -1.5, 0.2], atol=1e-15)
-    np.testing.assert_allclose(move.pose(1.25), [0.15, -1.75, 0.1], atol=1e-15)  # symmetric quintic
+@SPACES
+def test_circle_stays_at_its_radius_in_the_plane_of_the_first_two_position_axes(space):
+    circle = _ramped_circle(space)[0]
+    pose = circle.pose(np.linspace(-1.0, 12.0, 131))  # before, during and after the ramp
+    offset = pose[:, :2] - np.array(circle.center[:2])
+    np.testing.assert_allclose(np.hypot(offset[:, 0], offset[:, 1]), circle.radius, atol=1e-15)
+    held = slice(2, space.position_size)  # the other position axes (z in space) never change
+    np.testing.assert_array_equal(pose[:, held], np.tile(circle.center[held], (len(pose), 1)))
+    np.testing.assert_array_equal(circle.velocity(TIMES)[:, held], 0.0)
+
+
+@pytest.mark.parametrize("move", [PLANAR_MOVE, SPATIAL_MOVE], ids=["planar", "spatial"])
+def test_point_to_point_is_rest_to_rest_and_holds_outside_the_motion(move):
+    start, end = np.array(move.start), np.array(move.end)
+    np.testing.assert_array_equal(move.pose(0.0), start)
+    np.testing.assert_allclose(move.pose(2.0), end, atol=1e-15)
+    np.testing.assert_allclose(move.pose(9.0), end, atol=1e-15)
+    np.testing.assert_allclose(move.pose(1.25), 0.5 * (start + end), atol=1e-15)  # symmetric quintic
     for t in (0.5, 2.0):
         np.testing.assert_allclose(move.velocity(t), 0.0, atol=1e-15)
         np.testing.assert_allclose(move.acceleration(t), 0.0, atol=1e-12)
+    np.testing.assert_array_equal(move.turning_times(5.0), [0.5, 2.0])
 
 
-def test_hold_is_constant_and_still():
-    hold = HoldTrajectory((0.1, -2.0, 0.05))
-    np.testing.assert_array_equal(hold.pose(TIMES), np.tile([0.1, -2.0, 0.05], (len(TIMES), 1)))
+@pytest.mark.parametrize("hold", [TRAJECTORIES["planar_hold"], TRAJECTORIES["spatial_hold"]], ids=["planar", "spatial"])
+def test_hold_is_constant_and_still(hold):
+    np.testing.assert_array_equal(hold.pose(TIMES), np.tile(hold.held_pose, (len(TIMES), 1)))
     np.testing.assert_array_equal(hold.velocity(TIMES), 0.0)
-    np.testing.assert_array_equal(hold.acceleration(3.0), [0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(hold.acceleration(3.0), np.zeros(hold.space.pose_size))
 
 
-@pytest.mark.parametrize("trajectory", TRAJECTORIES, ids=lambda tr: tr.kind)
+@SPACES
+def test_circle_turning_times_are_the_quarter_turns_where_a_circled_axis_is_extreme(space):
+    circle = replace(_ramped_circle(space)[1], angular_rate=1.5)
+    times = circle.turning_times(5.0)
+    np.testing.assert_allclose(np.diff(times), 0.5 * np.pi / 1.5, atol=1e-15)
+    np.testing.assert_allclose(np.min(np.abs(circle.velocity(times)[:, :2]), axis=1), 0.0, atol=1e-15)
+    assert _ramped_circle(space)[0].turning_times(5.0).size == 0  # ramped: no closed form
+    assert replace(circle, radius=0.0).turning_times(5.0).size == (0 if space is PLANE else times.size)  # rocks
+    with pytest.raises(SceneError, match="trajectory.angular_rate"):
+        replace(circle, angular_rate=1e9).turning_times(5.0)
+
+
+@ALL
 def test_dict_round_trip_gives_an_equal_trajectory(trajectory):
     data = trajectory.to_dict()
     assert all(not isinstance(value, tuple) for value in data.values())  # TOML-friendly lists
-    assert trajectory_from_dict(data) == trajectory
+    assert trajectory_from_dict(data, trajectory.space) == trajectory
 
 
-def test_dicts_use_kind_and_field_names():
-    assert trajectory_from_dict({"kind": "circle"}) == CircleTrajectory()
-    assert trajectory_from_dict({"kind": "hold", "pose": [0.0, -1.0, 0.0]}) == HoldTrajectory((0.0, -1.0, 0.0))
-    assert HoldTrajectory((0.0, -1.0, 0.0)).to_dict() == {"kind": "hold", "pose": [0.0, -1.0, 0.0]}
-    move = trajectory_from_dict({"kind": "point_to_point", "start": [0, -2, 0], "end": [0, -1, 0], "duration": 2})
-    assert move.duration == 2.0 and move.end == (0.0, -1.0, 0.0)
+def test_dicts_use_kind_and_field_names_and_a_circle_that_does_not_rock_has_no_tilt():
+    assert trajectory_from_dict({"kind": "circle", "center": [0, -1.6]}, PLANE) == PAPER_CIRCLE
+    assert PAPER_CIRCLE.to_dict() == {"kind": "circle", "center": [0.0, -1.6], "radius": 0.4, "angular_rate": 1.5,
+                                      "rotation": 0.0, "ramp_time": 0.0}  # as the committed planar scene files
+    assert RAMPED_TILTED_CIRCLE.to_dict()["tilt"] == [0.04, -0.03, 0.0]
+    assert "tilt" not in replace(RAMPED_TILTED_CIRCLE, tilt=None).to_dict()
+    for space, pose in ((PLANE, [0.0, -1.0, 0.0]), (SPACE, [0.0, 0.0, 1.0, 0.0, 0.0, 0.0])):
+        hold = HoldTrajectory(tuple(pose), space=space)
+        assert trajectory_from_dict({"kind": "hold", "pose": pose}, space) == hold
+        assert hold.to_dict() == {"kind": "hold", "pose": [float(v) for v in pose]}
+        move = trajectory_from_dict({"kind": "point_to_point", "start": pose, "end": pose, "duration": 2}, space)
+        assert move.duration == 2.0 and move.end == tuple(pose) and move.space is space
 
 
-@pytest.mark.parametrize(
-    "data, name",
-    [
-        ({"kind": "spiral"}, "kind"),
-        ({"radius": 0.4}, "kind"),
-        ({"kind": "circle", "speed": 1.0}, "speed"),
-        ({"kind": "circle", "radius": -0.4}, "radius"),
-        ({"kind": "circle", "angular_rate": np.nan}, "angular_rate"),
-        ({"kind": "circle", "center": [0.0]}, "center"),
-        ({"kind": "circle", "ramp_time": -1.0}, "ramp_time"),
-        ({"kind": "hold", "pose": [0.0, "low", 0.0]}, "pose"),
-        ({"kind": "point_to_point", "duration": 0.0}, "duration"),
-        ({"kind": "point_to_point", "end": [0.0, np.inf, 0.0]}, "end"),
-    ],
-)
-def test_bad_trajectory_fields_raise_scene_error_naming_them(data, name):
+#: A good centre and pose of each space, beside the bad value a case gives.
+GOOD = {PLANE: {"center": [0.0, -1.6], "pose": [0.0, -2.0, 0.0]},
+        SPACE: {"center": [0.0, 0.0, 2.0], "pose": [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]}}
+
+
+@SPACES
+@pytest.mark.parametrize("data, name", [
+    ({"kind": "spiral"}, "trajectory.kind"),
+    ({}, "trajectory.kind"),
+    ({"kind": "circle", "speed": 1.0}, "speed"),
+    ({"kind": "circle", "radius": np.nan}, "trajectory.radius"),
+    ({"kind": "circle", "radius": -0.4}, r"trajectory.radius must be >= 0 \[m\], got -0.4"),
+    ({"kind": "circle", "ramp_time": -1.0}, "trajectory.ramp_time"),
+    ({"kind": "circle", "angular_rate": np.inf}, "trajectory.angular_rate"),
+    ({"kind": "circle", "center": [0.0]}, "trajectory.center"),
+    ({"kind": "circle", "center": [0.0, 0.0, 0.0, 0.0]}, "trajectory.center"),
+    ({"kind": "circle", "tilt": [0.1, 0.0]}, "trajectory.tilt"),
+    ({"kind": "circle", "rotation": "up"}, "trajectory.rotation"),
+    ({"kind": "circle", "center": None}, "trajectory.center"),
+    ({"kind": "hold", "pose": [0.0, "low", 0.0]}, "trajectory.pose"),
+    ({"kind": "hold", "pose": [0.0, -2.0]}, "trajectory.pose"),
+    ({"kind": "hold", "held_pose": "good"}, "held_pose"),
+    ({"kind": "point_to_point", "duration": 0.0}, r"trajectory.duration must be > 0 \[s\]"),
+    ({"kind": "point_to_point", "end": [0.0, np.inf, 0.0]}, "trajectory.end"),
+    ({"kind": "point_to_point", "start_time": "now"}, "trajectory.start_time"),
+])
+def test_bad_trajectory_fields_raise_scene_error_naming_them(space, data, name):
+    data = {**({"center": GOOD[space]["center"]} if data.get("kind") == "circle" else {}),
+            **({"pose": GOOD[space]["pose"]} if data.get("kind") == "hold" else {}),
+            **({"start": GOOD[space]["pose"], "end": GOOD[space]["pose"]} if data.get("kind") == "point_to_point"
+               else {}), **data}
     with pytest.raises(SceneError, match=name):
-        trajectory_from_dict(data)
+        trajectory_from_dict(data, space)
 
 
-def test_trajectories_are_frozen():
+@pytest.mark.parametrize("space, data, message", [
+    (PLANE, {"kind": "circle"}, r"trajectory.center is required for kind 'circle' \(a position x \[m\], z \[m\]\)"),
+    (SPACE, {"kind": "circle"}, r"trajectory.center is required .*\(a position x \[m\], y \[m\], z \[m\]\)"),
+    (PLANE, {"kind": "hold"}, r"trajectory.pose is required .*\(a pose x \[m\], z \[m\], rotation \[rad\]\)"),
+    (SPACE, {"kind": "hold"}, r"trajectory.pose is required .*\(a pose x \[m\], y \[m\], z \[m\], rx \[rad\], "
+                              r"ry \[rad\], rz \[rad\]\)"),
+    (PLANE, {"kind": "point_to_point", "end": [0, -2, 0]}, "trajectory.start is required"),
+    (SPACE, {"kind": "point_to_point", "start": [0, 0, 1, 0, 0, 0]}, "trajectory.end is required"),
+], ids=["planar_circle", "spatial_circle", "planar_hold", "spatial_hold", "planar_move", "spatial_move"])
+def test_a_missing_position_or_pose_is_named_with_the_spaces_axes(space, data, message):
+    with pytest.raises(SceneError, match=message):
+        trajectory_from_dict(data, space)
+
+
+def test_a_non_table_or_a_non_space_is_refused():
+    with pytest.raises(SceneError, match="trajectory must be a table"):
+        trajectory_from_dict([("kind", "hold")], PLANE)
+    with pytest.raises(SceneError, match="trajectory.space"):
+        HoldTrajectory((0.0, -2.0, 0.0), space=3)
+
+
+@pytest.mark.parametrize("name, other", [("paper-circle", TRAJECTORIES["spatial_hold"]),
+                                         ("spatial-cogiro", TRAJECTORIES["planar_hold"])])
+def test_a_scene_refuses_a_trajectory_of_the_other_space(name, other):
+    scene = load_scene(name)
+    with pytest.raises(SceneError, match=f"trajectory must be a Trajectory of the {scene.space.name} space"):
+        scene.with_changes(trajectory=other)
+
+
+@ALL
+def test_trajectories_are_frozen(trajectory):
     with pytest.raises(AttributeError):
-        CircleTrajectory().radius = 1.0
+        trajectory.space = SPACE
+
+
+# ------------------------------------------------------------------ facts of one space
+
+
+def test_the_planar_default_circle_is_the_papers_reference():
+    t = np.linspace(0.0, 10.0, 41)
+    expected = np.stack([0.4 * np.sin(1.5 * t), -1.6 - 0.4 * np.cos(1.5 * t), 0.0 * t], axis=-1)
+    np.testing.assert_allclose(PAPER_CIRCLE.pose(t), expected, atol=1e-15)
+    np.testing.assert_array_equal(PAPER_CIRCLE.pose(0.0), [0.0, -2.0, 0.0])  # the bottom of a vertical circle
+
+
+def test_the_spatial_circle_is_horizontal_starts_below_the_centre_in_y_and_rocks_once_per_turn():
+    circle = CircleTrajectory((0.0, 0.0, 2.0), radius=0.4, angular_rate=1.5, rotation=(0.0, 0.0, 0.1),
+                              tilt=(0.05, 0.0, 0.0), space=SPACE)
+    np.testing.assert_allclose(circle.pose(0.0), [0.0, -0.4, 2.0, 0.0, 0.0, 0.1], atol=1e-15)
+    quarter = 0.5 * np.pi / 1.5
+    np.testing.assert_allclose(circle.pose(quarter), [0.4, 0.0, 2.0, 0.05, 0.0, 0.1], atol=1e-15)
+    np.testing.assert_allclose(circle.pose(4 * quarter), circle.pose(0.0), atol=1e-15)
+
+
+def test_the_planar_rotation_rate_is_the_angular_velocity():
+    rocking = TRAJECTORIES["planar_circle_rocking"]
+    np.testing.assert_array_equal(rocking.angular_velocity(TIMES), rocking.velocity(TIMES)[:, 2:])
+
+
+@pytest.mark.parametrize("circle", [
+    RAMPED_TILTED_CIRCLE,
+    CircleTrajectory((0.0, 0.0, 2.0), rotation=(0.0, 0.0, 1.2), tilt=(0.3, 0.0, 0.0), space=SPACE),
+], ids=["small_tilt", "large_turn"])
+def test_the_spatial_velocity_is_the_rotation_vector_rate_and_angular_velocity_converts_it(circle):
+    t, step = 3.3, 1e-5
+    # fixed-frame angular velocity from the rotation matrices: R(t+h) R(t-h)^T = exp(2h [omega]x) + O(h^3)
+    change = rotation_from_vector(circle.pose(t + step)[3:]) @ rotation_from_vector(circle.pose(t - step)[3:]).T
+    omega = rotation_vector(change) / (2 * step)
+    theta, theta_rate = circle.pose(t)[3:], circle.velocity(t)[3:]
+    np.testing.assert_allclose(omega, left_jacobian(theta) @ theta_rate, atol=1e-8)  # O(h^2) + 1e-16 / h
+    np.testing.assert_allclose(circle.angular_velocity(t), omega, atol=1e-8)
+    np.testing.assert_array_equal(circle.angular_velocity(np.array([t]))[0], circle.angular_velocity(t))
+    # base rotation and tilt are not parallel: omega - theta' ~ (1 - cos a) / a^2 theta x theta' (a = |theta|,
+    # the factor 1/2 for small a, 0.44 at a = 1.2) plus a smaller [theta]x^2 term
+    expected_gap = 0.5 * np.linalg.norm(np.cross(theta, theta_rate))
+    assert np.linalg.norm(omega - theta_rate) > 0.5 * expected_gap > 0.0
+
+
+def test_planar_rotation_phi_is_the_spatial_rotation_about_minus_y():
+    for phi in (0.3, -1.1, 2.5):
+        spatial = rotation_from_vector((0.0, -phi, 0.0))
+        np.testing.assert_allclose(spatial[np.ix_([0, 2], [0, 2])], rotation_matrix(phi), atol=1e-15)
+        np.testing.assert_allclose(spatial[1], [0.0, 1.0, 0.0], atol=1e-15)  # y stays y
+
+
+def test_a_move_in_the_x_z_plane_is_the_planar_move_embedded():
+    spatial = PointToPointTrajectory(tuple(PLANE.embed(PLANAR_MOVE.start)), tuple(PLANE.embed(PLANAR_MOVE.end)),
+                                     duration=1.5, start_time=0.5, space=SPACE)
+    for method in ("pose", "velocity", "acceleration"):
+        np.testing.assert_allclose(getattr(spatial, method)(TIMES), PLANE.embed(getattr(PLANAR_MOVE, method)(TIMES)),
+                                   atol=1e-15)
+    # and the platform anchors agree: planar r + R(phi) b, spatial r + exp([theta]x) (b_x, 0, b_z)
+    anchor = np.array([[0.2, 0.05]])
+    planar_points = PLANE.anchor_points(PLANAR_MOVE.pose(TIMES), anchor)
+    spatial_points = SPACE.anchor_points(spatial.pose(TIMES), np.array([[0.2, 0.0, 0.05]]))
+    np.testing.assert_allclose(spatial_points[..., [0, 2]], planar_points, atol=1e-15)
+    np.testing.assert_allclose(spatial_points[..., 1], 0.0, atol=1e-15)
+
+
+@pytest.mark.parametrize("name", ["paper-circle", "spatial-ipanema"])
+def test_the_comparisons_smooth_start_ramps_a_circle_that_starts_at_full_speed_in_either_space(name):
+    """``cdpr compare --ramp-time`` (:func:`smooth_start`): one circle class, so a spatial circle without a
+    ramp of its own gets one too (it was left at full speed before the kinds were one)."""
+    from cdpr_exu.studies.comparison import smooth_start
+
+    scene = load_scene(name)
+    full_speed = scene.with_changes(trajectory=replace(scene.trajectory, ramp_time=0.0))
+    started = smooth_start(full_speed, 1.5)
+    assert started.trajectory == replace(full_speed.trajectory, ramp_time=1.5)
+    np.testing.assert_allclose(started.trajectory.velocity(0.0), 0.0, atol=1e-15)
+    assert smooth_start(full_speed, 0.0) is full_speed
+    ramped = full_speed.with_changes(trajectory=replace(full_speed.trajectory, ramp_time=0.5))
+    assert smooth_start(ramped, 1.5) is ramped  # a circle with its own ramp keeps it
+
+
+# ------------------------------------------------------------------ a new kind: one class, one entry
+
+
+@dataclass(frozen=True)
+class Bob(Trajectory):
+    """A toy kind: the platform bobs up and down about ``around`` [m, rad], ``amplitude sin(rate t)`` along
+    its space's vertical axis."""
+
+    kind: ClassVar[str] = "bob"
+    required_fields: ClassVar[dict[str, str]] = {"around": "pose"}
+
+    around: tuple
+    amplitude: float = 0.02
+    rate: float = 2.0
+
+    def __post_init__(self):
+        super().__post_init__()
+        if len(self.around) != self.space.pose_size:
+            raise SceneError(f"trajectory.around must have {self.space.pose_size} entries, got {list(self.around)}")
+
+    def _along(self, t, value):
+        t = np.asarray(t, dtype=float)
+        out = np.zeros(t.shape + (self.space.pose_size,))
+        out[..., self.space.vertical] = value
+        return out
+
+    def pose(self, t):
+        return np.asarray(self.around) + self._along(t, self.amplitude * np.sin(self.rate * np.asarray(t)))
+
+    def velocity(self, t):
+        return self._along(t, self.amplitude * self.rate * np.cos(self.rate * np.asarray(t)))
+
+    def acceleration(self, t):
+        return self._along(t, -self.amplitude * self.rate**2 * np.sin(self.rate * np.asarray(t)))
+
+
+@pytest.mark.parametrize("name, around", [
+    ("paper-circle", [0.0, -2.0, 0.0]),
+    ("spatial-cogiro", [-0.034, -0.013, 2.265, 0.0, 0.0, 0.0]),  # the start of its own circle
+])
+def test_a_kind_registered_at_test_time_loads_in_a_planar_and_a_spatial_scene(monkeypatch, tmp_path, name, around):
+    monkeypatch.setitem(TRAJECTORY_KINDS, "bob", Bob)
+    data = load_scene(name).to_dict()
+    data["trajectory"] = {"kind": "bob", "around": around, "amplitude": 0.03}
+    scene = scene_from_dict(data)
+    assert isinstance(scene.trajectory, Bob) and scene.trajectory.space is scene.space
+    top = np.array(around)
+    top[scene.space.vertical] += 0.03  # a quarter period in: 3 cm up, z in either space
+    np.testing.assert_allclose(scene.trajectory.pose(np.pi / 4), top, atol=1e-15)
+    # saved and loaded back as the same scene
+    assert load_scene(save_scene(scene, tmp_path / "bob.toml")) == scene
+    # the ideal kinematics follow it: each cable's length changes at u . v, the rate of its length
+    t = np.linspace(0.0, 2.0, 21)
+    lengths, rates = ideal_paid_out(scene, scene.trajectory.pose(t), scene.trajectory.velocity(t))
+    step = 1e-6
+    numeric = (ideal_paid_out(scene, scene.trajectory.pose(t + step))[0]
+               - ideal_paid_out(scene, scene.trajectory.pose(t - step))[0]) / (2 * step)
+    np.testing.assert_allclose(rates, numeric, atol=1e-7)  # O(step^2) + 1e-16 m / 1e-6 s
+    assert np.ptp(lengths, axis=0).max() > 0.01  # the bob moves the cables: 3 cm up and down
+    # the scene's space decides the pose size: a pose of the other space is refused, naming the field
+    data["trajectory"]["around"] = around[:3] if len(around) == 6 else around + [0.0, 0.0, 0.0]
+    with pytest.raises(SceneError, match="trajectory.around"):
+        scene_from_dict(data)
+    with pytest.raises(SceneError, match="trajectory.kind must be one of .*'bob'"):
+        trajectory_from_dict({"kind": "wobble"}, scene.space)

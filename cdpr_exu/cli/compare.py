@@ -75,8 +75,7 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
 
 
 def _check_time_options(args: argparse.Namespace) -> None:
-    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run,
-    on planar and spatial scenes alike)."""
+    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run)."""
     non_negative("--after", args.after)
     non_negative("--ramp-time", args.ramp_time)
 
@@ -85,15 +84,15 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     _check_time_options(args)
     check_output_folder(args.out, command="compare")
     scene = load_scene(args.scene)
-    if scene.dimension == 3:  # one comparison when the controllers are one (issue 24, slice 8)
-        return _compare_spatial(scene, args)
-    if args.end_time is not None:
-        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
     started = smooth_start(scene, args.ramp_time)
     if started is not scene and not args.quiet:
         print(f"{scene.name}: the circle starts smoothly from rest over {args.ramp_time} s "
               "(--ramp-time 0 keeps the scene's start at full speed)")
     scene = started
+    if scene.dimension == 3:  # one comparison when the controllers are one (issue 24, slice 8)
+        return _compare_spatial(scene, args)
+    if args.end_time is not None:
+        scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
     # A reference no controller can follow is bad input (exit 2), not six failed runs.
     check_reference(scene)
     try:

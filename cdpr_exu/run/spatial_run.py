@@ -40,7 +40,7 @@ import exudyn as exu
 import numpy as np
 
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
-from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_vector
+from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, write_npz, write_pose_csv, write_summary
 from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
@@ -165,19 +165,16 @@ def reference_wrenches(scene: Scene, times: np.ndarray) -> np.ndarray:
 
     The force ``M (a + g e_z)`` and the moment about the centre of mass ``I w' + w x I w``
     (Euler's equations in the world frame, ``I = R diag(platform.inertia) R^T``): zero
-    for a platform at rest, whatever its orientation. The angular velocity is
-    ``w = J_l(theta) theta'``; its rate comes from a central difference over 1e-6 s
-    (one-sided at t = 0, where the reference starts).
+    for a platform at rest, whatever its orientation. The angular velocity is the reference's
+    (:meth:`~cdpr_exu.scenes.trajectories.Trajectory.angular_velocity`, ``J_l(theta) theta'``); its
+    rate comes from a central difference over 1e-6 s (one-sided at t = 0, where the reference starts).
     """
     times = np.asarray(times, dtype=float)
     gravity = scene.gravity if scene.effects.gravity else 0.0
     acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
     force = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
 
-    def angular_velocity(t):
-        pose, rate = np.atleast_2d(scene.trajectory.pose(t)), np.atleast_2d(scene.trajectory.velocity(t))
-        return np.einsum("nij,nj->ni", np.array([left_jacobian(theta) for theta in pose[:, 3:]]), rate[:, 3:])
-
+    angular_velocity = scene.trajectory.angular_velocity
     delta = 1e-6
     before, after = np.maximum(times - delta, 0.0), times + delta
     omega = angular_velocity(times)

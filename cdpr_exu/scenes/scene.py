@@ -37,7 +37,6 @@ from cdpr_exu.core.geometry import above_exits
 from cdpr_exu.core.validation import entries, finite, from_table, non_negative, positive, shown
 from cdpr_exu.exits import EXIT_KINDS, Exit, PointExit, Pulley, exit_from_dict
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
-from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialTrajectory, spatial_trajectory_from_dict
 from cdpr_exu.scenes.trajectories import HoldTrajectory, Trajectory, trajectory_from_dict
 from cdpr_exu.space import DIMENSIONS, PLANE, Space, space_of
 from cdpr_exu.statics.statics import catenary_platform
@@ -764,7 +763,7 @@ class Scene:
     winch : WinchSpec
     effects : Effects
     solver : SolverSpec
-    trajectory : Trajectory, SpatialTrajectory or None
+    trajectory : Trajectory or None
         Reference pose of the platform over time (default: hold a planar initial pose; a spatial
         scene without one has a static mode only).
     gravity : float [m/s^2]
@@ -816,8 +815,8 @@ class Scene:
                            ("solver", SolverSpec)):
             if not isinstance(getattr(self, name), kind):
                 raise SceneError(f"{name} must be a {kind.__name__}, got {shown(getattr(self, name))}")
-        if self.trajectory is not None and not isinstance(self.trajectory, rules.trajectory):
-            raise SceneError(f"trajectory must be a {rules.trajectory.__name__}, got {shown(self.trajectory)}")
+        if self.trajectory is not None and not (isinstance(self.trajectory, Trajectory) and self.trajectory.space is space):
+            raise SceneError(f"trajectory must be a Trajectory of the {space.name} space, got {shown(self.trajectory)}")
         m = len(self.cables)
         if m < 1:
             raise SceneError("cables must list at least one cable")
@@ -840,7 +839,7 @@ class Scene:
             exit_.check(cable, i, f"{table}[{i}]")
         rules.check(self)
         if self.trajectory is None and self.platform.initial_pose is not None:
-            _set(self, "trajectory", rules.hold(tuple(self.platform.initial_pose)))
+            _set(self, "trajectory", HoldTrajectory(tuple(self.platform.initial_pose), space=space))
         self._check_start()
         if self.controller_model is not None:
             if not isinstance(self.controller_model, ControllerModel):
@@ -1052,17 +1051,13 @@ def _spatial_rules(scene: Scene) -> None:
 
 @dataclass(frozen=True)
 class DimensionRules:
-    """What a scene of one dimension takes where the two dimensions still differ: its trajectories
-    (their base class, the maker of a ``[trajectory]`` table, the one that holds a pose), what its
-    builder builds (``check`` refuses the rest, naming the field), the platform fields a scene file
-    must give (besides a rigid platform's inertia) and whether it must give ``[trajectory]`` (a
-    spatial scene without one has a static mode only). Transitional: one trajectory registry and one
-    builder (issue 24, slices 7 and 9) remove these differences.
+    """What a scene of one dimension takes where the two dimensions still differ: what its builder
+    builds (``check`` refuses the rest, naming the field), the platform fields a scene file must give
+    (besides a rigid platform's inertia) and whether it must give ``[trajectory]`` (a spatial scene
+    without one has a static mode only). Transitional: one builder (issue 24, slice 9) removes these
+    differences.
     """
 
-    trajectory: type
-    trajectory_from_dict: Callable[[Any], Any]
-    hold: Callable[[tuple], Any]
     check: Callable[[Scene], None]
     platform_fields: tuple[str, ...]
     trajectory_required: bool
@@ -1070,10 +1065,8 @@ class DimensionRules:
 
 #: The rules of each dimension (:class:`DimensionRules`), by dimension.
 DIMENSION_RULES: dict[int, DimensionRules] = {
-    2: DimensionRules(Trajectory, trajectory_from_dict, HoldTrajectory, _planar_rules,
-                      ("mass", "anchors", "initial_pose"), trajectory_required=True),
-    3: DimensionRules(SpatialTrajectory, spatial_trajectory_from_dict, SpatialHoldTrajectory, _spatial_rules,
-                      ("mass", "anchors"), trajectory_required=False),
+    2: DimensionRules(_planar_rules, ("mass", "anchors", "initial_pose"), trajectory_required=True),
+    3: DimensionRules(_spatial_rules, ("mass", "anchors"), trajectory_required=False),
 }
 
 
@@ -1185,7 +1178,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
         dimension=space.dimension, cables=cables, exits=exits, platform=platform,
         winch=_build(WinchSpec, data.get("winch", {}), "winch"), effects=effects,
         solver=_build(SolverSpec, data.get("solver", {}), "solver"),
-        trajectory=rules.trajectory_from_dict(data["trajectory"]) if "trajectory" in data else None,
+        trajectory=trajectory_from_dict(data["trajectory"], space) if "trajectory" in data else None,
         controller_model=controller_model_from_dict(data["controller_model"]) if "controller_model" in data else None,
     )
     for key in ("name", "description", "gravity"):

@@ -1,51 +1,73 @@
-"""Reference trajectories of the platform pose ``(x, z, phi)``.
+"""Reference trajectories of the platform pose: one set of kinds for the plane and for space.
 
-Pure NumPy. Every trajectory offers ``pose(t)``, ``velocity(t)`` and
-``acceleration(t)``: a scalar time gives shape (3,), a time array of shape (N,) gives
-(N, 3) (any time shape ``S`` gives ``S + (3,)``). Units: [m, m, rad] and their time
-derivatives. Trajectories are frozen dataclasses that round-trip through plain dicts
-(``to_dict`` / :func:`trajectory_from_dict`) for TOML scene files.
+A trajectory is a pose of its :class:`~cdpr_exu.space.Space` (its ``space``, the plane unless
+given) as a function of time [s]: ``(x, z, phi)`` [m, m, rad] in the paper's vertical plane,
+``(x, y, z, theta_x, theta_y, theta_z)`` [m, rad] in space, with ``theta`` the platform's
+rotation vector, ``R = exp([theta]x)`` (z up in both). Pure NumPy. Every trajectory offers
+``pose(t)``, ``velocity(t)`` and ``acceleration(t)``: a scalar time gives shape
+(pose_size,), a time array of shape ``S`` gives ``S + (pose_size,)``.
 
-The paper's reference (scenario 1) is ``CircleTrajectory()``:
+Velocity convention (the one place it is stated)
+------------------------------------------------
+``velocity(t)`` is the time derivative of the pose and ``acceleration(t)`` its second
+derivative, entry by entry. In the plane the rotation's rate ``phi'`` is the angular
+velocity. In space it is the rate of the rotation *vector*, ``theta'``, NOT the angular
+velocity, which is ``omega = J_l(theta) theta'`` in the fixed frame
+(:func:`cdpr_exu.core.geometry.left_jacobian`; :meth:`Trajectory.angular_velocity`,
+:meth:`cdpr_exu.space.Space.angular_velocity`); the two agree only while ``theta`` and
+``theta'`` are parallel (a turn about one fixed axis) or ``theta`` is 0. Likewise
+``acceleration`` is not the angular acceleration.
+
+Kinds
+-----
+:data:`TRAJECTORY_KINDS` holds the kinds by name (``kind = "..."`` in a scene's
+``[trajectory]``): ``"hold"``, ``"point_to_point"`` and ``"circle"``, each written once for
+both spaces. A trajectory is a frozen dataclass whose fields are checked against its space
+when it is made, and it round-trips through a plain dict (``to_dict`` /
+:func:`trajectory_from_dict`) for TOML. Adding a kind is one subclass of :class:`Trajectory`
+plus one entry ``TRAJECTORY_KINDS["name"] = Class``.
+
+The paper's reference (scenario 1) is ``CircleTrajectory((0.0, -1.6))``:
 ``r_ref(t) = (0.4 sin 1.5t, -1.6 - 0.4 cos 1.5t)`` [m], orientation 0.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
-from dataclasses import fields as dataclass_fields
+from dataclasses import KW_ONLY, dataclass, field, fields
+from typing import Any, ClassVar, Mapping
 
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import finite, shown
+from cdpr_exu.core.validation import entries, finite, shown
+from cdpr_exu.space import PLANE, Space
 
 __all__ = [
     "Trajectory",
     "CircleTrajectory",
     "HoldTrajectory",
     "PointToPointTrajectory",
+    "TRAJECTORY_KINDS",
     "trajectory_from_dict",
 ]
 
 
-# ----------------------------------------------------------------------------------
-# argument checks
-# ----------------------------------------------------------------------------------
-def _finite_float(name, value):
-    """``value`` as a finite float: the scenes' one number check (text and booleans refused)."""
-    return finite(name, value)
+def _set(trajectory, name: str, value) -> None:
+    object.__setattr__(trajectory, name, value)
 
 
-def _finite_tuple(name, value, size):
-    try:
-        items = tuple(value)
-    except TypeError as exc:
-        raise SceneError(f"{name} must be a sequence of {size} numbers, got {shown(value)}") from exc
-    if len(items) != size:
-        raise SceneError(f"{name} must have {size} entries, got {shown(value)}")
-    return tuple(_finite_float(f"{name}[{i}]", item) for i, item in enumerate(items))
+def _pose(name: str, value, space: Space) -> tuple[float, ...]:
+    """A pose of ``space`` as a tuple of floats, or SceneError naming ``name``."""
+    return entries(name, value, space.pose_size, ", ".join(space.pose_units))
+
+
+def _at_least(name: str, value, low: float, unit: str, strict: bool = False) -> float:
+    """``value`` as a finite float >= ``low`` (> when ``strict``), or SceneError naming ``name``."""
+    number = finite(name, value)
+    if number < low or (strict and number == low):
+        raise SceneError(f"{name} must be {'>' if strict else '>='} {low:g} [{unit}], got {shown(value)}")
+    return number
 
 
 def _times(t):
@@ -54,9 +76,10 @@ def _times(t):
     return array, array.ndim == 0
 
 
-def _stack(x, z, phi, scalar):
-    out = np.stack(np.broadcast_arrays(x, z, phi), axis=-1)
-    return out if not scalar else out.reshape(3)
+def _stack(components, scalar):
+    """Pose entries (broadcast together) as the last axis: shape t.shape + (n,), or (n,)."""
+    out = np.stack(np.broadcast_arrays(*components), axis=-1)
+    return out if not scalar else out.reshape(len(components))
 
 
 # ----------------------------------------------------------------------------------
@@ -79,14 +102,58 @@ def _quintic_integral(tau):
 
 
 # ----------------------------------------------------------------------------------
-# trajectories
+# the protocol
 # ----------------------------------------------------------------------------------
-class ReferenceTrajectory(ABC):
-    """What every reference trajectory has, planar (:class:`Trajectory`) or spatial
-    (:class:`~cdpr_exu.scenes.spatial_trajectories.SpatialTrajectory`): its turning times
-    and its plain-dict form."""
+@dataclass(frozen=True)
+class Trajectory(ABC):
+    """A reference pose of ``space`` as a function of time [s] (see the module notes).
 
-    kind: str = ""
+    Class attributes
+    ----------------
+    kind : str
+        The name of the kind in scene files and in :data:`TRAJECTORY_KINDS`.
+    required_fields : dict of str to str
+        The keys a ``[trajectory]`` table of this kind must give (no default would be the
+        motion its author meant), each with what it is: ``"position"`` or ``"pose"`` (of
+        the space), for the message that names a missing one.
+    keys : dict of str to str
+        The fields whose key in a table is not their name (``held_pose`` is ``pose``).
+
+    Parameters
+    ----------
+    space : Space, keyword only
+        The space of the poses (:data:`~cdpr_exu.space.PLANE`, the default, or
+        :data:`~cdpr_exu.space.SPACE`); the fields' sizes are checked against it.
+    """
+
+    kind: ClassVar[str] = ""
+    required_fields: ClassVar[dict[str, str]] = {}
+    keys: ClassVar[dict[str, str]] = {}
+
+    space: Space = field(default=PLANE, kw_only=True)
+
+    def __post_init__(self):
+        if not isinstance(self.space, Space):
+            raise SceneError(f"trajectory.space must be a Space (PLANE or SPACE), got {shown(self.space)}")
+
+    @abstractmethod
+    def pose(self, t):
+        """Pose [m, rad]: shape (pose_size,) for scalar t, S + (pose_size,) for t of shape S."""
+
+    @abstractmethod
+    def velocity(self, t):
+        """The pose's time derivative [m/s, rad/s] (in space the rotation vector's rate; see the module
+        notes), shaped as :meth:`pose`."""
+
+    @abstractmethod
+    def acceleration(self, t):
+        """The pose's second time derivative [m/s^2, rad/s^2], shaped as :meth:`pose`."""
+
+    def angular_velocity(self, t):
+        """The platform's angular velocity in the fixed frame [rad/s]: shape (rotation_size,) for scalar t,
+        S + (rotation_size,) for t of shape S (``J_l(theta) theta'`` in space, ``phi'`` in the plane)."""
+        start = self.space.position_size
+        return self.space.angular_velocity(self.pose(t)[..., start:], self.velocity(t)[..., start:])
 
     def turning_times(self, end_time: float) -> np.ndarray:
         """Times in [0, end_time] [s] where a pose coordinate may be extreme (for exact workspace checks).
@@ -95,185 +162,120 @@ class ReferenceTrajectory(ABC):
         """
         return np.zeros(0)
 
-    def to_dict(self):
+    @classmethod
+    def table_keys(cls) -> dict[str, str]:
+        """The key of each field in a ``[trajectory]`` table, by field name (all but ``space``)."""
+        return {f.name: cls.keys.get(f.name, f.name) for f in fields(cls) if f.name != "space"}
+
+    def to_dict(self) -> dict[str, Any]:
         """Plain dict with a ``kind`` key and the fields (tuples as lists), for TOML."""
-        data = {"kind": self.kind}
-        for field in dataclass_fields(self):
-            value = getattr(self, field.name)
-            data[field.name] = list(value) if isinstance(value, tuple) else value
+        data: dict[str, Any] = {"kind": self.kind}
+        for name, key in self.table_keys().items():
+            value = getattr(self, name)
+            data[key] = list(value) if isinstance(value, tuple) else value
         return data
 
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], space: Space) -> "Trajectory":
+        """The trajectory of a ``[trajectory]`` table without its ``kind``, in ``space``.
 
-class Trajectory(ReferenceTrajectory):
-    """A reference planar platform pose as a function of time [s]."""
-
-    @abstractmethod
-    def pose(self, t):
-        """Pose ``(x, z, phi)`` [m, m, rad]: shape (3,) for scalar t, (N, 3) for t of shape (N,)."""
-
-    @abstractmethod
-    def velocity(self, t):
-        """Pose rate [m/s, m/s, rad/s]: shape (3,) or (N, 3)."""
-
-    @abstractmethod
-    def acceleration(self, t):
-        """Second derivative of the pose [m/s^2, m/s^2, rad/s^2]: shape (3,) or (N, 3)."""
-
-
-def circle_phase(t, angular_rate: float, ramp_time: float):
-    """Phase [rad] of a circle run at ``angular_rate`` [rad/s], and its first two time derivatives.
-
-    With ``ramp_time`` [s] > 0 the rate rises from 0 along the quintic blend (C2 from
-    rest); each output has t's shape.
-    """
-    t = np.asarray(t, dtype=float)
-    if ramp_time == 0.0:
-        return angular_rate * t, np.full_like(t, angular_rate), np.zeros_like(t)
-    tau = t / ramp_time
-    blend, blend_rate, _ = _quintic(tau)
-    return (angular_rate * ramp_time * _quintic_integral(np.maximum(tau, 0.0)), angular_rate * blend,
-            angular_rate * blend_rate / ramp_time)
+        Raises
+        ------
+        SceneError
+            For a key that is not a field of the kind, a required key left out, or a bad value.
+        """
+        keys = cls.table_keys()
+        allowed = sorted(keys.values())
+        unknown = sorted(set(data) - set(allowed))
+        if unknown:
+            raise SceneError(f"trajectory of kind {shown(cls.kind)} has unknown key(s) {unknown}; allowed: {allowed}")
+        missing = [key for key in cls.required_fields if key not in data]
+        if missing:
+            raise SceneError(f"trajectory.{missing[0]} is required for kind {shown(cls.kind)} "
+                             f"({_described(cls.required_fields[missing[0]], space)}); it has no sensible default")
+        return cls(**{name: data[key] for name, key in keys.items() if key in data}, space=space)
 
 
-#: Most quarter turns of a circle a reference check samples (25 000 turns): beyond, the
-#: reference turns faster than any robot could follow, and the samples would not fit in memory.
-MAX_QUARTER_TURNS = 100_000
+def _described(what: str, space: Space) -> str:
+    """``"position"`` or ``"pose"`` of ``space`` in words, with units (``"a pose x [m], z [m], rotation [rad]"``)."""
+    if what == "position":
+        return "a position " + ", ".join(f"{label} [m]" for label in space.position_labels)
+    if what == "pose":
+        return "a pose " + ", ".join(f"{label} [{unit}]" for label, unit in zip(space.pose_labels, space.pose_units))
+    return what
 
 
-def quarter_turn_times(end_time: float, angular_rate: float, ramp_time: float, moves: bool) -> np.ndarray:
-    """Times [s] where a circle's phase is a multiple of pi/2, up to ``end_time``; none for a
-    ramped (no closed form), standing or motionless (``moves`` false) circle.
-
-    Raises
-    ------
-    SceneError
-        Naming trajectory.angular_rate when the circle makes more than :data:`MAX_QUARTER_TURNS`
-        quarter turns before ``end_time``.
-    """
-    if ramp_time > 0.0 or angular_rate == 0.0 or not moves:
-        return np.zeros(0)
-    quarter = 0.5 * np.pi / abs(angular_rate)
-    if end_time / quarter > MAX_QUARTER_TURNS:
-        raise SceneError(f"trajectory.angular_rate = {shown(angular_rate)} rad/s makes {end_time / quarter:.3g} quarter "
-                         f"turns in {shown(end_time)} s, more than the {MAX_QUARTER_TURNS} a reference check samples "
-                         "(a circle far faster than any robot)")
-    return np.arange(0.0, end_time + 1e-12, quarter)
-
-
-@dataclass(frozen=True)
-class CircleTrajectory(Trajectory):
-    """Circle ``x = c_x + R sin(theta)``, ``z = c_z - R cos(theta)`` at constant orientation.
-
-    Defaults are the paper's reference, ``theta = 1.5 t``: the platform starts at the
-    bottom of the circle, (0, -2) m, and moves counter-clockwise.
-
-    Parameters
-    ----------
-    center : tuple of 2 float [m]
-        Circle centre ``(c_x, c_z)``.
-    radius : float [m]
-        Circle radius ``R >= 0``.
-    angular_rate : float [rad/s]
-        Steady phase rate ``w`` (negative: clockwise). Smaller is more quasi-static.
-    rotation : float [rad]
-        Constant platform orientation ``phi``.
-    ramp_time : float [s]
-        0 (the paper): ``theta = w t``, which starts at full speed. If > 0, the phase
-        rate rises from rest to ``w`` along the quintic ``w s(t / T)``, so that pose,
-        velocity and acceleration are continuous and the start is from rest; after the
-        ramp ``theta = w (t - T / 2)``. Before t = 0 the pose holds the start.
-    """
-
-    center: tuple = (0.0, -1.6)
-    radius: float = 0.4
-    angular_rate: float = 1.5
-    rotation: float = 0.0
-    ramp_time: float = 0.0
-    kind = "circle"
-
-    def __post_init__(self):
-        object.__setattr__(self, "center", _finite_tuple("trajectory.center", self.center, 2))
-        radius = _finite_float("trajectory.radius", self.radius)
-        if radius < 0.0:
-            raise SceneError(f"trajectory.radius must be >= 0 [m], got {shown(self.radius)}")
-        object.__setattr__(self, "radius", radius)
-        object.__setattr__(self, "angular_rate", _finite_float("trajectory.angular_rate", self.angular_rate))
-        object.__setattr__(self, "rotation", _finite_float("trajectory.rotation", self.rotation))
-        ramp_time = _finite_float("trajectory.ramp_time", self.ramp_time)
-        if ramp_time < 0.0:
-            raise SceneError(f"trajectory.ramp_time must be >= 0 [s], got {shown(self.ramp_time)}")
-        object.__setattr__(self, "ramp_time", ramp_time)
-
-    def turning_times(self, end_time: float) -> np.ndarray:
-        """Times where x or z is extreme: the phase at a multiple of pi/2 (no ramp), [s]."""
-        return quarter_turn_times(end_time, self.angular_rate, self.ramp_time, self.radius != 0.0)
-
-    def phase(self, t):
-        """Phase ``theta`` [rad] and its first two time derivatives, each of t's shape."""
-        return circle_phase(t, self.angular_rate, self.ramp_time)
-
-    def pose(self, t):
-        t, scalar = _times(t)
-        theta, _, _ = self.phase(t)
-        x = self.center[0] + self.radius * np.sin(theta)
-        z = self.center[1] - self.radius * np.cos(theta)
-        return _stack(x, z, np.full_like(t, self.rotation), scalar)
-
-    def velocity(self, t):
-        t, scalar = _times(t)
-        theta, theta_rate, _ = self.phase(t)
-        x = self.radius * np.cos(theta) * theta_rate
-        z = self.radius * np.sin(theta) * theta_rate
-        return _stack(x, z, np.zeros_like(t), scalar)
-
-    def acceleration(self, t):
-        t, scalar = _times(t)
-        theta, theta_rate, theta_acc = self.phase(t)
-        sin, cos = np.sin(theta), np.cos(theta)
-        x = self.radius * (cos * theta_acc - sin * theta_rate**2)
-        z = self.radius * (sin * theta_acc + cos * theta_rate**2)
-        return _stack(x, z, np.zeros_like(t), scalar)
-
-
+# ----------------------------------------------------------------------------------
+# the kinds
+# ----------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class HoldTrajectory(Trajectory):
     """A constant pose.
 
     Parameters
     ----------
-    held_pose : tuple of 3 float [m, m, rad]
-        The held pose ``(x, z, phi)``; the key ``pose`` in dicts. (Not a field named
-        ``pose``, which would hide the method; pass it positionally:
-        ``HoldTrajectory((0, -2, 0))``.)
+    held_pose : tuple of pose_size float [m, rad]
+        The held pose; required; the key ``pose`` in dicts. (Not a field named ``pose``,
+        which would hide the method; pass it positionally: ``HoldTrajectory((0, -2, 0))``,
+        ``HoldTrajectory((0, 0, 1, 0, 0, 0), space=SPACE)``.)
     """
 
-    held_pose: tuple = (0.0, -2.0, 0.0)
-    kind = "hold"
+    kind: ClassVar[str] = "hold"
+    required_fields: ClassVar[dict[str, str]] = {"pose": "pose"}
+    keys: ClassVar[dict[str, str]] = {"held_pose": "pose"}
+
+    held_pose: tuple
 
     def __post_init__(self):
-        object.__setattr__(self, "held_pose", _finite_tuple("trajectory.pose", self.held_pose, 3))
+        super().__post_init__()
+        _set(self, "held_pose", _pose("trajectory.pose", self.held_pose, self.space))
 
     def pose(self, t):
         t, _ = _times(t)
-        return np.broadcast_to(np.asarray(self.held_pose), t.shape + (3,)).copy()
+        return np.broadcast_to(np.asarray(self.held_pose), t.shape + (len(self.held_pose),)).copy()
 
     def velocity(self, t):
         t, _ = _times(t)
-        return np.zeros(t.shape + (3,))
+        return np.zeros(t.shape + (len(self.held_pose),))
 
     def acceleration(self, t):
         return self.velocity(t)
 
-    def to_dict(self):
-        return {"kind": self.kind, "pose": list(self.held_pose)}
 
+@dataclass(frozen=True)
+class PointToPointTrajectory(Trajectory):
+    """Rest-to-rest quintic motion from ``start`` to ``end``; holds outside the motion.
 
-class PointToPointMotion:
-    """The rest-to-rest quintic motion from ``start`` to ``end`` over ``duration`` from ``start_time``.
+    ``pose(t) = start + (end - start) s((t - start_time) / duration)``, with
+    ``s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5``: zero velocity and acceleration at both ends.
+    In space the rotation vector is blended linearly, so the platform turns about one fixed
+    axis only if ``start``'s and ``end``'s rotation vectors are parallel (or one is 0).
 
-    Shared by the planar and the spatial point-to-point trajectories (any pose size):
-    ``pose(t) = start + (end - start) s((t - start_time) / duration)``, holding outside the motion.
+    Parameters
+    ----------
+    start, end : tuple of pose_size float [m, rad]
+        Initial and final pose; both required.
+    duration : float [s]
+        Motion time (> 0, default 1).
+    start_time : float [s]
+        Time at which the motion begins (default 0).
     """
+
+    kind: ClassVar[str] = "point_to_point"
+    required_fields: ClassVar[dict[str, str]] = {"start": "pose", "end": "pose"}
+
+    start: tuple
+    end: tuple
+    _: KW_ONLY
+    duration: float = 1.0
+    start_time: float = 0.0
+
+    def __post_init__(self):
+        super().__post_init__()
+        _set(self, "start", _pose("trajectory.start", self.start, self.space))
+        _set(self, "end", _pose("trajectory.end", self.end, self.space))
+        _set(self, "duration", _at_least("trajectory.duration", self.duration, 0.0, "s", strict=True))
+        _set(self, "start_time", finite("trajectory.start_time", self.start_time))
 
     def turning_times(self, end_time: float) -> np.ndarray:
         """The start and the end of the motion [s] (the pose is monotone in between)."""
@@ -301,57 +303,158 @@ class PointToPointMotion:
         return second[..., None] * (np.asarray(self.end) - np.asarray(self.start))
 
 
-@dataclass(frozen=True)
-class PointToPointTrajectory(PointToPointMotion, Trajectory):
-    """Rest-to-rest quintic motion from ``start`` to ``end``; holds outside the motion.
+#: Most quarter turns of a circle a reference check samples (25 000 turns): beyond, the
+#: reference turns faster than any robot could follow, and the samples would not fit in memory.
+MAX_QUARTER_TURNS = 100_000
 
-    ``pose(t) = start + (end - start) s((t - start_time) / duration)``, with
-    ``s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5``: zero velocity and acceleration at both ends.
+
+@dataclass(frozen=True)
+class CircleTrajectory(Trajectory):
+    """A circle in the plane of the space's first two position axes, with an optional rocking.
+
+    ``a = c_a + R sin(p)``, ``b = c_b - R cos(p)``, the other position entries (space's z)
+    held at the centre's, and the rotation ``rotation + tilt sin(p)``, for the first two
+    position axes ``(a, b)``: ``(x, z)`` in the plane, a vertical circle (the paper's),
+    ``(x, y)`` in space, a horizontal one. The platform starts at ``(c_a, c_b - R)`` (the
+    bottom of the planar circle) and moves counter-clockwise (seen with x to the right and
+    the second axis up) for ``angular_rate > 0``, rocking once per turn.
 
     Parameters
     ----------
-    start, end : tuple of 3 float [m, m, rad]
-        Initial and final pose.
-    duration : float [s]
-        Motion time (> 0).
-    start_time : float [s]
-        Time at which the motion begins (default 0).
+    center : tuple of position_size float [m]
+        Circle centre; required (no position suits every robot).
+    radius : float [m]
+        Circle radius ``R >= 0`` (default 0.4, the paper's).
+    angular_rate : float [rad/s]
+        Steady phase rate ``w`` (default 1.5, the paper's; negative: clockwise). Smaller is
+        more quasi-static.
+    rotation : float or tuple of 3 float [rad]
+        Constant base orientation: the angle in the plane, a rotation vector in space
+        (default none).
+    tilt : float or tuple of 3 float [rad]
+        Amplitude of the periodic rocking added to the rotation as ``tilt sin(p)``; keep it
+        small (default 0: no rocking; it is written to files only when it rocks).
+    ramp_time : float [s]
+        0 (default, the paper): ``p = w t``, which starts at full speed. If > 0, the phase
+        rate rises from rest to ``w`` along the quintic ``w s(t / T)``, so that pose,
+        velocity and acceleration are continuous and the start is from rest; after the
+        ramp ``p = w (t - T / 2)``. Before t = 0 the pose holds the start.
     """
 
-    start: tuple = (0.0, -2.0, 0.0)
-    end: tuple = (0.0, -1.6, 0.0)
-    duration: float = 1.0
-    start_time: float = 0.0
-    kind = "point_to_point"
+    kind: ClassVar[str] = "circle"
+    required_fields: ClassVar[dict[str, str]] = {"center": "position"}
+
+    center: tuple
+    _: KW_ONLY
+    radius: float = 0.4
+    angular_rate: float = 1.5
+    rotation: Any = None
+    tilt: Any = None
+    ramp_time: float = 0.0
 
     def __post_init__(self):
-        object.__setattr__(self, "start", _finite_tuple("trajectory.start", self.start, 3))
-        object.__setattr__(self, "end", _finite_tuple("trajectory.end", self.end, 3))
-        duration = _finite_float("trajectory.duration", self.duration)
-        if duration <= 0.0:
-            raise SceneError(f"trajectory.duration must be > 0 [s], got {shown(self.duration)}")
-        object.__setattr__(self, "duration", duration)
-        object.__setattr__(self, "start_time", _finite_float("trajectory.start_time", self.start_time))
+        super().__post_init__()
+        _set(self, "center", entries("trajectory.center", self.center, self.space.position_size, "m"))
+        _set(self, "radius", _at_least("trajectory.radius", self.radius, 0.0, "m"))
+        _set(self, "angular_rate", finite("trajectory.angular_rate", self.angular_rate))
+        _set(self, "rotation", self.space.rotation("trajectory.rotation", self.rotation))
+        _set(self, "tilt", self.space.rotation("trajectory.tilt", self.tilt))
+        _set(self, "ramp_time", _at_least("trajectory.ramp_time", self.ramp_time, 0.0, "s"))
+
+    def to_dict(self) -> dict[str, Any]:
+        data = super().to_dict()
+        if not np.any(self.tilt):
+            del data["tilt"]  # a circle that does not rock is written as before tilts (the planar files)
+        return data
+
+    def phase(self, t):
+        """Phase ``p`` [rad] and its first two time derivatives, each of t's shape.
+
+        With ``ramp_time`` > 0 the rate rises from 0 along the quintic blend (C2 from rest).
+        """
+        t = np.asarray(t, dtype=float)
+        rate, ramp = self.angular_rate, self.ramp_time
+        if ramp == 0.0:
+            return rate * t, np.full_like(t, rate), np.zeros_like(t)
+        tau = t / ramp
+        blend, blend_rate, _ = _quintic(tau)
+        return rate * ramp * _quintic_integral(np.maximum(tau, 0.0)), rate * blend, rate * blend_rate / ramp
+
+    def _rocking(self):
+        """(base, amplitude) [rad] of each rotation entry."""
+        return zip(np.atleast_1d(self.rotation).tolist(), np.atleast_1d(self.tilt).tolist())
+
+    def turning_times(self, end_time: float) -> np.ndarray:
+        """Times [s] where a circled position entry or a rocking rotation entry is extreme: the phase
+        at a multiple of pi/2, up to ``end_time``; none for a ramped circle (no closed form) or one
+        that stands or neither moves nor rocks.
+
+        Raises
+        ------
+        SceneError
+            Naming trajectory.angular_rate when the circle makes more than :data:`MAX_QUARTER_TURNS`
+            quarter turns before ``end_time``.
+        """
+        moves = self.radius != 0.0 or bool(np.any(self.tilt))
+        if self.ramp_time > 0.0 or self.angular_rate == 0.0 or not moves:
+            return np.zeros(0)
+        quarter = 0.5 * np.pi / abs(self.angular_rate)
+        if end_time / quarter > MAX_QUARTER_TURNS:
+            raise SceneError(f"trajectory.angular_rate = {shown(self.angular_rate)} rad/s makes "
+                             f"{end_time / quarter:.3g} quarter turns in {shown(end_time)} s, more than the "
+                             f"{MAX_QUARTER_TURNS} a reference check samples (a circle far faster than any robot)")
+        return np.arange(0.0, end_time + 1e-12, quarter)
+
+    def pose(self, t):
+        t, scalar = _times(t)
+        p, _, _ = self.phase(t)
+        sin, cos = np.sin(p), np.cos(p)
+        position = (self.center[0] + self.radius * sin, self.center[1] - self.radius * cos,
+                    *(np.full_like(t, c) for c in self.center[2:]))
+        turn = tuple(np.full_like(t, base) if amplitude == 0.0 else base + amplitude * sin
+                     for base, amplitude in self._rocking())
+        return _stack(position + turn, scalar)
+
+    def velocity(self, t):
+        t, scalar = _times(t)
+        p, p_rate, _ = self.phase(t)
+        sin, cos = np.sin(p), np.cos(p)
+        position = (self.radius * cos * p_rate, self.radius * sin * p_rate, *(np.zeros_like(t) for _ in self.center[2:]))
+        turn = tuple(np.zeros_like(t) if amplitude == 0.0 else amplitude * cos * p_rate for _, amplitude in self._rocking())
+        return _stack(position + turn, scalar)
+
+    def acceleration(self, t):
+        t, scalar = _times(t)
+        p, p_rate, p_acc = self.phase(t)
+        sin, cos = np.sin(p), np.cos(p)
+        along, across = cos * p_acc - sin * p_rate**2, sin * p_acc + cos * p_rate**2
+        position = (self.radius * along, self.radius * across, *(np.zeros_like(t) for _ in self.center[2:]))
+        turn = tuple(np.zeros_like(t) if amplitude == 0.0 else amplitude * along for _, amplitude in self._rocking())
+        return _stack(position + turn, scalar)
 
 
-#: Fields a trajectory table must give, by kind (no default would be what the user meant).
-REQUIRED_FIELDS = {"point_to_point": ("end",), "hold": ("pose",)}
-
-_KINDS = {
+# ----------------------------------------------------------------------------------
+# the registry
+# ----------------------------------------------------------------------------------
+#: The trajectory kinds by name (``kind = "..."`` in a scene's ``[trajectory]``).
+TRAJECTORY_KINDS: dict[str, type[Trajectory]] = {
     "circle": CircleTrajectory,
     "hold": HoldTrajectory,
     "point_to_point": PointToPointTrajectory,
 }
 
 
-def trajectory_from_dict(data):
-    """Build a trajectory from a dict with a ``kind`` key, as written by ``to_dict``.
+def trajectory_from_dict(data: Any, space: Space) -> Trajectory:
+    """Build a trajectory of ``space`` from a dict with a ``kind`` key, as written by ``to_dict``.
 
     Parameters
     ----------
     data : mapping
-        ``{"kind": "circle" | "hold" | "point_to_point", <fields>}``; missing fields
-        take their defaults. ``hold`` takes its pose under the key ``pose``.
+        ``{"kind": <a name in TRAJECTORY_KINDS>, <fields>}``. Required: ``center``
+        (circle), ``pose`` (hold; the key is ``pose``, not the field name ``held_pose``),
+        ``start`` and ``end`` (point_to_point); other missing fields take their defaults.
+    space : Space
+        The scene's space (:data:`~cdpr_exu.space.PLANE` or :data:`~cdpr_exu.space.SPACE`).
 
     Returns
     -------
@@ -360,26 +463,13 @@ def trajectory_from_dict(data):
     Raises
     ------
     SceneError
-        If ``kind`` is missing or unknown, a key is not a field of that kind, or a
-        value is invalid.
+        If ``kind`` is missing or unknown, a key is not a field of that kind, a required
+        field is missing, or a value is invalid.
     """
     if not hasattr(data, "keys"):
         raise SceneError(f"trajectory must be a table (dict), got {shown(data)}")
     values = dict(data)
     kind = values.pop("kind", None)
-    if not isinstance(kind, str) or kind not in _KINDS:
-        raise SceneError(f"trajectory.kind must be one of {sorted(_KINDS)}, got {shown(kind)}")
-    cls = _KINDS[kind]
-    missing = [name for name in REQUIRED_FIELDS.get(kind, ()) if name not in values]
-    if cls is HoldTrajectory and "pose" in values:
-        values["held_pose"] = values.pop("pose")
-    allowed = {field.name for field in dataclass_fields(cls)}
-    unknown = sorted(set(values) - allowed)
-    if unknown:
-        names = ["pose" if name == "held_pose" else name for name in sorted(allowed)]
-        raise SceneError(f"trajectory of kind {shown(kind)} has unknown key(s) {unknown}; allowed: {names}")
-    trajectory = cls(**values)  # the values given are checked first
-    if missing:
-        raise SceneError(f"trajectory.{missing[0]} is required for kind {shown(kind)} (a pose x [m], z [m], "
-                         f"rotation [rad]); it has no sensible default")
-    return trajectory
+    if not isinstance(kind, str) or kind not in TRAJECTORY_KINDS:
+        raise SceneError(f"trajectory.kind must be one of {sorted(TRAJECTORY_KINDS)}, got {shown(kind)}")
+    return TRAJECTORY_KINDS[kind].from_dict(values, space)

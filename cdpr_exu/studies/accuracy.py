@@ -59,7 +59,6 @@ from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
-from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
 from cdpr_exu.scenes.trajectories import HoldTrajectory
 from cdpr_exu.studies.study import (SINGLE_THREAD_ENVIRONMENT, apply_parameters, executor_for, progress_bar,
                                     warm_up)
@@ -453,7 +452,7 @@ def rotation_angles_deg(rotation_vectors: np.ndarray, reference_vectors: np.ndar
 
 def comparison_for(scene) -> str:
     """``"final"`` for a static scene (held pose, fixed winches), else ``"path"``."""
-    static = isinstance(scene.trajectory, (HoldTrajectory, SpatialHoldTrajectory)) and scene.winch.kind == "fixed"
+    static = isinstance(scene.trajectory, HoldTrajectory) and scene.winch.kind == "fixed"
     return "final" if static else "path"
 
 

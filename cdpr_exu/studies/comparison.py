@@ -69,7 +69,7 @@ COMPARISON_RAMP_TIME = 1.0
 def smooth_start(scene: Scene, ramp_time: float = COMPARISON_RAMP_TIME) -> Scene:
     """``scene`` with its circle reference starting smoothly from rest over ``ramp_time`` [s].
 
-    Only a circle that starts at full speed (``ramp_time = 0``) is changed; other
+    Only a circle (planar or spatial: one kind) that starts at full speed (``ramp_time = 0``) is changed; other
     references (hold, point-to-point) already start from rest, and a circle with its own
     ramp keeps it. ``ramp_time = 0`` returns the scene unchanged.
     """

@@ -279,15 +279,16 @@ def planar_chain_statics():
 @case
 def spatial_four_cable_ideal_ik():
     """The four-cable robot (no reference of its own) moved 5 cm across and 3 cm up from its rest."""
-    from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
+    from cdpr_exu.scenes.trajectories import PointToPointTrajectory
+    from cdpr_exu.space import SPACE
     from cdpr_exu.statics.statics import catenary_platform, solve_statics
 
     scene = _spatial("spatial-four-cable", 0.6)
     rest = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     start = np.concatenate([rest.position, rest.rotation])
     end = start + np.array([0.05, 0.0, 0.03, 0.0, 0.0, 0.0])
-    return _spatial_run(scene.with_changes(trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end),
-                                                                                     duration=0.5)))
+    return _spatial_run(scene.with_changes(trajectory=PointToPointTrajectory(tuple(start), tuple(end),
+                                                                              duration=0.5, space=SPACE)))
 
 
 @case
