@@ -15,7 +15,8 @@ from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.run.spatial_rest import PENALTY, solve_spatial_rest
 from cdpr_exu.scenes.scene import Effects, PlatformSpec, load_scene
 from cdpr_exu.statics import chain_statics, statics
-from cdpr_exu.statics.chain_statics import (ChainRobot, _Model, cable_paid_out, chain_forces, chain_rest, chain_robot,
+from cdpr_exu.statics.chain_kernels import SpatialChains
+from cdpr_exu.statics.chain_statics import (ChainRobot, cable_paid_out, chain_forces, chain_rest, chain_robot,
                                             robot_paid_out, solve_chain_statics, solve_inverse_chain_statics)
 from controllers.tension_aware import suspended_platform
 
@@ -62,7 +63,7 @@ def _node_forces(robot, equilibrium):
     nodal forces (plane), and the platform's wrench."""
     if robot.space.dimension == 2:
         return chain_forces(robot, equilibrium.nodes, equilibrium.position, equilibrium.rotation)
-    model = _Model(robot)
+    model = SpatialChains(robot)
     p = np.concatenate(equilibrium.nodes)
     G = model.point_derivatives(p, np.zeros(0))[0]
     return -G.reshape(-1, 3)[model.free], None
@@ -429,7 +430,7 @@ def test_over_swivel_pulleys_the_gradient_and_hessian_are_the_energys_derivative
 
     scene = _swivel_scene()  # bending, tension-only elements
     robot, equilibrium = chain_robot(scene), chain_rest(scene)
-    model = _Model(robot)
+    model = SpatialChains(robot)
     p = np.concatenate([n for n in equilibrium.nodes])
     rng = np.random.default_rng(3)
     # off the equilibrium, and the swivels turned, so that every term has a gradient: the groove's
