@@ -17,23 +17,16 @@ a scene by :func:`chain_robot`, one :class:`ChainEquilibrium`, and two drivers:
 * :func:`solve_chain_statics` (:func:`chain_rest` from a scene): the lengths given, the rest
   pose found (in space; the plane's rest for given lengths is Exudyn's, :mod:`cdpr_exu.run.rest`).
 
-Behind them, the per-dimension kernels, kept operation for operation (the simulator's own
-floating-point numbers): in the plane (x, z) the numba energy and force kernels (exact-angle
-bending, rim contact; the winch end moved along the winch line ``x = c_x + side r_p`` by the
-paid-out length, :mod:`cdpr_exu.builder.winch`) under two nested Newton iterations, the nodes
-minimising the potential at fixed paid-out lengths, the lengths cancelling the force the held
-platform needs; in space (x, y, z) the potential of :class:`SpatialChains` (3-D exact-angle bending
-:mod:`cdpr_exu.physics.bending_3d`, the tension-only law :mod:`cdpr_exu.physics.axial_3d`, the
-swivel groove :mod:`cdpr_exu.physics.swivel_pulley`, the platform's pose and the swivel angles
-among the unknowns) minimised by Newton's method, and the inverse by Gauss-Newton on the
-lengths over chains held at their anchors (:func:`solve_held_chain`). Both minimise with
-:func:`descent_step` and the same Armijo line search (:func:`_line_search`).
-
-Why the spatial forward statics exists for swivel pulleys: Exudyn's static solver does not
-converge from the catenary start over a swivel pulley
-(:func:`cdpr_exu.builder.spatial_robot.settle`); Newton on the energy with a line search does,
-and its answer is the start of runs and of the static mode on swivel scenes
-(:func:`cdpr_exu.builder.spatial_robot.start_at_rest`).
+Behind them, each dimension's kernels (:mod:`cdpr_exu.statics.chain_kernels`), kept operation for
+operation: in the plane (x, z) two nested Newton iterations, the nodes minimising the potential at
+fixed paid-out lengths (the winch end on the winch line ``x = c_x + side r_p``,
+:mod:`cdpr_exu.builder.winch`), the lengths cancelling the force the held platform needs; in space
+(x, y, z) Newton's method on the potential of the chains, the platform's pose and the swivel
+angles, and the inverse by Gauss-Newton on the lengths over chains held at their anchors
+(:func:`solve_held_chain`). All minimise with :func:`descent_step` and one Armijo line search
+(:func:`_line_search`). Over swivel pulleys, where Exudyn's static solver does not converge from
+the catenary start (:func:`cdpr_exu.builder.spatial_robot.settle`), the forward statics' answer
+starts the runs (:func:`cdpr_exu.builder.spatial_robot.start_at_rest`).
 
 Units SI (m, N, kg, rad); the vertical axis up, gravity along it downwards.
 """
@@ -724,23 +717,13 @@ def _predict(robot, layout, guess, interior, rotation, paid_out, position, wrenc
 def _planar_inverse(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None, external_wrench=None,
                     guess: ChainEquilibrium | None = None, tension_guess=None, tolerance: float = 1e-7,
                     max_iterations: int = 50) -> ChainEquilibrium:
-    """Paid-out lengths, node positions and rotation that hold the planar platform at ``position``
-    (:func:`solve_inverse_chain_statics` in the plane).
+    """:func:`solve_inverse_chain_statics` in the plane: two nested Newton iterations (:func:`_planar_solve`).
 
     Tension-only (slack) elements have no stiffness in compression, so Newton started
     from a guess with compressed elements can stall on them. Their equilibrium is first
     sought with springs that also push: where no element of that equilibrium is
     compressed it is the tension-only one as well (the two potentials agree wherever
     every element is stretched); otherwise it is the start of the tension-only solve.
-
-    Two nested Newton iterations. Inner: with the platform held at ``position`` and the
-    paid-out lengths given, the nodes (and the free rotation) minimise the potential
-    (:func:`_minimise`). Outer: the paid-out lengths are corrected until the cables
-    carry the platform, i.e. the force the held platform needs vanishes; its
-    derivative follows from the inner tangent stiffness (the nodes stay in equilibrium).
-    ``free_rotation`` defaults to a rigid platform on two cables; the problem must be square:
-    a point mass or a rigid platform with a free rotation on two cables, or a rigid platform
-    with its rotation imposed on three.
     """
     kwargs = dict(free_rotation=free_rotation, external_wrench=external_wrench, tolerance=tolerance,
                   max_iterations=max_iterations)
@@ -759,7 +742,13 @@ def _planar_inverse(robot: ChainRobot, position, rotation=0.0, *, free_rotation=
 def _planar_solve(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None, external_wrench=None,
                   guess: ChainEquilibrium | None = None, tension_guess=None, tolerance: float = 1e-7,
                   max_iterations: int = 50) -> ChainEquilibrium:
-    """:func:`_planar_inverse` for one element law (the robot's own)."""
+    """:func:`_planar_inverse` for one element law (the robot's own).
+
+    Inner: with the platform held at ``position`` and the paid-out lengths given, the nodes (and the
+    free rotation) minimise the potential (:func:`_minimise`). Outer: the paid-out lengths are
+    corrected until the cables carry the platform, i.e. the force the held platform needs vanishes;
+    its derivative follows from the inner tangent stiffness (the nodes stay in equilibrium).
+    """
     position = vector("position", position, 2)
     rotation = finite("rotation", rotation)
     m = len(robot.cables)
@@ -865,42 +854,7 @@ def catenary_start(robot: ChainRobot, equilibrium):
 
 def _spatial_forward(robot: ChainRobot, nodes, position, rotation=None, swivel_angles=None, *,
                      tolerance: float = 1e-9, max_iterations: int = 100, external_force=None) -> ChainEquilibrium:
-    """The rest configuration of the chains and platform for the cables' unstrained lengths.
-
-    Parameters
-    ----------
-    robot : ChainRobot
-    nodes : sequence of array_like, each shape (n + 1, 3) [m]
-        Start positions of each cable's nodes, exit first (eg :func:`catenary_start`);
-        the exit node is put on the exit point and (with exact joints) the last on the anchor.
-    position : (x, y, z) [m]
-        Start of the platform's centre of mass.
-    rotation : ndarray, shape (3, 3), optional
-        Start of the platform's rotation (default identity; ignored for a point mass).
-    swivel_angles : array_like, shape (m,) [rad], optional
-        Start of each swivel pulley's psi (entries of point exits ignored); default each
-        pulley turned towards its cable's last start node.
-    tolerance : float [N]
-        Largest entry of the potential's gradient accepted (node forces, platform force, moment,
-        torques on the swivels [N m]); at least the rounding of the element forces
-        (:func:`rounding_floor`: 4e-9 N on the four-cable robot, 1.6e-7 N on CoGiRo's steel
-        ropes, where 1e-9 N cannot be reached).
-    max_iterations : int
-    external_force : (fx, fy, fz) [N], optional
-        A constant extra force on the platform's centre of mass (eg the d'Alembert force
-        -M a of an acceleration); its potential is -F . x.
-
-    Returns
-    -------
-    ChainEquilibrium
-
-    Raises
-    ------
-    UnreachableError
-        If Newton finds no equilibrium.
-    SceneError
-        On malformed input.
-    """
+    """:func:`solve_chain_statics` in space: Newton's method on the total potential from a start."""
     model = SpatialChains(robot)
     if external_force is not None:
         model.external_force = vector("external_force", external_force, 3, " (fx, fy, fz) [N]")
@@ -1384,12 +1338,37 @@ def solve_chain_statics(robot: ChainRobot, nodes, position, rotation=None, swive
                         **kwargs) -> ChainEquilibrium:
     """The rest of the chains and platform for the cables' unstrained lengths (the forward chain statics).
 
-    In space Newton's method on the total potential from a start (:func:`_spatial_forward`, whose
-    parameters these are: ``nodes`` each cable's start nodes, exit first, eg :func:`catenary_start`;
-    ``position`` and ``rotation`` the platform's start; ``swivel_angles`` the swivel pulleys' start;
-    ``tolerance``, ``max_iterations``, ``external_force``). The plane has no forward chain statics:
-    its rest for given lengths is Exudyn's (:func:`cdpr_exu.run.rest.solve_rest`), its chain
-    statics solve a pose (:func:`solve_inverse_chain_statics`).
+    In space, Newton's method on the total potential from a start (the unknowns: the free nodes, the
+    platform's pose, the swivel pulleys' angles). The plane has none: its rest for given lengths is
+    Exudyn's (:func:`cdpr_exu.run.rest.solve_rest`), its chain statics hold a pose
+    (:func:`solve_inverse_chain_statics`).
+
+    Parameters
+    ----------
+    robot : ChainRobot
+    nodes : sequence of array_like, each shape (n + 1, 3) [m]
+        Start positions of each cable's nodes, exit first (eg :func:`catenary_start`);
+        the exit node is put on the exit point and (with exact joints) the last on the anchor.
+    position : (x, y, z) [m]
+        Start of the platform's centre of mass.
+    rotation : ndarray, shape (3, 3), optional
+        Start of the platform's rotation (default identity; ignored for a point mass).
+    swivel_angles : array_like, shape (m,) [rad], optional
+        Start of each swivel pulley's psi (entries of point exits ignored); default each
+        pulley turned towards its cable's last start node.
+    tolerance : float [N]
+        Largest entry of the potential's gradient accepted (node forces, platform force, moment,
+        torques on the swivels [N m]); at least the rounding of the element forces
+        (:func:`rounding_floor`: 4e-9 N on the four-cable robot, 1.6e-7 N on CoGiRo's steel
+        ropes, where 1e-9 N cannot be reached).
+    max_iterations : int
+    external_force : (fx, fy, fz) [N], optional
+        A constant extra force on the platform's centre of mass (eg the d'Alembert force
+        -M a of an acceleration); its potential is -F . x.
+
+    Returns
+    -------
+    ChainEquilibrium
 
     Raises
     ------
