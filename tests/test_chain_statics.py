@@ -84,14 +84,15 @@ def test_the_equilibrium_balances_every_node_and_the_platform(dimension):
     weight[space.vertical] = -scene.platform.mass * scene.gravity
     rotation = space.rotation_matrix(equilibrium.pose[space.position_size:])
     arms = np.asarray(scene.platform.anchors) @ rotation.T
-    assert np.abs(equilibrium.forces_on_platform.sum(axis=0) + weight).max() < 1e-6
+    balance = {2: 1e-6, 3: 1e-8}[dimension]  # ten times the solver's tolerance: 1e-7 N (plane), 1e-9 N (space)
+    assert np.abs(equilibrium.forces_on_platform.sum(axis=0) + weight).max() < balance
     in_3d = ((0, 0), (0, 3 - dimension))
     moments = np.cross(np.pad(arms, in_3d), np.pad(equilibrium.forces_on_platform, in_3d))
-    assert np.abs(moments.sum(axis=0)).max() < 1e-6
+    assert np.abs(moments.sum(axis=0)).max() < balance
     assert np.all(equilibrium.anchor_tensions > 5.0)  # a 2.5 kg (5 kg) platform on two (four) cables
     # the anchors sit where the pose puts them (exact joints)
     anchors = np.array([n[-1] for n in equilibrium.nodes])
-    assert np.allclose(anchors, equilibrium.position + arms, atol=1e-12)
+    assert np.abs(anchors - (equilibrium.position + arms)).max() < 1e-12
 
 
 def _catenary_errors(dimension, n):
