@@ -24,6 +24,7 @@ import exudyn as exu
 import numpy as np
 
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec, settle, start_at_rest
+from cdpr_exu.statics.statics import catenary_platform
 from cdpr_exu.scenes.scene import load_scene
 
 RESULTS = Path(__file__).resolve().parent / "results" / "swivel_start.md"
@@ -31,7 +32,7 @@ RESULTS = Path(__file__).resolve().parent / "results" / "swivel_start.md"
 
 def _built(scene, tension_only):
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
+    items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
                                 scene_chain_spec(scene, tension_only=tension_only), swivels=scene.swivel_exits)
     mbs.Assemble()
     return mbs, items

@@ -12,7 +12,7 @@ reads neither pose nor tension.
 Two cable models (``statics``), as the planar :class:`controllers.tension_aware.TensionAwareController`:
 
 * ``"catenary"``: continuous elastic catenaries without bending
-  (:func:`cdpr_exu.physics.spatial_statics.solve_inverse_spatial_statics`, the horizontal
+  (:func:`cdpr_exu.statics.statics.solve_inverse_statics`, the horizontal
   tensions kept near the previous sample's); the command is the initial paid-out length
   plus the change of these lengths, which cancels at the start the offset between the
   catenary and the simulator's chains (1e-5 m on IPAnema);
@@ -119,15 +119,15 @@ class SpatialTensionAwareController:
 
     def _catenary_solver(self, scene, initial):
         """pose, acceleration -> lengths [m] on elastic catenaries, the horizontal tensions continued."""
-        from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics, solve_spatial_statics
+        from cdpr_exu.statics.statics import catenary_platform, solve_inverse_statics, solve_statics
 
-        platform = scene.catenary_platform()
-        rest = solve_spatial_statics(platform, initial)
+        platform = catenary_platform(scene)
+        rest = solve_statics(platform, initial)
         state = {"tensions": np.array([c.catenary.horizontal_tension for c in rest.cables])}
 
         def solve(pose, acceleration):
             inertial = np.concatenate([-platform.mass * acceleration[:3], np.zeros(3)])
-            inverse = solve_inverse_spatial_statics(platform, pose, state["tensions"], external_wrench=inertial)
+            inverse = solve_inverse_statics(platform, pose, inertial, initial_guess=state["tensions"])
             state["tensions"] = inverse.horizontal_tensions
             self.inverses.append(inverse)
             return inverse.unstrained_lengths
@@ -136,16 +136,16 @@ class SpatialTensionAwareController:
     def _chain_solver(self, scene, initial):
         """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued."""
         from cdpr_exu.core.errors import UnreachableError
-        from cdpr_exu.physics.spatial_statics import solve_cable, solve_inverse_spatial_statics, solve_spatial_statics
+        from cdpr_exu.statics.statics import catenary_platform, forward_cable, solve_inverse_statics, solve_statics
         from cdpr_exu.statics.chain_statics import (InverseChainStatics, catenary_start, chain_robot, robot_paid_out,
                                                     solve_chain_statics)
         from cdpr_exu.core.geometry import rotation_from_vector
 
-        platform = scene.catenary_platform()
+        platform = catenary_platform(scene)
         robot = chain_robot(scene)
         over_swivel = [cable.pulley is not None for cable in robot.cables]
         inverse_statics = InverseChainStatics(robot)
-        catenary_rest = solve_spatial_statics(platform, initial)
+        catenary_rest = solve_statics(platform, initial)
         started = robot_paid_out(robot, initial)
         rest = solve_chain_statics(started, *catenary_start(started, catenary_rest))
         # the straight distances change as the paid-out lengths: from the exit point, or the swivel pulley's inlet
@@ -169,7 +169,7 @@ class SpatialTensionAwareController:
         def catenary_guess(pose, inertial):
             """Lengths and nodes of the catenary inverse at ``pose`` (a start far from any previous sample);
             a chain over a swivel pulley keeps the previous sample's nodes."""
-            inverse = solve_inverse_spatial_statics(platform, pose, state["horizontal"], external_wrench=inertial)
+            inverse = solve_inverse_statics(platform, pose, inertial, initial_guess=state["horizontal"])
             state["horizontal"] = inverse.horizontal_tensions
             points = anchor_points(pose)
             nodes = []
@@ -178,7 +178,7 @@ class SpatialTensionAwareController:
                 if over_swivel[i]:
                     nodes.append(state["previous"][0].nodes[i])
                     continue
-                shape, _ = solve_cable(cable, length, point)
+                shape, _ = forward_cable(cable, length, point)
                 nodes.append(shape.points(length - np.linspace(0.0, length, chain.n_elements + 1)))
             return inverse.unstrained_lengths, nodes
 

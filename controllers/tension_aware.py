@@ -53,26 +53,6 @@ from .base import Measurement, WinchCommand
 from .feedback import FilteredPositionPI
 
 
-def suspended_platform(scene) -> statics.SuspendedPlatform:
-    """The catenary-statics model of a scene's robot (pulleys or fixed exits).
-
-    Parameters
-    ----------
-    scene : cdpr_exu.scenes.scene.Scene
-
-    Returns
-    -------
-    statics.SuspendedPlatform
-        Cable weight per length rho0 g [N/m], EA [N], anchors, pulleys, platform mass.
-    """
-    cables = []
-    for cable, pulley, anchor in zip(scene.cables, scene.exits, scene.platform.anchors):
-        weight = cable.linear_density * scene.gravity if (scene.effects.cable_mass and scene.effects.gravity) else 0.0
-        cables.append(statics.SuspendedCable(weight, cable.axial_rigidity, anchor=anchor, pulley=pulley))
-    gravity = scene.gravity if scene.effects.gravity else 0.0
-    return statics.SuspendedPlatform(tuple(cables), scene.platform.mass, gravity, scene.platform.inertia)
-
-
 def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
     """Paid-out length of each straight, inextensible lumped chain reaching ``anchors``, shape (m,) [m].
 
@@ -145,7 +125,7 @@ class TensionAwareController:
             If a reference pose needs a cable to push or has no equilibrium; the message
             names the time.
         """
-        platform = suspended_platform(scene)
+        platform = statics.catenary_platform(scene)
         chain = chain_statics.chain_robot(scene) if self.statics == "chain" else None
         poses = scene.trajectory.pose(times)
         accelerations = scene.trajectory.acceleration(times)

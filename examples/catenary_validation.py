@@ -17,7 +17,7 @@ Writes into the output folder:
 Two catenaries are compared with each lumped rest state:
 
 * *forward*: the catenary with the same unstrained lengths and upper ends
-  (``solve_forward_statics``): where the catenary puts the platform;
+  (``solve_statics``): where the catenary puts the platform;
 * *inverse* (the paper's "inverse kineto-static analysis"): the catenary through the
   lumped model's rest position (``solve_inverse_statics``): the cable length the
   catenary needs to hold the platform there. The paper's 0.8 mm is a length difference
@@ -50,8 +50,8 @@ from cdpr_exu.physics import catenary
 from cdpr_exu.run.rest import RestState, solve_rest
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import Effects, Scene, load_scene
-from cdpr_exu.statics.statics import solve_forward_statics, solve_inverse_statics
-from controllers.tension_aware import suspended_platform
+from cdpr_exu.statics.statics import solve_statics, solve_inverse_statics
+from cdpr_exu.statics.statics import catenary_platform
 
 #: What the paper reports for Fig. 8 with 15 elements [m].
 PAPER_LENGTH_DIFFERENCE = 0.8e-3
@@ -129,7 +129,7 @@ def hang_point_unstrained_length(scene: Scene, rest: RestState, i: int) -> float
 
 def catenary_curves(scene: Scene, equilibrium) -> list[np.ndarray]:
     """Points (x, z) of each catenary's suspended part, anchor first, shape (CURVE_SAMPLES, 2) [m]."""
-    platform = suspended_platform(scene)
+    platform = catenary_platform(scene)
     curves = []
     for model, cable in zip(platform.cables, equilibrium.cables):
         shape = model.catenary(cable.suspended_length)
@@ -158,9 +158,9 @@ def free_span_points(rest: RestState, i: int) -> np.ndarray:
 
 def compare(scene: Scene, rest: RestState) -> dict:
     """Forward and inverse catenary against a lumped rest state; numbers in SI."""
-    platform = suspended_platform(scene)
+    platform = catenary_platform(scene)
     lengths = [hang_point_unstrained_length(scene, rest, i) for i in range(scene.n_cables)]
-    forward = solve_forward_statics(platform, lengths, initial_pose=rest.platform_position_m)
+    forward = solve_statics(platform, lengths, initial_pose=rest.platform_position_m)
     inverse = solve_inverse_statics(platform, rest.platform_position_m)
     out = {
         "scene": scene.name, "effects": scene.effects.preset, "n_elements": scene.cables[0].n_elements,
@@ -192,7 +192,7 @@ def compare(scene: Scene, rest: RestState) -> dict:
             "max_distance_to_inverse_catenary_m": float(d_inverse.max()),
             "node_distances_to_inverse_catenary_m": d_inverse.tolist(),
             "lumped_leave_point_m": rest.upper_points_m[i].tolist(),
-            "catenary_tangent_point_m": inverse.cables[i].upper_point.tolist(),
+            "catenary_tangent_point_m": inverse.cables[i].exit_point.tolist(),
             "lumped_platform_force_N": rest.platform_forces_N[i].tolist(),
             "inverse_platform_force_N": inverse.cables[i].force_on_platform.tolist(),
         }
@@ -259,8 +259,8 @@ def rest_comparisons(scenes: dict[str, Scene]) -> dict[str, tuple[Scene, RestSta
 def convergence(counts, lumpings=("consistent", "paper")) -> list[dict]:
     """Bending off, fixed ends: errors of the rest state against the catenary over n."""
     base = bending_off(load_scene("paper-catenary-fixed"))
-    platform = suspended_platform(base)
-    reference = solve_forward_statics(platform, [c.unstrained_length for c in base.cables])
+    platform = catenary_platform(base)
+    reference = solve_statics(platform, [c.unstrained_length for c in base.cables])
     reference_length = reference.cables[0].catenary.stretched_length
     rows = []
     for lumping in lumpings:
@@ -405,7 +405,7 @@ def boundary_layers(scene: Scene, comparison: dict) -> dict:
     cable = scene.cables[0]
     bending = cable.youngs_modulus * cable.second_moment
     weight = cable.linear_density * scene.gravity
-    platform = suspended_platform(scene)
+    platform = catenary_platform(scene)
     equilibrium = solve_inverse_statics(platform, comparison["lumped_position_m"])
     state = equilibrium.cables[0].catenary
     out = {}

@@ -13,7 +13,7 @@ import math
 import pytest
 
 from cdpr_exu.physics.catenary import CatenaryCable
-from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
+from cdpr_exu.statics.statics import SuspendedCable, SuspendedPlatform
 from cdpr_exu.exits import PointExit
 from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, Scene, SolverSpec, WinchSpec
 
@@ -119,13 +119,13 @@ ASYMMETRIC_LENGTHS = [2.4, 2.5, 2.6, 2.55]
 PENALTY = 100.0
 
 
-def four_cable_robot(rigid: bool, mass: float = 5.0) -> SpatialPlatform:
+def four_cable_robot(rigid: bool, mass: float = 5.0) -> SuspendedPlatform:
     """The paper's cable from the corners of a 3 m x 3 m frame (exits at z = 0) to a point mass, or to
     a rigid 0.2 m square platform whose anchors sit 5 cm above its centre of mass."""
     w, ea = PAPER_CATENARY_CABLE.weight_per_length, PAPER_CATENARY_CABLE.axial_stiffness
-    cables = [SpatialCable((1.5 * sx, 1.5 * sy, 0.0), w, ea,
-                           anchor=(0.1 * sx, 0.1 * sy, 0.05) if rigid else (0.0, 0.0, 0.0)) for sx, sy in CORNERS]
-    return SpatialPlatform(cables, mass=mass, inertia=(0.05, 0.05, 0.08))
+    cables = [SuspendedCable(w, ea, anchor=(0.1 * sx, 0.1 * sy, 0.05) if rigid else (0.0, 0.0, 0.0),
+                             exit_point=(1.5 * sx, 1.5 * sy, 0.0)) for sx, sy in CORNERS]
+    return SuspendedPlatform(cables, mass=mass, inertia=(0.05, 0.05, 0.08))
 
 
 @pytest.fixture
@@ -157,7 +157,7 @@ def small_spatial_scene(end_time: float = 0.3, n_elements: int = 4):
 
     import numpy as np
 
-    from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+    from cdpr_exu.statics.statics import catenary_platform, solve_statics
     from cdpr_exu.scenes.scene import load_scene
     from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
 
@@ -165,8 +165,8 @@ def small_spatial_scene(end_time: float = 0.3, n_elements: int = 4):
     scene = replace(scene, cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables),
                     effects=replace(scene.effects, slack=False),
                     solver=replace(scene.solver, end_time=end_time, step_size=1e-2, output_period=1e-2))
-    rest = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
-    start = np.concatenate([rest.position, rest.rotation_vector])
+    rest = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
+    start = np.concatenate([rest.position, rest.rotation])
     end = start + np.array([0.05, 0.0, 0.0, 0.0, 0.0, 0.0])
     return replace(scene, name="small-spatial",
                    trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=end_time))

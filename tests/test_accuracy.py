@@ -157,13 +157,13 @@ def _spatial_move_scene(tmp_path):
     rest pose, as a TOML file; its path is compared after the move (1 s)."""
     from dataclasses import replace
 
-    from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+    from cdpr_exu.statics.statics import catenary_platform, solve_statics
     from cdpr_exu.scenes.scene import load_scene, save_scene
     from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
 
     scene = load_scene("spatial-four-cable")
-    rest = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
-    start = np.concatenate([rest.position, rest.rotation_vector])
+    rest = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
+    start = np.concatenate([rest.position, rest.rotation])
     end = start + np.array([0.15, -0.10, 0.05, 0.0, 0.0, 0.0])
     move = SpatialPointToPointTrajectory(tuple(start), tuple(end), duration=1.0)
     scene = replace(scene, trajectory=move, solver=replace(scene.solver, output_period=0.01))

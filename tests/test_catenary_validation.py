@@ -19,8 +19,8 @@ import pytest
 from cdpr_exu.physics import catenary
 from cdpr_exu.run.rest import solve_rest
 from cdpr_exu.scenes.scene import Effects, load_scene
-from cdpr_exu.statics.statics import solve_forward_statics
-from controllers.tension_aware import suspended_platform
+from cdpr_exu.statics.statics import solve_statics
+from cdpr_exu.statics.statics import catenary_platform
 
 pytestmark = pytest.mark.slow
 
@@ -36,12 +36,12 @@ def base():
 @pytest.fixture(scope="module")
 def reference(base):
     """The elastic catenary with the same unstrained lengths and end points."""
-    return solve_forward_statics(suspended_platform(base), [c.unstrained_length for c in base.cables])
+    return solve_statics(catenary_platform(base), [c.unstrained_length for c in base.cables])
 
 
 def catenary_curve(base, reference, samples=4001):
     cable = reference.cables[0]
-    shape = suspended_platform(base).cables[0].catenary(cable.suspended_length)
+    shape = catenary_platform(base).cables[0].catenary(cable.suspended_length)
     return cable.anchor_point + catenary.profile(shape, cable.catenary, np.linspace(0.0, cable.suspended_length,
                                                                                      samples))
 

@@ -11,14 +11,13 @@ from cdpr_exu.builder.model import initial_nodes
 from cdpr_exu.builder.spatial_robot import (build_spatial_robot, chain_statics_robot, scene_chain_spec,
                                             set_configuration, solve_static, swivel_angles)
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.physics.spatial_statics import solve_spatial_statics
 from cdpr_exu.run.spatial_rest import PENALTY, solve_spatial_rest
 from cdpr_exu.scenes.scene import Effects, PlatformSpec, load_scene
 from cdpr_exu.statics import chain_statics, statics
 from cdpr_exu.statics.chain_kernels import SpatialChains
 from cdpr_exu.statics.chain_statics import (ChainRobot, cable_paid_out, chain_forces, chain_rest, chain_robot,
                                             robot_paid_out, solve_chain_statics, solve_inverse_chain_statics)
-from controllers.tension_aware import suspended_platform
+from cdpr_exu.statics.statics import catenary_platform, solve_statics
 
 PAPER = load_scene("paper-circle")
 FOUR = load_scene("spatial-four-cable")
@@ -26,7 +25,7 @@ FOUR = load_scene("spatial-four-cable")
 
 def _solve(scene, position, **kwargs):
     """Planar chain statics of ``scene`` at ``position``, started from its catenary statics."""
-    start = statics.solve_inverse_statics(suspended_platform(scene), position)
+    start = statics.solve_inverse_statics(catenary_platform(scene), position)
     return solve_inverse_chain_statics(chain_robot(scene), (*position, start.rotation),
                                        tension_guess=[c.tension_at_anchor for c in start.cables], **kwargs)
 
@@ -104,18 +103,18 @@ def _catenary_errors(dimension, n):
         position = (0.2, -1.6)
         scene = _catenary_scene(n)
         chain = _solve(scene, position)
-        platform = suspended_platform(scene)
+        platform = catenary_platform(scene)
         hung = statics.SuspendedPlatform(
             tuple(replace(c, exit_point=tuple(nodes[0])) for c, nodes in zip(platform.cables, chain.nodes)),
-            platform.mass, platform.gravity, platform.moment_of_inertia)
+            platform.mass, platform.gravity, platform.inertia)
         catenary = statics.solve_inverse_statics(hung, position)
         error = np.abs(catenary.unstrained_lengths - scene.cables[0].unstrained_length).max()
         assert catenary.rotation == pytest.approx(chain.rotation, abs=10 * error)
         return [error]
     chain = chain_rest(_scene(n, bending=False))
-    catenary = solve_spatial_statics(FOUR.catenary_platform(), FOUR.unstrained_lengths)
+    catenary = solve_statics(catenary_platform(FOUR), FOUR.unstrained_lengths)
     return [np.linalg.norm(chain.position - catenary.position),
-            np.linalg.norm(chain.rotation_vector - catenary.rotation_vector),
+            np.linalg.norm(chain.rotation_vector - catenary.rotation),
             np.abs(chain.tensions_at_anchor - catenary.tensions_at_anchor).max()]
 
 
@@ -247,7 +246,7 @@ def test_a_continued_solution_equals_a_fresh_one():
 
 def test_an_inertial_load_changes_the_lengths_as_the_static_load_would():
     """d'Alembert: -M a along x is the same load as a horizontal external force."""
-    platform = suspended_platform(PAPER)
+    platform = catenary_platform(PAPER)
     wrench = statics.inertial_wrench(platform, np.array([0.5, 0.0]), 0.0)
     with_load = _solve(PAPER, (0.0, -1.8), external_wrench=wrench)
     without = _solve(PAPER, (0.0, -1.8))
@@ -312,7 +311,7 @@ def test_the_penalty_joints_move_the_rigid_platform_by_their_compliance():
 def test_the_model_is_the_builders():
     scene = _scene(10)
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths, scene_chain_spec(scene))
+    items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths, scene_chain_spec(scene))
     robot = chain_robot(scene)
     for cable, masses, k, k_theta in zip(robot.cables, items.node_masses, items.axial_stiffnesses,
                                          items.bending_stiffnesses):
@@ -340,7 +339,7 @@ def _swivel_scene(asymmetric=True, rigid=False):
 
 def _exudyn_robot(scene, anchor_spring_factor=None, tension_only=False):
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
+    items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
                                 scene_chain_spec(scene, anchor_spring_factor, tension_only), swivels=scene.swivel_exits)
     mbs.Assemble()
     return mbs, items
@@ -488,13 +487,13 @@ def _ipanema(n_elements=10):
 def _catenary_start(scene, robot, pose):
     """Lengths and nodes of the catenary inverse at ``pose``: the start the controller takes."""
     from cdpr_exu.core.geometry import rotation_from_vector
-    from cdpr_exu.physics.spatial_statics import solve_cable, solve_inverse_spatial_statics
+    from cdpr_exu.statics.statics import forward_cable, solve_inverse_statics
 
-    platform = scene.catenary_platform()
-    rest = solve_spatial_statics(platform, scene.unstrained_lengths)
-    inverse = solve_inverse_spatial_statics(platform, pose, [c.catenary.horizontal_tension for c in rest.cables])
+    platform = catenary_platform(scene)
+    rest = solve_statics(platform, scene.unstrained_lengths)
+    inverse = solve_inverse_statics(platform, pose, initial_guess=rest.horizontal_tensions)
     points = pose[:3] + np.array(platform.anchors) @ rotation_from_vector(pose[3:6]).T
-    nodes = [solve_cable(c, length, point)[0].points(length - np.linspace(0.0, length, chain.n_elements + 1))
+    nodes = [forward_cable(c, length, point)[0].points(length - np.linspace(0.0, length, chain.n_elements + 1))
              for c, chain, length, point in zip(platform.cables, robot.cables, inverse.unstrained_lengths, points)]
     return inverse.unstrained_lengths, nodes
 

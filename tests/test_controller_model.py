@@ -8,8 +8,9 @@ import pytest
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import ControllerModel, Effects, load_scene, save_scene, scene_from_dict
-from cdpr_exu.statics.statics import solve_forward_statics
-from controllers.tension_aware import TensionAwareController, suspended_platform
+from cdpr_exu.statics.statics import solve_statics
+from controllers.tension_aware import TensionAwareController
+from cdpr_exu.statics.statics import catenary_platform
 
 from conftest import v_shaped_scene
 
@@ -86,8 +87,8 @@ def test_the_plant_hangs_where_the_catenary_statics_of_its_own_parameters_put_it
                                controller_model=ControllerModel(platform={"mass": 1.0}, cable={"linear_density": 0.35}))
     model = plant.controller_scene()
     lengths = [c.unstrained_length for c in plant.cables]
-    predicted = (solve_forward_statics(suspended_platform(plant), lengths).position
-                 - solve_forward_statics(suspended_platform(model), lengths).position)
+    predicted = (solve_statics(catenary_platform(plant), lengths).position
+                 - solve_statics(catenary_platform(model), lengths).position)
     simulated = simulate(plant).platform_pose[-1, :2] - simulate(model).platform_pose[-1, :2]
     assert predicted[1] < -5e-3  # the plant hangs lower by millimetres
     # The lumped cables miss the catenary's sag by a lumping error that falls as 1/n^2:

@@ -134,7 +134,7 @@ def test_ctrl_c_during_the_companion_run_is_the_users_not_a_failed_estimate():
 def _four_cable(n_elements, trajectory=None, end_time=1.5):
     """The shipped four-cable robot without bending (its continuum limit is the elastic
     catenary), coarse steps; held on its catenary pose unless ``trajectory`` is given."""
-    from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+    from cdpr_exu.statics.statics import catenary_platform, solve_statics
     from cdpr_exu.scenes.scene import load_scene
     from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory
 
@@ -142,8 +142,8 @@ def _four_cable(n_elements, trajectory=None, end_time=1.5):
     scene = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False),
                     cables=tuple(replace(c, n_elements=n_elements) for c in scene.cables),
                     solver=replace(scene.solver, step_size=1e-2, output_period=0.05, end_time=end_time))
-    rest = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
-    pose = np.concatenate([rest.position, rest.rotation_vector])
+    rest = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
+    pose = np.concatenate([rest.position, rest.rotation])
     return replace(scene, trajectory=trajectory or SpatialHoldTrajectory(tuple(pose))), rest.position
 
 

@@ -426,12 +426,12 @@ PUBLIC_CALLS = {
     "SuspendedCable pulley text": (lambda: statics.SuspendedCable(1, 1e5, pulley="p"), SceneError, "pulley must be a Pulley"),
     "SuspendedPlatform no cables": (lambda: statics.SuspendedPlatform((), 1), SceneError, "cables"),
     "SuspendedPlatform mass NaN": (lambda: statics.SuspendedPlatform(POINT_PLATFORM.cables, NAN), SceneError, "mass"),
-    "solve_forward_statics lengths count": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [1.0]), SceneError, "unstrained_lengths"),
-    "solve_forward_statics length negative": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [-1.0, 2.0]), SceneError, "unstrained_lengths"),
-    "solve_forward_statics wrench shape": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [2.5, 2.5], external_wrench=[1, 2]), SceneError, "external_wrench"),
-    "solve_forward_statics pose NaN": (lambda: statics.solve_forward_statics(POINT_PLATFORM, [2.5, 2.5], initial_pose=[NAN, 0]), SceneError, "initial_pose"),
+    "solve_statics lengths count": (lambda: statics.solve_statics(POINT_PLATFORM, [1.0]), SceneError, "unstrained_lengths"),
+    "solve_statics length negative": (lambda: statics.solve_statics(POINT_PLATFORM, [-1.0, 2.0]), SceneError, "unstrained_lengths"),
+    "solve_statics wrench shape": (lambda: statics.solve_statics(POINT_PLATFORM, [2.5, 2.5], external_wrench=[1, 2]), SceneError, "external_wrench"),
+    "solve_statics pose NaN": (lambda: statics.solve_statics(POINT_PLATFORM, [2.5, 2.5], initial_pose=[NAN, 0]), SceneError, "initial_pose"),
     "inertial_wrench acceleration NaN": (lambda: statics.inertial_wrench(POINT_PLATFORM, (NAN, 0)), SceneError, "acceleration"),
-    "solve_inverse_statics position NaN": (lambda: statics.solve_inverse_statics(POINT_PLATFORM, (NAN, -1)), SceneError, "position"),
+    "solve_inverse_statics position NaN": (lambda: statics.solve_inverse_statics(POINT_PLATFORM, (NAN, -1)), SceneError, "pose"),
     "solve_inverse_statics above the exits": (lambda: statics.solve_inverse_statics(POINT_PLATFORM, (0, 1)), UnreachableError, "pulling cables"),
     "bending positions odd": (lambda: bending.bending_energy([0, 0, 1], JOINTS, 1.0), SceneError, "positions"),
     "bending joints out of range": (lambda: bending.bending_energy(POSITIONS, [[0, 1, 3]], 1.0), SceneError, "joints refer to nodes outside"),
@@ -472,8 +472,8 @@ FORMER_GAPS = {
     "span_and_jacobian tension negative accepted": lambda: catenary.span_and_jacobian(CABLE, -5.0, 1.0),
     "profile s text -> ValueError": lambda: catenary.profile(CABLE, catenary.solve_forward(CABLE, [2, -2]), "a"),
     "SuspendedPlatform cables 5 -> TypeError": lambda: statics.SuspendedPlatform(5, 1.0),
-    "solve_forward_statics platform text -> AttributeError": lambda: statics.solve_forward_statics("p", [1.0]),
-    "solve_forward_statics pose text -> ValueError": lambda: statics.solve_forward_statics(POINT_PLATFORM, [2.5, 2.5], initial_pose="ab"),
+    "solve_statics platform text -> AttributeError": lambda: statics.solve_statics("p", [1.0]),
+    "solve_statics pose text -> ValueError": lambda: statics.solve_statics(POINT_PLATFORM, [2.5, 2.5], initial_pose="ab"),
 }
 
 
@@ -499,7 +499,7 @@ NUMPY_VALUES = {
     "per_item negative": lambda: _validation().per_item("x", np.array([-1.0, 1.0]), 2),
     "CatenaryCable length": lambda: catenary.CatenaryCable(np.float64(-1.0), 1.0, 1.0),
     "pulley_exit radius": lambda: kinematics.pulley_exit((0.0, 0.0), np.float64(-1.0), -1, [1.0, -1.0]),
-    "solve_forward_statics lengths": lambda: statics.solve_forward_statics(POINT_PLATFORM, np.array([-1.0, 2.0])),
+    "solve_statics lengths": lambda: statics.solve_statics(POINT_PLATFORM, np.array([-1.0, 2.0])),
     "SuspendedPlatform mass": lambda: statics.SuspendedPlatform(POINT_PLATFORM.cables, np.float64(np.nan)),
 }
 

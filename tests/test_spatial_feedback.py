@@ -13,7 +13,7 @@ from controllers.base import START_BLEND_TIME, WinchCommand, quintic_blend
 from controllers.feedback import ClosedLoopController
 from controllers.ideal_ik import IdealIKController
 from controllers.spatial_feedback import SpatialPositionPI
-from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.statics.statics import catenary_platform, solve_statics
 
 def four_cable(n_elements=10, **solver):
     """The shipped four-cable robot, coarser, without bending, at a 10 ms step."""
@@ -34,8 +34,8 @@ def ipanema(n_elements=10, **solver):
 
 def start_pose(scene):
     """The catenary equilibrium of the scene's lengths (x, y, z, rotation vector) [m, rad]."""
-    start = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
-    return np.concatenate([start.position, start.rotation_vector])
+    start = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
+    return np.concatenate([start.position, start.rotation])
 
 
 #: What the spy controller pays out beyond the initial lengths from t = 0 on [m].

@@ -7,7 +7,7 @@ import pytest
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.builder.spatial_robot import SpatialChainSpec, build_spatial_robot, solve_static
 from cdpr_exu.run.dynamics import run_dynamic
-from cdpr_exu.physics.spatial_statics import SpatialPlatform, solve_spatial_statics
+from cdpr_exu.statics.statics import SuspendedPlatform, solve_statics
 from conftest import ASYMMETRIC_LENGTHS, PENALTY, four_cable_robot
 
 def build(platform, lengths, chain, initial=None):
@@ -20,12 +20,12 @@ def build(platform, lengths, chain, initial=None):
 def static_errors(rigid, n_elements):
     """Exudyn's static chain robot minus the catenary statics: position [m], rotation [rad], tension [N]."""
     platform = four_cable_robot(rigid)
-    catenary = solve_spatial_statics(platform, ASYMMETRIC_LENGTHS)
+    catenary = solve_statics(platform, ASYMMETRIC_LENGTHS)
     chain = SpatialChainSpec(n_elements=n_elements, anchor_spring_factor=PENALTY if rigid else None)
     mbs, items = build(platform, ASYMMETRIC_LENGTHS, chain)
     exudyn_static = solve_static(mbs, items)
     return (np.abs(exudyn_static.position - catenary.position).max(),
-            np.abs(exudyn_static.rotation_vector - catenary.rotation_vector).max(),
+            np.abs(exudyn_static.rotation_vector - catenary.rotation).max(),
             np.abs(exudyn_static.tensions_at_anchor - catenary.tensions_at_anchor).max(),
             exudyn_static, platform)
 
@@ -90,7 +90,7 @@ def test_energy_without_damping_is_conserved_to_second_order_in_the_step(rigid):
     platform = four_cable_robot(rigid)
     lengths = [2.5] * 4
     push = [20.0, 8.0, 0.0, 1.0, 0.0, 0.5] if rigid else [20.0, 8.0, 0.0, 0.0, 0.0, 0.0]
-    start = solve_spatial_statics(platform, lengths, external_wrench=push)
+    start = solve_statics(platform, lengths, external_wrench=push)
     chain = SpatialChainSpec(n_elements=10, flexural_rigidity=0.05)
     drifts = []
     for step in (2e-3, 1e-3, 5e-4):
@@ -125,9 +125,9 @@ def test_a_rigid_platform_without_inertia_or_gravity_is_refused_before_anything_
     mbs = exu.SystemContainer().AddSystem()
     cables = four_cable_robot(True).cables
     with pytest.raises(SceneError, match="inertia"):
-        build_spatial_robot(mbs, SpatialPlatform(cables, mass=5.0), [2.5] * 4)
+        build_spatial_robot(mbs, SuspendedPlatform(cables, mass=5.0), [2.5] * 4)
     with pytest.raises(SceneError, match="gravity"):
-        build_spatial_robot(mbs, SpatialPlatform(cables, mass=5.0, inertia=(1, 1, 1), gravity=0.0), [2.5] * 4)
+        build_spatial_robot(mbs, SuspendedPlatform(cables, mass=5.0, inertia=(1, 1, 1), gravity=0.0), [2.5] * 4)
     with pytest.raises(SceneError, match="unstrained_lengths"):
         build_spatial_robot(mbs, four_cable_robot(True), [2.5] * 3)
     with pytest.raises(SceneError, match="chain"):

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
-from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.results.result import slack_time
 from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.studies.comparison import spatial_comparison_table
@@ -29,8 +29,8 @@ def four_cable(n_elements=10, bending=False, **solver):
 
 
 def start_pose(scene):
-    start = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
-    return np.concatenate([start.position, start.rotation_vector])
+    start = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
+    return np.concatenate([start.position, start.rotation])
 
 
 def test_a_robot_told_to_hold_its_equilibrium_stays_there():
@@ -98,14 +98,14 @@ def test_after_a_move_the_robot_rests_where_the_catenaries_of_the_paid_out_lengt
     result = simulate_spatial(scene)
     final = result.paid_out[-1]
     assert np.abs(final - scene.unstrained_lengths).max() > 0.25  # the winches moved decimetres
-    rest = solve_spatial_statics(scene.catenary_platform(), final, initial_pose=result.pose[-1])
+    rest = solve_statics(catenary_platform(scene), final, initial_pose=result.pose[-1])
     # The variable-length chains (rest lengths, stiffness, masses and weights all follow the
     # paid-out length) rest on the elastic catenaries of those lengths. Measured 4e-9 m and
     # 4e-9 rad after 1 s of settling (the same at 3 s more): the light rope's discretisation
     # error is that small; 1e-7 leaves room for the settling and still catches a chain whose
     # lengths, stiffness or weights did not follow its winch (micrometres and more).
     assert result.pose[-1, :3] == pytest.approx(rest.position, abs=1e-7)
-    assert result.pose[-1, 3:] == pytest.approx(rest.rotation_vector, abs=1e-7)
+    assert result.pose[-1, 3:] == pytest.approx(rest.rotation, abs=1e-7)
     assert [t[-1, -1] for t in result.tensions] == pytest.approx(rest.tensions_at_anchor, abs=0.5)
 
 

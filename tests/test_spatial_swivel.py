@@ -8,7 +8,7 @@ import pytest
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.geometry import swivel_pulley_exit
 from cdpr_exu.exits import Swivel
-from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.run.spatial_rest import solve_spatial_rest
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 
@@ -60,7 +60,7 @@ def test_bad_swivel_fields_are_refused_naming_the_field(change, field):
 
 def test_the_catenary_statics_over_swivel_pulleys_balance_and_point_each_pulley_at_its_anchor():
     scene = load_scene(NAME)
-    equilibrium = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    equilibrium = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     weight = scene.platform.mass * scene.gravity
     assert np.abs(equilibrium.net_wrench[:3]).max() < 1e-9 * weight
     for cable, swivel in zip(equilibrium.cables, scene.exits):
@@ -108,7 +108,7 @@ def test_spatial_scenes_honour_the_paper_mass_lumping():
     paper = replace(scene, cables=tuple(replace(c, mass_lumping="paper") for c in scene.cables))
     for chosen in (scene, paper):
         mbs = exu.SystemContainer().AddSystem()
-        items = build_spatial_robot(mbs, chosen.catenary_platform(), chosen.unstrained_lengths, scene_chain_spec(chosen))
+        items = build_spatial_robot(mbs, catenary_platform(chosen), chosen.unstrained_lengths, scene_chain_spec(chosen))
         cable = chosen.cables[0]
         # the planar cable's own lumping (CableSpec.node_masses), exit node first
         assert items.node_masses[0] == pytest.approx(cable.node_masses(), rel=1e-12)
@@ -128,7 +128,7 @@ def pushed_swivel_robot():
     scene = load_scene(NAME)
     scene = replace(scene, effects=replace(scene.effects, bending_damping=False))
     mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
+    items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
                                 scene_chain_spec(scene, tension_only=False), swivels=scene.swivel_exits)
     mbs.Assemble()
     settle(mbs, items)
@@ -189,20 +189,20 @@ def test_without_damping_the_energy_over_swivel_pulleys_is_bounded_and_its_first
 
 
 def test_the_inverse_statics_over_swivel_pulleys_give_lengths_whose_catenaries_hold_the_pose():
-    from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics
+    from cdpr_exu.statics.statics import solve_inverse_statics
 
     scene = load_scene(NAME)
-    platform, lengths = scene.catenary_platform(), scene.unstrained_lengths
-    rest = solve_spatial_statics(platform, lengths)
+    platform, lengths = catenary_platform(scene), scene.unstrained_lengths
+    rest = solve_statics(platform, lengths)
     tensions = np.array([c.catenary.horizontal_tension for c in rest.cables])
     # at the rest pose with the rest tensions: the scene's lengths (8.9e-16 m measured)
-    back = solve_inverse_spatial_statics(platform, rest.position, tensions)
+    back = solve_inverse_statics(platform, rest.position, initial_guess=tensions)
     assert back.unstrained_lengths == pytest.approx(lengths, abs=1e-12)
     # off the rest pose (an indeterminate robot: tensions nearest the rest ones); the forward statics of
     # the inverse lengths put the platform back there (2e-14 m measured), the wraps included
     pose = rest.position + [0.1, -0.05, 0.08]
-    inverse = solve_inverse_spatial_statics(platform, pose, tensions)
-    forward = solve_spatial_statics(platform, inverse.unstrained_lengths)
+    inverse = solve_inverse_statics(platform, pose, initial_guess=tensions)
+    forward = solve_statics(platform, inverse.unstrained_lengths)
     assert forward.position == pytest.approx(pose, abs=1e-10)
     assert np.abs(inverse.forces_on_platform.sum(axis=0) - [0.0, 0.0, scene.platform.mass * scene.gravity]).max() < 1e-8
 
@@ -216,7 +216,7 @@ def test_a_swivel_robot_starts_on_its_chain_statics_and_the_dynamic_settle_is_th
 
     def built():
         mbs = exu.SystemContainer().AddSystem()
-        items = build_spatial_robot(mbs, scene.catenary_platform(), scene.unstrained_lengths,
+        items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
                                     scene_chain_spec(scene, tension_only=False), swivels=scene.swivel_exits)
         mbs.Assemble()
         return mbs, items
@@ -266,7 +266,7 @@ def test_the_catenary_statics_find_a_small_swivel_robot_whose_straight_start_lay
     for cable in data["cables"]:
         cable["unstrained_length"] = 1.0
     scene = scene_from_dict(data)
-    equilibrium = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    equilibrium = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     weight = scene.platform.mass * scene.gravity
     assert np.abs(equilibrium.net_wrench[:3]).max() < 1e-9 * weight
     assert np.abs(equilibrium.position[:2]).max() < 1e-9

@@ -55,11 +55,11 @@ chain statics (:mod:`cdpr_exu.statics.chain_statics`, on the same discrete model
 :func:`chain_statics_robot`): Exudyn's static solver does not converge from that start.
 
 Units SI, z up, gravity along -z. The parameters are those of
-:mod:`cdpr_exu.physics.spatial_statics` (:class:`SpatialPlatform`, the unstrained
+:mod:`cdpr_exu.statics.statics` (:class:`SuspendedPlatform`, the unstrained
 lengths), plus the discretisation and the cable's damping and bending
 (:class:`SpatialChainSpec`); the chain's mass per length is ``weight_per_length /
 gravity``. The chains start on the catenary statics' solution (or any
-:class:`SpatialEquilibrium`, eg one under an extra load, to start the robot swinging):
+:class:`PlatformEquilibrium`, eg one under an extra load, to start the robot swinging):
 their reference configuration is straight and unstrained (element length ``L / n``),
 their initial displacements put the nodes on the catenary.
 """
@@ -82,8 +82,8 @@ from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # the disc and its angle psi
 from cdpr_exu.core.geometry import rotation_vector
-from cdpr_exu.physics.spatial_statics import (SpatialEquilibrium, SpatialPlatform, chain_element_mass,
-                                              checked_unstrained_lengths, node_masses_along, solve_spatial_statics)
+from cdpr_exu.statics.statics import (PlatformEquilibrium, SuspendedPlatform, chain_element_mass,
+                                      checked_unstrained_lengths, node_masses_along, solve_statics)
 from cdpr_exu.statics.chain_statics import ChainCable, ChainRobot, solve_chain_statics, swivel_chain_start, \
     winch_line_elements
 
@@ -177,7 +177,7 @@ class SpatialRobotItems:
 
     Attributes
     ----------
-    platform : SpatialPlatform
+    platform : SuspendedPlatform
     unstrained_lengths : ndarray, shape (n_cables,) [m]
     chain : SpatialChainSpec
     chains : list of SpatialChainItems
@@ -195,7 +195,7 @@ class SpatialRobotItems:
     anchor_markers, joints : list of int
         Platform markers at the anchors and the spherical joints (or penalty
         spring-dampers), one per cable.
-    initial : SpatialEquilibrium
+    initial : PlatformEquilibrium
         The catenary equilibrium the robot was started on.
     swivels : list of (SwivelItems or None)
         Each cable's swivel pulley in Exudyn (None: a point exit).
@@ -206,7 +206,7 @@ class SpatialRobotItems:
         ``winch_elements[i]`` started at the inlet.
     """
 
-    platform: SpatialPlatform
+    platform: SuspendedPlatform
     unstrained_lengths: np.ndarray
     chain: SpatialChainSpec
     chains: list
@@ -218,7 +218,7 @@ class SpatialRobotItems:
     platform_body: int
     anchor_markers: list
     joints: list
-    initial: SpatialEquilibrium = field(repr=False)
+    initial: PlatformEquilibrium = field(repr=False)
     swivels: list = field(default_factory=list)
     swivel_pulleys: list = field(default_factory=list)
     winch_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
@@ -253,14 +253,14 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     Parameters
     ----------
     mbs : exudyn.MainSystem
-    platform : SpatialPlatform
+    platform : SuspendedPlatform
         Its ``inertia`` must be positive for a rigid body.
     unstrained_lengths : array_like, shape (n_cables,) [m]
     chain : SpatialChainSpec, optional
         Default ``SpatialChainSpec()`` (20 elements, no damping, no bending).
-    initial : SpatialEquilibrium, optional
+    initial : PlatformEquilibrium, optional
         Start configuration: platform pose and cable shapes; default the catenary
-        statics of these lengths (:func:`solve_spatial_statics`).
+        statics of these lengths (:func:`solve_statics`).
     swivels : sequence of (Swivel or None), optional
         Each cable's swivel pulley (its contact, swivel inertia and bearing, winch line;
         see the module notes), None for a point exit; the platform's cable must then
@@ -275,8 +275,8 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     SceneError
         Naming the field, before anything is added to ``mbs``.
     """
-    if not isinstance(platform, SpatialPlatform):
-        raise SceneError(f"platform must be a SpatialPlatform, got {shown(platform)}")
+    if not isinstance(platform, SuspendedPlatform):
+        raise SceneError(f"platform must be a SuspendedPlatform, got {shown(platform)}")
     lengths = checked_unstrained_lengths(platform, unstrained_lengths)
     chain = SpatialChainSpec() if chain is None else chain
     if not isinstance(chain, SpatialChainSpec):
@@ -288,9 +288,9 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     if not platform.is_point_mass and platform.mass <= 0.0:
         raise SceneError(f"mass must be positive for a rigid platform, got {shown(platform.mass)}")
     if initial is None:
-        initial = solve_spatial_statics(platform, lengths)
-    elif not isinstance(initial, SpatialEquilibrium) or len(initial.cables) != len(platform.cables):
-        raise SceneError(f"initial must be a SpatialEquilibrium of this platform's {len(platform.cables)} cables, "
+        initial = solve_statics(platform, lengths)
+    elif not isinstance(initial, PlatformEquilibrium) or len(initial.cables) != len(platform.cables):
+        raise SceneError(f"initial must be a PlatformEquilibrium of this platform's {len(platform.cables)} cables, "
                          f"got {shown(initial)}")
 
     swivels = [None] * len(platform.cables) if swivels is None else list(swivels)
@@ -298,9 +298,9 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         raise SceneError(f"swivels must give one entry (or None) per cable ({len(platform.cables)}), got {len(swivels)}")
     for i, (cable, swivel) in enumerate(zip(platform.cables, swivels)):
         radius = 0.0 if swivel is None else swivel.radius
-        if cable.pulley_radius != radius or (swivel is not None and tuple(swivel.inlet) != cable.exit_point):
+        if cable.pulley_radius != radius or (swivel is not None and tuple(swivel.inlet) != cable.point):
             raise SceneError(f"swivels[{i}] does not match cables[{i}] of the platform (pulley_radius "
-                             f"{shown(cable.pulley_radius)} m, exit_point {cable.exit_point})")
+                             f"{shown(cable.pulley_radius)} m, exit point {cable.point})")
 
     n = chain.n_elements
     element_lengths = lengths / n
@@ -346,7 +346,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
             mbs.AddLoad(eii.LoadForceVector(markerNumber=centre, loadVector=[0.0, 0.0, -platform.mass * gravity]))
     else:
         body_inertia = RigidBodyInertia(mass=platform.mass, inertiaTensor=np.diag(inertia), inertiaTensorAtCOM=True)
-        created = mbs.CreateRigidBody(referencePosition=position, referenceRotationMatrix=initial.rotation,
+        created = mbs.CreateRigidBody(referencePosition=position, referenceRotationMatrix=initial.rotation_matrix,
                                       inertia=body_inertia, gravity=[0.0, 0.0, -gravity],
                                       nodeType=exu.NodeType.RotationEulerParameters, returnDict=True, show=False)
         platform_node, platform_body = created["nodeNumber"], created["bodyNumber"]

@@ -88,7 +88,7 @@ def print_spatial_rest(rest: SpatialRest, out: Path | None) -> None:
               f"force on platform {np.round(force, 4).tolist()} N")
     print(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
           f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
-          f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation_vector)):.4f} deg from the lumped robot")
+          f"{np.degrees(np.linalg.norm(rest.rotation_vector - catenary.rotation)):.4f} deg from the lumped robot")
     if rest.swivel_angles is not None:
         azimuths = [np.degrees(np.arctan2(*(c.anchor_point - c.inlet)[1::-1])) if c.inlet is not None else None
                     for c in catenary.cables]

@@ -4,7 +4,7 @@ Pure NumPy/SciPy; no Exudyn. The cables are ideal: straight, massless and
 inextensible. z is up, gravity along -z, SI units. A platform pose is
 ``(r, theta)``, shape (6,): the position ``r`` of its reference point [m] and a
 rotation vector ``theta`` [rad]; anchor i is at ``r + R(theta) b_i`` with
-``R = exp([theta]x)``, the conventions of :mod:`cdpr_exu.physics.spatial_statics`;
+``R = exp([theta]x)``, the conventions of :mod:`cdpr_exu.statics.statics`;
 the SO(3) helpers are :mod:`cdpr_exu.core.geometry`'s (``rotation_from_vector``,
 ``left_jacobian``). A
 point-mass platform (every cable on one point) has the pose ``r``, shape (3,).

@@ -2,7 +2,7 @@
 
 :func:`solve_spatial_rest` solves the scene twice, by two independent methods:
 
-* the **catenary statics** (:func:`cdpr_exu.physics.spatial_statics.solve_spatial_statics`):
+* the **catenary statics** (:func:`cdpr_exu.statics.statics.solve_statics`):
   each cable a continuous elastic catenary in its own vertical plane, the platform's
   pose from the cables' unstrained lengths (no bending);
 * the **lumped robot in Exudyn** (:mod:`cdpr_exu.builder.spatial_robot`): the scene's
@@ -40,7 +40,7 @@ from cdpr_exu.core.geometry import rotation_angles_deg
 from cdpr_exu.core.output import write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, scene_chain_spec, \
     solve_static, start_at_rest, swivel_angles
-from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import Scene
 
@@ -78,7 +78,7 @@ class SpatialRest:
         Force each cable exerts on the platform at its anchor.
     nodes : tuple of ndarray, each shape (n + 1, 3) [m]
         Node positions of each cable, exit first.
-    catenary : SpatialEquilibrium
+    catenary : PlatformEquilibrium
         The catenary statics of the same scene.
     element_tensions : tuple of ndarray, each shape (n,) [N]
         Axial force of each element, exit first (negative: compressed, which a real cable
@@ -147,12 +147,12 @@ class SpatialRest:
             "tension_at_anchor_N": self.tensions_at_anchor.tolist(),
             "force_on_platform_N": self.forces_on_platform.tolist(),
             "catenary_platform_position_m": catenary.position.tolist(),
-            "catenary_platform_rotation_vector_rad": catenary.rotation_vector.tolist(),
+            "catenary_platform_rotation_vector_rad": catenary.rotation.tolist(),
             "catenary_tension_at_anchor_N": catenary.tensions_at_anchor.tolist(),
             "min_element_tension_N": self.lowest_element_tension,
             "elements_pushed": self.lowest_element_tension < 0.0,
             "lumped_minus_catenary_position_m": self.catenary_distance,
-            "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(self.rotation_vector - catenary.rotation_vector)),
+            "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(self.rotation_vector - catenary.rotation)),
             "wall_time_s": self.wall_time,
             **({} if self.swivel_angles is None else {
                 "swivel_angle_rad": [None if np.isnan(a) else float(a) for a in self.swivel_angles],
@@ -202,7 +202,7 @@ def rest_above_exits(scene: Scene, position, rotation, lowest_tension: float, ca
         The platform's pose at that rest.
     lowest_tension : float [N]
         The lowest element force there (negative: compressed).
-    catenary : SpatialEquilibrium
+    catenary : PlatformEquilibrium
         The scene's elastic-catenary statics.
     """
     above = scene.above_exits(position, rotation)
@@ -231,9 +231,9 @@ def solve_spatial_rest(scene: Scene) -> SpatialRest:
         rest's summary.
     """
     start = _time.perf_counter()
-    platform = scene.catenary_platform()
+    platform = catenary_platform(scene)
     lengths = scene.unstrained_lengths
-    catenary = solve_spatial_statics(platform, lengths)
+    catenary = solve_statics(platform, lengths)
     rigid = not platform.is_point_mass
     chain = scene_chain_spec(scene, anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
     mbs = exu.SystemContainer().AddSystem()

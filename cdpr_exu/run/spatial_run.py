@@ -46,7 +46,7 @@ from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     scene_chain_spec, start_at_rest
 from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
-from cdpr_exu.physics.spatial_statics import solve_spatial_statics
+from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController
@@ -434,9 +434,9 @@ def build_spatial_model(scene: Scene):
     UnreachableError
         If no static equilibrium of the scene's lengths exists to start from.
     """
-    platform = scene.catenary_platform()
+    platform = catenary_platform(scene)
     lengths = scene.unstrained_lengths
-    start = solve_spatial_statics(platform, lengths)
+    start = solve_statics(platform, lengths)
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, platform, lengths, scene_chain_spec(scene), initial=start, swivels=scene.swivel_exits)
     mbs.Assemble()

@@ -36,11 +36,11 @@ from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, UnreachableErr
 from cdpr_exu.core.geometry import above_exits
 from cdpr_exu.core.validation import entries, finite, from_table, non_negative, positive, shown
 from cdpr_exu.exits import EXIT_KINDS, Exit, PointExit, Pulley, exit_from_dict
-from cdpr_exu.physics.spatial_statics import SpatialCable, SpatialPlatform
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
 from cdpr_exu.scenes.spatial_trajectories import SpatialHoldTrajectory, SpatialTrajectory, spatial_trajectory_from_dict
 from cdpr_exu.scenes.trajectories import HoldTrajectory, Trajectory, trajectory_from_dict
 from cdpr_exu.space import DIMENSIONS, PLANE, Space, space_of
+from cdpr_exu.statics.statics import catenary_platform
 
 # --------------------------------------------------------------------------- checks
 
@@ -962,23 +962,6 @@ class Scene:
         """
         return tuple(exit_ if exit_.wraps else None for exit_ in self.exits)
 
-    def catenary_platform(self) -> SpatialPlatform:
-        """A spatial scene as elastic catenaries (:mod:`cdpr_exu.physics.spatial_statics`).
-
-        Transitional: removed when the catenary statics has one driver for both dimensions (issue 24, slice 8).
-        """
-        gravity = self.gravity if self.effects.gravity else 0.0
-        weighs = self.effects.cable_mass and self.effects.gravity
-        weights = [c.linear_density * gravity if weighs else 0.0 for c in self.cables]
-        for i, (cable, weight) in enumerate(zip(self.cables, weights)):
-            if not math.isfinite(weight):
-                raise SceneError(f"cables[{i}].linear_density = {shown(cable.linear_density)} kg/m and gravity = "
-                                 f"{shown(gravity)} m/s^2 give a weight per length of {shown(weight)} N/m, out of "
-                                 "floating-point range")
-        cables = [SpatialCable(exit_.point, w, c.axial_rigidity, anchor=a, pulley_radius=exit_.radius)
-                  for c, w, exit_, a in zip(self.cables, weights, self.exits, self.platform.anchors)]
-        return SpatialPlatform(cables, self.platform.mass, gravity, self.platform.inertia)
-
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (TOML-ready) of the scene: the planar form for a planar scene whose exits are
         all pulleys or all point exits (:attr:`exits_table`), else the form with ``dimension`` and
@@ -1060,7 +1043,7 @@ def _spatial_rules(scene: Scene) -> None:
                 raise SceneError(f"cables[{i}].{name} = {shown(getattr(cable, name))} differs from cables[0].{name} = "
                                  f"{shown(getattr(first, name))}: the cables of a spatial scene share one "
                                  "discretisation, damping and bending so far")
-    scene.catenary_platform()  # refuses coincident exits, too few cables, anchors on one line
+    catenary_platform(scene)  # refuses coincident exits, too few cables, anchors on one line
     if scene.winch.kind == "servo":
         raise SceneError("winch.kind = 'servo': servo drums are planar only so far; use 'kinematic' or 'fixed'")
     if scene.solver.integrator != "generalized_alpha":

@@ -46,7 +46,7 @@ from cdpr_exu.core.geometry import rotation_from_vector, rotation_matrix, rotati
 from cdpr_exu.core.validation import finite, real_array, shown, vector
 from cdpr_exu.exits import Exit
 from cdpr_exu.physics import swivel_pulley as sp
-from cdpr_exu.physics.spatial_statics import chain_element_mass, node_masses_along, solve_spatial_statics
+from cdpr_exu.statics.statics import catenary_platform, chain_element_mass, node_masses_along, solve_statics
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS
 from cdpr_exu.space import space_of
 from cdpr_exu.statics.chain_kernels import PlanarChains, SpatialChains, planar_energy, planar_forces
@@ -246,7 +246,7 @@ def chain_robot(scene, anchor_spring_factor: float | None = None, tension_only: 
         In space, see :class:`ChainRobot` (the plane's chains end on their anchors).
     tension_only : bool, optional
         Default the scene's ``effects.slack`` (the spatial static mode builds spring elements: False).
-    catenary : SpatialEquilibrium, optional
+    catenary : PlatformEquilibrium, optional
         In space, the scene's catenary statics: a cable over a swivel pulley is held at the winch end
         its start shape puts it (:func:`swivel_chain_start`), as the builder holds it; solved here
         when not given and needed.
@@ -293,11 +293,11 @@ def _planar_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
 def _spatial_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
     """:func:`chain_robot` of a spatial scene."""
     effects = scene.effects
-    platform = scene.catenary_platform()  # what the builder builds from: weights, EA, gravity
+    platform = catenary_platform(scene)  # what the builder builds from: weights, EA, gravity
     gravity = platform.gravity
     swivels = scene.swivel_exits
     if catenary is None and any(s is not None for s in swivels):
-        catenary = solve_spatial_statics(platform, scene.unstrained_lengths)
+        catenary = solve_statics(platform, scene.unstrained_lengths)
     cables = []
     for i, (spec, cable, swivel) in enumerate(zip(scene.cables, platform.cables, swivels)):
         n, length = spec.n_elements, spec.unstrained_length
@@ -401,7 +401,7 @@ def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, co
     Parameters
     ----------
     equilibrium_cable : SpatialCableState
-        The cable in the catenary statics (:func:`cdpr_exu.physics.spatial_statics.solve_spatial_statics`).
+        The cable in the catenary statics (:func:`cdpr_exu.statics.statics.solve_statics`).
     length : float [m]
         Unstrained length from the inlet to the anchor (the catenary's).
     n_elements, winch_elements : int
@@ -822,8 +822,8 @@ def catenary_start(robot: ChainRobot, equilibrium):
     Parameters
     ----------
     robot : ChainRobot
-    equilibrium : SpatialEquilibrium
-        Of the same cables (:func:`cdpr_exu.physics.spatial_statics.solve_spatial_statics`).
+    equilibrium : PlatformEquilibrium
+        Of the same cables (:func:`cdpr_exu.statics.statics.solve_statics`).
 
     Returns
     -------
@@ -849,7 +849,7 @@ def catenary_start(robot: ChainRobot, equilibrium):
             points[0] = cable.exit_point
         points[-1] = state.anchor_point
         nodes.append(points)
-    return nodes, np.asarray(equilibrium.position, float), np.asarray(equilibrium.rotation, float), angles
+    return nodes, np.asarray(equilibrium.position, float), np.asarray(equilibrium.rotation_matrix, float), angles
 
 
 def _spatial_forward(robot: ChainRobot, nodes, position, rotation=None, swivel_angles=None, *,
@@ -932,7 +932,7 @@ def _forces_on_platform(model: SpatialChains, p, G):
 def _spatial_rest(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
                   **kwargs) -> ChainEquilibrium:
     """:func:`chain_rest` in space: started on the catenary statics, as the builder starts Exudyn's."""
-    catenary = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
+    catenary = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     robot = chain_robot(scene, anchor_spring_factor, tension_only, catenary)
     return _spatial_forward(robot, *catenary_start(robot, catenary), **kwargs)
 
@@ -1436,7 +1436,7 @@ def solve_inverse_chain_statics(robot: ChainRobot, pose, tension_guess=None, **k
     In space (Gauss-Newton on the lengths over chains held at their anchors, :func:`_solve_inverse`):
     the cables decouple and only the platform's balance ties them, six equations (three for a point
     mass, or a rigid platform on fewer than six cables, whose rotation is left free as in
-    :func:`cdpr_exu.physics.spatial_statics.solve_inverse_spatial_statics`) in the m lengths; among the
+    :func:`cdpr_exu.statics.statics.solve_inverse_statics`) in the m lengths; among the
     length changes that cancel the imbalance to first order, the one whose tensions (the norm of each
     cable's force on the platform) come nearest ``tension_guess``: continued along a trajectory, a
     redundant robot keeps its internal tension.

@@ -1,61 +1,53 @@
-"""Kineto-static equilibrium of a planar platform hung on elastic catenary cables.
+"""Kineto-static equilibrium of a platform hung on elastic catenary cables, in the plane or in space.
 
-The platform moves in the vertical x-z plane, gravity along -z. Its pose is the
-position ``r = (x, z)`` [m] of its centre of mass and its rotation ``phi`` [rad],
-positive counter-clockwise (the paper's eq. 17): an anchor ``b_i`` given in the
-platform frame sits at ``p_i = r + R(phi) b_i`` with ``R = [[cos, -sin], [sin, cos]]``.
-Moments are about the centre of mass, positive in the sense of ``phi``:
-``m = a_x f_z - a_z f_x`` for a force ``f`` applied at offset ``a``.
+One statics for both dimensions: a :class:`SuspendedPlatform` (its :class:`~cdpr_exu.space.Space`,
+cables, mass, gravity, inertia), made from a scene by :func:`catenary_platform`; one forward
+driver :func:`solve_statics` (the pose from the cables' unstrained lengths) and one inverse
+driver :func:`solve_inverse_statics` (the lengths that hold a pose), both returning a
+:class:`PlatformEquilibrium` of :class:`CableEquilibrium`. Units SI, gravity along -z.
 
-Each cable is an elastic catenary (`cdpr_exu.physics.catenary`) from its anchor on the
-platform (end A) to its upper end (end B), which is either
+**Poses.** Planar (the paper's vertical x-z plane): ``(x, z, phi)``, ``phi`` counter-clockwise
+(paper eq. 17), an anchor ``b_i`` at ``r + R(phi) b_i``, moments ``m = a_x f_z - a_z f_x``.
+Spatial (z up): ``(r, theta)``, ``theta`` the rotation vector, ``R = exp([theta]x)``; its
+derivative enters via the left Jacobian of SO(3) (a change ``d theta`` turns the body by the
+world-frame angle ``J_l(theta) d theta``, so the generalised force on ``theta`` is
+``J_l^T M``). A platform whose anchors all sit at its centre of mass is a point mass: only its
+position is solved. The two dimensions keep their own floating-point kernels (the pose
+kernels :class:`_PlanarStatics` and :class:`_SpatialStatics`, chosen by the platform's space):
+the residual, the pose Jacobian, the straight-cable start and the inverse differ per dimension.
 
-* a fixed exit point, or
-* a pulley: the cable comes up from its winch along the vertical line
-  ``x = c_x + side * r_p``, wraps over the top of the pulley and leaves it
-  tangentially at the point where the catenary's end direction is tangent to the
-  circle. The unstrained length counts from the anchor to the point
-  ``(c_x + side * r_p, c_z)`` and includes the wrapped arc.
+**Cables.** Each cable is an elastic catenary (:mod:`cdpr_exu.physics.catenary`: weight,
+axial elasticity, no bending) from its anchor (end A) to its exit (end B), chosen by the exit
+(:func:`forward_cable`, :func:`inverse_cable`):
 
-Pulley approximations (documented choices):
+* planar, a fixed exit point; or a planar pulley: the cable comes up from its winch along
+  ``x = c_x + side r_p``, wraps over the top and leaves the rim tangentially; its unstrained
+  length counts from the hang point ``(c_x + side r_p, c_z)`` and includes the wrap.
+  Frictionless (uniform tension along the wrap, whose unstrained length is
+  ``r_p wrap / (1 + T / EA)``); the wrap's weight is carried by the pulley (at most ``w r_p``
+  of tension, 7e-6 m of stretch for the paper's cable; a slight non-conservativeness, 2.5e-6
+  relative asymmetry of the stiffness); rigid rim, no pulley inertia. A platform under the
+  inner rim of a pulley cannot be held (:class:`UnreachableError`);
+* spatial, a point exit: the cable hangs in the vertical plane through its ends, the planar
+  catenary rotated back to 3-D (MoorPy's trick). With ``u`` the horizontal direction from
+  the anchor to the exit and ``h`` the horizontal span, its end stiffness is
+  ``Q K2 Q^T - (H / h) (P_h - u u^T)``, ``Q = [u, e_z]`` (a sideways step turns the pull;
+  for a vertical cable ``H / h`` tends to ``-K2[0, 0]``);
+* spatial, a swivel pulley: the disc turns to the vertical plane through its axis and the
+  anchor, where the cable is the planar pulley cable (centre ``(r_p, 0)``, side -1, hang
+  point at the inlet); its stiffness ``Q K2 Q^T + (f_rho / rho) (P_h - e_rho e_rho^T)``.
 
-* frictionless: the tension is the same all along the wrap, equal to the tension at
-  the tangent point; the wrapped arc's unstrained length is
-  ``r_p * wrap_angle / (1 + T / EA)``;
-* the weight of the wrapped part is carried by the pulley and neglected in the wrap's
-  tension. Exactly, a frictionless wrap gains ``w * height`` of tension going up
-  (``dT/ds = w dz/ds``): at most ``w r_p`` (0.86 N for the paper's cable, 12 % of the
-  7 N a 1 kg platform puts on each cable). It only changes the stretch of the wrapped
-  part, by ``r_p * wrap_angle * w r_p / EA`` (7e-6 m for the paper), and the tension
-  that reaches the winch, which is not modelled here. A side effect: length that
-  moves between the wrap and the span gains or loses weight, so the model is
-  slightly non-conservative and its stiffness slightly asymmetric (2.5e-6 relative
-  for the paper's cable; exactly symmetric for w = 0);
-* the pulley is a rigid circle; the cable has no bending stiffness; no pulley inertia
-  or friction;
-* a platform directly under the inner rim of a pulley (left of ``c_x + r_p`` for a
-  left pulley wrapped from its outer side) cannot be held: the cable there can only
-  pull it inwards, and `solve_inverse_statics` raises `UnreachableError`.
-
-Solvers:
-
-* `solve_forward_statics`: given the unstrained lengths, the pose and the forces;
-  unknowns ``(x, z)`` for a point mass, ``(x, z, phi)`` for a rigid platform.
-* `solve_inverse_statics`: given the position (and the rotation when it is free to
-  choose), the unstrained lengths, forces and, for a rigid platform on two cables,
-  the rotation that equilibrium imposes. Unknowns: the horizontal tension of each
-  cable (each cable's unstrained length follows from `catenary.solve_inverse`) and,
-  when it is not given, the rotation.
-
-Both are Newton iterations with analytic Jacobians built from the catenary end
-stiffnesses, and both accept an external wrench on the platform (eg the inertial
-load ``-M a`` for dynamic feed-forward, see `inertial_wrench`). The forward problem
-is an energy minimum: its line search follows the energy (see `minimise_energy`)
-and starts from `straight_cable_pose`. The inverse problem is a root search on the
-residual norm; for a rigid platform on two cables it is started at the rotations
-where straight massless cables balance the platform (up to a radian near the
-workspace edges). Horizontal tension cannot parametrise an exactly vertical cable,
-so inverse statics needs every cable off the vertical at the solution.
+**Solvers.** The forward problem is an energy minimum (cables conservative, weight ``M g z``):
+Newton's method with the analytic stiffness and a line search on the energy
+(:func:`minimise_energy`), started from :func:`straight_cable_pose` (straight, massless,
+elastic cables that may go slack), every evaluation solving each cable warm-started from the
+previous iterate; statically indeterminate robots need no tension distribution (the cables'
+elasticity picks the equilibrium). The inverse: planar, a square Newton iteration in the
+horizontal tensions (and the rotation a rigid platform on two cables takes), started from
+straight massless cables, with a weight continuation as the last resort; spatial, the
+horizontal tensions nearest a guess (least squares) that balance the platform, by
+Gauss-Newton. Horizontal tension cannot parametrise a vertical cable, so the inverse needs
+every cable off the vertical. Both accept an external wrench (eg :func:`inertial_wrench`).
 """
 
 from __future__ import annotations
@@ -64,47 +56,40 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import brentq, minimize
 
-from cdpr_exu.physics.catenary import (
-    DEFAULT_MAX_STRAIN,
-    STANDARD_GRAVITY,
-    CatenaryCable,
-    CatenaryState,
-    end_stiffness,
-    solve_forward,
-    solve_inverse,
-    span_and_jacobian,
-    state_from_end_forces,
-)
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import perpendicular, planar_cross, rotation_matrix
+from cdpr_exu.core.geometry import (left_jacobian, perpendicular, planar_cross, rotation_from_vector, rotation_matrix,
+                                    rotation_vector, skew, swivel_pulley_exit)
 from cdpr_exu.core.validation import finite, non_negative, positive, real_array, shown, vector
 from cdpr_exu.exits import Exit, Pulley
+from cdpr_exu.physics.catenary import (DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState,
+                                       end_stiffness, profile, solve_forward, solve_inverse, span_and_jacobian,
+                                       state_from_end_forces)
+from cdpr_exu.space import PLANE, SPACE, Space, space_of
 
 _RELATIVE_TOLERANCE = 1e-12
+"""Target of the scaled wrench residual (the cables are solved to 1e-12 of their length)."""
 
-
-# ---------------------------------------------------------------------------
-# validation helpers
-# ---------------------------------------------------------------------------
-def _point(name, value):
-    x, z = vector(name, value, 2, " (x, z) [m]")
-    return (float(x), float(z))
-
-
-def _wrench(value):
-    if value is None:
-        return np.zeros(3)
-    return vector("external_wrench", value, 3, " (fx [N], fz [N], moment [N m])")
+_E_Z = np.array([0.0, 0.0, 1.0])
+_HORIZONTAL = np.diag([1.0, 1.0, 0.0])
+_PLANE_X = np.array([1.0, 0.0])
 
 
 # ---------------------------------------------------------------------------
 # parameters
 # ---------------------------------------------------------------------------
+def _point(name, value, size=None):
+    """A point as a tuple of floats: (x, z) or (x, y, z) [m], its size given or read from ``value``."""
+    if size is None:
+        size = 2 if isinstance(value, (tuple, list, np.ndarray)) and len(value) == 2 else 3
+    labels = space_of(size).position_labels
+    return tuple(float(v) for v in vector(name, value, size, f" ({', '.join(labels)}) [m]"))
+
+
 @dataclass(frozen=True)
 class SuspendedCable:
-    """One cable of the platform: its material, its anchor and its upper end.
+    """One cable of the platform: its material, its anchor and its exit.
 
     Parameters
     ----------
@@ -112,56 +97,67 @@ class SuspendedCable:
         ``w >= 0``, weight per unstrained length.
     axial_stiffness : float [N]
         ``EA > 0``.
-    anchor : (float, float) [m]
-        Anchor point on the platform, in the platform frame (centre of mass at 0).
-    exit_point : (float, float) [m], optional
-        Fixed upper end, world frame. Give exactly one of ``exit_point`` and ``pulley``.
+    anchor : (x, z) or (x, y, z) [m], optional
+        Anchor on the platform, platform frame (centre of mass at 0); default the centre.
+    exit_point : (x, z) or (x, y, z) [m], optional
+        Fixed exit point, world frame; its size is the cable's dimension. Give exactly one of
+        ``exit_point`` and ``pulley``.
     pulley : Exit, optional
-        The planar exit the cable leaves from (:mod:`cdpr_exu.exits`): a
-        :class:`~cdpr_exu.exits.pulley.Pulley`, or an exit the cable does not wrap (a point
-        exit), taken as the fixed ``exit_point`` at its point.
+        The exit the cable leaves from (:mod:`cdpr_exu.exits`): a planar
+        :class:`~cdpr_exu.exits.pulley.Pulley` or a :class:`~cdpr_exu.exits.swivel.Swivel`, or
+        an exit the cable does not wrap (a point exit), taken as the fixed ``exit_point`` at
+        its point.
     """
 
     weight_per_length: float
     axial_stiffness: float
-    anchor: tuple = (0.0, 0.0)
+    anchor: tuple | None = None
     exit_point: tuple | None = None
     pulley: Exit | None = None
 
     def __post_init__(self):
-        object.__setattr__(
-            self, "weight_per_length", non_negative("weight_per_length", self.weight_per_length)
-        )
-        object.__setattr__(
-            self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness)
-        )
-        object.__setattr__(self, "anchor", _point("anchor", self.anchor))
+        set_ = object.__setattr__
+        set_(self, "weight_per_length", non_negative("weight_per_length", self.weight_per_length))
+        set_(self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness))
         if (self.exit_point is None) == (self.pulley is None):
-            raise SceneError(
-                f"give exactly one of exit_point and pulley, got exit_point={shown(self.exit_point)}, "
-                f"pulley={shown(self.pulley)}"
-            )
+            raise SceneError(f"give exactly one of exit_point and pulley, got exit_point={shown(self.exit_point)}, "
+                             f"pulley={shown(self.pulley)}")
         if self.exit_point is not None:
-            object.__setattr__(self, "exit_point", _point("exit_point", self.exit_point))
+            set_(self, "exit_point", _point("exit_point", self.exit_point))
         elif not isinstance(self.pulley, Exit):
             raise SceneError(f"pulley must be a Pulley or another exit (cdpr_exu.exits), got {shown(self.pulley)}")
         elif not self.pulley.wraps:  # the cable leaves from the exit's point
-            object.__setattr__(self, "exit_point", _point("exit_point", self.pulley.point))
-            object.__setattr__(self, "pulley", None)
+            set_(self, "exit_point", _point("exit_point", self.pulley.point))
+            set_(self, "pulley", None)
+        size = len(self.point)
+        set_(self, "anchor", _point("anchor", (0.0,) * size if self.anchor is None else self.anchor, size))
+
+    @property
+    def space(self) -> Space:
+        """The space the cable hangs in, from the size of its exit's point."""
+        return space_of(len(self.point))
+
+    @property
+    def point(self) -> tuple:
+        """The exit's fixed point [m]: the exit point, a planar pulley's centre or a swivel's inlet."""
+        return self.exit_point if self.pulley is None else tuple(self.pulley.point)
+
+    @property
+    def hang_point(self) -> np.ndarray:
+        """Where the unstrained length counts from, shape (d,) [m] (:attr:`cdpr_exu.exits.Exit.hang_point`)."""
+        return np.array(self.exit_point) if self.pulley is None else self.pulley.hang_point
+
+    @property
+    def pulley_radius(self) -> float:
+        """Radius [m] of the disc the cable wraps over; 0 for a fixed exit point."""
+        return 0.0 if self.pulley is None else float(self.pulley.radius)
 
     def catenary(self, unstrained_length):
         """The `CatenaryCable` of this cable with the given unstrained length [m]."""
         return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
 
-    @property
-    def upper_reference(self):
-        """Exit point, or pulley centre, shape (2,) [m]."""
-        if self.pulley is None:
-            return np.array(self.exit_point)
-        return np.array(self.pulley.center)
 
-
-def swivel_plane_cable(weight_per_length, axial_stiffness, radius) -> SuspendedCable:
+def _swivel_plane_cable(weight_per_length, axial_stiffness, radius) -> SuspendedCable:
     """The planar cable of a swivel pulley of radius ``radius`` [m], in the vertical plane through its axis
     and the anchor: over a pulley of centre (r_p, 0), hung on its left (side -1), so that its hang point
     is the inlet at the plane's origin and its winch line the swivel axis (:mod:`cdpr_exu.core.geometry`,
@@ -172,78 +168,158 @@ def swivel_plane_cable(weight_per_length, axial_stiffness, radius) -> SuspendedC
 
 @dataclass(frozen=True)
 class SuspendedPlatform:
-    """A planar platform hung on catenary cables.
+    """A platform hung on catenary cables, in the plane or in space (the cables' space).
 
     Parameters
     ----------
     cables : sequence of SuspendedCable
+        All planar or all spatial.
     mass : float [kg]
         ``M >= 0``; its weight ``M g`` acts at the centre of mass, along -z.
     gravity : float [m/s^2], optional
         Default 9.81.
-    moment_of_inertia : float [kg m^2], optional
-        About the centre of mass; only used by `inertial_wrench`.
+    inertia : float or (float, float, float) [kg m^2], optional
+        About the centre of mass: planar, the moment about the plane's normal; spatial, the
+        principal moments along the platform axes. Default 0; only :func:`inertial_wrench`
+        and the dynamics use it.
 
-    A platform whose anchors are all at the centre of mass is a point mass: its
-    rotation is irrelevant (fixed at 0) and only the force balance is solved.
+    Raises
+    ------
+    SceneError
+        Naming the field: no cables, cables of two dimensions, a negative mass, two cables
+        sharing an exit point, two cables of a rigid platform sharing an anchor, too few
+        cables to hang it (a point mass needs one, a rigid body two), or, in space, anchors
+        all on one line through the centre of mass (it would turn freely about it).
     """
 
     cables: tuple
     mass: float
     gravity: float = STANDARD_GRAVITY
-    moment_of_inertia: float = 0.0
+    inertia: float | tuple | None = None
 
     def __post_init__(self):
         try:
             cables = tuple(self.cables)
         except TypeError:
-            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {shown(self.cables)}") from None
-        if not cables or not all(isinstance(c, SuspendedCable) for c in cables):
-            raise SceneError(f"cables must be a non-empty sequence of SuspendedCable, got {shown(self.cables)}")
+            raise SceneError(f"cables must be a sequence of SuspendedCable, got {shown(self.cables)}") from None
+        if not all(isinstance(c, SuspendedCable) for c in cables):
+            raise SceneError(f"cables must be a sequence of SuspendedCable, got {shown(self.cables)}")
+        if len({c.space for c in cables}) > 1:
+            raise SceneError("cables must all be planar or all spatial, got exits "
+                             f"{[list(c.point) for c in cables]}")
         object.__setattr__(self, "cables", cables)
         object.__setattr__(self, "mass", non_negative("mass", self.mass))
         object.__setattr__(self, "gravity", non_negative("gravity", self.gravity))
-        object.__setattr__(
-            self, "moment_of_inertia", non_negative("moment_of_inertia", self.moment_of_inertia)
-        )
+        needed = 1 if self.is_point_mass else 2
+        if len(cables) < needed:
+            kind = "a point mass" if needed == 1 else "a rigid platform"
+            raise SceneError(f"cables: {kind} needs at least {needed} cable(s) to hang, got {len(cables)}")
+        object.__setattr__(self, "inertia", _KERNELS[self.space].inertia(self.inertia))
+        exits = np.array([c.point for c in cables])
+        anchors = self.anchors
+        size = max(1.0, float(np.abs(exits).max(initial=0.0)))
+        for i in range(len(cables)):
+            for j in range(i):
+                if np.linalg.norm(exits[i] - exits[j]) <= 1e-9 * size:
+                    raise SceneError(f"cables[{j}] and cables[{i}] share the exit_point {shown(exits[i])} m")
+        if not self.is_point_mass:
+            arm = max(float(np.linalg.norm(anchors, axis=1).max()), 1e-300)
+            for i in range(len(cables)):
+                for j in range(i):
+                    if np.linalg.norm(anchors[i] - anchors[j]) <= 1e-9 * arm:
+                        raise SceneError(f"cables[{j}] and cables[{i}] share the anchor {shown(anchors[i])} m "
+                                         f"on a rigid platform")
+            # the anchors must pin every axis the platform can turn about: in space, not all on one line
+            if np.linalg.matrix_rank(anchors, tol=1e-9 * arm) < min(2, self.space.rotation_size):
+                raise SceneError(f"cables: the anchors {anchors.tolist()} m lie on one line through the centre "
+                                 f"of mass; the platform would turn freely about it")
+
+    @property
+    def space(self) -> Space:
+        """The platform's space (:data:`~cdpr_exu.space.PLANE` or :data:`~cdpr_exu.space.SPACE`)."""
+        return self.cables[0].space
 
     @property
     def is_point_mass(self):
         """True when every anchor is at the centre of mass."""
-        return all(c.anchor == (0.0, 0.0) for c in self.cables)
+        return all(not any(c.anchor) for c in self.cables)
 
     @property
     def degrees_of_freedom(self):
-        """2 for a point mass ``(x, z)``, 3 for a rigid platform ``(x, z, phi)``."""
-        return 2 if self.is_point_mass else 3
+        """The position's size for a point mass, the pose's for a rigid platform: 2 | 3 planar, 3 | 6 spatial."""
+        return self.space.position_size if self.is_point_mass else self.space.pose_size
 
-    def anchor_points(self, position, rotation=0.0):
-        """World positions of the anchors, shape (n_cables, 2) [m]."""
-        turn = rotation_matrix(rotation)
-        return np.array([np.asarray(position) + turn @ c.anchor for c in self.cables])
+    @property
+    def anchors(self):
+        """Anchors in the platform frame, shape (n_cables, d) [m]."""
+        return np.array([c.anchor for c in self.cables])
+
+    @property
+    def hang_points(self):
+        """Where each cable's unstrained length counts from, shape (n_cables, d) [m]."""
+        return np.array([c.hang_point for c in self.cables])
 
 
-def inertial_wrench(platform, acceleration, angular_acceleration=0.0):
-    """D'Alembert load ``(-M a_x, -M a_z, -J alpha)`` for dynamic feed-forward.
+def catenary_platform(scene) -> SuspendedPlatform:
+    """The catenary-statics model of a scene's robot, planar or spatial: each cable's weight per length
+    ``rho0 g`` [N/m] (0 without cable mass or gravity), its ``EA`` [N], anchor and exit, the platform's
+    mass, gravity (0 when off) and inertia.
 
-    Parameters
-    ----------
-    platform : SuspendedPlatform
-    acceleration : (float, float) [m/s^2]
-        Acceleration of the centre of mass.
-    angular_acceleration : float [rad/s^2], optional
-
-    Returns
-    -------
-    ndarray, shape (3,) [N, N, N m]
-        To pass as ``external_wrench`` to the statics solvers. Cable inertia is
-        neglected (the cables stay in quasi-static equilibrium).
+    Raises
+    ------
+    SceneError
+        If a weight per length overflows, or the platform cannot hang (:class:`SuspendedPlatform`).
     """
-    a = _point("acceleration", acceleration)
-    alpha = finite("angular_acceleration", angular_acceleration)
-    return np.array(
-        [-platform.mass * a[0], -platform.mass * a[1], -platform.moment_of_inertia * alpha]
-    )
+    gravity = scene.gravity if scene.effects.gravity else 0.0
+    weighs = scene.effects.cable_mass and scene.effects.gravity
+    weights = [c.linear_density * gravity if weighs else 0.0 for c in scene.cables]
+    for i, (cable, weight) in enumerate(zip(scene.cables, weights)):
+        if not math.isfinite(weight):
+            raise SceneError(f"cables[{i}].linear_density = {shown(cable.linear_density)} kg/m and gravity = "
+                             f"{shown(gravity)} m/s^2 give a weight per length of {shown(weight)} N/m, out of "
+                             "floating-point range")
+    cables = [SuspendedCable(w, c.axial_rigidity, anchor=a, pulley=exit_)
+              for c, w, exit_, a in zip(scene.cables, weights, scene.exits, scene.platform.anchors)]
+    return SuspendedPlatform(tuple(cables), scene.platform.mass, gravity, scene.platform.inertia)
+
+
+def inertial_wrench(platform, acceleration, angular_acceleration=None):
+    """D'Alembert load ``(-M a, -I alpha)`` for dynamic feed-forward, shape (wrench_size,) [N, N m].
+
+    ``acceleration`` (d,) [m/s^2] of the centre of mass; ``angular_acceleration`` [rad/s^2]: planar a
+    float, spatial (3,) about the platform axes (its principal axes; the moment neglects the
+    gyroscopic term and holds at the reference orientation); default none. To pass as
+    ``external_wrench`` to the statics solvers; the cables' inertia is neglected (they stay in
+    quasi-static equilibrium).
+    """
+    space = platform.space
+    a = vector("acceleration", acceleration, space.position_size, f" ({', '.join(space.position_labels)}) [m/s^2]")
+    if angular_acceleration is None:
+        moment = np.zeros(space.rotation_size)
+    else:
+        alpha = real_array("angular_acceleration", angular_acceleration).reshape(-1)
+        if alpha.shape != (space.rotation_size,):
+            raise SceneError(f"angular_acceleration must have {space.rotation_size} entries [rad/s^2], "
+                             f"got {shown(angular_acceleration)}")
+        moment = -np.asarray(platform.inertia) * alpha
+    return np.concatenate([-platform.mass * a, moment])
+
+
+def chain_element_mass(cable, length, n_elements, gravity):
+    """Mass of one of the ``n_elements`` equal elements of ``cable`` (a :class:`SuspendedCable`) of unstrained
+    ``length`` [m] [kg]: its weight per length over ``gravity`` [m/s^2] (> 0)."""
+    return cable.weight_per_length / gravity * length / n_elements
+
+
+def node_masses_along(n_elements, element_mass, mass_lumping="consistent"):
+    """Lumped masses of the n + 1 nodes of a cable of equal elements, exit first, shape (n + 1,) [kg]:
+    "consistent" puts half of each element on each of its nodes; "paper" puts it on its far node,
+    the held exit node getting half an element."""
+    masses = np.full(n_elements + 1, float(element_mass))
+    masses[0] = 0.5 * element_mass
+    if mass_lumping == "consistent":
+        masses[-1] = 0.5 * element_mass
+    return masses
 
 
 # ---------------------------------------------------------------------------
@@ -256,31 +332,46 @@ class CableEquilibrium:
     Attributes
     ----------
     catenary : CatenaryState
-        The suspended part, from the anchor (A) to the exit or tangent point (B).
+        The suspended part in its vertical plane, A at the anchor, B at the exit or tangent point.
     unstrained_length : float [m]
-        Total: suspended part plus, with a pulley, the wrapped arc up to the winch
-        point.
-    suspended_length : float [m]
-        Unstrained length of the suspended part.
-    anchor_point : ndarray, shape (2,) [m]
-        World position of the anchor.
-    upper_point : ndarray, shape (2,) [m]
-        Exit point, or the point where the cable leaves the pulley.
+        Total: suspended part plus, over a pulley, the wrapped arc up to the hang point.
+    anchor_point, exit_point : ndarray, shape (d,) [m]
+        World positions of the anchor and of the exit point (over a pulley: the tangent point).
+    force_on_platform, force_on_exit : ndarray, shape (d,) [N]
+        Forces the cable exerts on the platform at its anchor and on its exit (tangent) point.
+    cable : CatenaryCable
+        The catenary parameters of the suspended part.
+    guess : tuple
+        Warm start of the next solve of this cable.
+    horizontal_direction : ndarray, shape (d,)
+        The x axis of the catenary's plane: planar (1, 0); spatial ``u``, the horizontal unit
+        vector from the anchor towards the exit (any one for a vertical cable), over a swivel
+        ``e_rho`` from the axis towards the anchor.
+    pulley_radius : float [m]
+        0 for a fixed exit point.
     wrap_angle : float [rad]
         Angle wrapped on the pulley (0 for a fixed exit point).
+    inlet : ndarray, shape (3,) [m] or None
+        A swivel pulley's inlet.
     """
 
     catenary: CatenaryState
     unstrained_length: float
-    suspended_length: float
     anchor_point: np.ndarray
-    upper_point: np.ndarray
+    exit_point: np.ndarray
+    force_on_platform: np.ndarray
+    force_on_exit: np.ndarray
+    cable: CatenaryCable = field(repr=False)
+    guess: tuple = field(default=None, repr=False)
+    horizontal_direction: np.ndarray | None = field(default=None, repr=False)
+    pulley_radius: float = 0.0
     wrap_angle: float = 0.0
+    inlet: np.ndarray | None = None
 
     @property
-    def force_on_platform(self):
-        """Force the cable exerts on the platform at its anchor, shape (2,) [N]."""
-        return self.catenary.force_on_a
+    def suspended_length(self):
+        """Unstrained length of the suspended part, anchor to exit or tangent point [m]."""
+        return self.cable.unstrained_length
 
     @property
     def tension_at_anchor(self):
@@ -292,13 +383,78 @@ class CableEquilibrium:
         """Tension at the exit or tangent point [N] (uniform along the wrap)."""
         return self.catenary.tension_b
 
+    def points(self, s):
+        """Points of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor, shape (n, d) [m].
 
-class PlatformEquilibriumViews:
-    """Per-cable views of a platform equilibrium that holds ``cables`` and ``stiffness``.
+        Over a swivel pulley, arc lengths beyond the suspended part lie on the wrap (stretched by the
+        tension at the tangent point), up to ``unstrained_length`` at the inlet."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        suspended = self.suspended_length
+        hanging = s <= suspended if self.inlet is not None else np.ones(s.shape, bool)
+        up = np.eye(len(self.anchor_point))[-1]
+        points = np.empty((s.size, len(self.anchor_point)))
+        if hanging.any():
+            planar = profile(self.cable, self.catenary, s[hanging])
+            points[hanging] = (self.anchor_point + np.outer(planar[:, 0], self.horizontal_direction)
+                               + np.outer(planar[:, 1], up))
+        if not hanging.all():
+            radius = self.pulley_radius
+            stretch = 1.0 + self.tension_at_exit / self.cable.axial_stiffness
+            # rim angle in the plane (rho, z) about the centre (r_p, 0): the inlet is at pi
+            angle = np.minimum(math.pi - self.wrap_angle + (s[~hanging] - suspended) * stretch / radius, math.pi)
+            points[~hanging] = (self.inlet + np.outer(radius * (1.0 + np.cos(angle)), self.horizontal_direction)
+                                + np.outer(radius * np.sin(angle), up))
+        return points
 
-    Shared by the planar :class:`PlatformEquilibrium` and the spatial
-    :class:`~cdpr_exu.physics.spatial_statics.SpatialEquilibrium`.
+
+@dataclass(frozen=True, eq=False)
+class PlatformEquilibrium:
+    """A static (or quasi-static) equilibrium of the platform on its cables.
+
+    Attributes
+    ----------
+    space : Space
+    position : ndarray, shape (d,) [m]
+        Centre of mass.
+    rotation : float or ndarray, shape (3,) [rad]
+        The space's rotation: planar the angle ``phi`` (counter-clockwise), spatial the rotation
+        vector; 0 for a point mass.
+    rotation_matrix : ndarray, shape (d, d)
+        ``R``: platform frame to world frame.
+    cables : tuple of CableEquilibrium
+    stiffness : ndarray, shape (k, k), or None
+        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths, ``k`` the degrees of
+        freedom (N/m, N/rad, N m/m, N m/rad); positive definite where the equilibrium is
+        stable. None where not computed (the spatial inverse).
+    external_wrench : ndarray, shape (wrench_size,) [N, N m]
+    net_wrench : ndarray, shape (wrench_size,) [N, N m]
+        Remaining force and moment (about the centre of mass) on the platform: cables,
+        weight and external load; zero to solver tolerance.
     """
+
+    space: Space
+    position: np.ndarray
+    rotation: float | np.ndarray
+    rotation_matrix: np.ndarray = field(repr=False)
+    cables: tuple = ()
+    stiffness: np.ndarray | None = field(default=None, repr=False)
+    external_wrench: np.ndarray | None = field(default=None, repr=False)
+    net_wrench: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def pose(self):
+        """Position and rotation, shape (pose_size,) [m, rad]."""
+        return np.append(self.position, self.rotation)
+
+    @property
+    def unstrained_lengths(self):
+        """Unstrained length of each cable, shape (n_cables,) [m]."""
+        return np.array([c.unstrained_length for c in self.cables])
+
+    @property
+    def horizontal_tensions(self):
+        """Horizontal tension of each cable, shape (n_cables,) [N]."""
+        return np.array([c.catenary.horizontal_tension for c in self.cables])
 
     @property
     def tensions_at_anchor(self):
@@ -306,45 +462,24 @@ class PlatformEquilibriumViews:
         return np.array([c.tension_at_anchor for c in self.cables])
 
     @property
+    def tensions_at_exit(self):
+        """Tension of each cable at its exit (tangent) point, shape (n_cables,) [N]."""
+        return np.array([c.tension_at_exit for c in self.cables])
+
+    @property
     def forces_on_platform(self):
-        """Force of each cable on the platform, shape (n_cables, 2) or (n_cables, 3) [N]."""
+        """Force of each cable on the platform, shape (n_cables, d) [N]."""
         return np.array([c.force_on_platform for c in self.cables])
+
+    @property
+    def anchor_points(self):
+        """World positions of the anchors, shape (n_cables, d) [m]."""
+        return np.array([c.anchor_point for c in self.cables])
 
     @property
     def is_stable(self):
         """True when the symmetric part of `stiffness` is positive definite."""
         return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
-
-
-@dataclass(frozen=True, eq=False)
-class PlatformEquilibrium(PlatformEquilibriumViews):
-    """A static (or quasi-static) equilibrium of the platform on its cables.
-
-    Attributes
-    ----------
-    position : ndarray, shape (2,) [m]
-        Centre of mass.
-    rotation : float [rad]
-        Counter-clockwise; 0 for a point mass.
-    cables : tuple of CableEquilibrium
-    stiffness : ndarray, shape (k, k)
-        ``-d(wrench on the platform)/d(pose)`` at fixed unstrained lengths, with
-        ``k = 2`` ``(x, z)`` for a point mass, ``k = 3`` ``(x, z, phi)`` otherwise;
-        units N/m, N/rad, N m/m, N m/rad. Positive definite where the equilibrium is
-        stable.
-    external_wrench : ndarray, shape (3,) [N, N, N m]
-    """
-
-    position: np.ndarray
-    rotation: float
-    cables: tuple
-    stiffness: np.ndarray = field(repr=False)
-    external_wrench: np.ndarray = field(repr=False)
-
-    @property
-    def unstrained_lengths(self):
-        """Unstrained length of each cable, shape (n_cables,) [m]."""
-        return np.array([c.unstrained_length for c in self.cables])
 
 
 # ---------------------------------------------------------------------------
@@ -538,25 +673,28 @@ def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_leng
     return residual, partial, catenary
 
 
-def forward_cable(cable, unstrained_length, point, guess, max_strain, max_tension):
-    """Cable of given length from an anchor point: equilibrium and ``dF_A/dp_A``.
+def _planar_equilibrium(state, catenary_cable, unstrained_length, point, upper, guess, wrap=0.0, radius=0.0):
+    return CableEquilibrium(state, unstrained_length, point.copy(), upper, state.force_on_a, state.force_on_b,
+                            catenary_cable, guess, _PLANE_X, radius, wrap)
 
-    Returns ``(CableEquilibrium, d(force on A)/d(anchor point) (2, 2), guess)``.
-    """
+
+def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, max_tension):
+    """A planar cable of given length from an anchor point: its equilibrium (the next guess in it) and
+    ``d(force on A)/d(anchor point)`` (2, 2)."""
     if cable.pulley is None:
         catenary_guess = None if guess is None else guess[:2]
+        catenary_cable = cable.catenary(unstrained_length)
         state = solve_forward(
-            cable.catenary(unstrained_length),
+            catenary_cable,
             np.array(cable.exit_point) - point,
             initial_guess=catenary_guess,
             max_strain=max_strain,
             max_tension=max_tension,
         )
-        equilibrium = CableEquilibrium(
-            state, unstrained_length, unstrained_length, point.copy(), np.array(cable.exit_point)
-        )
         stiffness = end_stiffness(cable.catenary(unstrained_length), state)
-        return equilibrium, stiffness, (state.horizontal_tension, state.vertical_tension_b)
+        guess = (state.horizontal_tension, state.vertical_tension_b)
+        return _planar_equilibrium(state, catenary_cable, unstrained_length, point, np.array(cable.exit_point),
+                                   guess), stiffness
 
     pulley, EA, w, r = cable.pulley, cable.axial_stiffness, cable.weight_per_length, cable.pulley.radius
 
@@ -613,7 +751,8 @@ def forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensio
     x, jacobian, sign_x, _ = _warm_then_cold(solve_from, guess)
     H, V_B, angle = x
     length, derivative, wrap = suspended_length(x)
-    state = state_from_end_forces(cable.catenary(length), H, V_B, sign_x)
+    catenary_cable = cable.catenary(length)
+    state = state_from_end_forces(catenary_cable, H, V_B, sign_x)
     if state.max_tension > _tension_limit(cable, max_strain, max_tension):
         raise UnreachableError(
             f"cable of unstrained_length {unstrained_length:g} m would need tension "
@@ -621,14 +760,11 @@ def forward_cable(cable, unstrained_length, point, guess, max_strain, max_tensio
         )
     # d(H, V_B, angle)/d(point) = -jacobian^-1 d(residual)/d(point), d(residual)/d(point) = [I; 0]
     sensitivity = -np.linalg.solve(jacobian, np.vstack([np.eye(2), np.zeros((1, 2))]))
-    force_derivative = np.array(
-        [[sign_x, 0.0, 0.0], [-w * derivative[0], 1.0 - w * derivative[1], -w * derivative[2]]]
-    )
+    force_derivative = np.array([[sign_x, 0.0, 0.0], [-w * derivative[0], 1.0 - w * derivative[1], -w * derivative[2]]])
     stiffness = force_derivative @ sensitivity
-    equilibrium = CableEquilibrium(
-        state, unstrained_length, length, point.copy(), pulley.rim_point(angle), wrap
-    )
-    return equilibrium, stiffness, (H, V_B, angle)
+    equilibrium = _planar_equilibrium(state, catenary_cable, unstrained_length, point, pulley.rim_point(angle),
+                                      (H, V_B, angle), wrap, r)
+    return equilibrium, stiffness
 
 
 def _tension_limit(cable, max_strain, max_tension):
@@ -636,10 +772,10 @@ def _tension_limit(cable, max_strain, max_tension):
     return limit if max_tension is None else min(limit, max_tension)
 
 
-def inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
-    """Cable with given horizontal tension from an anchor point.
+def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
+    """A planar cable with given horizontal tension from an anchor point.
 
-    Returns ``(CableEquilibrium, dF_A/dH (2,), dF_A/dp_A at fixed H (2, 2), guess)``.
+    Returns ``(CableEquilibrium, dF_A/dH (2,), dF_A/dp_A at fixed H (2, 2))``, the next guess in the first.
     """
     H, w, EA = horizontal_tension, cable.weight_per_length, cable.axial_stiffness
     if cable.pulley is None:
@@ -651,8 +787,8 @@ def inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tensi
         d_residual_dH = jac[:, 0]
         d_residual_dp = np.eye(2)
         sign_x = state.horizontal_sign
-        equilibrium = CableEquilibrium(state, length, length, point.copy(), np.array(cable.exit_point))
-        new_guess = None
+        equilibrium = _planar_equilibrium(state, cable.catenary(length), length, point, np.array(cable.exit_point),
+                                          None)
     else:
         pulley, r = cable.pulley, cable.pulley.radius
 
@@ -685,155 +821,666 @@ def inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tensi
 
         x, jacobian, sign_x, tension_scale = _warm_then_cold(solve_from, guess)
         length, V_B, angle = x
-        _, partial, catenary = _pulley_residual(
-            cable, pulley, sign_x, point, H, V_B, angle, length, tension_scale
-        )
+        _, partial, catenary = _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, length, tension_scale)
         d_residual_dH = partial[:, 0]
         d_residual_dp = np.vstack([np.eye(2), np.zeros((1, 2))])
         state = state_from_end_forces(catenary, H, V_B, sign_x)
         wrap = pulley.wrap_to(angle)
         total = length + r * wrap / (1.0 + state.tension_b / EA)
-        equilibrium = CableEquilibrium(state, total, length, point.copy(), pulley.rim_point(angle), wrap)
-        new_guess = (length, V_B, angle)
+        equilibrium = _planar_equilibrium(state, catenary, total, point, pulley.rim_point(angle), (length, V_B, angle),
+                                          wrap, r)
     if state.max_tension > _tension_limit(cable, max_strain, max_tension):
-        raise UnreachableError(
-            f"horizontal_tension {H:g} N needs tension {state.max_tension:g} N, above the limit"
-        )
+        raise UnreachableError(f"horizontal_tension {H:g} N needs tension {state.max_tension:g} N, above the limit")
     # unknowns u = (L_c, V_B[, angle]); force on A = (sign_x H, V_B - w L_c)
     d_u_dH = -np.linalg.solve(jacobian, d_residual_dH)
     d_u_dp = -np.linalg.solve(jacobian, d_residual_dp)
     force_dH = np.array([sign_x, d_u_dH[1] - w * d_u_dH[0]])
     force_dp = np.vstack([np.zeros(2), d_u_dp[1] - w * d_u_dp[0]])
-    return equilibrium, force_dH, force_dp, new_guess
+    return equilibrium, force_dH, force_dp
 
 
 # ---------------------------------------------------------------------------
-# the platform
+# one spatial cable: the planar cable in its vertical plane
 # ---------------------------------------------------------------------------
-def _scales(platform, lengths, wrench):
-    """Force [N] and length [m] scales of the equilibrium residual."""
-    weight = platform.mass * platform.gravity
-    cable_weight = sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths))
-    force = weight + cable_weight + float(np.hypot(wrench[0], wrench[1]))
-    arm = max((float(np.hypot(*c.anchor)) for c in platform.cables), default=0.0)
-    length = arm if arm > 0.0 else 1.0
-    force = max(force, abs(wrench[2]) / length, 1e-12)
-    return force, length
+def _vertical_plane_forward_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
+    """A spatial cable from a point exit: the planar catenary in the vertical plane through its ends."""
+    catenary_cable = cable.catenary(unstrained_length)
+    exit_point = np.array(cable.exit_point)
+    span = exit_point - anchor_point
+    horizontal = float(math.hypot(span[0], span[1]))
+    direction = np.array([span[0], span[1], 0.0]) / horizontal if horizontal > 0.0 else np.array([1.0, 0.0, 0.0])
+    state = solve_forward(catenary_cable, (horizontal, span[2]), initial_guess=guess, max_strain=max_strain,
+                          max_tension=max_tension)
+    planar = end_stiffness(catenary_cable, state)
+    basis = np.column_stack([direction, _E_Z])
+    stiffness = basis @ planar @ basis.T
+    vertical = horizontal <= 1e-9 * max(unstrained_length, float(np.linalg.norm(span)))
+    sideways = -planar[0, 0] if vertical else state.horizontal_tension / horizontal
+    stiffness -= sideways * (_HORIZONTAL - np.outer(direction, direction))
+    equilibrium = CableEquilibrium(
+        state, float(unstrained_length), np.array(anchor_point, dtype=float), exit_point,
+        state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
+        state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
+        catenary_cable, (state.horizontal_tension, state.vertical_tension_b), direction)
+    return equilibrium, stiffness
 
 
-def _platform_noise(platform, force_scale):
-    """Precision of the relative wrench balance.
+def _swivel_plane(cable, anchor_point):
+    """The vertical plane through a swivel pulley's axis and ``anchor_point`` (3,) [m], where its cable hangs.
 
-    Each cable is solved to ``1e-12`` of its length, which leaves a force error of
-    about ``1e-12 EA``: a stiff cable cannot balance a light platform any better.
+    Returns the inlet (3,) [m], the plane's horizontal unit vector e_rho (3,), the anchor's span from
+    the inlet in the plane (rho, dz) (2,) [m], and the planar pulley cable whose disc touches the axis
+    at the plane's origin (:func:`_swivel_plane_cable`).
+
+    Raises
+    ------
+    UnreachableError
+        If the anchor lies on the axis (its azimuth, and so the plane, is undefined).
     """
-    stiffest = max(c.axial_stiffness for c in platform.cables)
-    return 1e3 * _RELATIVE_TOLERANCE * (1.0 + stiffest / force_scale)
+    inlet = np.array(cable.point)
+    offset = np.asarray(anchor_point, dtype=float) - inlet
+    rho = float(math.hypot(offset[0], offset[1]))
+    if rho <= 1e-12 * (float(np.linalg.norm(offset)) + cable.pulley_radius):
+        raise UnreachableError(f"anchor {np.asarray(anchor_point).tolist()} lies on the axis of the swivel pulley at "
+                               f"{inlet.tolist()}: its azimuth is undefined")
+    e_rho = np.array([offset[0], offset[1], 0.0]) / rho
+    planar_cable = _swivel_plane_cable(cable.weight_per_length, cable.axial_stiffness, cable.pulley_radius)
+    return inlet, e_rho, np.array([rho, offset[2]]), planar_cable
 
 
-def _wrench_residual(platform, rotation, equilibria, wrench, dof):
-    """Net wrench on the platform ``(fx, fz[, m])`` [N, N, N m]."""
-    turn = rotation_matrix(rotation)
-    total = np.array([wrench[0], wrench[1] - platform.mass * platform.gravity, wrench[2]])
-    for cable, equilibrium in zip(platform.cables, equilibria):
-        force = equilibrium.force_on_platform
-        total[:2] += force
-        total[2] += planar_cross(turn @ cable.anchor, force)
-    return total[:dof]
+def _lifted(planar, cable, anchor_point, inlet, e_rho, force):
+    """The planar pulley cable's equilibrium in the swivel's plane, lifted to 3-D."""
+    state = planar.catenary
+    return CableEquilibrium(
+        state, planar.unstrained_length, np.array(anchor_point, dtype=float),
+        inlet + planar.exit_point[0] * e_rho + planar.exit_point[1] * _E_Z,
+        force[0] * e_rho + force[1] * _E_Z, state.force_on_b[0] * e_rho + state.force_on_b[1] * _E_Z,
+        cable.catenary(planar.suspended_length), None if planar.guess is None else tuple(planar.guess), e_rho,
+        cable.pulley_radius, float(planar.wrap_angle), inlet)
 
 
-def _pose_jacobian(platform, rotation, equilibria, stiffnesses, dof):
-    """``d(net wrench)/d(pose)`` from the cables' ``dF_A/dp_A``, shape (dof, dof)."""
-    turn = rotation_matrix(rotation)
-    jacobian = np.zeros((3, 3))
-    for cable, equilibrium, stiffness in zip(platform.cables, equilibria, stiffnesses):
-        arm = turn @ cable.anchor
-        d_point = np.column_stack([np.eye(2), perpendicular(arm)])  # dp/d(x, z, phi)
-        d_force = stiffness @ d_point
-        force = equilibrium.force_on_platform
-        jacobian[:2] += d_force
-        jacobian[2] += arm[0] * d_force[1] - arm[1] * d_force[0]
-        jacobian[2, 2] += planar_cross(perpendicular(arm), force)
-    return jacobian[:dof, :dof]
+def _swivel_forward_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
+    """A spatial cable over a swivel pulley: the planar pulley cable in the plane through the axis and the anchor."""
+    anchor_point = np.asarray(anchor_point, dtype=float)
+    inlet, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
+    planar, planar_stiffness = _planar_forward_cable(planar_cable, float(unstrained_length), span, guess,
+                                                     max_strain, max_tension)
+    basis = np.column_stack([e_rho, _E_Z])
+    force = planar.force_on_platform
+    stiffness = basis @ planar_stiffness @ basis.T + force[0] / span[0] * (_HORIZONTAL - np.outer(e_rho, e_rho))
+    return _lifted(planar, cable, anchor_point, inlet, e_rho, force), stiffness
 
 
-def _lengths(platform, unstrained_lengths):
-    try:
-        lengths = np.asarray(unstrained_lengths, dtype=float)
-    except (TypeError, ValueError):
-        raise SceneError(f"unstrained_lengths must be numbers [m], got {shown(unstrained_lengths)}") from None
+def _vertical_plane_inverse_cable(cable, horizontal_tension, anchor_point, guess, max_strain, max_tension):
+    """A spatial cable from a point exit at horizontal tension H (the plane's inverse catenary)."""
+    exit_point = np.array(cable.exit_point)
+    span = exit_point - anchor_point
+    horizontal = float(math.hypot(span[0], span[1]))
+    if horizontal <= 0.0:
+        raise UnreachableError(f"cable from {shown(exit_point)} hangs vertically above its anchor: its horizontal "
+                               "tension is zero and the inverse catenary has no answer")
+    direction = np.array([span[0], span[1], 0.0]) / horizontal
+    length, state = solve_inverse((horizontal, span[2]), cable.weight_per_length, cable.axial_stiffness,
+                                  horizontal_tension)
+    return CableEquilibrium(
+        state, length, np.array(anchor_point, dtype=float), exit_point,
+        state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
+        state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
+        cable.catenary(length), None, direction), None, None
+
+
+def _swivel_inverse_cable(cable, horizontal_tension, anchor_point, guess, max_strain, max_tension):
+    """A spatial cable over a swivel pulley at horizontal tension H: the planar pulley cable's inverse in the
+    vertical plane through the axis and the anchor (the length counts from the inlet, the wrap included)."""
+    inlet, e_rho, span, planar_cable = _swivel_plane(cable, anchor_point)
+    planar, _, _ = _planar_inverse_cable(planar_cable, float(horizontal_tension), span, None, DEFAULT_MAX_STRAIN,
+                                         None)
+    return _lifted(planar, cable, anchor_point, inlet, e_rho, planar.force_on_platform), None, None
+
+
+def _cable_kernel(cable):
+    """The per-cable solvers (forward, inverse) of ``cable``, by its space and whether it wraps over its exit."""
+    return _CABLE_KERNELS[cable.space][cable.pulley is not None]
+
+
+def forward_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
+                  max_tension=None):
+    """Solve one cable of given unstrained length [m] from a given anchor point (d,) [m] to its exit.
+
+    The solver is the exit's: planar fixed point or pulley, spatial vertical plane (point exit) or
+    swivel plane (module notes). ``guess``: a previous :attr:`CableEquilibrium.guess` of this cable.
+
+    Returns
+    -------
+    equilibrium : CableEquilibrium
+    stiffness : ndarray, shape (d, d) [N/m]
+        ``d(force on platform)/d(anchor point)``.
+
+    Raises
+    ------
+    UnreachableError
+        If the span is beyond the cable's reach at its tension limit.
+    """
+    return _cable_kernel(cable)[0](cable, unstrained_length, np.asarray(anchor_point, dtype=float), guess,
+                                   max_strain, max_tension)
+
+
+def inverse_cable(cable, horizontal_tension, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
+                  max_tension=None):
+    """Solve one cable of given horizontal tension [N] from a given anchor point (d,) [m] to its exit.
+
+    Returns ``(CableEquilibrium, dF_A/dH, dF_A/dp_A at fixed H)``: the derivatives (d,) and (d, d) of
+    a planar cable; None for a spatial one (its inverse statics differentiates numerically).
+    """
+    return _cable_kernel(cable)[1](cable, horizontal_tension, np.asarray(anchor_point, dtype=float), guess,
+                                   max_strain, max_tension)
+
+
+_CABLE_KERNELS = {PLANE: {False: (_planar_forward_cable, _planar_inverse_cable),
+                          True: (_planar_forward_cable, _planar_inverse_cable)},
+                  SPACE: {False: (_vertical_plane_forward_cable, _vertical_plane_inverse_cable),
+                          True: (_swivel_forward_cable, _swivel_inverse_cable)}}
+
+
+# ---------------------------------------------------------------------------
+# the platform: the one driver and its checks
+# ---------------------------------------------------------------------------
+def checked_unstrained_lengths(platform, unstrained_lengths):
+    """The cables' unstrained lengths [m] as a float array, one per cable of ``platform``, each positive.
+
+    Raises
+    ------
+    SceneError
+        Naming ``unstrained_lengths``, if they are not numbers, not one per cable or not positive.
+    """
+    lengths = real_array("unstrained_lengths", unstrained_lengths)
     if lengths.shape != (len(platform.cables),):
-        raise SceneError(
-            f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
-            f"got {shown(unstrained_lengths)}"
-        )
-    if not np.all(np.isfinite(lengths)) or np.any(lengths <= 0.0):
-        raise SceneError(f"unstrained_lengths must be positive and finite, got {shown(unstrained_lengths)}")
+        raise SceneError(f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
+                         f"got {shown(unstrained_lengths)}")
+    if np.any(lengths <= 0.0):
+        raise SceneError(f"unstrained_lengths must be positive, got {shown(unstrained_lengths)}")
     return lengths
 
 
-def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
-    """Equilibrium pose on straight, massless, elastic cables that may go slack.
+def _checked_platform(platform):
+    if not isinstance(platform, SuspendedPlatform):
+        raise SceneError(f"platform must be a SuspendedPlatform, got {shown(platform)}")
+    return _KERNELS[platform.space]
 
-    Minimises the potential energy ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2``
-    with ``l_i`` the straight (pulley: tangent plus wrap) length from anchor to winch
-    point and ``k_i = EA_i / L_i``. Unlike intersecting the circles of inextensible
-    cables, this always has a solution, also when some cables are too long to be
-    taut; it is the starting guess of `solve_forward_statics`.
+
+def _wrench(platform, value):
+    space = platform.space
+    if value is None:
+        return np.zeros(space.wrench_size)
+    labels = ", ".join([f"f{c}" for c in space.position_labels] + (["moment"] if space.rotation_size == 1 else
+                                                                   [f"m{c}" for c in space.position_labels]))
+    return vector("external_wrench", value, space.wrench_size, f" ({labels}) [N, N m]")
+
+
+def _check_reach(platform, lengths, max_strain, max_tension):
+    """Refuse cables that cannot all meet the platform: hang points farther apart than two cables and the
+    anchors reach."""
+    reaches = []
+    for cable, length in zip(platform.cables, lengths):
+        limit = max_strain * cable.axial_stiffness
+        if max_tension is not None:
+            limit = min(limit, max_tension)
+        reaches.append(length * (1.0 + limit / cable.axial_stiffness))
+    exits, anchors = platform.hang_points, platform.anchors
+    for i in range(len(lengths)):
+        for j in range(i):
+            gap = float(np.linalg.norm(exits[i] - exits[j]))
+            reach = reaches[i] + reaches[j] + float(np.linalg.norm(anchors[i] - anchors[j]))
+            if gap > reach:
+                raise UnreachableError(
+                    f"unstrained_lengths: cables[{j}] and cables[{i}] cannot both reach the platform: their exit "
+                    f"points are {gap:g} m apart, beyond the {reach:g} m their lengths ({lengths[j]:g}, "
+                    f"{lengths[i]:g} m, at the tension limit) and anchors span")
+
+
+def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
+    """Equilibrium pose on straight, massless, elastic cables that may go slack (the forward statics' start).
+
+    Minimises the potential energy ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2`` with ``l_i``
+    the straight length from the anchor to the hang point (over a pulley: the wrapped arc plus the
+    tangent) and ``k_i = EA_i / L_i``. Unlike intersecting the circles of inextensible cables, this
+    always has a solution, also when some cables are too long to be taut.
+
+    Returns
+    -------
+    ndarray, shape (pose_size,)
+        Position [m] and rotation [rad] (0 for a point mass).
+    """
+    kernel = _checked_platform(platform)
+    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
+    return kernel.straight_cable_pose(platform, lengths, _wrench(platform, external_wrench))
+
+
+def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wrench=None,
+                  max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
+    """Equilibrium pose of the platform and every cable's forces, for given unstrained lengths.
+
+    Newton's method on the net generalised force (force, and the moment for a rigid platform:
+    planar about the centre of mass, spatial ``J_l^T M``), with the analytic stiffness assembled
+    from the cables' end stiffnesses and a line search on the energy (:func:`minimise_energy`);
+    every evaluation solves each cable's catenary, warm-started from the previous iterate.
 
     Parameters
     ----------
     platform : SuspendedPlatform
     unstrained_lengths : array_like, shape (n_cables,) [m]
-    external_wrench : (fx, fz, moment), optional
-        [N, N, N m].
+        Total unstrained length of each cable (over a pulley: from its hang point).
+    initial_pose : array_like, optional
+        Start: a position, or a pose (the rotation of a point mass is ignored) [m, rad]; default
+        :func:`straight_cable_pose`.
+    external_wrench : array_like, shape (wrench_size,) [N, N m], optional
+        Extra force and moment (about the centre of mass) on the platform, eg :func:`inertial_wrench`.
+    max_strain, max_tension : float, optional
+        Cable tension limits, as in :func:`cdpr_exu.physics.catenary.solve_forward`.
 
     Returns
     -------
-    position : ndarray, shape (2,) [m]
-    rotation : float [rad]
-        0 for a point mass.
+    PlatformEquilibrium
+
+    Raises
+    ------
+    SceneError
+        Naming the argument, if an input is invalid (checked before any solve).
+    UnreachableError
+        If two cables cannot both reach the platform (checked before any solve), or if no
+        equilibrium is found within the tension limits.
     """
-    lengths = _lengths(platform, unstrained_lengths)
-    wrench = _wrench(external_wrench)
+    kernel = _checked_platform(platform)
+    space = platform.space
+    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
+    wrench = _wrench(platform, external_wrench)
+    max_strain = positive("max_strain", max_strain)
+    if max_tension is not None:
+        max_tension = positive("max_tension", max_tension)
     dof = platform.degrees_of_freedom
-    stiffness = np.array([c.axial_stiffness / L for c, L in zip(platform.cables, lengths)])
-    uppers = np.array([c.upper_reference for c in platform.cables])
-    force_scale, length_scale = _scales(platform, lengths, wrench)
-    weight = platform.mass * platform.gravity
+    if initial_pose is not None:
+        start = real_array("initial_pose", initial_pose)
+        if start.shape not in ((space.position_size,), (space.pose_size,), (dof,)):
+            raise SceneError(f"initial_pose must be a position ({', '.join(space.position_labels)}) or a pose "
+                             f"({', '.join(space.pose_labels)}), got {shown(initial_pose)}")
+        start = np.append(start, np.zeros(space.pose_size - start.size))
+    _check_reach(platform, lengths, max_strain, max_tension)
+    if initial_pose is None:
+        start = kernel.straight_cable_pose(platform, lengths, wrench)
+    force_scale, length_scale = kernel.scales(platform, lengths, wrench)
+    residual_scale = np.array([force_scale] * space.position_size
+                              + [force_scale * length_scale] * space.rotation_size)[:dof]
+    pose_scale = np.array([1.0] * space.position_size + [length_scale] * space.rotation_size)[:dof]  # in metres
+    stiffest = max(c.axial_stiffness for c in platform.cables)
+    noise = 1e3 * _RELATIVE_TOLERANCE * (1.0 + stiffest / force_scale)
+    guesses = [None] * len(platform.cables)
+    cache = {}
 
-    def energy(q):
-        phi = q[2] if dof == 3 else 0.0
-        turn = rotation_matrix(phi)
-        value = weight * q[1] - wrench[0] * q[0] - wrench[1] * q[1] - wrench[2] * phi
-        gradient = np.array([-wrench[0], weight - wrench[1], -wrench[2]])
-        for cable, L, k in zip(platform.cables, lengths, stiffness):
+    def function(scaled):
+        residual, jacobian, cache["last"] = kernel.evaluate(platform, scaled / pose_scale, lengths, wrench, guesses,
+                                                            max_strain, max_tension)
+        return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
+
+    try:
+        scaled, _, _ = minimise_energy(function, start[:dof] * pose_scale, _RELATIVE_TOLERANCE, noise,
+                                       what="statics")
+    except UnreachableError as error:
+        raise UnreachableError(f"no equilibrium found for unstrained_lengths {lengths.tolist()} m: {error}") from None
+    function(scaled)  # the accepted point, with its own cable states
+    return kernel.result(platform, cache["last"], wrench)
+
+
+def solve_inverse_statics(platform, pose, external_wrench=None, initial_guess=None, max_strain=DEFAULT_MAX_STRAIN,
+                          max_tension=None):
+    """Unstrained lengths and cable forces that hold the platform at a pose, on elastic catenaries.
+
+    The unknowns are the cables' horizontal tensions (each cable's unstrained length and forces follow
+    from its inverse catenary, :func:`inverse_cable`); the equations the platform's balance.
+
+    * Planar: a square problem, solved by Newton's method from straight massless cables: a point
+      mass on 2 cables; a rigid platform on 2 cables at a position (the rotation is the one
+      equilibrium imposes: give ``pose`` as ``(x, z)``); on 3 cables at a pose ``(x, z, phi)``.
+    * Spatial: the tensions nearest ``initial_guess`` (least squares) that balance the force,
+      and the moment too for a rigid platform on at least six cables (with fewer, the rotation is
+      left free), by Gauss-Newton, each cable's force derivative by a forward difference.
+      Continuing from the previous sample's tensions along a trajectory keeps an
+      over-constrained robot's internal tension.
+
+    Parameters
+    ----------
+    platform : SuspendedPlatform
+    pose : array_like [m, rad]
+        A position or a pose (see above; spatial: (3,) for a point mass, or (6,)).
+    external_wrench : array_like, shape (wrench_size,) [N, N m], optional
+        Extra load, eg :func:`inertial_wrench` for dynamic feed-forward.
+    initial_guess : PlatformEquilibrium or array_like (n_cables,) [N], optional
+        A nearby solution (eg the previous sample's), or positive horizontal tensions: they start
+        the iteration (planar, with the solution's rotation) and, spatial, are the tensions to stay
+        near (required there).
+    max_strain, max_tension : float, optional
+        Cable tension limits, as in :func:`cdpr_exu.physics.catenary.solve_forward` (planar).
+
+    Returns
+    -------
+    PlatformEquilibrium
+        With the unstrained lengths and forces, the rotation, and (planar) the stiffness at fixed lengths.
+
+    Raises
+    ------
+    UnreachableError
+        If a cable would have to push (no equilibrium with positive tensions), a cable would be
+        vertical, a tension exceeds its limit, or the iteration fails.
+    SceneError
+        If an argument is invalid, or (planar) the problem is not square.
+    """
+    kernel = _checked_platform(platform)
+    wrench = _wrench(platform, external_wrench)
+    if initial_guess is not None and not isinstance(initial_guess, PlatformEquilibrium):
+        initial_guess = real_array("initial_guess", initial_guess)
+        if initial_guess.shape != (len(platform.cables),) or np.any(initial_guess <= 0.0):
+            raise SceneError(f"initial_guess must be a PlatformEquilibrium or one positive horizontal tension per "
+                             f"cable, got {shown(initial_guess.tolist())}")
+    elif initial_guess is not None and len(initial_guess.cables) != len(platform.cables):
+        raise SceneError(f"initial_guess must be a PlatformEquilibrium of this platform, got {shown(initial_guess)}")
+    return kernel.inverse(platform, pose, wrench, initial_guess, max_strain, max_tension)
+
+
+# ---------------------------------------------------------------------------
+# the pose kernels: what differs per dimension
+# ---------------------------------------------------------------------------
+class _PlanarStatics:
+    """The plane's pose kernel: ``(x, z, phi)``, planar cross products (the paper's statics, bit for bit)."""
+
+    @staticmethod
+    def inertia(value):
+        return non_negative("inertia", 0.0 if value is None else value)
+
+    @staticmethod
+    def anchor_points(platform, position, rotation=0.0):
+        turn = rotation_matrix(rotation)
+        return np.array([np.asarray(position) + turn @ c.anchor for c in platform.cables])
+
+    @staticmethod
+    def scales(platform, lengths, wrench):
+        """Force [N] and length [m] scales of the equilibrium residual."""
+        weight = platform.mass * platform.gravity
+        cable_weight = sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths))
+        force = weight + cable_weight + float(np.hypot(wrench[0], wrench[1]))
+        arm = max((float(np.hypot(*c.anchor)) for c in platform.cables), default=0.0)
+        length = arm if arm > 0.0 else 1.0
+        force = max(force, abs(wrench[2]) / length, 1e-12)
+        return force, length
+
+    @staticmethod
+    def wrench_residual(platform, rotation, equilibria, wrench):
+        """Net wrench on the platform ``(fx, fz, m)`` [N, N, N m]."""
+        turn = rotation_matrix(rotation)
+        total = np.array([wrench[0], wrench[1] - platform.mass * platform.gravity, wrench[2]])
+        for cable, equilibrium in zip(platform.cables, equilibria):
+            force = equilibrium.force_on_platform
+            total[:2] += force
+            total[2] += planar_cross(turn @ cable.anchor, force)
+        return total
+
+    @staticmethod
+    def pose_jacobian(platform, rotation, equilibria, stiffnesses, dof):
+        """``d(net wrench)/d(pose)`` from the cables' ``dF_A/dp_A``, shape (dof, dof)."""
+        turn = rotation_matrix(rotation)
+        jacobian = np.zeros((3, 3))
+        for cable, equilibrium, stiffness in zip(platform.cables, equilibria, stiffnesses):
             arm = turn @ cable.anchor
-            length, direction = _straight_length_and_gradient(cable, q[:2] + arm)
-            extension = length - L
-            if extension > 0.0:
-                value += 0.5 * k * extension**2
-                pull = k * extension * direction
-                gradient[:2] += pull
-                gradient[2] += planar_cross(arm, pull)
-        return value, gradient[:dof]
+            d_point = np.column_stack([np.eye(2), perpendicular(arm)])  # dp/d(x, z, phi)
+            d_force = stiffness @ d_point
+            force = equilibrium.force_on_platform
+            jacobian[:2] += d_force
+            jacobian[2] += arm[0] * d_force[1] - arm[1] * d_force[0]
+            jacobian[2, 2] += planar_cross(perpendicular(arm), force)
+        return jacobian[:dof, :dof]
 
-    start = np.array([uppers[:, 0].mean(), uppers[:, 1].mean() - lengths.mean(), 0.0])[:dof]
-    solution = minimize(
-        energy, start, jac=True, method="BFGS",
-        options={"gtol": 1e-9 * force_scale, "maxiter": 2000},
-    )
-    phi = _wrap_angle(solution.x[2]) if dof == 3 else 0.0
-    return solution.x[:2].copy(), phi
+    def evaluate(self, platform, pose, lengths, wrench, guesses, max_strain, max_tension):
+        dof = platform.degrees_of_freedom
+        phi = pose[2] if dof == 3 else 0.0
+        points = self.anchor_points(platform, pose[:2], phi)
+        equilibria, stiffnesses = [], []
+        for i, (cable, point, length) in enumerate(zip(platform.cables, points, lengths)):
+            equilibrium, stiffness = forward_cable(cable, length, point, guesses[i], max_strain, max_tension)
+            equilibria.append(equilibrium)
+            stiffnesses.append(stiffness)
+        guesses[:] = [e.guess for e in equilibria]
+        total = self.wrench_residual(platform, phi, equilibria, wrench)
+        jacobian = self.pose_jacobian(platform, phi, equilibria, stiffnesses, dof)
+        return total[:dof], jacobian, (pose, equilibria, jacobian, total)
+
+    def result(self, platform, state, wrench):
+        pose, equilibria, jacobian, total = state
+        phi = _wrap_angle(pose[2]) if platform.degrees_of_freedom == 3 else 0.0
+        return PlatformEquilibrium(PLANE, np.array(pose[:2], dtype=float), phi, rotation_matrix(phi),
+                                   tuple(equilibria), -np.array(jacobian), wrench, total)
+
+    def straight_cable_pose(self, platform, lengths, wrench):
+        dof = platform.degrees_of_freedom
+        stiffness = np.array([c.axial_stiffness / L for c, L in zip(platform.cables, lengths)])
+        uppers = np.array([c.point for c in platform.cables])
+        force_scale, length_scale = self.scales(platform, lengths, wrench)
+        weight = platform.mass * platform.gravity
+
+        def energy(q):
+            phi = q[2] if dof == 3 else 0.0
+            turn = rotation_matrix(phi)
+            value = weight * q[1] - wrench[0] * q[0] - wrench[1] * q[1] - wrench[2] * phi
+            gradient = np.array([-wrench[0], weight - wrench[1], -wrench[2]])
+            for cable, L, k in zip(platform.cables, lengths, stiffness):
+                arm = turn @ cable.anchor
+                length, direction = _straight_length_and_gradient(cable, q[:2] + arm)
+                extension = length - L
+                if extension > 0.0:
+                    value += 0.5 * k * extension**2
+                    pull = k * extension * direction
+                    gradient[:2] += pull
+                    gradient[2] += planar_cross(arm, pull)
+            return value, gradient[:dof]
+
+        start = np.array([uppers[:, 0].mean(), uppers[:, 1].mean() - lengths.mean(), 0.0])[:dof]
+        solution = minimize(energy, start, jac=True, method="BFGS",
+                            options={"gtol": 1e-9 * force_scale, "maxiter": 2000})
+        phi = _wrap_angle(solution.x[2]) if dof == 3 else 0.0
+        return np.append(solution.x[:2], phi)
+
+    def inverse(self, platform, pose, wrench, initial_guess, max_strain, max_tension):
+        pose = real_array("pose", pose)
+        if pose.shape not in ((2,), (3,)):
+            raise SceneError(f"pose must be a position (x, z) or a pose (x, z, rotation), got {shown(pose.tolist())}")
+        return _planar_inverse(platform, pose[:2], None if pose.size == 2 else float(pose[2]), wrench, max_strain,
+                               max_tension, initial_guess)
+
+
+class _SpatialStatics:
+    """Space's pose kernel: ``(r, theta)``, left Jacobians of SO(3)."""
+
+    @staticmethod
+    def inertia(value):
+        inertia = vector("inertia", (0.0, 0.0, 0.0) if value is None else value, 3,
+                         " (principal moments) [kg m^2]")
+        if np.any(inertia < 0.0):
+            raise SceneError(f"inertia must be zero or positive, got {shown(value)}")
+        return tuple(inertia)
+
+    @staticmethod
+    def scales(platform, lengths, wrench):
+        weight = platform.mass * platform.gravity
+        force_scale = max(weight + sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths))
+                          + float(np.linalg.norm(wrench[:3])), 1e-12)
+        arm = float(np.linalg.norm(platform.anchors, axis=1).max())
+        return force_scale, (arm if arm > 0.0 else 1.0)
+
+    @staticmethod
+    def pose(platform, coordinates):
+        """Position, rotation matrix and rotation vector from the unknowns."""
+        theta = coordinates[3:6] if platform.degrees_of_freedom == 6 else np.zeros(3)
+        return coordinates[:3], rotation_from_vector(theta), theta
+
+    def evaluate(self, platform, coordinates, lengths, wrench, guesses, max_strain, max_tension):
+        dof = platform.degrees_of_freedom
+        position, rotation, theta = self.pose(platform, coordinates)
+        arms = platform.anchors @ rotation.T
+        wrench_total = wrench.copy()
+        wrench_total[2] -= platform.mass * platform.gravity
+        jacobian = np.zeros((6, 6))  # d(force, moment)/d(r, world rotation)
+        equilibria = []
+        for i, (cable, length, arm_) in enumerate(zip(platform.cables, lengths, arms)):
+            equilibrium, stiffness = forward_cable(cable, length, position + arm_, guesses[i], max_strain, max_tension)
+            guesses[i] = equilibrium.guess
+            equilibria.append(equilibrium)
+            force = equilibrium.force_on_platform
+            wrench_total[:3] += force
+            wrench_total[3:] += np.cross(arm_, force)
+            arm_skew = skew(arm_)
+            jacobian[:3, :3] += stiffness
+            jacobian[:3, 3:] -= stiffness @ arm_skew
+            jacobian[3:, :3] += arm_skew @ stiffness
+            jacobian[3:, 3:] += -arm_skew @ stiffness @ arm_skew + skew(force) @ arm_skew
+        if dof == 3:
+            residual, generalised = wrench_total[:3], jacobian[:3, :3]
+        else:
+            tangent = left_jacobian(theta)
+            residual = np.concatenate([wrench_total[:3], tangent.T @ wrench_total[3:]])
+            # d(J_l^T M)/d(theta) also has a term in dJ_l/d(theta) M, which vanishes at equilibrium: left out
+            generalised = jacobian @ np.block([[np.eye(3), np.zeros((3, 3))], [np.zeros((3, 3)), tangent]])
+            generalised[3:] = tangent.T @ generalised[3:]
+        return residual, generalised, (position, rotation, equilibria, generalised, wrench_total)
+
+    def result(self, platform, state, wrench):
+        position, rotation, equilibria, jacobian, wrench_total = state
+        return PlatformEquilibrium(SPACE, np.array(position, dtype=float),
+                                   rotation_vector(rotation) if platform.degrees_of_freedom == 6 else np.zeros(3),
+                                   rotation, tuple(equilibria), -jacobian, wrench, wrench_total)
+
+    def straight_cable_pose(self, platform, lengths, wrench):
+        dof = platform.degrees_of_freedom
+        stiffness = np.array([c.axial_stiffness for c in platform.cables]) / lengths
+        exits = np.array([c.point for c in platform.cables])
+        weight = platform.mass * platform.gravity
+        scale = weight + sum(c.weight_per_length * L for c, L in zip(platform.cables, lengths)) + 1e-12
+
+        def energy(q):
+            position, rotation, theta = self.pose(platform, q)
+            arms = platform.anchors @ rotation.T
+            value = weight * position[2] - wrench[:3] @ position - (wrench[3:] @ theta if dof == 6 else 0.0)
+            force = np.array([0.0, 0.0, weight]) - wrench[:3]
+            moment = -wrench[3:].copy()
+            for cable, arm, exit_point, length, k in zip(platform.cables, arms, exits, lengths, stiffness):
+                distance, direction = _straight_path(cable, exit_point, position + arm)
+                if distance > length:
+                    value += 0.5 * k * (distance - length) ** 2
+                    pull = k * (distance - length) * direction
+                    force += pull
+                    moment += np.cross(arm, pull)
+            gradient = force if dof == 3 else np.concatenate([force, left_jacobian(theta).T @ moment])
+            return value / scale, gradient / scale
+
+        # Unknowns in metres (the rotation vector times the largest arm), so that a step turns the
+        # anchors as far as it moves them: with stiff cables (EA / L of 3e5 N/m, CoGiRo) unscaled
+        # steps spun the platform through several turns.
+        arm = float(np.linalg.norm(platform.anchors, axis=1).max()) if dof == 6 else 1.0
+        unit = np.array([1.0] * 3 + [max(arm, 1e-3)] * 3)[:dof]
+
+        def scaled_energy(x):
+            value, gradient = energy(x / unit)
+            return value, gradient / unit
+
+        # Start at the exits' centroid, unrotated: inside the frame, the cables slack or short of their
+        # lengths, so the weight and the taut cables pull the platform onto its equilibrium. (Starting a
+        # cable length below the exits stretched CoGiRo's stiff cables by metres.)
+        start = np.zeros(dof)
+        start[:3] = exits.mean(axis=0)
+        solution = minimize(scaled_energy, start * unit, jac=True, method="BFGS",
+                            options={"gtol": 1e-10, "maxiter": 5000})
+        return np.append(solution.x / unit, np.zeros(6 - dof))
+
+    def inverse(self, platform, pose, wrench, initial_guess, max_strain, max_tension, tolerance=1e-9,
+                max_iterations=30):
+        pose = real_array("pose", pose)
+        dof = platform.degrees_of_freedom
+        if pose.shape != (6,) and not (dof == 3 and pose.shape == (3,)):
+            raise SceneError(f"pose must have 6 entries (3 for a point mass), got {shown(pose.tolist())}")
+        if initial_guess is None:
+            raise SceneError("initial_guess: the spatial inverse statics needs horizontal tensions to stay near "
+                             "(eg the rest's), got None")
+        guess = (initial_guess.horizontal_tensions if isinstance(initial_guess, PlatformEquilibrium)
+                 else initial_guess)
+        position = pose[:3]
+        theta = pose[3:6] if pose.shape == (6,) and dof == 6 else np.zeros(3)
+        rotation = rotation_from_vector(pose[3:6]) if pose.shape == (6,) and dof == 6 else np.eye(3)
+        arms = platform.anchors @ rotation.T
+        anchor_points = position + arms
+        rows = 6 if (dof == 6 and len(platform.cables) >= 6) else 3
+        weight = platform.mass * platform.gravity
+        arm_scale = max(float(np.linalg.norm(platform.anchors, axis=1).max()), 1e-3)
+        scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
+
+        def balance(tensions):
+            cables = [inverse_cable(c, h, p)[0] for c, p, h in zip(platform.cables, anchor_points, tensions)]
+            forces = np.array([c.force_on_platform for c in cables])
+            total = np.concatenate([forces.sum(axis=0) + wrench[:3] - [0.0, 0.0, weight],
+                                    np.cross(arms, forces).sum(axis=0) + wrench[3:]])
+            return cables, forces, total
+
+        tensions = guess.copy()
+        for _ in range(max_iterations):
+            cables, forces, total = balance(tensions)
+            residual = float(np.abs(total[:rows] * scale).max())
+            if residual <= tolerance * max(weight, float(np.abs(forces).max()), 1e-12):
+                return PlatformEquilibrium(SPACE, position.copy(), theta.copy(), rotation, tuple(cables), None,
+                                           wrench, total)
+            jacobian = np.zeros((rows, len(tensions)))
+            for i, (cable, point, h) in enumerate(zip(platform.cables, anchor_points, tensions)):
+                step = 1e-6 * h
+                shifted = inverse_cable(cable, h + step, point)[0].force_on_platform
+                derivative = (shifted - forces[i]) / step
+                jacobian[:, i] = np.concatenate([derivative, np.cross(arms[i], derivative)])[:rows] * scale
+            # the change nearest the guess that cancels the imbalance to first order
+            offset = tensions - guess
+            correction = -offset + np.linalg.pinv(jacobian) @ (jacobian @ offset - total[:rows] * scale)
+            tensions = tensions + correction
+            if np.any(tensions <= 0.0):
+                raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: the catenaries balance the platform only "
+                                       f"if a cable pushes (horizontal tensions {np.round(tensions, 3).tolist()} N): "
+                                       "it is outside the wrench-feasible workspace")
+        raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: the catenaries' balance did not converge "
+                               f"(imbalance {residual:.3g} N after {max_iterations} iterations)")
+
+
+_KERNELS = {PLANE: _PlanarStatics(), SPACE: _SpatialStatics()}
+
+
+def _straight_path(cable, exit_point, point):
+    """Length [m] of a straight, massless spatial cable from its exit to ``point`` (3,), and the unit
+    vector (3,) along its last straight part towards ``point`` (the length's gradient in ``point``).
+
+    Over a swivel pulley the path wraps the disc in the plane through the axis and ``point``
+    (:func:`cdpr_exu.core.geometry.swivel_pulley_exit`: arc plus free length); where that is
+    undefined (``point`` on the axis or inside the disc, only ever an iterate of the starting
+    guess) the straight distance from the inlet stands in.
+    """
+    span = point - exit_point
+    distance = float(np.linalg.norm(span))
+    if cable.pulley_radius > 0.0:
+        try:
+            path = swivel_pulley_exit(exit_point, cable.pulley_radius, point)
+        except UnreachableError:
+            pass
+        else:
+            return float(path.arc_length + path.free_length), np.asarray(path.unit_vector, dtype=float)
+    return distance, span / distance if distance > 0.0 else np.zeros(3)
 
 
 def _straight_length_and_gradient(cable, point):
-    """Straight length from ``point`` to the winch point [m] and its gradient in ``point``.
+    """Straight length of a planar cable from ``point`` to the hang point [m] and its gradient in ``point``.
 
-    With a pulley, the length is tangent plus wrapped arc; its gradient is the unit
-    vector from the tangent point to ``point`` (the wrap change cancels the tangent
-    point's motion to first order). Inside a pulley disc (no tangent) the distance
-    to the centre plus half a turn stands in, to keep the energy continuous-ish.
+    With a pulley, the length is tangent plus wrapped arc; its gradient is the unit vector from the
+    tangent point to ``point`` (the wrap change cancels the tangent point's motion to first order).
+    Inside a pulley disc (no tangent) the distance to the centre plus half a turn stands in, to keep
+    the energy continuous-ish.
     """
     if cable.pulley is None:
         offset = point - np.array(cable.exit_point)
@@ -858,111 +1505,12 @@ def _wrap_angle(angle):
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def solve_forward_statics(
-    platform,
-    unstrained_lengths,
-    initial_pose=None,
-    external_wrench=None,
-    max_strain=DEFAULT_MAX_STRAIN,
-    max_tension=None,
-):
-    """Equilibrium pose and cable forces of the platform for given cable lengths.
-
-    Solves the force balance (and the moment balance about the centre of mass for a
-    rigid platform) by Newton's method with the analytic Jacobian, assembled from the
-    cables' end stiffnesses; each residual evaluation solves every cable's catenary,
-    warm-started from the previous iterate.
-
-    Parameters
-    ----------
-    platform : SuspendedPlatform
-    unstrained_lengths : array_like, shape (n_cables,) [m]
-        Total unstrained length of each cable (with a pulley: up to its winch point).
-    initial_pose : (x, z) or (x, z, phi), optional
-        Starting pose [m, m, rad]; default: `straight_cable_pose` (massless elastic
-        cables).
-    external_wrench : (fx, fz, moment), optional
-        Extra load on the platform [N, N, N m] at its centre of mass, eg
-        `inertial_wrench`.
-    max_strain, max_tension : float, optional
-        Cable tension limits, as in `catenary.solve_forward`.
-
-    Returns
-    -------
-    PlatformEquilibrium
-
-    Raises
-    ------
-    UnreachableError
-        If no equilibrium is found within the tension limits.
-    SceneError
-        If an argument is invalid.
-    """
-    if not isinstance(platform, SuspendedPlatform):
-        raise SceneError(f"platform must be a SuspendedPlatform, got {shown(platform)}")
-    lengths = _lengths(platform, unstrained_lengths)
-    wrench = _wrench(external_wrench)
-    dof = platform.degrees_of_freedom
-    if initial_pose is None:
-        position, rotation = straight_cable_pose(platform, lengths, wrench)
-    else:
-        pose = real_array("initial_pose", initial_pose)
-        if pose.shape not in ((2,), (3,)) or not np.all(np.isfinite(pose)):
-            raise SceneError(f"initial_pose must be (x, z) or (x, z, phi), got {shown(initial_pose)}")
-        position, rotation = pose[:2], (float(pose[2]) if pose.size == 3 else 0.0)
-    if dof == 2:
-        rotation = 0.0
-    force_scale, length_scale = _scales(platform, lengths, wrench)
-    residual_scale = np.array([force_scale, force_scale, force_scale * length_scale])[:dof]
-    pose_scale = np.array([1.0, 1.0, length_scale])[:dof]  # unknowns in metres
-    guesses = [None] * len(platform.cables)
-    cache = {}
-
-    def evaluate(pose):
-        phi = pose[2] if dof == 3 else 0.0
-        points = platform.anchor_points(pose[:2], phi)
-        equilibria, stiffnesses, new_guesses = [], [], []
-        for i, (cable, point, length) in enumerate(zip(platform.cables, points, lengths)):
-            equilibrium, stiffness, guess = forward_cable(
-                cable, length, point, guesses[i], max_strain, max_tension
-            )
-            equilibria.append(equilibrium)
-            stiffnesses.append(stiffness)
-            new_guesses.append(guess)
-        guesses[:] = new_guesses
-        residual = _wrench_residual(platform, phi, equilibria, wrench, dof)
-        jacobian = _pose_jacobian(platform, phi, equilibria, stiffnesses, dof)
-        cache["last"] = (equilibria, jacobian)
-        return residual, jacobian
-
-    def function(scaled_pose):
-        residual, jacobian = evaluate(scaled_pose / pose_scale)
-        return residual / residual_scale, jacobian / residual_scale[:, None] / pose_scale[None, :]
-
-    start = np.append(position, rotation)[:dof] * pose_scale
-    scaled, _, _ = minimise_energy(
-        function, start, _RELATIVE_TOLERANCE, _platform_noise(platform, force_scale),
-        what="forward statics",
-    )
-    pose = scaled / pose_scale
-    _, jacobian = evaluate(pose)  # the accepted point, with its own cable states
-    equilibria, _ = cache["last"]
-    return _result(platform, pose, equilibria, jacobian, wrench, dof)
-
-
-def _result(platform, pose, equilibria, jacobian, wrench, dof):
-    return PlatformEquilibrium(
-        position=np.array(pose[:2], dtype=float),
-        rotation=_wrap_angle(pose[2]) if dof == 3 else 0.0,
-        cables=tuple(equilibria),
-        stiffness=-np.array(jacobian),
-        external_wrench=wrench,
-    )
-
-
+# ---------------------------------------------------------------------------
+# the planar inverse: a square Newton iteration in the horizontal tensions
+# ---------------------------------------------------------------------------
 def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
     """Horizontal tensions of straight massless cables balancing the load (start guess)."""
-    points = platform.anchor_points(position, rotation)
+    points = _PlanarStatics.anchor_points(platform, position, rotation)
     turn = rotation_matrix(rotation)
     load = -np.array([wrench[0], wrench[1] - platform.mass * platform.gravity, wrench[2]])
     columns, horizontal = [], []
@@ -988,13 +1536,11 @@ def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
 def _straight_cable_rotations(platform, position, wrench):
     """Rotations at which straight massless cables hold the platform with positive tensions.
 
-    Roots of the moment balance (after the force balance fixes the tensions) found by
-    scanning ``[-pi, pi)`` and refining with Brent's method; sorted by size. These
-    start the inverse statics of a rigid platform on two cables, whose equilibrium
-    rotation can be large (near the workspace edge the platform tilts by a radian).
+    Roots of the moment balance (after the force balance fixes the tensions) found by scanning
+    ``[-pi, pi)`` and refining with Brent's method; sorted by size. These start the inverse statics
+    of a rigid platform on two cables, whose equilibrium rotation can be large (near the workspace
+    edge the platform tilts by a radian).
     """
-    from scipy.optimize import brentq
-
     def moment(phi):
         try:
             _, tensions, residual = _ideal_tensions(platform, position, phi, wrench, True)
@@ -1017,60 +1563,11 @@ def _straight_cable_rotations(platform, position, wrench):
     return sorted(set(roots), key=abs)
 
 
-def solve_inverse_statics(
-    platform,
-    position,
-    rotation=None,
-    external_wrench=None,
-    max_strain=DEFAULT_MAX_STRAIN,
-    max_tension=None,
-    initial_guess=None,
-    _continuation=True,
-):
-    """Cable lengths and forces that hold the platform at a given position.
-
-    Unknowns: each cable's horizontal tension, plus the rotation when it is not
-    given; each cable's unstrained length and end forces follow from
-    `catenary.solve_inverse` (or its pulley version). Equations: force balance, and
-    moment balance for a rigid platform. The problem must be square:
-
-    * point mass: 2 cables (more would need a tension distribution);
-    * rigid platform on 2 cables: ``rotation=None`` (3 DOF, 2 cables: equilibrium
-      fixes the rotation);
-    * rigid platform on 3 cables: ``rotation`` given.
-
-    Parameters
-    ----------
-    platform : SuspendedPlatform
-    position : (x, z) [m]
-        Desired position of the centre of mass.
-    rotation : float [rad], optional
-        Desired rotation, when the cables can choose it (see above).
-    external_wrench : (fx, fz, moment), optional
-        Extra load [N, N, N m], eg `inertial_wrench` for dynamic feed-forward.
-    max_strain, max_tension : float, optional
-        Cable tension limits, as in `catenary.solve_forward`.
-    initial_guess : PlatformEquilibrium, optional
-        A nearby solution (eg the previous pose along a trajectory): its horizontal
-        tensions and rotation start the iteration.
-
-    Returns
-    -------
-    PlatformEquilibrium
-        With the unstrained lengths, forces, the rotation and the stiffness at fixed
-        lengths.
-
-    Raises
-    ------
-    UnreachableError
-        If a cable would have to push (no equilibrium with positive tensions), a cable
-        would be vertical (its horizontal tension cannot parametrise it), a tension
-        exceeds the limit, or Newton fails.
-    SceneError
-        If an argument is invalid or the problem is not square.
-    """
-    position = np.array(_point("position", position))
-    wrench = _wrench(external_wrench)
+def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tension, initial_guess=None,
+                    continuation=True):
+    """:func:`solve_inverse_statics` of a planar platform (``rotation`` None: free, or a point mass)."""
+    kernel = _KERNELS[PLANE]
+    position = np.array(_point("pose", position, 2))
     dof = platform.degrees_of_freedom
     n = len(platform.cables)
     if dof == 2:
@@ -1085,7 +1582,7 @@ def solve_inverse_statics(
         raise SceneError(
             f"inverse statics needs as many unknowns as equations: {n} cables"
             f"{' + rotation' if free_rotation else ''} for {dof} equations; "
-            f"pass rotation=None for a rigid platform on 2 cables, a rotation on 3"
+            f"give a position (x, z) for a rigid platform on 2 cables, a pose (x, z, rotation) on 3"
         )
     horizontal, tensions, _ = _ideal_tensions(platform, position, rotation, wrench, free_rotation)
     if np.any(tensions <= 0.0):
@@ -1093,13 +1590,12 @@ def solve_inverse_statics(
         # Newton decide (it fails, with UnreachableError, if they really must push)
         weight = max(platform.mass * platform.gravity, 1e-9)
         horizontal = np.maximum(horizontal, 0.1 * weight)
-    lengths_guess = [
-        _straight_length_and_gradient(c, p)[0]
-        for c, p in zip(platform.cables, platform.anchor_points(position, rotation))
-    ]
-    force_scale, length_scale = _scales(platform, lengths_guess, wrench)
+    lengths_guess = [_straight_length_and_gradient(c, p)[0]
+                     for c, p in zip(platform.cables, kernel.anchor_points(platform, position, rotation))]
+    force_scale, length_scale = kernel.scales(platform, lengths_guess, wrench)
     residual_scale = np.array([force_scale, force_scale, force_scale * length_scale])[:dof]
     unknown_scale = np.append(np.full(n, 1.0 / force_scale), [1.0 / math.pi] if free_rotation else [])
+    noise = 1e3 * _RELATIVE_TOLERANCE * (1.0 + max(c.axial_stiffness for c in platform.cables) / force_scale)
     guesses = [None] * n
     cache = {}
 
@@ -1108,16 +1604,13 @@ def solve_inverse_statics(
         phi = u[n] if free_rotation else rotation
         if np.any(H <= 0.0):
             raise UnreachableError("a cable would have to push (horizontal tension <= 0)")
-        points = platform.anchor_points(position, phi)
+        points = kernel.anchor_points(platform, position, phi)
         turn = rotation_matrix(phi)
-        equilibria, new_guesses = [], []
+        equilibria = []
         jacobian = np.zeros((3, n + 1))
         for i, (cable, point) in enumerate(zip(platform.cables, points)):
-            equilibrium, force_dH, force_dp, guess = inverse_cable(
-                cable, H[i], point, guesses[i], max_strain, max_tension
-            )
+            equilibrium, force_dH, force_dp = inverse_cable(cable, H[i], point, guesses[i], max_strain, max_tension)
             equilibria.append(equilibrium)
-            new_guesses.append(guess)
             arm = turn @ cable.anchor
             jacobian[:2, i] = force_dH
             jacobian[2, i] = planar_cross(arm, force_dH)
@@ -1126,8 +1619,8 @@ def solve_inverse_statics(
             jacobian[2, n] += planar_cross(arm, d_force_dphi) + planar_cross(
                 perpendicular(arm), equilibrium.force_on_platform
             )
-        guesses[:] = new_guesses
-        residual = _wrench_residual(platform, phi, equilibria, wrench, dof)
+        guesses[:] = [e.guess for e in equilibria]
+        residual = kernel.wrench_residual(platform, phi, equilibria, wrench)[:dof]
         columns = list(range(n)) + ([n] if free_rotation else [])
         cache["last"] = (equilibria, phi)
         return residual, jacobian[:dof][:, columns]
@@ -1138,16 +1631,17 @@ def solve_inverse_statics(
 
     # With a free rotation, a start where a cable hangs exactly vertical (H = 0
     # cannot parametrise it) or far from the answer is retried at other rotations.
+    guessed_rotation = None
     if initial_guess is not None:
-        if not isinstance(initial_guess, PlatformEquilibrium) or len(initial_guess.cables) != n:
-            raise SceneError(f"initial_guess must be a PlatformEquilibrium of this platform, got {shown(initial_guess)}")
-        guessed = np.array([c.catenary.horizontal_tension for c in initial_guess.cables])
+        guessed = initial_guess
+        if isinstance(initial_guess, PlatformEquilibrium):
+            guessed, guessed_rotation = initial_guess.horizontal_tensions, initial_guess.rotation
         if np.all(guessed > 0.0):
             horizontal = guessed
 
     def rotation_starts():
-        if free_rotation and initial_guess is not None:
-            yield initial_guess.rotation
+        if free_rotation and guessed_rotation is not None:
+            yield guessed_rotation
         yield rotation
         if free_rotation:  # only computed when the plain start fails
             yield from _straight_cable_rotations(platform, position, wrench)
@@ -1157,31 +1651,26 @@ def solve_inverse_statics(
     for rotation_start in rotation_starts():
         guesses[:] = [None] * n
         start_tensions = horizontal
-        if free_rotation and not (initial_guess is not None and rotation_start == initial_guess.rotation):
+        if free_rotation and not (guessed_rotation is not None and rotation_start == guessed_rotation):
             start_tensions, tensions, _ = _ideal_tensions(platform, position, rotation_start, wrench, True)
             if np.any(tensions <= 0.0):
                 start_tensions = np.maximum(start_tensions, 0.1 * max(platform.mass * platform.gravity, 1e-9))
         start = np.append(start_tensions, [rotation_start] if free_rotation else []) * unknown_scale
         try:
-            scaled, _, _ = _damped_newton(
-                function, start, _RELATIVE_TOLERANCE, positive=tuple(range(n)),
-                what="inverse statics", noise=_platform_noise(platform, force_scale),
-            )
+            scaled, _, _ = _damped_newton(function, start, _RELATIVE_TOLERANCE, positive=tuple(range(n)),
+                                          what="inverse statics", noise=noise)
             break
         except UnreachableError as caught:
             error = caught
     else:
-        if _continuation and any(c.weight_per_length > 0.0 for c in platform.cables):
+        if continuation and any(c.weight_per_length > 0.0 for c in platform.cables):
             try:
-                return _inverse_by_weight_continuation(
-                    platform, position, None if free_rotation else rotation, wrench,
-                    max_strain, max_tension,
-                )
+                return _inverse_by_weight_continuation(platform, position, None if free_rotation else rotation,
+                                                       wrench, max_strain, max_tension)
             except UnreachableError:
                 pass
         raise UnreachableError(
-            f"no equilibrium with pulling cables at position ({position[0]:g}, {position[1]:g}) m"
-            f" ({error})"
+            f"no equilibrium with pulling cables at position ({position[0]:g}, {position[1]:g}) m ({error})"
         ) from None
     evaluate(scaled / unknown_scale)
     equilibria, phi = cache["last"]
@@ -1193,15 +1682,15 @@ def solve_inverse_statics(
             guess = (
                 equilibrium.catenary.horizontal_tension,
                 equilibrium.catenary.vertical_tension_b,
-                _rim_angle(cable.pulley, equilibrium.upper_point),
+                _rim_angle(cable.pulley, equilibrium.exit_point),
             )
-        _, stiffness, _ = forward_cable(
-            cable, equilibrium.unstrained_length, equilibrium.anchor_point, guess, max_strain, max_tension
-        )
+        _, stiffness = forward_cable(cable, equilibrium.unstrained_length, equilibrium.anchor_point, guess,
+                                     max_strain, max_tension)
         stiffnesses.append(stiffness)
-    jacobian = _pose_jacobian(platform, phi, equilibria, stiffnesses, dof)
+    jacobian = kernel.pose_jacobian(platform, phi, equilibria, stiffnesses, dof)
     pose = np.append(position, phi)
-    return _result(platform, pose, equilibria, jacobian, wrench, dof)
+    total = kernel.wrench_residual(platform, phi, equilibria, wrench)
+    return kernel.result(platform, (pose, equilibria, jacobian, total), wrench)
 
 
 _CONTINUATION_STEPS = (0.0, 0.1, 0.25, 0.45, 0.7, 1.0)
@@ -1210,23 +1699,17 @@ _CONTINUATION_STEPS = (0.0, 0.1, 0.25, 0.45, 0.7, 1.0)
 def _inverse_by_weight_continuation(platform, position, rotation, wrench, max_strain, max_tension):
     """Inverse statics by growing the cables' weight from zero, warm-starting each step.
 
-    The last resort when every direct start fails: massless cables are solved
-    reliably from the straight-cable guess, and each step's solution starts the next.
-    Slow (a handful of solves), so only used on failure.
+    The last resort when every direct start fails: massless cables are solved reliably from the
+    straight-cable guess, and each step's solution starts the next. Slow (a handful of solves), so
+    only used on failure.
     """
     previous = None
     for fraction in _CONTINUATION_STEPS:
-        cables = tuple(
-            SuspendedCable(
-                c.weight_per_length * fraction, c.axial_stiffness, c.anchor, c.exit_point, c.pulley
-            )
-            for c in platform.cables
-        )
-        scaled = SuspendedPlatform(cables, platform.mass, platform.gravity, platform.moment_of_inertia)
-        previous = solve_inverse_statics(
-            scaled if fraction < 1.0 else platform, position, rotation, wrench, max_strain,
-            max_tension, initial_guess=previous, _continuation=False,
-        )
+        cables = tuple(SuspendedCable(c.weight_per_length * fraction, c.axial_stiffness, c.anchor, c.exit_point,
+                                      c.pulley) for c in platform.cables)
+        scaled = SuspendedPlatform(cables, platform.mass, platform.gravity, platform.inertia)
+        previous = _planar_inverse(scaled if fraction < 1.0 else platform, position, rotation, wrench, max_strain,
+                                   max_tension, initial_guess=previous, continuation=False)
     return previous
 
 

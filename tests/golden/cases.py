@@ -247,13 +247,12 @@ def planar_rest_point_exits():
 
 @case
 def planar_catenary_statics():
-    from controllers.tension_aware import suspended_platform
-    from cdpr_exu.statics import statics
+    from cdpr_exu.statics.statics import catenary_platform, solve_inverse_statics, solve_statics
 
     scene = _planar("paper-circle", 1.0)
-    platform = suspended_platform(scene)
-    inverse = statics.solve_inverse_statics(platform, (0.2, -1.8))
-    forward = statics.solve_forward_statics(platform, inverse.unstrained_lengths)
+    platform = catenary_platform(scene)
+    inverse = solve_inverse_statics(platform, (0.2, -1.8))
+    forward = solve_statics(platform, inverse.unstrained_lengths)
     return {"inverse_lengths": np.asarray(inverse.unstrained_lengths), "inverse_rotation": np.array(inverse.rotation),
             "forward_position": np.asarray(forward.position), "forward_rotation": np.array(forward.rotation),
             "forward_tensions": np.asarray(forward.tensions_at_anchor)}
@@ -261,12 +260,11 @@ def planar_catenary_statics():
 
 @case
 def planar_chain_statics():
-    from controllers.tension_aware import suspended_platform
-    from cdpr_exu.statics import statics
+    from cdpr_exu.statics.statics import catenary_platform, solve_inverse_statics
     from cdpr_exu.statics.chain_statics import chain_robot, solve_inverse_chain_statics
 
     scene = _planar("paper-circle", 1.0)
-    start = statics.solve_inverse_statics(suspended_platform(scene), (0.2, -1.8))
+    start = solve_inverse_statics(catenary_platform(scene), (0.2, -1.8))
     equilibrium = solve_inverse_chain_statics(chain_robot(scene), (0.2, -1.8, start.rotation),
                                               tension_guess=[c.tension_at_anchor for c in start.cables])
     arrays = {"paid_out": np.asarray(equilibrium.paid_out), "rotation": np.array(equilibrium.rotation)}
@@ -281,12 +279,12 @@ def planar_chain_statics():
 @case
 def spatial_four_cable_ideal_ik():
     """The four-cable robot (no reference of its own) moved 5 cm across and 3 cm up from its rest."""
-    from cdpr_exu.physics.spatial_statics import solve_spatial_statics
     from cdpr_exu.scenes.spatial_trajectories import SpatialPointToPointTrajectory
+    from cdpr_exu.statics.statics import catenary_platform, solve_statics
 
     scene = _spatial("spatial-four-cable", 0.6)
-    rest = solve_spatial_statics(scene.catenary_platform(), scene.unstrained_lengths)
-    start = np.concatenate([rest.position, rest.rotation_vector])
+    rest = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
+    start = np.concatenate([rest.position, rest.rotation])
     end = start + np.array([0.05, 0.0, 0.03, 0.0, 0.0, 0.0])
     return _spatial_run(scene.with_changes(trajectory=SpatialPointToPointTrajectory(tuple(start), tuple(end),
                                                                                      duration=0.5)))
@@ -373,14 +371,14 @@ def spatial_rest_swivel():
 
 @case
 def spatial_catenary_statics():
-    from cdpr_exu.physics.spatial_statics import solve_inverse_spatial_statics, solve_spatial_statics
+    from cdpr_exu.statics.statics import catenary_platform, solve_inverse_statics, solve_statics
 
     scene = _spatial("spatial-ipanema", 1.0)
-    platform = scene.catenary_platform()
-    rest = solve_spatial_statics(platform, scene.unstrained_lengths)
+    platform = catenary_platform(scene)
+    rest = solve_statics(platform, scene.unstrained_lengths)
     pose = np.concatenate([rest.position + [0.05, -0.03, 0.02], [0.0, 0.0, 0.05]])
     guess = np.array([c.catenary.horizontal_tension for c in rest.cables])
-    inverse = solve_inverse_spatial_statics(platform, pose, guess)
-    return {"rest_position": np.asarray(rest.position), "rest_rotation": np.asarray(rest.rotation),
+    inverse = solve_inverse_statics(platform, pose, initial_guess=guess)
+    return {"rest_position": np.asarray(rest.position), "rest_rotation": np.asarray(rest.rotation_matrix),
             "inverse_lengths": np.asarray(inverse.unstrained_lengths),
             "inverse_tensions": np.asarray(inverse.horizontal_tensions)}
