@@ -17,8 +17,8 @@ Two cable models (``statics``), as the planar :class:`controllers.tension_aware.
   plus the change of these lengths, which cancels at the start the offset between the
   catenary and the simulator's chains (1e-5 m on IPAnema);
 * ``"chain"``: the simulator's own lumped cables, n straight elements with the nodes'
-  weight and the exact-angle bending (:func:`cdpr_exu.statics.spatial_chain_statics.
-  solve_inverse_spatial_chain_statics`, the tensions at the anchors kept near the previous
+  weight and the exact-angle bending (:func:`cdpr_exu.statics.chain_statics.
+  solve_inverse_chain_statics`, the tensions at the anchors kept near the previous
   sample's). With the pose given, each chain hangs between two fixed points, so the cables
   decouple and only the platform's balance (six equations) ties their m lengths together:
   one small Newton solve per cable inside a Gauss-Newton on the lengths, started from the
@@ -40,6 +40,8 @@ Units SI.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -135,20 +137,19 @@ class SpatialTensionAwareController:
         """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued."""
         from cdpr_exu.core.errors import UnreachableError
         from cdpr_exu.statics.statics import catenary_platform, forward_cable, solve_inverse_statics, solve_statics
-        from cdpr_exu.statics.spatial_chain_statics import (InverseChainStatics, SpatialChainInverse, catenary_start,
-                                                            robot_paid_out, solve_spatial_chain_statics,
-                                                            spatial_chain_robot)
+        from cdpr_exu.statics.chain_statics import (InverseChainStatics, catenary_start, chain_robot, robot_paid_out,
+                                                    solve_chain_statics)
         from cdpr_exu.core.geometry import rotation_from_vector
 
         platform = catenary_platform(scene)
-        robot = spatial_chain_robot(scene)
-        over_swivel = [cable.swivel is not None for cable in robot.cables]
+        robot = chain_robot(scene)
+        over_swivel = [cable.pulley is not None for cable in robot.cables]
         inverse_statics = InverseChainStatics(robot)
         catenary_rest = solve_statics(platform, initial)
         started = robot_paid_out(robot, initial)
-        rest = solve_spatial_chain_statics(started, *catenary_start(started, catenary_rest))
+        rest = solve_chain_statics(started, *catenary_start(started, catenary_rest))
         # the straight distances change as the paid-out lengths: from the exit point, or the swivel pulley's inlet
-        exits = np.array([cable.swivel.inlet_array if swivel else cable.exit_point
+        exits = np.array([cable.pulley.inlet_array if swivel else cable.exit_point
                           for cable, swivel in zip(robot.cables, over_swivel)])
         anchors = np.array([c.anchor for c in robot.cables])
         state = {"tensions": rest.tensions_at_anchor, "horizontal": np.array([c.catenary.horizontal_tension
@@ -158,9 +159,7 @@ class SpatialTensionAwareController:
             # Over swivel pulleys the first sample starts from the rest the robot starts in, not from the
             # catenaries: these hang lower (no bending over the disc: 22 mm on spatial-four-cable-swivel), and
             # their nodes cannot start a chain that runs up the axis and over the disc
-            state["previous"] = (SpatialChainInverse(np.array(initial, dtype=float), rest.tensions_at_anchor,
-                                                     rest.forces_on_platform, rest.nodes, rest.residual, 0,
-                                                     rest.swivel_angles),
+            state["previous"] = (replace(rest, paid_out=np.array(initial, dtype=float), iterations=0),
                                  np.linalg.norm(exits - rest.position - anchors @ rest.rotation.T, axis=1))
 
         def anchor_points(pose):
@@ -192,20 +191,21 @@ class SpatialTensionAwareController:
             else:  # the previous lengths, changed as the straight cables change
                 points = anchor_points(pose)
                 chords = np.linalg.norm(exits - points, axis=1)
-                lengths = previous[0].unstrained_lengths + chords - previous[1]
+                lengths = previous[0].paid_out + chords - previous[1]
                 nodes, angles = previous[0].nodes, previous[0].swivel_angles
             try:
-                inverse = inverse_statics.solve(pose, state["tensions"], lengths, nodes, inertial,
-                                                swivel_angles=angles)
+                inverse = inverse_statics.solve(pose, state["tensions"], lengths=lengths, nodes=nodes,
+                                                external_wrench=inertial, swivel_angles=angles)
             except UnreachableError:
                 if previous is None:
                     raise
-                inverse = inverse_statics.solve(pose, state["tensions"], *catenary_guess(pose, inertial), inertial,
-                                                swivel_angles=angles)
-            state["tensions"] = inverse.tensions
+                lengths, nodes = catenary_guess(pose, inertial)
+                inverse = inverse_statics.solve(pose, state["tensions"], lengths=lengths, nodes=nodes,
+                                                external_wrench=inertial, swivel_angles=angles)
+            state["tensions"] = inverse.tensions_at_anchor
             state["previous"] = (inverse, np.linalg.norm(exits - anchor_points(pose), axis=1))
             self.inverses.append(inverse)
-            return inverse.unstrained_lengths
+            return inverse.paid_out
         return solve
 
     def command(self, measurement: Measurement) -> WinchCommand:

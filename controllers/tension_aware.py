@@ -158,12 +158,12 @@ class TensionAwareController:
         """Chain statics at one reference pose, continued from the previous one when there is one."""
         if previous is not None:
             try:
-                return chain_statics.solve_chain_statics(chain, pose[:2], external_wrench=wrench, guess=previous)
+                return chain_statics.solve_inverse_chain_statics(chain, pose[:2], external_wrench=wrench, guess=previous)
             except UnreachableError:
                 pass  # start afresh from the catenary below
         start = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
-        return chain_statics.solve_chain_statics(chain, pose[:2], start.rotation, external_wrench=wrench,
-                                                 tension_guess=[c.tension_at_anchor for c in start.cables])
+        return chain_statics.solve_inverse_chain_statics(chain, (*pose[:2], start.rotation), external_wrench=wrench,
+                                                         tension_guess=[c.tension_at_anchor for c in start.cables])
 
     def _period(self, scene) -> float:
         """Table period [s]: ``table_period``, or longer where the reference moves less

@@ -233,14 +233,14 @@ class _TensionSpy(_Spy):
 
 
 def test_a_controller_that_uses_the_tensions_gets_tensions_that_hold_the_platform_at_rest():
-    from cdpr_exu.statics.spatial_chain_statics import spatial_chain_robot, spatial_chain_statics
+    from cdpr_exu.statics.chain_statics import chain_rest, chain_robot
 
     scene = ipanema(end_time=0.3, output_period=0.01)
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     spy = _TensionSpy()
     result = simulate_spatial(scene, spy)
-    robot = spatial_chain_robot(scene)
-    rest = np.array([t[-1] for t in spatial_chain_statics(scene).tensions])  # the lumped robot's statics
+    robot = chain_robot(scene)
+    rest = np.array([t[-1] for t in chain_rest(scene).tensions])  # the lumped robot's statics
     anchor_weights = np.array([c.node_masses[-1] for c in robot.cables]) * robot.gravity
     during = [m for m in spy.seen if m.state_time is not None]
     assert during and all(m.cable_tensions.shape == (8,) and m.platform_pose.shape == (6,) for m in during)

@@ -51,7 +51,7 @@ moves its node along the winch line, so cable flows over the pulley. The chain s
 on the catenary statics' shape: the winch line stretched under the tension at the
 tangent point less its own weight, the wrap on the groove bottom, psi at the anchor's
 azimuth. From there :func:`start_at_rest` brings the robot to its static equilibrium by the
-chain statics (:mod:`cdpr_exu.statics.spatial_chain_statics`, on the same discrete model,
+chain statics (:mod:`cdpr_exu.statics.chain_statics`, on the same discrete model,
 :func:`chain_statics_robot`): Exudyn's static solver does not converge from that start.
 
 Units SI, z up, gravity along -z. The parameters are those of
@@ -84,8 +84,8 @@ from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # th
 from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.statics.statics import (PlatformEquilibrium, SuspendedPlatform, chain_element_mass,
                                       checked_unstrained_lengths, node_masses_along, solve_statics)
-from cdpr_exu.statics.spatial_chain_statics import SpatialChainCable, SpatialChainRobot, solve_spatial_chain_statics, \
-    swivel_chain_start, winch_line_elements
+from cdpr_exu.statics.chain_statics import ChainCable, ChainRobot, solve_chain_statics, swivel_chain_start, \
+    winch_line_elements
 
 
 @dataclass(frozen=True)
@@ -611,8 +611,8 @@ def _start_at_rest(mbs):
     return state
 
 
-def chain_statics_robot(mbs, items) -> SpatialChainRobot:
-    """The chain statics' model (:mod:`cdpr_exu.statics.spatial_chain_statics`) of a built robot, read from its items:
+def chain_statics_robot(mbs, items) -> ChainRobot:
+    """The chain statics' model (:mod:`cdpr_exu.statics.chain_statics`) of a built robot, read from its items:
     the same node masses, element stiffnesses, bending, tension-only law, held first nodes (a swivel
     cable's winch end where the builder holds it), swivel pulleys and anchor joints.
 
@@ -626,14 +626,14 @@ def chain_statics_robot(mbs, items) -> SpatialChainRobot:
     cables = []
     for i, cable in enumerate(platform.cables):
         held = chain_positions(mbs, items, i, current=False)[0]
-        cables.append(SpatialChainCable(
+        cables.append(ChainCable(
             exit_point=held, node_masses=tuple(float(m) for m in items.node_masses[i]),
             element_length=float(items.unstrained_lengths[i]) / chain.n_elements,
             axial_stiffness=float(items.axial_stiffnesses[i]), bending_stiffness=float(items.bending_stiffnesses[i]),
             slack=chain.tension_only, anchor=cable.anchor,
-            swivel=items.swivel_pulleys[i] if items.has_swivel(i) else None,
+            pulley=items.swivel_pulleys[i] if items.has_swivel(i) else None,
             winch_elements=int(items.winch_elements[i]) if items.has_swivel(i) else 0))
-    return SpatialChainRobot(tuple(cables), platform.mass, platform.gravity, chain.anchor_spring_factor)
+    return ChainRobot(tuple(cables), platform.mass, platform.gravity, chain.anchor_spring_factor)
 
 
 def set_configuration(mbs, items, equilibrium):
@@ -644,7 +644,7 @@ def set_configuration(mbs, items, equilibrium):
     mbs : exudyn.MainSystem
         Assembled.
     items : SpatialRobotItems
-    equilibrium : SpatialChainEquilibrium
+    equilibrium : ChainEquilibrium
         Of :func:`chain_statics_robot` (the nodes, the platform's pose and the swivel angles).
     """
     q = np.array(mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Initial))
@@ -677,7 +677,7 @@ class RestStart:
     method : str
         "chain statics" (the chain statics' equilibrium, polished by Exudyn's static solver
         where it applies) or "dynamic settle" (the fallback, :func:`settle`).
-    statics : SpatialChainEquilibrium or None
+    statics : ChainEquilibrium or None
         The chain statics' answer (None after the fallback).
     polish_shift : float or None [m, rad]
         Largest change of any coordinate by Exudyn's static solver from the chain statics'
@@ -692,7 +692,7 @@ class RestStart:
 def start_at_rest(mbs, items, max_iterations: int = 100) -> RestStart:
     """Bring the assembled robot to its static equilibrium by the chain statics and make that its start (at rest).
 
-    The chain statics (:func:`cdpr_exu.statics.spatial_chain_statics.solve_spatial_chain_statics`
+    The chain statics (:func:`cdpr_exu.statics.chain_statics.solve_chain_statics`
     on :func:`chain_statics_robot`, the same discrete model, started where the builder
     started Exudyn's) solve the robot over swivel pulleys, where Exudyn's static solver
     does not converge from the catenary start; then Exudyn's static solver polishes that
@@ -719,7 +719,7 @@ def start_at_rest(mbs, items, max_iterations: int = 100) -> RestStart:
     start = ([chain_positions(mbs, items, i, current=False) for i in range(len(items.chains))],
              *platform_pose(mbs, items, current=False), swivel_angles(mbs, items, current=False))
     try:
-        statics = solve_spatial_chain_statics(robot, *start, max_iterations=max_iterations)
+        statics = solve_chain_statics(robot, *start, max_iterations=max_iterations)
     except UnreachableError as failure:
         warnings.warn(f"the chain statics found no equilibrium ({failure}); the robot is brought to rest by the "
                       "dynamic settle instead (slower)", RuntimeWarning, stacklevel=2)

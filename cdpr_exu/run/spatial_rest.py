@@ -9,7 +9,7 @@
   chains with its effects (bending included), started on the catenary solution and
   brought to equilibrium by Exudyn's static solver (``mbs.SolveStatic``). Over swivel
   pulleys, where Exudyn's static solver does not converge from the catenary start, the
-  chain statics (:mod:`cdpr_exu.statics.spatial_chain_statics`, the same discrete model)
+  chain statics (:mod:`cdpr_exu.statics.chain_statics`, the same discrete model)
   first take it to equilibrium (:func:`cdpr_exu.builder.spatial_robot.start_at_rest`),
   and Exudyn's static solver confirms it.
 

@@ -1,53 +1,63 @@
-"""Static equilibrium of the simulator's own lumped cables: chains of nodes over pulleys.
+"""Static equilibrium of the simulator's own lumped cables: chains of nodes, in the plane and in space.
 
 :mod:`cdpr_exu.statics.statics` treats each cable as a continuous elastic catenary. The
-simulator does not: its cable is a chain of n straight elements whose nodes carry the
-mass, with exact-angle bending springs at the interior nodes, and a pulley pushes the
-*nodes* out of its disc (:mod:`cdpr_exu.builder.pulley`). On the paper's robot (0.25 m elements
-on 0.25 m pulleys) the chain wraps the pulley as a coarse polygon, and its bending
-springs lift it off the rim near the tangent point. Both change the paid-out length
-that puts the platform on a given pose by millimetres to centimetres, by an amount that
-depends on where the nodes happen to sit. This module solves the same discrete model
-the simulator integrates, at rest:
+simulator does not: its cable is a chain of n straight elements whose nodes carry the mass
+(the scene's lumping), with exact-angle bending springs at the interior nodes, and an exit
+that holds or pushes the nodes (a planar pulley's rim, a swivel pulley's groove). On the
+paper's robot (0.25 m elements on 0.25 m pulleys) the chain wraps the pulley as a coarse
+polygon and its bending springs lift it off the rim; both change the paid-out length that
+puts the platform on a pose by millimetres to centimetres. This module solves the same
+discrete model the simulator integrates, at rest, without Exudyn and without damping.
 
-* unknowns: the interior node positions of every cable, the platform rotation (when
-  equilibrium chooses it) and the paid-out length of every winch;
-* equations: force balance of every interior node (axial springs k_i (|d| - l0i),
-  tension-only when the scene's elements are slack; bending moments k_theta dtheta;
-  pulley penalty k_p (r_p - d) along the radius; node weight m_j g) and the force and
-  moment balance of the platform, which also carries the last node of each cable
-  (joined to it at the anchor) and an optional external wrench.
+One description for both dimensions: a :class:`ChainRobot` of :class:`ChainCable` built from
+a scene by :func:`chain_robot`, one :class:`ChainEquilibrium`, and two drivers:
 
-Newton's method with the analytic Jacobian (axial, contact and bending tangent
-stiffness) and a backtracking line search on the residual norm. The equilibrium at
-rest needs no damping, so damping constants do not enter.
+* :func:`solve_inverse_chain_statics` (and :class:`InverseChainStatics` for many poses): the
+  pose given, the paid-out lengths, nodes and tensions found;
+* :func:`solve_chain_statics` (:func:`chain_rest` from a scene): the lengths given, the rest
+  pose found (in space; the plane's rest for given lengths is Exudyn's, :mod:`cdpr_exu.run.rest`).
 
-The winch geometry is the simulator's (:mod:`cdpr_exu.builder.winch`): node 0 sits on the
-winch line ``x = c_x + side r_p`` at height ``z = c_z - (L0 - lambda)``, with ``L0``
-the cable's unstrained length and ``lambda`` the paid-out length (cable beyond the
-hang point). A fixed exit point is the limit ``r_p = 0``.
+Behind them, each dimension's kernels (:mod:`cdpr_exu.statics.chain_kernels`), kept operation for
+operation: in the plane (x, z) two nested Newton iterations, the nodes minimising the potential at
+fixed paid-out lengths (the winch end on the winch line ``x = c_x + side r_p``,
+:mod:`cdpr_exu.builder.winch`), the lengths cancelling the force the held platform needs; in space
+(x, y, z) Newton's method on the potential of the chains, the platform's pose and the swivel
+angles, and the inverse by Gauss-Newton on the lengths over chains held at their anchors
+(:func:`solve_held_chain`). All minimise with :func:`descent_step` and one Armijo line search
+(:func:`_line_search`). Over swivel pulleys, where Exudyn's static solver does not converge from
+the catenary start (:func:`cdpr_exu.builder.spatial_robot.settle`), the forward statics' answer
+starts the runs (:func:`cdpr_exu.builder.spatial_robot.start_at_rest`).
 
-Coordinates are the paper's x-z plane (z up, gravity along -z); units SI (m, N, kg,
-rad). Plain NumPy plus the numba bending kernels; no Exudyn.
+Units SI (m, N, kg, rad); the vertical axis up, gravity along it downwards.
 """
 
 from __future__ import annotations
 
+import copy
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from numba import njit
+import scipy.sparse as sparse
+import scipy.sparse.linalg as sparse_linalg
 
-from cdpr_exu.physics import bending
-from cdpr_exu.scenes.contact_models import CONTACT_MODELS
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import rotation_matrix
+from cdpr_exu.core.geometry import rotation_from_vector, rotation_matrix, rotation_vector
+from cdpr_exu.core.validation import finite, real_array, shown, vector
 from cdpr_exu.exits import Exit
+from cdpr_exu.physics import swivel_pulley as sp
+from cdpr_exu.statics.statics import catenary_platform, chain_element_mass, node_masses_along, solve_statics
+from cdpr_exu.scenes.contact_models import CONTACT_MODELS
+from cdpr_exu.space import space_of
+from cdpr_exu.statics.chain_kernels import PlanarChains, SpatialChains, planar_energy, planar_forces
 from cdpr_exu.statics.kinematics import initial_cable_nodes, straight_cable_nodes
-from cdpr_exu.core.validation import finite, shown, vector
 
-__all__ = ["ChainCable", "ChainRobot", "ChainEquilibrium", "chain_robot", "solve_chain_statics",
-           "chain_forces"]
+__all__ = ["ChainCable", "ChainRobot", "ChainEquilibrium", "chain_robot", "solve_chain_statics", "chain_rest",
+           "solve_inverse_chain_statics", "InverseChainStatics", "chain_forces", "catenary_start",
+           "swivel_chain_start", "winch_line_elements", "cable_paid_out", "robot_paid_out", "HeldChain",
+           "solve_held_chain", "descent_step", "rounding_floor"]
+
+_E_Z = np.array([0.0, 0.0, 1.0])
 
 
 @dataclass(frozen=True)
@@ -57,21 +67,33 @@ class ChainCable:
     Parameters
     ----------
     node_masses : tuple of float, length n + 1 [kg]
-        Winch node first (its mass is carried by the winch).
+        Winch (or exit) node first; its weight is carried by the winch or the frame.
     element_length : float [m]
-        Unstrained element length l0i = L0 / n.
+        Unstrained element length l0 = L / n.
     axial_stiffness : float [N/m]
-        k_i = EA / l0i; ``inf`` is not supported (inextensible chains have no statics here).
+        k = EA / l0 (inextensible chains have no statics here).
     bending_stiffness : float [N m/rad]
-        k_theta of each interior joint (0: no bending).
+        k_theta = EJ / l0 of each interior joint (0: no bending).
     slack : bool
         Tension-only elements.
-    pulley : Exit
-        Where the cable leaves the frame (:mod:`cdpr_exu.exits`: a pulley, or a point exit).
+    anchor : (x, z) or (x, y, z) [m]
+        Anchor in the platform frame (centre of mass at 0); its size is the Space's.
+    pulley : Exit, SwivelPulley or None
+        What the cable runs over. In the plane the exit (:mod:`cdpr_exu.exits`, required): node 0
+        hangs on its winch line by the paid-out length, and a pulley's rim pushes the nodes. In
+        space the swivel pulley every node may touch
+        (:class:`cdpr_exu.physics.swivel_pulley.SwivelPulley`), None at a point exit.
     contact_stiffness : float [N/m]
-        Pulley penalty k_p (0: no contact).
-    anchor : (x, z) [m]
-        Anchor in the platform frame.
+        In the plane, the rim's penalty k_p (0: no contact); a swivel pulley carries its own.
+    exit_point : (x, y, z) [m], in space (required there)
+        Where node 0 is held: the exit point, or over a swivel pulley the winch end on the
+        pulley's vertical axis below its inlet, where the builder holds it.
+    winch_elements : int
+        Over a swivel pulley: the elements of the winch line, below the inlet (else 0).
+    winch_travel : float [m]
+        Over a swivel pulley: how far the winch has moved the held winch end up the axis from
+        ``exit_point`` (paying out; else 0). The run's swivel winch keeps the chain's elements
+        and moves only this end (:class:`cdpr_exu.run.spatial_run._SpatialWinches`).
     """
 
     node_masses: tuple
@@ -79,11 +101,18 @@ class ChainCable:
     axial_stiffness: float
     bending_stiffness: float
     slack: bool
-    pulley: Exit
-    contact_stiffness: float
     anchor: tuple
+    pulley: object = None
+    contact_stiffness: float = 0.0
+    exit_point: tuple | None = None
+    winch_elements: int = 0
+    winch_travel: float = 0.0
 
     def __post_init__(self):
+        anchor = real_array("anchor", self.anchor)
+        if anchor.shape not in ((2,), (3,)):
+            raise SceneError(f"anchor must be (x, z) or (x, y, z) [m], got {shown(self.anchor)}")
+        object.__setattr__(self, "anchor", tuple(float(a) for a in anchor))
         if len(self.node_masses) < 2:
             raise SceneError(f"node_masses needs at least 2 nodes, got {len(self.node_masses)}")
         for name in ("element_length", "axial_stiffness"):
@@ -95,9 +124,13 @@ class ChainCable:
                 raise SceneError(f"{name} must be zero or positive, got {shown(getattr(self, name))}")
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
             raise SceneError(f"node_masses must be finite and non-negative, got {shown(self.node_masses)}")
-        if not isinstance(self.pulley, Exit):
-            raise SceneError(f"pulley must be an exit (cdpr_exu.exits), got {shown(self.pulley)}")
-        vector("anchor", self.anchor, 2)
+        finite("winch_travel", self.winch_travel)
+        _CABLE_CHECKS[anchor.size](self)
+
+    @property
+    def space(self):
+        """The cable's :class:`~cdpr_exu.space.Space` (from its anchor)."""
+        return space_of(len(self.anchor))
 
     @property
     def n_elements(self) -> int:
@@ -105,12 +138,51 @@ class ChainCable:
 
     @property
     def unstrained_length(self) -> float:
-        """L0 = n l0i [m]."""
+        """L = n l0 [m] (over a swivel pulley the winch line's elements included)."""
         return self.n_elements * self.element_length
 
     def winch_node(self, paid_out: float) -> np.ndarray:
-        """Position of node 0 for a paid-out length lambda [m], shape (2,) [m]."""
+        """In the plane: position of node 0 for a paid-out length lambda [m], shape (2,) [m]."""
         return self.pulley.winch_end(self.unstrained_length, paid_out)
+
+    @property
+    def held_point(self) -> np.ndarray:
+        """In space: where node 0 is held [m], ``exit_point`` moved up the axis by ``winch_travel``."""
+        return np.asarray(self.exit_point, dtype=float) + self.winch_travel * _E_Z
+
+    @property
+    def paid_out_length(self) -> float:
+        """In space: the winch's paid-out length [m], L = n l0 at a point exit; over a swivel pulley the
+        length from the inlet the cable was built with, (n - k) l0 (k = ``winch_elements``), plus
+        ``winch_travel``. (In the plane the paid-out length is the statics' unknown.)"""
+        return (self.n_elements - self.winch_elements) * self.element_length + self.winch_travel
+
+
+def _check_planar_cable(cable: ChainCable) -> None:
+    if not isinstance(cable.pulley, Exit):
+        raise SceneError(f"pulley must be an exit (cdpr_exu.exits), got {shown(cable.pulley)}")
+    if cable.exit_point is not None or cable.winch_elements or cable.winch_travel:
+        raise SceneError("exit_point, winch_elements and winch_travel are the spatial chain's: a planar cable "
+                         f"hangs from its pulley, got {shown(cable.exit_point)}, {shown(cable.winch_elements)}, "
+                         f"{shown(cable.winch_travel)}")
+
+
+def _check_spatial_cable(cable: ChainCable) -> None:
+    if cable.exit_point is None:
+        raise SceneError("exit_point (x, y, z) [m] is needed for a spatial cable: where its node 0 is held")
+    object.__setattr__(cable, "exit_point", tuple(vector("exit_point", cable.exit_point, 3)))
+    if cable.pulley is not None and not isinstance(cable.pulley, sp.SwivelPulley):
+        raise SceneError(f"pulley must be a SwivelPulley or None in space, got {shown(cable.pulley)}")
+    if not 0 <= int(cable.winch_elements) <= len(cable.node_masses) - 3 or (cable.pulley is None) != (
+            cable.winch_elements == 0):
+        raise SceneError(f"winch_elements must be 0 for a point exit and leave 2 elements above the inlet "
+                         f"over a swivel pulley, got {shown(cable.winch_elements)}")
+    if cable.winch_travel != 0.0 and cable.pulley is None:
+        raise SceneError(f"winch_travel must be 0 for a point exit, got {shown(cable.winch_travel)}")
+
+
+#: Each dimension's own checks of a cable, by the size of its anchor.
+_CABLE_CHECKS = {2: _check_planar_cable, 3: _check_spatial_cable}
 
 
 @dataclass(frozen=True)
@@ -120,39 +192,91 @@ class ChainRobot:
     Parameters
     ----------
     cables : tuple of ChainCable
+        All of one dimension.
     mass : float [kg]
     gravity : float [m/s^2]
-        Magnitude along -z (0: no gravity, also on the cables).
+        Along the vertical, downwards (0: no gravity, also on the cables).
+    anchor_spring_factor : float or None
+        In space: None, each cable's last node sits on its anchor (an exact spherical joint); a
+        number f > 0, it is tied to the anchor by an isotropic spring of stiffness f k (the
+        builder's penalty joint, :class:`cdpr_exu.builder.spatial_robot.SpatialChainSpec`).
     """
 
     cables: tuple
     mass: float
     gravity: float
+    anchor_spring_factor: float | None = None
+
+    def __post_init__(self):
+        if not self.cables or not all(isinstance(c, ChainCable) for c in self.cables):
+            raise SceneError(f"cables must be a non-empty tuple of ChainCable, got {shown(self.cables)}")
+        object.__setattr__(self, "cables", tuple(self.cables))
+        if len({len(c.anchor) for c in self.cables}) != 1:
+            raise SceneError("cables must all be planar or all spatial (their anchors' sizes differ)")
+        if finite("mass", self.mass) < 0 or finite("gravity", self.gravity) < 0:
+            raise SceneError(f"mass and gravity must be zero or positive, got {shown(self.mass)}, "
+                             f"{shown(self.gravity)}")
+        if self.anchor_spring_factor is not None and not finite("anchor_spring_factor", self.anchor_spring_factor) > 0:
+            raise SceneError(f"anchor_spring_factor must be positive or None, got {shown(self.anchor_spring_factor)}")
+
+    @property
+    def space(self):
+        """The robot's :class:`~cdpr_exu.space.Space`."""
+        return self.cables[0].space
 
     @property
     def is_point_mass(self) -> bool:
         """True when every anchor sits at the centre of mass (no rotation to balance)."""
         return all(np.allclose(c.anchor, 0.0) for c in self.cables)
 
+    @property
+    def swivel_cables(self) -> list:
+        """Indices of the cables that run over a swivel pulley."""
+        return [i for i, c in enumerate(self.cables) if isinstance(c.pulley, sp.SwivelPulley)]
 
-def chain_robot(scene) -> ChainRobot:
+
+def chain_robot(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
+                catenary=None) -> ChainRobot:
     """The chain-statics model of a scene, with the effects the scene's builder adds.
+
+    Parameters
+    ----------
+    scene : Scene
+    anchor_spring_factor : float or None
+        In space, see :class:`ChainRobot` (the plane's chains end on their anchors).
+    tension_only : bool, optional
+        Default the scene's ``effects.slack`` (the spatial static mode builds spring elements: False).
+    catenary : PlatformEquilibrium, optional
+        In space, the scene's catenary statics: a cable over a swivel pulley is held at the winch end
+        its start shape puts it (:func:`swivel_chain_start`), as the builder holds it; solved here
+        when not given and needed.
 
     Raises
     ------
     SceneError
-        For massless or inextensible cables (no nodes, or no axial spring to solve for).
+        For a bending model other than the exact angle; in the plane also for massless or
+        inextensible cables and contact models other than the node contact.
     """
+    effects = scene.effects
+    if effects.bending and effects.bending_model != "exact":
+        raise SceneError("chain statics models the exact-angle bending only, "
+                         f"got effects.bending_model = {shown(effects.bending_model)}")
+    slack = bool(effects.slack if tension_only is None else tension_only)
+    return _SCENE_CABLES[scene.space.dimension](scene, slack, anchor_spring_factor, catenary)
+
+
+def _planar_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
+    """:func:`chain_robot` of a planar scene."""
     effects = scene.effects
     if not effects.cable_mass or not effects.axial_elasticity:
         raise SceneError("chain statics needs effects.cable_mass and effects.axial_elasticity "
                          f"(the scene's preset is {shown(effects.preset)}); use the catenary statics instead")
-    if effects.bending and effects.bending_model != "exact":
-        raise SceneError("chain statics models the exact-angle bending only, "
-                         f"got effects.bending_model = {shown(effects.bending_model)}")
     if scene.contact_model not in (None, CONTACT_MODELS["node"]):
         raise SceneError("chain statics models the node contact on pulleys only, got "
                          f"effects.pulley_contact_model = {shown(effects.pulley_contact_model)}")
+    if anchor_spring_factor is not None:
+        raise SceneError(f"anchor_spring_factor must be None in the plane (the chains end on their anchors), "
+                         f"got {shown(anchor_spring_factor)}")
     gravity = scene.gravity if effects.gravity else 0.0
     cables = []
     for cable, exit_, anchor in zip(scene.cables, scene.exits, scene.platform.anchors):
@@ -162,8 +286,40 @@ def chain_robot(scene) -> ChainRobot:
             node_masses=tuple(float(m) for m in masses), element_length=cable.element_length,
             axial_stiffness=cable.axial_stiffness,
             bending_stiffness=cable.bending_stiffness if effects.bending else 0.0,
-            slack=effects.slack, pulley=exit_, contact_stiffness=contact, anchor=tuple(anchor)))
+            slack=slack, pulley=exit_, contact_stiffness=contact, anchor=tuple(anchor)))
     return ChainRobot(tuple(cables), scene.platform.mass, gravity)
+
+
+def _spatial_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
+    """:func:`chain_robot` of a spatial scene."""
+    effects = scene.effects
+    platform = catenary_platform(scene)  # what the builder builds from: weights, EA, gravity
+    gravity = platform.gravity
+    swivels = scene.swivel_exits
+    if catenary is None and any(s is not None for s in swivels):
+        catenary = solve_statics(platform, scene.unstrained_lengths)
+    cables = []
+    for i, (spec, cable, swivel) in enumerate(zip(scene.cables, platform.cables, swivels)):
+        n, length = spec.n_elements, spec.unstrained_length
+        l0 = length / n
+        below, held, pulley = 0, cable.exit_point, None
+        if swivel is not None:
+            below = winch_line_elements(swivel.winch_line, l0)
+            held = swivel_chain_start(catenary.cables[i], length, n, below, swivel.contact_stiffness)[1][0]
+            pulley = swivel.pulley()
+        # the builder's lumping (:func:`cdpr_exu.builder.spatial_robot.build_spatial_robot`), to the last bit
+        masses = (node_masses_along(n + below, chain_element_mass(cable, length, n, gravity), spec.mass_lumping)
+                  if gravity > 0 else np.zeros(n + below + 1))
+        cables.append(ChainCable(
+            exit_point=held, node_masses=tuple(float(m) for m in masses), element_length=l0,
+            axial_stiffness=cable.axial_stiffness / l0,
+            bending_stiffness=spec.youngs_modulus * spec.second_moment / l0 if effects.bending else 0.0,
+            slack=slack, anchor=cable.anchor, pulley=pulley, winch_elements=below))
+    return ChainRobot(tuple(cables), scene.platform.mass, gravity, anchor_spring_factor)
+
+
+#: Each dimension's cables from a scene, by the scene's Space.
+_SCENE_CABLES = {2: _planar_robot, 3: _spatial_robot}
 
 
 @dataclass(frozen=True, eq=False)
@@ -172,79 +328,183 @@ class ChainEquilibrium:
 
     Attributes
     ----------
-    position : ndarray, shape (2,) [m]
-    rotation : float [rad]
-    paid_out : ndarray, shape (m,) [m]
-        Paid-out length lambda of each winch.
-    nodes : tuple of ndarray, each shape (n + 1, 2) [m]
-        Node positions, winch node first, anchor last.
+    position : ndarray, shape (2,) or (3,) [m]
+        Platform centre of mass.
+    rotation : float [rad] in the plane, ndarray (3, 3) in space
+        Platform frame to world frame (0 / identity for a point mass).
+    nodes : tuple of ndarray, each shape (n + 1, 2 or 3) [m]
+        Node positions of each cable, winch (exit) node first, anchor last.
     tensions : tuple of ndarray, each shape (n,) [N]
-        Axial force of each element (positive in tension).
+        Axial force of each element, winch first (positive in tension).
+    forces_on_platform : ndarray, shape (m, 2 or 3) [N]
+        Force each cable exerts on the platform at its anchor (the last element's pull, the
+        bending shear and the anchor node's weight; a penalty joint's force if any).
+    paid_out : ndarray, shape (m,) [m]
+        Each winch's paid-out length (in the plane beyond the pulley's hang point; in space
+        :attr:`ChainCable.paid_out_length`).
     residual : float [N]
-        Largest force imbalance left.
+        Largest force (moment) imbalance left.
     iterations : int
+    swivel_angles : ndarray, shape (m,) [rad] or None
+        In space, each swivel pulley's angle psi (NaN at a point exit).
+    rotation_vector : ndarray, shape (1,) or (3,) [rad]
+        The rotation's coordinates in the pose: (rotation,) in the plane, the rotation vector in space.
     """
 
     position: np.ndarray
-    rotation: float
-    paid_out: np.ndarray
+    rotation: object
     nodes: tuple
     tensions: tuple
+    forces_on_platform: np.ndarray
+    paid_out: np.ndarray
     residual: float
     iterations: int = field(default=0)
+    swivel_angles: np.ndarray | None = None
+    rotation_vector: np.ndarray = None
+
+    @property
+    def pose(self) -> np.ndarray:
+        """The platform's pose in its Space's coordinates: (x, z, rotation) or (x, y, z, rotation vector) [m, rad]."""
+        return np.concatenate([self.position, self.rotation_vector])
 
     @property
     def anchor_tensions(self) -> np.ndarray:
         """Tension of each cable's last element, at the platform, shape (m,) [N]."""
         return np.array([t[-1] for t in self.tensions])
 
+    @property
+    def tensions_at_anchor(self) -> np.ndarray:
+        """Norm of each cable's force on the platform, shape (m,) [N]."""
+        return np.linalg.norm(self.forces_on_platform, axis=1)
 
-class _Layout:
-    """Index bookkeeping: global nodes of all cables and the inner unknowns.
 
-    The inner unknowns ``v`` are the interior node coordinates of every cable, cable
-    after cable, then the rotation when it is free.
+def winch_line_elements(winch_line: float, element_length: float) -> int:
+    """Elements of a cable below a swivel pulley's inlet (its winch line along the axis): the
+    winch line ``winch_line`` [m] in elements of ``element_length`` [m], at least 2 (the builder's)."""
+    return max(2, int(round(winch_line / element_length)))
+
+
+def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, contact_stiffness):
+    """Straight unstrained reference (winch end first) and the catenary statics' node positions of a
+    cable over a swivel pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``.
+
+    From the anchor: the catenary up to the tangent point; then the wrap as the lumped
+    cable lies on it, a polygon of chords of the stretched element length (on the arc
+    instead, each chord is short by r_p theta^3 / 24 and pushes with up to 3 kN at
+    l_e = r_p: Newton then diverged), each node inside the groove by the depth that carries
+    its share of the pressure, ``T l_e / (r_p k_p)`` (on the rim itself psi has no stiffness:
+    Exudyn's static solver met a singular matrix); then down the axis to the winch end.
+    The tension is the catenary's at the tangent point (frictionless wrap, its weight
+    left out, as in the statics). The winch end (the first row of both) is where the
+    cable is held: the builder holds it there, and so do the chain statics.
+
+    Parameters
+    ----------
+    equilibrium_cable : SpatialCableState
+        The cable in the catenary statics (:func:`cdpr_exu.statics.statics.solve_statics`).
+    length : float [m]
+        Unstrained length from the inlet to the anchor (the catenary's).
+    n_elements, winch_elements : int
+        Elements from the inlet to the anchor, and below the inlet.
+    contact_stiffness : float [N/m]
+        The pulley's penalty stiffness k_p.
     """
+    element = length / n_elements
+    inlet = equilibrium_cable.inlet
+    axial = equilibrium_cable.cable.axial_stiffness
+    tension = equilibrium_cable.tension_at_exit
+    radius = equilibrium_cable.pulley_radius
+    direction = equilibrium_cable.horizontal_direction
+    suspended = equilibrium_cable.suspended_length
+    arcs = length - element * np.arange(-winch_elements, n_elements + 1)  # unstrained, from the anchor
+    hanging = arcs <= suspended
+    current = np.empty((len(arcs), 3))
+    current[hanging] = equilibrium_cable.points(arcs[hanging])
+    stretched = element * (1.0 + tension / axial)
+    chord_angle = 2.0 * math.asin(min(1.0, stretched / (2.0 * radius)))  # rim angle per element
+    angle = math.pi - equilibrium_cable.wrap_angle + (arcs[~hanging] - suspended) / element * chord_angle
+    depth = tension * stretched / (radius * contact_stiffness)
+    centre = inlet + radius * direction
+    rim = centre + np.outer((radius - depth) * np.cos(angle), direction) + np.outer((radius - depth) * np.sin(angle), _E_Z)
+    axis = inlet - np.outer((angle - math.pi) / chord_angle * stretched, _E_Z)
+    current[~hanging] = np.where((angle <= math.pi)[:, None], rim, axis)
+    # the winch end on the axis, below the inlet by the winch line stretched under the tension at
+    # the inlet less its own weight: where the paid-out length puts it, whatever the polygon
+    weight = equilibrium_cable.cable.weight_per_length
+    below = element * winch_elements
+    current[0] = inlet - (below * (1.0 + tension / axial) - weight * below**2 / (2.0 * axial)) * _E_Z
+    reference = current[0] + np.outer(element * np.arange(len(current)), _E_Z)
+    return reference, current
 
-    def __init__(self, robot: ChainRobot, free_rotation: bool):
-        self.counts = [c.n_elements + 1 for c in robot.cables]
-        self.first = np.concatenate([[0], np.cumsum(self.counts)[:-1]]).astype(int)
-        self.n_nodes = int(sum(self.counts))
-        self.interior = np.concatenate([
-            np.arange(f + 1, f + n - 1) for f, n in zip(self.first, self.counts)]).astype(int)
-        self.winch = self.first.copy()
-        self.anchor = (self.first + np.asarray(self.counts) - 1).astype(int)
-        self.free_rotation = free_rotation
-        self.n_interior = 2 * self.interior.size
-        self.n_inner = self.n_interior + int(free_rotation)
-        self.interior_rows = (2 * self.interior[:, None] + np.arange(2)).ravel()
-        joints = bending.cable_joints(self.counts)
-        joint_stiffness = np.concatenate([
-            np.full(n - 2, c.bending_stiffness) for c, n in zip(robot.cables, self.counts)])
-        self.bending = (bending.BendingSpringDamper(self.n_nodes, joints, joint_stiffness, np.zeros_like(joint_stiffness))
-                        if np.any(joint_stiffness > 0) else None)
-        self.zero_velocities = np.zeros(2 * self.n_nodes)
-        # (2, 2N): sums the anchor nodes' coordinates; its transpose moves every anchor
-        # with the platform position
-        self.anchor_sum = np.zeros((2, 2 * self.n_nodes))
-        for j in self.anchor:
-            self.anchor_sum[:, 2 * j:2 * j + 2] = np.eye(2)
-        self.joints, self.joint_stiffness = joints, joint_stiffness
-        # per node: the pulley it may touch (stiffness 0: none)
-        self.node_center = np.concatenate([np.tile(np.asarray(c.pulley.point, float), (n, 1))
-                                           for c, n in zip(robot.cables, self.counts)])
-        self.node_radius = np.concatenate([np.full(n, c.pulley.radius) for c, n in zip(robot.cables, self.counts)])
-        self.node_contact = np.concatenate([
-            np.full(n, c.contact_stiffness if c.pulley.wraps else 0.0)
-            for c, n in zip(robot.cables, self.counts)])
-        elements = [np.stack([np.arange(f, f + n - 1), np.arange(f + 1, f + n)], axis=1)
-                    for f, n in zip(self.first, self.counts)]
-        self.elements = np.concatenate(elements).astype(int)
-        self.element_cable = np.concatenate([np.full(n - 1, i) for i, n in enumerate(self.counts)])
-        self.k = np.array([robot.cables[c].axial_stiffness for c in self.element_cable])
-        self.l0 = np.array([robot.cables[c].element_length for c in self.element_cable])
-        self.slack = np.array([robot.cables[c].slack for c in self.element_cable])
-        self.masses = np.concatenate([np.asarray(c.node_masses) for c in robot.cables])
+
+def _anchor_azimuth(equilibrium_cable) -> float:
+    """Azimuth [rad] of the cable's anchor seen from its swivel axis: where the builder starts psi."""
+    return sp.exit_azimuth(equilibrium_cable.anchor_point, equilibrium_cable.inlet)
+
+
+# ---------------------------------------------------------------------------
+# shared: the descent step, the line search, the rounding floor
+# ---------------------------------------------------------------------------
+def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
+    """Newton's step -H^-1 g, with H shifted by a multiple of the identity until it is a descent direction.
+
+    An indefinite or singular Hessian (a node on a rim, a slack element, a swivel angle
+    with no stiffness) is shifted by ``relative_shift`` times its largest diagonal entry,
+    then ten times more each time. ``hessian``: dense (N, N) or a scipy sparse matrix;
+    ``gradient``: (N,). Returns the step, shape (N,).
+    """
+    is_sparse = sparse.issparse(hessian)
+    if is_sparse:
+        identity = sparse.identity(hessian.shape[0], format="csc")
+    scale = float(np.abs(hessian.diagonal()).max())
+    shift = 0.0
+    while True:
+        try:
+            if is_sparse:
+                step = sparse_linalg.splu((hessian + shift * identity).tocsc()).solve(-gradient)
+            else:
+                step = np.linalg.solve(hessian + shift * np.eye(len(gradient)), -gradient)
+        except (np.linalg.LinAlgError, RuntimeError):  # exactly singular
+            step = None
+        if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
+            return step
+        shift = max(10.0 * shift, relative_shift * scale)
+
+
+def _line_search(move, energy_of, improves, energy: float, slope: float):
+    """Armijo's backtracking along a descent step: ``(trial, its energy)`` or None when no step is accepted.
+
+    Tries ``move(alpha)`` for alpha = 1, 1/2, 1/4... (40 halvings) and takes the first whose energy
+    (``energy_of(trial)``) falls by 1e-4 of what the ``slope`` (g . step) promises. The penalty contact
+    makes the Hessian jump where a node lands on or leaves a rim or groove; the energy stays
+    continuously differentiable, so every step is a descent step (a force residual would not be).
+    Near the solution the energy's decrease, ~ |g|^2 / k, falls below its rounding (~1e-13 |E|):
+    there the step is taken if ``improves(trial)`` (the gradient shrinks), and refused if not (the
+    gradient is then as small as it gets).
+    """
+    roundoff = 1e-13 * (1.0 + abs(energy))
+    alpha = 1.0
+    for _ in range(40):
+        trial = move(alpha)
+        trial_energy = energy_of(trial)
+        if trial_energy <= energy + 1e-4 * alpha * slope:
+            return trial, trial_energy
+        if abs(trial_energy - energy) <= roundoff:
+            return (trial, trial_energy) if improves(trial) else None
+        alpha *= 0.5
+    return None
+
+
+def rounding_floor(stiffness, points) -> float:
+    """The force [N] below which a chain's node forces are rounding: an element's k (l - l0), its length
+    computed from coordinates of size |p|, carries k |p| eps; 16 times that for the sums. ``stiffness``:
+    the elements' k [N/m]; ``points``: the coordinates [m]."""
+    return 16.0 * np.finfo(float).eps * float(np.max(stiffness)) * float(np.abs(points).max())
+
+
+# ---------------------------------------------------------------------------
+# the plane: numba kernels (exact-angle bending, rim contact), nodes and paid-out lengths at a pose
+# ---------------------------------------------------------------------------
 
 
 def _positions(robot, layout, position, rotation, v, paid_out):
@@ -258,121 +518,6 @@ def _positions(robot, layout, position, rotation, v, paid_out):
         p[layout.winch[i]] = cable.winch_node(paid_out[i])
         p[layout.anchor[i]] = position + R @ np.asarray(cable.anchor)
     return p, rotation
-
-
-@njit(cache=True)
-def _energy_kernel(p, elements, k, l0, slack, weights, center, radius, contact, joints, joint_k):
-    """Potential of the chains [J]: axial springs, pulley penalty, weight, bending."""
-    energy = 0.0
-    for j in range(p.shape[0]):
-        energy += weights[j] * p[j, 1]
-        if contact[j] > 0.0:
-            dx, dz = p[j, 0] - center[j, 0], p[j, 1] - center[j, 1]
-            depth = radius[j] - np.sqrt(dx * dx + dz * dz)
-            if depth > 0.0:
-                energy += 0.5 * contact[j] * depth * depth
-    for e in range(elements.shape[0]):
-        a, b = elements[e, 0], elements[e, 1]
-        dx, dz = p[b, 0] - p[a, 0], p[b, 1] - p[a, 1]
-        stretch = np.sqrt(dx * dx + dz * dz) - l0[e]
-        if stretch > 0.0 or not slack[e]:
-            energy += 0.5 * k[e] * stretch * stretch
-    for i in range(joints.shape[0]):
-        a, b, c = joints[i, 0], joints[i, 1], joints[i, 2]
-        e1x, e1z = p[b, 0] - p[a, 0], p[b, 1] - p[a, 1]
-        e2x, e2z = p[c, 0] - p[b, 0], p[c, 1] - p[b, 1]
-        angle = np.arctan2(e1x * e2z - e1z * e2x, e1x * e2x + e1z * e2z)
-        energy += 0.5 * joint_k[i] * angle * angle
-    return energy
-
-
-@njit(cache=True)
-def _force_kernel(p, elements, k, l0, slack, weights, center, radius, contact, with_stiffness, F, K, tension):
-    """Axial, contact and weight forces on the nodes into F (N, 2), -dF/dX into K, tensions."""
-    F[:, :] = 0.0
-    if with_stiffness:
-        K[:, :] = 0.0
-    for j in range(p.shape[0]):
-        F[j, 1] -= weights[j]
-        if contact[j] > 0.0:
-            dx, dz = p[j, 0] - center[j, 0], p[j, 1] - center[j, 1]
-            dist = np.sqrt(dx * dx + dz * dz)
-            depth = radius[j] - dist
-            if depth > 0.0 and dist > 0.0:
-                nx, nz = dx / dist, dz / dist
-                F[j, 0] += contact[j] * depth * nx
-                F[j, 1] += contact[j] * depth * nz
-                if with_stiffness:
-                    # k_p (n n^T - depth / d (I - n n^T))
-                    ratio = depth / dist
-                    K[2 * j, 2 * j] += contact[j] * (nx * nx - ratio * (1.0 - nx * nx))
-                    K[2 * j + 1, 2 * j + 1] += contact[j] * (nz * nz - ratio * (1.0 - nz * nz))
-                    K[2 * j, 2 * j + 1] += contact[j] * (nx * nz + ratio * nx * nz)
-                    K[2 * j + 1, 2 * j] += contact[j] * (nx * nz + ratio * nx * nz)
-    for e in range(elements.shape[0]):
-        a, b = elements[e, 0], elements[e, 1]
-        dx, dz = p[b, 0] - p[a, 0], p[b, 1] - p[a, 1]
-        length = np.sqrt(dx * dx + dz * dz)
-        tx, tz = dx / length, dz / length
-        force = k[e] * (length - l0[e])
-        if slack[e] and force < 0.0:
-            tension[e] = 0.0
-            continue
-        tension[e] = force
-        F[a, 0] += force * tx
-        F[a, 1] += force * tz
-        F[b, 0] -= force * tx
-        F[b, 1] -= force * tz
-        if with_stiffness:
-            geometric = force / length
-            kxx = k[e] * tx * tx + geometric * (1.0 - tx * tx)
-            kzz = k[e] * tz * tz + geometric * (1.0 - tz * tz)
-            kxz = (k[e] - geometric) * tx * tz
-            for r, c, sign in ((a, a, 1.0), (b, b, 1.0), (a, b, -1.0), (b, a, -1.0)):
-                K[2 * r, 2 * c] += sign * kxx
-                K[2 * r + 1, 2 * c + 1] += sign * kzz
-                K[2 * r, 2 * c + 1] += sign * kxz
-                K[2 * r + 1, 2 * c] += sign * kxz
-
-
-def _energy(robot, layout, p):
-    """Potential energy of the chains at node positions p (n_nodes, 2) [J]."""
-    return _energy_kernel(p, layout.elements, layout.k, layout.l0, layout.slack, layout.masses * robot.gravity,
-                          layout.node_center, layout.node_radius, layout.node_contact, layout.joints,
-                          layout.joint_stiffness)
-
-
-def _forces(robot, layout, p, with_stiffness=True):
-    """Nodal forces, tangent stiffness, element tensions and potential energy.
-
-    Returns
-    -------
-    F : ndarray, shape (n_nodes, 2) [N]
-        Net force on every node (springs, bending, contact, weight).
-    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m] or None
-        ``-dF/dX``.
-    tension : ndarray, shape (n_elements_total,) [N]
-    energy : float [J]
-        Elastic, contact and gravitational potential of the cables.
-    """
-    N = layout.n_nodes
-    p = np.ascontiguousarray(p, dtype=float)
-    if np.any(np.hypot(*(p[layout.elements[:, 1]] - p[layout.elements[:, 0]]).T) <= 0):
-        raise UnreachableError("chain statics: two neighbouring cable nodes coincide")
-    F = np.empty((N, 2))
-    K = np.empty((2 * N, 2 * N)) if with_stiffness else np.empty((0, 0))
-    tension = np.empty(len(layout.elements))
-    _force_kernel(p, layout.elements, layout.k, layout.l0, layout.slack, layout.masses * robot.gravity,
-                  layout.node_center, layout.node_radius, layout.node_contact, with_stiffness, F, K, tension)
-    if layout.bending is not None:
-        flat = p.ravel()
-        if with_stiffness:
-            force, Kb, _ = layout.bending.force_and_jacobian(flat, layout.zero_velocities)
-            K += Kb
-        else:
-            force = layout.bending.force(flat, layout.zero_velocities)
-        F += force.reshape(-1, 2)
-    return F, (K if with_stiffness else None), tension, _energy(robot, layout, p)
 
 
 def _cross(a, f):
@@ -407,7 +552,7 @@ class _Inner:
 
     def energy(self, v):
         p, rotation = _positions(self.robot, self.layout, self.position, self.rotation, v, self.paid_out)
-        return _energy(self.robot, self.layout, p) - self.wrench[2] * rotation
+        return planar_energy(self.robot, self.layout, p) - self.wrench[2] * rotation
 
     def _gradient(self, S, F):
         """dPi/dv from dX/dv (2N, n_inner) and the nodal forces (N, 2)."""
@@ -419,7 +564,7 @@ class _Inner:
     def gradient(self, v):
         """dPi/dv without the Hessian."""
         p, _ = _positions(self.robot, self.layout, self.position, self.rotation, v, self.paid_out)
-        F, _, _, _ = _forces(self.robot, self.layout, p, with_stiffness=False)
+        F, _, _, _ = planar_forces(self.robot, self.layout, p, with_stiffness=False)
         S, _ = _selection(self.robot, self.layout, p, self.position)
         return self._gradient(S, F)
 
@@ -427,7 +572,7 @@ class _Inner:
         """Energy, gradient, Hessian and the state they came from."""
         layout = self.layout
         p, rotation = _positions(self.robot, layout, self.position, self.rotation, v, self.paid_out)
-        F, K, tension, energy = _forces(self.robot, layout, p)
+        F, K, tension, energy = planar_forces(self.robot, layout, p)
         S, S_lambda = _selection(self.robot, layout, p, self.position)
         gradient = self._gradient(S, F)
         hessian = S.T @ K @ S
@@ -438,43 +583,10 @@ class _Inner:
                 "p": p, "rotation": rotation, "F": F, "K": K, "S": S, "S_lambda": S_lambda, "tension": tension}
 
 
-def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
-    """Newton's step -H^-1 g, with H shifted by a multiple of the identity until it is a descent direction.
-
-    An indefinite or singular Hessian (a node on a rim, a slack element, a swivel angle
-    with no stiffness) is shifted by ``relative_shift`` times its largest diagonal entry,
-    then ten times more each time. ``hessian``: dense (N, N) or a scipy sparse matrix;
-    ``gradient``: (N,). Returns the step, shape (N,).
-    """
-    import scipy.sparse as sparse
-
-    is_sparse = sparse.issparse(hessian)
-    if is_sparse:
-        import scipy.sparse.linalg as sparse_linalg
-
-        identity = sparse.identity(hessian.shape[0], format="csc")
-    scale = float(np.abs(hessian.diagonal()).max())
-    shift = 0.0
-    while True:
-        try:
-            if is_sparse:
-                step = sparse_linalg.splu((hessian + shift * identity).tocsc()).solve(-gradient)
-            else:
-                step = np.linalg.solve(hessian + shift * np.eye(len(gradient)), -gradient)
-        except (np.linalg.LinAlgError, RuntimeError):  # exactly singular
-            step = None
-        if step is not None and np.all(np.isfinite(step)) and float(step @ gradient) < 0.0:
-            return step
-        shift = max(10.0 * shift, relative_shift * scale)
-
-
 def _minimise(inner: _Inner, v, tolerance, max_iterations):
-    """Newton's method on the potential with an Armijo line search; returns (v, state, iterations).
+    """Newton's method on the potential with the line search (:func:`_line_search`); returns (v, state, iterations).
 
-    The penalty contact makes the Hessian jump where a node lands on or leaves a rim;
-    the energy stays continuously differentiable, so the line search on it keeps every
-    step a descent step (a force residual would not). An indefinite Hessian is shifted
-    towards the identity until the step descends.
+    An indefinite Hessian is shifted towards the identity until the step descends (:func:`descent_step`).
     """
     state = inner.evaluate(v)
     for iteration in range(max_iterations):
@@ -482,25 +594,12 @@ def _minimise(inner: _Inner, v, tolerance, max_iterations):
             return v, state, iteration
         g, H = state["gradient"], state["hessian"]
         step = descent_step(H, g, relative_shift=1e-6)
-        slope = float(np.dot(step, g))
-        # Near the solution the energy's decrease, ~ |g|^2 / k_p, falls below its rounding
-        # (~1e-16 |E|): there the full step is taken if it shrinks the gradient, and the
-        # iteration stops if it does not (the gradient is then as small as it gets).
-        roundoff = 1e-13 * (1.0 + abs(state["energy"]))
-        alpha, accepted = 1.0, False
-        for _ in range(40):
-            trial = v + alpha * step
-            energy = inner.energy(trial)
-            if energy <= state["energy"] + 1e-4 * alpha * slope:
-                accepted = True
-                break
-            if abs(energy - state["energy"]) <= roundoff:
-                accepted = np.linalg.norm(inner.gradient(trial)) < np.linalg.norm(g)
-                break
-            alpha *= 0.5
-        if not accepted:
+        found = _line_search(lambda alpha: v + alpha * step, inner.energy,
+                             lambda trial: np.linalg.norm(inner.gradient(trial)) < np.linalg.norm(g),
+                             state["energy"], float(np.dot(step, g)))
+        if found is None:
             break
-        v = trial
+        v = found[0]
         state = inner.evaluate(v)
     if np.max(np.abs(state["gradient"])) < 10.0 * tolerance:  # stalled at rounding, close enough
         return v, state, max_iterations
@@ -543,13 +642,13 @@ def chain_forces(robot: ChainRobot, nodes, position, rotation=0.0, external_wren
     platform_wrench : ndarray, shape (3,) [N, N, N m]
         Net force and moment on the platform about its centre of mass.
     """
-    layout = _Layout(robot, free_rotation=False)
+    layout = PlanarChains(robot, free_rotation=False)
     p = np.concatenate([np.asarray(n, dtype=float) for n in nodes])
     if p.shape != (layout.n_nodes, 2):
         raise SceneError(f"nodes must hold {layout.counts} nodes per cable, got shape {p.shape}")
     wrench = np.zeros(3) if external_wrench is None else vector("external_wrench", external_wrench, 3)
     position = vector("position", position, 2)
-    F, _, _, _ = _forces(robot, layout, p, with_stiffness=False)
+    F, _, _, _ = planar_forces(robot, layout, p, with_stiffness=False)
     arms = p[layout.anchor] - position
     force = _platform_force(robot, layout, F, wrench)
     moment = _cross(arms, F[layout.anchor]).sum() + wrench[2]
@@ -615,76 +714,41 @@ def _predict(robot, layout, guess, interior, rotation, paid_out, position, wrenc
     return v[:layout.n_interior], rotation, paid_out + delta[n:]
 
 
-def solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None,
-                        external_wrench=None, guess: ChainEquilibrium | None = None,
-                        tension_guess=None, tolerance: float = 1e-7, max_iterations: int = 50) -> ChainEquilibrium:
-    """Paid-out lengths, node positions and rotation that hold the platform at ``position``.
+def _planar_inverse(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None, external_wrench=None,
+                    guess: ChainEquilibrium | None = None, tension_guess=None, tolerance: float = 1e-7,
+                    max_iterations: int = 50) -> ChainEquilibrium:
+    """:func:`solve_inverse_chain_statics` in the plane: two nested Newton iterations (:func:`_planar_solve`).
 
     Tension-only (slack) elements have no stiffness in compression, so Newton started
     from a guess with compressed elements can stall on them. Their equilibrium is first
     sought with springs that also push: where no element of that equilibrium is
     compressed it is the tension-only one as well (the two potentials agree wherever
     every element is stretched); otherwise it is the start of the tension-only solve.
-
-    Two nested Newton iterations. Inner: with the platform held at ``position`` and the
-    paid-out lengths given, the nodes (and the free rotation) minimise the potential
-    (:func:`_minimise`). Outer: the paid-out lengths are corrected until the cables
-    carry the platform, i.e. the force the held platform needs vanishes; its
-    derivative follows from the inner tangent stiffness (the nodes stay in equilibrium).
-
-    Parameters
-    ----------
-    robot : ChainRobot
-    position : (x, z) [m]
-        Where the platform's centre of mass must be.
-    rotation : float [rad]
-        The platform's rotation when it is imposed, else the start of the iteration.
-    free_rotation : bool, optional
-        Let equilibrium choose the rotation (default: for a rigid platform on two
-        cables). The problem must be square: a point mass or a rigid platform with a
-        free rotation on two cables, or a rigid platform with its rotation imposed on
-        three.
-    external_wrench : (fx, fz, moment), optional [N, N, N m]
-        Extra load on the platform, eg the inertial load -M a.
-    guess : ChainEquilibrium, optional
-        A nearby solution (the previous pose of a trajectory) to start from.
-    tension_guess : array_like, shape (m,) [N], optional
-        Cable tensions to start from when there is no ``guess`` (eg the catenary
-        statics'): the iteration starts from straight chains that carry them.
-    tolerance : float [N]
-        Largest force imbalance accepted, on nodes and platform.
-    max_iterations : int
-        Of each Newton iteration.
-
-    Returns
-    -------
-    ChainEquilibrium
-
-    Raises
-    ------
-    UnreachableError
-        If there is no equilibrium with the cables in tension, or Newton fails.
-    SceneError
-        On malformed input or a problem that is not square.
     """
     kwargs = dict(free_rotation=free_rotation, external_wrench=external_wrench, tolerance=tolerance,
                   max_iterations=max_iterations)
     if not any(c.slack for c in robot.cables):
-        return _solve_chain_statics(robot, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
+        return _planar_solve(robot, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
     springs = ChainRobot(tuple(replace(c, slack=False) for c in robot.cables), robot.mass, robot.gravity)
     try:
-        spring = _solve_chain_statics(springs, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
+        spring = _planar_solve(springs, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
     except UnreachableError:
-        return _solve_chain_statics(robot, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
+        return _planar_solve(robot, position, rotation, guess=guess, tension_guess=tension_guess, **kwargs)
     if all(np.all(t >= 0.0) for t in spring.tensions):
         return spring
-    return _solve_chain_statics(robot, position, rotation, guess=spring, **kwargs)
+    return _planar_solve(robot, position, rotation, guess=spring, **kwargs)
 
 
-def _solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None,
-                         external_wrench=None, guess: ChainEquilibrium | None = None,
-                         tension_guess=None, tolerance: float = 1e-7, max_iterations: int = 50) -> ChainEquilibrium:
-    """:func:`solve_chain_statics` for one element law (the robot's own)."""
+def _planar_solve(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None, external_wrench=None,
+                  guess: ChainEquilibrium | None = None, tension_guess=None, tolerance: float = 1e-7,
+                  max_iterations: int = 50) -> ChainEquilibrium:
+    """:func:`_planar_inverse` for one element law (the robot's own).
+
+    Inner: with the platform held at ``position`` and the paid-out lengths given, the nodes (and the
+    free rotation) minimise the potential (:func:`_minimise`). Outer: the paid-out lengths are
+    corrected until the cables carry the platform, i.e. the force the held platform needs vanishes;
+    its derivative follows from the inner tangent stiffness (the nodes stay in equilibrium).
+    """
     position = vector("position", position, 2)
     rotation = finite("rotation", rotation)
     m = len(robot.cables)
@@ -698,7 +762,7 @@ def _solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rota
         raise SceneError(f"chain statics needs as many cables as platform equations: {m} cables "
                          f"for {equations} ({'rotation free' if free_rotation else 'rotation imposed'})")
     wrench = np.zeros(3) if external_wrench is None else vector("external_wrench", external_wrench, 3)
-    layout = _Layout(robot, bool(free_rotation))
+    layout = PlanarChains(robot, bool(free_rotation))
     if guess is not None:
         rotation = float(guess.rotation) if free_rotation else rotation
         interior = np.concatenate([n[1:-1].ravel() for n in guess.nodes])
@@ -708,7 +772,7 @@ def _solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rota
         interior, rotation, paid_out = _predict(robot, layout, guess, interior, rotation, paid_out, position, wrench)
     else:
         if tension_guess is None:
-            raise SceneError("solve_chain_statics needs a guess or tension_guess")
+            raise SceneError("the planar inverse chain statics need a guess or tension_guess")
         tension_guess = np.asarray(tension_guess, dtype=float)
         if tension_guess.shape != (m,) or not np.all(np.isfinite(tension_guess)) or np.any(tension_guess < 0):
             raise SceneError(f"tension_guess must be {m} finite tensions >= 0 [N], got {shown(tension_guess)}")
@@ -743,4 +807,725 @@ def _solve_chain_statics(robot: ChainRobot, position, rotation=0.0, *, free_rota
         raise UnreachableError(f"at position {np.round(position, 4).tolist()} m a cable would have to push "
                                f"(anchor tensions {[round(float(t[-1]), 3) for t in tensions]} N)")
     residual = max(np.max(np.abs(state["gradient"])), np.max(np.abs(force)))
-    return ChainEquilibrium(position, rotation, paid_out, nodes, tensions, float(residual), outer + inner_iterations)
+    return ChainEquilibrium(position=position, rotation=rotation, nodes=nodes, tensions=tensions,
+                            forces_on_platform=state["F"][layout.anchor].copy(), paid_out=paid_out,
+                            residual=float(residual), iterations=outer + inner_iterations,
+                            rotation_vector=np.array([rotation]))
+
+
+# ---------------------------------------------------------------------------
+# space: the potential of the 3-D chains (bending, tension-only law, swivel groove), pose and swivels free
+# ---------------------------------------------------------------------------
+def catenary_start(robot: ChainRobot, equilibrium):
+    """Start of the iteration: the nodes on the catenary statics' cables, as the builder starts its chains.
+
+    Parameters
+    ----------
+    robot : ChainRobot
+    equilibrium : PlatformEquilibrium
+        Of the same cables (:func:`cdpr_exu.statics.statics.solve_statics`).
+
+    Returns
+    -------
+    nodes : list of ndarray, each shape (n + 1, 3) [m]
+        Over a swivel pulley the builder's start (:func:`swivel_chain_start`).
+    position : ndarray, shape (3,) [m]
+    rotation : ndarray, shape (3, 3)
+    swivel_angles : ndarray, shape (m,) [rad]
+        Each swivel pulley at its anchor's azimuth, as the builder starts it (NaN for a point exit).
+    """
+    if len(equilibrium.cables) != len(robot.cables):
+        raise SceneError(f"equilibrium has {len(equilibrium.cables)} cables, the robot {len(robot.cables)}")
+    nodes, angles = [], np.full(len(robot.cables), np.nan)
+    for i, (cable, state) in enumerate(zip(robot.cables, equilibrium.cables)):
+        length = cable.unstrained_length
+        if cable.pulley is not None:
+            n = cable.n_elements - cable.winch_elements
+            points = swivel_chain_start(state, n * cable.element_length, n, cable.winch_elements,
+                                        cable.pulley.contact_stiffness)[1]
+            angles[i] = _anchor_azimuth(state)
+        else:
+            points = state.points(length - np.linspace(0.0, length, cable.n_elements + 1))
+            points[0] = cable.exit_point
+        points[-1] = state.anchor_point
+        nodes.append(points)
+    return nodes, np.asarray(equilibrium.position, float), np.asarray(equilibrium.rotation_matrix, float), angles
+
+
+def _spatial_forward(robot: ChainRobot, nodes, position, rotation=None, swivel_angles=None, *,
+                     tolerance: float = 1e-9, max_iterations: int = 100, external_force=None) -> ChainEquilibrium:
+    """:func:`solve_chain_statics` in space: Newton's method on the total potential from a start."""
+    model = SpatialChains(robot)
+    if external_force is not None:
+        model.external_force = vector("external_force", external_force, 3, " (fx, fy, fz) [N]")
+    x = vector("position", position, 3)
+    R = np.eye(3) if rotation is None or not model.rigid else np.asarray(rotation, float)
+    if R.shape != (3, 3) or not np.allclose(R.T @ R, np.eye(3), atol=1e-9):
+        raise SceneError(f"rotation must be a 3 x 3 rotation matrix, got {shown(rotation)}")
+    if len(nodes) != len(robot.cables):
+        raise SceneError(f"nodes must give one array per cable ({len(robot.cables)}), got {len(nodes)}")
+    start = np.zeros((model.n_points, 3))
+    for i, (cable, n) in enumerate(zip(robot.cables, nodes)):
+        n = np.asarray(n, dtype=float)
+        if n.shape != (cable.n_elements + 1, 3) or not np.all(np.isfinite(n)):
+            raise SceneError(f"nodes[{i}] must be finite, shape {(cable.n_elements + 1, 3)}, got {n.shape}")
+        start[model.first[i]:model.first[i] + cable.n_elements + 1] = n
+    if model.penalty:
+        for j, i in model.body:
+            start[j] = x + R @ model.local[i]
+    if swivel_angles is None:
+        psi = np.array([sp.exit_azimuth(np.asarray(nodes[i], float)[-1], robot.cables[i].pulley.inlet_array)
+                        for i in model.swivel_cables])
+    else:
+        angles = np.asarray(swivel_angles, dtype=float)
+        if angles.shape != (len(robot.cables),) or not np.all(np.isfinite(angles[model.swivel_cables])):
+            raise SceneError(f"swivel_angles must give one finite angle per cable ({len(robot.cables)}, NaN "
+                             f"allowed at point exits), got {shown(swivel_angles)}")
+        psi = angles[model.swivel_cables].copy()
+    state = (start[model.free].ravel(), x, R, psi)
+    energy = model.energy(*state)
+    tolerance = max(tolerance, rounding_floor(model.k, start))
+    for iteration in range(max_iterations):
+        gradient, hessian, p, G, force = model.derivatives(*state)
+        if np.max(np.abs(gradient)) < tolerance:
+            break
+        step = descent_step(hessian, gradient)
+        found = _line_search(lambda alpha: model.step(*state, alpha * step), lambda trial: model.energy(*trial),
+                             lambda trial: np.max(np.abs(model.derivatives(*trial)[0])) < np.max(np.abs(gradient)),
+                             energy, float(step @ gradient))
+        if found is None:
+            # stalled at rounding, close enough: a coordinate's last bit (eps |p|) on the stiffest spring
+            # (a penalty joint, f k ~ 1e8 N/m) is a force of 1e-8 N, above the default tolerance
+            rounding = rounding_floor(np.abs(hessian.diagonal()), max(1.0, float(np.abs(p).max())))
+            if np.max(np.abs(gradient)) < max(10.0 * tolerance, rounding):
+                break
+            raise UnreachableError(f"spatial chain statics: the line search failed (force imbalance "
+                                   f"{np.max(np.abs(gradient)):.3g} N after {iteration} iterations)")
+        state, energy = found
+    else:
+        raise UnreachableError(f"spatial chain statics did not converge in {max_iterations} iterations "
+                               f"(force imbalance {np.max(np.abs(gradient)):.3g} N)")
+    _, x, R, psi = state
+    chain_nodes = tuple(p[f:f + n].copy() for f, n in zip(model.first, model.counts))
+    tensions = tuple(force[model.element_cable == i] for i in range(len(robot.cables)))
+    forces = _forces_on_platform(model, p, G)
+    angles = np.full(len(robot.cables), np.nan)
+    angles[model.swivel_cables] = psi
+    return ChainEquilibrium(position=x.copy(), rotation=R.copy(), nodes=chain_nodes, tensions=tensions,
+                            forces_on_platform=forces, paid_out=np.array([c.paid_out_length for c in robot.cables]),
+                            residual=float(np.max(np.abs(gradient))), iterations=iteration, swivel_angles=angles,
+                            rotation_vector=rotation_vector(R) if model.rigid else np.zeros(3))
+
+
+def _forces_on_platform(model: SpatialChains, p, G):
+    """Force each cable exerts on its anchor, shape (m, 3) [N], from the point gradient ``G``."""
+    forces = np.zeros((len(model.robot.cables), 3))
+    for (j, i) in model.body:
+        if model.penalty:
+            forces[i] = model.penalty_k[i] * (p[model.last[i]] - p[j])
+        else:
+            # the chain's pull on the anchor node, its weight included: -dU_chain/dp
+            forces[i] = -G[3 * j:3 * j + 3]
+    return forces
+
+
+def _spatial_rest(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
+                  **kwargs) -> ChainEquilibrium:
+    """:func:`chain_rest` in space: started on the catenary statics, as the builder starts Exudyn's."""
+    catenary = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
+    robot = chain_robot(scene, anchor_spring_factor, tension_only, catenary)
+    return _spatial_forward(robot, *catenary_start(robot, catenary), **kwargs)
+
+
+#: The swivel angles of a chain without swivel pulleys.
+_NO_SWIVEL = np.zeros(0)
+
+
+# ---------------------------------------------------------------------------
+# the inverse: lengths whose chains hold a pose
+# ---------------------------------------------------------------------------
+def cable_paid_out(cable: ChainCable, length: float) -> ChainCable:
+    """``cable`` paid out to the unstrained ``length`` [m], as the run's variable-length winch changes it
+    (:class:`cdpr_exu.run.spatial_run._SpatialWinches`): at a point exit the same n elements of length
+    L / n, their stiffness E A n / L, the node masses rho L / n and the bending stiffness E J n / L; over a
+    swivel pulley the same elements, the held winch end moved up the axis by the change of the paid-out
+    length (``winch_travel``, :attr:`ChainCable.paid_out_length`), the cable running over the disc."""
+    length = finite("length", length)
+    if length <= 0:
+        raise SceneError(f"length must be positive [m], got {shown(length)}")
+    if cable.pulley is not None:
+        return replace(cable, winch_travel=cable.winch_travel + length - cable.paid_out_length)
+    scale = length / cable.unstrained_length
+    return replace(cable, element_length=cable.element_length * scale, axial_stiffness=cable.axial_stiffness / scale,
+                   node_masses=tuple(m * scale for m in cable.node_masses),
+                   bending_stiffness=cable.bending_stiffness / scale)
+
+
+def robot_paid_out(robot: ChainRobot, lengths) -> ChainRobot:
+    """``robot`` with each cable paid out to ``lengths`` (m,) [m] (:func:`cable_paid_out`)."""
+    lengths = np.asarray(lengths, dtype=float).reshape(-1)
+    if lengths.size != len(robot.cables):
+        raise SceneError(f"lengths must give one length per cable ({len(robot.cables)}), got {lengths.size}")
+    return replace(robot, cables=tuple(cable_paid_out(c, L) for c, L in zip(robot.cables, lengths)))
+
+
+@dataclass(frozen=True, eq=False)
+class HeldChain:
+    """One lumped cable at rest between its exit point and a fixed anchor point.
+
+    Attributes
+    ----------
+    nodes : ndarray, shape (n + 1, 3) [m]
+        Exit (over a swivel pulley the held winch end) first, the anchor point last.
+    tensions : ndarray, shape (n,) [N]
+        Axial force of each element, exit first.
+    force : ndarray, shape (3,) [N]
+        Force the cable exerts on the anchor (the last element's pull, the bending shear and
+        the anchor node's weight: what it exerts on the platform).
+    force_rate : ndarray, shape (3,) [N/m]
+        d(force)/d(paid-out length) with the anchor held: the chain re-settles (implicit
+        function theorem on the nodes' and the swivel's balance). Paid out as the run's winch
+        pays out (:func:`cable_paid_out`): longer elements at a point exit, the winch end moved
+        up the axis over a swivel pulley.
+    swivel_angle : float [rad]
+        The swivel pulley's angle psi (NaN at a point exit).
+    """
+
+    nodes: np.ndarray
+    tensions: np.ndarray
+    force: np.ndarray
+    force_rate: np.ndarray
+    swivel_angle: float = float("nan")
+
+
+def _held_model(cable: ChainCable, gravity: float) -> SpatialChains:
+    """The model of one cable whose anchor is a fixed point: a one-cable robot of no mass with the anchor at
+    its centre, whose position unknowns are kept fixed."""
+    return SpatialChains(ChainRobot((replace(cable, anchor=(0.0, 0.0, 0.0)),), 0.0, gravity))
+
+
+def solve_held_chain(cable: ChainCable, gravity: float, anchor_point, nodes, *, tolerance: float = 1e-9,
+                     max_iterations: int = 50, swivel_angle: float | None = None) -> HeldChain:
+    """The rest shape of one lumped cable held at its exit point (or winch end) and at ``anchor_point``.
+
+    Newton's method on its free nodes and, over a swivel pulley, the pulley's angle psi (the
+    potential of :func:`solve_chain_statics`, with the same line search), then the force
+    on the anchor and its rate with the paid-out length. If Newton fails from ``nodes``, the
+    anchor (and a swivel cable's winch end) is moved there from the start's in sub-steps, each
+    solved from the last (:func:`_solve_held`). Over the swivel pulleys of
+    spatial-four-cable-swivel, started from the rest's chains with the length changed as the
+    straight distance from the inlet: Newton alone crawled (line search) and stopped at 50
+    iterations from 2 cm up or 5 cm across; with the sub-steps, 30 cm across and 20 cm up
+    converge (0.5 to 4 s, to within 1e-10 relative of Newton alone given 2000 iterations),
+    30 cm up does not.
+
+    Parameters
+    ----------
+    cable : ChainCable
+        At the paid-out length wanted (:func:`cable_paid_out`); its ``anchor`` is not used.
+    gravity : float [m/s^2]
+    anchor_point : (x, y, z) [m]
+        World position of the anchor.
+    nodes : array_like, shape (n + 1, 3) [m]
+        Start of the nodes, exit first; the ends are put on the held and anchor points, the nodes
+        between moved along by the same share of the ends' displacement as of the cable.
+    tolerance : float [N]
+        Largest force left on a free node; below the rounding of the element forces
+        (:func:`rounding_floor`: 4e-8 N on IPAnema's stiff cables, 2e-14 m of stretch), the
+        iteration also stops once a Newton step no longer halves it.
+    swivel_angle : float [rad], optional
+        Start of psi over a swivel pulley (default the anchor's azimuth about the axis).
+
+    Raises
+    ------
+    UnreachableError
+        If Newton finds no rest shape, neither from ``nodes`` nor in sub-steps.
+    """
+    return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations,
+                       swivel_angle)
+
+
+#: Halvings of a held chain's jump the continuation may make (:func:`_solve_held`): at most 2^5 = 32 sub-steps.
+CONTINUATION_HALVINGS = 5
+
+
+def _solve_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, tolerance: float,
+                max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
+    """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other lengths).
+
+    Newton from ``nodes`` first; only if it fails, by continuation: the anchor moved from the start's last
+    node to ``anchor_point`` (and over a swivel pulley the held winch end from the start's height on the axis
+    to the model's) in sub-steps, each solved from the previous one's chain, a sub-step that fails halved
+    again, at most :data:`CONTINUATION_HALVINGS` times. A start that converges keeps its answer bit for bit.
+    """
+    anchor_point = vector("anchor_point", anchor_point, 3)
+    nodes = np.array(nodes, dtype=float)
+    n = cable.n_elements
+    if nodes.shape != (n + 1, 3) or not np.all(np.isfinite(nodes)):
+        raise SceneError(f"nodes must be finite, shape {(n + 1, 3)}, got {nodes.shape}")
+    try:
+        return _newton_held(model, cable, anchor_point, nodes, tolerance, max_iterations, swivel_angle)
+    except UnreachableError as failure:
+        direct = failure
+    held_point = model.fixed_positions[0]
+    start_anchor = nodes[-1].copy()
+    # over a swivel pulley the start's winch end is its height on the axis (the start is slid along itself to it)
+    travel = float(np.dot(nodes[0] - held_point, _E_Z)) if cable.pulley is not None else 0.0
+
+    def at(share):
+        """The model and anchor point [m] a ``share`` (0 to 1) of the way from the start's to the target's."""
+        if share == 1.0:
+            return model, anchor_point
+        moved = copy.copy(model)
+        moved.fixed_positions = {0: held_point + (1.0 - share) * travel * _E_Z}
+        return moved, start_anchor + share * (anchor_point - start_anchor)
+
+    def continued(chain_nodes, psi, begin, finish, halvings, failed=False):
+        """The chain at share ``finish`` from ``chain_nodes`` (n + 1, 3) [m] and ``psi`` [rad] at share ``begin``
+        (``failed``: Newton from there is known to fail)."""
+        if not failed:
+            sub_model, sub_anchor = at(finish)
+            try:
+                return _newton_held(sub_model, cable, sub_anchor, chain_nodes, tolerance, max_iterations, psi)
+            except UnreachableError:
+                if halvings == 0:
+                    raise
+        middle = 0.5 * (begin + finish)
+        half = continued(chain_nodes, psi, begin, middle, halvings - 1)
+        return continued(half.nodes, half.swivel_angle, middle, finish, halvings - 1)
+
+    if CONTINUATION_HALVINGS == 0:
+        raise direct
+    try:
+        return continued(nodes, swivel_angle, 0.0, 1.0, CONTINUATION_HALVINGS, failed=True)
+    except UnreachableError as failure:
+        raise UnreachableError(f"{direct}; and by continuation in up to {2 ** CONTINUATION_HALVINGS} sub-steps: "
+                               f"{failure}") from None
+
+
+def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, tolerance: float,
+                 max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
+    """Newton for :func:`_solve_held` from ``nodes`` (n + 1, 3) [m] (checked), its ends first moved onto the held
+    and anchor points (over a swivel pulley by :func:`_swivel_start`)."""
+    nodes = np.array(nodes, dtype=float)
+    n = cable.n_elements
+    share = np.linspace(0.0, 1.0, n + 1)[:, None]
+    held_point = model.fixed_positions[0]
+    if cable.pulley is None:
+        nodes += (1.0 - share) * (held_point - nodes[0]) + share * (anchor_point - nodes[-1])
+    else:
+        nodes = _swivel_start(nodes, cable.pulley, held_point, anchor_point)
+    if cable.pulley is None:
+        psi = _NO_SWIVEL
+    elif swivel_angle is None or not np.isfinite(swivel_angle):
+        psi = np.array([sp.exit_azimuth(anchor_point, cable.pulley.inlet_array)])
+    else:
+        psi = np.array([float(swivel_angle)])
+    R = np.eye(3)
+    # the unknowns among the point coordinates (exit, free nodes, anchor, then psi): the free nodes and psi
+    inner = np.concatenate([np.arange(3, 3 * n), np.arange(3 * (n + 1), model.size)])
+    end = slice(3 * n, 3 * n + 3)
+    n_free = 3 * (n - 1)
+    free = nodes[1:-1].ravel().copy()
+    energy = model.energy(free, anchor_point, R, psi)
+    # Below the rounding floor Newton keeps gaining while it can: the anchor force of a chain stopped
+    # at the floor is off by about the floor, and m of them stall the platform's balance (CoGiRo's
+    # Gauss-Newton crawled for 30 iterations at 1e-5 N). So stop at the tolerance, or below the floor
+    # once a step no longer halves the imbalance.
+    floor = rounding_floor(model.k, nodes)
+    last = np.inf
+    # a point exit's chain is solved dense (57 unknowns at 20 elements); over a swivel pulley sparse (SuperLU:
+    # 163 unknowns at 48 + 6 elements, whose dense solve took 0.14 s with OpenBLAS's threads on a busy machine)
+    dense = cable.pulley is None
+    for iteration in range(max_iterations):
+        nodes[1:-1] = free.reshape(-1, 3)
+        G, H, force = model.point_derivatives(nodes, psi)
+        H = H.toarray() if dense else H.tocsc()
+        H_inner = H[np.ix_(inner, inner)] if dense else H[inner][:, inner]
+        g = G[inner]
+        imbalance = float(np.max(np.abs(g)))
+        if imbalance < tolerance or (imbalance < floor and imbalance > 0.5 * last):
+            break
+        last = imbalance
+        step = descent_step(H_inner, g)
+
+        def improves(trial):
+            moved = nodes.copy()
+            moved[1:-1] = trial[0].reshape(-1, 3)
+            return np.max(np.abs(model.point_derivatives(moved, trial[1])[0][inner])) < np.max(np.abs(g))
+        found = _line_search(lambda alpha: (free + alpha * step[:n_free], psi + alpha * step[n_free:]),
+                             lambda trial: model.energy(trial[0], anchor_point, R, trial[1]), improves, energy,
+                             float(step @ g))
+        if found is None:
+            if imbalance < max(10.0 * tolerance, floor):
+                break
+            raise UnreachableError(f"held chain statics: the line search failed (force imbalance "
+                                   f"{np.max(np.abs(g)):.3g} N after {iteration} iterations)")
+        (free, psi), energy = found
+    else:
+        raise UnreachableError(f"held chain statics did not converge in {max_iterations} iterations "
+                               f"(force imbalance {np.max(np.abs(g)):.3g} N)")
+    if cable.pulley is None:
+        # d(gradient)/dL at fixed nodes by central differences of the chain paid out by +-dL (the run's
+        # scaling, :func:`cable_paid_out`)
+        step = 1e-6
+        rate = (_scaled_model(model, 1.0 + step).point_derivatives(nodes, psi)[0]
+                - _scaled_model(model, 1.0 - step).point_derivatives(nodes, psi)[0]) / (2.0 * step * cable.unstrained_length)
+    else:
+        # paying out moves the held winch end up the axis by dL, the elements kept: d(gradient)/dL at
+        # fixed free nodes is the Hessian's column of the held node's z
+        rate = H[:, 2].toarray().ravel()
+    # then the free nodes (and psi) re-settle: d(unknowns)/dL = -H^-1 dg/dL; the anchor's force is -(its gradient)
+    if dense:
+        settle = -np.linalg.solve(H_inner, rate[inner])
+    else:
+        settle = -sparse_linalg.splu(H_inner.tocsc()).solve(rate[inner])
+    force_rate = -(rate[end] + H[end][:, inner] @ settle)
+    return HeldChain(nodes, np.asarray(force, dtype=float).copy(), -G[end].copy(), force_rate,
+                     float(psi[0]) if psi.size else float("nan"))
+
+
+def _swivel_start(nodes, pulley, held_point, anchor_point):
+    """Start nodes (n + 1, 3) [m] of a chain over a swivel pulley from ``nodes`` held elsewhere: turned about the
+    axis to the new anchor's azimuth (the wrap stays in the groove: shifted across, it cuts into the disc or its
+    flange at 1e6 N/m), all slid along themselves by the winch end's travel (the cable flows over the disc, its
+    elements keep their lengths: slid by a share of the travel, a 5 cm element's length changes by 0.15 mm per
+    8 mm of travel, 235 N of tension), and the hanging part beyond the wrap moved onto the anchor by the share
+    of its length (about across the cable when the travel follows the anchor's distance)."""
+    inlet = pulley.inlet_array
+    azimuth = sp.exit_azimuth(anchor_point, inlet)
+    turn = azimuth - sp.exit_azimuth(nodes[-1], inlet)
+    c, s = math.cos(turn), math.sin(turn)
+    turned = nodes - inlet
+    turned[:, :2] = turned[:, :2] @ np.array([[c, s], [-s, c]])
+    nodes = inlet + turned
+    centre = inlet + pulley.radius * np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
+    radii = np.linalg.norm(nodes - centre, axis=1)
+    slid, element, fraction = _slid(nodes, np.full(len(nodes), float(np.dot(held_point - nodes[0], _E_Z))))
+    # on the wrap, along the arc: a node slid along a chord sits inside the groove by up to the chord's
+    # sagitta (3 mm for 5 cm elements on a 0.1 m disc: 3 kN at 1e6 N/m, which Newton could not undo)
+    wrap = (radii[element] < 1.02 * pulley.radius) & (radii[element + 1] < 1.02 * pulley.radius)
+    radius = (1.0 - fraction) * radii[element] + fraction * radii[element + 1]
+    offset = slid - centre
+    slid[wrap] = centre + offset[wrap] * (radius[wrap] / np.linalg.norm(offset[wrap], axis=1))[:, None]
+    nodes = slid
+    touching = np.flatnonzero(np.linalg.norm(nodes - centre, axis=1) < 1.05 * pulley.radius)
+    tangent = int(touching.max()) if touching.size else 0
+    weight = np.clip((np.arange(len(nodes)) - tangent) / (len(nodes) - 1 - tangent), 0.0, 1.0)
+    nodes += weight[:, None] * (anchor_point - nodes[-1])
+    nodes[0] = held_point
+    return nodes
+
+
+def _slid(nodes, shift):
+    """``nodes`` (n + 1, 3) [m] each moved along their own polyline by ``shift`` (n + 1,) [m] of arc length
+    (positive: towards the last node; beyond the ends along the end elements); with the element each
+    lands on and the fraction along it, shape (n + 1,) each."""
+    lengths = np.linalg.norm(np.diff(nodes, axis=0), axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(lengths)])
+    target = arc + shift
+    element = np.clip(np.searchsorted(arc, target, side="right") - 1, 0, len(lengths) - 1)
+    fraction = (target - arc[element]) / lengths[element]
+    return nodes[element] + fraction[:, None] * (nodes[element + 1] - nodes[element]), element, fraction
+
+
+def _paid_out_model(model: SpatialChains, cable: ChainCable, length: float) -> SpatialChains:
+    """A copy of the held ``model`` of ``cable`` (the model's own cable) paid out to ``length`` [m], as
+    :func:`cable_paid_out`: at a point exit scaled (:func:`_scaled_model`), over a swivel pulley its held
+    winch end moved up the axis."""
+    if cable.pulley is None:
+        return _scaled_model(model, length / cable.unstrained_length)
+    moved = copy.copy(model)
+    moved.fixed_positions = {0: cable_paid_out(cable, length).held_point}
+    return moved
+
+
+def _scaled_model(model: SpatialChains, scale: float) -> SpatialChains:
+    """A copy of a one-cable ``model`` with its cable paid out ``scale`` times as long, as :func:`cable_paid_out`
+    at a point exit: element lengths and weights times ``scale``, axial and bending stiffness over it."""
+    scaled = copy.copy(model)
+    scaled.l0, scaled.k = model.l0 * scale, model.k / scale
+    scaled.weights, scaled.joint_k = model.weights * scale, model.joint_k / scale
+    return scaled
+
+
+def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench, tolerance, max_iterations,
+                   swivel_angles=None):
+    """The Gauss-Newton of :func:`solve_inverse_chain_statics` in space, each cable's held model given."""
+
+    m = len(robot.cables)
+    pose = real_array("pose", pose)
+    rigid = not robot.is_point_mass
+    if pose.shape != (6,) and not (not rigid and pose.shape == (3,)):
+        raise SceneError(f"pose must have 6 entries (3 for a point mass), got {shown(pose.tolist())}")
+    guess = real_array("tension_guess", tension_guess)
+    if guess.shape != (m,) or np.any(guess <= 0.0):
+        raise SceneError(f"tension_guess must be one positive tension per cable, got {shown(tension_guess)}")
+    lengths = real_array("lengths", lengths)
+    if lengths.shape != (m,) or np.any(lengths <= 0.0):
+        raise SceneError(f"lengths must be one positive length per cable, got {shown(lengths)}")
+    if len(nodes) != m:
+        raise SceneError(f"nodes must give one array per cable ({m}), got {len(nodes)}")
+    angles = np.full(m, np.nan) if swivel_angles is None else real_array("swivel_angles", swivel_angles, require_finite=False)
+    if angles.shape != (m,):
+        raise SceneError(f"swivel_angles must give one angle per cable ({m}, NaN: the anchor's azimuth), "
+                         f"got {shown(swivel_angles)}")
+    wrench = np.zeros(6) if external_wrench is None else vector("external_wrench", external_wrench, 6)
+    rotation = rotation_from_vector(pose[3:6]) if rigid else np.eye(3)
+    arms = np.array([c.anchor for c in robot.cables]) @ rotation.T
+    anchor_points = pose[:3] + arms
+    rows = 6 if (rigid and m >= 6) else 3
+    weight = robot.mass * robot.gravity
+    arm_scale = max(float(np.linalg.norm(arms, axis=1).max()), 1e-3)
+    scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
+
+    def held(trial_lengths, trial_nodes, trial_angles):
+        chains = [_solve_held(_paid_out_model(model, c, L), cable_paid_out(c, L), a, start, 1e-9, 50, psi)
+                  for model, c, L, a, start, psi in zip(models, robot.cables, trial_lengths, anchor_points,
+                                                        trial_nodes, trial_angles)]
+        forces = np.array([chain.force for chain in chains])
+        total = np.concatenate([forces.sum(axis=0) + wrench[:3] - [0.0, 0.0, weight],
+                                np.cross(arms, forces).sum(axis=0) + wrench[3:]])[:rows] * scale
+        return chains, forces, total
+
+    chains, forces, total = held(lengths, nodes, angles)
+    residual = float(np.abs(total).max())
+    for iteration in range(max_iterations + 1):
+        if residual <= tolerance * max(weight, float(np.abs(forces).max()), 1e-12):
+            return ChainEquilibrium(position=pose[:3].copy(), rotation=rotation,
+                                    nodes=tuple(chain.nodes for chain in chains),
+                                    tensions=tuple(chain.tensions for chain in chains), forces_on_platform=forces,
+                                    paid_out=lengths, residual=residual, iterations=iteration,
+                                    swivel_angles=np.array([chain.swivel_angle for chain in chains]),
+                                    rotation_vector=pose[3:6].copy() if rigid else np.zeros(3))
+        if iteration == max_iterations:
+            break
+        tensions = np.linalg.norm(forces, axis=1)
+        rates = np.array([chain.force_rate for chain in chains])
+        slope = np.einsum("ij,ij->i", forces, rates) / tensions  # d(tension)/d(length): negative if taut
+        if np.any(tensions <= 0.0) or np.any(slope >= 0.0):
+            raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: cable(s) "
+                                   f"{(np.flatnonzero((tensions <= 0.0) | (slope >= 0.0)) + 1).tolist()} hang slack "
+                                   "at these lengths: the chains hold the platform only if a cable pushes")
+        jacobian = np.concatenate([rates.T, np.cross(arms, rates).T])[:rows] * scale[:, None]  # d(total)/d(lengths)
+        # in the tensions' variables y = slope * dL: the change nearest the guess that cancels the imbalance
+        in_tensions = jacobian / slope[None, :]
+        offset = tensions - guess
+        change = (-offset + np.linalg.pinv(in_tensions) @ (in_tensions @ offset - total)) / slope
+        for _ in range(20):  # halve the step until the imbalance falls
+            trial = lengths + change
+            if np.all(trial > 0.0):
+                try:
+                    trial_chains, trial_forces, trial_total = held(trial, [c.nodes for c in chains],
+                                                                   [c.swivel_angle for c in chains])
+                except UnreachableError:
+                    trial_total = None
+                if trial_total is not None and float(np.abs(trial_total).max()) < residual:
+                    break
+            change = 0.5 * change
+        else:
+            break
+        lengths, chains, forces, total = trial, trial_chains, trial_forces, trial_total
+        residual = float(np.abs(total).max())
+    raise UnreachableError(f"pose {np.round(pose, 6).tolist()}: the chains' balance did not converge "
+                           f"(imbalance {residual:.3g} N after {iteration} iterations)")
+
+
+# ---------------------------------------------------------------------------
+# the drivers: one interface, the kernel chosen by the robot's Space
+# ---------------------------------------------------------------------------
+def solve_chain_statics(robot: ChainRobot, nodes, position, rotation=None, swivel_angles=None,
+                        **kwargs) -> ChainEquilibrium:
+    """The rest of the chains and platform for the cables' unstrained lengths (the forward chain statics).
+
+    In space, Newton's method on the total potential from a start (the unknowns: the free nodes, the
+    platform's pose, the swivel pulleys' angles). The plane has none: its rest for given lengths is
+    Exudyn's (:func:`cdpr_exu.run.rest.solve_rest`), its chain statics hold a pose
+    (:func:`solve_inverse_chain_statics`).
+
+    Parameters
+    ----------
+    robot : ChainRobot
+    nodes : sequence of array_like, each shape (n + 1, 3) [m]
+        Start positions of each cable's nodes, exit first (eg :func:`catenary_start`);
+        the exit node is put on the exit point and (with exact joints) the last on the anchor.
+    position : (x, y, z) [m]
+        Start of the platform's centre of mass.
+    rotation : ndarray, shape (3, 3), optional
+        Start of the platform's rotation (default identity; ignored for a point mass).
+    swivel_angles : array_like, shape (m,) [rad], optional
+        Start of each swivel pulley's psi (entries of point exits ignored); default each
+        pulley turned towards its cable's last start node.
+    tolerance : float [N]
+        Largest entry of the potential's gradient accepted (node forces, platform force, moment,
+        torques on the swivels [N m]); at least the rounding of the element forces
+        (:func:`rounding_floor`: 4e-9 N on the four-cable robot, 1.6e-7 N on CoGiRo's steel
+        ropes, where 1e-9 N cannot be reached).
+    max_iterations : int
+    external_force : (fx, fy, fz) [N], optional
+        A constant extra force on the platform's centre of mass (eg the d'Alembert force
+        -M a of an acceleration); its potential is -F . x.
+
+    Returns
+    -------
+    ChainEquilibrium
+
+    Raises
+    ------
+    UnreachableError
+        If Newton finds no equilibrium.
+    SceneError
+        On malformed input, or a planar robot.
+    """
+    return _FORWARD[robot.space.dimension](robot, nodes, position, rotation, swivel_angles, **kwargs)
+
+
+def chain_rest(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
+               **kwargs) -> ChainEquilibrium:
+    """The lumped robot of a scene at rest on its unstrained lengths (:func:`solve_chain_statics` from
+    :func:`chain_robot`, started on the catenary statics as the builder starts Exudyn's); ``kwargs`` go to
+    :func:`solve_chain_statics`.
+
+    Raises
+    ------
+    UnreachableError
+        If the catenary statics or the chains find no equilibrium.
+    SceneError
+        For a planar scene (:func:`solve_chain_statics`).
+    """
+    return _REST[scene.space.dimension](scene, anchor_spring_factor, tension_only, **kwargs)
+
+
+def _no_planar_forward(*args, **kwargs):
+    raise SceneError("the planar chain statics hold the platform at a pose (solve_inverse_chain_statics); a planar "
+                     "robot's rest on given lengths is Exudyn's (cdpr_exu.run.rest.solve_rest)")
+
+
+class InverseChainStatics:
+    """The inverse chain statics of one robot, for many poses (:func:`solve_inverse_chain_statics`).
+
+    In space each cable's held model is built once (the lengths change by scaling it, or by moving a
+    swivel cable's winch end: :func:`_paid_out_model`).
+
+    Parameters
+    ----------
+    robot : ChainRobot
+    """
+
+    def __init__(self, robot: ChainRobot):
+        if not isinstance(robot, ChainRobot):
+            raise SceneError(f"robot must be a ChainRobot, got {shown(robot)}")
+        self.robot = robot
+        self._solve = _INVERSE[robot.space.dimension](robot)
+
+    def solve(self, pose, tension_guess=None, *, guess: ChainEquilibrium | None = None, lengths=None, nodes=None,
+              swivel_angles=None, free_rotation=None, external_wrench=None, tolerance: float | None = None,
+              max_iterations: int | None = None) -> ChainEquilibrium:
+        """As :func:`solve_inverse_chain_statics` (same parameters, robot aside)."""
+        return self._solve(pose, tension_guess, guess=guess, lengths=lengths, nodes=nodes, swivel_angles=swivel_angles,
+                           free_rotation=free_rotation, external_wrench=external_wrench, tolerance=tolerance,
+                           max_iterations=max_iterations)
+
+
+def solve_inverse_chain_statics(robot: ChainRobot, pose, tension_guess=None, **kwargs) -> ChainEquilibrium:
+    """Paid-out lengths, nodes and tensions of the chains that hold ``robot``'s platform at ``pose``.
+
+    In the plane (two nested Newton iterations, :func:`_planar_inverse`): the nodes minimise the
+    potential at fixed paid-out lengths, the lengths cancel the force the held platform needs; a
+    rigid platform on two cables chooses its rotation (``free_rotation``), on three it is imposed.
+    In space (Gauss-Newton on the lengths over chains held at their anchors, :func:`_solve_inverse`):
+    the cables decouple and only the platform's balance ties them, six equations (three for a point
+    mass, or a rigid platform on fewer than six cables, whose rotation is left free as in
+    :func:`cdpr_exu.statics.statics.solve_inverse_statics`) in the m lengths; among the
+    length changes that cancel the imbalance to first order, the one whose tensions (the norm of each
+    cable's force on the platform) come nearest ``tension_guess``: continued along a trajectory, a
+    redundant robot keeps its internal tension.
+
+    Parameters
+    ----------
+    robot : ChainRobot
+        In space any lengths: they are paid out to ``lengths`` as the run's winches pay out
+        (:func:`cable_paid_out`).
+    pose : array_like [m, rad]
+        Plane: (x, z) or (x, z, rotation), the rotation imposed or (free) the start. Space: (x, y, z)
+        for a point mass or (x, y, z, rotation vector).
+    tension_guess : array_like, shape (m,) [N], optional
+        Plane: tensions (>= 0) the straight start chains carry, when there is no ``guess`` (eg the
+        catenary statics'). Space: positive tensions to stay near (default the ``guess``'s).
+    guess : ChainEquilibrium, optional
+        A nearby solution (the previous pose of a trajectory) to start from (in space its paid-out
+        lengths, nodes and swivel angles, unless given).
+    lengths, nodes, swivel_angles : optional, in space
+        Start of the paid-out lengths (m,) [m], of each cable's nodes (n + 1, 3) [m], exit first (moved
+        onto the anchors as :func:`solve_held_chain` does), and of each swivel pulley's psi (m,) [rad]
+        (NaN or default: the anchor's azimuth about its axis).
+    free_rotation : bool, optional, in the plane
+        Let equilibrium choose the rotation (default: for a rigid platform on two cables).
+    external_wrench : array_like, optional [N, N m]
+        Extra load on the platform about its centre of mass (eg the d'Alembert load -M a): (fx, fz,
+        moment) in the plane, (f, moment) in space.
+    tolerance : float, optional
+        Plane: the largest force imbalance accepted on nodes and platform [N] (default 1e-7). Space:
+        the platform's imbalance accepted relative to the larger of the weight and the largest cable
+        force (default 1e-9).
+    max_iterations : int, optional
+        Of each Newton iteration (plane, default 50) or of the Gauss-Newton (space, default 30).
+
+    Returns
+    -------
+    ChainEquilibrium
+
+    Raises
+    ------
+    UnreachableError
+        If no lengths with the cables in tension hold the platform there, or the iteration fails.
+    SceneError
+        On malformed input or (in the plane) a problem that is not square.
+    """
+    return InverseChainStatics(robot).solve(pose, tension_guess, **kwargs)
+
+
+def _planar_inverse_solver(robot: ChainRobot):
+    """The plane's :meth:`InverseChainStatics.solve` for ``robot``."""
+    def solve(pose, tension_guess, *, guess, lengths, nodes, swivel_angles, free_rotation, external_wrench,
+              tolerance, max_iterations):
+        if lengths is not None or nodes is not None or swivel_angles is not None:
+            raise SceneError("lengths, nodes and swivel_angles start the spatial inverse chain statics; the planar "
+                             "one starts from guess or tension_guess")
+        pose = real_array("pose", pose, require_finite=False)
+        if pose.shape not in ((2,), (3,)):
+            raise SceneError(f"pose must be (x, z) or (x, z, rotation), got {shown(pose.tolist())}")
+        return _planar_inverse(robot, pose[:2], pose[2] if pose.size == 3 else 0.0, free_rotation=free_rotation,
+                               external_wrench=external_wrench, guess=guess, tension_guess=tension_guess,
+                               tolerance=1e-7 if tolerance is None else tolerance,
+                               max_iterations=50 if max_iterations is None else max_iterations)
+    return solve
+
+
+def _spatial_inverse_solver(robot: ChainRobot):
+    """Space's :meth:`InverseChainStatics.solve` for ``robot``: each cable's held model built once."""
+    models = [_held_model(c, robot.gravity) for c in robot.cables]
+
+    def solve(pose, tension_guess, *, guess, lengths, nodes, swivel_angles, free_rotation, external_wrench,
+              tolerance, max_iterations):
+        if free_rotation is not None:
+            raise SceneError("free_rotation is the planar inverse's: in space a rigid platform on fewer than six "
+                             f"cables keeps its rotation free, got {shown(free_rotation)}")
+        if guess is not None:
+            lengths = guess.paid_out if lengths is None else lengths
+            nodes = guess.nodes if nodes is None else nodes
+            swivel_angles = guess.swivel_angles if swivel_angles is None else swivel_angles
+            tension_guess = guess.tensions_at_anchor if tension_guess is None else tension_guess
+        if tension_guess is None or lengths is None or nodes is None:
+            raise SceneError("the spatial inverse chain statics need tension_guess, lengths and nodes to start "
+                             "from, or a guess")
+        return _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench,
+                              1e-9 if tolerance is None else tolerance,
+                              30 if max_iterations is None else max_iterations, swivel_angles)
+    return solve
+
+
+#: Each dimension's kernels, by the robot's (the scene's) Space.
+_FORWARD = {2: _no_planar_forward, 3: _spatial_forward}
+_REST = {2: _no_planar_forward, 3: _spatial_rest}
+_INVERSE = {2: _planar_inverse_solver, 3: _spatial_inverse_solver}

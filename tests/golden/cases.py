@@ -261,12 +261,12 @@ def planar_catenary_statics():
 @case
 def planar_chain_statics():
     from cdpr_exu.statics.statics import catenary_platform, solve_inverse_statics
-    from cdpr_exu.statics.chain_statics import chain_robot, solve_chain_statics
+    from cdpr_exu.statics.chain_statics import chain_robot, solve_inverse_chain_statics
 
     scene = _planar("paper-circle", 1.0)
     start = solve_inverse_statics(catenary_platform(scene), (0.2, -1.8))
-    equilibrium = solve_chain_statics(chain_robot(scene), (0.2, -1.8), start.rotation,
-                                      tension_guess=[c.tension_at_anchor for c in start.cables])
+    equilibrium = solve_inverse_chain_statics(chain_robot(scene), (0.2, -1.8, start.rotation),
+                                              tension_guess=[c.tension_at_anchor for c in start.cables])
     arrays = {"paid_out": np.asarray(equilibrium.paid_out), "rotation": np.array(equilibrium.rotation)}
     for i, nodes in enumerate(equilibrium.nodes):
         arrays[f"nodes_{i}"] = np.asarray(nodes)
