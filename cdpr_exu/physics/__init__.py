@@ -4,9 +4,8 @@ Planar: the elastic catenary (``catenary``), the numba kernels of exact-angle be
 (``bending``), tension-only axial elements (``axial``) and pulley contact on nodes or
 segments (``node_contact``, ``segment_contact``). Spatial: exact-angle bending and
 tension-only elements in 3-D (``bending_3d``, ``axial_3d``), the elastic-catenary statics
-of a spatial robot and its inverse (``spatial_statics``), the ideal kinematics with
-swivel pulleys, the structure matrix and the tension distribution
-(``spatial_kinematics``), the swivel pulley's contact on a turning disc (``swivel_pulley``),
+of a spatial robot and its inverse (``spatial_statics``), the swivel pulley's contact on a
+turning disc (``swivel_pulley``),
 and CoGiRo's published geometry (``cogiro``). Their Exudyn
 assemblies are in :mod:`cdpr_exu.builder`. Units SI; spatial: z up, gravity along -z.
 """

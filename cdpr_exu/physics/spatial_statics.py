@@ -21,7 +21,7 @@ and the turning of ``u``::
 Swivel pulleys
 --------------
 A cable whose exit is a swivel pulley (``SpatialCable.pulley_radius > 0``; the exit
-point is then the pulley's inlet, :mod:`cdpr_exu.physics.spatial_kinematics`) comes up
+point is then the pulley's inlet, :class:`cdpr_exu.exits.Swivel`) comes up
 the vertical axis through the inlet, wraps over the disc and hangs to the anchor. The
 suspended part hangs in a vertical plane, and the disc, free to turn about the axis,
 has no torque on it only when that plane contains the axis: the pulley's azimuth is
