@@ -12,19 +12,22 @@ fields that conflict, when
 * a cable would be reeled in completely, or its exit's winch cannot pay out what the pose
   needs (:meth:`cdpr_exu.exits.base.Exit.paid_out_refusal`: a planar pulley's cable
   longer than the cable, a swivel's winch line);
-* the winches follow the reference, and no cable tensions, non-negative or within the
-  cables' ``min_tension`` / ``max_tension``, give the platform what following it takes:
-  the force ``M (a_ref + g e_z)`` (every cable pulls along the line from its anchor to
-  where it leaves its exit, so a platform above its exits could only be held by cables
-  that push) and, where the cables can give a moment, the moment about the centre of mass
-  that the reference's rotation needs (:func:`reference_wrenches`).
+* the winches follow the reference, and no allowed cable tensions hold the platform there.
+  Without tension limits, non-negative tensions must hold its weight at rest: every cable
+  pulls along the line from its anchor to where it leaves its exit, so a platform above its
+  exits could only be held by cables that push (a reference that accelerates the platform
+  beyond what taut cables give is a run's to show: the cables go slack and snap taut). With
+  the cables' ``min_tension`` / ``max_tension``, tensions within them must give it its
+  weight and the reference's acceleration, ``M (a_ref + g e_z)``, and the moment about the
+  centre of mass that the reference's rotation needs (:func:`reference_wrenches`).
 
-**One rule for the moment.** The cables can turn the platform about every axis when it is
-rigid (not a point mass), it has at least as many cables as its wrench has entries (3 in
-the plane, 6 in space) and its structure matrix at the first sample has full rank: then the
-whole wrench-feasible workspace is asked. With fewer cables (the paper's two, the spatial
-four-cable robots) the platform turns to balance the moment, as a suspended platform does,
-and the force alone is asked. Pure NumPy/SciPy (no Exudyn). Units SI.
+**One rule for the moment, both dimensions.** The cables can turn the platform about every
+axis when it is rigid (not a point mass), it has at least as many cables as its wrench has
+entries (3 in the plane, 6 in space) and its structure matrix at the first sample has full
+rank: then the moment is asked with the force (none at rest, or the rotation's within
+tension limits). With fewer cables (the paper's two, the spatial four-cable robots) the
+platform turns to balance the moment, as a suspended platform does, and the force alone is
+asked. Pure NumPy/SciPy (no Exudyn). Units SI.
 """
 
 from __future__ import annotations
@@ -168,37 +171,41 @@ def _turns(scene, matrix: np.ndarray) -> bool:
             and len(matrix) == size and np.linalg.matrix_rank(matrix) == size)
 
 
-def _check_held(scene, times, poses, wrenches) -> None:
+def _check_held(scene, times, poses) -> None:
+    """Refuse a pose where no allowed tensions give the platform what following the reference takes (module notes)."""
     if scene.winch.kind == "fixed":
         return  # fixed winches follow no reference: it only measures the error (a pendulum swings)
-    d, limits = scene.space.position_size, scene.tension_limits
+    d, limits, inertia = scene.space.position_size, scene.tension_limits, shown(scene.platform.inertia)
     matrices = structure_matrix(scene, poses)  # (N, n, m): force and moment about the centre of mass
-
-    def why(free: np.ndarray) -> str:
-        return ("with non-negative tensions" if limits is None
-                else f"within the cables' tension limits ({limits_text(free, limits)})")
-
-    unheld = first_unheld(matrices[:, :d], wrenches[:, :d], limits)
-    if unheld is not None:
-        k, residual, free = unheld
-        above = scene.above_exits(poses[k, :d], scene.space.rotation_matrix(poses[k, d:]))
-        raise UnreachableError(
-            f"{_pose_text(scene, times, poses, k)} is outside the workspace: the cables cannot hold the platform's "
-            f"weight and give it the reference's acceleration ({np.round(wrenches[k, :d], 4).tolist()} N, "
-            f"platform.mass = {scene.platform.mass} kg) {why(free)}; {residual:.4g} N would remain unbalanced"
-            + ("" if above is None else f"; the pose is above the exits: {above}"))
-    if not _turns(scene, matrices[0]):
-        return  # the platform turns to balance the moment (a point mass has none)
-    unheld = first_unheld(matrices, wrenches, limits)
-    if unheld is not None:
-        k, residual, free = unheld
-        raise UnreachableError(
-            f"{_pose_text(scene, times, poses, k)} is outside the workspace: the cables can give the platform the "
-            f"force it needs ({np.round(wrenches[k, :d], 4).tolist()} N, its weight and the reference's "
-            f"acceleration), but not together with the moment about its centre of mass that the reference's "
-            f"rotation needs ({np.round(wrenches[k, d:], 4).tolist()} N m: zero at rest, plus the angular "
-            f"acceleration and velocity with platform.inertia = {shown(scene.platform.inertia)} kg m^2) "
-            f"{why(free)}; {residual:.4g} (N, N m) would remain unbalanced")
+    if limits is None:  # held at rest at each pose: its weight, no moment
+        wrenches = np.zeros((len(poses), scene.space.wrench_size))
+        wrenches[:, scene.space.vertical] = scene.platform.mass * (scene.gravity if scene.effects.gravity else 0.0)
+        what, allowed = "hold the platform's weight", "with non-negative tensions"
+        moment = (f"no moment about its centre of mass (at rest; the reference's angular acceleration, with "
+                  f"platform.inertia = {inertia} kg m^2, is asked within tension limits)")
+    else:
+        wrenches = reference_wrenches(scene, times)
+        what, allowed = "hold the platform's weight and give it the reference's acceleration", "within the cables' tension limits"
+        moment = ("the moment about its centre of mass that the reference's rotation needs ({} N m: zero at rest, plus "
+                  f"the angular acceleration and velocity with platform.inertia = {inertia} kg m^2)")
+    for rows, unit in ((slice(0, d), "N"), (slice(None), "(N, N m)")):
+        unheld = first_unheld(matrices[:, rows], wrenches[:, rows], limits)
+        if unheld is not None:
+            k, residual, free = unheld
+            why = allowed if limits is None else f"{allowed} ({limits_text(free, limits)})"
+            force = f"{what} ({np.round(wrenches[k, :d], 4).tolist()} N, platform.mass = {scene.platform.mass} kg)"
+            if unit == "N":
+                above = scene.above_exits(poses[k, :d], scene.space.rotation_matrix(poses[k, d:]))
+                raise UnreachableError(
+                    f"{_pose_text(scene, times, poses, k)} is outside the workspace: the cables cannot {force} {why}; "
+                    f"{residual:.4g} N would remain unbalanced"
+                    + ("" if above is None else f"; the pose is above the exits: {above}"))
+            raise UnreachableError(
+                f"{_pose_text(scene, times, poses, k)} is outside the workspace: the cables can {force}, but not "
+                f"together with {moment.format(np.round(wrenches[k, d:], 4).tolist())} {why}; {residual:.4g} {unit} "
+                "would remain unbalanced")
+        if not _turns(scene, matrices[0]):
+            return  # the platform turns to balance the moment (a point mass has none)
 
 
 def check_reference(scene) -> None:
@@ -224,4 +231,4 @@ def check_reference(scene) -> None:
     lengths = np.stack([np.asarray(_exit_named(scene, i, times, poses, points[:, i]).cable_length)
                         for i in range(scene.n_cables)], axis=1)
     _check_lengths(scene, times, poses, lengths)
-    _check_held(scene, times, poses, reference_wrenches(scene, times))
+    _check_held(scene, times, poses)
