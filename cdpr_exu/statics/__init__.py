@@ -1,4 +1,4 @@
-"""Statics and ideal kinematics, pure NumPy/SciPy (no Exudyn): the planar kineto-statics on elastic catenaries, the chain statics of the lumped cables, inverse kinematics and the structure matrix, and the workspace check of a reference.
+"""Statics and ideal kinematics, pure NumPy/SciPy (no Exudyn): the ideal kinematics and structure matrix, the tension distribution and the workspace check of a reference (planar and spatial, one each), the planar kineto-statics on elastic catenaries and the chain statics of the lumped cables.
 
 Data flows scene (``cdpr_exu.scenes``) -> model (``cdpr_exu.builder``) -> run (``cdpr_exu.run``)
 -> result (``cdpr_exu.results``) -> studies and plots (``cdpr_exu.studies``, ``cdpr_exu.post``).
