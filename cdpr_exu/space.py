@@ -123,6 +123,18 @@ class Space:
         (N, pose_size) -> (N,)."""
         raise NotImplementedError
 
+    def moments(self, pose, anchors, forces) -> np.ndarray:
+        """Moments about the platform's reference point of forces at its anchors, ``(R b_i) x f_i``: pose
+        (pose_size,) or (N, pose_size), anchors (m, d), forces (m, d) or (N, m, d) -> (..., m, rotation_size)."""
+        raise NotImplementedError
+
+    def rotation_moment(self, rotation, rotation_rate, rotation_acceleration, inertia) -> np.ndarray:
+        """The moment about the centre of mass that turns a platform of ``inertia`` (:meth:`inertia`) along a
+        rotation, its rate and acceleration (N, rotation_size) [rad, rad/s, rad/s^2] -> (N, rotation_size) [N m]:
+        ``J phi''`` in the plane, Euler's ``I w' + w x I w`` in space (``I = R diag(inertia) R^T``, ``w =
+        J_l(theta) theta'``)."""
+        raise NotImplementedError
+
     def embed(self, pose) -> np.ndarray:
         """Pose(s) (..., pose_size) as spatial poses (..., 6): ``(x, z, phi) -> (x, 0, z, 0, -phi, 0)``
         in the plane (see the module notes), the identity in space."""
@@ -168,6 +180,13 @@ class PlanarSpace(Space):
     def rotation_error_deg(self, pose, reference) -> np.ndarray:
         return np.degrees(np.abs(np.asarray(pose)[:, 2] - np.asarray(reference)[:, 2]))
 
+    def moments(self, pose, anchors, forces) -> np.ndarray:
+        arms = geometry.rotated_anchors(np.asarray(pose, dtype=float), np.asarray(anchors, dtype=float))
+        return geometry.planar_cross(arms, forces)[..., None]
+
+    def rotation_moment(self, rotation, rotation_rate, rotation_acceleration, inertia) -> np.ndarray:
+        return inertia * np.asarray(rotation_acceleration, dtype=float)
+
     def embed(self, pose) -> np.ndarray:
         pose = np.asarray(pose, dtype=float)
         zero = np.zeros(pose.shape[:-1])
@@ -211,6 +230,20 @@ class SpatialSpace(Space):
             relative = geometry.rotation_from_vector(theta_ref).T @ geometry.rotation_from_vector(theta)
             angles.append(np.linalg.norm(geometry.rotation_vector(relative)))
         return np.degrees(np.asarray(angles))
+
+    def moments(self, pose, anchors, forces) -> np.ndarray:
+        return np.cross(geometry.spatial_arms(np.asarray(pose, dtype=float), np.asarray(anchors, dtype=float)), forces)
+
+    def rotation_moment(self, rotation, rotation_rate, rotation_acceleration, inertia) -> np.ndarray:
+        theta, rate = np.asarray(rotation, dtype=float), np.asarray(rotation_rate, dtype=float)
+        step = 1e-6  # d/dt J_l(theta(t)) by a central difference along theta': relative error ~ 1e-12
+        turning = (geometry.left_jacobians(theta + step * rate) - geometry.left_jacobians(theta - step * rate)) / (2 * step)
+        omega = np.einsum("nij,nj->ni", geometry.left_jacobians(theta), rate)
+        omega_rate = (np.einsum("nij,nj->ni", geometry.left_jacobians(theta), rotation_acceleration)
+                      + np.einsum("nij,nj->ni", turning, rate))
+        rotations = geometry.rotation_matrices(theta)
+        world = np.einsum("nij,j,nkj->nik", rotations, np.asarray(inertia, dtype=float), rotations)
+        return np.einsum("nij,nj->ni", world, omega_rate) + np.cross(omega, np.einsum("nij,nj->ni", world, omega))
 
     def embed(self, pose) -> np.ndarray:
         return np.asarray(pose, dtype=float)

@@ -37,7 +37,7 @@ import numpy as np
 
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import shown
-from cdpr_exu.statics.kinematics import cable_exits
+from cdpr_exu.statics.kinematics import length_jacobian
 
 from .base import Measurement, WinchCommand, quintic_blend
 
@@ -105,12 +105,11 @@ class FilteredPositionPI:
         return goal - pose[:2]
 
     def jacobian(self, pose: np.ndarray) -> np.ndarray:
-        """d(lambda)/d(position) of the ideal cables at ``pose`` (x, z, rotation), shape (m, 2) [m/m].
-
-        Moving an anchor by d changes the ideal length by u . d, u the unit vector
-        from the cable's exit point to the anchor (with the rotation held).
-        """
-        return np.stack([exit_.unit_vector for exit_ in cable_exits(self._scene, pose)], axis=-2)
+        """d(lambda)/d(the error's coordinates) of the ideal cables at ``pose``, shape (m, error_size) [m/m, m/rad]:
+        the first columns of the length Jacobian ``-A^T`` (:func:`cdpr_exu.statics.kinematics.length_jacobian`;
+        moving an anchor by d changes the ideal length by u . d, u the unit vector from the cable's exit
+        towards the anchor)."""
+        return length_jacobian(self._scene, pose)[:, :self.error_size(self._scene)]
 
     def _advance(self, time: float, error: np.ndarray, weight: float):
         """The filter and integral state at ``time`` [s] from the last earlier call, and stored."""

@@ -44,7 +44,7 @@ from scipy.signal import butter, filtfilt
 
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import shown
-from cdpr_exu.statics.kinematics import cable_exits, ideal_paid_out
+from cdpr_exu.statics.kinematics import ideal_paid_out, length_jacobian
 
 from .base import Measurement, WinchCommand
 
@@ -72,19 +72,20 @@ def position_jacobian(scene, poses: np.ndarray) -> np.ndarray:
     """Length change of each ideal cable per platform position change, rotation held.
 
     Moving the anchors by d changes the ideal paid-out length of cable i by u_i . d,
-    u_i the unit vector from the cable's exit point to its anchor.
+    u_i the unit vector from the cable's exit point to its anchor: the position columns of
+    :func:`cdpr_exu.statics.kinematics.length_jacobian`.
 
     Parameters
     ----------
     scene : cdpr_exu.scenes.scene.Scene
-    poses : ndarray, shape (N, 3) [m, m, rad]
+    poses : ndarray, shape (N, pose_size) [m, rad]
 
     Returns
     -------
-    ndarray, shape (N, m, 2) [m/m]
+    ndarray, shape (N, m, position_size) [m/m]
     """
     poses = np.atleast_2d(np.asarray(poses, dtype=float))
-    return np.stack([exit_.unit_vector for exit_ in cable_exits(scene, poses)], axis=-2).reshape(len(poses), -1, 2)
+    return length_jacobian(scene, poses)[..., :scene.space.position_size]
 
 
 def ideal_changes(scene, times: np.ndarray) -> np.ndarray:

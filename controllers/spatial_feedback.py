@@ -12,7 +12,7 @@ mapped onto the cables by the ideal inverse-kinematics Jacobian at the reference
 
     dL = -A^T (d, phi),
 
-A the structure matrix (:func:`cdpr_exu.physics.spatial_kinematics.structure_matrix`,
+A the structure matrix (:func:`cdpr_exu.statics.kinematics.structure_matrix`,
 columns ``[u_i; (R b_i) x u_i]``): moving the platform by d and turning it by a small
 global rotation phi moves anchor i by ``d + phi x R b_i`` and so lengthens the straight
 cable by ``-u_i . (d + phi x R b_i)``.
@@ -70,22 +70,6 @@ class SpatialPositionPI(FilteredPositionPI):
             return position
         turn = rotation_from_vector(goal[3:6]) @ rotation_from_vector(pose[3:6]).T
         return np.concatenate([position, rotation_vector(turn)])
-
-    def jacobian(self, pose: np.ndarray) -> np.ndarray:
-        """d(lambda)/d(position, global rotation) of the ideal cables at ``pose``: -A^T, shape (m, 6) or (m, 3).
-
-        A is the structure matrix at ``pose`` (x, y, z, rotation vector); with the rotation
-        left out, its force rows only.
-        """
-        from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
-
-        scene = self._scene
-        pose = np.asarray(pose, dtype=float)
-        anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
-        point = pose[:3] if anchors is None else pose[:6]
-        units = cable_unit_vectors(point, anchors, scene.exit_points, scene.pulley_radii)
-        matrix = structure_matrix(point, anchors, units)
-        return -matrix[:self.error_size(scene)].T
 
 
 def spatial_closed_loop_tension_aware(**feedback) -> ClosedLoopController:

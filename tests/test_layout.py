@@ -10,8 +10,9 @@ from pathlib import Path
 #: The layers that must stay free of Exudyn (tested without it, reusable on their own).
 PURE = ("cdpr_exu.core.geometry", "cdpr_exu.space", "cdpr_exu.core.output", "cdpr_exu.scenes.scene", "cdpr_exu.exits",
         "cdpr_exu.scenes.trajectories", "cdpr_exu.physics.catenary", "cdpr_exu.physics.bending",
-        "cdpr_exu.physics.axial_3d", "cdpr_exu.physics.swivel_pulley", "cdpr_exu.physics.spatial_kinematics",
+        "cdpr_exu.physics.axial_3d", "cdpr_exu.physics.swivel_pulley",
         "cdpr_exu.statics.statics", "cdpr_exu.statics.chain_statics", "cdpr_exu.statics.workspace",
+        "cdpr_exu.statics.kinematics", "cdpr_exu.statics.tension_distribution",
         "cdpr_exu.results.result", "cdpr_exu.results.energy", "controllers.ideal_ik", "controllers.tension_aware",
         "controllers.spatial_tension_aware", "controllers.ilc")
 

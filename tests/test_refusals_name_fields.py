@@ -56,12 +56,12 @@ def test_every_refusal_of_a_malformed_scene_names_a_field_path(data):
 def test_every_refusal_of_a_malformed_spatial_scene_names_a_field_path(data):
     """The same for spatial scenes (issue 23): a shipped spatial scene's plain data with one to
     three fields broken, refused by the validation or by the reference check of `cdpr run`."""
-    from cdpr_exu.run.spatial_run import check_spatial_reference
+    from cdpr_exu.statics.workspace import check_reference
 
     try:
         scene = scene_from_dict(data)
         if scene.trajectory is not None:
-            check_spatial_reference(scene)
+            check_reference(scene)
     except CdprError as err:
         assert FIELD_PATH.search(str(err)), str(err)
         assert not NUMPY_REPR.search(str(err)), str(err)

@@ -348,13 +348,13 @@ def test_a_winch_line_shorter_than_its_margin_is_refused_in_millimetres_with_wha
     """Issue 23.9: a 0.1 mm winch_line was refused as "paid out by 0.0000 m ... more than
     exits[0].winch_line = 0.0001 m less two elements holds"."""
     from cdpr_exu.core.errors import UnreachableError
-    from cdpr_exu.run.spatial_run import check_spatial_reference
+    from cdpr_exu.statics.workspace import check_reference
 
     data = load_scene(NAME).to_dict()
     for entry in data["exits"]:
         entry["winch_line"] = 1e-4
     with pytest.raises(UnreachableError) as caught:
-        check_spatial_reference(scene_from_dict(data))
+        check_reference(scene_from_dict(data))
     message = str(caught.value)
     for words in ("exits[0].winch_line = 0.1 mm less two elements (2 x 50 mm", "leaves -99.9 mm",
                   "give exits[0].winch_line = 100 mm or more"):
@@ -365,12 +365,12 @@ def test_a_winch_line_shorter_than_its_margin_is_refused_in_millimetres_with_wha
 def test_an_anchor_on_a_swivel_axis_says_what_to_change_in_the_scene():
     """Issue 23.9: the refusal asked for `azimuth_hint`, which no scene has."""
     from cdpr_exu.core.errors import UnreachableError
-    from cdpr_exu.run.spatial_run import check_spatial_reference
+    from cdpr_exu.statics.workspace import check_reference
 
     data = load_scene(NAME).to_dict()
     data["trajectory"] = {"kind": "hold", "pose": [1.5, 1.5, -0.5, 0.0, 0.0, 0.0]}  # below the first inlet
     with pytest.raises(UnreachableError) as caught:
-        check_spatial_reference(scene_from_dict(data))
+        check_reference(scene_from_dict(data))
     message = str(caught.value)
     assert "start the reference (the scene's trajectory) with every anchor off the vertical axis" in message, message
     assert "give azimuth_hint" not in message

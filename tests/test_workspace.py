@@ -7,7 +7,8 @@ import pytest
 
 from cdpr_exu.studies.comparison import CONTROLLERS
 from cdpr_exu.core.errors import UnreachableError
-from cdpr_exu.scenes.scene import Effects, load_scene
+from cdpr_exu.exits import Pulley
+from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, Scene, SolverSpec, load_scene
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.trajectories import CircleTrajectory, PointToPointTrajectory
 from cdpr_exu.statics.workspace import check_reference, reference_samples
@@ -80,11 +81,40 @@ def test_the_circle_is_checked_at_its_extreme_poses_exactly():
 
 
 def test_the_shipped_scenes_pass_the_check():
+    """Planar and spatial: one check (a spatial scene without a trajectory has nothing to follow)."""
     from cdpr_exu.scenes.scene import shipped_scenes
 
     for scene in map(load_scene, shipped_scenes()):
-        if scene.dimension == 2:  # the spatial reference check: tests/test_spatial_run.py
-            check_reference(scene)
+        check_reference(scene)
+
+
+def _four_cables(end_rotation: float, duration: float):
+    """A rigid planar platform on four cables (two pulleys above, two below, 1-60 N each) turning on the spot."""
+    exits = (Pulley((-1.75, 0.0), 0.25, -1), Pulley((1.75, 0.0), 0.25, 1), Pulley((-1.75, -4.0), 0.25, -1),
+             Pulley((1.75, -4.0), 0.25, 1))
+    return Scene(cables=(CableSpec(min_tension=1.0, max_tension=60.0),) * 4, exits=exits,
+                 platform=PlatformSpec(anchors=((-0.15, 0.1), (0.15, 0.1), (-0.15, -0.1), (0.15, -0.1))),
+                 trajectory=PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.0, -2.0, end_rotation),
+                                                   duration=duration),
+                 solver=SolverSpec(end_time=duration + 0.5))
+
+
+def test_a_planar_platform_on_three_cables_or_more_must_get_the_moment_its_rotation_needs():
+    """One rule for both dimensions: a rigid platform with as many cables as its wrench has entries (3 in the
+    plane, 6 in space) is asked the whole wrench (within tension limits, the moment its rotation needs). Turning 0.1 rad in 2 s is held within 1-60 N; in 50 ms it
+    needs J phi'' of several N m (J = 0.0271 kg m^2), more than 60 N on 0.15 m arms can give."""
+    check_reference(_four_cables(0.1, 2.0))
+    with pytest.raises(UnreachableError, match=r"\(x \[m\], z \[m\], rotation \[rad\]\) at t = 0\.\d{3} s is "
+                                               r"outside the workspace: .*moment about its centre of mass") as err:
+        check_reference(_four_cables(0.1, 0.05))
+    assert "platform.inertia = 0.0271 kg m^2" in str(err.value) and "max_tension = 60 N" in str(err.value)
+    # without tension limits the cables must hold it at rest at each pose; the turn's dynamics is the run's
+    unlimited = _four_cables(0.1, 0.05)
+    check_reference(unlimited.with_changes(cables=tuple(replace(c, min_tension=None, max_tension=None)
+                                                        for c in unlimited.cables)))
+    # the paper's two cables cannot turn the platform: it turns to balance the moment, only the force is asked
+    fast_turn = PointToPointTrajectory(start=(0.0, -2.0, 0.0), end=(0.0, -2.0, 0.1), duration=0.05)
+    check_reference(PAPER.with_changes(trajectory=fast_turn, solver=replace(PAPER.solver, end_time=0.55)))
 
 
 @pytest.mark.parametrize("preset", ["elastic", "ideal"])

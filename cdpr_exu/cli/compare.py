@@ -16,7 +16,6 @@ from cdpr_exu.core.errors import EXIT_CODES, EXIT_OK, EXIT_RUN_FAILED, SceneErro
 from cdpr_exu.core.output import check_output_folder
 from cdpr_exu.core.validation import non_negative
 from cdpr_exu.results.result import raise_warnings, status_text
-from cdpr_exu.run.spatial_run import check_spatial_reference
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, compare_spatial,
@@ -64,7 +63,7 @@ def _compare_spatial(scene, args: argparse.Namespace) -> int:
         scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
     if scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr compare` needs one")
-    check_spatial_reference(scene)
+    check_reference(scene)
     names = args.controllers.split(",") if args.controllers else None
     if not args.quiet:
         print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")

@@ -108,6 +108,13 @@ class Exit:
         unless the kind needs short elements beside its disc."""
         return 1
 
+    def paid_out_refusal(self, cable, index: int, lengths, lumped: bool, path: str):
+        """The first sample at which the ideal lengths ``lengths`` (N,) [m] of ``cables[index]`` (``cable``) along a
+        reference need more cable than this exit's winch can pay out, and what it needs (the end of a sentence
+        "the reference pose ... needs ...", naming the fields; ``lumped``: the cable has elements), or None.
+        None by default: the winch pays out through the exit without limit, or the cable is fixed there."""
+        return None
+
     def check(self, cable, index: int, path: str) -> None:
         """Refuse a cable (:class:`~cdpr_exu.scenes.scene.CableSpec`, ``cables[index]``) that this exit
         (``path``, e.g. ``"exits[2]"``) cannot carry; the message names both. Nothing by default."""

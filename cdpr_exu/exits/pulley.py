@@ -84,6 +84,19 @@ class Pulley(Exit):
         (:func:`cdpr_exu.core.geometry.pulley_exit`)."""
         return planar_exit(self.center, self.radius, self.side, anchor_points)
 
+    def paid_out_refusal(self, cable, index: int, lengths, lumped: bool, path: str):
+        """Refuse ideal lengths beyond the cable: a lumped cable keeps one element on the winch side of the
+        pulley, a massless rope (no elements) may pay out its whole length."""
+        spare = cable.element_length if lumped else 0.0
+        too_long = np.flatnonzero(np.asarray(lengths) > cable.unstrained_length - spare + 1e-12)
+        if not too_long.size:
+            return None
+        k = int(too_long[0])
+        kept = (f"one element, {cable.element_length:.4f} m, must stay on the winch side"
+                if lumped else "a massless rope can pay out at most its whole length")
+        return k, (f"{lengths[k]:.4f} m of cable {index + 1} between {path} and platform.anchors[{index}], but "
+                   f"cables[{index}].unstrained_length is {cable.unstrained_length} m ({kept})")
+
     def rim_point(self, angle: float) -> np.ndarray:
         """Point of the rim at polar angle ``angle`` [rad], shape (2,) [m]."""
         return np.array(self.center) + self.radius * np.array([math.cos(angle), math.sin(angle)])

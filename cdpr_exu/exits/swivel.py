@@ -15,6 +15,8 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+import numpy as np
+
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.geometry import SwivelExit, swivel_pulley_exit
 from cdpr_exu.core.validation import positive, shown
@@ -94,6 +96,20 @@ class Swivel(Exit):
         """The cable's exit towards ``anchor_points`` (3,) or (N, 3) [m], with the disc's azimuth
         (:func:`cdpr_exu.core.geometry.swivel_pulley_exit`; ``azimuth_hint`` for an anchor on the axis)."""
         return swivel_pulley_exit(self.inlet, self.radius, anchor_points, azimuth_hint)
+
+    def paid_out_refusal(self, cable, index: int, lengths, lumped: bool, path: str):
+        """Refuse a reference that pays out more than the winch line, less two elements (the winch end's margin
+        below the inlet), beyond the start."""
+        margin = 2.0 * cable.element_length
+        room = self.winch_line - margin
+        gain = np.asarray(lengths) - lengths[0]
+        if gain.max() <= room:
+            return None
+        k = int(np.argmax(gain))
+        return k, (f"cable {index + 1} paid out by {1000 * gain[k]:.3g} mm over its swivel pulley, more than its winch "
+                   f"line holds: {path}.winch_line = {1000 * self.winch_line:.3g} mm less two elements (2 x "
+                   f"{1000 * margin / 2:.3g} mm, the winch end's margin below the inlet) leaves {1000 * room:.3g} mm; "
+                   f"give {path}.winch_line = {1000 * (margin + max(gain[k], 0.0)):.3g} mm or more")
 
     def fewest_elements(self, cable) -> int:
         """Elements no longer than ``SAFE_ELEMENT_FRACTION`` of the disc's radius (:meth:`check`)."""

@@ -21,9 +21,9 @@ each corner. Cables 1, 3, 5, 7 hold the platform at its bottom (anchors at z abo
 0), cables 2, 4, 6, 8 at its top (z about 1 m), and the bottom ones cross over to
 the far side of the platform in x or y.
 
-Use with :class:`cdpr_exu.physics.spatial_kinematics.IdealSpatialRobot`::
-
-    IdealSpatialRobot(EXIT_POINTS, ANCHORS, 0.0, MASS, MIN_TENSION, MAX_TENSION, CENTER_OF_MASS)
+The shipped scene ``spatial-cogiro`` is this robot with its anchors measured from the centre
+of mass (its kinematics and tensions: :mod:`cdpr_exu.statics.kinematics`,
+:mod:`cdpr_exu.statics.tension_distribution`).
 """
 
 import numpy as np

@@ -8,7 +8,7 @@ robot's own equilibrium, found by the chain statics:
 implicit solver (the scene's ``[solver]``) while the winches follow the ideal inverse
 kinematics of the reference: each cable's paid-out length is its initial length plus
 the change of the straight distance from its exit point to its anchor along the
-reference (:mod:`cdpr_exu.physics.spatial_kinematics`), the spatial counterpart of the
+reference (:mod:`cdpr_exu.statics.kinematics`), the spatial counterpart of the
 planar ``ideal_ik`` controller.
 
 **The winch at a point exit.** A spatial scene's cable leaves the frame at a fixed
@@ -39,13 +39,11 @@ from typing import Any
 import exudyn as exu
 import numpy as np
 
-from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, write_npz, write_pose_csv, write_summary
-from cdpr_exu.core.validation import shown
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     scene_chain_spec, start_at_rest
-from cdpr_exu.physics.spatial_kinematics import cable_unit_vectors, structure_matrix
 from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
 from controllers.base import Controller, Measurement, SmoothStart
@@ -57,133 +55,9 @@ from cdpr_exu.run.simulate import (interrupt_flag, output_times, progress_report
 from cdpr_exu.run.spatial_rest import rest_above_exits
 from cdpr_exu.scenes.scene import Scene, tension_limits
 from cdpr_exu.space import SPACE
-from cdpr_exu.statics.kinematics import ideal_paid_out
-from cdpr_exu.statics.workspace import first_unheld, limits_text
+from cdpr_exu.statics.workspace import check_reference
 
-__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model", "check_spatial_reference"]
-
-
-#: Samples of the reference checked before a run.
-REFERENCE_SAMPLES = 401
-
-
-def check_spatial_reference(scene: Scene) -> None:
-    """Refuse a reference the cables cannot follow, before the run.
-
-    At 401 samples of the reference: every commanded paid-out length stays positive, and
-    straight cables from the exits to the anchors can give the platform its weight and
-    the reference's acceleration, ``M (a + g e_z)``, with non-negative tensions (within
-    the cables' ``min_tension`` / ``max_tension`` where given): the force part of the
-    wrench-feasible workspace, as the planar check. With six cables or more on a rigid
-    platform whose structure matrix has full rank, the rotation is not free: the same
-    tensions must also give the moment about the centre of mass that the reference's
-    rotation needs (:func:`reference_wrenches`), the whole wrench-feasible workspace.
-    With fewer cables the platform turns to balance the moment, and only the force is asked. A pose with every anchor above its exit is such a pose; the
-    message then says so (:meth:`Scene.above_exits`).
-
-    Raises
-    ------
-    UnreachableError
-        Naming the time, the pose and what fails.
-    """
-    times = np.linspace(0.0, scene.solver.end_time, REFERENCE_SAMPLES)
-    poses = np.atleast_2d(scene.trajectory.pose(times))
-    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
-    for name, values in (("pose", poses), ("acceleration", acceleration)):
-        if not np.all(np.isfinite(values)):
-            k = int(np.argmin(np.all(np.isfinite(values), axis=1)))
-            raise UnreachableError(f"trajectory is out of floating-point range: its {name} at t = {times[k]:.3f} s is "
-                                   f"{shown(values[k])} (a trajectory field far beyond any robot, e.g. its "
-                                   "angular_rate or radius)")
-    try:
-        ideal, _ = ideal_paid_out(scene, poses)
-    except UnreachableError as err:
-        raise UnreachableError(f"trajectory is refused before the run: {err}") from None
-    lengths = scene.unstrained_lengths + ideal - ideal[0]
-    short = np.argwhere(lengths <= 0.0)
-    if short.size:
-        k, i = short[0]
-        raise UnreachableError(f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs "
-                               f"cable {i + 1} paid out to {lengths[k, i]:.4g} m from its "
-                               f"cables[{i}].unstrained_length = {scene.cables[i].unstrained_length:.4g} m at the start: "
-                               "it would be reeled in completely")
-    for i, swivel in enumerate(scene.swivel_exits):
-        if swivel is None:
-            continue
-        margin = 2.0 * scene.cables[i].element_length  # the winch end stays two elements below the inlet
-        room = swivel.winch_line - margin
-        gain = lengths[:, i] - lengths[0, i]
-        if gain.max() > room:
-            k = int(np.argmax(gain))
-            raise UnreachableError(
-                f"the reference pose {np.round(poses[k], 4).tolist()} at t = {times[k]:.3f} s needs cable {i + 1} paid "
-                f"out by {1000 * gain[k]:.3g} mm over its swivel pulley, more than its winch line holds: "
-                f"exits[{i}].winch_line = {1000 * swivel.winch_line:.3g} mm less two elements (2 x "
-                f"{1000 * margin / 2:.3g} mm, the winch end's margin below the inlet) leaves {1000 * room:.3g} mm; give "
-                f"exits[{i}].winch_line = {1000 * (margin + max(gain[k], 0.0)):.3g} mm or more")
-
-    anchors = None if scene.platform.is_point_mass else np.asarray(scene.platform.anchors)
-    points = poses[:, :3] if anchors is None else poses
-    units = cable_unit_vectors(points, anchors, scene.exit_points, scene.pulley_radii)
-    wrenches = reference_wrenches(scene, times)
-    limits = tension_limits(scene.cables)
-
-    def why(free: np.ndarray) -> str:
-        return ("with non-negative tensions" if limits is None
-                else f"within the cables' tension limits ({limits_text(free, limits)})")
-
-    def where(k: int) -> str:
-        return (f"the reference pose {np.round(poses[k], 4).tolist()} (x, y, z [m], rotation vector [rad]) "
-                f"at t = {times[k]:.3f} s is outside the workspace")
-
-    unheld = first_unheld(np.swapaxes(units, 1, 2), wrenches[:, :3], limits)
-    if unheld is not None:
-        k, residual, free = unheld
-        above = scene.above_exits(poses[k, :3], rotation_from_vector(poses[k, 3:]))
-        raise UnreachableError(
-            f"{where(k)}: the cables cannot give the platform its weight and the reference's acceleration "
-            f"({np.round(wrenches[k, :3], 4).tolist()} N) {why(free)}; "
-            f"{residual:.4g} N would remain unbalanced" + ("" if above is None else f"; the pose is above the exits: {above}"))
-    if anchors is None or scene.n_cables < 6:
-        return  # the platform turns to balance the moment (a point mass has none)
-    matrices = structure_matrix(poses, anchors, units)  # (N, 6, m): force and moment about the centre of mass
-    if np.linalg.matrix_rank(matrices[0]) < 6:
-        return  # the cables cannot turn the platform about some axis: its rotation there is free
-    unheld = first_unheld(matrices, wrenches, limits)
-    if unheld is not None:
-        k, residual, free = unheld
-        raise UnreachableError(
-            f"{where(k)}: the cables can give the platform the force it needs ({np.round(wrenches[k, :3], 4).tolist()} "
-            f"N, its weight and the reference's acceleration), but not together with the moment about its centre "
-            f"of mass that the reference's rotation needs ({np.round(wrenches[k, 3:], 4).tolist()} N m: zero at rest, "
-            f"plus the angular acceleration and velocity with platform.inertia = {list(scene.platform.inertia)} kg m^2) "
-            f"{why(free)}; {residual:.4g} (N, N m) would remain unbalanced")
-
-
-def reference_wrenches(scene: Scene, times: np.ndarray) -> np.ndarray:
-    """The wrench the cables must give the platform to follow the reference, shape (N, 6) [N, N m].
-
-    The force ``M (a + g e_z)`` and the moment about the centre of mass ``I w' + w x I w``
-    (Euler's equations in the world frame, ``I = R diag(platform.inertia) R^T``): zero
-    for a platform at rest, whatever its orientation. The angular velocity is the reference's
-    (:meth:`~cdpr_exu.scenes.trajectories.Trajectory.angular_velocity`, ``J_l(theta) theta'``); its
-    rate comes from a central difference over 1e-6 s (one-sided at t = 0, where the reference starts).
-    """
-    times = np.asarray(times, dtype=float)
-    gravity = scene.gravity if scene.effects.gravity else 0.0
-    acceleration = np.atleast_2d(scene.trajectory.acceleration(times))[:, :3]
-    force = scene.platform.mass * (acceleration + np.array([0.0, 0.0, gravity]))
-
-    angular_velocity = scene.trajectory.angular_velocity
-    delta = 1e-6
-    before, after = np.maximum(times - delta, 0.0), times + delta
-    omega = angular_velocity(times)
-    omega_rate = (angular_velocity(after) - angular_velocity(before)) / (after - before)[:, None]
-    rotations = np.array([rotation_from_vector(theta) for theta in np.atleast_2d(scene.trajectory.pose(times))[:, 3:]])
-    inertia = np.einsum("nij,j,nkj->nik", rotations, np.asarray(scene.platform.inertia, dtype=float), rotations)
-    spin = np.einsum("nij,nj->ni", inertia, omega)
-    moment = np.einsum("nij,nj->ni", inertia, omega_rate) + np.cross(omega, spin)
-    return np.column_stack([force, moment])
+__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model"]
 
 
 @dataclass
@@ -407,7 +281,7 @@ def _rest_above_exits(scene: Scene, mbs, items) -> str | None:
 
 def check_runnable(scene: Scene) -> None:
     """Refuse a scene ``cdpr run`` cannot run, before anything is built or written: no ``[trajectory]``,
-    or a reference the cables cannot follow (:func:`check_spatial_reference`).
+    or a reference the cables cannot follow (:func:`cdpr_exu.statics.workspace.check_reference`).
 
     Raises
     ------
@@ -415,7 +289,7 @@ def check_runnable(scene: Scene) -> None:
     """
     if scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
-    check_spatial_reference(scene)
+    check_reference(scene)
 
 
 def build_spatial_model(scene: Scene):

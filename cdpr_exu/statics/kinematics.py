@@ -1,12 +1,29 @@
-"""Ideal kinematics of a cable robot: cable lengths, rates and unit vectors, the planar wrench matrix.
+"""Ideal kinematics of a cable robot, planar or spatial: cable lengths, rates, pull directions, structure matrix.
 
 Pure NumPy/SciPy; no Exudyn. The ideal cables (straight, massless, inextensible) of a
-scene, planar or spatial, are its exits' (:mod:`cdpr_exu.exits`: each computes its cable
-with the kernels of :mod:`cdpr_exu.core.geometry`) at the anchors its
-:class:`~cdpr_exu.space.Space` places: :func:`cable_exits`, :func:`ideal_paid_out`. The
-planar wrench matrix and the initial node layouts of planar cables are here too (the
-spatial ones: :mod:`cdpr_exu.physics.spatial_kinematics`). The planar geometry names are
-re-exported here for code that imports them from ``cdpr_exu.statics.kinematics``.
+scene are its exits' (:mod:`cdpr_exu.exits`: each computes its cable towards an anchor
+with the kernels of :mod:`cdpr_exu.core.geometry`, a planar pulley's, a swivel pulley's, a
+point's) at the anchors its :class:`~cdpr_exu.space.Space` places. On those two, written
+once for both dimensions: the ideal paid-out lengths and their rates
+(:func:`ideal_paid_out`), the directions in which the cables pull the platform
+(:func:`pull_directions`), the structure matrix (:func:`structure_matrix`) and the
+length Jacobian (:func:`length_jacobian`). The initial node layouts of planar cables are
+here too. The tensions that hold the platform: :mod:`cdpr_exu.statics.tension_distribution`.
+
+Sign conventions
+----------------
+An exit's ``unit_vector`` ``u_i`` points from where the cable leaves the exit towards its
+anchor; the cable pulls the platform along ``w_i = -u_i``. The length rate is
+``dL_i/dt = u_i . v_i`` (``v_i`` the anchor's velocity: a change of wrap cancels the
+motion of the tangent point along the rim, a swivel's turn moves it sideways). The
+structure matrix ``A`` has columns ``[w_i; (R b_i) x w_i]``: tensions ``f`` exert the
+wrench ``A f`` on the platform, the moment about its reference point (the centre of mass),
+the Space's cross product (planar: ``a_x b_z - a_z b_x``, counter-clockwise positive). A
+point-mass platform (every anchor at the centre of mass) has the force rows only. With
+the pose rate and, in space, the angular velocity ``omega = J_l(theta) dtheta/dt``::
+
+    dL/dt = -A^T (dr/dt, dphi/dt)            (plane)
+    dL/d(r, theta) = -A^T blockdiag(I, J_l(theta))   (space)
 """
 
 from __future__ import annotations
@@ -16,28 +33,29 @@ from scipy.optimize import brentq
 
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import shown
-from cdpr_exu.core.geometry import (anchor_points, anchor_velocities, check_pose_and_anchors, check_radius, check_side,
-                                    exit_arrays, finite_array, planar_cross, pulley_exit, rotated_anchors,
-                                    rotation_matrix)
+from cdpr_exu.core.geometry import anchor_points, check_radius, check_side, exit_arrays, finite_array
 
-#: The geometry names above are re-exported for code that imports them from here.
 __all__ = [
     "cable_exits",
     "ideal_paid_out",
+    "pull_directions",
     "structure_matrix",
+    "length_jacobian",
     "initial_cable_nodes",
     "straight_cable_nodes",
+    "anchor_points",  # re-exported for the planar builder and controllers
 ]
 
 
-# ----------------------------------------------------------------------------------
-# the whole robot, planar or spatial: through its exits
-# ----------------------------------------------------------------------------------
+def _anchors(scene) -> np.ndarray:
+    return np.asarray(scene.platform.anchors, dtype=float)
+
+
 def cable_exits(scene, poses: np.ndarray) -> list:
     """Each cable's ideal exit towards its anchor at the platform pose(s) (N, pose_size) or (pose_size,):
     :class:`~cdpr_exu.core.geometry.PulleyExit` (tangent point, wrap, free length, unit vector ``u_i``
     from the exit towards the anchor), one per cable, from its exit (:meth:`cdpr_exu.exits.base.Exit.exit`)."""
-    points = scene.space.anchor_points(poses, np.asarray(scene.platform.anchors, dtype=float))
+    points = scene.space.anchor_points(poses, _anchors(scene))
     return [exit_.exit(points[..., i, :]) for i, exit_ in enumerate(scene.exits)]
 
 
@@ -51,58 +69,63 @@ def ideal_paid_out(scene, poses: np.ndarray, pose_rates: np.ndarray | None = Non
     Parameters
     ----------
     scene : cdpr_exu.scenes.scene.Scene
-    poses : ndarray, shape (N, pose_size) [m, rad]
-    pose_rates : ndarray, shape (N, pose_size) or None [m/s, rad/s]
+    poses : ndarray, shape (N, pose_size) or (pose_size,) [m, rad]
+    pose_rates : ndarray, same shape, or None [m/s, rad/s]
         The poses' time derivatives (in space, the rotation vector's rate).
 
     Returns
     -------
-    lengths : ndarray, shape (N, m) [m]
-    rates : ndarray, shape (N, m) [m/s] or None
+    lengths : ndarray, shape (N, m) or (m,) [m]
+    rates : ndarray, shape (N, m) or (m,) [m/s], or None
     """
     exits = cable_exits(scene, poses)
     lengths = np.stack([e.cable_length for e in exits], axis=-1)
     if pose_rates is None:
         return lengths, None
-    velocities = scene.space.anchor_velocities(poses, pose_rates, np.asarray(scene.platform.anchors, dtype=float))
+    velocities = scene.space.anchor_velocities(poses, pose_rates, _anchors(scene))
     return lengths, np.stack([np.sum(e.unit_vector * velocities[..., i, :], axis=-1) for i, e in enumerate(exits)],
                              axis=-1)
 
 
-def structure_matrix(pose, anchors, unit_vectors):
-    """Wrench (structure) matrix ``A`` of the platform: cable tensions ``f`` give wrench ``A f``.
+def pull_directions(scene, poses: np.ndarray) -> np.ndarray:
+    """Unit vectors ``w_i = -u_i`` along each cable at its anchor, towards its exit: the direction it pulls the
+    platform, shape (m, d) or (N, m, d) for pose(s) (pose_size,) or (N, pose_size)."""
+    return np.stack([-e.unit_vector for e in cable_exits(scene, poses)], axis=-2)
 
-    Column i is ``[w_i; (R(phi) b_i) x w_i]``, the force and the moment about the
-    platform reference point of a unit tension in cable i.
+
+def structure_matrix(scene, poses: np.ndarray) -> np.ndarray:
+    """Structure (wrench) matrix ``A`` of the platform: cable tensions ``f`` exert the wrench ``A f``.
+
+    Column i is ``[w_i; (R b_i) x w_i]`` (module notes): the force and the moment about the
+    centre of mass of a unit tension in cable i; the force rows only for a point mass.
 
     Parameters
     ----------
-    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
-        Platform pose(s).
-    anchors : array_like, shape (m, 2) [m]
-        Anchor points ``b_i`` in the platform frame.
-    unit_vectors : array_like, shape (m, 2) or (N, m, 2)
-        Unit vectors ``w_i`` from each anchor towards its cable's exit point (the
-        direction of pull: minus the exits' unit vectors, :func:`cable_exits`). Not re-normalised.
+    scene : cdpr_exu.scenes.scene.Scene
+    poses : ndarray, shape (pose_size,) or (N, pose_size) [m, rad]
 
     Returns
     -------
-    ndarray, shape (3, m) or (N, 3, m) [1, 1, m]
-        Rows: force x, force z, moment (counter-clockwise positive).
-
-    Notes
-    -----
-    The length rates of the ideal cables are ``dL/dt = -A^T (xdot, zdot, phidot)``.
+    ndarray, shape (n, m) or (N, n, m) [1, m]
+        n = the Space's wrench size (3 planar: force x, z, moment; 6 spatial: force x, y, z,
+        moment x, y, z), or its position size for a point mass.
     """
-    pose, anchors = check_pose_and_anchors(pose, anchors)
-    units = finite_array("unit_vectors", unit_vectors, (2,))
-    arm = rotated_anchors(pose, anchors)
-    try:
-        units = np.broadcast_to(units, arm.shape)
-    except ValueError as exc:
-        raise SceneError(f"unit_vectors must have shape {arm.shape}, got shape {units.shape}") from exc
-    moment = planar_cross(arm, units)
-    return np.concatenate([np.swapaxes(units, -1, -2), moment[..., None, :]], axis=-2)
+    pulls = pull_directions(scene, poses)
+    forces = np.swapaxes(pulls, -1, -2)
+    if scene.platform.is_point_mass:
+        return np.array(forces)
+    moments = scene.space.moments(poses, _anchors(scene), pulls)
+    return np.concatenate([forces, np.swapaxes(moments, -1, -2)], axis=-2)
+
+
+def length_jacobian(scene, poses: np.ndarray) -> np.ndarray:
+    """``-A^T``: the change of each ideal cable length per platform displacement and small rotation (about
+    the world axes, in space; the angle in the plane), shape (m, n) or (N, m, n) (:func:`structure_matrix`).
+
+    Moving the platform by ``d`` and turning it by ``phi`` moves anchor i by ``d + phi x R b_i`` and
+    lengthens its cable by ``u_i . (d + phi x R b_i)``; its first position columns are the ``u_i``.
+    """
+    return -np.swapaxes(structure_matrix(scene, poses), -1, -2)
 
 
 # ----------------------------------------------------------------------------------
