@@ -18,17 +18,16 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import OutputError
+from cdpr_exu.results.result import Result
+from cdpr_exu.space import SPACE
 
 __all__ = ["is_spatial_run", "SpatialFrames"]
 
 
 def is_spatial_run(run_dir: str | Path) -> bool:
-    """True for a folder written by a spatial ``cdpr run`` (a result.npz with 6-DOF poses)."""
+    """True for a folder written by a spatial ``cdpr run`` (a result.npz whose :class:`Result` is in space)."""
     path = Path(run_dir) / "result.npz"
-    if not path.is_file():
-        return False
-    with np.load(path) as data:
-        return "pose" in data.files and data["pose"].ndim == 2 and data["pose"].shape[1] == 6
+    return path.is_file() and Result.load(path).space is SPACE
 
 
 class SpatialFrames:
@@ -52,10 +51,8 @@ class SpatialFrames:
         if not is_spatial_run(run_dir):
             raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
                               "write one with `cdpr run SPATIAL-SCENE --out DIR`")
-        with np.load(run_dir / "result.npz") as data:
-            self.times, self.pose, self.reference = data["time"], data["pose"], data["reference"]
-            cables = sorted((k for k in data.files if k.startswith("nodes_")), key=lambda k: int(k.split("_")[1]))
-            self.nodes = [data[k] for k in cables]
+        result = Result.load(run_dir)
+        self.times, self.pose, self.reference, self.nodes = result.time, result.pose, result.reference, result.nodes
         summary = run_dir / "summary.json"
         self.name = json.loads(summary.read_text()).get("scene", run_dir.name) if summary.is_file() else run_dir.name
         self.size = (int(size[0]), int(size[1]))

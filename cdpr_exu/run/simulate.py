@@ -311,8 +311,8 @@ class _Recorder:
                 depth.append(np.zeros(k))
         reference = scene.trajectory.pose(times) if k else np.zeros((0, 3))
         return Result(
-            scene_name=scene.name, controller=controller_name, time=times, platform_pose=pose,
-            platform_velocity=velocity, reference_pose=np.atleast_2d(reference).reshape(-1, 3),
+            scene_name=scene.name, controller=controller_name, dimension=scene.space.dimension, time=times,
+            pose=pose, velocity=velocity, reference=np.atleast_2d(reference).reshape(-1, 3),
             nodes=nodes, node_velocities=node_velocities, tensions=tensions, paid_out=self.paid_out[:k],
             pulley_penetration=np.column_stack(depth) if depth else np.zeros((k, 0)),
         )
@@ -480,7 +480,11 @@ class _Stepper:
 def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
              progress: bool | Callable[[float, float], None] = False,
              sparse_jacobian: bool | None = None) -> Result:
-    """Simulate ``scene`` under ``controller`` (default: ideal inverse kinematics).
+    """Simulate ``scene``, planar or spatial, under ``controller`` (default: ideal inverse kinematics).
+
+    The one entry for both dimensions: the scene's space picks its run loop (:data:`RUNS`:
+    :func:`simulate_planar`, :func:`cdpr_exu.run.spatial_run.simulate_spatial`), and both return the
+    one :class:`~cdpr_exu.results.result.Result`.
 
     Parameters
     ----------
@@ -493,8 +497,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         True shows a progress bar (simulated time, ratio to real time); a callable
         is called as ``progress(t, wall_time)`` about 100 times per run.
     sparse_jacobian : bool, optional
-        Hand Exudyn the cables' Jacobian as sparse triplets (True) or a dense matrix
-        (False); default: sparse for fine cables (see :func:`cdpr_exu.builder.model.build_model`).
+        Planar runs: hand Exudyn the cables' Jacobian as sparse triplets (True) or a dense
+        matrix (False); default: sparse for fine cables (see :func:`cdpr_exu.builder.model.build_model`).
 
     Returns
     -------
@@ -502,12 +506,47 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
 
     Raises
     ------
-    UnreachableError
-        Before the run, if the reference leaves the workspace.
+    SceneError, UnreachableError
+        Before the run, if the scene has no reference or it leaves the workspace.
     SolverFailure
         If the solver fails; ``.time`` and ``.partial_result`` say when and what was
         computed up to then.
     """
+    return _runs()[scene.space][1](scene, controller, solution_file=solution_file, progress=progress,
+                                   sparse_jacobian=sparse_jacobian)
+
+
+def check_runnable(scene: Scene) -> None:
+    """Refuse a scene :func:`simulate` cannot run, before anything is built or written (``cdpr run`` checks
+    before it writes): no reference, or one the cables cannot follow (by the scene's space, :data:`RUNS`).
+
+    Raises
+    ------
+    SceneError, UnreachableError
+    """
+    _runs()[scene.space][0](scene)
+
+
+def _runs() -> dict:
+    """:data:`RUNS`, imported on first use (the spatial run loop imports this module's helpers)."""
+    if not RUNS:
+        from cdpr_exu.run import spatial_run
+        from cdpr_exu.space import PLANE, SPACE
+        from cdpr_exu.statics.workspace import check_reference
+
+        RUNS.update({PLANE: (check_reference, simulate_planar),
+                     SPACE: (spatial_run.check_runnable, spatial_run.simulate_spatial)})
+    return RUNS
+
+
+#: The check before a run and the run loop, by space: (check(scene), run(scene, controller, **options)).
+RUNS: dict = {}
+
+
+def simulate_planar(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
+                    progress: bool | Callable[[float, float], None] = False,
+                    sparse_jacobian: bool | None = None) -> Result:
+    """The planar run loop behind :func:`simulate` (its parameters and errors)."""
     controller = controller or IdealIKController()
     model = build_model(scene, sparse_jacobian=sparse_jacobian)
 
@@ -570,10 +609,10 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     last_time = float(result.time[-1]) if len(result.time) else 0.0
-    if failure is None and (not np.all(np.isfinite(result.platform_pose)) or len(result.time) < len(recorder.output_times)):
+    if failure is None and (not np.all(np.isfinite(result.pose)) or len(result.time) < len(recorder.output_times)):
         failure = "the solution contains NaN or stopped before the end time"
     if failure is not None:
-        finite = np.all(np.isfinite(result.platform_pose), axis=1) if len(result.time) else np.zeros(0, bool)
+        finite = np.all(np.isfinite(result.pose), axis=1) if len(result.time) else np.zeros(0, bool)
         last_time = float(result.time[finite][-1]) if finite.any() else 0.0
         result.status = f"failed: {failure}"
         result.failure_time = last_time

@@ -1,0 +1,75 @@
+"""One Result for planar and spatial runs (issue 24, step 3): the dimension is data, the summary's figures
+are named from the Space's labels, one save/load, and the safety figures (issue 23 follow-up) start
+after the initial condition."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cdpr_exu.results.result import LEFT_OUT, Result
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.scenes.scene import load_scene
+from cdpr_exu.space import PLANE, SPACE
+
+#: A short run of each dimension: the slow paper circle (planar, started smoothly: its cables stay taut)
+#: and CoGiRo (spatial), 0.3 s.
+SCENES = {2: "paper-circle-slow", 3: "spatial-cogiro"}
+
+
+@pytest.fixture(scope="module", params=[2, 3], ids=["planar", "spatial"])
+def run(request):
+    scene = load_scene(SCENES[request.param])
+    return simulate(scene.with_changes(solver=replace(scene.solver, end_time=0.3)))
+
+
+def test_a_run_of_either_dimension_is_one_result_type_with_its_space_as_data(run):
+    space = PLANE if run.dimension == 2 else SPACE
+    assert type(run) is Result and run.space is space and run.labels == space.pose_labels
+    n = len(run.time)
+    assert run.pose.shape == run.reference.shape == (n, space.pose_size)
+    assert run.position.shape == run.position_error.shape == (n, space.position_size)
+    assert all(nodes.shape[0] == n and nodes.shape[2] == space.dimension for nodes in run.nodes)
+    np.testing.assert_array_equal(run.position_error, (run.pose - run.reference)[:, :space.position_size])
+
+
+def test_save_and_load_give_back_every_array_and_the_dimension(run, tmp_path):
+    written = run.save(tmp_path / "run", after=0.1)
+    loaded = Result.load(written["npz"].parent)
+    assert (loaded.scene_name, loaded.controller, loaded.dimension, loaded.status, loaded.steps) == (
+        run.scene_name, run.controller, run.dimension, run.status, run.steps)
+    for name in ("time", "pose", "reference", "paid_out", "velocity", "pulley_penetration", "winch_reservoir"):
+        mine, theirs = getattr(run, name), getattr(loaded, name)
+        assert (mine is None) == (theirs is None), name
+        if mine is not None:
+            np.testing.assert_array_equal(theirs, mine, err_msg=name)
+    for mine, theirs in zip(run.nodes + run.tensions, loaded.nodes + loaded.tensions):
+        np.testing.assert_array_equal(theirs, mine)
+    # the same figures from the file as from the run (the wall time lives in timing.json)
+    summary = {k: v for k, v in run.summary(0.1).items() if k not in ("wall_time_s", "real_time_factor")}
+    assert {k: loaded.summary(0.1)[k] for k in summary} == summary
+    written_summary = json.loads(written["summary"].read_text())
+    assert written_summary["after_start_up"]["errors_measured_after_s"] == 0.1
+    header = written["csv"].read_text().splitlines()[0]
+    assert header.count("_ref_") == run.space.pose_size  # one reference column per pose entry
+
+
+def test_the_summary_names_its_figures_from_the_space_labels(run):
+    space, summary = run.space, run.summary(0.1)
+    mask = run.time >= 0.1
+    error = run.position_error[mask]
+    for k, axis in enumerate(space.position_labels):
+        assert summary[f"max_abs_error_{axis}_m"] == np.abs(error[:, k]).max()
+    assert summary["min_error_z_m"] == error[:, space.vertical].min()
+    assert summary["max_error_z_m"] == error[:, space.vertical].max()
+    assert summary["max_position_error_m"] == np.linalg.norm(error, axis=1).max()
+    assert summary["max_abs_rotation_deg"] == pytest.approx(
+        np.degrees(np.linalg.norm(run.pose[mask, space.position_size:], axis=1)).max(), rel=1e-12)
+    # every error figure is measured after the window; planar summaries keep their committed layout
+    assert set(run.error_figures) <= set(summary)
+    assert all(key not in summary for key in LEFT_OUT[space])
+    assert ("dimension" in summary) == (space is SPACE) and ("max_rotation_error_deg" in summary) == (space is SPACE)
+    assert summary["errors_measured_after_s"] == 0.1
