@@ -73,3 +73,38 @@ def test_the_summary_names_its_figures_from_the_space_labels(run):
     assert all(key not in summary for key in LEFT_OUT[space])
     assert ("dimension" in summary) == (space is SPACE) and ("max_rotation_error_deg" in summary) == (space is SPACE)
     assert summary["errors_measured_after_s"] == 0.1
+
+
+class _RateSpy:
+    """Ideal IK that records the winch rates it is given and the rates it commands."""
+
+    name, uses_pose, uses_tension = "spy", False, False
+
+    def __init__(self):
+        from controllers.ideal_ik import IdealIKController
+
+        self.inner, self.seen, self.sent = IdealIKController(), [], []
+
+    def reset(self, scene, initial_paid_out):
+        self.inner.reset(scene, initial_paid_out)
+
+    def command(self, measurement):
+        self.seen.append(np.array(measurement.paid_out_rate))
+        command = self.inner.command(measurement)
+        self.sent.append(np.array(command.paid_out_rate))
+        return command
+
+
+@pytest.mark.parametrize("dimension", [2, 3], ids=["planar", "spatial"])
+def test_the_controller_is_given_the_winches_rate_in_both_dimensions(dimension):
+    """Issue 24: Measurement.paid_out_rate is the winches' rate on spatial runs too (it was zero there):
+    the rate of the last command (the ideal IK's commands start where the winches are, so the run's
+    smooth start passes them on unchanged), zero before the first."""
+    scene = load_scene(SCENES[dimension])
+    spy = _RateSpy()
+    simulate(scene.with_changes(solver=replace(scene.solver, end_time=0.3)), spy)
+    # seen[0]: the smooth start's command at reset; seen[1]: the run's first step, before any command
+    assert not spy.seen[1].any() and len(spy.seen) > 20
+    for k in range(2, len(spy.seen)):
+        np.testing.assert_array_equal(spy.seen[k], spy.sent[k - 1])
+    assert max(np.abs(rate).max() for rate in spy.seen) > 1e-3  # the circle's winches move [m/s]

@@ -193,6 +193,7 @@ class _SpatialWinches:
         self.n = scene.cables[0].n_elements
         self.gravity = scene.gravity if (scene.effects.gravity and scene.effects.cable_mass) else 0.0
         self.applied = np.array(lengths, dtype=float)
+        self.rate = np.zeros(len(self.applied))  # the winches' rate [m/s]: the last command's, as planar runs
 
     def set_lengths(self, lengths: np.ndarray, rates: np.ndarray) -> None:
         """Give every cable the paid-out length ``lengths`` (m,) [m], changing at ``rates`` (m,) [m/s].
@@ -206,6 +207,7 @@ class _SpatialWinches:
         constant on a CoGiRo cable paid out at 0.25 m/s pulls with 740 N).
         """
         mbs, items = self.mbs, self.items
+        self.rate = np.array(rates, dtype=float)
         for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
             if items.has_swivel(i):  # the winch end moves along the swivel axis: up when paying out
                 if length != self.applied[i]:
@@ -415,10 +417,10 @@ def simulate_spatial(scene: Scene, controller: Controller | None = None, progres
     def measurement(t: float) -> Measurement:
         """What the controller may see when asked for the command at ``t`` [s]."""
         if not (controller.uses_pose or controller.uses_tension):
-            return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)))
+            return Measurement(t, winches.applied.copy(), winches.rate.copy())
         pose, velocity = measured_state()
         tensions = measured_tensions() if controller.uses_tension else None
-        return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)), pose, velocity, tensions,
+        return Measurement(t, winches.applied.copy(), winches.rate.copy(), pose, velocity, tensions,
                            state_time=state["step_start"])
 
     def record(t: float) -> None:
