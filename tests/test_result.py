@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.results.result import LEFT_OUT, Result
+from cdpr_exu.results.result import LEFT_OUT, Result, safety_figures
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.space import PLANE, SPACE
@@ -73,6 +73,51 @@ def test_the_summary_names_its_figures_from_the_space_labels(run):
     assert all(key not in summary for key in LEFT_OUT[space])
     assert ("dimension" in summary) == (space is SPACE) and ("max_rotation_error_deg" in summary) == (space is SPACE)
     assert summary["errors_measured_after_s"] == 0.1
+
+
+def test_the_safety_figures_start_after_the_initial_condition(run):
+    """Issue 23 follow-up: a planar run starts from straight unstretched cables whose every element
+    carries nothing at t = 0 (0 N, round-off of 1e-30 N); the lowest tension and the slack time are the
+    run's, after it (measured 16.2 N on the slow circle's first second)."""
+    summary = run.summary()
+    later = run.time > 0.0
+    lowest = [float(t[later].min()) for t in run.tensions]
+    assert summary["min_tension_per_cable_N"] == lowest and summary["min_element_tension_N"] == min(lowest)
+    if run.space is PLANE:  # the paper circle's cables carry nothing at t = 0, and something at once after
+        assert all(t[0].min() == 0.0 and t[0].max() < 1e-20 for t in run.tensions)
+        assert min(lowest) > 0.0 and summary["slack_time_per_cable_s"] == [0.0, 0.0]
+    assert not summary["elements_pushed"] and summary["warnings"] == []
+
+
+def test_compression_in_the_initial_state_is_still_flagged_and_said_to_be_there():
+    """Only the lowest tension and the slack time skip t = 0: an element that pushes in the state a run
+    starts from (a spatial start over bent chains does, issue 23.1) is reported, and the warning says
+    it is the initial state."""
+    times = np.array([0.0, 0.1, 0.2])
+    tensions = [np.array([[-3.0, 2.0], [1.0, 2.0], [1.5, 2.5]]), np.array([[4.0], [5.0], [6.0]])]
+    figures = safety_figures(times, tensions)
+    assert figures["elements_pushed"] and figures["min_element_tension_N"] == 1.0
+    assert figures["min_tension_per_cable_N"] == [1.0, 5.0] and figures["slack_time_per_cable_s"] == [0.0, 0.0]
+    (warning,) = figures["warnings"]
+    assert "lowest tension -3 N, cable 1 at t = 0.0000 s" in warning and "in the initial state, at t = 0 only" in warning
+    tensions[0][2, 0] = -1.0  # pushing later too: the initial state is named, not "only"
+    (warning,) = safety_figures(times, tensions)["warnings"]
+    assert "in the initial state, at t = 0, where" in warning and "t = 0 only" not in warning
+
+
+def test_a_spatial_start_with_a_compressed_element_is_flagged():
+    """The coarse four-cable robot held at its catenary start with spring elements: the lowest elements of
+    cables 2 and 4 are compressed at t = 0 (-0.1 N and -4.86 N measured, tests/test_spatial_run.py). The run is
+    flagged, and the warning says the compression is in the initial state."""
+    from test_spatial_run import pushing_four_cable
+
+    result = simulate(pushing_four_cable(end_time=0.2))
+    summary = result.summary()
+    assert summary["elements_pushed"] and min(t[0].min() for t in result.tensions) < -1.0
+    (warning,) = summary["warnings"]
+    assert "cable 4 at t = 0.0000 s; first push at t = 0.0000 s; in the initial state, at t = 0" in warning
+    later = result.time > 0.0
+    assert summary["min_element_tension_N"] == min(t[later].min() for t in result.tensions)
 
 
 class _RateSpy:

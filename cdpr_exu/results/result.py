@@ -329,7 +329,7 @@ def _nan_min(values) -> float | None:
 
 def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = None,
                    highest_exit: float | None = None, limits=None) -> dict[str, Any]:
-    """What a run did that a real robot could not, over all its samples (the start included).
+    """What a run did that a real robot could not, over its samples.
 
     One computation for planar and spatial summaries: the element tensions, each cable's
     slack time, elements that pushed (a negative tension: the lumped cable carried
@@ -337,6 +337,13 @@ def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = Non
     above its highest exit (every cable then pulls it down: only pushing cables could
     hold it there). Never limited to an error window: a run shorter than the window, or
     a jolt at its start, is reported all the same.
+
+    The lowest tensions and the slack times cover the samples after t = 0: the sample at
+    t = 0 is the initial condition, not something the run did (a planar run starts from
+    straight unstretched cables, which carry nothing there (0 N to round-off): every run would read 0 N and
+    one more output period of slack). Pushing, the largest tension, a platform above its
+    exits and the tension limits cover every sample, t = 0 included: the warning says when
+    the compression is in the initial state.
 
     Parameters
     ----------
@@ -360,17 +367,23 @@ def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = Non
     """
     times = np.asarray(times, dtype=float)
     tensions = [np.asarray(t, dtype=float) for t in tensions]
-    lowest = [_nan_min(t) for t in tensions]
+    later = times > 0.0  # after the initial condition
+    lowest = [_nan_min(t[later]) for t in tensions]
     known = [value for value in lowest if value is not None]
-    pushed = bool(known) and min(known) < 0.0
+    everywhere = [_nan_min(t) for t in tensions]  # t = 0 included
+    pushed_at = [value for value in everywhere if value is not None]
+    pushed = bool(pushed_at) and min(pushed_at) < 0.0
     warnings_ = []
     if pushed:
-        cable = int(np.argmin([np.inf if value is None else value for value in lowest]))
+        cable = int(np.argmin([np.inf if value is None else value for value in everywhere]))
         series = tensions[cable].reshape(len(times), -1)
         per_sample = np.min(np.where(np.isfinite(series), series, np.inf), axis=1)
-        warnings_.append(f"elements pushed (lowest tension {min(known):.4g} N, cable {cable + 1} at "
+        pushing = per_sample < 0.0
+        initial = "" if later[0] or not pushing[0] else (
+            "; in the initial state, at t = 0" + ("" if pushing[later].any() else " only") + ", where the run starts from")
+        warnings_.append(f"elements pushed (lowest tension {min(pushed_at):.4g} N, cable {cable + 1} at "
                          f"t = {times[int(np.argmin(per_sample))]:.4f} s; first push at "
-                         f"t = {times[int(np.argmax(per_sample < 0.0))]:.4f} s): the lumped cable carried compression, "
+                         f"t = {times[int(np.argmax(pushing))]:.4f} s{initial}): the lumped cable carried compression, "
                          "which a real cable cannot; effects.slack = true makes the elements tension-only")
     above = None
     if heights is not None and highest_exit is not None and len(times):
@@ -385,7 +398,7 @@ def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = Non
         "min_element_tension_N": min(known) if known else None,
         "max_element_tension_N": _nan_max(np.concatenate([t.ravel() for t in tensions])) if tensions else None,
         "min_tension_per_cable_N": lowest,
-        "slack_time_per_cable_s": [slack_time(times, t) for t in tensions],
+        "slack_time_per_cable_s": [slack_time(times[later], t[later]) for t in tensions],
         "elements_pushed": pushed,
         "platform_above_exits": above,
         "highest_exit_z_m": highest_exit,
