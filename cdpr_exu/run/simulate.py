@@ -9,10 +9,7 @@ carries the result up to that time.
 
 from __future__ import annotations
 
-import contextlib
 import math
-import signal
-import threading
 import time as _time
 from pathlib import Path
 from typing import Callable
@@ -28,101 +25,13 @@ from cdpr_exu.core.errors import RunInterrupted, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
 from cdpr_exu.results.result import Result
+from cdpr_exu.run.solver import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
+                                  solver_settings)
+from cdpr_exu.run import spatial_run
 from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.space import PLANE, SPACE
+from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.builder.winch import RopeReservoir, servo_force, set_paid_out_length
-
-
-@contextlib.contextmanager
-def quiet_exudyn():
-    """Keep Exudyn's own console messages (failure banners, allocation warnings) to itself.
-
-    The project reports failures in its own words; Exudyn's banner ("DYNAMIC SOLVER
-    FAILED ... use showHints=True") and its memory-allocation warning would only
-    confuse. Both go through ``exudyn.Print``, which ``exu.config.printToConsole``
-    switches off; the setting is restored afterwards.
-    """
-    before = exu.config.printToConsole
-    exu.config.printToConsole = False
-    try:
-        yield
-    finally:
-        exu.config.printToConsole = before
-
-
-@contextlib.contextmanager
-def interrupt_flag():
-    """While active, Ctrl-C (SIGINT) sets ``flag["interrupted"]`` instead of raising.
-
-    The solver's post-step function checks the flag and ends the time integration
-    cleanly, so the samples computed so far are kept. Outside the main thread (where
-    signal handlers cannot be installed) Ctrl-C behaves as usual.
-    """
-    flag = {"interrupted": False}
-    if threading.current_thread() is not threading.main_thread():
-        yield flag
-        return
-    previous = signal.getsignal(signal.SIGINT)
-
-    def handler(signum, frame):  # noqa: ARG001
-        if flag["interrupted"]:  # a second Ctrl-C: the user insists
-            raise KeyboardInterrupt
-        flag["interrupted"] = True
-
-    signal.signal(signal.SIGINT, handler)
-    try:
-        yield flag
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
-    """Exudyn settings of the implicit run of ``scene``.
-
-    Generalized-alpha with the scene's spectral radius, the sparse LU solver, and
-    (modified) Newton whose Jacobian is updated every step. The contact's own
-    step-size recommendation is switched off (it shrinks steps to about 1e-6 s).
-    """
-    solver = scene.solver
-    settings = exu.SimulationSettings()
-    ti = settings.timeIntegration
-    ti.numberOfSteps = solver.n_steps
-    ti.endTime = solver.end_time
-    ti.verboseMode = 0
-    ti.generalizedAlpha.spectralRadius = solver.spectral_radius
-    # By default start from zero accelerations. The consistent initial acceleration of a
-    # straight cable's free nodes is -g, but the Kelvin-Voigt damping (c_i / m_i ~ 4e6
-    # 1/s) cuts it off within microseconds; carried into the first step it injects a
-    # start-up energy jolt (13 J on the paper scene at 1.7e-2 s steps). Without it the
-    # paper circle's path moves by 0.7 mm and its step-size error halves; a drop from
-    # rest, though, then converges at first order (SolverSpec.initial_accelerations).
-    ti.generalizedAlpha.computeInitialAccelerations = bool(solver.initial_accelerations)
-    ti.newton.useModifiedNewton = solver.newton == "modified"
-    ti.newton.modifiedNewtonJacUpdatePerStep = True
-    ti.newton.maxIterations = solver.max_newton_iterations
-    # 1e-6 by default (SolverSpec.newton_tolerance): Exudyn's 1e-8 buys nothing at the
-    # millimetres asked here, and on stiff massless ropes it sits at the residual's
-    # round-off, so Newton stalls and the adaptive step shrinks up to 350-fold.
-    ti.newton.relativeTolerance = solver.newton_tolerance
-    ti.discontinuous.useRecommendedStepSize = False
-    ti.adaptiveStep = True
-    ti.minimumStepSize = solver.step_size * 1e-4
-    settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-    if solver.integrator == "rk44":
-        # Explicit classical Runge-Kutta at the fixed step (comparison runs only).
-        # SolveDynamic takes the solver type from these settings when called without
-        # solverType; ``timeIntegration.explicitIntegration`` is the deprecated name of
-        # ``timeIntegration.explicit``. The winch's ground-coordinate constraints are
-        # eliminated (``explicit.eliminateConstraints``, Exudyn's default); the
-        # platform joints must be spring-dampers (see cdpr_exu.builder.platform).
-        ti.solverType = exu.DynamicSolverType.RK44
-        ti.adaptiveStep = False
-        ti.explicit.eliminateConstraints = True
-    settings.solution.file.write = solution_file is not None
-    if solution_file is not None:
-        settings.solution.file.name = str(solution_file)
-        settings.solution.file.writePeriod = solver.output_period
-        settings.solution.file.binary = True
-    return settings
 
 
 #: A run stops when an element's strain exceeds this: the lumped model has left the
@@ -230,13 +139,6 @@ class _Monitor:
             return (f"the platform rose above the pulleys at t = {t:.4f} s (z = {pose[1]:.3f} m): only pushing "
                     f"cables can hold it there; the run has diverged (try a smaller step, or effects.slack = true)")
         return None
-
-
-def output_times(end_time: float, output_period: float) -> np.ndarray:
-    """The output times of a run [s], shape (N,): the multiples of ``output_period`` from 0 up to
-    ``end_time`` (none after it; the end time is one of them only when it is a multiple)."""
-    count = int(math.floor(end_time / output_period + 1e-9)) + 1
-    return np.arange(count) * output_period
 
 
 class _Recorder:
@@ -512,8 +414,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         If the solver fails; ``.time`` and ``.partial_result`` say when and what was
         computed up to then.
     """
-    return _runs()[scene.space][1](scene, controller, solution_file=solution_file, progress=progress,
-                                   sparse_jacobian=sparse_jacobian)
+    return RUNS[scene.space][1](scene, controller, solution_file=solution_file, progress=progress,
+                                sparse_jacobian=sparse_jacobian)
 
 
 def check_runnable(scene: Scene) -> None:
@@ -524,23 +426,7 @@ def check_runnable(scene: Scene) -> None:
     ------
     SceneError, UnreachableError
     """
-    _runs()[scene.space][0](scene)
-
-
-def _runs() -> dict:
-    """:data:`RUNS`, imported on first use (the spatial run loop imports this module's helpers)."""
-    if not RUNS:
-        from cdpr_exu.run import spatial_run
-        from cdpr_exu.space import PLANE, SPACE
-        from cdpr_exu.statics.workspace import check_reference
-
-        RUNS.update({PLANE: (check_reference, simulate_planar),
-                     SPACE: (spatial_run.check_runnable, spatial_run.simulate_spatial)})
-    return RUNS
-
-
-#: The check before a run and the run loop, by space: (check(scene), run(scene, controller, **options)).
-RUNS: dict = {}
+    RUNS[scene.space][0](scene)
 
 
 def simulate_planar(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
@@ -623,6 +509,10 @@ def simulate_planar(scene: Scene, controller: Controller | None = None, *, solut
     return result
 
 
+#: The check before a run and the run loop, by space: (check(scene), run(scene, controller, **options)).
+RUNS = {PLANE: (check_reference, simulate_planar), SPACE: (spatial_run.check_runnable, spatial_run.simulate_spatial)}
+
+
 def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
     """The slack-rope reservoir of kinematic winches on tension-only lumped cables (else None)."""
     forces = model.cable_forces
@@ -637,30 +527,6 @@ def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
         axial_rigidity=stiffness[first] * rest[first], damping_rigidity=damping[first] * rest[first],
         rest_length=rest, stiffness=stiffness, damping=damping,
         surplus=np.zeros(m), node_offset=np.zeros(m), max_surplus=np.zeros(m))
-
-
-def solver_report(mbs: exu.MainSystem, message: str) -> str:
-    """What Exudyn's solver said when it stopped: its error string, time, step and residual.
-
-    Exudyn's exception text is only "SolveDynamic terminated"; the stored solver
-    (``mbs.sys["dynamicSolver"]``) knows why.
-    """
-    solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
-    if solver is None:
-        return f"Exudyn's solver stopped: {message}"
-    try:
-        reason = solver.GetErrorString().strip() or message
-        it, conv = solver.it, solver.conv
-        details = [f"at t = {it.currentTime:.6g} s", f"step size then {it.currentStepSize:.3g} s"]
-        if not conv.newtonConverged:
-            details.append(f"Newton residual {conv.residual:.3g}")
-        if conv.linearSolverFailed:
-            details.append(f"the linear solver failed (singular Jacobian, row {conv.linearSolverCausingRow})")
-        if conv.massMatrixNotInvertible:
-            details.append("the mass matrix is not invertible")
-    except Exception:  # noqa: BLE001 - the report must never hide the failure itself
-        return f"Exudyn's solver stopped: {message}"
-    return f"Exudyn's solver stopped ({message}): {reason} ({', '.join(details)})"
 
 
 #: Largest step of Exudyn's explicit RK44 on a real negative eigenvalue, times -lambda
@@ -788,35 +654,3 @@ def _steepest_downward_acceleration(scene: Scene) -> float:
         return float(min(acceleration.min(), 0.0))
     except Exception:  # noqa: BLE001 - a hint must never raise
         return 0.0
-
-
-def progress_reporter(progress, scene: Scene):
-    """A per-step callback that updates a tqdm bar or a user callable ~100 times."""
-    if not progress:
-        return None
-    end = scene.solver.end_time
-    every = end / 100.0
-    last = {"t": -1.0}
-    if callable(progress):
-        def report(t, wall):
-            if t is None or t - last["t"] >= every:
-                last["t"] = end if t is None else t
-                progress(end if t is None else t, wall)
-        return report
-    from tqdm import tqdm
-
-    # disable=None: no bar when the output is not a terminal (logs, CI), so it never floods them.
-    bar = tqdm(total=end, unit="s", disable=None, mininterval=0.25,
-               bar_format="{desc}{percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}{postfix}]",
-               desc=scene.name + " ")
-
-    def report(t, wall):
-        if t is None:
-            bar.close()
-            return
-        if t - last["t"] >= every or t >= end - 1e-9:
-            last["t"] = t
-            bar.n = min(t, end)
-            bar.set_postfix_str(f"{t / wall:.1f}x real time" if wall > 0 else "", refresh=False)
-            bar.refresh()
-    return report

@@ -49,8 +49,8 @@ from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController
 
 from cdpr_exu.results.result import Result
-from cdpr_exu.run.simulate import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
-                                   solver_settings)
+from cdpr_exu.run.solver import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
+                                  solver_settings)
 from cdpr_exu.run.spatial_rest import rest_above_exits
 from cdpr_exu.scenes.scene import Scene, tension_limits
 from cdpr_exu.statics.kinematics import ideal_paid_out
