@@ -19,15 +19,16 @@ from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import OutputError
 from cdpr_exu.results.result import Result
-from cdpr_exu.space import SPACE
+from cdpr_exu.space import SPACE, Space
 
-__all__ = ["is_spatial_run", "SpatialFrames"]
+__all__ = ["run_space", "SpatialFrames"]
 
 
-def is_spatial_run(run_dir: str | Path) -> bool:
-    """True for a folder written by a spatial ``cdpr run`` (a result.npz whose :class:`Result` is in space)."""
+def run_space(run_dir: str | Path) -> Space | None:
+    """The :class:`~cdpr_exu.space.Space` of the run a ``cdpr run`` folder holds (its result.npz's
+    :class:`Result`), or None for a folder without one."""
     path = Path(run_dir) / "result.npz"
-    return path.is_file() and Result.load(path).space is SPACE
+    return Result.load(path).space if path.is_file() else None
 
 
 class SpatialFrames:
@@ -48,7 +49,7 @@ class SpatialFrames:
 
     def __init__(self, run_dir: str | Path, size: tuple[int, int]):
         run_dir = Path(run_dir)
-        if not is_spatial_run(run_dir):
+        if run_space(run_dir) is not SPACE:
             raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
                               "write one with `cdpr run SPATIAL-SCENE --out DIR`")
         result = Result.load(run_dir)
