@@ -83,7 +83,7 @@ def main() -> None:
             reference_pose = np.array([np.interp(result.time, reference["time"], reference["pose"][:, k])
                                        for k in range(2)]).T
             after = result.time >= min(1.0, 0.5 * args.end_time) - 1e-9  # after the start-up (half of a short run)
-            error = float(np.linalg.norm(result.platform_pose[after, :2] - reference_pose[after], axis=1).max())
+            error = float(np.linalg.norm(result.pose[after, :2] - reference_pose[after], axis=1).max())
             speed = result.simulated_time / cpu
             iterations = result.newton_iterations / max(result.steps, 1)
             rows.append((step, n, speed, iterations, error, cpu, "completed"))

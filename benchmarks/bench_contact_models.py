@@ -110,7 +110,7 @@ def main() -> None:
         scene = base.with_changes(effects=replace(base.effects, pulley_contact_model=model))
         with discontinuous_iterations(limit), onset_band(band):
             result, it, cpu = run(scene)
-        pose = result.platform_pose[:, :2]
+        pose = result.pose[:, :2]
         reference = pose if reference is None else reference
         moved = float(np.linalg.norm(pose - reference, axis=1).max())
         steps = max(int(it.currentStepIndex), 1)

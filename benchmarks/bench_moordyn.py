@@ -380,11 +380,11 @@ def run_ours(scene, damping_constant: float, spectral_radius: float, step_size: 
     index = np.rint(times / COUPLING_STEP).astype(int)
     if len(result.time) <= index[-1] or np.max(np.abs(result.time[index] - times)) > 1e-6:
         raise RuntimeError(f"our run (h={solver.step_size:g}) did not record the common output times: {result.status}")
-    x, z, _ = result.platform_pose[-1]
+    x, z, _ = result.pose[-1]
     return {"wall_time": result.wall_time, "position": (x, z), "step": solver.step_size,
             "spectral_radius": spectral_radius, "initial_accelerations": initial_accelerations,
             "newton": result.newton_iterations / max(result.steps, 1),
-            "times": times, "path": result.platform_pose[index, :2]}
+            "times": times, "path": result.pose[index, :2]}
 
 
 def path_differences(run: dict, reference: dict) -> dict:

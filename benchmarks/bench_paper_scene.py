@@ -47,7 +47,7 @@ def main() -> None:
         cpu = time.process_time()
         result = simulate(scene)
         cpu = time.process_time() - cpu
-        poses[step] = (result.time, result.platform_pose)
+        poses[step] = (result.time, result.pose)
         iterations = result.newton_iterations / max(result.steps, 1)
         rows.append({"step_size_s": step, "status": result.status, "cpu_time_s": cpu,
                      "real_time_factor": result.simulated_time / cpu, "newton_iterations_per_step": iterations})

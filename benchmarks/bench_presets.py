@@ -59,8 +59,8 @@ def path_error(result, reference_time, reference_pose) -> tuple[float, float]:
     """Max and RMS platform position error after AFTER s on the reference's times [m]."""
     mask = (reference_time >= AFTER) & (reference_time <= result.time[-1] + 1e-9)
     times = reference_time[mask]
-    x = np.interp(times, result.time, result.platform_pose[:, 0])
-    z = np.interp(times, result.time, result.platform_pose[:, 1])
+    x = np.interp(times, result.time, result.pose[:, 0])
+    z = np.interp(times, result.time, result.pose[:, 1])
     error = np.hypot(x - reference_pose[mask, 0], z - reference_pose[mask, 1])
     return float(error.max()), float(np.sqrt(np.mean(error**2)))
 
@@ -80,7 +80,7 @@ def main() -> None:
         reference_name = "full, 90 elements, 5e-4 s (results/accuracy/paper_circle/reference.npz)"
     else:
         result, _ = run(base, "full", {}, 5e-4, args.end_time)
-        reference_time, reference_pose = result.time, result.platform_pose
+        reference_time, reference_pose = result.time, result.pose
         reference_name = "full, 15 elements, 5e-4 s (step-size error only)"
 
     rows = []

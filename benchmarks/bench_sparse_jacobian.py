@@ -46,7 +46,7 @@ def main() -> None:
                                    solver=replace(paper.solver, end_time=args.end_time))
         sparse, sparse_cpu = _run(scene, True)
         dense, dense_cpu = _run(scene, False)
-        difference = float(np.abs(sparse.platform_pose - dense.platform_pose).max())
+        difference = float(np.abs(sparse.pose - dense.pose).max())
         per_sparse = sparse_cpu / max(sparse.newton_iterations, 1)
         per_dense = dense_cpu / max(dense.newton_iterations, 1)
         rows.append((n, per_dense, per_sparse, dense.newton_iterations / max(dense.steps, 1), difference))

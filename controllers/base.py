@@ -40,13 +40,18 @@ class Measurement:
     paid_out : ndarray, shape (m,) [m]
         Current paid-out length of each winch.
     paid_out_rate : ndarray, shape (m,) [m/s]
+        The winches' rate, the same rule on planar and spatial robots: the last command's
+        rate (kinematic winches; zero before the first command), or the drum's measured
+        rate (planar servo winches).
     platform_pose : ndarray, shape (3,) or (6,), or None [m, rad]
         Measured pose, only for controllers with ``uses_pose``: (x, z, rotation) on a
         planar robot; (x, y, z, rotation vector) on a spatial one (the rotation vector
         of the platform's rotation matrix, zero for a point mass).
     platform_velocity : ndarray, shape (3,) or (6,), or None [m/s, rad/s]
-        Its velocity: (vx, vz, angular rate) planar; (vx, vy, vz, angular velocity in
-        the global frame) spatial (the angular velocity, not the rotation vector's rate).
+        Its velocity: (vx, vz, angular rate) planar, the pose's time derivative; (vx, vy,
+        vz, angular velocity in the global frame) spatial, which is *not* the pose's time
+        derivative (the rotation vector's rate, which the spatial trajectories give, is
+        ``J_l(theta)^-1`` times the angular velocity; zero for a point mass).
     cable_tensions : ndarray, shape (m,) or None [N]
         Tension at the platform end of each cable, only for ``uses_tension``.
     state_time : float or None [s]

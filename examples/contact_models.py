@@ -63,7 +63,7 @@ def run(model: str, n_elements: int) -> dict:
             "newton_per_step": result.newton_iterations / max(result.steps, 1),
             "deepest_element_in_pulley_mm": 1000 * float(depth),
             "min_tension_N": float(min(t.min() for t in result.tensions)),
-            "_time": result.time, "_pose": result.platform_pose}
+            "_time": result.time, "_pose": result.pose}
 
 
 def main() -> None:

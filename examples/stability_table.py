@@ -142,7 +142,7 @@ def held_scene(name: str, step: float, end_time: float = RUN_TIME, output_period
 
 
 def finite(result) -> bool:
-    return all(np.all(np.isfinite(a)) for a in [result.platform_pose, result.platform_velocity,
+    return all(np.all(np.isfinite(a)) for a in [result.pose, result.velocity,
                                                  *result.nodes, *result.tensions])
 
 
@@ -172,8 +172,8 @@ def pose_deviation(result, reference) -> tuple[float, float]:
     """Largest position [m] and rotation [rad] difference from the reference, interpolated in time."""
     positions, rotation = 0.0, 0.0
     for k in range(3):
-        ref = np.interp(result.time, reference.time, reference.platform_pose[:, k])
-        diff = np.abs(result.platform_pose[:, k] - ref)
+        ref = np.interp(result.time, reference.time, reference.pose[:, k])
+        diff = np.abs(result.pose[:, k] - ref)
         if k < 2:
             positions = max(positions, float(diff.max()))
         else:
@@ -276,9 +276,9 @@ def explicit_ladder(name: str) -> dict:
             implicit, _, wall = attempt(held_scene(name, reference_step, end_time=end, output_period=end / 10))
             total += wall
             deviation = math.inf if implicit is None else float(
-                np.abs(result.platform_pose[:, :2] - implicit.platform_pose[:, :2]).max())
+                np.abs(result.pose[:, :2] - implicit.pose[:, :2]).max())
             moved = 0.0 if implicit is None else float(
-                np.abs(implicit.platform_pose[:, :2] - implicit.platform_pose[0, :2]).max())
+                np.abs(implicit.pose[:, :2] - implicit.pose[0, :2]).max())
             tolerance = max(EXPLICIT_TOLERANCE, 0.01 * moved)
             if rise > ENERGY_TOLERANCE:
                 why = f"energy rises by {rise:.3g} J"

@@ -20,6 +20,7 @@ from cdpr_exu.studies.accuracy import (ACCURACY_FILES, FULL_GRID, QUICK_GRID, Co
                                pareto_front)
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.output import ZIP_DATE
+from cdpr_exu.space import SPACE
 
 
 @pytest.fixture(scope="module")
@@ -208,7 +209,7 @@ def test_spatial_compare_measures_the_3d_path_and_the_rotation_angle():
     run = {"time": times, "pose": pose + np.array([0.003, 0.004, 0.012, 0.0, 0.0, 0.02]),
            "end_tensions": np.zeros((21, 4)), "speed": np.zeros(21)}
     reference = {"time": times, "pose": pose, "end_tensions": np.zeros((21, 4)), "speed": np.zeros(21)}
-    errors = compare(run, reference, "path", after=1.0)
+    errors = compare(run, reference, "path", after=1.0, space=SPACE)
     assert errors["position_error_max_m"] == pytest.approx(0.013)
     assert errors["rotation_error_max_deg"] == pytest.approx(math.degrees(0.02))
 

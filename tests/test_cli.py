@@ -33,9 +33,9 @@ def test_run_writes_result_summary_solution_and_figures(tmp_path):
                  "path.png", "rotation.png", "errors.png", "tensions.png"):
         assert (out / name).stat().st_size > 0, name
     result = Result.load(out)
-    assert result.platform_pose.shape == (31, 3) and np.all(np.isfinite(result.platform_pose))
+    assert result.pose.shape == (31, 3) and np.all(np.isfinite(result.pose))
     pose = np.loadtxt(out / "pose.csv", delimiter=",", skiprows=1)
-    np.testing.assert_allclose(pose[:, 1:4], result.platform_pose, rtol=1e-8, atol=1e-12)
+    np.testing.assert_allclose(pose[:, 1:4], result.pose, rtol=1e-8, atol=1e-12)
 
 
 def test_bad_input_exits_with_the_field_named_and_no_traceback(tmp_path):

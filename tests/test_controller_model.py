@@ -75,7 +75,7 @@ def test_the_run_hands_the_controllers_their_model_not_the_plant():
     # The heavier platform stretches the cables: knowing it, the controller hauls in less
     # (measured 0.014 mm at 0.05 s, inside the start-up blend; 3.4 mm at 1 s); the plants differ.
     assert np.abs(runs[2].paid_out - runs[0].paid_out).max() > 1e-5
-    assert not np.allclose(runs[0].platform_pose, runs[1].platform_pose, atol=1e-7, rtol=0)
+    assert not np.allclose(runs[0].pose, runs[1].pose, atol=1e-7, rtol=0)
 
 
 def test_the_plant_hangs_where_the_catenary_statics_of_its_own_parameters_put_it():
@@ -89,7 +89,7 @@ def test_the_plant_hangs_where_the_catenary_statics_of_its_own_parameters_put_it
     lengths = [c.unstrained_length for c in plant.cables]
     predicted = (solve_statics(catenary_platform(plant), lengths).position
                  - solve_statics(catenary_platform(model), lengths).position)
-    simulated = simulate(plant).platform_pose[-1, :2] - simulate(model).platform_pose[-1, :2]
+    simulated = simulate(plant).pose[-1, :2] - simulate(model).pose[-1, :2]
     assert predicted[1] < -5e-3  # the plant hangs lower by millimetres
     # The lumped cables miss the catenary's sag by a lumping error that falls as 1/n^2:
     # measured 0.24 mm with 6 elements, 0.061 mm with 12, 0.015 mm with 24.

@@ -195,7 +195,6 @@ def test_the_closed_loop_keeps_the_winch_commands_smooth_where_the_unfiltered_lo
     slack winch element snapped taut and the solver failed at 1.21 s. The filtered loop
     runs through, with commands as smooth as the reference's (3.2 and 6.7 m/s^2 measured
     on the 10 ms output grid; the circle itself needs about 1 m/s^2)."""
-    from cdpr_exu.results.result import slack_time
     from cdpr_exu.run.simulate import simulate
 
     scene = SMOOTH.with_changes(solver=replace(SMOOTH.solver, end_time=1.6))

@@ -138,7 +138,7 @@ def test_each_preset_runs_the_paper_scene_for_half_a_second(paper_scene, preset,
                                      solver=replace(paper_scene.solver, end_time=0.5))
     result = simulate(scene)
     assert result.status == "completed"
-    assert np.all(np.isfinite(result.platform_pose))
+    assert np.all(np.isfinite(result.pose))
     # in half a second the platform has started along the circle, not left it by metres
     assert np.abs(result.error[:, :2]).max() < 0.2
 
@@ -160,7 +160,7 @@ def test_very_stiff_elastic_cables_follow_the_ideal_cables_on_the_paper_circle(p
     for factor in (1.0, 100.0):
         scene = _with_stiffness(paper_scene, factor).with_changes(effects=Effects.from_preset("elastic"),
                                                                   solver=solver)
-        paths[factor] = np.linalg.norm(simulate(scene).platform_pose[:, :2] - ideal.platform_pose[:, :2], axis=1)
+        paths[factor] = np.linalg.norm(simulate(scene).pose[:, :2] - ideal.pose[:, :2], axis=1)
     # Measured over 3 s: 1.5 mm at the paper's E, 0.05 mm at 100 E (the ideal rope is
     # 1000 EA, not rigid). The stiffer the cable, the closer to the ideal one.
     assert paths[100.0].max() < 0.2e-3
@@ -189,7 +189,7 @@ def test_very_stiff_massless_cables_hold_the_platform_at_its_ideal_inverse_kinem
         result = simulate(_with_stiffness(scene, factor).with_changes(effects=Effects.from_preset(preset)))
         rigidity = cable.axial_rigidity * factor * (1000.0 if preset == "ideal" else 1.0)
         drop = tension * (cable.unstrained_length + MIN_WINCH_SEGMENT) / rigidity / math.sin(math.pi / 4)
-        x, z, _ = result.platform_pose[-1]
+        x, z, _ = result.pose[-1]
         assert x == pytest.approx(0.0, abs=1e-9)
         # 1 %: the cables turn slightly as they stretch, and the creep's last 3e-4
         assert -1.75 - z == pytest.approx(drop, rel=0.01)

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import math
 import re
 import time
 import tomllib
@@ -658,7 +657,7 @@ def test_malformed_scenes_are_refused_or_run_without_crash_hang_or_nan(data):
         return
     # At most 500 steps of at most 2 x 301 nodes: seconds, not minutes.
     assert time.perf_counter() - start < 120.0
-    for series in [result.platform_pose, result.platform_velocity, *result.nodes, *result.tensions]:
+    for series in [result.pose, result.velocity, *result.nodes, *result.tensions]:
         assert np.all(np.isfinite(series))
 
 

@@ -46,7 +46,7 @@ def test_learned_commands_replayed_on_the_model_reproduce_its_last_trial():
     learning, on_plant = model_feed_forward(MODEL, PLANT, rule=StoppingRule(max_trials=2, min_improvement=0.0))
     replay = simulate(MODEL, ReplayController(learning.table))
     # The solver is deterministic: the same commands on the same scene give the same run (to round-off).
-    np.testing.assert_allclose(replay.platform_pose, learning.result.platform_pose, atol=1e-9)
+    np.testing.assert_allclose(replay.pose, learning.result.pose, atol=1e-9)
     assert replay.summary(after=1.0)["max_position_error_m"] == pytest.approx(
         learning.trials[-1].max_position_error_m, abs=1e-9)
     # On the plant the model's commands still beat the ideal IK (measured 26.6 mm against the model's first 71.9 mm).

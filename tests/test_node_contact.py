@@ -155,7 +155,7 @@ def test_paper_circle_with_smooth_contact_follows_exudyns_node_contact():
     solver = replace(PAPER.solver, end_time=1.0, step_size=2.5e-4)
     smooth = simulate(smooth_scene().with_changes(solver=solver))
     sharp = simulate(PAPER.with_changes(solver=solver))
-    difference = np.linalg.norm(smooth.platform_pose[:, :2] - sharp.platform_pose[:, :2], axis=1).max()
+    difference = np.linalg.norm(smooth.pose[:, :2] - sharp.pose[:, :2], axis=1).max()
     # measured 0.110 mm (0.083 mm with the law's own Jacobian for damper-cut elements,
     # axial.CutSlopes); bound: the sum of the two step errors, 0.12 + 0.10 mm
     assert difference < 2.2e-4

@@ -34,9 +34,9 @@ def _cut_short(result, keep_fraction=0.5, nan_rows=5):
     return replace(
         result,
         time=np.array(result.time[:keep], dtype=float),
-        platform_pose=head(result.platform_pose),
-        platform_velocity=head(result.platform_velocity),
-        reference_pose=np.array(result.reference_pose[:keep], dtype=float),
+        pose=head(result.pose),
+        velocity=head(result.velocity),
+        reference=np.array(result.reference[:keep], dtype=float),
         nodes=[head(a) for a in result.nodes],
         node_velocities=[head(a) for a in result.node_velocities],
         tensions=[head(a) for a in result.tensions],
@@ -84,7 +84,7 @@ def test_overview_returns_every_file_with_its_fixed_name(run, tmp_path):
 
 def test_comparison_writes_paths_and_errors(run, tmp_path):
     scene, result = run
-    shifted = replace(result, platform_pose=result.platform_pose + np.array([0.02, -0.01, 0.0]))
+    shifted = replace(result, pose=result.pose + np.array([0.02, -0.01, 0.0]))
     paths = plots.plot_comparison(scene, {"real": result, "shifted": shifted, "cut": _cut_short(result)}, tmp_path)
     assert [p.name for p in paths] == ["comparison_paths.png", "comparison_errors.png"]
     for path in paths:
@@ -94,7 +94,7 @@ def test_comparison_writes_paths_and_errors(run, tmp_path):
 def test_a_run_cut_short_with_nan_rows_still_plots(run, tmp_path):
     scene, result = run
     partial = _cut_short(result)
-    assert np.isnan(partial.platform_pose[-1]).all()
+    assert np.isnan(partial.pose[-1]).all()
     # Snapshot instants after the end of the data get a "not reached" panel.
     _assert_png(plots.plot_snapshots(scene, partial, tmp_path / "s.png", times=(0, 0.25, 1.0)), min_width=900)
     for path in plots.plot_overview(scene, partial, tmp_path / "overview"):
@@ -104,7 +104,7 @@ def test_a_run_cut_short_with_nan_rows_still_plots(run, tmp_path):
 def test_a_run_with_no_valid_sample_still_plots(run, tmp_path):
     scene, result = run
     empty = _cut_short(result, keep_fraction=0.0, nan_rows=7)
-    assert np.isnan(empty.platform_pose).all()
+    assert np.isnan(empty.pose).all()
     for path in plots.plot_overview(scene, empty, tmp_path):
         _assert_png(path, min_width=300, min_height=200)
 

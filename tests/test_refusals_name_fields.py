@@ -12,7 +12,6 @@ from hypothesis import HealthCheck, given, seed, settings
 
 from cdpr_exu.core.errors import CdprError
 from cdpr_exu.scenes.scene import scene_from_dict
-from cdpr_exu.scenes.scene import scene_from_dict
 from cdpr_exu.statics.workspace import check_reference
 from test_input_validation import malformed_scene_dicts, malformed_spatial_scene_dicts
 

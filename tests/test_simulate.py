@@ -95,7 +95,7 @@ def test_paper_scene_runs_ten_seconds_without_nan(paper_run):
     scene, result = paper_run
     assert result.status == "completed"
     assert result.time[-1] == pytest.approx(scene.solver.end_time)
-    for series in [result.platform_pose, result.platform_velocity, result.pulley_penetration,
+    for series in [result.pose, result.velocity, result.pulley_penetration,
                    *result.nodes, *result.node_velocities, *result.tensions]:
         assert np.all(np.isfinite(series))
 
@@ -194,7 +194,7 @@ def test_solver_failure_keeps_the_result_up_to_the_failure(fault):
     # The time series run from 0 to the failure, on the output grid (each sample up to one
     # step after its output time where the start-up's snap-taut steps were shrunk), and
     # are finite.
-    finite = np.all(np.isfinite(partial.platform_pose), axis=1)
+    finite = np.all(np.isfinite(partial.pose), axis=1)
     assert partial.time[0] == 0.0
     assert partial.time[finite][-1] == pytest.approx(failure.time)
     assert np.sum(finite) >= int(round((fault_time - 0.02) / scene.solver.output_period))
@@ -223,7 +223,7 @@ def test_consistent_initial_accelerations_make_a_drop_from_rest_second_order():
         # would blur the finest step's 1e-6 m error).
         solver = dataclasses.replace(base.solver, end_time=0.4, step_size=step, output_period=4e-3, spectral_radius=1.0,
                                      initial_accelerations=consistent, newton_tolerance=1e-10)
-        return simulate(base.with_changes(solver=solver)).platform_pose[:, :2]
+        return simulate(base.with_changes(solver=solver)).pose[:, :2]
 
     for consistent, lowest_order in ((True, 1.9), (False, 0.9)):
         reference = path(1.25e-4, consistent)
@@ -255,9 +255,9 @@ def test_newton_tolerance_reaches_exudyn_and_moves_the_paper_path_by_less_than_a
         default, reference = simulate(short), simulate(tight)
         # samples lie up to a step after the output times where steps were shrunk: compare
         # the paths at the same instants
-        tight_path = np.column_stack([np.interp(default.time, reference.time, reference.platform_pose[:, k])
+        tight_path = np.column_stack([np.interp(default.time, reference.time, reference.pose[:, k])
                                       for k in (0, 1)])
-        assert np.abs(default.platform_pose[:, :2] - tight_path).max() < bound, preset
+        assert np.abs(default.pose[:, :2] - tight_path).max() < bound, preset
         assert default.newton_iterations < reference.newton_iterations
 
 
@@ -284,6 +284,6 @@ def test_a_controller_is_told_the_time_of_the_pose_it_measures():
     for k, t in enumerate(result.time[1:], start=1):
         rows = np.flatnonzero(np.abs(seen[:, 1] - t) < 1e-9)
         if rows.size:
-            np.testing.assert_array_equal(seen[rows[-1], 2:], result.platform_pose[k])
+            np.testing.assert_array_equal(seen[rows[-1], 2:], result.pose[k])
             checked += 1
     assert checked > 20  # every output time after the start-up steps (30 outputs in 0.3 s)

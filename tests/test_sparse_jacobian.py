@@ -65,7 +65,7 @@ def test_the_sparse_and_the_dense_jacobian_give_the_same_path(slack):
     paths = []
     for sparse in (True, False):
         result = simulate(scene, sparse_jacobian=sparse)
-        paths.append(result.platform_pose)
+        paths.append(result.pose)
         assert result.metadata["item_counts"]["cable_force_objects"] == 1
     # Same Newton iterates up to round-off: measured 1e-14 m at 15 to 240 elements.
     np.testing.assert_allclose(paths[0], paths[1], rtol=0, atol=1e-10)

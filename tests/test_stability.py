@@ -89,7 +89,7 @@ def run(scene: Scene, controller=None) -> tuple[Result, SolverFailure | None]:
 
 
 def assert_finite(result: Result) -> None:
-    for series in [result.platform_pose, result.platform_velocity, result.pulley_penetration,
+    for series in [result.pose, result.velocity, result.pulley_penetration,
                    *result.nodes, *result.node_velocities, *result.tensions]:
         assert np.all(np.isfinite(series))
 
@@ -232,7 +232,7 @@ def test_damping_scaled_by_1e3_gives_a_step_converged_answer():
     assert failure is None, str(failure)
     for result in (coarse, fine):
         assert_plausible(scene, result, max_position_error=None, max_rotation=None)
-    difference = np.abs(coarse.platform_pose - fine.platform_pose).max(axis=0)
+    difference = np.abs(coarse.pose - fine.pose).max(axis=0)
     assert difference[:2].max() < 5e-3
     assert difference[2] < 0.02
 
@@ -335,7 +335,7 @@ def assert_snap_taut_peak_bounded(scene: Scene, result: Result) -> float:
     the speeds the run reached: its damper, d_n A / l0 for the whole cable, at the largest
     relative speed of its ends (platform speed plus winch speed), plus its spring at the
     monitor's strain limit. Returns the peak [N]."""
-    platform_speed = np.linalg.norm(result.platform_velocity[:, :2], axis=1).max()
+    platform_speed = np.linalg.norm(result.velocity[:, :2], axis=1).max()
     winch_speed = np.abs(np.gradient(result.paid_out, result.time, axis=0)).max()
     peak = max(t.max() for t in result.tensions)
     for cable in scene.cables:
@@ -450,7 +450,7 @@ def test_step_size_gives_the_fine_step_answer_or_stops_clearly(step):
     times = np.round(reference.time / 0.02).astype(int)
     mine = np.round(result.time / 0.02).astype(int)
     common = np.intersect1d(times, mine)
-    difference = np.abs(result.platform_pose[np.isin(mine, common)] - reference.platform_pose[np.isin(times, common)])
+    difference = np.abs(result.pose[np.isin(mine, common)] - reference.pose[np.isin(times, common)])
     assert difference[:, :2].max() < 0.01
     assert difference[:, 2].max() < 0.05
 
@@ -504,7 +504,7 @@ def test_newton_failure_mid_run_says_when_what_and_why_and_keeps_a_savable_resul
     with np.load(paths["npz"]) as data:
         np.testing.assert_array_equal(data["time"], partial.time)
         assert data["time"][-1] == pytest.approx(failure.time)
-        np.testing.assert_array_equal(data["platform_pose"], partial.platform_pose)
+        np.testing.assert_array_equal(data["platform_pose"], partial.pose)
         np.testing.assert_array_equal(data["tensions_0"], partial.tensions[0])
         assert np.all(np.isfinite(data["nodes_1"]))
     loaded = Result.load(paths["npz"])
@@ -542,7 +542,7 @@ def test_explicit_rk44_runs_below_its_step_limit_and_matches_the_implicit_solver
     assert_finite(explicit)
     implicit, failure = run(shortened(held, end_time=1e-3, output_period=1e-4, step_size=1e-5))
     assert failure is None, str(failure)
-    assert np.abs(explicit.platform_pose - implicit.platform_pose)[:, :2].max() < 7.8e-6
+    assert np.abs(explicit.pose - implicit.pose)[:, :2].max() < 7.8e-6
 
 
 def test_explicit_rk44_above_its_step_limit_stops_clearly():
@@ -571,5 +571,5 @@ def test_fine_tension_only_cables_start_the_abrupt_circle_at_a_coarse_step():
     result = simulate(fine)
     assert result.time[-1] == pytest.approx(0.1)
     springs = simulate(fine.with_changes(effects=Effects.from_preset("paper")))
-    offset = np.abs(result.platform_pose[:, :2] - springs.platform_pose[:, :2]).max()
+    offset = np.abs(result.pose[:, :2] - springs.pose[:, :2]).max()
     assert offset < 5e-3, offset

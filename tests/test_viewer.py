@@ -55,10 +55,10 @@ def spatial_run_dir(tmp_path_factory) -> Path:
     """A run folder of a small spatial scene over 0.3 s (31 samples), as `cdpr run --out` writes it."""
     from conftest import small_spatial_scene
 
-    from cdpr_exu.cli.run import run_spatial_scene
+    from cdpr_exu.cli.run import run_scene
 
     out = tmp_path_factory.mktemp("spatial") / "small_spatial"
-    run_spatial_scene(small_spatial_scene(END_TIME), out, quiet=True, figures=False)
+    run_scene(small_spatial_scene(END_TIME), out, quiet=True, figures=False)
     return out
 
 
@@ -98,7 +98,7 @@ def test_replayed_platform_pose_matches_the_saved_result(run_dir):
     result = Result.load(run_dir)
     pose = viewer.load_replay(run_dir, decorate=False).positions()["platform"]
     # both are the solver's state at the same output times; only float formatting differs
-    np.testing.assert_allclose(pose, result.platform_pose, atol=1e-9)
+    np.testing.assert_allclose(pose, result.pose, atol=1e-9)
 
 
 def test_solution_of_another_model_is_refused_naming_the_file(run_dir, tmp_path):
@@ -142,8 +142,8 @@ def test_a_spatial_run_writes_scene_pose_csv_and_solution_file_as_every_run(spat
     table = np.loadtxt(spatial_run_dir / "pose.csv", delimiter=",", skiprows=1)
     with np.load(spatial_run_dir / "result.npz") as data:
         np.testing.assert_allclose(table[:, 0], data["time"], rtol=1e-8, atol=1e-12)
-        np.testing.assert_allclose(table[:, 1:7], data["pose"], rtol=1e-8, atol=1e-12)
-        np.testing.assert_allclose(table[:, 7:], data["reference"], rtol=1e-8, atol=1e-12)
+        np.testing.assert_allclose(table[:, 1:7], data["platform_pose"], rtol=1e-8, atol=1e-12)
+        np.testing.assert_allclose(table[:, 7:], data["reference_pose"], rtol=1e-8, atol=1e-12)
 
 
 def test_a_spatial_solution_file_replays_in_the_rebuilt_robot_at_the_recorded_poses(spatial_run_dir):
@@ -154,7 +154,7 @@ def test_a_spatial_solution_file_replays_in_the_rebuilt_robot_at_the_recorded_po
     assert isinstance(replay, viewer.SpatialReplay) and replay.n_rows == EXPECTED_ROWS
     with np.load(spatial_run_dir / "result.npz") as data:
         np.testing.assert_allclose(replay.times, data["time"], atol=1e-9)
-        np.testing.assert_allclose(replay.platform_pose(), data["pose"], atol=1e-9)
+        np.testing.assert_allclose(replay.platform_pose(), data["platform_pose"], atol=1e-9)
 
 
 def test_the_rebuilt_spatial_robot_draws_in_the_views_camera(spatial_run_dir):

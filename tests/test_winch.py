@@ -50,7 +50,7 @@ def test_servo_winch_tracks_the_command_and_matches_the_kinematic_winch():
     lag = np.abs(servo.paid_out - kinematic.paid_out)[servo.time > 0.5]
     assert lag.max() < 5e-3
     # ... so the platform moves as with the exact (kinematic) winch, to 5 mm.
-    difference = np.linalg.norm(servo.platform_pose[:, :2] - kinematic.platform_pose[:, :2], axis=1)
+    difference = np.linalg.norm(servo.pose[:, :2] - kinematic.pose[:, :2], axis=1)
     assert difference.max() < 5e-3
 
 

@@ -128,6 +128,6 @@ def test_massless_ropes_run_to_the_same_path_whatever_n_elements_says(preset):
         scene = low.with_changes(cables=tuple(replace(c, n_elements=n) for c in low.cables))
         result = simulate(scene)
         assert result.status == "completed" and result.time[-1] == pytest.approx(3.0)
-        paths.append(result.platform_pose)
+        paths.append(result.pose)
     np.testing.assert_allclose(paths[0], paths[1], rtol=0.0, atol=1e-12)
     assert paths[0][-1, 1] == pytest.approx(-2.6, abs=2e-3)  # it got there (elastic ropes stretch 0.8 mm)

@@ -79,7 +79,7 @@ from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.core.validation import non_negative, positive, shown
 
 from cdpr_exu.physics import axial_3d
-from cdpr_exu.builder.chain_3d import SpatialChainItems, add_spatial_chain, chain_energy
+from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # the disc and its angle psi
 from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.statics.statics import (PlatformEquilibrium, SuspendedPlatform, chain_element_mass,

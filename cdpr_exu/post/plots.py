@@ -32,11 +32,11 @@ from cdpr_exu.core.errors import CdprError
 from cdpr_exu.core.geometry import anchor_points, rotation_angles_deg
 from cdpr_exu.results.result import Result
 from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.space import PLANE, SPACE
 
 if TYPE_CHECKING:  # pragma: no cover
     from cdpr_exu.run.rest import RestState
     from cdpr_exu.run.spatial_rest import SpatialRest
-    from cdpr_exu.run.spatial_run import SpatialResult
 
 #: Resolution of the written PNGs [dots per inch].
 DPI = 150
@@ -95,7 +95,7 @@ def _cable_color(i: int) -> str:
 def _valid_rows(result: Result) -> np.ndarray:
     """Indices of the samples whose time and platform pose are finite, shape (K,)."""
     time = np.asarray(result.time, dtype=float)
-    pose = np.asarray(result.platform_pose, dtype=float).reshape(len(time), -1)
+    pose = np.asarray(result.pose, dtype=float).reshape(len(time), -1)
     ok = np.isfinite(time) & np.all(np.isfinite(pose), axis=1)
     return np.flatnonzero(ok)
 
@@ -119,7 +119,7 @@ def _reference_path(scene: Scene | None, result: Result | None) -> np.ndarray:
         t = np.linspace(0.0, end, max(200, int(end * 60)))
         return np.asarray(scene.trajectory.pose(t), dtype=float)[:, :2]
     if result is not None:
-        return np.asarray(result.reference_pose, dtype=float)[:, :2]
+        return np.asarray(result.reference, dtype=float)[:, :2]
     return np.zeros((0, 2))
 
 
@@ -144,7 +144,7 @@ def _robot_limits(scene: Scene, result: Result, rows: np.ndarray, margin: float 
         nodes = np.asarray(nodes, dtype=float)[rows].reshape(-1, 2)
         points.append(nodes[np.all(np.isfinite(nodes), axis=1)])
     for k in rows[:: max(1, len(rows) // 50)]:
-        points.append(_platform_corners(scene, np.asarray(result.platform_pose[k], dtype=float)))
+        points.append(_platform_corners(scene, np.asarray(result.pose[k], dtype=float)))
     if len(rows) == 0:
         points.append(_platform_corners(scene, np.asarray(scene.platform.initial_pose, dtype=float)))
     reference = _reference_path(scene, result)
@@ -235,7 +235,7 @@ def _draw_chords(ax, scene: Scene, result: Result, k: int) -> None:
 def _draw_robot(ax, scene: Scene, result: Result, k: int, alpha: float = 1.0,
                 markers: bool = True, zorder: float = 3) -> None:
     """Draw the cables (node polylines) and the platform rectangle at sample ``k``."""
-    pose = np.asarray(result.platform_pose[k], dtype=float)
+    pose = np.asarray(result.pose[k], dtype=float)
     for i, nodes in enumerate(result.nodes):
         xy = np.asarray(nodes[k], dtype=float)
         ax.plot(xy[:, 0], xy[:, 1], color=_cable_color(i), linewidth=1.4, alpha=alpha, zorder=zorder,
@@ -320,7 +320,7 @@ def _snapshot_axes(ax, scene: Scene, result: Result, rows: np.ndarray, t: float,
         ax.set_title(f"t = {t:g} s", fontsize=10)
     else:
         so_far = rows[rows <= k]
-        pose = np.asarray(result.platform_pose, dtype=float)[so_far]
+        pose = np.asarray(result.pose, dtype=float)[so_far]
         ax.plot(pose[:, 0], pose[:, 1], color="black", linewidth=1.0, zorder=2.5)
         _draw_chords(ax, scene, result, k)
         _draw_robot(ax, scene, result, k)
@@ -335,7 +335,7 @@ def _fading_snapshot_axes(ax, scene: Scene, result: Result, times: Sequence[floa
     _draw_pulleys(ax, scene)
     reference = _reference_path(scene, result)
     ax.plot(reference[:, 0], reference[:, 1], zorder=2, **_REFERENCE_STYLE)
-    pose = np.asarray(result.platform_pose, dtype=float)[rows]
+    pose = np.asarray(result.pose, dtype=float)[rows]
     ax.plot(pose[:, 0], pose[:, 1], color="black", linewidth=1.0, zorder=2.5)
     samples = [k for k in (_nearest_row(result, rows, t) for t in times) if k is not None]
     samples = sorted(set(samples))
@@ -358,7 +358,7 @@ def _path_axes(ax, scene: Scene | None, result: Result) -> None:
     reference = _reference_path(scene, result)
     ax.plot(reference[:, 0], reference[:, 1], label="reference", **_REFERENCE_STYLE)
     rows = _valid_rows(result)
-    pose = np.asarray(result.platform_pose, dtype=float)[rows]
+    pose = np.asarray(result.pose, dtype=float)[rows]
     if len(pose):
         ax.plot(pose[:, 0], pose[:, 1], color="tab:blue", linewidth=1.4, label="actual")
         ax.plot(pose[0, 0], pose[0, 1], "o", color="tab:green", markersize=5, label="start", zorder=4)
@@ -378,9 +378,9 @@ def _rotation_axes(ax, scene: Scene | None, result: Result) -> None:
     """Fig. 7b: platform rotation over time [deg]."""
     rows = _valid_rows(result)
     time = np.asarray(result.time, dtype=float)
-    ax.plot(time, np.degrees(np.asarray(result.reference_pose, dtype=float)[:, 2]),
+    ax.plot(time, np.degrees(np.asarray(result.reference, dtype=float)[:, 2]),
             label="reference", **_REFERENCE_STYLE)
-    ax.plot(time[rows], np.degrees(np.asarray(result.platform_pose, dtype=float)[rows, 2]),
+    ax.plot(time[rows], np.degrees(np.asarray(result.pose, dtype=float)[rows, 2]),
             color="tab:blue", linewidth=1.4, label="actual")
     if len(rows) == 0:
         _no_data(ax, "no data")
@@ -395,8 +395,8 @@ def _errors_axes(ax, scene: Scene | None, result: Result) -> None:
     """Fig. 7c: x and z position error over time [cm]."""
     rows = _valid_rows(result)
     time = np.asarray(result.time, dtype=float)[rows]
-    error = 100.0 * (np.asarray(result.platform_pose, dtype=float)[rows, :2]
-                     - np.asarray(result.reference_pose, dtype=float)[rows, :2])
+    error = 100.0 * (np.asarray(result.pose, dtype=float)[rows, :2]
+                     - np.asarray(result.reference, dtype=float)[rows, :2])
     ax.axhline(0.0, color="0.3", linewidth=0.8)
     ax.plot(time, error[:, 0], color="tab:blue", linewidth=1.4, label="x error")
     ax.plot(time, error[:, 1], color="tab:red", linewidth=1.4, label="z error")
@@ -559,9 +559,17 @@ def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
     return save_figure(figure, path)
 
 
-def plot_overview(scene: Scene, result: Result, folder: str | Path,
-                  times: Iterable[float] | None = None) -> list[Path]:
-    """All figures of one run into ``folder`` with fixed names, plus a 2x2 overview.
+def plot_overview(scene: Scene, result: Result, folder: str | Path, times: Iterable[float] | None = None,
+                  after: float = 1.0) -> list[Path]:
+    """The figures of one run, planar or spatial, into ``folder``: the figure functions of the result's
+    space (:data:`OVERVIEWS`): :func:`plot_planar_overview` or :func:`plot_spatial_run` (``overview.png``,
+    its errors marked from ``after`` [s] on). Returns the files written."""
+    return OVERVIEWS[result.space](scene, result, Path(folder), times, after)
+
+
+def plot_planar_overview(scene: Scene, result: Result, folder: str | Path,
+                         times: Iterable[float] | None = None, after: float = 1.0) -> list[Path]:  # noqa: ARG001
+    """All figures of one planar run into ``folder`` with fixed names, plus a 2x2 overview.
 
     Writes ``snapshots.png``, ``path.png``, ``rotation.png``, ``errors.png``,
     ``tensions.png`` and ``overview.png`` (path, rotation, errors and the robot at
@@ -635,7 +643,7 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     ax.plot(reference[:, 0], reference[:, 1], label="reference", **_REFERENCE_STYLE)
     for color, (label, result) in zip(colors, results.items()):
         rows = _valid_rows(result)
-        pose = np.asarray(result.platform_pose, dtype=float)[rows]
+        pose = np.asarray(result.pose, dtype=float)[rows]
         note = " (failed)" if _status_note(result) else ""
         ax.plot(pose[:, 0], pose[:, 1], color=color, linewidth=1.3, label=label + note)
         if note and len(pose):
@@ -652,8 +660,8 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     ax = figure.add_subplot()
     for color, (label, result) in zip(colors, results.items()):
         rows = _valid_rows(result)
-        error = (np.asarray(result.platform_pose, dtype=float)[rows, :2]
-                 - np.asarray(result.reference_pose, dtype=float)[rows, :2])
+        error = (np.asarray(result.pose, dtype=float)[rows, :2]
+                 - np.asarray(result.reference, dtype=float)[rows, :2])
         norm = 100.0 * np.linalg.norm(error, axis=1)
         ax.plot(np.asarray(result.time, dtype=float)[rows], norm, color=color, linewidth=1.3, label=label)
         if _status_note(result) and len(rows):
@@ -759,7 +767,7 @@ def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
     return path
 
 
-def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0) -> Path:
+def plot_spatial_run(result: Result, path: str | Path, after: float = 1.0) -> Path:
     """Overview figure: the path from above and from the side, against the reference; the position
     error over time; the lowest element tension of each cable over time."""
     figure = Figure(figsize=(11.0, 8.0))
@@ -798,3 +806,12 @@ def plot_spatial_run(result: SpatialResult, path: str | Path, after: float = 1.0
     path = Path(path)
     figure.savefig(path, dpi=100, format="png")
     return path
+
+
+def _spatial_overview(scene: Scene, result: Result, folder: Path, times, after: float) -> list[Path]:  # noqa: ARG001
+    folder.mkdir(parents=True, exist_ok=True)
+    return [plot_spatial_run(result, folder / OVERVIEW_FILES["overview"], after)]
+
+
+#: The overview figures of a run, by its space (:func:`plot_overview`).
+OVERVIEWS = {PLANE: plot_planar_overview, SPACE: _spatial_overview}

@@ -18,17 +18,17 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from cdpr_exu.core.errors import OutputError
+from cdpr_exu.results.result import Result
+from cdpr_exu.space import SPACE, Space
 
-__all__ = ["is_spatial_run", "SpatialFrames"]
+__all__ = ["run_space", "SpatialFrames"]
 
 
-def is_spatial_run(run_dir: str | Path) -> bool:
-    """True for a folder written by a spatial ``cdpr run`` (a result.npz with 6-DOF poses)."""
+def run_space(run_dir: str | Path) -> Space | None:
+    """The :class:`~cdpr_exu.space.Space` of the run a ``cdpr run`` folder holds (its result.npz's
+    :class:`Result`), or None for a folder without one."""
     path = Path(run_dir) / "result.npz"
-    if not path.is_file():
-        return False
-    with np.load(path) as data:
-        return "pose" in data.files and data["pose"].ndim == 2 and data["pose"].shape[1] == 6
+    return Result.load(path).space if path.is_file() else None
 
 
 class SpatialFrames:
@@ -49,13 +49,11 @@ class SpatialFrames:
 
     def __init__(self, run_dir: str | Path, size: tuple[int, int]):
         run_dir = Path(run_dir)
-        if not is_spatial_run(run_dir):
+        if run_space(run_dir) is not SPACE:
             raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
                               "write one with `cdpr run SPATIAL-SCENE --out DIR`")
-        with np.load(run_dir / "result.npz") as data:
-            self.times, self.pose, self.reference = data["time"], data["pose"], data["reference"]
-            cables = sorted((k for k in data.files if k.startswith("nodes_")), key=lambda k: int(k.split("_")[1]))
-            self.nodes = [data[k] for k in cables]
+        result = Result.load(run_dir)
+        self.times, self.pose, self.reference, self.nodes = result.time, result.pose, result.reference, result.nodes
         summary = run_dir / "summary.json"
         self.name = json.loads(summary.read_text()).get("scene", run_dir.name) if summary.is_file() else run_dir.name
         self.size = (int(size[0]), int(size[1]))

@@ -50,6 +50,7 @@ from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.core.output import check_output_folder, clear_outputs
 from cdpr_exu.run.spatial_run import build_spatial_model
 from cdpr_exu.scenes.scene import Scene, load_scene
+from cdpr_exu.space import SPACE
 
 #: File names inside a run folder (written by ``cdpr run --out``).
 SCENE_FILE = "scene.toml"
@@ -770,7 +771,7 @@ def check_animation_request(run_dir: str | Path, out_file: str | Path | None = N
     RunFolderError
         A folder that holds no run.
     """
-    from cdpr_exu.post.spatial_animation import is_spatial_run  # matplotlib: only where a run is drawn
+    from cdpr_exu.post.spatial_animation import run_space  # matplotlib: only where a run is drawn
 
     if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
             or not (np.isfinite(fps) and fps > 0):
@@ -787,7 +788,7 @@ def check_animation_request(run_dir: str | Path, out_file: str | Path | None = N
     if not run_dir.is_dir():
         raise RunFolderError(f"run folder {str(run_dir)!r} does not exist; write one with "
                              f"`cdpr run SCENE --out {run_dir}`")
-    spatial = is_spatial_run(run_dir)
+    spatial = run_space(run_dir) is SPACE
     if not spatial:
         run_files(run_dir)
     out_file = Path(out_file) if out_file is not None else run_dir / "animation.gif"
@@ -885,9 +886,9 @@ def render_spatial_animation(run_dir: str | Path, out: str | Path | None = None,
     :func:`render_animation` on a spatial folder, with its checks
     (a folder without a spatial run is refused, as every bad option).
     """
-    from cdpr_exu.post.spatial_animation import is_spatial_run  # matplotlib: only where a run is drawn
+    from cdpr_exu.post.spatial_animation import run_space  # matplotlib: only where a run is drawn
 
-    if not is_spatial_run(run_dir):
+    if run_space(run_dir) is not SPACE:
         raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
                           "write one with `cdpr run SPATIAL-SCENE --out DIR`")
     path, frames, _ = render_animation_timed(run_dir, out, fps=fps, every=every, size=size, frames_dir=frames_dir,

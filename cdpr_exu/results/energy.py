@@ -54,9 +54,9 @@ def energy_parts(scene: Scene, result: Result) -> EnergyParts:
         raise SceneError("energy_parts needs lumped-mass cables (effects.cable_mass = true)")
     g = scene.gravity if scene.effects.gravity else 0.0
     platform = scene.platform
-    velocity = result.platform_velocity
+    velocity = result.velocity
     kinetic = 0.5 * platform.mass * np.sum(velocity[:, :2] ** 2, axis=1) + 0.5 * platform.inertia * velocity[:, 2] ** 2
-    gravitational = platform.mass * g * result.platform_pose[:, 1]
+    gravitational = platform.mass * g * result.pose[:, 1]
     axial = np.zeros_like(kinetic)
     bending = np.zeros_like(kinetic)
     contact = np.zeros_like(kinetic)

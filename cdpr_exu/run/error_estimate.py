@@ -46,7 +46,6 @@ from cdpr_exu.builder.model import build_model
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import length_text
 from cdpr_exu.run.simulate import simulate
-from cdpr_exu.run.spatial_run import simulate_spatial
 
 #: Order of the error in the number of elements assumed by the estimate (see above).
 ORDER = 2.0
@@ -120,22 +119,6 @@ def _with_elements(scene, n: int):
     return scene.with_changes(cables=tuple(replace(c, n_elements=int(n)) for c in scene.cables))
 
 
-def simulate_any(scene, controller=None):
-    """Run a planar (:func:`~cdpr_exu.run.simulate.simulate`) or spatial
-    (:func:`~cdpr_exu.run.spatial_run.simulate_spatial`) scene under ``controller``."""
-    if scene.dimension == 3:  # one simulate() when the runs are one (issue 24, slice 9)
-        return simulate_spatial(scene, controller)
-
-    return simulate(scene, controller)
-
-
-def platform_positions(result) -> np.ndarray:
-    """The platform centre's positions of a planar (x, z) or spatial (x, y, z) result, shape (N, 2 or 3) [m]."""
-    if hasattr(result, "platform_pose"):
-        return np.asarray(result.platform_pose)[:, :2]
-    return np.asarray(result.pose)[:, :3]
-
-
 def path_distance(result, other, after: float = 0.0) -> float:
     """Largest distance [m] of ``result``'s platform centre from ``other``'s from ``after`` [s] on.
 
@@ -143,7 +126,7 @@ def path_distance(result, other, after: float = 0.0) -> float:
     shrunk: ``other``'s path is interpolated onto ``result``'s sample times.
     """
     mask = result.time >= after - 1e-9
-    positions, other_positions = platform_positions(result), platform_positions(other)
+    positions, other_positions = result.position, other.position
     path = np.column_stack([np.interp(result.time[mask], other.time, other_positions[:, k])
                             for k in range(other_positions.shape[1])])
     return float(np.linalg.norm(positions[mask] - path, axis=1).max())
@@ -159,7 +142,7 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     Parameters
     ----------
     scene : Scene
-    result : Result or SpatialResult
+    result : Result
         The run to judge (completed).
     controller_factory : callable, optional
         Makes a fresh controller of the same kind as the run's (default: ideal IK).
@@ -179,7 +162,7 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     controller = (controller_factory or IdealIKController)()
     start = time.perf_counter()
     try:
-        companion = simulate_any(companion_scene, controller)
+        companion = simulate(companion_scene, controller)
     except RunInterrupted:  # Ctrl-C is the user's, not a failed companion
         raise
     except (SolverFailure, CdprError) as err:

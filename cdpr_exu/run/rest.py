@@ -77,7 +77,8 @@ from cdpr_exu.core.output import write_npz, write_summary
 from cdpr_exu.builder.spatial_robot import static_settings
 from cdpr_exu.physics import bending
 from cdpr_exu.results.result import provenance
-from cdpr_exu.run.simulate import likely_cause, quiet_exudyn, solver_report, solver_settings
+from cdpr_exu.run.simulate import likely_cause
+from cdpr_exu.run.solver import quiet_exudyn, solver_report, solver_settings
 from cdpr_exu.scenes.scene import Scene
 
 #: Default tolerance on the largest node speed at rest [m/s].

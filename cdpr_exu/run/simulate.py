@@ -9,10 +9,7 @@ carries the result up to that time.
 
 from __future__ import annotations
 
-import contextlib
 import math
-import signal
-import threading
 import time as _time
 from pathlib import Path
 from typing import Callable
@@ -28,101 +25,13 @@ from cdpr_exu.core.errors import RunInterrupted, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
 from cdpr_exu.results.result import Result
+from cdpr_exu.run.solver import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
+                                  solver_settings)
+from cdpr_exu.run import spatial_run
 from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.space import PLANE, SPACE
+from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.builder.winch import RopeReservoir, servo_force, set_paid_out_length
-
-
-@contextlib.contextmanager
-def quiet_exudyn():
-    """Keep Exudyn's own console messages (failure banners, allocation warnings) to itself.
-
-    The project reports failures in its own words; Exudyn's banner ("DYNAMIC SOLVER
-    FAILED ... use showHints=True") and its memory-allocation warning would only
-    confuse. Both go through ``exudyn.Print``, which ``exu.config.printToConsole``
-    switches off; the setting is restored afterwards.
-    """
-    before = exu.config.printToConsole
-    exu.config.printToConsole = False
-    try:
-        yield
-    finally:
-        exu.config.printToConsole = before
-
-
-@contextlib.contextmanager
-def interrupt_flag():
-    """While active, Ctrl-C (SIGINT) sets ``flag["interrupted"]`` instead of raising.
-
-    The solver's post-step function checks the flag and ends the time integration
-    cleanly, so the samples computed so far are kept. Outside the main thread (where
-    signal handlers cannot be installed) Ctrl-C behaves as usual.
-    """
-    flag = {"interrupted": False}
-    if threading.current_thread() is not threading.main_thread():
-        yield flag
-        return
-    previous = signal.getsignal(signal.SIGINT)
-
-    def handler(signum, frame):  # noqa: ARG001
-        if flag["interrupted"]:  # a second Ctrl-C: the user insists
-            raise KeyboardInterrupt
-        flag["interrupted"] = True
-
-    signal.signal(signal.SIGINT, handler)
-    try:
-        yield flag
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
-    """Exudyn settings of the implicit run of ``scene``.
-
-    Generalized-alpha with the scene's spectral radius, the sparse LU solver, and
-    (modified) Newton whose Jacobian is updated every step. The contact's own
-    step-size recommendation is switched off (it shrinks steps to about 1e-6 s).
-    """
-    solver = scene.solver
-    settings = exu.SimulationSettings()
-    ti = settings.timeIntegration
-    ti.numberOfSteps = solver.n_steps
-    ti.endTime = solver.end_time
-    ti.verboseMode = 0
-    ti.generalizedAlpha.spectralRadius = solver.spectral_radius
-    # By default start from zero accelerations. The consistent initial acceleration of a
-    # straight cable's free nodes is -g, but the Kelvin-Voigt damping (c_i / m_i ~ 4e6
-    # 1/s) cuts it off within microseconds; carried into the first step it injects a
-    # start-up energy jolt (13 J on the paper scene at 1.7e-2 s steps). Without it the
-    # paper circle's path moves by 0.7 mm and its step-size error halves; a drop from
-    # rest, though, then converges at first order (SolverSpec.initial_accelerations).
-    ti.generalizedAlpha.computeInitialAccelerations = bool(solver.initial_accelerations)
-    ti.newton.useModifiedNewton = solver.newton == "modified"
-    ti.newton.modifiedNewtonJacUpdatePerStep = True
-    ti.newton.maxIterations = solver.max_newton_iterations
-    # 1e-6 by default (SolverSpec.newton_tolerance): Exudyn's 1e-8 buys nothing at the
-    # millimetres asked here, and on stiff massless ropes it sits at the residual's
-    # round-off, so Newton stalls and the adaptive step shrinks up to 350-fold.
-    ti.newton.relativeTolerance = solver.newton_tolerance
-    ti.discontinuous.useRecommendedStepSize = False
-    ti.adaptiveStep = True
-    ti.minimumStepSize = solver.step_size * 1e-4
-    settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-    if solver.integrator == "rk44":
-        # Explicit classical Runge-Kutta at the fixed step (comparison runs only).
-        # SolveDynamic takes the solver type from these settings when called without
-        # solverType; ``timeIntegration.explicitIntegration`` is the deprecated name of
-        # ``timeIntegration.explicit``. The winch's ground-coordinate constraints are
-        # eliminated (``explicit.eliminateConstraints``, Exudyn's default); the
-        # platform joints must be spring-dampers (see cdpr_exu.builder.platform).
-        ti.solverType = exu.DynamicSolverType.RK44
-        ti.adaptiveStep = False
-        ti.explicit.eliminateConstraints = True
-    settings.solution.file.write = solution_file is not None
-    if solution_file is not None:
-        settings.solution.file.name = str(solution_file)
-        settings.solution.file.writePeriod = solver.output_period
-        settings.solution.file.binary = True
-    return settings
 
 
 #: A run stops when an element's strain exceeds this: the lumped model has left the
@@ -232,13 +141,6 @@ class _Monitor:
         return None
 
 
-def output_times(end_time: float, output_period: float) -> np.ndarray:
-    """The output times of a run [s], shape (N,): the multiples of ``output_period`` from 0 up to
-    ``end_time`` (none after it; the end time is one of them only when it is a multiple)."""
-    count = int(math.floor(end_time / output_period + 1e-9)) + 1
-    return np.arange(count) * output_period
-
-
 class _Recorder:
     """Stores Exudyn's coordinates at the output times (called once per step).
 
@@ -311,8 +213,8 @@ class _Recorder:
                 depth.append(np.zeros(k))
         reference = scene.trajectory.pose(times) if k else np.zeros((0, 3))
         return Result(
-            scene_name=scene.name, controller=controller_name, time=times, platform_pose=pose,
-            platform_velocity=velocity, reference_pose=np.atleast_2d(reference).reshape(-1, 3),
+            scene_name=scene.name, controller=controller_name, dimension=scene.space.dimension, time=times,
+            pose=pose, velocity=velocity, reference=np.atleast_2d(reference).reshape(-1, 3),
             nodes=nodes, node_velocities=node_velocities, tensions=tensions, paid_out=self.paid_out[:k],
             pulley_penetration=np.column_stack(depth) if depth else np.zeros((k, 0)),
         )
@@ -480,7 +382,11 @@ class _Stepper:
 def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
              progress: bool | Callable[[float, float], None] = False,
              sparse_jacobian: bool | None = None) -> Result:
-    """Simulate ``scene`` under ``controller`` (default: ideal inverse kinematics).
+    """Simulate ``scene``, planar or spatial, under ``controller`` (default: ideal inverse kinematics).
+
+    The one entry for both dimensions: the scene's space picks its run loop (:data:`RUNS`:
+    :func:`simulate_planar`, :func:`cdpr_exu.run.spatial_run.simulate_spatial`), and both return the
+    one :class:`~cdpr_exu.results.result.Result`.
 
     Parameters
     ----------
@@ -493,8 +399,8 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         True shows a progress bar (simulated time, ratio to real time); a callable
         is called as ``progress(t, wall_time)`` about 100 times per run.
     sparse_jacobian : bool, optional
-        Hand Exudyn the cables' Jacobian as sparse triplets (True) or a dense matrix
-        (False); default: sparse for fine cables (see :func:`cdpr_exu.builder.model.build_model`).
+        Planar runs: hand Exudyn the cables' Jacobian as sparse triplets (True) or a dense
+        matrix (False); default: sparse for fine cables (see :func:`cdpr_exu.builder.model.build_model`).
 
     Returns
     -------
@@ -502,12 +408,31 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
 
     Raises
     ------
-    UnreachableError
-        Before the run, if the reference leaves the workspace.
+    SceneError, UnreachableError
+        Before the run, if the scene has no reference or it leaves the workspace.
     SolverFailure
         If the solver fails; ``.time`` and ``.partial_result`` say when and what was
         computed up to then.
     """
+    return RUNS[scene.space][1](scene, controller, solution_file=solution_file, progress=progress,
+                                sparse_jacobian=sparse_jacobian)
+
+
+def check_runnable(scene: Scene) -> None:
+    """Refuse a scene :func:`simulate` cannot run, before anything is built or written (``cdpr run`` checks
+    before it writes): no reference, or one the cables cannot follow (by the scene's space, :data:`RUNS`).
+
+    Raises
+    ------
+    SceneError, UnreachableError
+    """
+    RUNS[scene.space][0](scene)
+
+
+def simulate_planar(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
+                    progress: bool | Callable[[float, float], None] = False,
+                    sparse_jacobian: bool | None = None) -> Result:
+    """The planar run loop behind :func:`simulate` (its parameters and errors)."""
     controller = controller or IdealIKController()
     model = build_model(scene, sparse_jacobian=sparse_jacobian)
 
@@ -570,10 +495,10 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     last_time = float(result.time[-1]) if len(result.time) else 0.0
-    if failure is None and (not np.all(np.isfinite(result.platform_pose)) or len(result.time) < len(recorder.output_times)):
+    if failure is None and (not np.all(np.isfinite(result.pose)) or len(result.time) < len(recorder.output_times)):
         failure = "the solution contains NaN or stopped before the end time"
     if failure is not None:
-        finite = np.all(np.isfinite(result.platform_pose), axis=1) if len(result.time) else np.zeros(0, bool)
+        finite = np.all(np.isfinite(result.pose), axis=1) if len(result.time) else np.zeros(0, bool)
         last_time = float(result.time[finite][-1]) if finite.any() else 0.0
         result.status = f"failed: {failure}"
         result.failure_time = last_time
@@ -582,6 +507,10 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
             f"(step size {solver.step_size} s): {failure}. {likely_cause(scene, failure, last_time)}",
             time=last_time, partial_result=result)
     return result
+
+
+#: The check before a run and the run loop, by space: (check(scene), run(scene, controller, **options)).
+RUNS = {PLANE: (check_reference, simulate_planar), SPACE: (spatial_run.check_runnable, spatial_run.simulate_spatial)}
 
 
 def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
@@ -598,30 +527,6 @@ def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
         axial_rigidity=stiffness[first] * rest[first], damping_rigidity=damping[first] * rest[first],
         rest_length=rest, stiffness=stiffness, damping=damping,
         surplus=np.zeros(m), node_offset=np.zeros(m), max_surplus=np.zeros(m))
-
-
-def solver_report(mbs: exu.MainSystem, message: str) -> str:
-    """What Exudyn's solver said when it stopped: its error string, time, step and residual.
-
-    Exudyn's exception text is only "SolveDynamic terminated"; the stored solver
-    (``mbs.sys["dynamicSolver"]``) knows why.
-    """
-    solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
-    if solver is None:
-        return f"Exudyn's solver stopped: {message}"
-    try:
-        reason = solver.GetErrorString().strip() or message
-        it, conv = solver.it, solver.conv
-        details = [f"at t = {it.currentTime:.6g} s", f"step size then {it.currentStepSize:.3g} s"]
-        if not conv.newtonConverged:
-            details.append(f"Newton residual {conv.residual:.3g}")
-        if conv.linearSolverFailed:
-            details.append(f"the linear solver failed (singular Jacobian, row {conv.linearSolverCausingRow})")
-        if conv.massMatrixNotInvertible:
-            details.append("the mass matrix is not invertible")
-    except Exception:  # noqa: BLE001 - the report must never hide the failure itself
-        return f"Exudyn's solver stopped: {message}"
-    return f"Exudyn's solver stopped ({message}): {reason} ({', '.join(details)})"
 
 
 #: Largest step of Exudyn's explicit RK44 on a real negative eigenvalue, times -lambda
@@ -749,35 +654,3 @@ def _steepest_downward_acceleration(scene: Scene) -> float:
         return float(min(acceleration.min(), 0.0))
     except Exception:  # noqa: BLE001 - a hint must never raise
         return 0.0
-
-
-def progress_reporter(progress, scene: Scene):
-    """A per-step callback that updates a tqdm bar or a user callable ~100 times."""
-    if not progress:
-        return None
-    end = scene.solver.end_time
-    every = end / 100.0
-    last = {"t": -1.0}
-    if callable(progress):
-        def report(t, wall):
-            if t is None or t - last["t"] >= every:
-                last["t"] = end if t is None else t
-                progress(end if t is None else t, wall)
-        return report
-    from tqdm import tqdm
-
-    # disable=None: no bar when the output is not a terminal (logs, CI), so it never floods them.
-    bar = tqdm(total=end, unit="s", disable=None, mininterval=0.25,
-               bar_format="{desc}{percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}{postfix}]",
-               desc=scene.name + " ")
-
-    def report(t, wall):
-        if t is None:
-            bar.close()
-            return
-        if t - last["t"] >= every or t >= end - 1e-9:
-            last["t"] = t
-            bar.n = min(t, end)
-            bar.set_postfix_str(f"{t / wall:.1f}x real time" if wall > 0 else "", refresh=False)
-            bar.refresh()
-    return report

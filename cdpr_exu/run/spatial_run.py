@@ -32,16 +32,13 @@ from __future__ import annotations
 
 import time as _time
 import warnings
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import exudyn as exu
 import numpy as np
 
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.core.output import SPATIAL_POSE_COLUMNS, write_npz, write_pose_csv, write_summary
 from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
     scene_chain_spec, start_at_rest
 from cdpr_exu.statics.statics import catenary_platform, solve_statics
@@ -49,117 +46,14 @@ from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_con
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController
 
-from cdpr_exu.results.result import after_start_up, provenance, safety_figures
-from cdpr_exu.run.simulate import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
-                                   solver_settings)
+from cdpr_exu.results.result import Result
+from cdpr_exu.run.solver import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
+                                  solver_settings)
 from cdpr_exu.run.spatial_rest import rest_above_exits
 from cdpr_exu.scenes.scene import Scene, tension_limits
-from cdpr_exu.space import SPACE
 from cdpr_exu.statics.workspace import check_reference
 
-__all__ = ["SpatialResult", "simulate_spatial", "build_spatial_model"]
-
-
-@dataclass
-class SpatialResult:
-    """A spatial run: platform pose, reference, paid-out lengths, cable nodes and tensions.
-
-    Attributes
-    ----------
-    scene_name, controller : str
-    time : ndarray, shape (N,) [s]
-    pose, reference : ndarray, shape (N, 6) [m, rad]
-        Actual and reference pose: centre of mass and rotation vector.
-    paid_out : ndarray, shape (N, m) [m]
-        Each winch's paid-out (unstrained) cable length.
-    nodes : list of ndarray, each (N, n + 1, 3) [m]
-        Node positions of each cable, exit first.
-    tensions : list of ndarray, each (N, n) [N]
-        Axial force of each element, spring and damper as the model computes them (positive in
-        tension; never negative for tension-only elements).
-    wall_time : float [s]
-    steps, newton_iterations : int
-    status : str
-        "completed", "failed: <cause>" or "interrupted ...".
-    failure_time : float or None [s]
-    """
-
-    scene_name: str
-    controller: str
-    time: np.ndarray
-    pose: np.ndarray
-    reference: np.ndarray
-    paid_out: np.ndarray
-    nodes: list
-    tensions: list
-    wall_time: float = 0.0
-    steps: int = 0
-    newton_iterations: int = 0
-    status: str = "completed"
-    failure_time: float | None = None
-    metadata: dict = field(default_factory=dict)
-
-    @property
-    def position_error(self) -> np.ndarray:
-        """Actual minus reference position, shape (N, 3) [m]."""
-        return self.pose[:, :3] - self.reference[:, :3]
-
-    #: The figures of :meth:`summary` measured from its ``after`` on (the rest cover the whole run).
-    ERROR_FIGURES = ("max_position_error_m", "rms_position_error_m", "max_abs_error_m", "max_rotation_error_deg")
-
-    def summary(self, after: float = 1.0) -> dict[str, Any]:
-        """Figures of the run (strict JSON: null where there is no sample): errors (:data:`ERROR_FIGURES`)
-        from ``after`` [s] on, the safety figures (tensions, slack, pushing, tension limits, a platform above
-        its exits) over the whole run, the start included (:func:`~cdpr_exu.results.result.safety_figures`,
-        as planar summaries)."""
-        mask = self.time >= after
-        error = np.linalg.norm(self.position_error[mask], axis=1)
-        rotation = SPACE.rotation_error_deg(self.pose[mask], self.reference[mask]) if mask.any() else np.zeros(0)
-
-        def extreme(values, pick):
-            return float(pick(values)) if values.size else None
-
-        safety = safety_figures(self.time, self.tensions, self.pose[:, 2] if len(self.time) else None,
-                                self.metadata.get("highest_exit_z_m"), self.metadata.get("tension_limits_N"))
-        limits = {k: safety.pop(k) for k in ("tension_limits_N", "tension_limit_violations") if k in safety}
-        warnings_ = safety.pop("warnings")
-        notes = []
-        if not mask.any():
-            notes.append(f"no sample at or after t = {after:g} s: its error figures are null")
-        simulated = float(self.time[-1]) if len(self.time) else 0.0
-        return {
-            "scene": self.scene_name, "controller": self.controller, "dimension": 3, "status": self.status,
-            "errors_measured_after_s": after,
-            "max_position_error_m": extreme(error, np.max),
-            "rms_position_error_m": float(np.sqrt(np.mean(error**2))) if error.size else None,
-            "max_abs_error_m": [extreme(np.abs(self.position_error[mask, k]), np.max) for k in range(3)],
-            "max_rotation_error_deg": extreme(rotation, np.max),
-            **safety,
-            "wall_time_s": self.wall_time, "simulated_time_s": simulated,
-            "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
-            "steps": int(self.steps), "newton_iterations": int(self.newton_iterations),
-            "failure_time_s": self.failure_time, "notes": notes, "warnings": warnings_,
-            **limits,
-        }
-
-    def run_summary(self, after: float = 1.0) -> dict[str, Any]:
-        """The summary ``cdpr run`` writes, as the planar run's: every figure over the whole run, and the
-        errors from ``after`` [s] on under ``after_start_up``."""
-        return {**self.summary(0.0), "after_start_up": after_start_up(self.summary(after), self.ERROR_FIGURES)}
-
-    def save(self, folder: str | Path, after: float = 1.0, extra: dict | None = None) -> list[Path]:
-        """Write result.npz, pose.csv (time, pose and reference: x, y, z [m] and the rotation vector [rad])
-        and summary.json (:meth:`run_summary`, with ``extra``'s entries) into ``folder``; returns the paths.
-        The figure (``overview.png``) is :func:`cdpr_exu.post.plots.plot_spatial_run`'s."""
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        arrays = {"time": self.time, "pose": self.pose, "reference": self.reference, "paid_out": self.paid_out}
-        for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
-            arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = nodes, tensions
-        written = [write_npz(folder / "result.npz", **arrays),
-                   write_pose_csv(folder / "pose.csv", self.time, self.pose, self.reference, SPATIAL_POSE_COLUMNS),
-                   write_summary(folder, {**self.run_summary(after), **provenance(), **(extra or {})})]
-        return written
+__all__ = ["simulate_spatial", "build_spatial_model"]
 
 
 class _SpatialWinches:
@@ -170,6 +64,7 @@ class _SpatialWinches:
         self.n = scene.cables[0].n_elements
         self.gravity = scene.gravity if (scene.effects.gravity and scene.effects.cable_mass) else 0.0
         self.applied = np.array(lengths, dtype=float)
+        self.rate = np.zeros(len(self.applied))  # the winches' rate [m/s]: the last command's, as planar runs
 
     def set_lengths(self, lengths: np.ndarray, rates: np.ndarray) -> None:
         """Give every cable the paid-out length ``lengths`` (m,) [m], changing at ``rates`` (m,) [m/s].
@@ -183,6 +78,7 @@ class _SpatialWinches:
         constant on a CoGiRo cable paid out at 0.25 m/s pulls with 740 N).
         """
         mbs, items = self.mbs, self.items
+        self.rate = np.array(rates, dtype=float)
         for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
             if items.has_swivel(i):  # the winch end moves along the swivel axis: up when paying out
                 if length != self.applied[i]:
@@ -315,8 +211,10 @@ def build_spatial_model(scene: Scene):
 
 
 def simulate_spatial(scene: Scene, controller: Controller | None = None, progress=False, *,
-                     solution_file: str | Path | None = None) -> SpatialResult:
-    """Run ``scene``'s reference under ``controller`` (default: ideal inverse kinematics).
+                     solution_file: str | Path | None = None, sparse_jacobian: bool | None = None) -> Result:  # noqa: ARG001
+    """The spatial run loop behind :func:`cdpr_exu.run.simulate.simulate`: run ``scene``'s reference under
+    ``controller`` (default: ideal inverse kinematics). (``sparse_jacobian`` is the planar builder's choice;
+    the spatial robot's Jacobian is Exudyn's own.)
 
     The controller is any :class:`controllers.base.Controller` that works on spatial
     scenes (:class:`controllers.ideal_ik.IdealIKController`,
@@ -390,10 +288,10 @@ def simulate_spatial(scene: Scene, controller: Controller | None = None, progres
     def measurement(t: float) -> Measurement:
         """What the controller may see when asked for the command at ``t`` [s]."""
         if not (controller.uses_pose or controller.uses_tension):
-            return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)))
+            return Measurement(t, winches.applied.copy(), winches.rate.copy())
         pose, velocity = measured_state()
         tensions = measured_tensions() if controller.uses_tension else None
-        return Measurement(t, winches.applied.copy(), np.zeros(len(lengths)), pose, velocity, tensions,
+        return Measurement(t, winches.applied.copy(), winches.rate.copy(), pose, velocity, tensions,
                            state_time=state["step_start"])
 
     def record(t: float) -> None:
@@ -475,9 +373,9 @@ def simulate_spatial(scene: Scene, controller: Controller | None = None, progres
     tensions = [np.asarray(series) for series in tension_series]
     solved = mbs.sys.get("dynamicSolver")  # none when the start was refused
     steps, newton = (0, 0) if solved is None else (solved.it.currentStepIndex, solved.it.newtonStepsCount)
-    result = SpatialResult(scene.name, controller.name if kinematic else "fixed winches", time_array, pose,
-                           np.atleast_2d(scene.trajectory.pose(time_array)), paid_out, nodes, tensions, wall,
-                           int(steps), int(newton))
+    result = Result(scene.name, controller.name if kinematic else "fixed winches", scene.space.dimension, time_array,
+                    pose, np.atleast_2d(scene.trajectory.pose(time_array)), nodes, tensions, paid_out,
+                    wall_time=wall, steps=int(steps), newton_iterations=int(newton))
     if tension_limits(scene.cables) is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
         result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
     result.metadata["highest_exit_z_m"] = float(scene.exit_points[:, 2].max())

@@ -29,7 +29,7 @@ on an idle core the two agree, but on a shared machine the wall time of the same
 varied by a factor of two with the load of other processes, the CPU time by a few
 per cent.
 
-Spatial scenes (``dimension = 3``) run through :func:`~cdpr_exu.run.spatial_run.simulate_spatial`
+Spatial scenes (``dimension = 3``) run through the same :func:`~cdpr_exu.run.simulate.simulate`
 under ideal inverse kinematics, on their own grids (:data:`SPATIAL_FULL_GRID`,
 :data:`SPATIAL_QUICK_GRID`: the ``catenary`` and ``full`` presets, as a spatial cable is
 lumped and elastic; fewer elements, as spatial runs cost more); the position error is
@@ -55,10 +55,10 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure, UnreachableError
-from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
+from cdpr_exu.space import PLANE, Space
 from cdpr_exu.scenes.trajectories import HoldTrajectory
 from cdpr_exu.studies.study import (SINGLE_THREAD_ENVIRONMENT, apply_parameters, executor_for, progress_bar,
                                     warm_up)
@@ -308,9 +308,8 @@ def fewest_elements(scene) -> int:
 def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     """Simulate one configuration given as plain scene data; never raises.
 
-    The worker function of the study (top-level, plain data in and out); planar scenes
-    run :func:`~cdpr_exu.run.simulate.simulate`, spatial ones (``dimension = 3``)
-    :func:`~cdpr_exu.run.spatial_run.simulate_spatial` under ideal inverse kinematics.
+    The worker function of the study (top-level, plain data in and out): planar and spatial
+    scenes run :func:`~cdpr_exu.run.simulate.simulate` under ideal inverse kinematics.
 
     Returns
     -------
@@ -331,13 +330,12 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
         with warnings.catch_warnings():  # the study samples once per step where the step is coarser, knowingly
             warnings.simplefilter("ignore", CoarseOutputWarning)
             scene = scene_from_dict(scene_data)
-        spatial = scene.dimension == 3  # one Result in issue 24, slice 3
-        from cdpr_exu.run.error_estimate import simulate_any  # loads Numba and Exudyn: after the thread limits
+        from cdpr_exu.run.simulate import simulate  # loads Numba and Exudyn: after the thread limits
 
         warm_up(scene)
         cpu = time.process_time()
         try:
-            result = simulate_any(scene)
+            result = simulate(scene)
             status = "completed"
         except SolverFailure as err:
             result = err.partial_result
@@ -350,16 +348,15 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
         return {"status": "refused: " + " ".join(str(err).split()), **empty}
     except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
         return {"status": f"failed: {type(err).__name__}: " + " ".join(str(err).split()), **empty}
-    pose = np.asarray(result.pose if spatial else result.platform_pose)
+    pose = np.asarray(result.pose)
     finite = np.all(np.isfinite(pose), axis=1)
     tensions = np.column_stack([t[:, -1] for t in result.tensions]) if result.tensions else np.zeros((len(finite), 0))
     times = np.asarray(result.time)[finite]
-    if spatial:
-        positions = pose[finite, :3]
-        speed = (np.linalg.norm(np.gradient(positions, times, axis=0), axis=1) if len(times) > 1
-                 else np.zeros(len(times)))
+    if result.velocity is not None:  # recorded (planar runs)
+        speed = np.linalg.norm(result.velocity[finite, :result.space.position_size], axis=1)
     else:
-        speed = np.linalg.norm(result.platform_velocity[finite, :2], axis=1)
+        speed = (np.linalg.norm(np.gradient(result.position[finite], times, axis=0), axis=1) if len(times) > 1
+                 else np.zeros(len(times)))
     return {
         "status": status,
         "wall_time_s": float(result.wall_time),
@@ -384,7 +381,7 @@ ERROR_FIGURES = ("position_error_max_m", "position_error_rms_m", "rotation_error
 
 
 def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: str = "path",
-            after: float = 1.0) -> dict[str, float]:
+            after: float = 1.0, space: Space = PLANE) -> dict[str, float]:
     """Errors of one run against the reference.
 
     Parameters
@@ -395,6 +392,8 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
         ``"path"``: on the reference's times from ``after`` on (the run interpolated
         linearly onto them); ``"final"``: the last samples only.
     after : float [s]
+    space : Space
+        What the poses are (the scene's :attr:`~cdpr_exu.scenes.scene.Scene.space`; default the plane).
 
     Returns
     -------
@@ -412,7 +411,7 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
         if t_run[-1] < t_ref[-1] - 1e-9:
             return {**nan, "final_speed_m_s": speed}
         reference_pose = np.asarray(reference["pose"])[-1:]
-        pose_error = np.asarray(run["pose"])[-1:] - reference_pose
+        pose = np.asarray(run["pose"])[-1:]
         tension_error = np.asarray(run["end_tensions"])[-1:] - np.asarray(reference["end_tensions"])[-1:]
     elif comparison == "path":
         mask = t_ref >= min(after, t_ref[-1]) - 1e-9
@@ -422,17 +421,12 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
         pose = np.column_stack([np.interp(times, t_run, column) for column in np.asarray(run["pose"]).T])
         tensions = np.column_stack([np.interp(times, t_run, column) for column in np.asarray(run["end_tensions"]).T])
         reference_pose = np.asarray(reference["pose"])[mask]
-        pose_error = pose - reference_pose
         tension_error = tensions - np.asarray(reference["end_tensions"])[mask]
     else:
         raise SceneError(f"comparison must be 'path' or 'final', got {comparison!r}")
-    if pose_error.shape[1] == 6:  # spatial: the centre's 3-D error, the angle between the orientations
-        position = np.linalg.norm(pose_error[:, :3], axis=1)
-        rotation = rotation_angles_deg(pose_error[:, 3:] + np.asarray(reference_pose)[:, 3:],
-                                       np.asarray(reference_pose)[:, 3:])
-    else:
-        position = np.linalg.norm(pose_error[:, :2], axis=1)
-        rotation = np.degrees(np.abs(pose_error[:, 2]))
+    # the centre's error, the angle between the orientations
+    position = np.linalg.norm((pose - reference_pose)[:, :space.position_size], axis=1)
+    rotation = space.rotation_error_deg(pose, reference_pose)
     return {
         "position_error_max_m": float(position.max()),
         "position_error_rms_m": float(np.sqrt(np.mean(position**2))),
@@ -441,13 +435,6 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
         "tension_error_rms_N": float(np.sqrt(np.mean(tension_error**2))),
         "final_speed_m_s": speed,
     }
-
-
-def rotation_angles_deg(rotation_vectors: np.ndarray, reference_vectors: np.ndarray) -> np.ndarray:
-    """Angle [deg] of the rotation from each reference orientation to the run's, both given as
-    rotation vectors [rad], shapes (N, 3); returns shape (N,)."""
-    return np.degrees([np.linalg.norm(rotation_vector(rotation_from_vector(r).T @ rotation_from_vector(v)))
-                       for v, r in zip(rotation_vectors, reference_vectors)])
 
 
 def comparison_for(scene) -> str:
@@ -638,13 +625,13 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
         simulated = row.get("simulated_time_s", math.nan)
         row["real_time_factor"] = (simulated / row[COST]
                                    if _finite(simulated) and _finite(row[COST]) and row[COST] > 0 else math.nan)
-        figures = compare(series[row["run"]], reference, comparison, after) if row["run"] in series else {}
+        figures = compare(series[row["run"]], reference, comparison, after, base.space) if row["run"] in series else {}
         for name in ERROR_FIGURES:
             row[name] = figures.get(name, math.nan)
         if row["status"] != "completed":  # errors of a partial run are not comparable
             for name in ERROR_FIGURES[:-1]:
                 row[name] = math.nan
-    _effects_columns(rows, series, grid, comparison, after)
+    _effects_columns(rows, series, grid, comparison, after, base.space)
     study = AccuracyStudy(rows, grid.reference, comparison, base.name, base.solver.end_time, after, grid, series)
     if out is not None:
         write_accuracy_study(study, base, out)
@@ -652,7 +639,7 @@ def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Pa
 
 
 def _effects_columns(rows: list[dict[str, Any]], series: Mapping[int, Mapping[str, Any]], grid: AccuracyGrid,
-                     comparison: str, after: float) -> None:
+                     comparison: str, after: float, space: Space) -> None:
     """``moved_*`` columns: each run at the variant resolution against ``full`` there."""
     for row in rows:
         row["moved_position_max_m"] = row["moved_position_rms_m"] = row["moved_rotation_max_deg"] = math.nan
@@ -670,7 +657,7 @@ def _effects_columns(rows: list[dict[str, Any]], series: Mapping[int, Mapping[st
         row["at_variant_resolution"] = True
         if row.get("status") != "completed" or row["run"] not in series:
             continue
-        moved = compare(series[row["run"]], series[full["run"]], comparison, after)
+        moved = compare(series[row["run"]], series[full["run"]], comparison, after, space)
         row["moved_position_max_m"] = moved["position_error_max_m"]
         row["moved_position_rms_m"] = moved["position_error_rms_m"]
         row["moved_rotation_max_deg"] = moved["rotation_error_max_deg"]

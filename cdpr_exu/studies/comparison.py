@@ -32,11 +32,10 @@ from controllers.spatial_feedback import spatial_closed_loop_tension_aware
 from controllers.spatial_tension_aware import SpatialTensionAwareController
 
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
-from cdpr_exu.core.output import (PLANAR_POSE_COLUMNS, check_output_folder, clear_outputs, fixed, write_pose_csv,
+from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, write_pose_csv,
                                   write_summary)
-from cdpr_exu.results.result import Result, provenance, warning_flags
+from cdpr_exu.results.result import POSE_COLUMNS, Result, provenance, warning_flags
 from cdpr_exu.run.simulate import simulate
-from cdpr_exu.run.spatial_run import simulate_spatial
 from cdpr_exu.scenes.scene import Scene, save_scene
 from cdpr_exu.scenes.trajectories import CircleTrajectory
 from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
@@ -187,8 +186,8 @@ def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float
     (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
                                        + markdown_table(summaries))
     for name, result in results.items():
-        write_pose_csv(out / f"pose_{name}.csv", result.time, result.platform_pose, result.reference_pose,
-                       PLANAR_POSE_COLUMNS)
+        write_pose_csv(out / f"pose_{name}.csv", result.time, result.pose, result.reference,
+                       POSE_COLUMNS[result.space])
     if results:
         plot_comparison(scene, results, out)
 
@@ -257,7 +256,7 @@ def compare_spatial(scene: Scene, names: list[str] | None = None, out: str | Pat
     try:
         for name in names:
             try:
-                result = simulate_spatial(scene, SPATIAL_CONTROLLERS[name]())
+                result = simulate(scene, SPATIAL_CONTROLLERS[name]())
             except SolverFailure as err:
                 result = err.partial_result
                 if result is None:  # it failed before its first step (settling the robot)

@@ -134,7 +134,7 @@ def command_grid(scene: Scene) -> np.ndarray:
 
 def position_errors(result: Result, times: np.ndarray) -> np.ndarray:
     """Position error r_ref - r of ``result`` on ``times`` (linear interpolation), shape (N, 2) [m]."""
-    error = result.reference_pose[:, :2] - result.platform_pose[:, :2]
+    error = result.reference[:, :2] - result.pose[:, :2]
     return np.column_stack([np.interp(times, result.time, column) for column in error.T])
 
 
@@ -213,7 +213,7 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
         if on_trial is not None:
             on_trial(trial)
         if best is None or trial.max_position_error_m < best[0].max_position_error_m:
-            expected = np.column_stack([np.interp(times, result.time, column) for column in result.platform_pose[:, :2].T])
+            expected = np.column_stack([np.interp(times, result.time, column) for column in result.pose[:, :2].T])
             best = (trial, replace(table, expected_positions=expected), result)
         stop_reason = rule.reason_to_stop([t.max_position_error_m for t in trials])
         if stop_reason is not None:

@@ -325,7 +325,7 @@ def warm_up(scene) -> None:
     paths (0.2 to 1 s planar, about 2 s of CPU time spatial); without this, whichever
     run a worker takes first would report that in its time.
     """
-    from cdpr_exu.run.error_estimate import simulate_any
+    from cdpr_exu.run.simulate import simulate
 
     effects = scene.to_dict()["effects"]
     configuration = [scene.dimension, effects, [exit_.kind for exit_ in scene.exits], scene.winch.kind]
@@ -337,7 +337,7 @@ def warm_up(scene) -> None:
     solver = scene.solver
     short = replace(solver, end_time=2 * solver.step_size, output_period=solver.step_size)
     try:
-        simulate_any(scene.with_changes(solver=short))
+        simulate(scene.with_changes(solver=short))
     except Exception:  # noqa: BLE001 - only a warm-up; the real run reports any problem
         pass
 
@@ -364,7 +364,7 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)  # effective if the libraries are not loaded yet
     from cdpr_exu.core.errors import SolverFailure, UnreachableError
-    from cdpr_exu.run.error_estimate import simulate_any
+    from cdpr_exu.run.simulate import simulate
     from cdpr_exu.scenes.scene import scene_from_dict
 
     try:
@@ -372,7 +372,7 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
         warm_up(scene)
         after = after if after < scene.solver.end_time else 0.0
         try:
-            result = simulate_any(scene)
+            result = simulate(scene)
             status = "completed"
         except SolverFailure as err:
             result = err.partial_result

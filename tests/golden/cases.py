@@ -57,18 +57,14 @@ def _run_arrays(result, pose, reference):
     return arrays
 
 
-def _planar_run(scene, controller=None):
+def _run(scene, controller=None):
     from cdpr_exu.run.simulate import simulate
 
     result = simulate(scene, controller)
-    return _run_arrays(result, result.platform_pose, result.reference_pose)
-
-
-def _spatial_run(scene, controller=None):
-    from cdpr_exu.run.spatial_run import simulate_spatial
-
-    result = simulate_spatial(scene, controller)
     return _run_arrays(result, result.pose, result.reference)
+
+
+_planar_run = _spatial_run = _run
 
 
 def _comparison_scene(name="paper-circle", end_time=1.5):
