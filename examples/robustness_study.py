@@ -74,8 +74,9 @@ def margins_rows(cases, grid, gains: dict, rows, delay: float) -> list[dict]:
                       **{key: min(getattr(m, key) for m in margins)
                          for key in ("gain_margin_db", "phase_margin_deg", "disk_margin", "min_damping")},
                       "sensitivity_peak": max(m.sensitivity_peak for m in margins),
-                      "stable": all(m.stable for m in margins), "run": run.get("status"),
-                      "max_position_error_m": run.get("max_position_error_m"),
+                      "stable": all(m.stable for m in margins),
+                      "run": "completed" if run.get("completed") else f"failed at {run.get('failure_time_s', 0.0):.1f} s",
+                      "max_position_error_m": run.get("max_position_error_m") if run.get("completed") else None,
                       "max_error_vs_ideal_ik": run.get("max_error_vs_ideal_ik")})
     return table
 
