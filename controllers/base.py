@@ -119,6 +119,69 @@ def quintic_blend(tau):
     return tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2), 30.0 * tau**2 * (1.0 - tau) ** 2
 
 
+#: Where a model-based open-loop command starts from (``start`` of the tension-aware controllers):
+#: "absolute", the model's lengths L(t) themselves (:class:`SmoothStart` blends in their offset from the
+#: paid-out lengths p0); "relative", p0 + L(t) - L(0), the model's change since the reference's start;
+#: "calibrated", that change counted from the pose p the robot is measured at when the run starts (the
+#: rest a real robot starts from): p0 + L(t) - L(0) - (l(p) - l(r(0))), l the ideal lengths, r the reference
+#: position with the measured rotation.
+STARTS = ("absolute", "relative", "calibrated")
+
+
+class CommandStart:
+    """The ``start`` rule of a model-based open-loop command (:data:`STARTS`).
+
+    Parameters
+    ----------
+    start : {"absolute", "relative", "calibrated"}
+
+    Raises
+    ------
+    SceneError
+        If ``start`` is not one of :data:`STARTS`.
+    """
+
+    def __init__(self, start: str = "absolute") -> None:
+        if start not in STARTS:
+            from cdpr_exu.core.errors import SceneError
+
+            raise SceneError(f"start must be one of {STARTS}, got {shown(start)}")
+        self.start = start
+        self._scene = self._offset = None
+
+    @property
+    def uses_pose(self) -> bool:
+        """True for "calibrated": it reads the measured pose once, at t = 0."""
+        return self.start == "calibrated"
+
+    def commands(self, scene, lengths: np.ndarray, initial_paid_out) -> np.ndarray:
+        """The tabulated commands, shape (N, m) [m], from the model's ``lengths`` (N, m) along the reference."""
+        self._scene, self._offset = scene, None
+        if self.start == "absolute":
+            return lengths
+        return np.asarray(initial_paid_out, dtype=float) + lengths - lengths[0]
+
+    def offset(self, measurement: Measurement):
+        """What "calibrated" takes off the commands, l(p) - l(r(0)) [m], p the pose of the first measurement
+        (kept); 0 for the other rules."""
+        if self.start != "calibrated":
+            return 0.0
+        if self._offset is None:
+            from cdpr_exu.core.errors import SceneError
+            from cdpr_exu.statics.kinematics import ideal_paid_out
+
+            if measurement.platform_pose is None:
+                raise SceneError("start = 'calibrated' needs the measured pose at the start")
+            # the centre moved from where it was measured to the reference's start, the rotation held (a
+            # two-cable planar robot does not command it), as the position loop's Jacobian does
+            poses = np.array([measurement.platform_pose, measurement.platform_pose], dtype=float)
+            size = self._scene.space.position_size
+            poses[1, :size] = np.asarray(self._scene.trajectory.pose(0.0), dtype=float)[:size]
+            ideal = ideal_paid_out(self._scene, poses)[0]
+            self._offset = ideal[0] - ideal[1]
+        return self._offset
+
+
 class SmoothStart:
     """A controller whose commands start at what the winches paid out at t = 0.
 

@@ -48,7 +48,7 @@ from scipy.interpolate import CubicSpline
 
 from cdpr_exu.core.validation import shown
 
-from .base import Measurement, WinchCommand
+from .base import CommandStart, Measurement, WinchCommand
 
 #: Spacing of the statics samples along the reference [s].
 SAMPLE_PERIOD = 0.02
@@ -66,12 +66,16 @@ class SpatialTensionAwareController:
         Spacing of the statics samples (a cubic spline between them).
     statics : {"catenary", "chain"}
         The cable model of the equilibria (see the module notes).
+    start : {"absolute", "relative", "calibrated"}, optional
+        Where the commands start from (:data:`controllers.base.STARTS`). Default: today's, "relative" for
+        the catenary and "absolute" for the chain.
     """
 
     uses_pose = False
     uses_tension = False
 
-    def __init__(self, sample_period: float = SAMPLE_PERIOD, statics: str = "catenary") -> None:
+    def __init__(self, sample_period: float = SAMPLE_PERIOD, statics: str = "catenary",
+                 start: str | None = None) -> None:
         from cdpr_exu.core.errors import SceneError
 
         if not np.isfinite(sample_period) or sample_period <= 0:
@@ -80,7 +84,11 @@ class SpatialTensionAwareController:
             raise SceneError(f"statics must be one of {STATICS_MODELS}, got {shown(statics)}")
         self.sample_period = float(sample_period)
         self.statics = statics
-        self.name = "tension_aware" + ("_chain" if statics == "chain" else "")
+        default = "absolute" if statics == "chain" else "relative"
+        self.start = CommandStart(default if start is None else start)
+        self.uses_pose = self.start.uses_pose
+        self.name = ("tension_aware" + ("_chain" if statics == "chain" else "")
+                     + ("" if self.start.start == default else f"_{self.start.start}"))
         self._spline = None
         self.inverses: list = []
 
@@ -110,10 +118,10 @@ class SpatialTensionAwareController:
                 lengths[k] = solve(pose, acceleration)
             except UnreachableError as err:
                 raise UnreachableError(f"the reference at t = {t:.3f} s: {err}") from None
-        # catenary: the change of the lengths from the paid-out ones, which cancels the catenary's offset
-        # from the simulator's chains at the start; chain: the lengths themselves (the run blends
-        # the offset from the paid-out lengths in, SmoothStart), as the planar chain version
-        commands = lengths if self.statics == "chain" else initial + lengths - lengths[0]
+        # catenary ("relative"): the change of the lengths from the paid-out ones, which cancels the catenary's
+        # offset from the simulator's chains at the start; chain ("absolute"): the lengths themselves (the run
+        # blends the offset from the paid-out lengths in, SmoothStart), as the planar chain version
+        commands = self.start.commands(scene, lengths, initial)
         self._spline = CubicSpline(times, commands, axis=0)
         self._rate = self._spline.derivative()
 
@@ -212,4 +220,5 @@ class SpatialTensionAwareController:
         if self._spline is None:
             raise RuntimeError("SpatialTensionAwareController.reset(scene) must be called before command()")
         t = measurement.time
-        return WinchCommand(np.asarray(self._spline(t), dtype=float), np.asarray(self._rate(t), dtype=float))
+        return WinchCommand(np.asarray(self._spline(t), dtype=float) - self.start.offset(measurement),
+                            np.asarray(self._rate(t), dtype=float))

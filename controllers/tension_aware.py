@@ -49,7 +49,7 @@ from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.statics.kinematics import anchor_points, ideal_paid_out, initial_cable_nodes
 from cdpr_exu.core.validation import shown
 
-from .base import Measurement, WinchCommand
+from .base import CommandStart, Measurement, WinchCommand
 from .feedback import FilteredPositionPI
 
 
@@ -91,13 +91,16 @@ class TensionAwareController:
     table_spacing : float [m]
         Where the reference is slow, the table period grows until the reference moves
         this far in one period (at most 0.25 s); 0 keeps ``table_period``.
+    start : {"absolute", "relative", "calibrated"}
+        Where the commands start from (:data:`controllers.base.STARTS`); "absolute", the default, is today's.
     """
 
     uses_pose = False
     uses_tension = False
 
     def __init__(self, dynamic: bool = False, table_period: float = 0.02,
-                 chordal_correction: bool = False, statics: str = "catenary", table_spacing: float = 2e-3):
+                 chordal_correction: bool = False, statics: str = "catenary", table_spacing: float = 2e-3,
+                 start: str = "absolute"):
         if not np.isfinite(table_period) or table_period <= 0:
             raise SceneError(f"table_period must be positive, got {shown(table_period)}")
         if not np.isfinite(table_spacing) or table_spacing < 0:
@@ -106,13 +109,15 @@ class TensionAwareController:
             raise SceneError(f"statics must be one of {STATICS_MODELS}, got {shown(statics)}")
         if statics == "chain" and chordal_correction:
             raise SceneError("chordal_correction is for statics='catenary': the chain statics has the polygon already")
+        self.start = CommandStart(start)
+        self.uses_pose = self.uses_pose or self.start.uses_pose
         self.dynamic = bool(dynamic)
         self.chordal_correction = bool(chordal_correction)
         self.statics = statics
         self.table_period = float(table_period)
         self.table_spacing = float(table_spacing)
         self.name = ("tension_aware" + ("_chain" if statics == "chain" else "") + ("_dynamic" if self.dynamic else "")
-                     + ("_chordal" if self.chordal_correction else ""))
+                     + ("_chordal" if self.chordal_correction else "") + ("" if start == "absolute" else f"_{start}"))
         self._spline = None
         self.equilibria: list = []
 
@@ -180,9 +185,9 @@ class TensionAwareController:
         count = max(int(np.ceil(end / self._period(scene))), 3) + 1
         times = np.linspace(0.0, end, count)
         lengths = self.compensated_lengths(scene, times)
-        # The command is the compensated length itself; the run takes up its offset from
-        # the initial (straight-cable) paid-out length (controllers.base.SmoothStart).
-        commands = lengths
+        # start "absolute": the compensated length itself; the run takes up its offset from the
+        # initial (straight-cable) paid-out length (controllers.base.SmoothStart)
+        commands = self.start.commands(scene, lengths, initial_paid_out)
         at_rest = not (np.any(scene.trajectory.velocity(0.0)) or np.any(scene.trajectory.acceleration(0.0)))
         start = (1, np.zeros(scene.n_cables)) if at_rest else "not-a-knot"  # from rest: zero rate at t = 0
         self._spline = CubicSpline(times, commands, axis=0, bc_type=(start, "not-a-knot"))
@@ -196,7 +201,7 @@ class TensionAwareController:
 
     def command(self, measurement: Measurement) -> WinchCommand:
         lengths, rates = self.feed_forward(measurement.time)
-        return WinchCommand(lengths, rates)
+        return WinchCommand(lengths - self.start.offset(measurement), rates)
 
 
 class ClosedLoopTensionAwareController(TensionAwareController):
@@ -253,4 +258,4 @@ class ClosedLoopTensionAwareController(TensionAwareController):
         if measurement.platform_pose is None:
             raise SceneError(f"{self.name} needs the measured platform pose")
         lengths, rates = self.feed_forward(measurement.time)
-        return WinchCommand(lengths + self.feedback.correction(measurement), rates)
+        return WinchCommand(lengths - self.start.offset(measurement) + self.feedback.correction(measurement), rates)

@@ -101,6 +101,48 @@ def test_tension_aware_options_are_checked():
             PAPER.with_changes(effects=Effects.from_preset("elastic")), np.zeros(1))
 
 
+def test_a_relative_start_commands_the_paid_out_lengths_plus_the_models_change():
+    """Issue 27, item 3: "relative" keeps the model's change of the lengths and drops its absolute offset."""
+    times = np.linspace(0.0, 2.0, 21)
+    initial = np.array([3.0, 3.2])
+    absolute, _ = _commands(TensionAwareController(), PAPER, times, initial)
+    relative, _ = _commands(TensionAwareController(start="relative"), PAPER, times, initial)
+    # the same spline through commands that differ by a constant: equal to round-off (1e-12 m of 3 m)
+    np.testing.assert_allclose(relative, initial + absolute - absolute[0], atol=1e-12)
+
+
+def test_a_calibrated_start_moves_the_commands_by_the_ideal_change_from_the_measured_pose():
+    """Issue 27, item 3: "calibrated" counts the change from where the robot is measured at t = 0: the
+    commands take off l(p) - l(r(0)), the ideal lengths' change from the measured centre to the reference's
+    start with the measured rotation; the pose is read once."""
+    from cdpr_exu.core.errors import SceneError
+
+    controller = TensionAwareController(start="calibrated")
+    assert controller.uses_pose and controller.name == "tension_aware_calibrated"
+    initial = np.array([3.0, 3.2])
+    controller.reset(PAPER, initial)
+    start = PAPER.trajectory.pose(0.0)
+    measured = start + np.array([0.002, -0.003, 0.05])  # 2 mm right, 3 mm low, turned 0.05 rad
+    m = PAPER.n_cables
+    first = controller.command(Measurement(0.0, initial, np.zeros(m), measured))
+    ideal = ideal_paid_out(PAPER, np.array([measured, [*start[:2], measured[2]]]))[0]
+    relative = TensionAwareController(start="relative")
+    relative.reset(PAPER, initial)
+    np.testing.assert_allclose(first.paid_out, relative.command(Measurement(0.0, initial, np.zeros(m))).paid_out
+                               - (ideal[0] - ideal[1]), atol=1e-12)
+    # the change of a straight cable whose centre moves 3.6 mm: below 3.6 mm, and not zero
+    assert 1e-3 < np.abs(ideal[0] - ideal[1]).max() < 3.7e-3
+    later = controller.command(Measurement(1.0, initial, np.zeros(m), measured + 0.1))  # not read again
+    relative_later = relative.command(Measurement(1.0, initial, np.zeros(m))).paid_out
+    np.testing.assert_allclose(later.paid_out, relative_later - (ideal[0] - ideal[1]), atol=1e-12)
+    with pytest.raises(SceneError, match="start must be one of"):
+        TensionAwareController(start="rest")
+    from controllers.spatial_tension_aware import SpatialTensionAwareController  # the same rule, today's defaults
+
+    assert [SpatialTensionAwareController(statics=s, start=r).name for s, r in (("catenary", None), ("chain", None),
+            ("chain", "calibrated"))] == ["tension_aware", "tension_aware_chain", "tension_aware_chain_calibrated"]
+
+
 def test_a_reference_that_needs_a_pushing_cable_is_refused_before_the_run():
     # Above the pulleys both cables pull the platform down: only pushing cables could
     # hold its weight. (The platform starts below them: a scene starting above them is

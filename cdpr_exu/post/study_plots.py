@@ -92,14 +92,19 @@ def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], out
     return written
 
 
-def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], path: Path) -> Path:
-    """Maximum position error and Newton iterations over a 2-parameter grid, failed cells marked."""
+#: What :func:`_plot_heatmap` shows by default: (row key, scale, label) per panel.
+HEATMAP_QUANTITIES = (("max_position_error_m", 1000.0, "max position error [mm]"),
+                      ("newton_iterations", 1.0, "Newton iterations"))
+
+
+def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], path: Path,
+                  quantities=HEATMAP_QUANTITIES, title: str = "study grid") -> Path:
+    """``quantities`` (two panels) over a 2-parameter grid, failed cells marked."""
     first, second = variations
     figure = new_figure(11.0, 4.5, left=1.0, right=0.3, bottom=0.8, top=0.5, wspace=1.6, columns=2)
     axes = figure.subplots(1, 2)
     index = {(row[first.path], row[second.path]): row for row in rows}
-    for axis, quantity, scale, label in ((axes[0], "max_position_error_m", 1000.0, "max position error [mm]"),
-                                         (axes[1], "newton_iterations", 1.0, "Newton iterations")):
+    for axis, (quantity, scale, label) in zip(axes, quantities):
         grid = np.full((len(first.values), len(second.values)), np.nan)
         for i, a in enumerate(first.values):
             for j, b in enumerate(second.values):
@@ -125,9 +130,27 @@ def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], 
         axis.set_yticks(range(len(first.values)), [value_text(v) for v in first.values])
         axis.set_xlabel(second.path)
         axis.set_ylabel(first.path)
-    figure.suptitle("study grid (grey, red text: failed or refused run)", fontsize=10)
+    figure.suptitle(f"{title} (grey, red text: failed or refused run)", fontsize=10)
     figure.savefig(path, dpi=DPI, format="png")
     return path
+
+
+def plot_robustness(rows: Sequence[Mapping[str, Any]], out: str | Path) -> dict[str, Path]:
+    """A heat map per controller of a robustness study (:mod:`cdpr_exu.studies.robustness`) over its
+    platform mass and cable density errors (at the nominal stiffness): the max position error and its ratio to
+    ideal IK's;
+    ``robustness_<controller>.png``, returned by name."""
+    from cdpr_exu.studies.study import Variation
+
+    axes = [Variation(name, tuple(sorted({row[name] for row in rows}))) for name in ("platform_mass", "cable_density")]
+    quantities = (("max_position_error_m", 1000.0, "max position error [mm]"),
+                  ("max_error_vs_ideal_ik", 1.0, "ideal IK's max error / this one's"))
+    written = {}
+    for name in dict.fromkeys(row["controller"] for row in rows):
+        mine = [row for row in rows if row["controller"] == name and not row.get("cable_stiffness")]
+        written[f"robustness_{name}"] = _plot_heatmap(mine, axes, Path(out) / f"robustness_{name}.png", quantities,
+                                                      f"{name} on plants off its model")
+    return written
 
 
 # --------------------------------------------------------------------------- accuracy study

@@ -1,0 +1,299 @@
+"""Robustness as a measured property: controllers run on plants that differ from their model.
+
+The controllers' model is a scene's :meth:`~cdpr_exu.scenes.scene.Scene.controller_scene`; each
+plant of the grid is that model with relative errors on its platform's mass (and inertia, the
+same shape), its cables' linear density and their Young's modulus (:func:`perturbed`), and it
+carries the model back as its ``[controller_model]``, so that the controllers plan on the model
+and the run simulates the plant. Planar and spatial scenes alike: one run is
+:func:`cdpr_exu.run.error_estimate.simulate_any`.
+
+Each (grid point, controller) is one run on the process pool or Dask cluster of
+:mod:`cdpr_exu.studies.study`; each row is appended to ``rows.jsonl`` as it finishes, and a
+study started again skips the rows it finds there (it resumes). The table
+(``robustness.csv``, ``robustness.json``, ``robustness.md``) holds per grid point and
+controller: completed or not, the max and RMS position error and the max error's ratio to
+ideal IK's at the same grid point, the lowest element tension, the longest slack time and
+whether an element pushed; :func:`cdpr_exu.post.study_plots.plot_robustness` draws a heat map
+per controller.
+
+This module imports only the standard library and the study's helpers at its top, so that a
+spawned worker sets its thread limits before NumPy, Numba or Exudyn load.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import json
+import os
+from concurrent.futures import as_completed
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+from cdpr_exu.core.errors import CdprError, SceneError
+from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, executor_for, progress_bar, warm_up
+
+#: Files a robustness study writes.
+ROBUSTNESS_FILES = {"rows": "rows.jsonl", "csv": "robustness.csv", "json": "robustness.json",
+                    "table": "robustness.md", "scene": "base_scene.toml"}
+
+#: The model errors a grid point gives (relative, plant = model x (1 + error)).
+ERRORS = ("platform_mass", "cable_density", "cable_stiffness")
+
+#: The columns of a row, in order.
+COLUMNS = (*ERRORS, "controller", "status", "completed", "max_position_error_m", "rms_position_error_m",
+           "max_error_vs_ideal_ik", "min_element_tension_N", "slack_time_s", "elements_pushed", "failure_time_s")
+
+#: The kinds of controller a study runs; each row names one with its options (:func:`make_controller`).
+KINDS = ("ideal_ik", "tension_aware", "closed_loop_tension_aware", "model_feed_forward",
+         "closed_loop_model_feed_forward", "ilc")
+
+
+def error_grid(platform_mass=(-0.2, 0.0, 0.2), cable_density=(-0.2, 0.0, 0.2), cable_stiffness=(0.0,)) -> list[dict]:
+    """Every combination of the relative errors, as ``{error: value}`` dicts (:data:`ERRORS`)."""
+    return [dict(zip(ERRORS, values)) for values in itertools.product(platform_mass, cable_density, cable_stiffness)]
+
+
+def perturbed(model, platform_mass: float = 0.0, cable_density: float = 0.0, cable_stiffness: float = 0.0):
+    """The plant: ``model`` with relative errors on its platform's mass and inertia, its cables' linear
+    density and Young's modulus, carrying ``model``'s values as its controller model.
+
+    Raises
+    ------
+    SceneError
+        For an error at or below -1 (naming it), or a plant that is no valid robot.
+    """
+    from dataclasses import replace
+
+    from cdpr_exu.scenes.scene import ControllerModel
+
+    for name, value in (("platform_mass", platform_mass), ("cable_density", cable_density),
+                        ("cable_stiffness", cable_stiffness)):
+        if not isinstance(value, (int, float)) or not value > -1.0:
+            raise SceneError(f"{name} must be a relative error above -1, got {value!r}")
+    platform, scale = model.platform, 1.0 + platform_mass
+    inertia = platform.inertia
+    changes = {"mass": platform.mass * scale}
+    if inertia is not None:
+        changes["inertia"] = inertia * scale if isinstance(inertia, (int, float)) else tuple(v * scale for v in inertia)
+    believed = ControllerModel(platform={"mass": platform.mass, **({} if inertia is None else {"inertia": inertia})},
+                               cables=tuple({"linear_density": c.linear_density, "youngs_modulus": c.youngs_modulus}
+                                            for c in model.cables))
+    cables = tuple(replace(c, linear_density=c.linear_density * (1.0 + cable_density),
+                           youngs_modulus=c.youngs_modulus * (1.0 + cable_stiffness)) for c in model.cables)
+    return replace(model, platform=replace(platform, **changes), cables=cables, controller_model=believed)
+
+
+def make_controller(kind: str, plant, options: Mapping[str, Any] | None = None, after: float = 1.0):
+    """A controller of ``kind`` (:data:`KINDS`) for a run of ``plant``, planar or spatial, with ``options``.
+
+    ``tension_aware`` takes the tension-aware controller's options (``statics``, ``start``, ...);
+    ``closed_loop_tension_aware`` the comparison's closed loop (planar: with ``dynamic`` and
+    ``chordal_correction``) and the loop's gains; the learning kinds (planar) learn with the
+    comparison's stopping rule, ``ilc`` on ``plant`` itself.
+    """
+    from controllers.ideal_ik import IdealIKController
+    from controllers.spatial_feedback import spatial_closed_loop_tension_aware
+    from controllers.spatial_tension_aware import SpatialTensionAwareController
+    from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
+    from cdpr_exu.studies.comparison import LEARNING_CONTROLLERS
+    from cdpr_exu.studies.learning import DEFAULT_RULE
+
+    options = dict(options or {})
+    planar = plant.dimension == 2
+    if kind == "ideal_ik":
+        return IdealIKController()
+    if kind == "tension_aware":
+        return (TensionAwareController if planar else SpatialTensionAwareController)(**options)
+    if kind == "closed_loop_tension_aware":
+        if planar:
+            return ClosedLoopTensionAwareController(**{"dynamic": True, "chordal_correction": True, **options})
+        return spatial_closed_loop_tension_aware(**options)
+    if kind in LEARNING_CONTROLLERS and planar:
+        return LEARNING_CONTROLLERS[kind](DEFAULT_RULE, after=after, plant=plant, **options)
+    raise SceneError(f"kind must be one of {KINDS} (the learning ones on planar scenes), got {kind!r}")
+
+
+def run_point(plant_data: dict, kind: str, options: dict | None = None, after: float = 1.0) -> dict[str, Any]:
+    """One run of a study: ``plant_data`` (:meth:`Scene.to_dict`) under a controller of ``kind``.
+
+    Top-level and picklable, plain data in and out; never raises for a refused or failed run.
+
+    Returns
+    -------
+    dict
+        ``status``, ``completed`` and the figures of :data:`COLUMNS` from the run's summary.
+    """
+    for name, value in SINGLE_THREAD_ENVIRONMENT.items():
+        os.environ.setdefault(name, value)
+    from cdpr_exu.core.errors import SolverFailure
+    from cdpr_exu.run.error_estimate import simulate_any
+    from cdpr_exu.scenes.scene import scene_from_dict
+
+    try:
+        plant = scene_from_dict(plant_data)
+        warm_up(plant)
+        try:
+            result = simulate_any(plant, make_controller(kind, plant, options, after))
+        except SolverFailure as err:
+            if err.partial_result is None:
+                raise
+            result = err.partial_result
+    except CdprError as err:
+        return {"status": "refused: " + " ".join(str(err).split()), "completed": False}
+    except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
+        return {"status": f"failed: {type(err).__name__}: " + " ".join(str(err).split()), "completed": False}
+    summary = result.summary(after if after < plant.solver.end_time else 0.0)
+    slack = [s for s in summary.get("slack_time_per_cable_s") or [] if s is not None]
+    return {"status": result.status, "completed": result.status == "completed",
+            **{k: summary.get(k) for k in ("max_position_error_m", "rms_position_error_m", "min_element_tension_N",
+                                           "failure_time_s", "wall_time_s")},
+            "slack_time_s": max(slack) if slack else None, "elements_pushed": bool(summary.get("elements_pushed"))}
+
+
+def read_rows(out) -> list[dict]:
+    """The rows a study already wrote to ``out/rows.jsonl`` (a line cut short by an interruption is dropped)."""
+    path = Path(out) / ROBUSTNESS_FILES["rows"]
+    rows = []
+    for line in path.read_text().splitlines() if path.exists() else ():
+        try:
+            rows.append(json.loads(line))
+        except json.JSONDecodeError:
+            continue
+    return rows
+
+
+def _key(row: Mapping[str, Any]) -> tuple:
+    return (*(float(row[e]) for e in ERRORS), str(row["controller"]))
+
+
+def run_robustness(scene, controllers: Mapping[str, tuple[str, dict]], grid: Sequence[Mapping[str, float]],
+                   out: str | Path | None = None, *, after: float = 1.0, workers: int | None = None,
+                   scheduler: str | None = None, executor=None, progress: bool = True) -> list[dict]:
+    """Run every controller on the plant of every grid point; one row each (resumable).
+
+    Parameters
+    ----------
+    scene : Scene
+        Its controller scene is the controllers' model.
+    controllers : mapping
+        ``{label: (kind, options)}`` (:func:`make_controller`); ``ideal_ik`` is added when missing:
+        the ratios are to it.
+    grid : sequence of dict
+        ``{error: value}`` (:func:`error_grid`).
+    out : path, optional
+        Rows are appended to ``out/rows.jsonl`` as they finish, rows found there are not run
+        again, and the table and heat maps are written at the end (:func:`write_robustness`).
+    after : float [s]
+        Errors are measured from this time on.
+    workers, scheduler, executor
+        As :func:`cdpr_exu.studies.study.run_study`.
+
+    Returns
+    -------
+    list of dict
+        One row per grid point and controller, grid order then controller order (:data:`COLUMNS`).
+    """
+    controllers = {"ideal_ik": ("ideal_ik", {}), **controllers}
+    model = scene.controller_scene()
+    done = {_key(r): r for r in (read_rows(out) if out is not None else [])}
+    tasks = [({e: float(point.get(e, 0.0)) for e in ERRORS}, label) for point in grid for label in controllers]
+    tasks = [(point, label) for point, label in tasks if _key({**point, "controller": label}) not in done]
+    if out is not None:
+        Path(out).mkdir(parents=True, exist_ok=True)
+    bar = progress_bar(len(tasks), progress)
+    try:
+        if tasks:
+            plants = {tuple(p.values()): perturbed(model, **p).to_dict() for p, _ in tasks}
+            size = None if executor is not None or scheduler else min(workers or os.cpu_count() or 1, len(tasks))
+            with executor_for(executor, size or workers, scheduler) as pool:
+                futures = {pool.submit(run_point, plants[tuple(p.values())], *controllers[label], after): (p, label)
+                           for p, label in tasks}
+                for future in as_completed(futures):
+                    point, label = futures[future]
+                    try:
+                        row, lost = future.result(), False
+                    except Exception as err:  # noqa: BLE001 - a lost worker fails one run, not the study
+                        row, lost = {"status": f"failed: worker error: {type(err).__name__}: {err}", "completed": False}, True
+                    row = {**point, "controller": label, **row}
+                    done[_key(row)] = row
+                    if out is not None and not lost:  # a lost worker's run is run again when the study resumes
+                        from cdpr_exu.core.output import strict
+
+                        with open(Path(out) / ROBUSTNESS_FILES["rows"], "a") as handle:
+                            handle.write(json.dumps(strict(row), allow_nan=False) + "\n")
+                    bar.update(1)
+    finally:
+        bar.close()
+    rows = []
+    for point in grid:
+        point = {e: float(point.get(e, 0.0)) for e in ERRORS}
+        base = done.get(_key({**point, "controller": "ideal_ik"}), {})
+        for label in controllers:
+            row = dict(done.get(_key({**point, "controller": label}), {**point, "controller": label,
+                                                                       "status": "missing", "completed": False}))
+            mine, theirs = row.get("max_position_error_m"), base.get("max_position_error_m")
+            row["max_error_vs_ideal_ik"] = theirs / mine if row["completed"] and base.get("completed") and mine else None
+            rows.append(row)
+    if out is not None:
+        write_robustness(out, rows, scene, after)
+    return rows
+
+
+def write_robustness(out, rows: Sequence[Mapping[str, Any]], scene, after: float = 1.0, plots: bool = True) -> dict:
+    """Write ``robustness.csv``, ``robustness.json`` (wall times to ``timing.json``), ``robustness.md``,
+    ``base_scene.toml`` and a heat map per controller into ``out``; returns the paths."""
+    from cdpr_exu.core.output import csv_cell, write_summary
+    from cdpr_exu.results.result import provenance
+    from cdpr_exu.scenes.scene import save_scene
+
+    out = Path(out)
+    paths = {"scene": save_scene(scene, out / ROBUSTNESS_FILES["scene"]), "csv": out / ROBUSTNESS_FILES["csv"],
+             "table": out / ROBUSTNESS_FILES["table"]}
+    with open(paths["csv"], "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(COLUMNS)
+        writer.writerows([csv_cell(row.get(c)) for c in COLUMNS] for row in rows)
+    document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
+                "model_error": "plant = the controllers' model x (1 + error): platform mass and inertia, cable "
+                               "linear density, cable Young's modulus", "columns": list(COLUMNS),
+                "rows": [dict(r) for r in rows], **provenance()}
+    paths["json"] = write_summary(out, document, name=ROBUSTNESS_FILES["json"])
+    paths["table"].write_text(robustness_table(rows))
+    if plots:
+        from cdpr_exu.post.study_plots import plot_robustness
+
+        paths.update(plot_robustness(rows, out))
+    return paths
+
+
+def robustness_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    """A Markdown table, one line per controller over the grid: runs completed, the worst max and RMS
+    error, the worst and best ratio to ideal IK, the lowest tension, the longest slack, pushing runs and
+    the grid points not completed."""
+    groups: dict[str, list] = {}
+    for row in rows:
+        groups.setdefault(str(row["controller"]), []).append(row)
+    lines = ["| controller | completed | worst max error [mm] | worst RMS error [mm] | vs ideal IK (worst - best) | "
+             "lowest tension [N] | longest slack [s] | pushed | not completed at (mass, density, stiffness) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+
+    def pick(group, key, how):
+        values = [r[key] for r in group if r.get("completed") and r.get(key) is not None]
+        return how(values) if values else None
+
+    for name, group in groups.items():
+        ratios = [pick(group, "max_error_vs_ideal_ik", min), pick(group, "max_error_vs_ideal_ik", max)]
+        cells = [f"{sum(bool(r.get('completed')) for r in group)}/{len(group)}"]
+        for key, scale in (("max_position_error_m", 1000.0), ("rms_position_error_m", 1000.0)):
+            value = pick(group, key, max)
+            cells.append("" if value is None else f"{scale * value:.2f}")
+        cells.append("" if ratios[0] is None else f"{ratios[0]:.1f}x - {ratios[1]:.1f}x")
+        for key, how in (("min_element_tension_N", min), ("slack_time_s", max)):
+            value = pick(group, key, how)
+            cells.append("" if value is None else f"{value:.2f}")
+        cells.append(str(sum(bool(r.get("elements_pushed")) for r in group)))
+        cells.append("; ".join("(" + ", ".join(f"{r[e]:+g}" for e in ERRORS) + ")" for r in group
+                               if not r.get("completed")))
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"

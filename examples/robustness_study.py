@@ -1,0 +1,133 @@
+"""Robustness: the controllers on plants that differ from their model, and a loop designed from its margins.
+
+Issue 27. The controllers' model is the paper's robot (``paper-circle``, its circle started from rest over
+1 s as ``cdpr compare`` does); each plant is that model with its platform's mass (and inertia) and its cables'
+density off by -20, 0 or +20 % (:mod:`cdpr_exu.studies.robustness`). Three steps, one command:
+
+1. The position loop of ``closed_loop_tension_aware`` linearised on every plant at 8 poses of one turn
+   (:mod:`controllers.loop_design`), with today's gains (k_p = 2, k_i = 40 /s, f_c = 5 Hz), and gains chosen
+   from those margins: >= 6 dB and >= 30 deg on every plant and pose, the smallest sensitivity at the
+   circle's own frequency. ``margins.md`` and ``margins.json``: the worst margins over the poses per plant,
+   beside what the real run did.
+2. Every controller on every plant (``robustness.md``, ``robustness.csv``, ``robustness.json``, a heat map
+   per controller ``robustness_<controller>.png``), into ``results/robustness/planar/``.
+3. The spatial CoGiRo-class robot (``spatial-cogiro``) under the chain correction's three starts
+   (:data:`controllers.base.STARTS`) and the catenary's, nominal and with the 10 % model error of
+   ``spatial-cogiro-mismatch``: ``results/robustness/spatial-cogiro/``.
+
+Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
+this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after
+the first second. About 10 min of CPU time (ILC's 10 trials per plant are most of it); the spatial part
+about 8 min more. The model-based feed-forward (``model_feed_forward``, ``closed_loop_model_feed_forward``)
+runs as well with its kind (:data:`cdpr_exu.studies.robustness.KINDS`) added to :data:`PLANAR`.
+
+Run::
+
+    python examples/robustness_study.py [--workers N] [--fresh] [--skip-spatial]
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from cdpr_exu.core.output import write_summary
+from cdpr_exu.scenes.scene import load_scene
+from cdpr_exu.studies.comparison import smooth_start
+from cdpr_exu.studies.robustness import ROBUSTNESS_FILES, error_grid, perturbed, run_robustness
+from controllers import loop_design
+
+OUT = Path(__file__).resolve().parents[1] / "results" / "robustness"
+
+#: The planar controllers: label -> (kind, options) (:func:`cdpr_exu.studies.robustness.make_controller`).
+PLANAR = {
+    "tension_aware": ("tension_aware", {}),
+    "tension_aware_chain": ("tension_aware", {"statics": "chain"}),
+    "tension_aware_chain_relative": ("tension_aware", {"statics": "chain", "start": "relative"}),
+    "closed_loop_tension_aware": ("closed_loop_tension_aware", {}),
+    "ilc": ("ilc", {}),
+}
+
+#: The spatial controllers (item 3): the catenary's and the chain's starts.
+SPATIAL = {f"tension_aware{'_chain' if statics == 'chain' else ''}_{start}": ("tension_aware",
+                                                                             {"statics": statics, "start": start})
+           for statics in ("catenary", "chain") for start in ("absolute", "relative", "calibrated")}
+
+#: Poses the loop is linearised at: 8 over one turn of the circle, after the 1 s ramp.
+POSES = 8
+
+
+def margins_rows(cases, grid, gains: dict, rows, delay: float) -> list[dict]:
+    """Per gains and plant: the worst margins over the poses, and what the real run did."""
+    runs = {(r["platform_mass"], r["cable_density"], r["controller"]): r for r in rows}
+    table = []
+    for (name, chosen), (index, point) in ((g, p) for g in gains.items() for p in enumerate(grid)):
+        margins = [loop_design.loop_margins(robot, jacobian, chosen, delay, response=response)
+                   for i, _, robot, jacobian, response in cases if i == index]
+        label = "closed_loop_tension_aware" + ("" if name == "today" else f"_{name}")
+        run = runs.get((point["platform_mass"], point["cable_density"], label), {})
+        table.append({"platform_mass": point["platform_mass"], "cable_density": point["cable_density"],
+                      "gains": name, **asdict(chosen),
+                      **{key: min(getattr(m, key) for m in margins)
+                         for key in ("gain_margin_db", "phase_margin_deg", "disk_margin", "min_damping")},
+                      "sensitivity_peak": max(m.sensitivity_peak for m in margins),
+                      "stable": all(m.stable for m in margins),
+                      "run": "completed" if run.get("completed") else f"failed at {run.get('failure_time_s', 0.0):.1f} s",
+                      "max_position_error_m": run.get("max_position_error_m") if run.get("completed") else None,
+                      "max_error_vs_ideal_ik": run.get("max_error_vs_ideal_ik")})
+    return table
+
+
+def margins_markdown(table) -> str:
+    lines = ["| mass | density | gains (k_p, k_i [1/s], f_c [Hz]) | gain margin [dB] | phase margin [deg] | disk margin "
+             "| sensitivity peak | min pole damping | linear model | run | max error [mm] | vs ideal IK |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in table:
+        error, ratio = r["max_position_error_m"], r["max_error_vs_ideal_ik"]
+        lines.append(f"| {r['platform_mass']:+.0%} | {r['cable_density']:+.0%} | {r['gains']} ({r['proportional_gain']:g}, "
+                     f"{r['integral_gain']:g}, {r['cutoff']:g}) | {r['gain_margin_db']:.1f} | {r['phase_margin_deg']:.1f} | "
+                     f"{r['disk_margin']:.2f} | {r['sensitivity_peak']:.2f} | {r['min_damping']:.3f} | "
+                     f"{'stable' if r['stable'] else 'UNSTABLE'} | {r['run']} | "
+                     f"{'' if error is None else f'{1000 * error:.2f}'} | {'' if ratio is None else f'{ratio:.1f}x'} |")
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--workers", type=int, help="worker processes (default: one per core)")
+    parser.add_argument("--fresh", action="store_true", help="forget the rows of an earlier run (rows.jsonl)")
+    parser.add_argument("--skip-spatial", action="store_true", help="the planar study only")
+    args = parser.parse_args()
+    if args.fresh:
+        for folder in ("planar", "spatial-cogiro"):
+            (OUT / folder / ROBUSTNESS_FILES["rows"]).unlink(missing_ok=True)
+
+    model = smooth_start(load_scene("paper-circle"))
+    grid, delay = error_grid(), model.solver.step_size
+    turn = 2 * np.pi / model.trajectory.angular_rate
+    cases = loop_design.loop_cases(model, [perturbed(model, **point) for point in grid],
+                                   1.0 + turn * np.arange(POSES) / POSES)
+    designed, _ = loop_design.design_gains(cases, delay, model.trajectory.angular_rate / (2 * np.pi))
+    gains = {"today": loop_design.TODAY, "designed": designed}
+    controllers = {**PLANAR, "closed_loop_tension_aware_designed": ("closed_loop_tension_aware", asdict(designed))}
+    rows = run_robustness(model, controllers, grid, OUT / "planar", workers=args.workers)
+    table = margins_rows(cases, grid, gains, rows, delay)
+    write_summary(OUT / "planar", {"scene": model.name, "poses_per_plant": POSES, "delay_s": delay,
+                                   "design": "gain margin >= 6 dB and phase margin >= 30 deg on every plant and pose; "
+                                             "the smallest worst sensitivity at the circle's frequency",
+                                   "rows": table}, name="margins.json")
+    (OUT / "planar" / "margins.md").write_text(margins_markdown(table))
+    print((OUT / "planar" / ROBUSTNESS_FILES["table"]).read_text())
+    print(margins_markdown(table))
+    if not args.skip_spatial:
+        grid = [{"platform_mass": 0.0, "cable_density": 0.0}, {"platform_mass": 0.1, "cable_density": -0.1}]
+        run_robustness(load_scene("spatial-cogiro"), SPATIAL, grid, OUT / "spatial-cogiro", workers=args.workers)
+        print((OUT / "spatial-cogiro" / ROBUSTNESS_FILES["table"]).read_text())
+    print(f"written to {OUT}/")
+
+
+if __name__ == "__main__":  # required: the worker processes are spawned and re-import this file
+    main()
