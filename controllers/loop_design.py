@@ -60,12 +60,11 @@ FILTER_DAMPING = float(np.sqrt(0.5))
 def _equilibrium(scene, pose, wrench):
     """(chain robot, chain-statics equilibrium) holding ``scene``'s platform centre at ``pose[:2]`` under ``wrench``."""
     from cdpr_exu.statics import chain_statics, statics
-    from controllers.tension_aware import suspended_platform
 
     chain = chain_statics.chain_robot(scene)
-    start = statics.solve_inverse_statics(suspended_platform(scene), pose[:2], external_wrench=wrench)
-    return chain, chain_statics.solve_chain_statics(chain, pose[:2], start.rotation, external_wrench=wrench,
-                                                    tension_guess=[c.tension_at_anchor for c in start.cables])
+    start = statics.solve_inverse_statics(statics.catenary_platform(scene), pose[:2], external_wrench=wrench)
+    return chain, chain_statics.solve_inverse_chain_statics(chain, (*pose[:2], start.rotation), external_wrench=wrench,
+                                                            tension_guess=[c.tension_at_anchor for c in start.cables])
 
 
 def ideal_jacobian(scene, pose) -> np.ndarray:

@@ -5,7 +5,7 @@ plant of the grid is that model with relative errors on its platform's mass (and
 same shape), its cables' linear density and their Young's modulus (:func:`perturbed`), and it
 carries the model back as its ``[controller_model]``, so that the controllers plan on the model
 and the run simulates the plant. Planar and spatial scenes alike: one run is
-:func:`cdpr_exu.run.error_estimate.simulate_any`.
+:func:`cdpr_exu.run.simulate.simulate`.
 
 Each (grid point, controller) is one run on the process pool or Dask cluster of
 :mod:`cdpr_exu.studies.study`; each row is appended to ``rows.jsonl`` as it finishes, and a
@@ -127,14 +127,14 @@ def run_point(plant_data: dict, kind: str, options: dict | None = None, after: f
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)
     from cdpr_exu.core.errors import SolverFailure
-    from cdpr_exu.run.error_estimate import simulate_any
+    from cdpr_exu.run.simulate import simulate
     from cdpr_exu.scenes.scene import scene_from_dict
 
     try:
         plant = scene_from_dict(plant_data)
         warm_up(plant)
         try:
-            result = simulate_any(plant, make_controller(kind, plant, options, after))
+            result = simulate(plant, make_controller(kind, plant, options, after))
         except SolverFailure as err:
             if err.partial_result is None:
                 raise
