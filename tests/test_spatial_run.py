@@ -345,6 +345,9 @@ def test_cdpr_run_on_a_spatial_run_that_pushes_warns_once_and_prints_each_cables
     assert "completed (cables pushed: see the warnings)" in done.stdout
     slack = re.search(r"slack time per cable +(.*)", done.stdout).group(1)
     assert slack.count(" s") == 4, done.stdout
+    for axis in "xyz":  # sub-millimetre errors print in mm or um, never "0.00 cm"
+        row = re.search(rf"max \|error {axis}\| +(.*)", done.stdout).group(1)
+        assert "0.00 cm" not in row and re.search(r"\d( mm| um)", row), done.stdout
     summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
     # the push is in the initial state only (-4.86 N at t = 0): flagged, and said to be there; the lowest
     # tension is the run's, after its initial state (issue 23 follow-up)

@@ -62,6 +62,10 @@ def _print_summary(summary: dict, settled: dict, space: Space, out: Path | None)
     def pair(key, scale, unit, digits=2):  # a figure a space leaves out is n/a (and its row not printed)
         return _figure(summary.get(key), scale, unit, digits), _figure(settled.get(key), scale, unit, digits)
 
+    def length(key):  # centimetres as the paper's tables; below 1 mm (a spatial robot) never "0.00 cm"
+        return tuple("n/a" if s.get(key) is None else _figure(s[key], 100, "cm") if abs(s[key]) >= 1e-3
+                     else length_text(s[key]) for s in (summary, settled))
+
     def vertical_range(s):
         if s[f"min_error_{vertical}_m"] is None:
             return "n/a"
@@ -77,7 +81,7 @@ def _print_summary(summary: dict, settled: dict, space: Space, out: Path | None)
     factor = summary["real_time_factor"]
     rows = [
         ("status", status_text(summary), ""),
-        *((f"max |error {axis}|", *pair(f"max_abs_error_{axis}_m", 100, "cm")) for axis in space.position_labels),
+        *((f"max |error {axis}|", *length(f"max_abs_error_{axis}_m")) for axis in space.position_labels),
         (f"error {vertical} range", vertical_range(summary), vertical_range(settled)),
         ("max / RMS position error", position(summary), position(settled)),
         ("max |rotation|", *pair("max_abs_rotation_deg", 1, "deg")),
