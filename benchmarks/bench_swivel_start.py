@@ -3,8 +3,8 @@
 Builds ``spatial-four-cable-swivel`` (4 cables x 48 elements and 6 on each winch line,
 bending, tension-only elements: the model ``cdpr run`` builds) and brings it to rest
 twice, on two fresh models in this one process (one core): by
-:func:`cdpr_exu.builder.spatial_robot.start_at_rest` (the chain statics, then Exudyn's
-static solver to polish) and by the fallback :func:`cdpr_exu.builder.spatial_robot.settle`
+:func:`cdpr_exu.run.settle.start_at_rest` (the chain statics, then Exudyn's
+static solver to polish) and by the fallback :func:`cdpr_exu.run.settle.settle`
 (0.5 s of damped dynamics, then Exudyn's static solver). Then the same without bending,
 and with spring elements (the model ``cdpr static`` builds). It prints the CPU and wall
 time of each start, their ratio, and how far apart the two starts' states lie (largest
@@ -23,7 +23,8 @@ from pathlib import Path
 import exudyn as exu
 import numpy as np
 
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec, settle, start_at_rest
+from cdpr_exu.builder.robot_3d import build_spatial_robot, scene_chain_spec
+from cdpr_exu.run.settle import settle, start_at_rest
 from cdpr_exu.statics.statics import catenary_platform
 from cdpr_exu.scenes.scene import load_scene
 

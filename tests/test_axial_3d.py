@@ -13,8 +13,8 @@ from cdpr_exu.physics.axial import TAUT_BAND, cable_elements, slack_axial_force
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import add_spatial_chain
-from cdpr_exu.builder.spatial_robot import (SpatialChainSpec, anchor_forces, build_spatial_robot, dynamic_settings,
-                                            element_forces, robot_energy, solve_static)
+from cdpr_exu.builder.robot_3d import SpatialChainSpec, anchor_forces, build_spatial_robot, element_forces, robot_energy
+from cdpr_exu.run.settle import dynamic_settings, solve_static
 from conftest import ASYMMETRIC_LENGTHS, PAPER_CATENARY_CABLE, PENALTY, four_cable_robot
 
 # The paper's cable, and the four-cable robot of tests/conftest.py.

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from cdpr_exu.builder.model import initial_nodes
-from cdpr_exu.builder.spatial_robot import (build_spatial_robot, chain_statics_robot, scene_chain_spec,
-                                            set_configuration, solve_static, swivel_angles)
+from cdpr_exu.builder.robot_3d import build_spatial_robot, scene_chain_spec, swivel_angles
+from cdpr_exu.run.settle import chain_statics_robot, set_configuration, solve_static
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.run.spatial_rest import PENALTY, solve_spatial_rest
 from cdpr_exu.scenes.scene import Effects, PlatformSpec, load_scene
@@ -378,11 +378,12 @@ def test_over_swivel_pulleys_exudyns_static_solver_accepts_the_chain_statics_equ
 def test_a_rigid_platform_on_exact_joints_over_swivel_pulleys_starts_at_rest_and_stays_there():
     import warnings
 
-    from cdpr_exu.builder.spatial_robot import platform_pose, start_at_rest
+    from cdpr_exu.builder.robot_3d import platform_pose
+    from cdpr_exu.run.settle import start_at_rest
     from cdpr_exu.run.dynamics import run_dynamic
 
     # Exudyn's static solver diverges on exact spherical joints holding a turning rigid body
-    # (builder/spatial_robot.py), so it cannot check this start; its dynamic solver can: started
+    # (builder/robot_3d.py), so it cannot check this start; its dynamic solver can: started
     # at rest on the chain statics' equilibrium, the platform stays put. Measured over 0.05 s:
     # 1e-15 m and 3e-15 rad (the platform turned by 0.02 rad at rest)
     scene = _swivel_scene(rigid=True)

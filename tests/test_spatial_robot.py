@@ -1,11 +1,12 @@
-"""A spatial robot in Exudyn (cdpr_exu.builder.spatial_robot), real solver: statics against the catenary, energy."""
+"""A spatial robot in Exudyn (cdpr_exu.builder.robot_3d), real solver: statics against the catenary, energy."""
 
 import exudyn as exu
 import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError, SolverFailure
-from cdpr_exu.builder.spatial_robot import SpatialChainSpec, build_spatial_robot, solve_static
+from cdpr_exu.builder.robot_3d import SpatialChainSpec, build_spatial_robot
+from cdpr_exu.run.settle import solve_static
 from cdpr_exu.run.dynamics import run_dynamic
 from cdpr_exu.statics.statics import SuspendedPlatform, solve_statics
 from conftest import ASYMMETRIC_LENGTHS, PENALTY, four_cable_robot

@@ -161,7 +161,7 @@ def test_a_spatial_scene_gets_the_planar_bending_damping_constant_only_with_effe
     effects.bending_damping the chains have no dampers (and no cost for them)."""
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec
+    from cdpr_exu.builder.robot_3d import build_spatial_robot, scene_chain_spec
     from cdpr_exu.statics.statics import catenary_platform
 
     scene = load_scene("spatial-four-cable")

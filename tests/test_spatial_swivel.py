@@ -102,7 +102,7 @@ def test_a_symmetric_robot_over_swivel_pulleys_hangs_symmetric():
 def test_spatial_scenes_honour_the_paper_mass_lumping():
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec
+    from cdpr_exu.builder.robot_3d import build_spatial_robot, scene_chain_spec
 
     scene = load_scene("spatial-four-cable")
     paper = replace(scene, cables=tuple(replace(c, mass_lumping="paper") for c in scene.cables))
@@ -123,7 +123,8 @@ def pushed_swivel_robot():
     Returns (mbs, items, energy at rest [J], energy after the push [J])."""
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot, robot_energy, scene_chain_spec, settle
+    from cdpr_exu.builder.robot_3d import build_spatial_robot, robot_energy, scene_chain_spec
+    from cdpr_exu.run.settle import settle
 
     scene = load_scene(NAME)
     scene = replace(scene, effects=replace(scene.effects, bending_damping=False))
@@ -144,7 +145,7 @@ def pushed_swivel_robot():
 
 
 def _pushed_run(pushed, step, spectral_radius, modified_newton, end_time=0.05):
-    from cdpr_exu.builder.spatial_robot import dynamic_settings
+    from cdpr_exu.run.settle import dynamic_settings
     from cdpr_exu.run.dynamics import run_dynamic
 
     mbs, items, _, _ = pushed
@@ -210,7 +211,8 @@ def test_the_inverse_statics_over_swivel_pulleys_give_lengths_whose_catenaries_h
 def test_a_swivel_robot_starts_on_its_chain_statics_and_the_dynamic_settle_is_the_fallback():
     import exudyn as exu
 
-    from cdpr_exu.builder.spatial_robot import build_spatial_robot, scene_chain_spec, start_at_rest
+    from cdpr_exu.builder.robot_3d import build_spatial_robot, scene_chain_spec
+    from cdpr_exu.run.settle import start_at_rest
 
     scene = load_scene(NAME)  # bending on; spring elements, as cdpr static builds it
 

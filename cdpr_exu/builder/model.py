@@ -22,9 +22,11 @@ from cdpr_exu.core.errors import SceneError
 from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes, straight_cable_nodes
 from cdpr_exu.builder.platform import PlatformItems, add_platform, attach_cable
 from cdpr_exu.builder.pulley import add_pulley_contact, add_pulley_ground
+from cdpr_exu.builder.robot_3d import Model3D, build_model_3d
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.physics.segment_contact import contact_segments
 from cdpr_exu.builder.winch import ServoItems, WinchItems, add_servo_drum, add_winch
+from cdpr_exu.space import PLANE, SPACE
 
 
 @dataclass
@@ -196,8 +198,15 @@ def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.
 SPARSE_JACOBIAN_MIN_NODES = 50
 
 
-def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
-    """Build and assemble the Exudyn system of ``scene``.
+def build_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model | Model3D:
+    """Build and assemble the Exudyn system of ``scene``, planar or spatial: the scene's space picks the
+    item family (:data:`BUILDERS`: :func:`build_planar_model`, :func:`cdpr_exu.builder.robot_3d.build_model_3d`).
+    """
+    return BUILDERS[scene.space](scene, sparse_jacobian)
+
+
+def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Model:
+    """Build and assemble the Exudyn system of a planar ``scene``.
 
     ``sparse_jacobian`` hands Exudyn the Jacobian of the cables' Python-side forces
     (exact bending, tension-only elements) as sparse triplets, whose cost grows with the
@@ -313,3 +322,7 @@ def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems
     mbs.Assemble()
     return Model(scene, system_container, mbs, [], platform, winches, None, [[] for _ in ropes],
                  [np.zeros(0, dtype=int) for _ in ropes], np.asarray(paid_out), ropes)
+
+
+#: The builder of each space's item family, by :class:`cdpr_exu.space.Space`.
+BUILDERS = {PLANE: build_planar_model, SPACE: build_model_3d}

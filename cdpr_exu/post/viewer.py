@@ -3,7 +3,7 @@
 A run folder written by ``cdpr run SCENE --out DIR`` holds ``scene.toml`` and
 ``solution.sol`` (Exudyn's binary solution file), for planar and spatial scenes alike. The
 scene rebuilds the identical Exudyn system (:func:`cdpr_exu.builder.model.build_model`, or
-for a spatial scene :func:`cdpr_exu.run.spatial_run.build_spatial_model`); each row of the
+for a spatial scene the same entry); each row of the
 solution file is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
 
 - :func:`view_solution` (``cdpr view DIR``) replays the run in Exudyn's interactive
@@ -43,12 +43,11 @@ import numpy as np
 from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
 from exudyn.utilities import LoadSolutionFile, SetSolutionState
 
-from cdpr_exu.builder import spatial_robot
+from cdpr_exu.builder.robot_3d import platform_pose
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.errors import CdprError, OutputError
 from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.core.output import check_output_folder, clear_outputs
-from cdpr_exu.run.spatial_run import build_spatial_model
 from cdpr_exu.scenes.scene import Scene, load_scene
 from cdpr_exu.space import SPACE
 
@@ -221,7 +220,7 @@ class SpatialReplay:
     run_dir : Path
     scene : Scene
     mbs : exudyn.MainSystem
-        Rebuilt from ``scene.toml`` (:func:`cdpr_exu.run.spatial_run.build_spatial_model`).
+        Rebuilt from ``scene.toml`` (:func:`cdpr_exu.builder.model.build_model`).
     items : SpatialRobotItems
     solution : dict
         As for :class:`Replay`.
@@ -241,7 +240,7 @@ class SpatialReplay:
         poses = []
         for row in range(self.n_rows):
             SetSolutionState(self.mbs, self.solution, row, exu.ConfigurationType.Current)
-            position, rotation = spatial_robot.platform_pose(self.mbs, self.items)
+            position, rotation = platform_pose(self.mbs, self.items)
             poses.append(np.concatenate([position, rotation_vector(rotation)]))
         return np.asarray(poses)
 
@@ -268,12 +267,10 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | Spati
     scene_file, solution_file = run_files(run_dir)
     scene = load_scene(scene_file)
     solution = load_solution(solution_file)
-    if scene.dimension == 3:  # one replay when the builder is one (issue 24, slice 9)
-        mbs, items = build_spatial_model(scene)
-        check_solution_fits(mbs, solution, f"solution file {str(solution_file)!r}")
-        return SpatialReplay(Path(run_dir), scene, mbs, items, solution)
     model = build_model(scene)
     check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
+    if scene.dimension == 3:  # one replay when the replays are one
+        return SpatialReplay(Path(run_dir), scene, model.mbs, model.items, solution)
     if decorate:
         times = np.asarray(solution["data"][:, 0], dtype=float)
         decorate_model(model, reference_path(scene, times))

@@ -1,6 +1,6 @@
 """Dynamic runs of an assembled spatial robot or of one cable over a swivel pulley, for tests and benchmarks.
 
-:func:`run_dynamic` integrates a robot of :func:`cdpr_exu.builder.spatial_robot.build_spatial_robot`
+:func:`run_dynamic` integrates a robot of :func:`cdpr_exu.builder.robot_3d.build_spatial_robot`
 from its initial configuration at a fixed step (generalised-alpha, optional energy record);
 :func:`run_swivel_pendulum` builds and runs the measured swivel-pulley scene: a mass on a cable
 over the pulley, swinging around the axis (:mod:`cdpr_exu.builder.swivel_chain`). The
@@ -19,7 +19,8 @@ import exudyn as exu
 import numpy as np
 
 from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
-from cdpr_exu.builder.spatial_robot import dynamic_settings, platform_pose, robot_energy
+from cdpr_exu.builder.robot_3d import platform_pose, robot_energy
+from cdpr_exu.run.settle import dynamic_settings
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy
 from cdpr_exu.core.errors import SolverFailure
 from cdpr_exu.core.geometry import rotation_vector

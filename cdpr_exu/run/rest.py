@@ -74,7 +74,7 @@ from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.geometry import penetration
 from cdpr_exu.core.output import write_npz, write_summary
-from cdpr_exu.builder.spatial_robot import static_settings
+from cdpr_exu.run.settle import static_settings
 from cdpr_exu.physics import bending
 from cdpr_exu.results.result import provenance
 from cdpr_exu.run.simulate import likely_cause

@@ -5,12 +5,12 @@
 * the **catenary statics** (:func:`cdpr_exu.statics.statics.solve_statics`):
   each cable a continuous elastic catenary in its own vertical plane, the platform's
   pose from the cables' unstrained lengths (no bending);
-* the **lumped robot in Exudyn** (:mod:`cdpr_exu.builder.spatial_robot`): the scene's
+* the **lumped robot in Exudyn** (:mod:`cdpr_exu.builder.robot_3d`): the scene's
   chains with its effects (bending included), started on the catenary solution and
   brought to equilibrium by Exudyn's static solver (``mbs.SolveStatic``). Over swivel
   pulleys, where Exudyn's static solver does not converge from the catenary start, the
   chain statics (:mod:`cdpr_exu.statics.chain_statics`, the same discrete model)
-  first take it to equilibrium (:func:`cdpr_exu.builder.spatial_robot.start_at_rest`),
+  first take it to equilibrium (:func:`cdpr_exu.run.settle.start_at_rest`),
   and Exudyn's static solver confirms it.
 
 and reports the lumped robot's pose (position, rotation vector and the rotation as
@@ -18,7 +18,7 @@ angles), its tensions and end forces, and how far the catenary answer lies from 
 (the discretisation error, about n^-2, plus the effect of bending). A rigid platform's
 cable ends are held by stiff penalty joints in the static solve (Exudyn's static
 solver diverges on ``ObjectJointSpherical`` when the body must turn, see
-:mod:`cdpr_exu.builder.spatial_robot`); they add 1 / (:data:`PENALTY` n) of a cable's
+:mod:`cdpr_exu.builder.robot_3d`); they add 1 / (:data:`PENALTY` n) of a cable's
 compliance. The static solve uses spring elements also where the scene's cables are
 tension-only (``effects.slack``): a slack element has no stiffness, and Exudyn's static
 solver fails from such a start; while every element is taut the two give the same
@@ -38,8 +38,8 @@ import numpy as np
 from cdpr_exu.core.errors import SolverFailure
 from cdpr_exu.core.geometry import rotation_angles_deg
 from cdpr_exu.core.output import write_summary
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, scene_chain_spec, \
-    solve_static, start_at_rest, swivel_angles
+from cdpr_exu.builder.robot_3d import build_spatial_robot, chain_positions, element_forces, scene_chain_spec, swivel_angles
+from cdpr_exu.run.settle import solve_static, start_at_rest
 from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import Scene

@@ -1,10 +1,10 @@
 """Dynamic runs of spatial scenes: the lumped robot following a 6-DOF reference (issue 15).
 
-:func:`simulate_spatial` builds the scene's robot (:mod:`cdpr_exu.builder.spatial_robot`:
+:func:`simulate_spatial` builds the scene's robot (:mod:`cdpr_exu.builder.robot_3d`:
 chains held at their exit points, a point-mass or rigid platform on spherical joints),
 starts it at rest on its elastic-catenary equilibrium (over swivel pulleys on the lumped
 robot's own equilibrium, found by the chain statics:
-:func:`cdpr_exu.builder.spatial_robot.start_at_rest`), and integrates it with Exudyn's
+:func:`cdpr_exu.run.settle.start_at_rest`), and integrates it with Exudyn's
 implicit solver (the scene's ``[solver]``) while the winches follow the ideal inverse
 kinematics of the reference: each cable's paid-out length is its initial length plus
 the change of the straight distance from its exit point to its anchor along the
@@ -13,7 +13,7 @@ planar ``ideal_ik`` controller.
 
 **The winch at a point exit.** A spatial scene's cable leaves the frame at a fixed
 point, where the winch pays it out (over a swivel pulley the winch end moves along
-the pulley's axis instead, :mod:`cdpr_exu.builder.spatial_robot`). The lumped cable keeps
+the pulley's axis instead, :mod:`cdpr_exu.builder.robot_3d`). The lumped cable keeps
 its n elements and changes with its paid-out (unstrained) length L(t): every element's
 unstrained length L / n, its axial stiffness E A n / L and damping d_n A n / L, the node
 masses rho L / n (half at the ends) and their weights, and the bending stiffness
@@ -39,9 +39,9 @@ import numpy as np
 
 from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
-from cdpr_exu.builder.spatial_robot import build_spatial_robot, chain_positions, element_forces, platform_pose, \
-    scene_chain_spec, start_at_rest
-from cdpr_exu.statics.statics import catenary_platform, solve_statics
+from cdpr_exu.builder.robot_3d import chain_positions, element_forces, platform_pose
+from cdpr_exu.builder.model import build_model
+from cdpr_exu.run.settle import start_at_rest
 from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
 from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController
@@ -53,7 +53,7 @@ from cdpr_exu.run.spatial_rest import rest_above_exits
 from cdpr_exu.scenes.scene import Scene, tension_limits
 from cdpr_exu.statics.workspace import check_reference
 
-__all__ = ["simulate_spatial", "build_spatial_model"]
+__all__ = ["simulate_spatial"]
 
 
 class _SpatialWinches:
@@ -188,28 +188,6 @@ def check_runnable(scene: Scene) -> None:
     check_reference(scene)
 
 
-def build_spatial_model(scene: Scene):
-    """The scene's lumped robot in a new Exudyn system, assembled in its catenary start; returns (mbs, items).
-
-    What :func:`simulate_spatial` integrates and what a replay of its solution file
-    (:func:`cdpr_exu.post.viewer.load_replay`) rebuilds: the same items in the same order, so the
-    same coordinates. The start over swivel pulleys (:func:`start_at_rest`) moves only the
-    initial coordinates, which a replay takes from the solution file.
-
-    Raises
-    ------
-    UnreachableError
-        If no static equilibrium of the scene's lengths exists to start from.
-    """
-    platform = catenary_platform(scene)
-    lengths = scene.unstrained_lengths
-    start = solve_statics(platform, lengths)
-    mbs = exu.SystemContainer().AddSystem()
-    items = build_spatial_robot(mbs, platform, lengths, scene_chain_spec(scene), initial=start, swivels=scene.swivel_exits)
-    mbs.Assemble()
-    return mbs, items
-
-
 def simulate_spatial(scene: Scene, controller: Controller | None = None, progress=False, *,
                      solution_file: str | Path | None = None, sparse_jacobian: bool | None = None) -> Result:  # noqa: ARG001
     """The spatial run loop behind :func:`cdpr_exu.run.simulate.simulate`: run ``scene``'s reference under
@@ -244,7 +222,8 @@ def simulate_spatial(scene: Scene, controller: Controller | None = None, progres
         platform above its exits.
     """
     check_runnable(scene)
-    mbs, items = build_spatial_model(scene)
+    model = build_model(scene)
+    mbs, items = model.mbs, model.items
     lengths = scene.unstrained_lengths
     if any(scene.swivel_exits):
         _warn_outside_measured_region(scene)

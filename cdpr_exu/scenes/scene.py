@@ -1031,7 +1031,7 @@ def _planar_rules(scene: Scene) -> None:
 
 
 def _spatial_rules(scene: Scene) -> None:
-    """What the spatial builder builds so far (:mod:`cdpr_exu.builder.spatial_robot`)."""
+    """What the spatial builder builds so far (:mod:`cdpr_exu.builder.robot_3d`)."""
     if not (scene.effects.cable_mass and scene.effects.axial_elasticity):
         raise SceneError(f"effects.preset = {shown(scene.effects.preset)}: a spatial scene needs lumped, elastic "
                          "cables (effects.cable_mass and effects.axial_elasticity); use the 'full' or 'catenary' preset")

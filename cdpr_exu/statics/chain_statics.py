@@ -25,8 +25,8 @@ fixed paid-out lengths (the winch end on the winch line ``x = c_x + side r_p``,
 angles, and the inverse by Gauss-Newton on the lengths over chains held at their anchors
 (:func:`solve_held_chain`). All minimise with :func:`descent_step` and one Armijo line search
 (:func:`_line_search`). Over swivel pulleys, where Exudyn's static solver does not converge from
-the catenary start (:func:`cdpr_exu.builder.spatial_robot.settle`), the forward statics' answer
-starts the runs (:func:`cdpr_exu.builder.spatial_robot.start_at_rest`).
+the catenary start (:func:`cdpr_exu.run.settle.settle`), the forward statics' answer
+starts the runs (:func:`cdpr_exu.run.settle.start_at_rest`).
 
 Units SI (m, N, kg, rad); the vertical axis up, gravity along it downwards.
 """
@@ -199,7 +199,7 @@ class ChainRobot:
     anchor_spring_factor : float or None
         In space: None, each cable's last node sits on its anchor (an exact spherical joint); a
         number f > 0, it is tied to the anchor by an isotropic spring of stiffness f k (the
-        builder's penalty joint, :class:`cdpr_exu.builder.spatial_robot.SpatialChainSpec`).
+        builder's penalty joint, :class:`cdpr_exu.builder.robot_3d.SpatialChainSpec`).
     """
 
     cables: tuple
@@ -307,7 +307,7 @@ def _spatial_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
             below = winch_line_elements(swivel.winch_line, l0)
             held = swivel_chain_start(catenary.cables[i], length, n, below, swivel.contact_stiffness)[1][0]
             pulley = swivel.pulley()
-        # the builder's lumping (:func:`cdpr_exu.builder.spatial_robot.build_spatial_robot`), to the last bit
+        # the builder's lumping (:func:`cdpr_exu.builder.robot_3d.build_spatial_robot`), to the last bit
         masses = (node_masses_along(n + below, chain_element_mass(cable, length, n, gravity), spec.mass_lumping)
                   if gravity > 0 else np.zeros(n + below + 1))
         cables.append(ChainCable(
