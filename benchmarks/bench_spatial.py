@@ -19,7 +19,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import load_scene
 
 RESULTS = Path(__file__).resolve().parent / "results" / "spatial.md"
@@ -43,7 +43,7 @@ def main() -> None:
     rows = []
     for label, variant in variants(scene):
         cpu = time.process_time()
-        result = simulate_spatial(variant)
+        result = simulate(variant)
         cpu = time.process_time() - cpu
         summary = result.summary(1.0)
         rows.append((label, args.end_time / result.wall_time, args.end_time / cpu,

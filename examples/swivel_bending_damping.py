@@ -34,7 +34,7 @@ from matplotlib.figure import Figure
 from cdpr_exu.core.output import write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.run.error_estimate import path_distance
-from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import load_scene
 
 NAME = "spatial-four-cable-swivel"
@@ -83,7 +83,7 @@ def main(argv=None) -> int:
     for n in COUNTS:
         for damped in (False, True):
             start = time.process_time()
-            results[n, damped] = simulate_spatial(scene_for(n, damped))
+            results[n, damped] = simulate(scene_for(n, damped))
             cpu[n, damped] = time.process_time() - start
             print(f"{n:4d} elements, bending damping {'on ' if damped else 'off'}: {results[n, damped].status}, "
                   f"{cpu[n, damped]:.1f} s CPU", flush=True)

@@ -548,7 +548,7 @@ def test_over_swivel_pulleys_the_held_chains_force_rate_is_the_derivative_of_pay
     robot, rest = chain_robot(scene), chain_rest(scene)
     cable, length = robot.cables[1], scene.unstrained_lengths[1]
     # the run's swivel winch keeps the elements and moves the held winch end up the axis by the change
-    # of the paid-out length (spatial_run._SpatialWinches)
+    # of the paid-out length (run_3d._SpatialWinches)
     longer = cable_paid_out(cable, length + 2e-3)
     assert longer.paid_out_length == pytest.approx(length + 2e-3, abs=1e-15)
     assert longer.held_point - cable.held_point == pytest.approx([0.0, 0.0, 2e-3], abs=1e-15)

@@ -155,10 +155,10 @@ def test_the_estimate_of_a_held_spatial_robot_matches_its_error_against_the_cate
     limit without bending). Measured: 0.455 mm estimated, 0.435 mm true at 4 elements
     (ratio 1.05); 0.0959 mm and 0.0935 mm at 8 (1.03): the static error is of order 2 as
     assumed. Bound: within 0.8 to 1.5 of the truth."""
-    from cdpr_exu.run.spatial_run import simulate_spatial
+    from cdpr_exu.run.simulate import simulate
 
     scene, catenary = _four_cable(n)
-    result = simulate_spatial(scene)
+    result = simulate(scene)
     estimate = estimate_error(scene, result)
     mask = result.time >= 1.0 - 1e-9
     true = np.linalg.norm(result.pose[mask, :3] - catenary, axis=1).max()
@@ -173,7 +173,7 @@ def test_the_estimate_of_a_moving_spatial_robot_is_within_a_factor_two_of_a_four
     steps, before :class:`cdpr_exu.physics.axial.CutSlopes`): the step's error (0.3 to 0.5 mm
     at 1e-2 s) is of the discretisation error's size here (docs/accuracy.md). Bound: within
     0.5 to 2 (an estimate whose order is assumed)."""
-    from cdpr_exu.run.spatial_run import simulate_spatial
+    from cdpr_exu.run.simulate import simulate
     from cdpr_exu.scenes.trajectories import PointToPointTrajectory
     from cdpr_exu.space import SPACE
 
@@ -183,7 +183,7 @@ def test_the_estimate_of_a_moving_spatial_robot_is_within_a_factor_two_of_a_four
     move = PointToPointTrajectory(tuple(start), tuple(end), duration=1.0, space=SPACE)
     scene, _ = _four_cable(8, move, end_time=2.0)
     fine, _ = _four_cable(32, move, end_time=2.0)
-    result, reference = simulate_spatial(scene), simulate_spatial(fine)
+    result, reference = simulate(scene), simulate(fine)
     estimate = estimate_error(scene, result)
     mask = result.time >= 1.0 - 1e-9
     path = np.column_stack([np.interp(result.time, reference.time, reference.pose[:, k]) for k in range(3)])
@@ -225,7 +225,7 @@ def test_tension_only_spatial_references_converge_at_order_two_and_keep_their_st
     (:class:`cdpr_exu.physics.axial.CutSlopes`), Newton cut the 32- and 64-element runs' steps
     (1306 steps for 401) and their paths moved by 0.30 and 0.39 mm, not converging. Bound:
     a ratio above 3 (order above 1.58)."""
-    from cdpr_exu.run.spatial_run import simulate_spatial
+    from cdpr_exu.run.simulate import simulate
     from cdpr_exu.scenes.trajectories import PointToPointTrajectory
     from cdpr_exu.space import SPACE
 
@@ -237,7 +237,7 @@ def test_tension_only_spatial_references_converge_at_order_two_and_keep_their_st
     for n in (16, 32, 64):
         scene, _ = _four_cable(n, move, end_time=2.0)
         scene = replace(scene, solver=replace(scene.solver, step_size=5e-3, output_period=5e-3))
-        result = simulate_spatial(scene)
+        result = simulate(scene)
         assert result.status == "completed"
         if n == 32:
             assert result.steps <= scene.solver.n_steps + 1  # Exudyn counts the initial step too

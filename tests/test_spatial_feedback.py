@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cdpr_exu.statics.kinematics import ideal_paid_out
-from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.scenes.trajectories import HoldTrajectory, PointToPointTrajectory
 from cdpr_exu.space import SPACE
@@ -63,7 +63,7 @@ def spied():
     scene = four_cable(end_time=1.0)
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     spy = _Spy()
-    return scene, spy, simulate_spatial(scene, spy)
+    return scene, spy, simulate(scene, spy)
 
 
 def test_a_controller_that_uses_the_pose_gets_the_pose_recorded_at_its_state_time(spied):
@@ -132,7 +132,7 @@ def test_ideal_ik_under_the_smooth_start_is_unchanged_bit_for_bit():
             return WinchCommand(self.last, super().command(measurement).paid_out_rate)
 
     controller = Recorded()
-    result = simulate_spatial(scene, controller)
+    result = simulate(scene, controller)
     # the first pair is SmoothStart's own call at t = 0 (4e-16 m off the initial lengths, dropped)
     assert np.array_equal(result.paid_out[0], scene.unstrained_lengths)
     assert np.abs(controller.pairs[0][1] - scene.unstrained_lengths).max() < 1e-12
@@ -149,8 +149,8 @@ def test_the_spatial_loop_removes_most_of_what_ideal_ik_misses():
     start = start_pose(scene)
     end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
     scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.5, space=SPACE))
-    open_loop = simulate_spatial(scene, IdealIKController()).summary(2.25)
-    closed = simulate_spatial(scene, ClosedLoopController("closed", IdealIKController(), SpatialPositionPI(),
+    open_loop = simulate(scene, IdealIKController()).summary(2.25)
+    closed = simulate(scene, ClosedLoopController("closed", IdealIKController(), SpatialPositionPI(),
                                                           follow="reference")).summary(2.25)
     # measured 0.75 s after the move: 0.231 mm and 0.021 deg open loop, 1.7e-3 mm and 5.6e-4 deg
     # closed (during the move the loop lags: 0.098 mm against 0.234 mm)
@@ -214,8 +214,8 @@ def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_contr
     end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
     scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.5, space=SPACE),
                     controller_model=ControllerModel(platform={"mass": 20.0}, cable={"youngs_modulus": YOUNG}))
-    open_loop = simulate_spatial(scene, SpatialTensionAwareController()).summary(2.25)
-    closed = simulate_spatial(scene, spatial_closed_loop_tension_aware()).summary(2.25)
+    open_loop = simulate(scene, SpatialTensionAwareController()).summary(2.25)
+    closed = simulate(scene, spatial_closed_loop_tension_aware()).summary(2.25)
     # measured 0.75 s after the move: 6.6 um and 1.3e-3 deg open loop, 0.75 um and 4.4e-5 deg closed
     message = f"open {open_loop['max_position_error_m']:.3e} m, closed {closed['max_position_error_m']:.3e} m"
     assert closed["max_position_error_m"] < open_loop["max_position_error_m"] / 4.0, message
@@ -236,7 +236,7 @@ def test_a_controller_that_uses_the_tensions_gets_tensions_that_hold_the_platfor
     scene = ipanema(end_time=0.3, output_period=0.01)
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     spy = _TensionSpy()
-    result = simulate_spatial(scene, spy)
+    result = simulate(scene, spy)
     robot = chain_robot(scene)
     rest = np.array([t[-1] for t in chain_rest(scene).tensions])  # the lumped robot's statics
     anchor_weights = np.array([c.node_masses[-1] for c in robot.cables]) * robot.gravity

@@ -1,4 +1,4 @@
-"""Dynamic runs of spatial scenes (cdpr_exu.run.spatial_run), real solver: the variable-length winch and ideal IK."""
+"""Dynamic runs of spatial scenes (cdpr_exu.run.simulate), real solver: the variable-length winch and ideal IK."""
 
 import json
 import re
@@ -12,7 +12,7 @@ import pytest
 from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.results.result import slack_time
-from cdpr_exu.run.spatial_run import simulate_spatial
+from cdpr_exu.run.simulate import simulate
 from cdpr_exu.studies.comparison import spatial_comparison_table
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
@@ -36,7 +36,7 @@ def start_pose(scene):
 def test_a_robot_told_to_hold_its_equilibrium_stays_there():
     scene = four_cable(end_time=2.0)
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
-    result = simulate_spatial(scene)
+    result = simulate(scene)
     # It starts on the catenary, which the 10-element chains meet to their discretisation
     # error (6.6e-5 m measured for this robot, tests/test_spatial_robot.py); it settles there.
     assert np.abs(result.position_error).max() < 1.5e-4
@@ -76,7 +76,7 @@ def test_a_spatial_run_reports_how_long_each_cable_was_slack():
             rates[0] = 0.1 * self.initial[0] / 0.2 if s < 1.0 else 0.0
             return WinchCommand(lengths, rates)
 
-    result = simulate_spatial(scene, PayOut())
+    result = simulate(scene, PayOut())
     summary = result.summary(after=0.0)
     slack = summary["slack_time_per_cable_s"]
     widths = np.diff(result.time, append=result.time[-1])
@@ -97,7 +97,7 @@ def test_after_a_move_the_robot_rests_where_the_catenaries_of_the_paid_out_lengt
     start = start_pose(scene)
     end = start + np.array([0.2, -0.15, 0.1, 0.0, 0.0, 0.05])
     scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=2.0, space=SPACE))
-    result = simulate_spatial(scene)
+    result = simulate(scene)
     final = result.paid_out[-1]
     assert np.abs(final - scene.unstrained_lengths).max() > 0.25  # the winches moved decimetres
     rest = solve_statics(catenary_platform(scene), final, initial_pose=result.pose[-1])
@@ -120,7 +120,7 @@ def test_paying_out_at_speed_does_not_damp_the_cable():
     start = start_pose(scene)
     end = start + np.array([0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
     scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.0, space=SPACE))
-    result = simulate_spatial(scene)
+    result = simulate(scene)
     tensions = np.concatenate([t.ravel() for t in result.tensions])
     assert 250.0 < tensions.min() and tensions.max() < 550.0
     assert np.abs(result.position_error).max() < 1e-3
@@ -128,7 +128,7 @@ def test_paying_out_at_speed_does_not_damp_the_cable():
 
 def test_a_scene_without_trajectory_is_refused_before_the_run():
     with pytest.raises(SceneError, match=r"no \[trajectory\]"):
-        simulate_spatial(load_scene("spatial-four-cable"))
+        simulate(load_scene("spatial-four-cable"))
 
 
 def test_cdpr_run_on_a_spatial_scene_writes_its_summary_and_overview(tmp_path):
@@ -150,7 +150,7 @@ def test_a_reference_above_the_exits_is_refused_before_the_run_naming_the_time_a
     scene = replace(scene, trajectory=PointToPointTrajectory(start, (-0.034, -0.013, 6.5, 0.0, 0.0, 0.0),
                                                               duration=5.0, space=SPACE))
     with pytest.raises(UnreachableError, match=r"at t = 3\.\d+ s is outside the workspace.*non-negative tensions"):
-        simulate_spatial(scene)
+        simulate(scene)
 
 
 def test_a_reference_that_starts_above_the_exits_is_refused_saying_so():
@@ -160,7 +160,7 @@ def test_a_reference_that_starts_above_the_exits_is_refused_saying_so():
     scene = replace(scene, trajectory=HoldTrajectory((0.0, 0.0, 0.5, 0.0, 0.0, 0.0), space=SPACE))
     with pytest.raises(UnreachableError, match=r"at t = 0\.000 s is outside the workspace.*the pose is above the "
                        r"exits: .*platform\.anchors\[0\] at z = 0\.5 m, exits\[0\] up to z = 0\.1 m.*cables cannot push"):
-        simulate_spatial(scene)
+        simulate(scene)
 
 
 def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_ideal_ik():
@@ -170,9 +170,9 @@ def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_idea
     scene = load_scene("spatial-ipanema")
     scene = replace(scene, cables=tuple(replace(c, n_elements=10) for c in scene.cables),
                     solver=replace(scene.solver, end_time=4.0))
-    ideal = simulate_spatial(scene, IdealIKController()).summary(1.0)
-    aware = simulate_spatial(scene, SpatialTensionAwareController()).summary(1.0)
-    chain = simulate_spatial(scene, SpatialTensionAwareController(statics="chain")).summary(1.0)
+    ideal = simulate(scene, IdealIKController()).summary(1.0)
+    aware = simulate(scene, SpatialTensionAwareController()).summary(1.0)
+    chain = simulate(scene, SpatialTensionAwareController(statics="chain")).summary(1.0)
     # measured 0.40 mm and 0.020 mm: sag and stretch are what ideal IK misses; what is left is
     # the lumped chain's own discretisation and dynamics
     assert aware["max_position_error_m"] < ideal["max_position_error_m"] / 10.0
@@ -206,8 +206,8 @@ def test_the_chain_version_runs_over_swivel_pulleys_and_follows_the_ramp_closer_
     # reference's 11 um offset from that rest (measured 4.6 um)
     assert np.abs(controller.inverses[0].paid_out - scene.unstrained_lengths).max() < 2e-5
     assert all(np.all(np.isfinite(inverse.swivel_angles)) for inverse in controller.inverses)
-    ideal = simulate_spatial(scene, IdealIKController())
-    chain = simulate_spatial(scene, SpatialTensionAwareController(statics="chain"))
+    ideal = simulate(scene, IdealIKController())
+    chain = simulate(scene, SpatialTensionAwareController(statics="chain"))
     assert chain.status == "completed" and chain.controller == "tension_aware_chain"
     # measured: max 0.86 mm against ideal IK's 3.86 mm (later the paying-out cables' winch lines go slack
     # below the inlets at 1 rad/s, a dynamic lag both share: docs/spatial.md)
@@ -261,7 +261,7 @@ def test_a_spatial_run_reports_each_tension_limit_crossed_as_the_planar_run_does
     scene = four_cable(end_time=0.5)
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE),
                     cables=tuple(replace(c, min_tension=5.0, max_tension=25.0) for c in scene.cables))
-    result = simulate_spatial(scene)
+    result = simulate(scene)
     summary = result.summary(after=0.0)
     assert summary["tension_limits_N"] == [[5.0, 25.0]] * 4
     violations = {(v["cable"], v["limit"]): v for v in summary["tension_limit_violations"]}
@@ -280,7 +280,7 @@ def test_a_spatial_run_reports_each_tension_limit_crossed_as_the_planar_run_does
     assert violations, "straight cables need at most 22 N at the anchor; with the cables' weight the top elements carry more than 25 N"
     json.loads(json.dumps(summary))  # strict JSON
     assert "tension limit violations" in spatial_comparison_table({"ideal_ik": summary})
-    assert "violations" not in spatial_comparison_table({"ideal_ik": simulate_spatial(replace(
+    assert "violations" not in spatial_comparison_table({"ideal_ik": simulate(replace(
         scene, cables=tuple(replace(c, min_tension=None, max_tension=None) for c in scene.cables))).summary()})
 
 
@@ -297,7 +297,7 @@ def test_a_run_whose_solver_shrank_its_steps_completes_and_records_its_end_time(
                     trajectory=CircleTrajectory(center=(0.0, 0.1, -1.9), radius=0.1, angular_rate=1.0,
                                                 ramp_time=0.1, space=SPACE),
                     solver=replace(base.solver, step_size=0.03, output_period=0.03, end_time=0.35))
-    result = simulate_spatial(scene)
+    result = simulate(scene)
     assert result.steps > 2 * scene.solver.n_steps  # the solver shrank its steps
     assert result.status == "completed" and np.all(np.isfinite(result.pose))
     assert result.time[-1] == pytest.approx(0.35, abs=1e-12)  # the final state, at the end time
@@ -317,7 +317,7 @@ def test_a_run_shorter_than_the_error_window_still_reports_its_pushing_cables():
     """Issue 23.1: the spatial summary measured tensions only after the first second, so a 1 s run
     whose recorded tensions reached -24,094 N reported elements_pushed: false. The safety figures
     cover the whole run, the start included; only the errors keep the window."""
-    result = simulate_spatial(pushing_four_cable())
+    result = simulate(pushing_four_cable())
     lowest = min(t.min() for t in result.tensions)
     assert lowest < -1.0  # a recorded fact of the run (-4.86 N at t = 0)
     summary = result.summary(after=1.0)
@@ -378,7 +378,7 @@ def test_a_rotation_the_cables_cannot_hold_is_refused_before_the_run_naming_the_
         check_reference(scene)
     assert "platform.inertia" in str(refusal.value)
     with pytest.raises(UnreachableError, match=pattern):
-        simulate_spatial(scene)  # before anything is built
+        simulate(scene)  # before anything is built
 
 
 def test_a_spatial_run_that_fails_says_what_exudyn_said():
@@ -388,7 +388,7 @@ def test_a_spatial_run_that_fails_says_what_exudyn_said():
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     with pytest.raises(SolverFailure, match=r"failed at t = 0\.\d{4} s of 0\.3 s: Exudyn's solver stopped "
                                             r"\(SolveDynamic terminated\): reduction of step size reached minimum"):
-        simulate_spatial(scene)
+        simulate(scene)
 
 
 class ReelIn:
@@ -419,7 +419,7 @@ def test_a_platform_thrown_above_its_exits_stops_the_run_and_its_summary_flags_i
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE),
                     solver=replace(scene.solver, step_size=2e-3, output_period=0.01))
     with pytest.raises(SolverFailure, match=r"the platform rose above its highest exit at t = 0\.\d{4} s") as failure:
-        simulate_spatial(scene, ReelIn(0.1, 0.05))
+        simulate(scene, ReelIn(0.1, 0.05))
     partial = failure.value.partial_result
     assert partial.status.startswith("failed") and 0.0 < partial.pose[-1, 2] < 0.1  # stopped as it passed z = 0
     summary = partial.summary()
@@ -474,7 +474,7 @@ def test_a_robot_that_comes_to_rest_above_its_exits_is_not_run():
                     solver=replace(base.solver, step_size=0.0057, output_period=0.0057, end_time=0.133))
     with pytest.raises(SolverFailure, match=r"failed at t = 0\.0000 s .*cannot start from the robot's rest: "
                                             r".*holds the platform at z = 0\.65\d m") as failure:
-        simulate_spatial(scene)
+        simulate(scene)
     partial = failure.value.partial_result
     assert len(partial.time) == 1 and partial.summary()["platform_above_exits"]
 
@@ -517,7 +517,7 @@ def test_an_extreme_spatial_run_is_refused_fails_with_a_cause_or_completes_clean
                                                     angular_rate=1.0, ramp_time=0.1, space=SPACE),
                         solver=replace(base.solver, step_size=min(step, end), output_period=min(step, end),
                                        end_time=end))
-        result = simulate_spatial(scene)
+        result = simulate(scene)
     except (SceneError, UnreachableError) as refusal:  # refused before the run, naming why
         assert str(refusal)
         return

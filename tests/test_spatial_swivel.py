@@ -238,13 +238,13 @@ def test_a_swivel_robot_starts_on_its_chain_statics_and_the_dynamic_settle_is_th
 
 
 def test_a_short_run_over_swivel_pulleys_starts_at_rest_and_follows_the_reference():
-    from cdpr_exu.run.spatial_run import simulate_spatial
+    from cdpr_exu.run.simulate import simulate
 
     # the shipped scene, bending on: its start, the chain statics' equilibrium, takes 0.07 s of CPU time
     # (the dynamic settle took 15 s, benchmarks/results/swivel_start.md)
     scene = load_scene(NAME)
     scene = replace(scene, solver=replace(scene.solver, end_time=0.3))
-    result = simulate_spatial(scene)
+    result = simulate(scene)
     # The robot starts at rest on the axis, where the reference starts (z = -0.842 m in the scene,
     # -0.842011 m the lumped robot's rest), and tracks the ramp's first 0.3 s
     assert np.abs(result.pose[0, :2]).max() < 1e-9  # symmetric rest on the axis
@@ -338,12 +338,12 @@ def test_a_run_does_not_start_from_a_rest_above_the_pulleys():
     """The run over swivel pulleys starts from the chain statics' rest: at 2.4e11 Pa that stood the
     platform 0.63 m above the inlets, and the run reported `completed`."""
     from cdpr_exu.core.errors import SolverFailure
-    from cdpr_exu.run.spatial_run import simulate_spatial
+    from cdpr_exu.run.simulate import simulate
 
     scene = stiff_swivel(2.4e11)
     scene = replace(scene, solver=replace(scene.solver, end_time=0.05))
     with pytest.raises(SolverFailure, match=r"failed at t = 0\.0000 s.*cannot start from the robot's rest: .* at z = 0\.63\d+ m .*above the top"):
-        simulate_spatial(scene)
+        simulate(scene)
 
 
 def test_a_winch_line_shorter_than_its_margin_is_refused_in_millimetres_with_what_to_give():

@@ -20,6 +20,7 @@ import numpy as np
 from cdpr_exu.builder.cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes, straight_cable_nodes
+from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.builder.platform import PlatformItems, add_platform, attach_cable
 from cdpr_exu.builder.pulley import add_pulley_contact, add_pulley_ground
 from cdpr_exu.builder.robot_3d import Model3D, build_model_3d
@@ -160,16 +161,6 @@ def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 
     return np.flatnonzero(reach)
 
 
-def check_trajectory_reachable(scene: Scene) -> None:
-    """Refuse a reference the cables cannot reach or hold, before any simulation.
-
-    See :func:`cdpr_exu.statics.workspace.check_reference` (one check for every controller).
-    """
-    from cdpr_exu.statics.workspace import check_reference
-
-    check_reference(scene)
-
-
 def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.ndarray) -> None:
     """Refuse a cable whose straight elements cut deep into the pulley from the start.
 
@@ -177,7 +168,7 @@ def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.
     chord through the disc, and the cable then slips through the pulley. Segment contact
     pushes the chords themselves out of the disc: no element length is refused then
     (``effects.pulley_contact_model = "segment"``; the coarsest cables are limited by
-    :func:`check_trajectory_reachable` instead).
+    :func:`cdpr_exu.statics.workspace.check_reference` instead).
     """
     from cdpr_exu.core.geometry import segment_penetration
 
@@ -219,7 +210,7 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
     UnreachableError
         If the reference trajectory leaves the reachable workspace.
     """
-    check_trajectory_reachable(scene)
+    check_reference(scene)  # a reference the cables cannot reach or hold is refused before anything is built
     system_container = exu.SystemContainer()
     mbs = system_container.AddSystem()
     ground_node = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))

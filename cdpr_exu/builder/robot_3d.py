@@ -496,17 +496,8 @@ def swivel_angles(mbs, items, current=True):
 
 @dataclass
 class Model3D:
-    """A spatial scene's assembled Exudyn system, the role of the planar :class:`cdpr_exu.builder.model.Model`.
-
-    Attributes
-    ----------
-    scene : Scene
-    system_container : exudyn.SystemContainer
-    mbs : exudyn.MainSystem
-    items : SpatialRobotItems
-    initial_paid_out : ndarray, shape (m,) [m]
-        The unstrained lengths the chains start with (the winches' paid-out lengths at t = 0).
-    """
+    """A spatial scene's assembled Exudyn system (the planar :class:`cdpr_exu.builder.model.Model`'s role):
+    ``items`` (:class:`SpatialRobotItems`), ``initial_paid_out`` (m,) [m] the unstrained lengths it starts with."""
 
     scene: object
     system_container: object
@@ -524,13 +515,9 @@ class Model3D:
 
 
 def build_model_3d(scene, sparse_jacobian: bool | None = None) -> Model3D:  # noqa: ARG001 - the planar builder's
-    """The scene's lumped robot in a new Exudyn system, assembled in its catenary equilibrium.
-
-    What a spatial run integrates and what a replay of its solution file
-    (:func:`cdpr_exu.post.viewer.load_replay`) rebuilds: the same items in the same order, so the
-    same coordinates. The start over swivel pulleys (:func:`cdpr_exu.run.settle.start_at_rest`) moves
-    only the initial coordinates, which a replay takes from the solution file. (``sparse_jacobian`` is
-    the planar builder's choice; the spatial robot's Jacobian is Exudyn's own.)
+    """The scene's lumped robot in a new Exudyn system, assembled in its catenary equilibrium: what a run
+    integrates and a replay rebuilds (the start over swivel pulleys, :func:`cdpr_exu.run.settle.start_at_rest`,
+    moves only the initial coordinates). ``sparse_jacobian`` is the planar builder's choice.
 
     Raises
     ------

@@ -4,8 +4,7 @@
 from its initial configuration at a fixed step (generalised-alpha, optional energy record);
 :func:`run_swivel_pendulum` builds and runs the measured swivel-pulley scene: a mass on a cable
 over the pulley, swinging around the axis (:mod:`cdpr_exu.builder.swivel_chain`). The
-scene-level runs are :func:`cdpr_exu.run.spatial_run.simulate_spatial` and
-:func:`cdpr_exu.run.simulate.simulate`. Units SI; z up.
+scene-level runs are :func:`cdpr_exu.run.simulate.simulate`. Units SI; z up.
 """
 
 from __future__ import annotations

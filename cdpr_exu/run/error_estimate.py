@@ -17,7 +17,7 @@ reference of the accuracy study (``tests/test_error_estimate.py``).
 :func:`elements_for_tolerance` inverts the same model: the fewest elements whose
 estimated error stays below a tolerance.
 
-Spatial scenes (``dimension = 3``, :mod:`cdpr_exu.run.spatial_run`) get the same estimate
+Spatial scenes (``dimension = 3``, :mod:`cdpr_exu.run.run_3d`) get the same estimate
 on the platform centre's 3-D path. Measured on the four-cable robot without bending
 (``tests/test_error_estimate.py``): held on its catenary pose, the error falls as n^-2
 and the estimate is 1.05 (4 elements) and 1.03 (8) times the true error against the
@@ -105,9 +105,8 @@ def companion_elements(scene) -> int:
     n = max(c.n_elements for c in scene.cables)
     if n >= 30:
         try:
-            half = _with_elements(scene, n // 2)  # a spatial scene checks its swivel pulleys here
-            if half.dimension == 2:  # the planar builder checks its elements against the pulleys
-                build_model(half)
+            build_model(_with_elements(scene, n // 2))  # a spatial scene checks its swivel pulleys, the planar
+            # builder its elements against the pulleys
             return n // 2
         except CdprError:
             pass

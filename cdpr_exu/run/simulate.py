@@ -21,15 +21,15 @@ from controllers.base import Controller, Measurement, SmoothStart
 from controllers.ideal_ik import IdealIKController
 
 from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
-from cdpr_exu.core.errors import RunInterrupted, SolverFailure
+from cdpr_exu.core.errors import RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
+from cdpr_exu.builder.robot_3d import Model3D
 from cdpr_exu.core.geometry import penetration
 from cdpr_exu.results.result import Result
 from cdpr_exu.run.solver import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
                                   solver_settings)
-from cdpr_exu.run import spatial_run
+from cdpr_exu.run.run_3d import Run3D
 from cdpr_exu.scenes.scene import Scene
-from cdpr_exu.space import PLANE, SPACE
 from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.builder.winch import RopeReservoir, servo_force, set_paid_out_length
 
@@ -245,14 +245,14 @@ def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndar
     return nodes, velocities, tensions
 
 
-class _Stepper:
-    """The per-step state of one run and Exudyn's pre- and post-step functions.
+class Run2D:
+    """The planar robot's side of a run: its winch drive, measurement, records and checks.
 
     Before each step it asks the controller for the winch commands (from a
     :class:`Measurement`) and drives the winches (kinematic lengths, servo motor forces,
-    the slack-rope reservoir); after each step it records the outputs that are due,
-    checks them (:class:`_Monitor`), reports progress and ends the integration on a
-    problem or a Ctrl-C, keeping what was computed.
+    the slack-rope reservoir); after each step it records the outputs that are due
+    (:class:`_Recorder`), checks them (:class:`_Monitor`), reports progress and ends the
+    integration on a problem or a Ctrl-C, keeping what was computed.
 
     Attributes
     ----------
@@ -260,22 +260,21 @@ class _Stepper:
         The last commanded (or, for servos, measured) paid-out lengths and rates.
     stop_reason : str or None
         Why the run was stopped early (a monitor problem or a controller error).
-    stop_exception : Exception or None
-        The controller's exception, when it raised.
     interrupted : dict
         ``{"interrupted": bool}``, set by :func:`interrupt_flag` during the solve.
     """
 
-    def __init__(self, scene: Scene, model: Model, controller: Controller, recorder: "_Recorder",
-                 monitor: "_Monitor", report, ref_q: np.ndarray):
-        self.scene, self.model, self.controller = scene, model, controller
-        self.recorder, self.monitor, self.report = recorder, monitor, report
-        self.ref_q = ref_q
+    def __init__(self, scene: Scene, model: Model):
+        self.scene, self.model = scene, model
+        self.controller: Controller | None = None
+        self.report = None
+        self.recorder = recorder = _Recorder(model, scene.solver.output_period, scene.solver.end_time)
+        self.ref_q = ref_q = model.mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
+        self.monitor = _Monitor(scene, recorder.indices, ref_q)
         self.indices = recorder.indices
         self.paid_out = model.initial_paid_out.copy()
         self.rate = np.zeros(len(scene.cables))
         self.stop_reason: str | None = None
-        self.stop_exception: Exception | None = None
         self.interrupted = {"interrupted": False}
         self.reservoir = _rope_reservoir(scene, model)
         self.first_step_kink = arm_first_step_kink(model.cable_forces)
@@ -286,6 +285,16 @@ class _Stepper:
         self.servo_integral = np.zeros(len(model.servos))
         self.servo_time = 0.0
         self.step_start = 0.0  # end of the last accepted step: the time of the state the solver has [s]
+        self.start = _time.perf_counter()
+
+    def initial_pose(self) -> None:
+        """The pose the controller starts from: None, the scene's initial pose (the model is built there)."""
+        return None
+
+    def begin(self, controller: Controller, report) -> None:
+        """Record the start (a planar start is always runnable)."""
+        self.controller, self.report = controller, report
+        self.recorder.record_if_due(0.0, self.paid_out)
         self.start = _time.perf_counter()
 
     def _cable_tensions(self, q: np.ndarray, v: np.ndarray, i: int, which: slice) -> np.ndarray:
@@ -346,7 +355,6 @@ class _Stepper:
         except Exception as err:  # noqa: BLE001 - reported as the cause of the stop
             self.stop_reason = (f"controller {self.controller.name!r} raised at t = {t:.4f} s: "
                                 f"{type(err).__name__}: {err}")
-            self.stop_exception = err
             return False
         self.paid_out = paid_out
         self.rate = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
@@ -379,14 +387,39 @@ class _Stepper:
         return True
 
 
+    def result(self, controller_name: str, failure: str | None) -> Result:
+        """What was recorded, as a :class:`Result`; after a failure it ends at its last finite sample."""
+        recorder = self.recorder
+        if failure is not None and not self.interrupted["interrupted"]:
+            recorded = slice(0, recorder.count)
+            finite_rows = np.all(np.isfinite(recorder.q[recorded]) & np.isfinite(recorder.v[recorded]), axis=1)
+            if not finite_rows.all():
+                recorder.count = int(np.argmin(finite_rows))
+        result = recorder.result(self.scene, controller_name)
+        if self.reservoir is not None:
+            result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
+        return result
+
+    def reached(self, result: Result) -> tuple[float, bool]:
+        """The time of the last finite sample [s], and whether every output time was sampled."""
+        finite = np.all(np.isfinite(result.pose), axis=1) if len(result.time) else np.zeros(0, bool)
+        return float(result.time[finite][-1]) if finite.any() else 0.0, len(result.time) == len(self.recorder.output_times)
+
+    def notes(self, failure: str, time: float) -> tuple[str, str]:
+        """What the failure's message says before and after the cause: the step size and the likely cause."""
+        return f" (step size {self.scene.solver.step_size} s)", f". {likely_cause(self.scene, failure, time)}"
+
+
 def simulate(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
              progress: bool | Callable[[float, float], None] = False,
              sparse_jacobian: bool | None = None) -> Result:
     """Simulate ``scene``, planar or spatial, under ``controller`` (default: ideal inverse kinematics).
 
-    The one entry for both dimensions: the scene's space picks its run loop (:data:`RUNS`:
-    :func:`simulate_planar`, :func:`cdpr_exu.run.spatial_run.simulate_spatial`), and both return the
-    one :class:`~cdpr_exu.results.result.Result`.
+    One run loop for both dimensions: it builds the scene's model (:func:`cdpr_exu.builder.model.build_model`),
+    wraps the controller in :class:`SmoothStart` (its commands start at the paid-out lengths), integrates
+    with Exudyn's implicit solver and returns the one :class:`~cdpr_exu.results.result.Result`. What
+    differs by dimension (the winch drive, the measurement, the records and the checks) lives in the
+    model's run side (:data:`RUNS`: :class:`Run2D`, :class:`cdpr_exu.run.run_3d.Run3D`).
 
     Parameters
     ----------
@@ -414,103 +447,77 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
         If the solver fails; ``.time`` and ``.partial_result`` say when and what was
         computed up to then.
     """
-    return RUNS[scene.space][1](scene, controller, solution_file=solution_file, progress=progress,
-                                sparse_jacobian=sparse_jacobian)
+    check_runnable(scene)
+    model = build_model(scene, sparse_jacobian=sparse_jacobian)
+    run = RUNS[type(model)](scene, model)
+    # The controller plans on its own model of the robot (the scene's controller model, if it has one),
+    # never on the plant's parameters; what the winches paid out at t = 0 and the pose it starts from are
+    # the plant's. Every controller starts from what the winches paid out at t = 0 (SmoothStart).
+    controller = SmoothStart(controller or IdealIKController())
+    controller.reset(scene.controller_scene(), model.initial_paid_out.copy(),
+                     initial_pose=run.initial_pose() if controller.uses_pose else None)
+    mbs, solver = model.mbs, scene.solver
+    report = progress_reporter(progress, scene)
+    run.begin(controller, report)
+    mbs.SetPreStepUserFunction(run.pre_step)
+    mbs.SetPostStepUserFunction(run.post_step)
+    failure = None
+    with interrupt_flag() as interrupted, quiet_exudyn():
+        run.interrupted = interrupted
+        try:
+            if run.stop_reason is None:
+                mbs.SolveDynamic(solver_settings(scene, solution_file))
+        except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn's own cause, not only "terminated"
+            failure = solver_report(mbs, " ".join(str(err).split()))
+    failure = run.stop_reason or failure
+    wall = _time.perf_counter() - run.start
+    if report is not None:
+        report(None, wall)
+    result = run.result(controller.name, failure)
+    solved = mbs.sys.get("dynamicSolver")  # none when the start was refused
+    result.wall_time = wall
+    result.steps, result.newton_iterations = (0, 0) if solved is None else (
+        int(solved.it.currentStepIndex), int(solved.it.newtonStepsCount))
+    result.metadata.update({"effects": scene.effects.preset, "step_size_s": solver.step_size,
+                            "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts(),
+                            # above the highest exit every cable pulls the platform down (Result.summary)
+                            "highest_exit_z_m": float(scene.exit_points[:, -1].max())})
+    if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
+        result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
+    reached, complete = run.reached(result)
+    if interrupted["interrupted"]:
+        result.status, result.failure_time = f"interrupted at t = {reached:.4f} s", reached
+        raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
+                             time=reached, partial_result=result)
+    if failure is None and not (complete and np.all(np.isfinite(result.pose))):
+        failure = "the solution contains NaN or stopped before the end time"
+    if failure is not None:
+        result.status, result.failure_time = f"failed: {failure}", reached
+        before, after = run.notes(failure, reached)
+        raise SolverFailure(f"the run failed at t = {reached:.4f} s of {solver.end_time} s{before}: {failure}{after}",
+                            time=reached, partial_result=result)
+    return result
 
 
 def check_runnable(scene: Scene) -> None:
     """Refuse a scene :func:`simulate` cannot run, before anything is built or written (``cdpr run`` checks
-    before it writes): no reference, or one the cables cannot follow (by the scene's space, :data:`RUNS`).
+    before it writes): no ``[trajectory]``, or a reference the cables cannot follow
+    (:func:`cdpr_exu.statics.workspace.check_reference`).
 
     Raises
     ------
     SceneError, UnreachableError
     """
-    RUNS[scene.space][0](scene)
+    if scene.trajectory is None:
+        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
+    check_reference(scene)
 
 
-def simulate_planar(scene: Scene, controller: Controller | None = None, *, solution_file: str | Path | None = None,
-                    progress: bool | Callable[[float, float], None] = False,
-                    sparse_jacobian: bool | None = None) -> Result:
-    """The planar run loop behind :func:`simulate` (its parameters and errors)."""
-    controller = controller or IdealIKController()
-    model = build_model(scene, sparse_jacobian=sparse_jacobian)
-
-    # The controller plans on its own model of the robot (the scene's controller model,
-    # if it has one), never on the plant's parameters; what the winches paid out at t = 0
-    # is the plant's.
-    # Every controller starts from what the winches paid out at t = 0 (SmoothStart).
-    controller = SmoothStart(controller)
-    controller.reset(scene.controller_scene(), model.initial_paid_out.copy())
-    mbs = model.mbs
-    solver = scene.solver
-    recorder = _Recorder(model, solver.output_period, solver.end_time)
-    ref_q = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
-    report = progress_reporter(progress, scene)
-    stepper = _Stepper(scene, model, controller, recorder, _Monitor(scene, recorder.indices, ref_q), report, ref_q)
-    start = stepper.start
-    mbs.SetPreStepUserFunction(stepper.pre_step)
-    mbs.SetPostStepUserFunction(stepper.post_step)
-    recorder.record_if_due(0.0, stepper.paid_out)
-    settings = solver_settings(scene, solution_file)
-    failure = None
-    with interrupt_flag() as interrupted, quiet_exudyn():
-        stepper.interrupted = interrupted
-        try:
-            mbs.SolveDynamic(settings)
-        except (exu.SolverError, RuntimeError, SystemError) as err:  # Exudyn reports failures this way
-            failure = solver_report(mbs, " ".join(str(err).split()))
-    if interrupted["interrupted"]:
-        wall = _time.perf_counter() - start
-        if report is not None:
-            report(None, wall)
-        result = recorder.result(scene, controller.name)
-        result.wall_time = wall
-        reached = float(result.time[-1]) if len(result.time) else 0.0
-        result.status = f"interrupted at t = {reached:.4f} s"
-        result.failure_time = reached
-        raise RunInterrupted(f"interrupted by the user at t = {reached:.4f} s of {solver.end_time} s",
-                             time=reached, partial_result=result)
-    if stepper.stop_reason is not None:
-        failure = stepper.stop_reason
-    if failure is not None:  # the partial result ends at its last finite sample
-        recorded = slice(0, recorder.count)
-        finite_rows = np.all(np.isfinite(recorder.q[recorded]) & np.isfinite(recorder.v[recorded]), axis=1)
-        if not finite_rows.all():
-            recorder.count = int(np.argmin(finite_rows))
-    wall = _time.perf_counter() - start
-    if report is not None:
-        report(None, wall)
-    result = recorder.result(scene, controller.name)
-    iterations = mbs.sys["dynamicSolver"].it
-    result.wall_time = wall
-    result.steps = int(iterations.currentStepIndex)
-    result.newton_iterations = int(iterations.newtonStepsCount)
-    if stepper.reservoir is not None:
-        result.winch_reservoir = recorder.surplus[:len(result.time)].copy()
-    result.metadata = {"effects": scene.effects.preset, "step_size_s": solver.step_size,
-                       "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts(),
-                       # above the highest pulley centre every cable pulls the platform down (Result.summary)
-                       "highest_exit_z_m": max(float(e.point[-1]) for e in scene.exits)}
-    if scene.tension_limits is not None:  # (t_min, t_max) per cable; JSON has no inf: null is "no limit"
-        result.metadata["tension_limits_N"] = [[c.min_tension, c.max_tension] for c in scene.cables]
-    last_time = float(result.time[-1]) if len(result.time) else 0.0
-    if failure is None and (not np.all(np.isfinite(result.pose)) or len(result.time) < len(recorder.output_times)):
-        failure = "the solution contains NaN or stopped before the end time"
-    if failure is not None:
-        finite = np.all(np.isfinite(result.pose), axis=1) if len(result.time) else np.zeros(0, bool)
-        last_time = float(result.time[finite][-1]) if finite.any() else 0.0
-        result.status = f"failed: {failure}"
-        result.failure_time = last_time
-        raise SolverFailure(
-            f"the run failed at t = {last_time:.4f} s of {solver.end_time} s "
-            f"(step size {solver.step_size} s): {failure}. {likely_cause(scene, failure, last_time)}",
-            time=last_time, partial_result=result)
-    return result
-
-
-#: The check before a run and the run loop, by space: (check(scene), run(scene, controller, **options)).
-RUNS = {PLANE: (check_reference, simulate_planar), SPACE: (spatial_run.check_runnable, spatial_run.simulate_spatial)}
+#: The run side of each dimension's model, ``RUNS[type(model)](scene, model)``: its winch drive, measurement,
+#: records and checks behind one interface (``initial_pose()``, ``begin(controller, report)``, ``pre_step``,
+#: ``post_step``, ``stop_reason``, ``interrupted``, ``start``, ``result(name, failure)``, ``reached(result)``,
+#: ``notes(failure, time)``).
+RUNS = {Model: Run2D, Model3D: Run3D}
 
 
 def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:

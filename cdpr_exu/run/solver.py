@@ -1,8 +1,8 @@
-"""What the planar and the spatial run loops share: Exudyn's settings and console, Ctrl-C, the
+"""What the run loop and each dimension's run side share: Exudyn's settings and console, Ctrl-C, the
 output times, the solver's own report of a failure, and the progress bar.
 
-Below both run loops (:mod:`cdpr_exu.run.simulate` and :mod:`cdpr_exu.run.spatial_run`), so that the
-one :func:`~cdpr_exu.run.simulate.simulate` can choose between them without a circle of imports.
+Below the run loop (:mod:`cdpr_exu.run.simulate`) and the spatial run side (:mod:`cdpr_exu.run.run_3d`),
+so that the one :func:`~cdpr_exu.run.simulate.simulate` uses both without a circle of imports.
 """
 
 from __future__ import annotations

@@ -93,7 +93,7 @@ class ChainCable:
     winch_travel : float [m]
         Over a swivel pulley: how far the winch has moved the held winch end up the axis from
         ``exit_point`` (paying out; else 0). The run's swivel winch keeps the chain's elements
-        and moves only this end (:class:`cdpr_exu.run.spatial_run._SpatialWinches`).
+        and moves only this end (:class:`cdpr_exu.run.run_3d._SpatialWinches`).
     """
 
     node_masses: tuple
@@ -946,7 +946,7 @@ _NO_SWIVEL = np.zeros(0)
 # ---------------------------------------------------------------------------
 def cable_paid_out(cable: ChainCable, length: float) -> ChainCable:
     """``cable`` paid out to the unstrained ``length`` [m], as the run's variable-length winch changes it
-    (:class:`cdpr_exu.run.spatial_run._SpatialWinches`): at a point exit the same n elements of length
+    (:class:`cdpr_exu.run.run_3d._SpatialWinches`): at a point exit the same n elements of length
     L / n, their stiffness E A n / L, the node masses rho L / n and the bending stiffness E J n / L; over a
     swivel pulley the same elements, the held winch end moved up the axis by the change of the paid-out
     length (``winch_travel``, :attr:`ChainCable.paid_out_length`), the cable running over the disc."""
