@@ -729,11 +729,6 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
     return paths
 
 
-def load_accuracy_study(out: str | Path) -> dict[str, Any]:
-    """Read ``accuracy.json`` back (rows, reference, grid, provenance)."""
-    return json.loads((Path(out) / ACCURACY_FILES["json"]).read_text())
-
-
 # --------------------------------------------------------------------------- tables
 
 

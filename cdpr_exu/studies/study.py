@@ -115,18 +115,6 @@ class Variation:
             if isinstance(value, (dict, list, tuple)) or value is None:
                 raise SceneError(f"parameter {self.path!r}: values must be numbers, booleans or strings, got {value!r}")
 
-    def to_text(self) -> str:
-        """The ``PATH=V1,V2`` form that :func:`parse_parameter` reads back."""
-        return f"{self.path}=" + ",".join(_toml_scalar(v) for v in self.values)
-
-
-def _toml_scalar(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return json.dumps(value)
-    return repr(value)
-
 
 def _parse_value(text: str, path: str) -> Any:
     """One TOML scalar; a bare word (``full``) is taken as a string."""
@@ -619,11 +607,6 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
 
         paths.update(plot_study(rows, variations, out, mode=mode))
     return paths
-
-
-def load_study(out: str | Path) -> dict[str, Any]:
-    """Read a study's ``study.json`` back (rows, variations, base scene, provenance)."""
-    return json.loads((Path(out) / STUDY_FILES["json"]).read_text())
 
 
 # --------------------------------------------------------------------------- table
