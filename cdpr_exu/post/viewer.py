@@ -395,10 +395,9 @@ def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
     return ground
 
 
-def _style(model: Model) -> None:
-    """Visualization settings shared by the viewer and the animation."""
-    settings = model.system_container.visualizationSettings
-    extent = scene_extent(model.scene)
+def _style_settings(settings, extent: float) -> None:
+    """Visualization settings of every replay (viewer and animation): no load arrows or markers, cable
+    elements as lines, nodes as small spheres for a scene ``extent`` [m] across, the view kept where set."""
     settings.loads.show = False
     settings.markers.show = False
     settings.connectors.springNumberOfWindings = 1
@@ -406,25 +405,24 @@ def _style(model: Model) -> None:
     settings.nodes.defaultSize = 0.006 * extent
     settings.nodes.defaultColor = NODE_COLOR
     settings.nodes.tiling = 8
-    settings.view0.scene.drawCoordinateSystem = 0
     settings.general.autoFitScene = False
 
 
+def _style(model: Model) -> None:
+    """Visualization settings of a planar replay (:func:`_style_settings`), without the coordinate system."""
+    settings = model.system_container.visualizationSettings
+    _style_settings(settings, scene_extent(model.scene))
+    settings.view0.scene.drawCoordinateSystem = 0
+
+
 def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768)) -> None:
-    """Visualization settings of a spatial replay: small nodes, no load arrows or markers, and a view
+    """Visualization settings of a spatial replay (:func:`_style_settings`) and a view
     from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
     settings = replay.mbs.GetSystemContainer().visualizationSettings
     points = np.vstack([replay.scene.exit_points, replay.platform_pose()[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
     extent = float((high - low).max()) or 1.0
-    settings.loads.show = False
-    settings.markers.show = False
-    settings.connectors.springNumberOfWindings = 1
-    settings.nodes.drawNodesAsPoint = False
-    settings.nodes.defaultSize = 0.006 * extent
-    settings.nodes.defaultColor = NODE_COLOR
-    settings.nodes.tiling = 8
-    settings.general.autoFitScene = False
+    _style_settings(settings, extent)
     settings.view0.window.renderWindowSize = [int(size[0]), int(size[1])]
     advanced = settings.openGL.advanced
     advanced.initialCenterPoint = [float(x) for x in (low + high) / 2.0]
