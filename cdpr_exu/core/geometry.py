@@ -198,14 +198,28 @@ def rotated_anchors(pose, anchors):
     return np.stack([c * bx - s * bz, s * bx + c * bz], axis=-1)
 
 
-def check_pose_and_anchors(pose, anchors, pose_name="pose"):
-    pose = finite_array(pose_name, pose, (3,))
+def check_pose_and_anchors(pose, anchors, pose_rate=None, sizes=(3, 2), pose_name="pose"):
+    """Pose(s) (w,) or (N, w) and anchors (m, d), ``sizes`` = (w, d): (3, 2) in the plane, (6, 3) in space;
+    finite. With ``pose_rate``, also the rate, of the pose's shape. Returns them as float arrays.
+
+    Raises
+    ------
+    SceneError
+        Naming the argument whose shape is wrong or value not finite.
+    """
+    width, d = sizes
+    pose = finite_array(pose_name, pose, (width,))
     if pose.ndim > 2:
-        raise SceneError(f"{pose_name} must have shape (3,) or (N, 3), got shape {pose.shape}")
-    anchors = finite_array("anchors", anchors, (2,))
+        raise SceneError(f"{pose_name} must have shape ({width},) or (N, {width}), got shape {pose.shape}")
+    anchors = finite_array("anchors", anchors, (d,))
     if anchors.ndim != 2:
-        raise SceneError(f"anchors must have shape (m, 2), got shape {anchors.shape}")
-    return pose, anchors
+        raise SceneError(f"anchors must have shape (m, {d}), got shape {anchors.shape}")
+    if pose_rate is None:
+        return pose, anchors
+    pose_rate = finite_array("pose_rate", pose_rate, (width,))
+    if pose_rate.shape != pose.shape:
+        raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
+    return pose, anchors, pose_rate
 
 
 def anchor_points(pose, anchors):
@@ -247,10 +261,7 @@ def anchor_velocities(pose, pose_rate, anchors):
     -------
     ndarray, shape (m, 2) or (N, m, 2) [m/s]
     """
-    pose, anchors = check_pose_and_anchors(pose, anchors)
-    pose_rate = finite_array("pose_rate", pose_rate, (3,))
-    if pose_rate.shape != pose.shape:
-        raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
+    pose, anchors, pose_rate = check_pose_and_anchors(pose, anchors, pose_rate)
     arm = rotated_anchors(pose, anchors)
     return pose_rate[..., None, :2] + pose_rate[..., 2][..., None, None] * perpendicular(arm)
 
@@ -609,19 +620,6 @@ def left_jacobians(rotation_vectors):
     return np.array([left_jacobian(t) for t in theta.reshape(-1, 3)]).reshape(theta.shape[:-1] + (3, 3))
 
 
-def check_spatial_pose(pose, anchors, pose_name="pose"):
-    """Pose (6,)/(N, 6) and anchors (m, 3), or pose (3,)/(N, 3) for a point mass (anchors None)."""
-    width = 3 if anchors is None else 6
-    pose = finite_array(pose_name, pose, (width,))
-    if pose.ndim > 2:
-        raise SceneError(f"{pose_name} must have shape ({width},) or (N, {width}), got shape {pose.shape}")
-    if anchors is not None:
-        anchors = finite_array("anchors", anchors, (3,))
-        if anchors.ndim != 2:
-            raise SceneError(f"anchors must have shape (m, 3), got shape {anchors.shape}")
-    return pose, anchors
-
-
 def spatial_arms(pose, anchors):
     """``R(theta) b_i``, shape (..., m, 3)."""
     return np.einsum("...jk,mk->...mj", rotation_matrices(pose[..., 3:6]), anchors)
@@ -641,7 +639,7 @@ def spatial_anchor_points(pose, anchors):
     -------
     ndarray, shape (m, 3) or (N, m, 3) [m]
     """
-    pose, anchors = check_spatial_pose(pose, anchors)
+    pose, anchors = check_pose_and_anchors(pose, anchors, sizes=(6, 3))
     return pose[..., None, :3] + spatial_arms(pose, anchors)
 
 
@@ -661,10 +659,7 @@ def spatial_anchor_velocities(pose, pose_rate, anchors):
     -------
     ndarray, shape (m, 3) or (N, m, 3) [m/s]
     """
-    pose, anchors = check_spatial_pose(pose, anchors)
-    pose_rate = finite_array("pose_rate", pose_rate, (6,))
-    if pose_rate.shape != pose.shape:
-        raise SceneError(f"pose_rate must have the shape of pose {pose.shape}, got shape {pose_rate.shape}")
+    pose, anchors, pose_rate = check_pose_and_anchors(pose, anchors, pose_rate, (6, 3))
     omega = np.einsum("...jk,...k->...j", left_jacobians(pose[..., 3:6]), pose_rate[..., 3:6])
     return pose_rate[..., None, :3] + np.cross(omega[..., None, :], spatial_arms(pose, anchors))
 

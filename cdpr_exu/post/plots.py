@@ -130,11 +130,6 @@ def _platform_corners(scene: Scene, pose: np.ndarray) -> np.ndarray:
     return anchor_points(pose, local)
 
 
-def _anchor_world(scene: Scene, pose: np.ndarray) -> np.ndarray:
-    """World anchor points r + R(phi) b_i at ``pose``, shape (m, 2) [m]."""
-    return anchor_points(pose, np.asarray(scene.platform.anchors, dtype=float))
-
-
 def _robot_limits(scene: Scene, result: Result, rows: np.ndarray, margin: float = 0.12):
     """Axis limits (xmin, xmax, zmin, zmax) [m] holding pulleys, cables, platform, path."""
     points = [np.asarray(p.point) + np.array([sx, sz]) * p.radius

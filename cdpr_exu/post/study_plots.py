@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any, Mapping, Sequence
 
 import matplotlib
@@ -140,9 +141,8 @@ def plot_robustness(rows: Sequence[Mapping[str, Any]], out: str | Path) -> dict[
     platform mass and cable density errors (at the nominal stiffness): the max position error and its ratio to
     ideal IK's;
     ``robustness_<controller>.png``, returned by name."""
-    from cdpr_exu.studies.study import Variation
-
-    axes = [Variation(name, tuple(sorted({row[name] for row in rows}))) for name in ("platform_mass", "cable_density")]
+    axes = [SimpleNamespace(path=name, values=tuple(sorted({row[name] for row in rows})))  # as a study's Variation
+            for name in ("platform_mass", "cable_density")]
     quantities = (("max_position_error_m", 1000.0, "max position error [mm]"),
                   ("max_error_vs_ideal_ik", 1.0, "ideal IK's max error / this one's"))
     written = {}

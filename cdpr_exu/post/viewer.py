@@ -13,8 +13,8 @@ solution file is then loaded into it (:func:`exudyn.utilities.SetSolutionState`)
 - :func:`render_animation` (``cdpr animate DIR``) draws each chosen row with Exudyn's
   software raytracer (no window, no OpenGL) and writes a GIF (Pillow) or an MP4
   (the optional package ``imageio-ffmpeg``), and optionally the PNG frames; a spatial
-  run is drawn from its ``result.npz`` with matplotlib's 3-D axes
-  (:mod:`cdpr_exu.post.spatial_animation`).
+  run is drawn from its ``result.npz`` with matplotlib's 3-D axes. The frames source is
+  the one the run's :class:`~cdpr_exu.space.Space` names in :data:`FRAME_SOURCES`.
 
 Both add drawing-only items before replaying (:func:`decorate_model`): the pulleys
 as discs, the platform as its rectangle (``platform.size``) and the reference path
@@ -31,6 +31,7 @@ Examples::
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import time as _time
@@ -45,11 +46,12 @@ from exudyn.utilities import LoadSolutionFile, SetSolutionState
 
 from cdpr_exu.builder.robot_3d import platform_pose
 from cdpr_exu.builder.model import Model, build_model
-from cdpr_exu.core.errors import CdprError, OutputError
+from cdpr_exu.core.errors import CdprError
 from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.core.output import check_output_folder, clear_outputs
 from cdpr_exu.scenes.scene import Scene, load_scene
-from cdpr_exu.space import SPACE
+from cdpr_exu.results.result import Result
+from cdpr_exu.space import PLANE, SPACE, Space
 
 #: File names inside a run folder (written by ``cdpr run --out``).
 SCENE_FILE = "scene.toml"
@@ -390,10 +392,9 @@ def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
     return ground
 
 
-def _style(model: Model) -> None:
-    """Visualization settings shared by the viewer and the animation."""
-    settings = model.system_container.visualizationSettings
-    extent = scene_extent(model.scene)
+def _style_settings(settings, extent: float) -> None:
+    """Visualization settings of every replay (viewer and animation): no load arrows or markers, cable
+    elements as lines, nodes as small spheres for a scene ``extent`` [m] across, the view kept where set."""
     settings.loads.show = False
     settings.markers.show = False
     settings.connectors.springNumberOfWindings = 1
@@ -401,25 +402,24 @@ def _style(model: Model) -> None:
     settings.nodes.defaultSize = 0.006 * extent
     settings.nodes.defaultColor = NODE_COLOR
     settings.nodes.tiling = 8
-    settings.view0.scene.drawCoordinateSystem = 0
     settings.general.autoFitScene = False
 
 
+def _style(model: Model) -> None:
+    """Visualization settings of a planar replay (:func:`_style_settings`), without the coordinate system."""
+    settings = model.system_container.visualizationSettings
+    _style_settings(settings, scene_extent(model.scene))
+    settings.view0.scene.drawCoordinateSystem = 0
+
+
 def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768)) -> None:
-    """Visualization settings of a spatial replay: small nodes, no load arrows or markers, and a view
+    """Visualization settings of a spatial replay (:func:`_style_settings`) and a view
     from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
     settings = replay.mbs.GetSystemContainer().visualizationSettings
     points = np.vstack([replay.scene.exit_points, replay.platform_pose()[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
     extent = float((high - low).max()) or 1.0
-    settings.loads.show = False
-    settings.markers.show = False
-    settings.connectors.springNumberOfWindings = 1
-    settings.nodes.drawNodesAsPoint = False
-    settings.nodes.defaultSize = 0.006 * extent
-    settings.nodes.defaultColor = NODE_COLOR
-    settings.nodes.tiling = 8
-    settings.general.autoFitScene = False
+    _style_settings(settings, extent)
     settings.view0.window.renderWindowSize = [int(size[0]), int(size[1])]
     advanced = settings.openGL.advanced
     advanced.initialCenterPoint = [float(x) for x in (low + high) / 2.0]
@@ -736,9 +736,8 @@ class AnimationRequest:
     size : (width, height) [pixels]
     frames_dir : Path or None
         Created; its old ``frame_*.png`` are removed when the rendering starts.
-    spatial : bool
-        A spatial run (drawn from ``result.npz`` with matplotlib) or a planar one
-        (Exudyn's raytracer on the solution file).
+    space : Space
+        The run's space: it names the frames source (:data:`FRAME_SOURCES`).
     """
 
     run_dir: Path
@@ -747,7 +746,7 @@ class AnimationRequest:
     every: int | None
     size: tuple[int, int]
     frames_dir: Path | None
-    spatial: bool
+    space: Space
 
 
 def check_animation_request(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
@@ -768,8 +767,6 @@ def check_animation_request(run_dir: str | Path, out_file: str | Path | None = N
     RunFolderError
         A folder that holds no run.
     """
-    from cdpr_exu.post.spatial_animation import run_space  # matplotlib: only where a run is drawn
-
     if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
             or not (np.isfinite(fps) and fps > 0):
         raise CdprError(f"--fps must be a finite number of frames per second > 0, got {fps!r}")
@@ -785,19 +782,30 @@ def check_animation_request(run_dir: str | Path, out_file: str | Path | None = N
     if not run_dir.is_dir():
         raise RunFolderError(f"run folder {str(run_dir)!r} does not exist; write one with "
                              f"`cdpr run SCENE --out {run_dir}`")
-    spatial = run_space(run_dir) is SPACE
-    if not spatial:
-        run_files(run_dir)
+    space = run_space(run_dir)
+    FRAME_SOURCES[space].check(run_dir)
     out_file = Path(out_file) if out_file is not None else run_dir / "animation.gif"
     _Writer.check(out_file, (width, height), float(fps))
     if frames_dir is not None:
         frames_dir = check_output_folder(frames_dir, "--frames-dir")
     return AnimationRequest(run_dir, out_file, float(fps), None if every is None else int(every), (width, height),
-                            frames_dir, spatial)
+                            frames_dir, space)
 
 
-class _PlanarFrames:
+def run_space(run_dir: str | Path) -> Space:
+    """The :class:`~cdpr_exu.space.Space` of the run a ``cdpr run`` folder holds (its result.npz's
+    :class:`~cdpr_exu.results.result.Result`); planar for a folder without one (older planar runs)."""
+    path = Path(run_dir) / "result.npz"
+    return Result.load(path).space if path.is_file() else PLANE
+
+
+class _RaytracedFrames:
     """The frames of a planar run: its solution file's rows in the rebuilt model, drawn by Exudyn's raytracer."""
+
+    @staticmethod
+    def check(run_dir: Path) -> None:
+        """Refuse a folder without the scene and solution files (:func:`run_files`)."""
+        run_files(run_dir)
 
     def __init__(self, run_dir: Path, size: tuple[int, int], multi_sampling: int):
         self.replay = replay = load_replay(run_dir)
@@ -825,6 +833,71 @@ class _PlanarFrames:
         return self.caption.draw(image, row, float(self.times[row]))
 
 
+
+class _AxesFrames:
+    """The frames of a spatial run: the samples of its ``result.npz`` (cables' nodes, pose, reference)
+    drawn with matplotlib's 3-D axes, each a PIL RGB image of ``size`` pixels.
+
+    Attributes
+    ----------
+    name : str
+        The scene's name (from summary.json), else the folder's.
+    times : ndarray, shape (N,) [s]
+        Time of each stored sample; :meth:`frame` takes its index.
+    """
+
+    @staticmethod
+    def check(run_dir: Path) -> None:
+        """Nothing more to check: :func:`run_space` read the folder's result.npz."""
+
+    def __init__(self, run_dir: Path, size: tuple[int, int], multi_sampling: int):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg  # matplotlib: only where a run is drawn
+        from matplotlib.figure import Figure
+
+        result = Result.load(run_dir)
+        self.times, self.pose, self.reference, self.nodes = result.time, result.pose, result.reference, result.nodes
+        summary = run_dir / "summary.json"
+        self.name = json.loads(summary.read_text()).get("scene", run_dir.name) if summary.is_file() else run_dir.name
+        self.size = (int(size[0]), int(size[1]))
+        self.figure = figure = Figure(figsize=(self.size[0] / 100.0, self.size[1] / 100.0), dpi=100)
+        self.canvas = FigureCanvasAgg(figure)
+        ax = figure.add_subplot(1, 1, 1, projection="3d")
+        span = np.vstack([n.reshape(-1, 3) for n in self.nodes])
+        low, high = span.min(axis=0), span.max(axis=0)
+        centre, half = (low + high) / 2.0, 0.55 * float((high - low).max())
+        ax.set_xlim(centre[0] - half, centre[0] + half)
+        ax.set_ylim(centre[1] - half, centre[1] + half)
+        ax.set_zlim(centre[2] - half, centre[2] + half)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_zlabel("z [m]")
+        ax.plot(self.reference[:, 0], self.reference[:, 1], self.reference[:, 2], "k--", linewidth=0.8)
+        self.lines = [ax.plot([], [], [], "-", linewidth=1.0)[0] for _ in self.nodes]
+        self.trace, = ax.plot([], [], [], "tab:blue", linewidth=1.2)
+        self.platform, = ax.plot([], [], [], "ks", markersize=4)
+        self.title = ax.set_title("", fontsize=9)
+
+    def frame(self, k: int):
+        """Sample ``k`` drawn as a PIL RGB image."""
+        from PIL import Image
+
+        pose = self.pose
+        for line, cable in zip(self.lines, self.nodes):
+            line.set_data_3d(cable[k, :, 0], cable[k, :, 1], cable[k, :, 2])
+        self.trace.set_data_3d(pose[:k + 1, 0], pose[:k + 1, 1], pose[:k + 1, 2])
+        self.platform.set_data_3d([pose[k, 0]], [pose[k, 1]], [pose[k, 2]])
+        error = 1000.0 * float(np.linalg.norm(pose[k, :3] - self.reference[k, :3]))
+        self.title.set_text(f"{self.name}: t = {self.times[k]:.2f} s, position error {error:.2f} mm")
+        self.canvas.draw()
+        image = Image.fromarray(np.asarray(self.canvas.buffer_rgba())[:, :, :3].copy())
+        return image if image.size == self.size else image.resize(self.size)
+
+
+#: The frames source of a run, by its space: each is built as ``source(run_dir, size, multi_sampling)``,
+#: has ``name``, ``times`` [s] and ``frame(row)`` (a PIL RGB image), and ``check(run_dir)`` refuses a
+#: folder it cannot draw before any work.
+FRAME_SOURCES = {PLANE: _RaytracedFrames, SPACE: _AxesFrames}
+
 def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
                      every: int | None = None, size: tuple[int, int] = DEFAULT_SIZE,
                      frames_dir: str | Path | None = None, progress: bool = False,
@@ -834,8 +907,8 @@ def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *,
     A planar run: each chosen row of the solution file is loaded into the rebuilt model
     and drawn with Exudyn's raytracer; a caption gives scene name and time, and the
     platform's travelled path is drawn over the frame next to the reference path. A
-    spatial run: each chosen sample of ``result.npz`` is drawn with matplotlib's 3-D axes
-    (:class:`cdpr_exu.post.spatial_animation.SpatialFrames`). Both go through the same
+    spatial run: each chosen sample of ``result.npz`` is drawn with matplotlib's 3-D axes.
+    The run's space names the frames source (:data:`FRAME_SOURCES`). Both go through the same
     checks (:func:`check_animation_request`), frames folder and file writer.
 
     Parameters
@@ -875,36 +948,13 @@ def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *,
     return path
 
 
-def render_spatial_animation(run_dir: str | Path, out: str | Path | None = None, fps: float = 25.0,
-                             every: int | None = None, size: tuple[int, int] = (640, 480),
-                             frames_dir: str | Path | None = None) -> tuple[Path, int]:
-    """Render the spatial run in ``run_dir`` to a GIF (or MP4); returns (the file, the number of frames).
-
-    :func:`render_animation` on a spatial folder, with its checks
-    (a folder without a spatial run is refused, as every bad option).
-    """
-    from cdpr_exu.post.spatial_animation import run_space  # matplotlib: only where a run is drawn
-
-    if run_space(run_dir) is not SPACE:
-        raise OutputError(f"{run_dir} holds no spatial run (result.npz with 6-DOF poses); "
-                          "write one with `cdpr run SPATIAL-SCENE --out DIR`")
-    path, frames, _ = render_animation_timed(run_dir, out, fps=fps, every=every, size=size, frames_dir=frames_dir,
-                                             progress=False, multi_sampling=2)
-    return path, frames
-
-
 def render_animation_timed(run_dir, out_file, *, fps, every, size, frames_dir, progress,
                            multi_sampling) -> tuple[Path, int, float]:
     """:func:`render_animation`, also returning the frame count and seconds per frame."""
     from tqdm import tqdm
 
     request = check_animation_request(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir)
-    if request.spatial:
-        from cdpr_exu.post.spatial_animation import SpatialFrames
-
-        source = SpatialFrames(request.run_dir, request.size)
-    else:
-        source = _PlanarFrames(request.run_dir, request.size, multi_sampling)
+    source = FRAME_SOURCES[request.space](request.run_dir, request.size, multi_sampling)
     step = request.every if request.every is not None else _rows_per_frame(source.times, request.fps)
     rows = range(0, len(source.times), step)
     if request.frames_dir is not None:

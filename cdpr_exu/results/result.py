@@ -209,11 +209,6 @@ class Result:
             del summary[key]
         return summary
 
-    def run_summary(self, after: float = 1.0) -> dict[str, Any]:
-        """The summary ``cdpr run`` writes: every figure over the whole run (:meth:`summary` from 0), and the
-        error figures from ``after`` [s] on under ``after_start_up``."""
-        return {**self.summary(0.0), "after_start_up": after_start_up(self.summary(after), self.error_figures)}
-
     # ----------------------------------------------------------------- files
     def save(self, folder: str | Path, after: float = 1.0, extra: dict[str, Any] | None = None) -> dict[str, Path]:
         """Write ``result.npz``, ``pose.csv`` and ``summary.json`` into ``folder``.

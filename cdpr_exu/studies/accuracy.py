@@ -45,7 +45,6 @@ import csv
 import json
 import math
 import os
-import time
 import warnings
 from concurrent.futures import Executor, Future, as_completed
 from dataclasses import dataclass, field, replace
@@ -54,14 +53,13 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure, UnreachableError
+from cdpr_exu.core.errors import CoarseOutputWarning, SceneError
 from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 from cdpr_exu.space import PLANE, Space
 from cdpr_exu.scenes.trajectories import HoldTrajectory
-from cdpr_exu.studies.study import (SINGLE_THREAD_ENVIRONMENT, apply_parameters, executor_for, progress_bar,
-                                    warm_up)
+from cdpr_exu.studies.study import apply_parameters, executor_for, progress_bar, recorded_run
 
 # --------------------------------------------------------------------------- configurations
 
@@ -321,33 +319,12 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
         [N] at the platform end of each cable, ``speed`` (N,) [m/s] of the platform
         (spatial: by finite differences of the sampled positions).
     """
-    for name, value in SINGLE_THREAD_ENVIRONMENT.items():
-        os.environ.setdefault(name, value)
-
     empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
              "newton_iterations": 0, "failure_time_s": math.nan}
-    try:
-        with warnings.catch_warnings():  # the study samples once per step where the step is coarser, knowingly
-            warnings.simplefilter("ignore", CoarseOutputWarning)
-            scene = scene_from_dict(scene_data)
-        from cdpr_exu.run.simulate import simulate  # loads Numba and Exudyn: after the thread limits
-
-        warm_up(scene)
-        cpu = time.process_time()
-        try:
-            result = simulate(scene)
-            status = "completed"
-        except SolverFailure as err:
-            result = err.partial_result
-            status = "failed: " + " ".join(str(err).split())
-            if result is None:
-                return {"status": status, **empty}
-        finally:
-            cpu = time.process_time() - cpu
-    except (SceneError, UnreachableError) as err:
-        return {"status": "refused: " + " ".join(str(err).split()), **empty}
-    except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
-        return {"status": f"failed: {type(err).__name__}: " + " ".join(str(err).split()), **empty}
+    # the study samples once per step where the step is coarser, knowingly
+    _, result, status, cpu = recorded_run(scene_data, quiet=(CoarseOutputWarning,))
+    if result is None:
+        return {"status": status, **empty}
     pose = np.asarray(result.pose)
     finite = np.all(np.isfinite(pose), axis=1)
     tensions = np.column_stack([t[:, -1] for t in result.tensions]) if result.tensions else np.zeros((len(finite), 0))
@@ -727,11 +704,6 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
 
     paths["pareto"] = plot_pareto(study, out / ACCURACY_FILES["pareto"])
     return paths
-
-
-def load_accuracy_study(out: str | Path) -> dict[str, Any]:
-    """Read ``accuracy.json`` back (rows, reference, grid, provenance)."""
-    return json.loads((Path(out) / ACCURACY_FILES["json"]).read_text())
 
 
 # --------------------------------------------------------------------------- tables

@@ -40,6 +40,7 @@ import os
 import re
 import time
 import tomllib
+import warnings
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -114,18 +115,6 @@ class Variation:
         for value in self.values:
             if isinstance(value, (dict, list, tuple)) or value is None:
                 raise SceneError(f"parameter {self.path!r}: values must be numbers, booleans or strings, got {value!r}")
-
-    def to_text(self) -> str:
-        """The ``PATH=V1,V2`` form that :func:`parse_parameter` reads back."""
-        return f"{self.path}=" + ",".join(_toml_scalar(v) for v in self.values)
-
-
-def _toml_scalar(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return json.dumps(value)
-    return repr(value)
 
 
 def _parse_value(text: str, path: str) -> Any:
@@ -342,11 +331,56 @@ def warm_up(scene) -> None:
         pass
 
 
+def recorded_run(scene_data: Mapping[str, Any], quiet: tuple[type[Warning], ...] = ()):
+    """Build a scene from plain data and simulate it once warmed up (:func:`warm_up`); never raises for a
+    bad scene or a failed run. The one run of a study's workers (:func:`run_variation`,
+    :func:`cdpr_exu.studies.accuracy.run_configuration`), in a single thread per process.
+
+    Parameters
+    ----------
+    scene_data : dict
+        Plain scene data (as :meth:`Scene.to_dict` gives).
+    quiet : tuple of Warning classes
+        Warnings not shown while the scene is built.
+
+    Returns
+    -------
+    (scene, result, status, cpu_time_s)
+        ``status`` ``"completed"``, ``"failed: ..."`` (``result`` the partial result, or None when the run
+        produced none) or ``"refused: ..."`` (an invalid or unreachable scene: ``result`` None);
+        ``scene`` None where it could not be built; ``cpu_time_s`` [s] of the simulation, model building
+        included (NaN without one).
+    """
+    for name, value in SINGLE_THREAD_ENVIRONMENT.items():
+        os.environ.setdefault(name, value)  # effective if the libraries are not loaded yet
+    from cdpr_exu.core.errors import SolverFailure, UnreachableError
+    from cdpr_exu.scenes.scene import scene_from_dict
+
+    scene = None
+    try:
+        with warnings.catch_warnings():
+            for kind in quiet:
+                warnings.simplefilter("ignore", kind)
+            scene = scene_from_dict(scene_data)
+        from cdpr_exu.run.simulate import simulate  # loads Numba and Exudyn: after the thread limits
+
+        warm_up(scene)
+        cpu = time.process_time()
+        try:
+            return scene, simulate(scene), "completed", time.process_time() - cpu
+        except SolverFailure as err:
+            return scene, err.partial_result, "failed: " + " ".join(str(err).split()), time.process_time() - cpu
+    except (SceneError, UnreachableError) as err:
+        return scene, None, "refused: " + " ".join(str(err).split()), math.nan
+    except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
+        return scene, None, f"failed: {type(err).__name__}: " + " ".join(str(err).split()), math.nan
+
+
 def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, Any]:
     """Simulate one scene given as plain data; return its status and summary figures.
 
     The worker function of a study: top-level and picklable, it takes and returns
-    plain data only. Never raises for a bad scene or a failed run.
+    plain data only. Never raises for a bad scene or a failed run (:func:`recorded_run`).
 
     Parameters
     ----------
@@ -361,29 +395,10 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
         ``status`` (``"completed"``, ``"failed: ..."``, ``"refused: ..."``) and
         the figures of :data:`FIGURES` (NaN for a refused run).
     """
-    for name, value in SINGLE_THREAD_ENVIRONMENT.items():
-        os.environ.setdefault(name, value)  # effective if the libraries are not loaded yet
-    from cdpr_exu.core.errors import SolverFailure, UnreachableError
-    from cdpr_exu.run.simulate import simulate
-    from cdpr_exu.scenes.scene import scene_from_dict
-
-    try:
-        scene = scene_from_dict(scene_data)
-        warm_up(scene)
-        after = after if after < scene.solver.end_time else 0.0
-        try:
-            result = simulate(scene)
-            status = "completed"
-        except SolverFailure as err:
-            result = err.partial_result
-            status = "failed: " + " ".join(str(err).split())
-            if result is None:
-                return {"status": status, **_nan_figures()}
-    except (SceneError, UnreachableError) as err:
-        return {"status": "refused: " + " ".join(str(err).split()), **_nan_figures()}
-    except Exception as err:  # noqa: BLE001 - a study records every failure and goes on
-        return {"status": f"failed: {type(err).__name__}: " + " ".join(str(err).split()), **_nan_figures()}
-    summary = result.summary(after=after)
+    scene, result, status, _ = recorded_run(scene_data)
+    if result is None:
+        return {"status": status, **_nan_figures()}
+    summary = result.summary(after=after if after < scene.solver.end_time else 0.0)
     row = {"status": status}
     for name in FIGURES:
         value = summary.get(name)
@@ -619,11 +634,6 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
 
         paths.update(plot_study(rows, variations, out, mode=mode))
     return paths
-
-
-def load_study(out: str | Path) -> dict[str, Any]:
-    """Read a study's ``study.json`` back (rows, variations, base scene, provenance)."""
-    return json.loads((Path(out) / STUDY_FILES["json"]).read_text())
 
 
 # --------------------------------------------------------------------------- table
