@@ -44,7 +44,7 @@ import numpy as np
 from exudyn.rigidBodyUtilities import RotationMatrixX, RotationMatrixZ
 from exudyn.utilities import LoadSolutionFile, SetSolutionState
 
-from cdpr_exu.builder.robot_3d import platform_pose
+from cdpr_exu.builder.robot_3d import Model3D, platform_pose
 from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.core.errors import CdprError
 from cdpr_exu.core.geometry import rotation_vector
@@ -106,8 +106,9 @@ class Replay:
     ----------
     run_dir : Path
     scene : Scene
-    model : Model
-        Rebuilt from ``scene.toml`` and decorated (:func:`decorate_model`).
+    model : Model or Model3D
+        Rebuilt from ``scene.toml`` (:func:`cdpr_exu.builder.model.build_model`); a planar one decorated
+        (:func:`decorate_model`).
     solution : dict
         As returned by :func:`exudyn.utilities.LoadSolutionFile`; ``solution["data"]``
         has shape (n_rows, n_columns + 1), time first.
@@ -115,7 +116,7 @@ class Replay:
 
     run_dir: Path
     scene: Scene
-    model: Model
+    model: Model | Model3D
     solution: dict
 
     @property
@@ -142,6 +143,11 @@ class Replay:
         n_ode2 = int(self.solution["columnsExported"][0])
         q = reference + self.solution["data"][:, 1:1 + n_ode2]
         return {name: q[:, index] for name, index in self.model.coordinate_indices().items()}
+
+    def platform_pose(self) -> np.ndarray:
+        """The platform's pose in each row, shape (n_rows, pose size): planar (x, z, rotation) [m, m, rad],
+        spatial centre of mass [m] and rotation vector [rad] (by the scene's space, :data:`VIEWS`)."""
+        return VIEWS[self.scene.space].poses(self)
 
 
 def _require_file(path: Path, what: str) -> Path:
@@ -213,54 +219,16 @@ def check_solution_fits(model, solution: dict, source: str = "the solution") -> 
             "edited, or the package changed, after the run? Run the scene again with `cdpr run`")
 
 
-@dataclass
-class SpatialReplay:
-    """A spatial run folder loaded for replay: its scene, the rebuilt robot and the solution.
-
-    Attributes
-    ----------
-    run_dir : Path
-    scene : Scene
-    mbs : exudyn.MainSystem
-        Rebuilt from ``scene.toml`` (:func:`cdpr_exu.builder.model.build_model`).
-    items : SpatialRobotItems
-    solution : dict
-        As for :class:`Replay`.
-    """
-
-    run_dir: Path
-    scene: object
-    mbs: object
-    items: object
-    solution: dict
-
-    n_rows = Replay.n_rows
-    times = Replay.times
-
-    def platform_pose(self) -> np.ndarray:
-        """The platform's pose in each row: centre of mass [m] and rotation vector [rad], shape (n_rows, 6)."""
-        poses = []
-        for row in range(self.n_rows):
-            SetSolutionState(self.mbs, self.solution, row, exu.ConfigurationType.Current)
-            position, rotation = platform_pose(self.mbs, self.items)
-            poses.append(np.concatenate([position, rotation_vector(rotation)]))
-        return np.asarray(poses)
-
-
-def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | SpatialReplay:
-    """Load a run folder: scene, rebuilt (and decorated) model, solution file.
+def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
+    """Load a run folder, planar or spatial: scene, rebuilt (and decorated) model, solution file.
 
     Parameters
     ----------
     run_dir : path
         Folder written by ``cdpr run SCENE --out DIR``.
     decorate : bool
-        Add pulleys, platform rectangle and reference path (:func:`decorate_model`; planar runs).
-
-    Returns
-    -------
-    Replay or SpatialReplay
-        By the dimension of the folder's scene.
+        Add the drawing-only items of the scene's view (:data:`VIEWS`: on planar runs the pulleys,
+        platform rectangle and reference path, :func:`decorate_model`).
 
     Raises
     ------
@@ -271,13 +239,10 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay | Spati
     solution = load_solution(solution_file)
     model = build_model(scene)
     check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
-    if scene.dimension == 3:  # one replay when the replays are one
-        return SpatialReplay(Path(run_dir), scene, model.mbs, model.items, solution)
-    if decorate:
-        times = np.asarray(solution["data"][:, 0], dtype=float)
-        decorate_model(model, reference_path(scene, times))
+    replay = Replay(Path(run_dir), scene, model, solution)
+    if decorate and VIEWS[scene.space].decorate(replay):
         check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
-    return Replay(Path(run_dir), scene, model, solution)
+    return replay
 
 
 # --------------------------------------------------------------------------- drawing
@@ -412,11 +377,23 @@ def _style(model: Model) -> None:
     settings.view0.scene.drawCoordinateSystem = 0
 
 
-def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768)) -> None:
+def _spatial_poses(replay: Replay) -> np.ndarray:
+    """A spatial replay's platform pose in each row: centre of mass [m] and rotation vector [rad],
+    shape (n_rows, 6)."""
+    mbs, items = replay.model.mbs, replay.model.items
+    poses = []
+    for row in range(replay.n_rows):
+        SetSolutionState(mbs, replay.solution, row, exu.ConfigurationType.Current)
+        position, rotation = platform_pose(mbs, items)
+        poses.append(np.concatenate([position, rotation_vector(rotation)]))
+    return np.asarray(poses)
+
+
+def _style_spatial(replay: Replay, size: tuple[int, int] = (1024, 768)) -> None:
     """Visualization settings of a spatial replay (:func:`_style_settings`) and a view
     from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
-    settings = replay.mbs.GetSystemContainer().visualizationSettings
-    points = np.vstack([replay.scene.exit_points, replay.platform_pose()[:, :3]])
+    settings = replay.model.system_container.visualizationSettings
+    points = np.vstack([replay.scene.exit_points, _spatial_poses(replay)[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
     extent = float((high - low).max()) or 1.0
     _style_settings(settings, extent)
@@ -427,6 +404,29 @@ def _style_spatial(replay: "SpatialReplay", size: tuple[int, int] = (1024, 768))
     advanced.initialMaxSceneSize = 4.0 * extent
     # Exudyn takes the transpose of the view's rotation: this one shows z up, x to the right, seen from -y.
     advanced.initialModelRotation = (RotationMatrixX(-0.5 * np.pi) @ RotationMatrixZ(-0.15 * np.pi)).T.tolist()
+
+
+def _decorate_planar(replay: Replay) -> bool:
+    """Add the planar drawing items (:func:`decorate_model`); True: the model changed."""
+    decorate_model(replay.model, reference_path(replay.scene, replay.times))
+    return True
+
+
+def _view_planar(replay: Replay) -> None:
+    """The planar replay's look in SolutionViewer: its style and a camera fitted to the x-z plane."""
+    _style(replay.model)
+    fit_camera(_view_points(replay), (1024, 768), caption_band=0.12).apply(replay.model)
+
+
+@dataclass(frozen=True)
+class View:
+    """How a replay of one space is read and drawn: ``poses(replay)`` the platform's pose in each row,
+    ``decorate(replay) -> bool`` adds drawing-only items (True if any), ``style(replay)`` sets
+    SolutionViewer's look and camera."""
+
+    poses: object
+    decorate: object
+    style: object
 
 
 # --------------------------------------------------------------------------- camera
@@ -519,6 +519,12 @@ def _view_points(replay: Replay) -> np.ndarray:
 # --------------------------------------------------------------------------- viewer
 
 
+#: How each space's replay is drawn: planar runs decorated and fitted to the x-z plane, spatial runs in
+#: Exudyn's own 3-D view fitted to the exits and the platform's path.
+VIEWS = {PLANE: View(lambda replay: replay.positions()["platform"], _decorate_planar, _view_planar),
+         SPACE: View(_spatial_poses, lambda replay: False, _style_spatial)}
+
+
 def display_problem() -> str | None:
     """Why no window can be opened here, or None if one can.
 
@@ -584,14 +590,8 @@ def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
     from exudyn.interactive import SolutionViewer
 
     replay = load_replay(run_dir)
-    if isinstance(replay, SpatialReplay):  # a 3-D robot: Exudyn's own view, fitted to the scene
-        mbs = replay.mbs
-        _style_spatial(replay)
-    else:
-        mbs = replay.model.mbs
-        _style(replay.model)
-        camera = fit_camera(_view_points(replay), (1024, 768), caption_band=0.12)
-        camera.apply(replay.model)
+    VIEWS[replay.scene.space].style(replay)
+    mbs = replay.model.mbs
     if every is None:
         every = _rows_per_frame(replay.times, DEFAULT_FPS)
     SolutionViewer(mbs, replay.solution, rowIncrement=min(int(every), replay.n_rows),
