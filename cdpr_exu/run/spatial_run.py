@@ -49,7 +49,7 @@ from controllers.ideal_ik import IdealIKController
 from cdpr_exu.results.result import Result
 from cdpr_exu.run.solver import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
                                   solver_settings)
-from cdpr_exu.run.spatial_rest import rest_above_exits
+from cdpr_exu.run.rest import rest_above_exits
 from cdpr_exu.scenes.scene import Scene, tension_limits
 from cdpr_exu.statics.workspace import check_reference
 
@@ -168,7 +168,7 @@ def _warn_outside_measured_region(scene: Scene) -> None:
 
 def _rest_above_exits(scene: Scene, mbs, items) -> str | None:
     """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
-    above its exits (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: its bending or pushing elements do)."""
+    above its exits (:func:`cdpr_exu.run.rest.rest_above_exits`: its bending or pushing elements do)."""
     position, rotation = platform_pose(mbs, items, current=False)
     lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
     above = rest_above_exits(scene, position, rotation, lowest, items.initial)
