@@ -68,9 +68,9 @@ def add_commands(subparsers) -> None:
     """Register ``cdpr static``."""
     parser = subparsers.add_parser(
         "static", help="bring a scene to rest and write its static state",
-        description="Bring a scene to rest (dynamics with its own damping, then Exudyn's static solver) with the "
-        "winches held, and write summary.json (platform pose, free-span lengths, end forces, nodes), rest.npz and "
-        "rest_profile.png.", epilog=EPILOG + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
+        description="Bring a scene to rest with the winches held (a planar scene: dynamics with its own damping, "
+        "then Exudyn's static solver; a spatial one: Exudyn's static solver from its catenaries), and write "
+        "summary.json (platform pose, end forces, nodes), rest_profile.png and, planar, rest.npz.", epilog=EPILOG + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scene", help="shipped scene name (see `cdpr scenes`) or path to a .toml file")
     parser.add_argument("--out", help="output folder (created); nothing is written without it")
     parser.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCE,

@@ -87,7 +87,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -235,8 +235,8 @@ class Rest:
     platform_forces: np.ndarray
     method: str
     wall_time_s: float = 0.0
-    warnings: tuple = field(default=())
-    notes: tuple = field(default=())
+    warnings: tuple = ()
+    notes: tuple = ()
     cable_stretched_length_m: np.ndarray | None = None
     cable_unstrained_length_m: np.ndarray | None = None
     first_free_node: np.ndarray | None = None
