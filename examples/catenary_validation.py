@@ -47,7 +47,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from cdpr_exu.physics import catenary
-from cdpr_exu.run.rest import RestState, solve_rest
+from cdpr_exu.run.rest import Rest, solve_rest
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import Effects, Scene, load_scene
 from cdpr_exu.statics.statics import solve_statics, solve_inverse_statics
@@ -111,7 +111,7 @@ def bending_off(scene: Scene) -> Scene:
 # --------------------------------------------------------------------------- catenary side
 
 
-def hang_point_unstrained_length(scene: Scene, rest: RestState, i: int) -> float:
+def hang_point_unstrained_length(scene: Scene, rest: Rest, i: int) -> float:
     """Unstrained length of lumped cable ``i`` beyond its pulley's hang point [m].
 
     The hanging leg runs up from node 0 along x = c_x + side r_p; the hang point is where
@@ -150,26 +150,26 @@ def distances_to_curve(points: np.ndarray, curve: np.ndarray) -> np.ndarray:
     return out
 
 
-def free_span_points(rest: RestState, i: int) -> np.ndarray:
+def free_span_points(rest: Rest, i: int) -> np.ndarray:
     """The leave point (or node 0) and the free nodes of cable i, upper end first."""
     return np.vstack([rest.upper_points_m[i], rest.nodes[i][rest.first_free_node[i] + 1:]]) \
         if rest.first_free_node[i] > 0 else rest.nodes[i]
 
 
-def compare(scene: Scene, rest: RestState) -> dict:
+def compare(scene: Scene, rest: Rest) -> dict:
     """Forward and inverse catenary against a lumped rest state; numbers in SI."""
     platform = catenary_platform(scene)
     lengths = [hang_point_unstrained_length(scene, rest, i) for i in range(scene.n_cables)]
-    forward = solve_statics(platform, lengths, initial_pose=rest.platform_position_m)
-    inverse = solve_inverse_statics(platform, rest.platform_position_m)
+    forward = solve_statics(platform, lengths, initial_pose=rest.position)
+    inverse = solve_inverse_statics(platform, rest.position)
     out = {
         "scene": scene.name, "effects": scene.effects.preset, "n_elements": scene.cables[0].n_elements,
         "mass_lumping": scene.cables[0].mass_lumping, "method": rest.method,
         "max_node_speed_m_s": rest.max_node_speed_m_s,
-        "lumped_position_m": rest.platform_position_m.tolist(),
+        "lumped_position_m": rest.position.tolist(),
         "catenary_position_m": forward.position.tolist(),
-        "position_difference_m": (rest.platform_position_m - forward.position).tolist(),
-        "position_error_m": float(np.hypot(*(rest.platform_position_m - forward.position))),
+        "position_difference_m": (rest.position - forward.position).tolist(),
+        "position_error_m": float(np.hypot(*(rest.position - forward.position))),
         "lumped_stretched_length_m": rest.cable_stretched_length_m.tolist(),
         "lumped_unstrained_length_m": rest.cable_unstrained_length_m.tolist(),
         "unstrained_length_beyond_hang_point_m": lengths,
@@ -193,7 +193,7 @@ def compare(scene: Scene, rest: RestState) -> dict:
             "node_distances_to_inverse_catenary_m": d_inverse.tolist(),
             "lumped_leave_point_m": rest.upper_points_m[i].tolist(),
             "catenary_tangent_point_m": inverse.cables[i].exit_point.tolist(),
-            "lumped_platform_force_N": rest.platform_forces_N[i].tolist(),
+            "lumped_platform_force_N": rest.platform_forces[i].tolist(),
             "inverse_platform_force_N": inverse.cables[i].force_on_platform.tolist(),
         }
         if over_pulleys(scene):
@@ -218,7 +218,7 @@ def sag(points: np.ndarray) -> float:
     return float(((points - points[0]) @ normal).max())
 
 
-def chord_deficit(scene: Scene, rest: RestState, i: int) -> float:
+def chord_deficit(scene: Scene, rest: Rest, i: int) -> float:
     """How much shorter the lumped cable's path over the pulley is than the rim [m].
 
     From the hang point to the leave point, the lumped cable runs along straight chords
@@ -242,13 +242,13 @@ def chord_deficit(scene: Scene, rest: RestState, i: int) -> float:
 # --------------------------------------------------------------------------- studies
 
 
-def rest_comparisons(scenes: dict[str, Scene]) -> dict[str, tuple[Scene, RestState, dict]]:
+def rest_comparisons(scenes: dict[str, Scene]) -> dict[str, tuple[Scene, Rest, dict]]:
     out = {}
     for label, scene in scenes.items():
         rest = solve_rest(scene)
         out[label] = (scene, rest, compare(scene, rest))
         c = out[label][2]
-        print(f"{label:28s} {rest.method:28s} z = {rest.platform_position_m[1]:.6f} m (catenary "
+        print(f"{label:28s} {rest.method:28s} z = {rest.position[1]:.6f} m (catenary "
               f"{c['catenary_position_m'][1]:.6f}), free span {rest.cable_stretched_length_m[0]:.6f} m, "
               f"dL(inverse) = {1000 * c['cables'][0]['inverse_length_difference_m']:+.4f} mm, "
               f"max distance {1000 * c['cables'][0]['max_distance_to_inverse_catenary_m']:.3f} mm "
@@ -267,11 +267,11 @@ def convergence(counts, lumpings=("consistent", "paper")) -> list[dict]:
         for n in counts:
             scene = with_elements(base, n, lumping)
             rest = solve_rest(scene)
-            inverse = solve_inverse_statics(platform, rest.platform_position_m)
+            inverse = solve_inverse_statics(platform, rest.position)
             row = {
                 "mass_lumping": lumping, "n_elements": n,
-                "position_error_m": float(np.hypot(*(rest.platform_position_m - reference.position))),
-                "z_error_m": float(rest.platform_position_m[1] - reference.position[1]),
+                "position_error_m": float(np.hypot(*(rest.position - reference.position))),
+                "z_error_m": float(rest.position[1] - reference.position[1]),
                 "stretched_length_error_m": float(rest.cable_stretched_length_m[0] - reference_length),
                 "inverse_length_error_m": float(base.cables[0].unstrained_length - inverse.cables[0].suspended_length),
                 "max_node_speed_m_s": rest.max_node_speed_m_s,
@@ -331,7 +331,7 @@ def plot_profiles(cases: dict, path: Path) -> Path:
             if over_pulleys(scene):
                 ax.plot(*rest.upper_points_m[i], "+", color="tab:blue", markersize=9, zorder=4)
                 ax.plot(*rest_off.upper_points_m[i], "+", color="tab:green", markersize=9, zorder=4)
-        x, z = rest.platform_position_m
+        x, z = rest.position
         ax.plot(x, z, "s", color="0.2", markersize=6, zorder=4, label="platform (1 kg point mass)")
         c_on, c_off = comparison["cables"][0], comparison_off["cables"][0]
         if ax is axes[3]:
@@ -502,7 +502,7 @@ def main(argv=None) -> int:
     bending = {
         "EI_N_m2": scene.cables[0].youngs_modulus * scene.cables[0].second_moment,
         "boundary_layers": layers,
-        "platform_lower_with_bending_m": float(rest_off.platform_position_m[1] - rest_on.platform_position_m[1]),
+        "platform_lower_with_bending_m": float(rest_off.position[1] - rest_on.position[1]),
         "max_node_distance_between_bending_on_and_off_m":
             float(np.linalg.norm(rest_on.nodes[0] - rest_off.nodes[0], axis=1).max()),
         "anchor_angle_difference_deg": _anchor_angle_difference(rest_on, c_on),
@@ -548,7 +548,7 @@ def main(argv=None) -> int:
     return 0
 
 
-def _anchor_angle_difference(rest: RestState, comparison: dict) -> float:
+def _anchor_angle_difference(rest: Rest, comparison: dict) -> float:
     """Angle between the lumped anchor element and the catenary's tangent at the anchor [deg]."""
     nodes = rest.nodes[0]
     lumped = nodes[-2] - nodes[-1]

@@ -14,8 +14,8 @@ minutes on one core (the chain version's statics, ``tension_aware_chain``, take 
 from pathlib import Path
 
 from cdpr_exu.cli.compare import print_spatial_controller_row
-from cdpr_exu.post.plots import plot_spatial_rest
-from cdpr_exu.run.spatial_rest import solve_spatial_rest
+from cdpr_exu.post.plots import plot_rest
+from cdpr_exu.run.rest import solve_rest
 from cdpr_exu.studies.comparison import compare_spatial
 from cdpr_exu.scenes.scene import load_scene
 
@@ -24,9 +24,9 @@ RESULTS = Path("results/spatial")
 
 def main() -> None:
     for name in ("spatial-four-cable", "spatial-cogiro", "spatial-ipanema"):
-        rest = solve_spatial_rest(load_scene(name))
+        rest = solve_rest(load_scene(name))
         rest.save(RESULTS / name / "static")
-        plot_spatial_rest(rest, RESULTS / name / "static" / "rest_profile.png")
+        plot_rest(rest, RESULTS / name / "static" / "rest_profile.png")
         print(f"{name}: at rest at {rest.position.round(6).tolist()} m")
     rows = ["| robot | controller | max position error [mm] | RMS position error [mm] | max rotation error [deg] "
             "| min element tension [N] |", "|---|---|---|---|---|---|"]

@@ -26,7 +26,7 @@ its cables go slack, a winch paying out several elements over the pulley):
   answer at a step of min(run / 100, 1e-5 s) (the stiff joint spring of explicit runs stretches by 7.8e-6 m under the
   platform's weight). Below 1e-8 s the runs would take hours: reported as
   "< 1e-8". Also shown: the estimate 2.8 m_i / (4 c_i) of
-  ``cdpr_exu.run.simulate.explicit_step_limit``.
+  ``cdpr_exu.run.solver.explicit_step_limit``.
 
 Writes ``stability.csv`` and ``stability.md`` (the table and these criteria) into
 ``results/stability/``. Run: ``python examples/stability_table.py [--quick]``;
@@ -48,7 +48,8 @@ from cdpr_exu.results.energy import energy_rise, mechanical_energy
 from cdpr_exu.core.errors import CdprError, SolverFailure
 from cdpr_exu.core.output import write_json
 from cdpr_exu.scenes.scene import Effects, Scene, WinchSpec, load_scene
-from cdpr_exu.run.simulate import explicit_step_limit, simulate
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.run.solver import explicit_step_limit
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 
 PAPER = load_scene("paper-circle")
@@ -407,7 +408,7 @@ def write(rows: list[dict], out: Path, wall: float) -> None:
         f"never rises by more than {ENERGY_TOLERANCE:g} J, and the platform stays within "
         f"{EXPLICIT_TOLERANCE:g} m (or 1 % of its motion) of the implicit solver's answer (step "
         "min(run / 100, 1e-5 s)). *RK44 estimate*: 2.8 / max(4 c_i / m_i, 2 sqrt(k_i / m_i) (+) sqrt(k_p / m_i)) "
-        "(`cdpr_exu.run.simulate.explicit_step_limit`): the zig-zag mode of the over-damped axial chain. "
+        "(`cdpr_exu.run.solver.explicit_step_limit`): the zig-zag mode of the over-damped axial chain. "
         f"'< {EXPLICIT_STEPS[-1]:g}': not stable at any rung; smaller steps would take hours.",
     ]
     (out / "stability.md").write_text("\n".join(lines) + "\n")

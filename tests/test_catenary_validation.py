@@ -67,7 +67,7 @@ def errors(base, reference):
                                                    for c in base.cables))
             rest = solve_rest(scene)
             rows.append({
-                "position": float(np.hypot(*(rest.platform_position_m - reference.position))),
+                "position": float(np.hypot(*(rest.position - reference.position))),
                 "length": abs(rest.cable_stretched_length_m[0] - reference.cables[0].catenary.stretched_length),
                 "profile": float(distance_to_curve(rest.nodes[0], curve).max()),
             })

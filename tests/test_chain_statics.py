@@ -11,7 +11,7 @@ from cdpr_exu.builder.model import initial_nodes
 from cdpr_exu.builder.robot_3d import build_spatial_robot, scene_chain_spec, swivel_angles
 from cdpr_exu.run.settle import chain_statics_robot, set_configuration, solve_static
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.run.spatial_rest import PENALTY, solve_spatial_rest
+from cdpr_exu.run.rest import PENALTY, solve_rest
 from cdpr_exu.scenes.scene import Effects, PlatformSpec, load_scene
 from cdpr_exu.statics import chain_statics, statics
 from cdpr_exu.statics.chain_kernels import SpatialChains
@@ -206,15 +206,15 @@ def test_it_finds_the_rest_that_exudyn_finds_with_the_same_winch_lengths():
     rest = solve_rest(scene)
     held = np.array([scene.cables[i].unstrained_length - (scene.exits[i].center[1] - initial_nodes(scene, i)[0, 1])
                      for i in range(2)])
-    solution = _solve(scene, rest.platform_position_m)
+    solution = _solve(scene, rest.position)
     # Exudyn's rest is an equilibrium to ~1e-11 N and its nodes to ~1e-7 m (rest.py notes);
     # an axial stiffness of 3e5 N/m turns 1e-6 m of node error into 0.3 N, so lengths
     # and nodes are compared at the micrometre.
     assert np.abs(solution.paid_out - held).max() < 5e-6
-    assert solution.rotation == pytest.approx(np.radians(rest.platform_rotation_deg), abs=1e-5)
+    assert solution.rotation == pytest.approx(rest.rotation, abs=1e-5)
     for ours, exudyn in zip(solution.nodes, rest.nodes):
         assert np.abs(ours - exudyn).max() < 5e-6
-    assert np.allclose(solution.anchor_tensions, rest.anchor_tensions_N, rtol=1e-4)
+    assert np.allclose(solution.anchor_tensions, rest.anchor_tensions, rtol=1e-4)
 
 
 def test_massless_straight_cables_give_hookes_law():
@@ -282,19 +282,19 @@ def test_point_mass_platform_needs_no_rotation():
 @pytest.mark.parametrize("bending, point_mass", [(True, False), (False, False), (True, True)])
 def test_the_chain_statics_reproduce_exudyns_static_solution(bending, point_mass):
     scene = _scene(10, bending, point_mass)
-    exudyn = solve_spatial_rest(scene)  # penalty joints on a rigid platform, exact ones on a point mass
+    exudyn = solve_rest(scene)  # penalty joints on a rigid platform, exact ones on a point mass
     factor = None if point_mass else PENALTY
     chain = chain_rest(scene, factor)
     # The same discrete model: Exudyn's Newton stops at a residual of 1e-9, ours at 1e-9 N; with element
     # stiffnesses ~3e5 N/m that is 1e-14 m. Measured: 2e-14 m and 1e-12 rad (bending), 1e-15 m (none).
     # 1e-10 m is 4 orders below the penalty joints' compliance (below) and 6 below the bending's effect.
     assert np.abs(chain.position - exudyn.position).max() < 1e-10
-    assert np.abs(chain.rotation_vector - exudyn.rotation_vector).max() < 1e-10
+    assert np.abs(chain.rotation_vector - exudyn.rotation).max() < 1e-10
     assert max(np.abs(a - b).max() for a, b in zip(chain.nodes, exudyn.nodes)) < 1e-10
     # element forces ~10-40 N: measured 7e-11 N apart
-    assert max(np.abs(a - b).max() for a, b in zip(chain.tensions, exudyn.element_tensions)) < 1e-8
+    assert max(np.abs(a - b).max() for a, b in zip(chain.tensions, exudyn.tensions)) < 1e-8
     # the anchor forces: Exudyn reads the penalty spring's force, 3e7 N/m x 1e-13 m -> measured 3e-6 N
-    assert np.abs(chain.forces_on_platform - exudyn.forces_on_platform).max() < 1e-4
+    assert np.abs(chain.forces_on_platform - exudyn.platform_forces).max() < 1e-4
     assert chain.tensions[0].min() > 0.0  # all taut: the tension-only law and the static mode's springs agree
 
 

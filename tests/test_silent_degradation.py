@@ -11,7 +11,8 @@ import pytest
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, SolverFailure
 from cdpr_exu.scenes.scene import load_scene, shipped_scenes
-from cdpr_exu.run.simulate import likely_cause, simulate
+from cdpr_exu.run.simulate import simulate
+from cdpr_exu.run.solver import likely_cause
 
 PAPER = load_scene("paper-circle")
 

@@ -1,5 +1,5 @@
-"""Spatial scenes in TOML (cdpr_exu.scenes.scene with dimension = 3) and their static mode (cdpr_exu.run.spatial_rest),
-real solver."""
+"""Spatial scenes in TOML (cdpr_exu.scenes.scene with dimension = 3), real solver (their static mode:
+tests/test_rest.py)."""
 
 import json
 import subprocess
@@ -10,9 +10,6 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.physics import cogiro
-from cdpr_exu.run.rest import solve_rest
-from cdpr_exu.run.spatial_rest import solve_spatial_rest
 from cdpr_exu.scenes.scene import load_scene, scene_from_dict, shipped_scenes
 
 #: The paper's catenary scene with fixed cable ends, written as a spatial scene in the
@@ -47,72 +44,6 @@ def test_run_and_the_accuracy_study_need_a_trajectory_on_a_spatial_scene(tmp_pat
     assert done.returncode == 2 and "no [trajectory]" in done.stderr
 
 
-def test_a_planar_robot_written_as_a_spatial_scene_rests_where_the_planar_model_rests():
-    spatial = solve_spatial_rest(scene_from_dict(PLANAR_AS_SPATIAL))
-    planar = solve_rest(load_scene("paper-catenary-fixed"))
-    x, z = planar.platform_position_m
-    # Both are exact static equilibria of the same discrete model (the 3-D bending force of a
-    # cable in a vertical plane is the planar one to 1e-12 N, tests/test_bending_3d.py); the
-    # planar state is polished by Exudyn's static solver too. Measured 2.5e-12 m and 3e-10 N;
-    # the bounds leave room for the Newton tolerance (1e-9 relative) and are far below the
-    # 4.5 mm that bending moves the platform here and the 1e-5 m discretisation error.
-    assert spatial.position == pytest.approx([x, 0.0, z], abs=1e-9)
-    assert np.abs(spatial.rotation_vector).max() < 1e-12  # a point mass does not turn
-    for i in range(2):  # the joint reactions, bending shear included
-        assert spatial.forces_on_platform[i][[0, 2]] == pytest.approx(planar.platform_forces_N[i], abs=1e-7)
-        assert spatial.forces_on_platform[i][1] == pytest.approx(0.0, abs=1e-12)
-
-
-def test_without_bending_the_lumped_robot_rests_within_its_discretisation_error_of_the_catenaries():
-    scene = load_scene("spatial-four-cable")
-    scene = replace(scene, effects=replace(scene.effects, bending=False, bending_damping=False))
-    rest = solve_spatial_rest(scene)
-    # tests/test_spatial_robot.py measures the lumped robot against the catenaries as n^-2,
-    # 1.9e-5 m, 1.7e-5 rad and 0.016 N at 20 elements: 2.5e-5 and 0.025 N bound them.
-    assert np.linalg.norm(rest.position - rest.catenary.position) < 2.5e-5
-    assert np.linalg.norm(rest.rotation_vector - rest.catenary.rotation) < 2.5e-5
-    assert rest.tensions_at_anchor == pytest.approx(rest.catenary.tensions_at_anchor, abs=0.025)
-
-
-@pytest.mark.parametrize("name", ["spatial-four-cable", "spatial-cogiro", "spatial-ipanema"])
-def test_the_cables_hold_the_platform_in_force_and_moment_balance(name):
-    scene = load_scene(name)
-    rest = solve_spatial_rest(scene)
-    weight = scene.platform.mass * scene.gravity
-    forces = rest.forces_on_platform
-    arms = np.asarray(scene.platform.anchors) @ rest.rotation.T
-    # Exudyn's static solver converges to 1e-9 (relative); the penalty joints move nothing
-    # in the balance: 1e-8 of the weight (49 N, 893 N and 245 N).
-    assert forces.sum(axis=0) == pytest.approx([0.0, 0.0, weight], abs=1e-8 * weight)
-    assert np.cross(arms, forces).sum(axis=0) == pytest.approx(np.zeros(3), abs=1e-8 * weight)
-    assert np.all(rest.tensions_at_anchor > 0.0)
-
-
-def test_the_cogiro_scene_is_caspr_s_geometry_and_hangs_where_its_ideal_cables_put_it():
-    scene = load_scene("spatial-cogiro")
-    # the TOML holds CASPR's numbers (cdpr_exu/physics/cogiro.py) to their 4 decimals
-    assert scene.exit_points == pytest.approx(cogiro.EXIT_POINTS, abs=1e-12)
-    assert np.asarray(scene.platform.anchors) == pytest.approx(cogiro.ANCHORS - cogiro.CENTER_OF_MASS, abs=5e-5)
-    rest = solve_spatial_rest(scene)
-    ideal = cogiro.INITIAL_POSE[:3] + cogiro.CENTER_OF_MASS
-    # Lengths are the ideal ones less their straight stretch, so only the sag (about 15 mm
-    # mid-span, which shortens each chord by ~0.1 mm) moves the platform: it rises by 1.1 mm
-    # (measured); 3 mm bounds that, while a wrong anchor or exit moves it by centimetres.
-    assert rest.position == pytest.approx(ideal, abs=3e-3)
-    assert np.linalg.norm(rest.rotation_vector) < 1e-3
-    assert np.all((rest.tensions_at_anchor > cogiro.MIN_TENSION) & (rest.tensions_at_anchor < cogiro.MAX_TENSION))
-
-
-def test_cdpr_static_on_a_spatial_scene_prints_the_pose_and_writes_a_strict_summary(tmp_path):
-    out = tmp_path / "static"
-    done = _cdpr("static", "spatial-four-cable", "--out", str(out))
-    assert done.returncode == 0, done.stderr
-    assert "platform at x =" in done.stdout and "rotation vector" in done.stdout
-    summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
-    assert len(summary["platform_position_m"]) == 3 and len(summary["platform_rotation_vector_rad"]) == 3
-    assert summary["dimension"] == 3 and (out / "rest_profile.png").stat().st_size > 20_000
-
-
 @pytest.mark.parametrize("change, field", [
     (lambda d: d.update(exits=d["exits"][:1]), "exits"),
     (lambda d: d.update(effects={"preset": "ideal"}), "effects.preset"),
@@ -131,29 +62,6 @@ def test_a_bad_spatial_scene_is_refused_naming_the_field(change, field):
     change(data)
     with pytest.raises(SceneError, match=field):
         scene_from_dict(data)
-
-
-def test_the_ipanema_scene_is_held_from_above_and_below_at_its_design_pose():
-    scene = load_scene("spatial-ipanema")
-    rest = solve_spatial_rest(scene)
-    # Fully constrained by 8 pretensioned cables (EA = 0.5 MN) whose lengths are the ideal ones
-    # less their stretch: sag (a few mm over 4.7 m of a 0.012 kg/m rope at 300-480 N) hardly
-    # moves the platform; measured 17 um from (0, 0, 2) m. 0.2 mm bounds it, while a flipped
-    # or wrong equilibrium of the catenary start lies decimetres away.
-    assert rest.position == pytest.approx([0.0, 0.0, 2.0], abs=2e-4)
-    assert np.linalg.norm(rest.rotation_vector) < 1e-4
-    upper, lower = rest.forces_on_platform[:4], rest.forces_on_platform[4:]
-    assert np.all(upper[:, 2] > 0.0) and np.all(lower[:, 2] < 0.0)  # pulled up and pulled down
-    assert np.all(rest.tensions_at_anchor > 50.0)  # the pretension floor the lengths were made with
-
-
-
-def test_the_static_mode_reports_every_element_taut_on_the_shipped_robots():
-    for name in ("spatial-four-cable", "spatial-cogiro", "spatial-ipanema"):
-        summary = solve_spatial_rest(load_scene(name)).summary()
-        # the lowest of all elements (4 x 20 or 8 x 20): the four-cable robot's slackest cable
-        # still carries about 10 N; nothing is compressed
-        assert summary["min_element_tension_N"] > 5.0 and not summary["elements_pushed"], name
 
 
 def test_a_spatial_scene_gets_the_planar_bending_damping_constant_only_with_effects_bending_damping():

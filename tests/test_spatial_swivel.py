@@ -9,7 +9,7 @@ from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.geometry import swivel_pulley_exit
 from cdpr_exu.exits import Swivel
 from cdpr_exu.statics.statics import catenary_platform, solve_statics
-from cdpr_exu.run.spatial_rest import solve_spatial_rest
+from cdpr_exu.run.rest import solve_rest
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 
 NAME = "spatial-four-cable-swivel"
@@ -76,7 +76,7 @@ def test_the_catenary_statics_over_swivel_pulleys_balance_and_point_each_pulley_
 
 
 def test_exudyn_s_static_hang_converges_to_the_catenary_statics_as_the_elements_shrink():
-    rests = [solve_spatial_rest(without_bending(load_scene(NAME), n)) for n in (48, 96)]
+    rests = [solve_rest(without_bending(load_scene(NAME), n)) for n in (48, 96)]
     errors = [np.linalg.norm(r.position - r.catenary.position) for r in rests]
     # Measured 4.90 / 1.17 / 0.34 mm at 48 / 96 / 192 elements (the chords of the wrap are
     # shorter than its arc, r_p theta^3 / 24 each, and the nodes sink T l_e / (r_p k_p) into
@@ -84,19 +84,19 @@ def test_exudyn_s_static_hang_converges_to_the_catenary_statics_as_the_elements_
     assert errors[0] < 5.9e-3 and errors[1] < 1.4e-3
     assert errors[0] / errors[1] > 3.0  # second order (4.2 measured)
     for rest in rests:  # tensions at the anchor: the same order
-        assert rest.tensions_at_anchor == pytest.approx(rest.catenary.tensions_at_anchor, abs=0.5)
+        assert rest.anchor_tensions == pytest.approx(rest.catenary.tensions_at_anchor, abs=0.5)
 
 
 def test_a_symmetric_robot_over_swivel_pulleys_hangs_symmetric():
     scene = without_bending(load_scene(NAME))
-    rest = solve_spatial_rest(scene)
+    rest = solve_rest(scene)
     # four equal cables from the corners of a square: on the axis, equal tensions, each
     # pulley turned to its anchor (-135, -45, 45, 135 degrees)
     assert np.abs(rest.position[:2]).max() < 1e-9
-    assert np.ptp(rest.tensions_at_anchor) < 1e-6 * rest.tensions_at_anchor.max()
+    assert np.ptp(rest.anchor_tensions) < 1e-6 * rest.anchor_tensions.max()
     assert rest.swivel_angles == pytest.approx(np.radians([-135.0, -45.0, 45.0, 135.0]), abs=1e-9)
     weight = scene.platform.mass * scene.gravity
-    assert rest.forces_on_platform.sum(axis=0) == pytest.approx([0.0, 0.0, weight], abs=1e-8 * weight)
+    assert rest.platform_forces.sum(axis=0) == pytest.approx([0.0, 0.0, weight], abs=1e-8 * weight)
 
 
 def test_spatial_scenes_honour_the_paper_mass_lumping():
@@ -272,7 +272,7 @@ def test_the_catenary_statics_find_a_small_swivel_robot_whose_straight_start_lay
     weight = scene.platform.mass * scene.gravity
     assert np.abs(equilibrium.net_wrench[:3]).max() < 1e-9 * weight
     assert np.abs(equilibrium.position[:2]).max() < 1e-9
-    rest = solve_spatial_rest(scene)
+    rest = solve_rest(scene)
     assert np.linalg.norm(rest.position - equilibrium.position) < 8e-4
 
 
@@ -319,11 +319,11 @@ def test_a_static_answer_far_from_its_catenaries_warns_in_the_summary_and_on_the
     from its catenaries' answer, the bending's doing; the shipped robot's 22 mm (0.9 %) is not flagged."""
     import json
 
-    from cdpr_exu.run.spatial_rest import FAR_FROM_CATENARY
+    from cdpr_exu.run.rest import FAR_FROM_CATENARY
     from cdpr_exu.scenes.scene import save_scene
 
-    shipped = solve_spatial_rest(load_scene(NAME))
-    assert shipped.catenary_distance < 0.2 * FAR_FROM_CATENARY * 2.4 and shipped.warnings == []  # 22 mm of 120
+    shipped = solve_rest(load_scene(NAME))
+    assert shipped.catenary_distance < 0.2 * FAR_FROM_CATENARY * 2.4 and shipped.warnings == ()  # 22 mm of 120
     path = save_scene(stiff_swivel(1e10), tmp_path / "stiffer.toml")
     out = tmp_path / "static"
     done = _cdpr("static", str(path), "--out", str(out))

@@ -36,7 +36,8 @@ from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.builder.model import build_model
 from cdpr_exu.results.result import Result
 from cdpr_exu.scenes.scene import Effects, Scene, WinchSpec, load_scene
-from cdpr_exu.run.simulate import MAX_STRAIN, explicit_step_limit, simulate
+from cdpr_exu.run.simulate import MAX_STRAIN, simulate
+from cdpr_exu.run.solver import explicit_step_limit
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 from controllers.base import WinchCommand
 from controllers.ideal_ik import IdealIKController

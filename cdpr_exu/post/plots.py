@@ -1,7 +1,7 @@
 """Figures of a run: the robot at several instants, the platform's path, rotation,
 errors and cable tensions (the paper's Figs. 6 and 7), and controller comparisons; the
-rest profile of the static mode (:func:`plot_rest`); a spatial run's overview
-(:func:`plot_spatial_run`) and a spatial robot at rest (:func:`plot_spatial_rest`).
+rest of the static mode (:func:`plot_rest`: a profile in the plane, 3-D and from above in
+space); a spatial run's overview (:func:`plot_spatial_run`).
 
 Every function takes a :class:`~cdpr_exu.scenes.scene.Scene` and/or a
 :class:`~cdpr_exu.results.result.Result`, writes one PNG and returns its path. Figures are
@@ -35,8 +35,7 @@ from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.space import PLANE, SPACE
 
 if TYPE_CHECKING:  # pragma: no cover
-    from cdpr_exu.run.rest import RestState
-    from cdpr_exu.run.spatial_rest import SpatialRest
+    from cdpr_exu.run.rest import Rest
 
 #: Resolution of the written PNGs [dots per inch].
 DPI = 150
@@ -675,11 +674,14 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
 # --------------------------------------------------------------------------- rest states and spatial runs
 
 
-def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None = None) -> Path:
-    """Figure of the rest profile: nodes, pulleys, leave points and the platform; writes a PNG.
+def plot_rest(rest: Rest, path: str | Path) -> Path:
+    """Figure of a scene at rest, its space's (:data:`REST_FIGURES`); writes a PNG and returns its path."""
+    return REST_FIGURES[rest.space](rest, path)
 
-    Returns the path written.
-    """
+
+def _planar_rest(rest: Rest, path: str | Path) -> Path:
+    """The rest profile: nodes, pulleys, leave points and the platform."""
+    scene = rest.scene
     figure = Figure(figsize=(7.0, 5.0))
     FigureCanvasAgg(figure)
     ax = figure.add_subplot(1, 1, 1)
@@ -694,26 +696,26 @@ def plot_rest(scene: Scene, rest: RestState, path: str | Path, title: str | None
                 label=f"cable {i + 1}: free span {rest.cable_stretched_length_m[i]:.4f} m, "
                       f"upper force |F| = {np.hypot(*rest.upper_forces_N[i]):.2f} N")
         ax.plot(*rest.upper_points_m[i], marker="x", color=color, markersize=8, zorder=4)
-    x, z = rest.platform_position_m
+    x, z = rest.position
     ax.plot(x, z, marker="s", color="0.2", markersize=7, zorder=5,
-            label=f"platform ({x:.4f}, {z:.4f}) m, {rest.platform_rotation_deg:.2f} deg")
+            label=f"platform ({x:.4f}, {z:.4f}) m, {float(np.degrees(rest.rotation)):.2f} deg")
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
     ax.grid(True, linewidth=0.4, alpha=0.5)
     ax.legend(loc="upper center", fontsize=7, framealpha=0.9)
-    ax.set_title(title or f"{rest.scene_name} at rest ({rest.method}; x: leave points)", fontsize=9)
+    ax.set_title(f"{scene.name} at rest ({rest.method}; x: leave points)", fontsize=9)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(path, dpi=DPI, format="png", bbox_inches="tight")
     return path
 
 
-#: Points per catenary curve in :func:`plot_spatial_rest`.
+#: Points per catenary curve in a spatial rest's figure.
 CURVE_SAMPLES = 60
 
 
-def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
+def _spatial_rest(rest: Rest, path: str | Path) -> Path:
     """Figure of the robot at rest, in 3-D and from above: lumped cables (dots), catenaries (dashed), platform."""
     figure = Figure(figsize=(11.0, 5.2))
     FigureCanvasAgg(figure)
@@ -721,13 +723,13 @@ def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
     top = figure.add_subplot(1, 2, 2)
     figure.subplots_adjust(wspace=0.35)
     colors = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive")
-    anchors = rest.position + np.asarray(rest.scene.platform.anchors) @ rest.rotation.T
+    anchors = rest.position + np.asarray(rest.scene.platform.anchors) @ rest.rotation_matrix.T
     outline = np.vstack([anchors, anchors[:1]])
     exits = rest.scene.exit_points
     for i, (nodes, cable) in enumerate(zip(rest.nodes, rest.catenary.cables)):
         color = colors[i % len(colors)]
         curve = cable.points(np.linspace(0.0, cable.unstrained_length, CURVE_SAMPLES))
-        label = f"cable {i + 1}: {rest.tensions_at_anchor[i]:.1f} N at the anchor"
+        label = f"cable {i + 1}: {rest.anchor_tensions[i]:.1f} N at the anchor"
         ax.plot(nodes[:, 0], nodes[:, 1], nodes[:, 2], "o-", color=color, markersize=2, linewidth=1.0, label=label)
         ax.plot(curve[:, 0], curve[:, 1], curve[:, 2], "--", color="0.3", linewidth=0.7)
         top.plot(nodes[:, 0], nodes[:, 1], "o-", color=color, markersize=2, linewidth=1.0)
@@ -747,7 +749,7 @@ def plot_spatial_rest(rest: SpatialRest, path: str | Path) -> Path:
     top.grid(True, linewidth=0.3)
     top.set_title("from above (exits: triangles)", fontsize=9)
     x, y, z = rest.position
-    roll, pitch, yaw = rotation_angles_deg(rest.rotation)
+    roll, pitch, yaw = rotation_angles_deg(rest.rotation_matrix)
     figure.suptitle(f"{rest.scene.name} at rest: platform at ({x:.4f}, {y:.4f}, {z:.4f}) m, roll {roll:.2f}, "
                     f"pitch {pitch:.2f}, yaw {yaw:.2f} deg\nlumped cables (dots) and elastic catenaries (dashed)",
                     fontsize=9)
@@ -810,3 +812,5 @@ def _spatial_overview(scene: Scene, result: Result, folder: Path, times, after: 
 
 #: The overview figures of a run, by its space (:func:`plot_overview`).
 OVERVIEWS = {PLANE: plot_planar_overview, SPACE: _spatial_overview}
+#: The figure of a rest, by its space (:func:`plot_rest`).
+REST_FIGURES = {PLANE: _planar_rest, SPACE: _spatial_rest}

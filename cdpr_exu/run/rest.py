@@ -1,12 +1,20 @@
-"""The static mode: a scene brought to rest, and what the cables look like there.
+"""The static mode: a scene brought to rest, in either space, and what the cables look like there.
 
-:func:`solve_rest` integrates a scene with its own damping and solver settings, in
-chunks, until the largest node speed falls below a tolerance, then polishes the state
-with Exudyn's static solver (``mbs.SolveStatic``). The winches hold their initial
-lengths: the scene's trajectory is not followed. The answer, a :class:`RestState`,
-holds the platform pose, every node, every element's axial force, and for each cable
-the length and end forces of its *free span*, the part that the elastic catenary
+:func:`solve_rest` brings a scene to rest with the winches holding their initial lengths
+(the trajectory is not followed) by its space's method (:data:`REST_METHODS`, chosen
+once from the scene's :class:`~cdpr_exu.space.Space`), and returns one :class:`Rest`:
+the platform's position and rotation, every node, every element's axial force, the
+anchor tensions and the forces on the platform, the method, warnings; and what only one
+space's method gives as optional fields (the free spans and the dynamics in the plane,
+the catenary comparison and the swivel angles in space). Units SI; z up, gravity along -z.
+
+**In the plane** (dynamic relaxation of the lumped :class:`~cdpr_exu.builder.model.Model`):
+the scene is integrated with its own damping and solver settings, in chunks, until the
+largest node speed falls below a tolerance, then the state is polished with Exudyn's
+static solver (``mbs.SolveStatic``). For each cable the rest holds the length and end
+forces of its *free span*, the part that the elastic catenary
 (:mod:`cdpr_exu.physics.catenary`) describes:
+
 
 * with a point exit (the cable does not wrap its exit), or over a pulley that no node
   touches, the whole cable, from its upper end (node 0, held by the winch
@@ -54,32 +62,53 @@ swinging modes are all but undamped (still 0.5 to 0.9 m/s after 60 s on the pape
 scene): there the scene is settled with the paper's bending stiffness and damping
 switched on, and the static solver then finds the rest of the scene's own model from
 that state (a continuation in the bending stiffness; from the straight start it finds
-equilibria of pushing elements instead). ``RestState.method`` says which path was taken.
+equilibria of pushing elements instead). ``Rest.method`` says which path was taken.
+
+**In space** (the lumped robot of :mod:`cdpr_exu.builder.robot_3d` in Exudyn's static
+solve, beside its elastic catenaries): the scene is solved twice, by two independent
+methods: the **catenary statics** (:func:`cdpr_exu.statics.statics.solve_statics`: each
+cable a continuous elastic catenary in its own vertical plane, no bending), and the scene's
+chains with its effects (bending included), started on the catenary solution and brought to
+equilibrium by Exudyn's static solver. Over swivel pulleys, where Exudyn's static solver
+does not converge from the catenary start, the chain statics
+(:mod:`cdpr_exu.statics.chain_statics`, the same discrete model) first take it to
+equilibrium (:func:`cdpr_exu.run.settle.start_at_rest`), and Exudyn's static
+solver confirms it. The rest says how far the catenary answer lies from it (the
+discretisation error, about n^-2, plus the effect of bending). A rigid platform's cable ends
+are held by stiff penalty joints in the static solve (Exudyn's static solver diverges on
+``ObjectJointSpherical`` when the body must turn); they add 1 / (:data:`PENALTY` n) of a
+cable's compliance. The static solve uses spring elements also where the scene's cables are
+tension-only (``effects.slack``): a slack element has no stiffness, and Exudyn's static
+solver fails from such a start; while every element is taut the two give the same
+equilibrium, and a compressed element is reported.
 """
 
 from __future__ import annotations
 
 import math
 import time as _time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
 from cdpr_exu.builder.cable import arm_first_step_kink, element_tensions
-from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.builder.model import Model, build_model
-from cdpr_exu.core.geometry import penetration
-from cdpr_exu.core.output import write_npz, write_summary
-from cdpr_exu.run.settle import static_settings
+from cdpr_exu.builder.robot_3d import build_spatial_robot, chain_positions, element_forces, scene_chain_spec, \
+    swivel_angles
+from cdpr_exu.core.errors import SceneError, SolverFailure
+from cdpr_exu.core.geometry import penetration, rotation_angles_deg
+from cdpr_exu.core.output import fixed, write_npz, write_summary
+from cdpr_exu.run.settle import solve_static, start_at_rest, static_settings
 from cdpr_exu.physics import bending
 from cdpr_exu.results.result import provenance
-from cdpr_exu.run.simulate import likely_cause
-from cdpr_exu.run.solver import quiet_exudyn, solver_report, solver_settings
+from cdpr_exu.run.solver import likely_cause, quiet_exudyn, solver_report, solver_settings
 from cdpr_exu.scenes.scene import Scene
+from cdpr_exu.space import PLANE, SPACE
+from cdpr_exu.statics.statics import catenary_platform, solve_statics
 
 #: Default tolerance on the largest node speed at rest [m/s].
 DEFAULT_TOLERANCE = 1.0e-6
@@ -98,7 +127,7 @@ POLISH_MAX_SHIFT = 1.0e-3
 #: Simulated time of the check run from a static solution of a scene without bending
 #: damping [s]: its largest node speed is reported as ``max_node_speed_m_s``.
 CHECK_TIME = 0.2
-#: Name of the path taken by :func:`solve_rest`, by case.
+#: Name of the path taken by the planar relaxation, by case.
 METHODS = {
     "dynamic": "dynamics with the scene's damping",
     "dynamic+static": "dynamics with the scene's damping, polished by Exudyn's static solver",
@@ -109,8 +138,20 @@ METHODS = {
 #: rotation of a point mass feels no moment (its anchors are at its centre of mass),
 #: so locking it changes no answer; it makes the static Jacobian regular.
 ROTATION_LOCK = True
+#: Stiffness of the penalty spherical joints of a rigid platform in space, in element axial
+#: stiffnesses: they add 1 / (100 n) of a cable's compliance (3e-7 m at n = 40 on the
+#: four-cable robot, measured in tests/test_spatial_robot.py).
+PENALTY = 100.0
+#: A spatial answer farther than this fraction of the shortest cable's unstrained length from
+#: its own elastic-catenary answer is flagged (``warnings``). The two differ by the
+#: discretisation (n^-2: at most 0.5 mm on the shipped point-exit robots) and by the bending
+#: the catenary leaves out: the shipped swivel robot, whose cables wrap 0.1 m pulleys, rests
+#: 22 mm from its catenaries, 0.9 % of its 2.4 m cables (measured). 5 % is over five times
+#: that; beyond it the answer is the bending model's more than a hanging cable's (E = 1e10 Pa
+#: on the same robot: 132 mm, 5.5 %; 1e11 Pa: above its pulleys).
+FAR_FROM_CATENARY = 0.05
 
-#: Definitions written into ``summary.json``.
+#: Definitions written into a planar rest's ``summary.json``.
 DEFINITIONS = {
     "free_span": "the cable from its upper point to the platform anchor: the whole cable for a point exit; over a "
                  "pulley, from the point where it leaves the rim (tangent from the first free node) to the anchor",
@@ -131,165 +172,205 @@ DEFINITIONS = {
 
 
 @dataclass(frozen=True, eq=False)
-class RestState:
-    """A scene at rest. Units SI, positions (x, z) in the paper's plane, m cables.
+class Rest:
+    """A scene at rest, in its space (d = 2: (x, z) in the paper's plane; d = 3), m cables. Units SI.
 
     Attributes
     ----------
-    scene_name : str
-    platform_position_m : ndarray, shape (2,) [m]
-        Centre of mass (x, z).
-    platform_rotation_deg : float [deg]
-        Counter-clockwise.
-    nodes : tuple of ndarray, each shape (n_i + 1, 2) [m]
-        Node positions of each cable, winch end first.
+    scene : Scene
+    position : ndarray, shape (d,) [m]
+        Platform centre of mass.
+    rotation : float or ndarray, shape (3,) [rad]
+        The platform's rotation as its space has it: the counter-clockwise angle in the plane,
+        the rotation vector in space.
+    rotation_matrix : ndarray, shape (d, d)
+        Platform frame to world frame.
+    nodes : tuple of ndarray, each shape (n_i + 1, d) [m]
+        Node positions of each cable, upper end (winch or exit) first.
     tensions : tuple of ndarray, each shape (n_i,) [N]
-        Axial force of each element (tension positive), as the spring-dampers compute it.
-    cable_stretched_length_m : ndarray, shape (m,) [m]
-        Length of each cable's free span (see the module notes).
-    cable_unstrained_length_m : ndarray, shape (m,) [m]
-        Unstrained length of the free span.
-    first_free_node : ndarray of int, shape (m,)
-        First node of the free span: 0 for a point exit, c + 1 over a pulley.
-    upper_points_m : ndarray, shape (m, 2) [m]
-        Upper end of the free span: node 0, or the leave point on the rim.
-    upper_forces_N : ndarray, shape (m, 2) [N]
-        Force each free span exerts on its upper support.
-    platform_forces_N : ndarray, shape (m, 2) [N]
+        Axial force of each element (tension positive; negative: compressed, which a real
+        cable cannot be).
+    anchor_tensions : ndarray, shape (m,) [N]
+        Axial force of each cable at its anchor.
+    platform_forces : ndarray, shape (m, d) [N]
         Force each cable exerts on the platform at its anchor.
-    anchor_tensions_N : ndarray, shape (m,) [N]
-        Axial force of the anchor element.
-    span_weights_N : ndarray, shape (m,) [N]
-        Weight of the nodes of each free span.
-    max_node_speed_m_s : float [m/s]
-        Largest node speed over the last :data:`SPEED_WINDOW` of the dynamics.
-    time_s : float [s]
-        Simulated time of the dynamics.
     method : str
-        Key of :data:`METHODS`.
-    static_shift_m : float or None [m]
-        How far the static solver moved the farthest node (None: not used or refused).
+        How the rest was found: a key of :data:`METHODS` in the plane, a description in space.
     wall_time_s : float [s]
+    warnings : tuple of str
+        What makes this answer suspect, each with its figures (empty: nothing).
     notes : tuple of str
         What the solver tried and refused (eg a static polish that did not converge).
+
+    Planar only (dynamic relaxation; None in space), see the module notes:
+    cable_stretched_length_m, cable_unstrained_length_m : ndarray, shape (m,) [m]
+        Length and unstrained length of each cable's free span.
+    first_free_node : ndarray of int, shape (m,)
+        First node of the free span: 0 for a point exit, c + 1 over a pulley.
+    upper_points_m, upper_forces_N : ndarray, shape (m, 2) [m], [N]
+        Upper end of the free span (node 0, or the leave point on the rim), and the force
+        each free span exerts on its upper support there.
+    span_weights_N : ndarray, shape (m,) [N]
+        Weight of the nodes of each free span.
+    max_node_speed_m_s, time_s : float [m/s], [s]
+        Largest node speed over the last :data:`SPEED_WINDOW` of the dynamics; their simulated time.
+    static_shift_m : float or None [m]
+        How far the static solver moved the farthest node (None: not used or refused).
+
+    Spatial only (None in the plane):
+    catenary : PlatformEquilibrium
+        The elastic-catenary statics of the same scene.
+    anchor_joint : str
+        How the cable ends are held in the static solve.
+    swivel_angles : ndarray, shape (m,) [rad], or None
+        Each swivel pulley's angle (None: no swivel pulleys).
     """
 
-    scene_name: str
-    platform_position_m: np.ndarray
-    platform_rotation_deg: float
+    scene: Scene
+    position: np.ndarray
+    rotation: Any
+    rotation_matrix: np.ndarray
     nodes: tuple
     tensions: tuple
-    cable_stretched_length_m: np.ndarray
-    cable_unstrained_length_m: np.ndarray
-    first_free_node: np.ndarray
-    upper_points_m: np.ndarray
-    upper_forces_N: np.ndarray
-    platform_forces_N: np.ndarray
-    anchor_tensions_N: np.ndarray
-    span_weights_N: np.ndarray
-    max_node_speed_m_s: float
-    time_s: float
+    anchor_tensions: np.ndarray
+    platform_forces: np.ndarray
     method: str
-    static_shift_m: float | None = None
     wall_time_s: float = 0.0
-    notes: tuple = field(default=())
+    warnings: tuple = ()
+    notes: tuple = ()
+    cable_stretched_length_m: np.ndarray | None = None
+    cable_unstrained_length_m: np.ndarray | None = None
+    first_free_node: np.ndarray | None = None
+    upper_points_m: np.ndarray | None = None
+    upper_forces_N: np.ndarray | None = None
+    span_weights_N: np.ndarray | None = None
+    max_node_speed_m_s: float | None = None
+    time_s: float | None = None
+    static_shift_m: float | None = None
+    catenary: Any = None
+    anchor_joint: str | None = None
+    swivel_angles: np.ndarray | None = None
+
+    @property
+    def space(self):
+        """The scene's :class:`~cdpr_exu.space.Space`."""
+        return self.scene.space
+
+    @property
+    def lowest_element_tension(self) -> float:
+        """The lowest axial force of all elements [N] (negative: compressed)."""
+        return float(min(t.min() for t in self.tensions))
+
+    @property
+    def catenary_distance(self) -> float | None:
+        """Distance [m] from the platform position to its elastic catenaries' answer (None: not computed)."""
+        return None if self.catenary is None else float(np.linalg.norm(self.position - self.catenary.position))
 
     def force_balance_residual(self) -> np.ndarray:
-        """``platform_force + upper_force + (0, W)`` of each free span, shape (m, 2) [N]: 0 at rest."""
+        """``platform_force + upper_force + (0, W)`` of each planar free span, shape (m, 2) [N]: 0 at rest."""
         weight = np.column_stack([np.zeros_like(self.span_weights_N), self.span_weights_N])
-        return self.platform_forces_N + self.upper_forces_N + weight
+        return self.platform_forces + self.upper_forces_N + weight
 
     def summary(self) -> dict[str, Any]:
-        """Plain-data summary (JSON-ready) of the rest state, with the definitions used."""
-        return {
-            "scene": self.scene_name,
-            "method": self.method,
-            "method_description": METHODS[self.method],
-            "platform_position_m": self.platform_position_m.tolist(),
-            "platform_rotation_deg": self.platform_rotation_deg,
-            "cable_stretched_length_m": self.cable_stretched_length_m.tolist(),
-            "cable_unstrained_length_m": self.cable_unstrained_length_m.tolist(),
-            "first_free_node": self.first_free_node.tolist(),
-            "upper_points_m": self.upper_points_m.tolist(),
-            "upper_forces_N": self.upper_forces_N.tolist(),
-            "platform_forces_N": self.platform_forces_N.tolist(),
-            "anchor_tensions_N": self.anchor_tensions_N.tolist(),
-            "span_weights_N": self.span_weights_N.tolist(),
-            "force_balance_residual_N": self.force_balance_residual().tolist(),
-            "max_node_speed_m_s": self.max_node_speed_m_s,
-            "simulated_time_s": self.time_s,
-            "static_shift_m": self.static_shift_m,
-            "wall_time_s": self.wall_time_s,
-            "notes": list(self.notes),
-            "nodes_m": [n.tolist() for n in self.nodes],
-            "element_tensions_N": [t.tolist() for t in self.tensions],
-            "definitions": DEFINITIONS,
-        }
+        """Plain data (JSON-ready, SI units in the key names) for ``summary.json``."""
+        return REST_METHODS[self.space].summary(self)
+
+    def summary_lines(self) -> list[str]:
+        """The rest in a few lines of text, for the console (the CLI prints them)."""
+        return REST_METHODS[self.space].lines(self)
 
     def save(self, folder: str | Path) -> dict[str, Path]:
-        """Write ``summary.json`` (with provenance) and ``rest.npz`` into ``folder``."""
+        """Write ``summary.json`` (with provenance) and, in the plane, ``rest.npz`` into ``folder``; returns
+        their paths by kind ("summary", "npz"). The figure (``rest_profile.png``) is
+        :func:`cdpr_exu.post.plots.plot_rest`'s."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
-        summary = {**self.summary(), **provenance()}
-        write_summary(folder, summary)
-        arrays = {
-            "platform_position_m": self.platform_position_m,
-            "platform_rotation_deg": np.array(self.platform_rotation_deg),
-            "cable_stretched_length_m": self.cable_stretched_length_m,
-            "cable_unstrained_length_m": self.cable_unstrained_length_m,
-            "first_free_node": self.first_free_node,
-            "upper_points_m": self.upper_points_m,
-            "upper_forces_N": self.upper_forces_N,
-            "platform_forces_N": self.platform_forces_N,
-            "anchor_tensions_N": self.anchor_tensions_N,
-            "span_weights_N": self.span_weights_N,
-            "max_node_speed_m_s": np.array(self.max_node_speed_m_s),
-        }
-        for i, (nodes, tensions) in enumerate(zip(self.nodes, self.tensions)):
-            arrays[f"nodes_{i}"] = nodes
-            arrays[f"tensions_{i}"] = tensions
-        write_npz(folder / "rest.npz", **arrays)
-        return {"summary": folder / "summary.json", "npz": folder / "rest.npz"}
+        paths = {"summary": write_summary(folder, {**self.summary(), **provenance()})}
+        arrays = REST_METHODS[self.space].arrays(self)
+        if arrays:
+            paths["npz"] = write_npz(folder / "rest.npz", **arrays)
+        return paths
 
 
-# --------------------------------------------------------------------------- solver
-
-
-def solve_rest(scene: Scene, *, tolerance: float = DEFAULT_TOLERANCE, max_time: float = DEFAULT_MAX_TIME,
-               chunk_time: float = DEFAULT_CHUNK_TIME, polish: bool = True) -> RestState:
-    """Bring ``scene`` to rest and return its static state.
-
-    Integrates with the scene's solver settings up to its end time, then in chunks of
-    ``chunk_time`` until the largest node speed over the last :data:`SPEED_WINDOW` of a
-    chunk is below ``tolerance``; then (``polish``) runs Exudyn's static solver from
-    there and keeps its answer if it converged within :data:`POLISH_MAX_SHIFT`. A scene
-    without bending damping is settled with the paper's bending on and then solved
-    statically with its own effects (see the module notes).
-
-    Parameters
-    ----------
-    scene : Scene
-        A scene with massive cables (``effects.cable_mass``) and the implicit solver.
-        The winches hold their initial lengths.
-    tolerance : float [m/s]
-        Largest node speed counted as rest.
-    max_time : float [s]
-        Longest simulated time before giving up.
-    chunk_time : float [s]
-        Length of each extension of the run.
-    polish : bool
-        Polish the settled state with Exudyn's static solver.
-
-    Returns
-    -------
-    RestState
+def solve_rest(scene: Scene, **options) -> Rest:
+    """Bring ``scene`` to rest, the winches holding their initial lengths, by its space's method
+    (:data:`REST_METHODS`). ``options`` are the planar relaxation's (:func:`_relax`: ``tolerance``
+    [m/s], ``max_time`` [s], ``chunk_time`` [s], ``polish``); a spatial static solve ignores them.
 
     Raises
     ------
     SceneError
-        If the scene has massless cables or an explicit integrator, or an argument is bad.
+        If the scene cannot be brought to rest this way (massless planar cables, an explicit
+        integrator, a bad option), naming the field.
+    UnreachableError
+        If the catenary statics of a spatial scene find no equilibrium.
     SolverFailure
-        If the solver fails, or the scene is not at rest after ``max_time``.
+        If the solver fails, the planar scene is not at rest after ``max_time``, or the spatial
+        equilibrium holds the platform above its exits (:func:`rest_above_exits`).
+    """
+    return REST_METHODS[scene.space].solve(scene, **options)
+
+
+def bending_text(scene: Scene, catenary, what: str) -> str:
+    """The cables' bending against their pulleys, for messages: ``what`` (e.g. "what moves it") is
+    the bending E J [N m^2] whose bending length sqrt(E J / T) at the catenaries' largest tension T
+    is compared with the smallest swivel radius (or the shortest cable: point exits)."""
+    cable = scene.cables[0]
+    if not scene.effects.bending:
+        return "the cables have no bending (effects.bending = false)"
+    stiffness = cable.youngs_modulus * cable.second_moment
+    tension = float(np.max(catenary.tensions_at_anchor))
+    length = math.sqrt(stiffness / tension) if tension > 0.0 else math.inf
+    radii = scene.pulley_radii[scene.pulley_radii > 0.0]
+    scale, name = ((float(radii.min()), "the pulleys' radius") if radii.size
+                   else (float(scene.unstrained_lengths.min()), "the shortest cable"))
+    return (f"{what} is the cables' bending: E J = {stiffness:.3g} N m^2 (cables[0].youngs_modulus = "
+            f"{cable.youngs_modulus:.3g} Pa on the solid section pi r^4 / 4) has a bending length sqrt(E J / T) = "
+            f"{length:.3g} m at the catenaries' tension T = {tension:.4g} N, {length / scale:.2g} times {name} "
+            f"({scale:.4g} m)")
+
+
+def rest_above_exits(scene: Scene, position, rotation, lowest_tension: float, catenary) -> str | None:
+    """Why a rest of the lumped robot with every anchor above its exit is no cable robot's rest, or None.
+
+    Such a rest is held by elements that push or by the cables' bending, not by hanging cables
+    (:meth:`Scene.above_exits`): cables whose bending length sqrt(E J / T) is many
+    times their pulleys' radius stand up like rods rather than wrap their pulleys (measured on
+    the swivel robot: E = 1e11 Pa, 16.8 kg: 6.9 times, platform 0.14 m above the inlets).
+
+    Parameters
+    ----------
+    position : (3,) [m]; rotation : (3, 3)
+        The platform's pose at that rest.
+    lowest_tension : float [N]
+        The lowest element force there (negative: compressed).
+    catenary : PlatformEquilibrium
+        The scene's elastic-catenary statics.
+    """
+    above = scene.above_exits(position, rotation)
+    if above is None:
+        return None
+    return (f"the lumped robot's equilibrium holds the platform at z = {float(position[2]):.4g} m (its elastic "
+            f"catenaries hang it at z = {float(catenary.position[2]):.4g} m, {1000 * float(np.linalg.norm(np.asarray(position) - catenary.position)):.0f} mm away) and {above}; "
+            + bending_text(scene, catenary, "what holds it up")
+            + f", and its lowest element force is {lowest_tension:.3g} N. Give the cables a smaller "
+            "youngs_modulus or radius (a wire rope bends far more easily than a solid rod of its modulus)")
+
+
+# --------------------------------------------------------------------------- in the plane: dynamic relaxation
+
+
+def _relax(scene: Scene, *, tolerance: float = DEFAULT_TOLERANCE, max_time: float = DEFAULT_MAX_TIME,
+           chunk_time: float = DEFAULT_CHUNK_TIME, polish: bool = True) -> Rest:
+    """Bring a planar ``scene`` to rest by dynamic relaxation (see the module notes).
+
+    Integrates with the scene's solver settings up to its end time, then in chunks of
+    ``chunk_time`` until the largest node speed over the last :data:`SPEED_WINDOW` of a
+    chunk is below ``tolerance`` [m/s] (giving up after ``max_time`` [s] of simulated time);
+    then (``polish``) runs Exudyn's static solver from there and keeps its answer if it
+    converged within :data:`POLISH_MAX_SHIFT`. A scene without bending damping is settled
+    with the paper's bending on and then solved statically with its own effects. The scene
+    needs massive cables (``effects.cable_mass``) and the implicit solver.
     """
     for name, value in (("tolerance", tolerance), ("max_time", max_time), ("chunk_time", chunk_time)):
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
@@ -307,11 +388,12 @@ def solve_rest(scene: Scene, *, tolerance: float = DEFAULT_TOLERANCE, max_time: 
         elapsed, speed = _integrate_until_rest(model, scene, tolerance, max_time, chunk_time)
         method, shift = "dynamic", None
         if polish:
-            shift, note = _static_polish(model)
-            if shift is not None:
-                method = "dynamic+static"
+            shift = _static_solve(model, POLISH_MAX_SHIFT)
+            if shift is None:
+                notes.append("static polish refused: Exudyn's static solver did not converge within "
+                             f"{POLISH_MAX_SHIFT * 1000:g} mm of the settled state; the dynamic rest state is kept")
             else:
-                notes.append(note)
+                method = "dynamic+static"
     else:
         helper = scene.with_changes(effects=replace(scene.effects, bending=True, bending_damping=True,
                                                     bending_model="exact"))
@@ -460,15 +542,6 @@ def _static_solve(model: Model, max_shift: float | None) -> float | None:
     return shift
 
 
-def _static_polish(model: Model) -> tuple[float | None, str]:
-    """Polish a settled state statically; returns (shift or None, note on refusal)."""
-    shift = _static_solve(model, POLISH_MAX_SHIFT)
-    if shift is None:
-        return None, ("static polish refused: Exudyn's static solver did not converge within "
-                      f"{POLISH_MAX_SHIFT * 1000:g} mm of the settled state; the dynamic rest state is kept")
-    return shift, ""
-
-
 def _copy_state(source: Model, target: Model) -> None:
     """Copy the positions (and contact data) of one model of a scene into another of the same nodes."""
     source_data, target_data = source.mbs.systemData, target.mbs.systemData
@@ -561,7 +634,7 @@ def _bending_cut_force(scene: Scene, cable_index: int, positions: np.ndarray, ve
 
 
 def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method: str,
-                shift: float | None, notes: tuple, reaction_sign: float = 1.0) -> RestState:
+                shift: float | None, notes: tuple, reaction_sign: float = 1.0) -> Rest:
     """Read the rest state off the model (see the module notes for the definitions).
 
     ``reaction_sign`` is -1 when the state comes from Exudyn's static solver, whose
@@ -615,12 +688,178 @@ def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method
         strain = tension[c] / cable.axial_rigidity
         unstrained.append(piece / (1.0 + strain) + (len(elements) - c - 1) * cable.element_length)
         weights.append(float(node_weights[c + 1:].sum()))
-    return RestState(
-        scene_name=scene.name, platform_position_m=pose[:2].copy(),
-        platform_rotation_deg=float(np.degrees(pose[2])), nodes=tuple(positions), tensions=tuple(tensions),
+    return Rest(
+        scene=scene, position=pose[:2].copy(), rotation=float(pose[2]), rotation_matrix=PLANE.rotation_matrix(pose[2]),
+        nodes=tuple(positions), tensions=tuple(tensions), anchor_tensions=np.array(anchor_tensions),
+        platform_forces=np.array(platform_forces), method=method, notes=notes,
         cable_stretched_length_m=np.array(lengths), cable_unstrained_length_m=np.array(unstrained),
         first_free_node=np.array(first, dtype=int), upper_points_m=np.array(upper_points),
-        upper_forces_N=np.array(upper_forces), platform_forces_N=np.array(platform_forces),
-        anchor_tensions_N=np.array(anchor_tensions), span_weights_N=np.array(weights),
-        max_node_speed_m_s=float(speed), time_s=float(elapsed), method=method, static_shift_m=shift, notes=notes,
+        upper_forces_N=np.array(upper_forces), span_weights_N=np.array(weights),
+        max_node_speed_m_s=float(speed), time_s=float(elapsed), static_shift_m=shift,
     )
+
+
+def _planar_arrays(rest: Rest) -> dict[str, np.ndarray]:
+    """The arrays of ``rest.npz``; the first ten are in ``summary.json`` too."""
+    arrays = {
+        "platform_position_m": rest.position, "platform_rotation_deg": np.array(float(np.degrees(rest.rotation))),
+        "cable_stretched_length_m": rest.cable_stretched_length_m,
+        "cable_unstrained_length_m": rest.cable_unstrained_length_m, "first_free_node": rest.first_free_node,
+        "upper_points_m": rest.upper_points_m, "upper_forces_N": rest.upper_forces_N,
+        "platform_forces_N": rest.platform_forces, "anchor_tensions_N": rest.anchor_tensions,
+        "span_weights_N": rest.span_weights_N, "max_node_speed_m_s": np.array(rest.max_node_speed_m_s),
+    }
+    for i, (nodes, tensions) in enumerate(zip(rest.nodes, rest.tensions)):
+        arrays[f"nodes_{i}"] = nodes
+        arrays[f"tensions_{i}"] = tensions
+    return arrays
+
+
+def _planar_summary(rest: Rest) -> dict[str, Any]:
+    arrays = list(_planar_arrays(rest).items())[:10]
+    return {
+        "scene": rest.scene.name, "method": rest.method, "method_description": METHODS[rest.method],
+        **{key: value.tolist() for key, value in arrays},
+        "force_balance_residual_N": rest.force_balance_residual().tolist(),
+        "max_node_speed_m_s": rest.max_node_speed_m_s, "simulated_time_s": rest.time_s,
+        "static_shift_m": rest.static_shift_m, "wall_time_s": rest.wall_time_s, "notes": list(rest.notes),
+        "nodes_m": [n.tolist() for n in rest.nodes], "element_tensions_N": [t.tolist() for t in rest.tensions],
+        "definitions": DEFINITIONS,
+    }
+
+
+def _planar_lines(rest: Rest) -> list[str]:
+    x, z = rest.position
+    lines = [f"{rest.scene.name} at rest after {rest.time_s:.2f} s simulated ({rest.method}), "
+             f"largest node speed {rest.max_node_speed_m_s:.2g} m/s",
+             f"  platform at x = {fixed(x, 6)} m, z = {fixed(z, 6)} m, rotation {fixed(np.degrees(rest.rotation), 4)} deg"]
+    lines += [f"  cable {i + 1}: free span {rest.cable_stretched_length_m[i]:.6f} m "
+              f"(unstrained {rest.cable_unstrained_length_m[i]:.6f} m), force on platform "
+              f"{np.round(rest.platform_forces[i], 4).tolist()} N, on upper support "
+              f"{np.round(rest.upper_forces_N[i], 4).tolist()} N" for i in range(len(rest.nodes))]
+    return lines + [f"  note: {note}" for note in rest.notes]
+
+
+# --------------------------------------------------------------------------- in space: Exudyn's static solve
+
+
+def _solve_from_catenaries(scene: Scene, **relaxation) -> Rest:
+    """Bring a spatial ``scene`` to rest: catenary statics, then Exudyn's static solve of the lumped robot
+    (see the module notes); the planar relaxation's options (``relaxation``) do not apply."""
+    start = _time.perf_counter()
+    platform = catenary_platform(scene)
+    lengths = scene.unstrained_lengths
+    catenary = solve_statics(platform, lengths)
+    rigid = not platform.is_point_mass
+    chain = scene_chain_spec(scene, anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
+    mbs = exu.SystemContainer().AddSystem()
+    swivels = any(scene.swivel_exits)
+    items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary, swivels=scene.swivel_exits)
+    mbs.Assemble()
+    if swivels:
+        start_at_rest(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley
+    static = solve_static(mbs, items)
+    nodes = tuple(chain_positions(mbs, items, i) for i in range(scene.n_cables))
+    tensions = tuple(element_forces(mbs, items, i) for i in range(scene.n_cables))
+    joint = f"penalty spherical joints of {PENALTY:g} element stiffnesses" if rigid else "exact spherical joints"
+    method = (f"Exudyn static solver on the lumped robot ({scene.cables[0].n_elements} elements per cable, {joint}), "
+              "started on the elastic-catenary statics"
+              + (" and, over swivel pulleys, on the chain statics' equilibrium from there" if swivels else ""))
+    rest = Rest(scene, static.position, static.rotation_vector, static.rotation, nodes, tensions,
+                static.tensions_at_anchor, static.forces_on_platform, method, catenary=catenary, anchor_joint=joint,
+                swivel_angles=swivel_angles(mbs, items) if swivels else None)
+    rest = replace(rest, warnings=_spatial_warnings(rest), wall_time_s=_time.perf_counter() - start)
+    above = rest_above_exits(scene, rest.position, rest.rotation_matrix, rest.lowest_element_tension, catenary)
+    if above is not None:
+        raise SolverFailure(f"no rest of a cable robot: {above}", partial_result=rest.summary())
+    return rest
+
+
+def _spatial_warnings(rest: Rest) -> tuple[str, ...]:
+    """An answer far from the catenaries' (:data:`FAR_FROM_CATENARY`) and compressed elements, with figures."""
+    found = []
+    shortest = float(rest.scene.unstrained_lengths.min())
+    if rest.catenary_distance > FAR_FROM_CATENARY * shortest:
+        found.append(
+            f"the lumped robot rests {1000 * rest.catenary_distance:.0f} mm from its elastic catenaries' answer, "
+            f"more than {100 * FAR_FROM_CATENARY:g} % of its shortest cable ({shortest:.4g} m); "
+            + bending_text(rest.scene, rest.catenary, "what the catenary leaves out and moves it"))
+    lowest = rest.lowest_element_tension
+    if lowest < 0.0:
+        found.append(f"an element is compressed ({lowest:.3g} N), which a real cable cannot be (the static solve "
+                     "uses spring elements): a cable is slack at rest (longer than the catenary the lumped model "
+                     "can hang), or the cables' bending holds the platform up")
+    return tuple(found)
+
+
+def _spatial_summary(rest: Rest) -> dict[str, Any]:
+    catenary = rest.catenary
+    return {
+        "scene": rest.scene.name,
+        "dimension": 3,
+        "method": rest.method,
+        "platform_position_m": rest.position.tolist(),
+        "platform_rotation_vector_rad": rest.rotation.tolist(),
+        "platform_roll_pitch_yaw_deg": rotation_angles_deg(rest.rotation_matrix).tolist(),
+        "platform_rotation_matrix": rest.rotation_matrix.tolist(),
+        "tension_at_anchor_N": rest.anchor_tensions.tolist(),
+        "force_on_platform_N": rest.platform_forces.tolist(),
+        "catenary_platform_position_m": catenary.position.tolist(),
+        "catenary_platform_rotation_vector_rad": catenary.rotation.tolist(),
+        "catenary_tension_at_anchor_N": catenary.tensions_at_anchor.tolist(),
+        "min_element_tension_N": rest.lowest_element_tension,
+        "elements_pushed": rest.lowest_element_tension < 0.0,
+        "lumped_minus_catenary_position_m": rest.catenary_distance,
+        "lumped_minus_catenary_rotation_rad": float(np.linalg.norm(rest.rotation - catenary.rotation)),
+        "wall_time_s": rest.wall_time_s,
+        **({} if rest.swivel_angles is None else {
+            "swivel_angle_rad": [None if np.isnan(a) else float(a) for a in rest.swivel_angles],
+            "catenary_wrap_angle_rad": [float(c.wrap_angle) for c in catenary.cables]}),
+        "warnings": list(rest.warnings),
+    }
+
+
+def _spatial_lines(rest: Rest) -> list[str]:
+    x, y, z = rest.position
+    roll, pitch, yaw = rotation_angles_deg(rest.rotation_matrix)
+    catenary = rest.catenary
+    lines = [f"{rest.scene.name} at rest (Exudyn's static solver, {rest.scene.cables[0].n_elements} elements per "
+             f"cable, {rest.anchor_joint}; {rest.wall_time_s:.2f} s)",
+             f"  platform at x = {x:.6f} m, y = {y:.6f} m, z = {z:.6f} m; rotation vector "
+             f"{np.round(rest.rotation, 6).tolist()} rad (roll {roll:.4f}, pitch {pitch:.4f}, yaw {yaw:.4f} deg)"]
+    lines += [f"  cable {i + 1}: {tension:.4f} N at the anchor (catenary {catenary.tensions_at_anchor[i]:.4f} N), "
+              f"force on platform {np.round(force, 4).tolist()} N"
+              for i, (tension, force) in enumerate(zip(rest.anchor_tensions, rest.platform_forces))]
+    lines.append(f"  elastic catenaries (no bending): platform at {np.round(catenary.position, 6).tolist()} m, "
+                 f"{1000 * np.linalg.norm(rest.position - catenary.position):.3f} mm and "
+                 f"{np.degrees(np.linalg.norm(rest.rotation - catenary.rotation)):.4f} deg from the lumped robot")
+    for i, psi in enumerate(() if rest.swivel_angles is None else rest.swivel_angles):
+        cable = catenary.cables[i]
+        if cable.inlet is not None:
+            azimuth = np.degrees(np.arctan2(*(cable.anchor_point - cable.inlet)[1::-1]))
+            lines.append(f"  swivel pulley {i + 1}: psi = {np.degrees(psi):.4f} deg (anchor azimuth {azimuth:.4f} "
+                         f"deg), wrap {np.degrees(cable.wrap_angle):.2f} deg")
+    return lines
+
+
+# --------------------------------------------------------------------------- the one choice of the method
+
+
+@dataclass(frozen=True)
+class _RestMethod:
+    """How a scene of one space is brought to rest, and how its rest is told: the solver
+    (``solve(scene, **options) -> Rest``), the summary, the arrays of ``rest.npz`` (None: no
+    such file) and the console lines."""
+
+    solve: Callable[..., Rest]
+    summary: Callable[[Rest], dict]
+    arrays: Callable[[Rest], dict | None]
+    lines: Callable[[Rest], list]
+
+
+#: The static mode's method by the scene's space: dynamic relaxation of the planar model, Exudyn's
+#: static solve of the spatial robot started on its catenaries.
+REST_METHODS = {
+    PLANE: _RestMethod(_relax, _planar_summary, _planar_arrays, _planar_lines),
+    SPACE: _RestMethod(_solve_from_catenaries, _spatial_summary, lambda rest: None, _spatial_lines),
+}

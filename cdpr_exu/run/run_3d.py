@@ -35,7 +35,7 @@ from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_con
 from cdpr_exu.results.result import Result
 from cdpr_exu.run.settle import start_at_rest
 from cdpr_exu.run.solver import output_times, solver_report
-from cdpr_exu.run.spatial_rest import rest_above_exits
+from cdpr_exu.run.rest import rest_above_exits
 from cdpr_exu.scenes.scene import Scene
 
 __all__ = ["Run3D"]
@@ -153,7 +153,7 @@ def _warn_outside_measured_region(scene: Scene) -> None:
 
 def _rest_above_exits(scene: Scene, mbs, items) -> str | None:
     """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
-    above its exits (:func:`cdpr_exu.run.spatial_rest.rest_above_exits`: its bending or pushing elements do)."""
+    above its exits (:func:`cdpr_exu.run.rest.rest_above_exits`: its bending or pushing elements do)."""
     position, rotation = platform_pose(mbs, items, current=False)
     lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
     above = rest_above_exits(scene, position, rotation, lowest, items.initial)

@@ -9,7 +9,6 @@ carries the result up to that time.
 
 from __future__ import annotations
 
-import math
 import time as _time
 from pathlib import Path
 from typing import Callable
@@ -26,8 +25,8 @@ from cdpr_exu.builder.model import Model, build_model
 from cdpr_exu.builder.robot_3d import Model3D
 from cdpr_exu.core.geometry import penetration
 from cdpr_exu.results.result import Result
-from cdpr_exu.run.solver import (interrupt_flag, output_times, progress_reporter, quiet_exudyn, solver_report,
-                                  solver_settings)
+from cdpr_exu.run.solver import (interrupt_flag, likely_cause, output_times, progress_reporter, quiet_exudyn,
+                                  solver_report, solver_settings)
 from cdpr_exu.run.run_3d import Run3D
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.statics.workspace import check_reference
@@ -534,130 +533,3 @@ def _rope_reservoir(scene: Scene, model: Model) -> RopeReservoir | None:
         axial_rigidity=stiffness[first] * rest[first], damping_rigidity=damping[first] * rest[first],
         rest_length=rest, stiffness=stiffness, damping=damping,
         surplus=np.zeros(m), node_offset=np.zeros(m), max_surplus=np.zeros(m))
-
-
-#: Largest step of Exudyn's explicit RK44 on a real negative eigenvalue, times -lambda
-#: (the classical Runge-Kutta stability interval is [-2.785, 0]).
-RK44_STABILITY_LIMIT = 2.785
-
-
-def explicit_step_limit(scene: Scene) -> float:
-    """Estimated largest stable step of explicit RK44 on ``scene``'s cables [s].
-
-    The fastest mode of a chain of over-damped Kelvin-Voigt elements is the zig-zag,
-    eigenvalue about -4 c_i / m_i; undamped, its frequency is 2 sqrt(k_i / m_i), and a
-    pulley contact adds sqrt(k_p / m_i). RK44 needs h |lambda| below about 2.8.
-    """
-    limits = []
-    for cable, pulley in zip(scene.cables, scene.exits):
-        mass = float(cable.node_masses()[1:-1].min()) if cable.n_elements > 1 else cable.element_mass
-        damping = cable.axial_damping if scene.effects.axial_damping else 0.0
-        stiffness = cable.axial_stiffness if scene.effects.axial_elasticity else 0.0
-        rate = 4.0 * damping / mass
-        frequency = 2.0 * math.sqrt(stiffness / mass)
-        if scene.pulley_contact:
-            frequency = math.hypot(frequency, math.sqrt(pulley.contact_stiffness / mass))
-        limits.append(RK44_STABILITY_LIMIT / max(rate, frequency, 1e-300))
-    return min(limits)
-
-
-def _cause_hints(scene: Scene, failure: str) -> list[str]:
-    """Hints that follow the cause the monitor (or Exudyn) named in ``failure``."""
-    hints = []
-    if "is strained by +" in failure:
-        hints.append("an element stretched beyond the strain limit: the cable is too soft for its load "
-                     "(cables[i].youngs_modulus, platform.mass), or the winch command pulls against the platform")
-    elif "is strained by -" in failure:
-        hints.append("a slack (tension-only) element shortened beyond the monitor's strain limit: the cable "
-                     "went slack and bunched up, which the monitor counts as leaving the model's range "
-                     "(simulate.MAX_STRAIN)" if scene.effects.slack else
-                     "an element was compressed beyond the strain limit: the cable pushes, which a real cable "
-                     "cannot (effects.slack = true makes elements tension-only)")
-    if "deep into pulley" in failure:
-        hints.append("a node or element slipped into the pulley: elements too long for the pulley radius "
-                     "(cables[i].n_elements) or a contact too soft for the tension (pulleys[i].contact_stiffness)")
-    if "rose above the pulleys" in failure:
-        hints.append("the platform was thrown upwards: only pushing cables can hold it above the pulleys; "
-                     "a start-up jolt at a large solver.step_size or a reference that accelerates downwards "
-                     "faster than gravity does this (effects.slack = true lets the cables go slack instead)")
-    if "left the reachable region" in failure or "no longer finite" in failure:
-        hints.append("the integration diverged: solver.step_size is too large for the stiffest mode "
-                     "(axial stiffness or pulley contact), or solver.spectral_radius near 1 leaves it undamped")
-    if "minimum step size" in failure or "Newton" in failure:
-        hints.append("Newton's iteration found no solution even for tiny steps: a force jumps within a step "
-                     "(a winch command that jumps, a slack cable snapping taut, a node striking the rim)")
-    return hints
-
-
-def first_step_hints(scene: Scene) -> list[str]:
-    """What in ``scene`` can make the very first step fail (a run that stops at t = 0)."""
-    hints = []
-    solver = scene.solver
-    cable = scene.cables[0]
-    mass = cable.element_mass if scene.effects.cable_mass else scene.platform.mass
-    if scene.pulley_contact:
-        worst = max(scene.exits, key=lambda p: p.contact_stiffness)
-        # The paper's pulley (1e7 N/m on 0.0875 kg nodes) runs at 2e-3 s: k h^2 / m = 457.
-        ratio = worst.contact_stiffness * solver.step_size**2 / mass
-        if ratio > 1e4:
-            hints.append(f"pulleys[i].contact_stiffness = {worst.contact_stiffness:g} N/m is stiff for "
-                         f"solver.step_size = {solver.step_size} s (k h^2 / m = {ratio:.3g}; the paper scene runs "
-                         "at 457): the nodes resting on the rim cannot be balanced in one step")
-    if scene.effects.axial_elasticity and scene.effects.cable_mass:
-        ratio = cable.axial_stiffness * solver.step_size**2 / cable.element_mass
-        if ratio > 1e5:
-            hints.append(f"cables[i] axial stiffness ({cable.axial_stiffness:.3g} N/m per element) is stiff for "
-                         f"solver.step_size = {solver.step_size} s (k h^2 / m = {ratio:.3g})")
-    if solver.max_newton_iterations < 4:
-        hints.append(f"solver.max_newton_iterations = {solver.max_newton_iterations} is too few for Newton to "
-                     "converge from the initial state")
-    if not hints:
-        hints.append("the initial state is far from balanced (platform.initial_pose against the cables' "
-                     "lengths) or solver.step_size is too large; try a smaller step")
-    return hints
-
-
-def likely_cause(scene: Scene, failure: str = "", failure_time: float | None = None) -> str:
-    """A hint at what most likely made the integration fail.
-
-    Parameters
-    ----------
-    scene : Scene
-    failure : str
-        What stopped the run (the monitor's or the solver's words): the hint follows
-        the cause named there.
-    failure_time : float, optional [s]
-        When the run stopped; a stop within the first step gets hints about what in
-        the scene makes the first step fail.
-    """
-    hints = []
-    if scene.solver.integrator == "rk44":
-        limit = explicit_step_limit(scene)
-        if scene.solver.step_size > limit:
-            hints.append(f"explicit RK44 is unstable above a step of about {limit:.2g} s on these cables "
-                         f"(axial damping c_i / m_i and stiffness); use a smaller step or the implicit solver")
-    if failure_time is not None and failure_time < scene.solver.step_size:
-        hints += ["at t = 0 the first step failed: " + hint for hint in first_step_hints(scene)]
-    hints += _cause_hints(scene, failure)
-    downward = -_steepest_downward_acceleration(scene)
-    if scene.winch.kind == "kinematic" and downward > scene.gravity > 0.0:
-        hints.append(f"the reference accelerates the platform downwards at up to {downward:.3g} m/s^2, more than "
-                     f"gravity ({scene.gravity} m/s^2): cables can only pull, so they go slack"
-                     + ("" if scene.effects.slack else " (with effects.slack off they push instead)"))
-    if not hints and not scene.effects.bending:
-        hints.append("bending is off: the paper scene relies on bending stiffness to stay well-behaved")
-    if not hints and scene.solver.integrator == "generalized_alpha" and scene.solver.spectral_radius > 0.9:
-        hints.append("spectral radius near 1 leaves the stiff axial modes undamped; try 0")
-    if not hints:
-        hints.append("a sudden jump of the winch command or the step size; try a smaller solver.step_size")
-    return "Likely cause: " + "; ".join(dict.fromkeys(hints)) + "."
-
-
-def _steepest_downward_acceleration(scene: Scene) -> float:
-    """Most negative vertical acceleration of the reference over the run [m/s^2] (0 if none)."""
-    try:
-        times = np.linspace(0.0, scene.solver.end_time, 2001)
-        acceleration = np.asarray(scene.trajectory.acceleration(times), dtype=float)[:, 1]
-        return float(min(acceleration.min(), 0.0))
-    except Exception:  # noqa: BLE001 - a hint must never raise
-        return 0.0

@@ -220,8 +220,8 @@ def planar_controller_closed_loop_model_feed_forward():
 
 
 def _rest_arrays(rest):
-    arrays = {"position": np.asarray(rest.platform_position_m), "rotation": np.array(rest.platform_rotation_deg),
-              "anchor_tensions": np.asarray(rest.anchor_tensions_N)}
+    arrays = {"position": np.asarray(rest.position), "rotation": np.array(float(np.degrees(rest.rotation))),
+              "anchor_tensions": np.asarray(rest.anchor_tensions)}
     for i, (nodes, tensions) in enumerate(zip(rest.nodes, rest.tensions)):
         arrays[f"nodes_{i}"], arrays[f"tensions_{i}"] = np.asarray(nodes), np.asarray(tensions)
     return arrays
@@ -337,8 +337,8 @@ def spatial_swivel_tension_aware_chain():
 
 
 def _spatial_rest_arrays(rest):
-    arrays = {"position": np.asarray(rest.position), "rotation": np.asarray(rest.rotation),
-              "tensions_at_anchor": np.asarray(rest.tensions_at_anchor),
+    arrays = {"position": np.asarray(rest.position), "rotation": np.asarray(rest.rotation_matrix),
+              "tensions_at_anchor": np.asarray(rest.anchor_tensions),
               "catenary_position": np.asarray(rest.catenary.position)}
     for i, nodes in enumerate(rest.nodes):
         arrays[f"nodes_{i}"] = np.asarray(nodes)
@@ -347,23 +347,23 @@ def _spatial_rest_arrays(rest):
 
 @case
 def spatial_rest_four_cable():
-    from cdpr_exu.run.spatial_rest import solve_spatial_rest
+    from cdpr_exu.run.rest import solve_rest
 
-    return _spatial_rest_arrays(solve_spatial_rest(_spatial("spatial-four-cable", 1.0)))
+    return _spatial_rest_arrays(solve_rest(_spatial("spatial-four-cable", 1.0)))
 
 
 @case
 def spatial_rest_cogiro():
-    from cdpr_exu.run.spatial_rest import solve_spatial_rest
+    from cdpr_exu.run.rest import solve_rest
 
-    return _spatial_rest_arrays(solve_spatial_rest(_spatial("spatial-cogiro", 1.0)))
+    return _spatial_rest_arrays(solve_rest(_spatial("spatial-cogiro", 1.0)))
 
 
 @case
 def spatial_rest_swivel():
-    from cdpr_exu.run.spatial_rest import solve_spatial_rest
+    from cdpr_exu.run.rest import solve_rest
 
-    return _spatial_rest_arrays(solve_spatial_rest(_spatial("spatial-four-cable-swivel", 1.0)))
+    return _spatial_rest_arrays(solve_rest(_spatial("spatial-four-cable-swivel", 1.0)))
 
 
 @case
