@@ -13,7 +13,7 @@ from cdpr_exu.physics.axial import TAUT_BAND, cable_elements, slack_axial_force
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import add_spatial_chain
-from cdpr_exu.builder.robot_3d import SpatialChainSpec, anchor_forces, build_spatial_robot, element_forces, robot_energy
+from cdpr_exu.builder.robot_3d import ChainSpec3D, anchor_forces, build_spatial_robot, element_forces, robot_energy
 from cdpr_exu.run.settle import dynamic_settings, solve_static
 from conftest import ASYMMETRIC_LENGTHS, PAPER_CATENARY_CABLE, PENALTY, four_cable_robot
 
@@ -249,7 +249,7 @@ def test_exudyns_system_jacobian_with_tension_only_elements_is_the_one_with_its_
 
 def test_a_bad_tension_only_flag_is_refused_naming_the_field():
     with pytest.raises(SceneError, match="tension_only"):
-        SpatialChainSpec(tension_only="yes")
+        ChainSpec3D(tension_only="yes")
 
 
 # ---------------------------------------------------------------------------
@@ -275,7 +275,7 @@ def test_static_robot_with_tension_only_taut_cables_equals_the_one_with_exudyn_s
     platform = four_cable_robot(rigid)
     results, energies, forces = [], [], []
     for tension_only in (False, True):
-        chain = SpatialChainSpec(n_elements=10, flexural_rigidity=bending, tension_only=tension_only,
+        chain = ChainSpec3D(n_elements=10, flexural_rigidity=bending, tension_only=tension_only,
                                  anchor_spring_factor=PENALTY if rigid else None)
         mbs, items = _build(platform, TAUT_LENGTHS, chain)
         results.append(solve_static(mbs, items))
@@ -304,7 +304,7 @@ def test_static_solver_from_a_start_with_slack_elements_and_no_bending_fails():
     stiffness at all, and Exudyn's static solver reports a singular Jacobian (its springs, which
     push, converge). Start from taut cables, or integrate to rest."""
     platform = four_cable_robot(True)
-    chain = SpatialChainSpec(n_elements=10, tension_only=True, anchor_spring_factor=PENALTY)
+    chain = ChainSpec3D(n_elements=10, tension_only=True, anchor_spring_factor=PENALTY)
     mbs, items = _build(platform, ASYMMETRIC_LENGTHS, chain)
     assert min(element_forces(mbs, items, cable, current=False).min() for cable in range(4)) == 0.0
     with pytest.raises(SolverFailure):
@@ -320,7 +320,7 @@ def _pay_out(tension_only, payout=0.2, duration=0.5, end_time=0.6, step=1e-3, da
     with tension-only elements the lowest element force recovered from the chains' ObjectGenericODE2
     force (what Exudyn integrates, not the law read again)."""
     platform = four_cable_robot(False)
-    chain = SpatialChainSpec(n_elements=10, tension_only=tension_only, axial_damping_constant=damping)
+    chain = ChainSpec3D(n_elements=10, tension_only=tension_only, axial_damping_constant=damping)
     mbs, items = _build(platform, [2.5] * 4, chain)
     if tension_only:
         base = [(c.axial_rest_length.copy(), c.axial_stiffness.copy(), c.axial_damping.copy()) for c in items.chains]

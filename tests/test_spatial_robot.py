@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError, SolverFailure
-from cdpr_exu.builder.robot_3d import SpatialChainSpec, build_spatial_robot
+from cdpr_exu.builder.robot_3d import ChainSpec3D, build_spatial_robot
 from cdpr_exu.run.settle import solve_static
 from cdpr_exu.run.dynamics import run_dynamic
 from cdpr_exu.statics.statics import SuspendedPlatform, solve_statics
@@ -22,7 +22,7 @@ def static_errors(rigid, n_elements):
     """Exudyn's static chain robot minus the catenary statics: position [m], rotation [rad], tension [N]."""
     platform = four_cable_robot(rigid)
     catenary = solve_statics(platform, ASYMMETRIC_LENGTHS)
-    chain = SpatialChainSpec(n_elements=n_elements, anchor_spring_factor=PENALTY if rigid else None)
+    chain = ChainSpec3D(n_elements=n_elements, anchor_spring_factor=PENALTY if rigid else None)
     mbs, items = build(platform, ASYMMETRIC_LENGTHS, chain)
     exudyn_static = solve_static(mbs, items)
     return (np.abs(exudyn_static.position - catenary.position).max(),
@@ -62,7 +62,7 @@ def test_exudyn_static_anchor_forces_balance_the_platform_weight_and_moment(rigi
 
 def test_exudyn_static_symmetric_robot_hangs_on_the_axis_with_equal_tensions():
     platform = four_cable_robot(True)
-    chain = SpatialChainSpec(n_elements=10, anchor_spring_factor=PENALTY)
+    chain = ChainSpec3D(n_elements=10, anchor_spring_factor=PENALTY)
     mbs, items = build(platform, [2.5] * 4, chain)
     result = solve_static(mbs, items)
     # symmetric to the static solver's tolerance (1e-9 of ~100 N over stiffnesses >= 10 N/m)
@@ -77,7 +77,7 @@ def test_static_solver_on_exact_spherical_joints_of_a_rigid_platform_fails_with_
     Should this start to converge, Exudyn has changed: the penalty joint may then go.
     """
     platform = four_cable_robot(True)
-    mbs, items = build(platform, ASYMMETRIC_LENGTHS, SpatialChainSpec(n_elements=5))
+    mbs, items = build(platform, ASYMMETRIC_LENGTHS, ChainSpec3D(n_elements=5))
     with pytest.raises(SolverFailure, match="anchor_spring_factor"):
         solve_static(mbs, items)
 
@@ -92,7 +92,7 @@ def test_energy_without_damping_is_conserved_to_second_order_in_the_step(rigid):
     lengths = [2.5] * 4
     push = [20.0, 8.0, 0.0, 1.0, 0.0, 0.5] if rigid else [20.0, 8.0, 0.0, 0.0, 0.0, 0.0]
     start = solve_statics(platform, lengths, external_wrench=push)
-    chain = SpatialChainSpec(n_elements=10, flexural_rigidity=0.05)
+    chain = ChainSpec3D(n_elements=10, flexural_rigidity=0.05)
     drifts = []
     for step in (2e-3, 1e-3, 5e-4):
         mbs, items = build(platform, lengths, chain, initial=start)
@@ -119,7 +119,7 @@ def test_energy_without_damping_is_conserved_to_second_order_in_the_step(rigid):
 ])
 def test_a_bad_chain_spec_is_refused_naming_the_field(fields, name):
     with pytest.raises(SceneError, match=name):
-        SpatialChainSpec(**fields)
+        ChainSpec3D(**fields)
 
 
 def test_a_rigid_platform_without_inertia_or_gravity_is_refused_before_anything_is_built():

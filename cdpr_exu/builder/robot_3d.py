@@ -6,9 +6,9 @@ exact-angle bending in one ``ObjectGenericODE2``, gravity along -z), its first n
 held at the cable's exit point (a point exit, no pulley). Its last node is joined to
 the platform's anchor by an ``ObjectJointSpherical`` (the three translations; a
 spherical joint transmits no moment, like a cable end on a swivel eye), or, when
-``SpatialChainSpec.anchor_spring_factor`` is given, by a stiff
+``ChainSpec3D.anchor_spring_factor`` is given, by a stiff
 ``ObjectConnectorCartesianSpringDamper`` (a penalty spherical joint). With
-``SpatialChainSpec.tension_only`` the axial elements are tension-only
+``ChainSpec3D.tension_only`` the axial elements are tension-only
 (:mod:`cdpr_exu.physics.axial_3d`, in the chain's ``ObjectGenericODE2``) instead of
 Exudyn's spring-dampers, which push when compressed.
 
@@ -57,7 +57,7 @@ chain statics (:mod:`cdpr_exu.statics.chain_statics`, on the same discrete model
 Units SI, z up, gravity along -z. The parameters are those of
 :mod:`cdpr_exu.statics.statics` (:class:`SuspendedPlatform`, the unstrained
 lengths), plus the discretisation and the cable's damping and bending
-(:class:`SpatialChainSpec`); the chain's mass per length is ``weight_per_length /
+(:class:`ChainSpec3D`); the chain's mass per length is ``weight_per_length /
 gravity``. The chains start on the catenary statics' solution (or any
 :class:`PlatformEquilibrium`, eg one under an extra load, to start the robot swinging):
 their reference configuration is straight and unstrained (element length ``L / n``),
@@ -85,7 +85,7 @@ from cdpr_exu.statics.chain_statics import swivel_chain_start, winch_line_elemen
 
 
 @dataclass(frozen=True)
-class SpatialChainSpec:
+class ChainSpec3D:
     """How the cables are discretised, damped and bent.
 
     Parameters
@@ -150,14 +150,14 @@ class SpatialChainSpec:
 
 
 def scene_chain_spec(scene, anchor_spring_factor: float | None = None,
-                     tension_only: bool | None = None) -> SpatialChainSpec:
+                     tension_only: bool | None = None) -> ChainSpec3D:
     """The lumped cables of a spatial scene (:class:`~cdpr_exu.scenes.scene.Scene`), with its effects.
 
     ``tension_only`` defaults to ``effects.slack``; the static mode asks for False (Exudyn's
     static solver needs every element's stiffness, which a slack element has not).
     """
     effects, cable = scene.effects, scene.cables[0]  # the cables share one discretisation (the scene checks)
-    return SpatialChainSpec(
+    return ChainSpec3D(
         tension_only=effects.slack if tension_only is None else bool(tension_only),
         n_elements=cable.n_elements,
         axial_damping_constant=cable.damping_constant * cable.area if effects.axial_damping else 0.0,
@@ -175,7 +175,7 @@ class SpatialRobotItems:
     ----------
     platform : SuspendedPlatform
     unstrained_lengths : ndarray, shape (n_cables,) [m]
-    chain : SpatialChainSpec
+    chain : ChainSpec3D
     chains : list of SpatialChainItems
         One per cable, node 0 at the exit point.
     node_masses : list of ndarray
@@ -204,7 +204,7 @@ class SpatialRobotItems:
 
     platform: SuspendedPlatform
     unstrained_lengths: np.ndarray
-    chain: SpatialChainSpec
+    chain: ChainSpec3D
     chains: list
     node_masses: list
     axial_stiffnesses: np.ndarray
@@ -252,8 +252,8 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     platform : SuspendedPlatform
         Its ``inertia`` must be positive for a rigid body.
     unstrained_lengths : array_like, shape (n_cables,) [m]
-    chain : SpatialChainSpec, optional
-        Default ``SpatialChainSpec()`` (20 elements, no damping, no bending).
+    chain : ChainSpec3D, optional
+        Default ``ChainSpec3D()`` (20 elements, no damping, no bending).
     initial : PlatformEquilibrium, optional
         Start configuration: platform pose and cable shapes; default the catenary
         statics of these lengths (:func:`solve_statics`).
@@ -274,9 +274,9 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     if not isinstance(platform, SuspendedPlatform):
         raise SceneError(f"platform must be a SuspendedPlatform, got {shown(platform)}")
     lengths = checked_unstrained_lengths(platform, unstrained_lengths)
-    chain = SpatialChainSpec() if chain is None else chain
-    if not isinstance(chain, SpatialChainSpec):
-        raise SceneError(f"chain must be a SpatialChainSpec, got {shown(chain)}")
+    chain = ChainSpec3D() if chain is None else chain
+    if not isinstance(chain, ChainSpec3D):
+        raise SceneError(f"chain must be a ChainSpec3D, got {shown(chain)}")
     gravity = positive("gravity", platform.gravity)  # the chains' mass is weight_per_length / gravity
     inertia = np.array(platform.inertia)
     if not platform.is_point_mass and np.any(inertia <= 0.0):

@@ -276,11 +276,11 @@ def solve_static(mbs, items, settings=None):
     ------
     SolverFailure
         If Exudyn's static solver does not converge (on a rigid platform with exact
-        spherical joints it does not: use ``SpatialChainSpec.anchor_spring_factor``).
+        spherical joints it does not: use ``ChainSpec3D.anchor_spring_factor``).
     """
     settings = static_settings() if settings is None else settings
     hint = ("" if items.is_point_mass or items.chain.anchor_spring_factor is not None else
-            " (a rigid platform on exact spherical joints: set SpatialChainSpec.anchor_spring_factor)")
+            " (a rigid platform on exact spherical joints: set ChainSpec3D.anchor_spring_factor)")
     start = time.perf_counter()
     printing = exu.config.printToConsole
     exu.config.printToConsole = False  # a failed static solve prints a page of hints

@@ -199,7 +199,7 @@ class ChainRobot:
     anchor_spring_factor : float or None
         In space: None, each cable's last node sits on its anchor (an exact spherical joint); a
         number f > 0, it is tied to the anchor by an isotropic spring of stiffness f k (the
-        builder's penalty joint, :class:`cdpr_exu.builder.robot_3d.SpatialChainSpec`).
+        builder's penalty joint, :class:`cdpr_exu.builder.robot_3d.ChainSpec3D`).
     """
 
     cables: tuple
