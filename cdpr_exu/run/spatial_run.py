@@ -218,9 +218,9 @@ def simulate_spatial(scene: Scene, controller: Controller | None = None, progres
 
     The controller is any :class:`controllers.base.Controller` that works on spatial
     scenes (:class:`controllers.ideal_ik.IdealIKController`,
-    :class:`controllers.spatial_tension_aware.SpatialTensionAwareController` (catenary or, with
-    ``statics="chain"``, the simulator's own chains),
-    :func:`controllers.spatial_feedback.spatial_closed_loop_tension_aware`); it is asked
+    :class:`controllers.tension_aware.TensionAwareController` (catenary or, with
+    ``statics="chain"``, the simulator's own chains), its closed loop; every kind of
+    :data:`controllers.registry.CONTROLLERS` made for a spatial scene); it is asked
     for the winch commands before every step, wrapped in
     :class:`controllers.base.SmoothStart` as on planar scenes (its commands start at the
     paid-out lengths). A controller with ``uses_pose`` reads the platform's pose
