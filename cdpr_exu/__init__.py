@@ -33,7 +33,7 @@ _EXPORTS: dict[str, str] = {
     "CdprWarning": "cdpr_exu.core.errors",
     "CoarseOutputWarning": "cdpr_exu.core.errors",
     "compare_controllers": "cdpr_exu.studies.comparison",
-    "CONTROLLERS": "cdpr_exu.studies.comparison",
+    "CONTROLLERS": "controllers.registry",
     "Controller": "controllers.base",
     "IdealIKController": "controllers.ideal_ik",
     "TensionAwareController": "controllers.tension_aware",

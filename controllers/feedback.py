@@ -1,10 +1,12 @@
-"""Position feedback around a feed-forward: a PI loop on the filtered platform position error.
+"""Position feedback around a feed-forward: a PI loop on the filtered platform pose error, planar or spatial.
 
 :class:`FilteredPositionPI` turns the measured platform position error e = r_ref - r
-(x, z) [m] into winch length corrections: the error passes a second-order low-pass
+((x, z) or (x, y, z) [m]; with ``rotation`` also phi [rad], the rotation that takes the measured
+orientation to the reference one, R(phi) = R_ref R^T) into winch length corrections: the error passes a second-order low-pass
 filter (Butterworth, cut-off ``cutoff`` [Hz]) and is mapped onto the cables with the
-ideal inverse-kinematics Jacobian U (rows: unit vectors from each pulley's tangent point
-to its anchor), so that a length change U d moves the platform by about d:
+ideal inverse-kinematics Jacobian U = -A^T at the reference pose (A the structure matrix,
+:func:`cdpr_exu.statics.kinematics.structure_matrix`; rows: unit vectors from each cable's exit
+to its anchor, and their moments), so that a length change U d moves the platform by about d:
 
     dlambda = w(t) U(r_ref) (k_p e_f + k_i integral(w e_f) dt),
 
@@ -36,10 +38,19 @@ from typing import Callable
 import numpy as np
 
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.core.validation import shown
 from cdpr_exu.statics.kinematics import length_jacobian
 
 from .base import Measurement, WinchCommand, quintic_blend
+
+
+def _rotation_coordinates(matrix: np.ndarray) -> np.ndarray:
+    """The rotation's coordinates of a rotation matrix: the angle (1,) [rad] of a 2 x 2 one, the rotation
+    vector (3,) [rad] of a 3 x 3 one."""
+    if matrix.shape == (2, 2):
+        return np.array([np.arctan2(matrix[1, 0], matrix[0, 0])])
+    return rotation_vector(matrix)
 
 
 class FilteredPositionPI:
@@ -55,6 +66,12 @@ class FilteredPositionPI:
         Cut-off frequency of the error filter (> 0).
     start_time : float [s]
         The feedback and its integral fade in over this time from t = 0 (>= 0).
+    rotation : bool
+        Feed the rotation error back too (a rigid platform only); otherwise the position alone. The
+        spatial closed loop of the registry does (:mod:`controllers.registry`), with lower gains than
+        these defaults (0.5, 5 /s, 2 Hz): the shipped spatial scenes step at 10 ms and the loop acts one
+        step late; with the planar gains the IPAnema circle oscillated from 1 s and the run failed at 2 s
+        (217 mm).
 
     Raises
     ------
@@ -66,7 +83,7 @@ class FilteredPositionPI:
     FILTER_DAMPING = np.sqrt(0.5)
 
     def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, cutoff: float = 5.0,
-                 start_time: float = 0.5):
+                 start_time: float = 0.5, rotation: bool = False):
         for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
             if not np.isfinite(value) or value < 0:
                 raise SceneError(f"{name} must be zero or positive, got {shown(value)}")
@@ -78,6 +95,7 @@ class FilteredPositionPI:
         self.integral_gain = float(integral_gain)
         self.cutoff = float(cutoff)
         self.start_time = float(start_time)
+        self.rotation = bool(rotation)
         self._scene = None
 
     def reset(self, scene) -> None:
@@ -89,26 +107,38 @@ class FilteredPositionPI:
 
     @property
     def integral(self) -> np.ndarray:
-        """Integral of the filtered position error at the last call [m s], shape (2,)."""
+        """Integral of the filtered error at the last call [m s, rad s], shape (error_size,)."""
         return self._history[-1][3]
 
+    def _with_rotation(self, scene) -> bool:
+        return self.rotation and not scene.platform.is_point_mass
+
     def error_size(self, scene) -> int:
-        """Length of the error vector the loop filters: 2, the position (x, z)."""
-        return 2
+        """Length of the error vector the loop filters: the position's (2 | 3), and with ``rotation`` (a rigid
+        platform) the rotation's too (+1 | +3)."""
+        space = scene.space
+        return space.position_size + (space.rotation_size if self._with_rotation(scene) else 0)
 
     def target(self, time: float) -> np.ndarray:
-        """The scene's reference at ``time`` [s] as the loop compares it: (x, z) [m]."""
-        return self._scene.trajectory.pose(time)[:2]
+        """The scene's reference pose at ``time`` [s] [m, rad]."""
+        return np.asarray(self._scene.trajectory.pose(time), dtype=float)
 
     def error(self, goal: np.ndarray, pose: np.ndarray) -> np.ndarray:
-        """The error e = goal - measured position, shape (2,) [m], for the target ``goal`` and the measured ``pose``."""
-        return goal - pose[:2]
+        """The error e = (r_goal - r, phi), R(phi) = R_goal R^T the rotation from the measured orientation to
+        the goal's (with ``rotation``), for the target ``goal`` and the measured ``pose``, shape (error_size,)."""
+        space = self._scene.space
+        size = space.position_size
+        position = goal[:size] - pose[:size]
+        if not self._with_rotation(self._scene):
+            return position
+        turn = space.rotation_matrix(goal[size:]) @ space.rotation_matrix(pose[size:]).T
+        return np.concatenate([position, _rotation_coordinates(turn)])
 
     def jacobian(self, pose: np.ndarray) -> np.ndarray:
         """d(lambda)/d(the error's coordinates) of the ideal cables at ``pose``, shape (m, error_size) [m/m, m/rad]:
         the first columns of the length Jacobian ``-A^T`` (:func:`cdpr_exu.statics.kinematics.length_jacobian`;
         moving an anchor by d changes the ideal length by u . d, u the unit vector from the cable's exit
-        towards the anchor)."""
+        towards the anchor; turning the platform by a small rotation phi moves anchor i by ``phi x R b_i``)."""
         return length_jacobian(self._scene, pose)[:, :self.error_size(self._scene)]
 
     def _advance(self, time: float, error: np.ndarray, weight: float):

@@ -1,60 +1,69 @@
-"""Tension-aware winch commands: sag and stretch compensation from catenary statics.
+"""Tension-aware winch commands: sag and stretch compensation from the cables' statics, planar and spatial.
 
-For each reference position the platform's kineto-static equilibrium on elastic
-catenary cables (:func:`cdpr_exu.statics.statics.solve_inverse_statics`) gives the cable
-tensions, the rotation the platform takes, and the unstrained lengths (wrap on the
-pulley included) that put its centre on the reference. Those lengths are the command.
+For each sample of the reference the controller finds the platform's kineto-static equilibrium on
+the cables (:func:`cdpr_exu.statics.statics.solve_inverse_statics` on elastic catenaries, or
+:mod:`cdpr_exu.statics.chain_statics` on the simulator's own lumped chains): the cable tensions and
+the unstrained lengths that put the platform on the reference. Those lengths are the command. One
+class for both dimensions; what differs is the equilibrium each space has, behind one interface
+(:data:`EQUILIBRIA`, chosen by the scene's :class:`~cdpr_exu.space.Space`):
+
+* **planar**: the platform's rotation is the one its balance imposes (two cables), and the lengths
+  include the wrap on the pulley;
+* **spatial**: the tensions nearest the previous sample's, starting from the tensions the robot has
+  at rest with the lengths it starts with (an over-constrained robot so keeps the internal tension
+  it started with); the platform's angular acceleration is left out of the inertial load.
+
 Options:
 
-* ``dynamic=True`` adds the platform's inertial load -M a from the reference
-  acceleration to the equilibrium (dynamic feed-forward; the cables' own inertia is
-  neglected);
-* ``chordal_correction=True`` accounts for the lumped model's own geometry over the
-  pulley: its straight elements wrap the pulley as a polygon of chords, which needs
-  less cable than the arc (up to 3 cm with the paper's 0.25 m elements on a 0.25 m
-  pulley), by an amount that depends on where the nodes sit. The command is then the
-  length of the straight discretised chain (the chord walk of
+* ``dynamic`` adds the platform's inertial load -M a of the reference acceleration (dynamic
+  feed-forward; the cables' own inertia is neglected). Default: off planar, on spatial (today's);
+* ``chordal_correction=True`` (planar) corrects for the lumped model's polygon of chords over the
+  pulley, which needs less cable than the arc (up to 3 cm with the paper's 0.25 m elements on a
+  0.25 m pulley): the command is the length of the straight discretised chain (the chord walk of
   :func:`cdpr_exu.statics.kinematics.initial_cable_nodes`) plus the catenary's sag and stretch
-  correction (catenary length minus ideal length). A real cable has no such polygon:
-  this option compensates the simulator's discretisation, and says so in its name;
-* ``statics="chain"`` solves each equilibrium on the simulator's own lumped cables
-  instead of continuous catenaries (:mod:`cdpr_exu.statics.chain_statics`): chains of straight
-  elements with the nodes' weight, exact-angle bending springs and the penalty contact
-  of the nodes on the pulleys. It has the polygon over the pulley, where the nodes sit
-  on it, and the bending of the cable where it leaves the pulley, which the continuous
-  catenary lacks; it costs about 5 ms per tabulated pose (the catenary: about 3 ms).
-  As for ``chordal_correction``, what it adds over the catenary is the simulator's
-  discretisation;
-* :class:`ClosedLoopTensionAwareController` adds a PI correction from the measured
-  platform position, mapped onto the cables by the ideal inverse-kinematics Jacobian
+  correction. A real cable has no such polygon: it compensates the simulator's discretisation;
+* ``statics="chain"`` solves each equilibrium on the simulator's own lumped cables (nodes' weight,
+  exact-angle bending, planar: the nodes' contact on the pulleys), which have the polygon and the
+  bending where the cable leaves the pulley; about 5 ms per tabulated pose (the catenary: 3 ms).
+  In space the pose given decouples the cables: one small Newton solve per held chain inside a
+  Gauss-Newton on the lengths (the platform's six balance equations), started from the previous
+  sample's lengths plus the change of the straight exit-to-anchor distance (the first sample from
+  the catenary inverse). Over a swivel pulley the held chain runs from its winch end up the axis
+  and over the disc, psi solved with it; the straight distance is the inlet's, and the first sample
+  starts from the robot's rest (the catenaries, without the bending over the disc, hang 22 mm lower
+  on spatial-four-cable-swivel);
+* ``start`` (:data:`controllers.base.STARTS`): default today's, "absolute" (the lengths themselves;
+  the run blends their offset from the paid-out lengths in, :class:`controllers.base.SmoothStart`),
+  but the spatial catenary's "relative" (the paid-out lengths plus the lengths' change, which
+  cancels the catenary's 1e-5 m offset from the simulator's chains on IPAnema);
+* :class:`ClosedLoopTensionAwareController` adds a PI correction from the measured platform pose
   (:class:`controllers.feedback.FilteredPositionPI`).
 
-The commands are tabulated once per run on a coarse time grid and interpolated with a
-cubic spline, so they and their rates are continuous. The cables start straight (the
-paper's initial state), with a paid-out length that differs from the compensated one:
-the run blends every controller's command from the initial length into its own
-(:class:`controllers.base.SmoothStart`) instead of jumping.
+The commands are tabulated once per run on a coarse time grid and interpolated with a cubic
+spline, so they and their rates are continuous.
 
-Plain NumPy/SciPy; no Exudyn.
+Plain NumPy/SciPy; no Exudyn. Units SI.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from cdpr_exu.statics import chain_statics
-from cdpr_exu.statics import statics
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.statics.kinematics import anchor_points, ideal_paid_out, initial_cable_nodes
 from cdpr_exu.core.validation import shown
+from cdpr_exu.space import PLANE, SPACE
+from cdpr_exu.statics import chain_statics, statics
+from cdpr_exu.statics.kinematics import anchor_points, ideal_paid_out, initial_cable_nodes
 
 from .base import CommandStart, Measurement, WinchCommand
 from .feedback import FilteredPositionPI
 
 
 def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
-    """Paid-out length of each straight, inextensible lumped chain reaching ``anchors``, shape (m,) [m].
+    """Paid-out length of each straight, inextensible lumped chain reaching ``anchors``, shape (m,) [m] (planar).
 
     The chain of n elements of length l0/n is laid from the anchor back over the pulley
     with exact chords (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`); what is not
@@ -74,55 +83,241 @@ def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
 STATICS_MODELS = ("catenary", "chain")
 
 
+class _PlanarEquilibria:
+    """The planar robot's equilibria (:data:`PLANE`): the platform's rotation is the one its balance takes."""
+
+    #: Today's defaults of the options left at None: no inertial load, a table spaced by the reference's speed,
+    #: the commands the lengths themselves, a spline with zero rate where the reference starts from rest.
+    dynamic = False
+    table_spacing = 2e-3
+    starts = {"catenary": "absolute", "chain": "absolute"}
+    from_rest = True
+
+    @staticmethod
+    def solver(controller, scene, initial_paid_out):
+        """``solve(pose, acceleration) -> lengths`` [m] along the reference (the chain continued)."""
+        platform = statics.catenary_platform(scene)
+        chain = chain_statics.chain_robot(scene) if controller.statics == "chain" else None
+        chordal = controller.chordal_correction and all(exit_.wraps for exit_ in scene.exits)
+        state = {"previous": None}
+
+        def solve(pose, acceleration):
+            wrench = statics.inertial_wrench(platform, acceleration[:2], acceleration[2]) if controller.dynamic else None
+            if chain is not None:
+                equilibrium = _chain_equilibrium(chain, platform, pose, wrench, state["previous"])
+                state["previous"] = equilibrium
+                controller.equilibria.append(equilibrium)
+                return equilibrium.paid_out
+            equilibrium = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
+            controller.equilibria.append(equilibrium)
+            lengths = equilibrium.unstrained_lengths
+            if chordal:
+                pose_eq = np.array([*pose[:2], equilibrium.rotation])
+                anchors = anchor_points(pose_eq, np.asarray(scene.platform.anchors))
+                lengths = lengths + (chain_length(scene, anchors) - ideal_paid_out(scene, pose_eq[None, :])[0][0])
+            return lengths
+        return solve
+
+
+def _chain_equilibrium(chain, platform, pose, wrench, previous):
+    """Planar chain statics at one reference pose, continued from the previous one when there is one."""
+    if previous is not None:
+        try:
+            return chain_statics.solve_inverse_chain_statics(chain, pose[:2], external_wrench=wrench, guess=previous)
+        except UnreachableError:
+            pass  # start afresh from the catenary below
+    start = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
+    return chain_statics.solve_inverse_chain_statics(chain, (*pose[:2], start.rotation), external_wrench=wrench,
+                                                     tension_guess=[c.tension_at_anchor for c in start.cables])
+class _SpatialEquilibria:
+    """The spatial robot's equilibria (:data:`SPACE`): the tensions nearest the previous sample's."""
+
+    #: Today's defaults of the options left at None: the inertial load always, a fixed table period, the
+    #: catenary's commands relative to the paid-out lengths, a not-a-knot spline at both ends.
+    dynamic = True
+    table_spacing = 0.0
+    starts = {"catenary": "relative", "chain": "absolute"}
+    from_rest = False
+
+    @staticmethod
+    def _inertial(controller, mass, acceleration):
+        """The d'Alembert wrench of the reference's acceleration (the platform's, -M a), shape (6,)."""
+        return np.concatenate([-mass * acceleration[:3] if controller.dynamic else np.zeros(3), np.zeros(3)])
+
+    @staticmethod
+    def solver(controller, scene, initial):
+        """``solve(pose, acceleration) -> lengths`` [m] along the reference, the tensions continued."""
+        if controller.chordal_correction:
+            raise SceneError(f"chordal_correction corrects the planar pulley's polygon of chords; scene {scene.name!r} "
+                             "is spatial (use statics='chain' for the simulator's own chains)")
+        if initial is None:
+            raise SceneError("the spatial tension-aware lengths start from the paid-out lengths: give initial_paid_out")
+        initial = np.asarray(initial, dtype=float)
+        kernel = _SpatialEquilibria._chain_solver if controller.statics == "chain" else _SpatialEquilibria._catenary_solver
+        return kernel(controller, scene, initial)
+
+    @staticmethod
+    def _catenary_solver(controller, scene, initial):
+        """pose, acceleration -> lengths [m] on elastic catenaries, the horizontal tensions continued."""
+        platform = statics.catenary_platform(scene)
+        rest = statics.solve_statics(platform, initial)
+        state = {"tensions": np.array([c.catenary.horizontal_tension for c in rest.cables])}
+
+        def solve(pose, acceleration):
+            inertial = _SpatialEquilibria._inertial(controller, platform.mass, acceleration)
+            inverse = statics.solve_inverse_statics(platform, pose, inertial, initial_guess=state["tensions"])
+            state["tensions"] = inverse.horizontal_tensions
+            controller.equilibria.append(inverse)
+            return inverse.unstrained_lengths
+        return solve
+
+    @staticmethod
+    def _chain_solver(controller, scene, initial):
+        """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued."""
+        from cdpr_exu.core.geometry import rotation_from_vector
+
+        platform = statics.catenary_platform(scene)
+        robot = chain_statics.chain_robot(scene)
+        over_swivel = [cable.pulley is not None for cable in robot.cables]
+        inverse_statics = chain_statics.InverseChainStatics(robot)
+        catenary_rest = statics.solve_statics(platform, initial)
+        started = chain_statics.robot_paid_out(robot, initial)
+        rest = chain_statics.solve_chain_statics(started, *chain_statics.catenary_start(started, catenary_rest))
+        # the straight distances change as the paid-out lengths: from the exit point, or the swivel pulley's inlet
+        exits = np.array([cable.pulley.inlet_array if swivel else cable.exit_point
+                          for cable, swivel in zip(robot.cables, over_swivel)])
+        anchors = np.array([c.anchor for c in robot.cables])
+        state = {"tensions": rest.tensions_at_anchor, "horizontal": np.array([c.catenary.horizontal_tension
+                                                                             for c in catenary_rest.cables]),
+                 "previous": None}
+        if any(over_swivel):
+            # Over swivel pulleys the first sample starts from the rest the robot starts in, not from the
+            # catenaries: these hang lower (no bending over the disc: 22 mm on spatial-four-cable-swivel), and
+            # their nodes cannot start a chain that runs up the axis and over the disc
+            state["previous"] = (replace(rest, paid_out=np.array(initial, dtype=float), iterations=0),
+                                 np.linalg.norm(exits - rest.position - anchors @ rest.rotation.T, axis=1))
+
+        def anchor_points_at(pose):
+            rotation = np.eye(3) if robot.is_point_mass else rotation_from_vector(pose[3:6])
+            return pose[:3] + anchors @ rotation.T
+
+        def catenary_guess(pose, inertial):
+            """Lengths and nodes of the catenary inverse at ``pose`` (a start far from any previous sample);
+            a chain over a swivel pulley keeps the previous sample's nodes."""
+            inverse = statics.solve_inverse_statics(platform, pose, inertial, initial_guess=state["horizontal"])
+            state["horizontal"] = inverse.horizontal_tensions
+            points = anchor_points_at(pose)
+            nodes = []
+            for i, (cable, chain, length, point) in enumerate(zip(platform.cables, robot.cables,
+                                                                  inverse.unstrained_lengths, points)):
+                if over_swivel[i]:
+                    nodes.append(state["previous"][0].nodes[i])
+                    continue
+                shape, _ = statics.forward_cable(cable, length, point)
+                nodes.append(shape.points(length - np.linspace(0.0, length, chain.n_elements + 1)))
+            return inverse.unstrained_lengths, nodes
+
+        def solve(pose, acceleration):
+            inertial = _SpatialEquilibria._inertial(controller, robot.mass, acceleration)
+            previous = state["previous"]
+            angles = None
+            if previous is None:
+                lengths, nodes = catenary_guess(pose, inertial)
+            else:  # the previous lengths, changed as the straight cables change
+                chords = np.linalg.norm(exits - anchor_points_at(pose), axis=1)
+                lengths = previous[0].paid_out + chords - previous[1]
+                nodes, angles = previous[0].nodes, previous[0].swivel_angles
+            try:
+                inverse = inverse_statics.solve(pose, state["tensions"], lengths=lengths, nodes=nodes,
+                                                external_wrench=inertial, swivel_angles=angles)
+            except UnreachableError:
+                if previous is None:
+                    raise
+                lengths, nodes = catenary_guess(pose, inertial)
+                inverse = inverse_statics.solve(pose, state["tensions"], lengths=lengths, nodes=nodes,
+                                                external_wrench=inertial, swivel_angles=angles)
+            state["tensions"] = inverse.tensions_at_anchor
+            state["previous"] = (inverse, np.linalg.norm(exits - anchor_points_at(pose), axis=1))
+            controller.equilibria.append(inverse)
+            return inverse.paid_out
+        return solve
+
+
+#: The equilibria of each space: one interface (``solver`` and today's defaults), a kernel per dimension.
+EQUILIBRIA = {PLANE: _PlanarEquilibria, SPACE: _SpatialEquilibria}
+
+
 class TensionAwareController:
-    """Open-loop unstrained lengths from the elastic-catenary equilibrium of each reference pose.
+    """Open-loop unstrained lengths from the equilibrium of each reference pose, planar or spatial.
 
     Parameters
     ----------
-    dynamic : bool
-        Add the inertial load -M a of the reference acceleration (dynamic feed-forward).
+    dynamic : bool, optional
+        Add the inertial load -M a of the reference acceleration (dynamic feed-forward). Default: today's
+        (:data:`EQUILIBRIA`: off planar, on spatial).
     table_period : float [s]
-        Time grid of the equilibrium table (interpolated by a cubic spline; where the
+        Time grid of the equilibrium table (interpolated by a cubic spline; where a planar
         reference starts from rest, the spline starts with zero rate).
     chordal_correction : bool
-        Correct for the lumped model's polygon over the pulley (see the module notes).
+        Correct for the planar lumped model's polygon over the pulley (see the module notes).
     statics : {"catenary", "chain"}
         The cable model of the equilibria (see the module notes).
-    table_spacing : float [m]
+    table_spacing : float [m], optional
         Where the reference is slow, the table period grows until the reference moves
-        this far in one period (at most 0.25 s); 0 keeps ``table_period``.
-    start : {"absolute", "relative", "calibrated"}
-        Where the commands start from (:data:`controllers.base.STARTS`); "absolute", the default, is today's.
+        this far in one period (at most 0.25 s); 0 keeps ``table_period``. Default: today's
+        (2 mm planar, 0 spatial).
+    start : {"absolute", "relative", "calibrated"}, optional
+        Where the commands start from (:data:`controllers.base.STARTS`); default today's (see the module
+        notes). A start given names the controller (``tension_aware_relative``...).
+
+    Raises
+    ------
+    SceneError
+        If an option is out of its range (naming it); at ``reset``, for an option the scene's space
+        has no physics for (``chordal_correction`` on a spatial scene).
     """
 
     uses_pose = False
     uses_tension = False
 
-    def __init__(self, dynamic: bool = False, table_period: float = 0.02,
-                 chordal_correction: bool = False, statics: str = "catenary", table_spacing: float = 2e-3,
-                 start: str = "absolute"):
+    def __init__(self, dynamic: bool | None = None, table_period: float = 0.02, chordal_correction: bool = False,
+                 statics: str = "catenary", table_spacing: float | None = None, start: str | None = None):
         if not np.isfinite(table_period) or table_period <= 0:
             raise SceneError(f"table_period must be positive, got {shown(table_period)}")
-        if not np.isfinite(table_spacing) or table_spacing < 0:
+        if table_spacing is not None and (not np.isfinite(table_spacing) or table_spacing < 0):
             raise SceneError(f"table_spacing must be zero or positive, got {shown(table_spacing)}")
         if statics not in STATICS_MODELS:
             raise SceneError(f"statics must be one of {STATICS_MODELS}, got {shown(statics)}")
         if statics == "chain" and chordal_correction:
             raise SceneError("chordal_correction is for statics='catenary': the chain statics has the polygon already")
-        self.start = CommandStart(start)
+        self._options = {"dynamic": dynamic, "table_spacing": table_spacing, "start": start}
+        self.start = CommandStart("absolute" if start is None else start)
         self.uses_pose = self.uses_pose or self.start.uses_pose
         self.dynamic = bool(dynamic)
         self.chordal_correction = bool(chordal_correction)
         self.statics = statics
         self.table_period = float(table_period)
-        self.table_spacing = float(table_spacing)
-        self.name = ("tension_aware" + ("_chain" if statics == "chain" else "") + ("_dynamic" if self.dynamic else "")
-                     + ("_chordal" if self.chordal_correction else "") + ("" if start == "absolute" else f"_{start}"))
+        self.table_spacing = table_spacing
+        self.name = ("tension_aware" + ("_chain" if statics == "chain" else "") + ("_dynamic" if dynamic else "")
+                     + ("_chordal" if self.chordal_correction else "") + ("" if start is None else f"_{start}"))
         self._spline = None
         self.equilibria: list = []
 
-    def compensated_lengths(self, scene, times: np.ndarray) -> np.ndarray:
-        """Unstrained paid-out lengths that hold the platform on the reference, shape (N, m) [m].
+    def _resolve(self, scene):
+        """The equilibria of ``scene``'s space, with the options left at None set to its defaults."""
+        kernel = EQUILIBRIA[scene.space]
+        dynamic, spacing, start = (self._options[k] for k in ("dynamic", "table_spacing", "start"))
+        self.dynamic = kernel.dynamic if dynamic is None else bool(dynamic)
+        self.table_spacing = float(kernel.table_spacing if spacing is None else spacing)
+        if start is None:
+            self.start = CommandStart(kernel.starts[self.statics])
+        return kernel
+
+    def compensated_lengths(self, scene, times: np.ndarray, initial_paid_out=None) -> np.ndarray:
+        """Unstrained paid-out lengths that hold the platform on the reference at ``times``, shape (N, m) [m].
+
+        ``initial_paid_out`` (m,) [m]: what the winches paid out at t = 0 (the spatial equilibria start
+        from the robot's rest with it).
 
         Raises
         ------
@@ -130,65 +325,42 @@ class TensionAwareController:
             If a reference pose needs a cable to push or has no equilibrium; the message
             names the time.
         """
-        platform = statics.catenary_platform(scene)
-        chain = chain_statics.chain_robot(scene) if self.statics == "chain" else None
-        poses = scene.trajectory.pose(times)
-        accelerations = scene.trajectory.acceleration(times)
+        solve = self._resolve(scene).solver(self, scene, initial_paid_out)
+        poses = np.atleast_2d(scene.trajectory.pose(times))
+        accelerations = np.atleast_2d(scene.trajectory.acceleration(times))
+        size = scene.space.position_size
         lengths = np.zeros((len(times), scene.n_cables))
         self.equilibria = []
-        equilibrium = None
         for k, (t, pose, acceleration) in enumerate(zip(times, poses, accelerations)):
-            wrench = statics.inertial_wrench(platform, acceleration[:2], acceleration[2]) if self.dynamic else None
             try:
-                if chain is not None:
-                    equilibrium = self._chain_equilibrium(chain, platform, pose, wrench, equilibrium)
-                else:
-                    equilibrium = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
+                lengths[k] = solve(pose, acceleration)
             except UnreachableError as err:
-                raise UnreachableError(f"the reference at t = {t:.3f} s, position {np.round(pose[:2], 4).tolist()} m, "
-                                       f"cannot be held by the cables: {err}") from None
-            self.equilibria.append(equilibrium)
-            if chain is not None:
-                lengths[k] = equilibrium.paid_out
-                continue
-            lengths[k] = equilibrium.unstrained_lengths
-            if self.chordal_correction and all(exit_.wraps for exit_ in scene.exits):
-                pose_eq = np.array([*pose[:2], equilibrium.rotation])
-                anchors = anchor_points(pose_eq, np.asarray(scene.platform.anchors))
-                lengths[k] += chain_length(scene, anchors) - ideal_paid_out(scene, pose_eq[None, :])[0][0]
+                raise UnreachableError(f"the reference at t = {t:.3f} s, position {np.round(pose[:size], 4).tolist()} "
+                                       f"m, cannot be held by the cables: {err}") from None
         return lengths
-
-    @staticmethod
-    def _chain_equilibrium(chain, platform, pose, wrench, previous):
-        """Chain statics at one reference pose, continued from the previous one when there is one."""
-        if previous is not None:
-            try:
-                return chain_statics.solve_inverse_chain_statics(chain, pose[:2], external_wrench=wrench, guess=previous)
-            except UnreachableError:
-                pass  # start afresh from the catenary below
-        start = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
-        return chain_statics.solve_inverse_chain_statics(chain, (*pose[:2], start.rotation), external_wrench=wrench,
-                                                         tension_guess=[c.tension_at_anchor for c in start.cables])
 
     def _period(self, scene) -> float:
         """Table period [s]: ``table_period``, or longer where the reference moves less
         than ``table_spacing`` in it (slow references need fewer equilibria)."""
+        if self.table_spacing == 0:
+            return self.table_period
         times = np.linspace(0.0, scene.solver.end_time, 400)
-        speed = float(np.linalg.norm(scene.trajectory.velocity(times)[:, :2], axis=1).max())
-        if self.table_spacing == 0 or speed == 0:
+        velocity = np.atleast_2d(scene.trajectory.velocity(times))[:, :scene.space.position_size]
+        speed = float(np.linalg.norm(velocity, axis=1).max())
+        if speed == 0:
             return self.table_period
         return max(self.table_period, min(self.table_spacing / speed, 0.25))
 
     def reset(self, scene, initial_paid_out) -> None:
         """Solve the equilibria along the reference and tabulate the commands."""
+        kernel = self._resolve(scene)
         end = scene.solver.end_time
         count = max(int(np.ceil(end / self._period(scene))), 3) + 1
         times = np.linspace(0.0, end, count)
-        lengths = self.compensated_lengths(scene, times)
-        # start "absolute": the compensated length itself; the run takes up its offset from the
-        # initial (straight-cable) paid-out length (controllers.base.SmoothStart)
+        lengths = self.compensated_lengths(scene, times, initial_paid_out)
         commands = self.start.commands(scene, lengths, initial_paid_out)
-        at_rest = not (np.any(scene.trajectory.velocity(0.0)) or np.any(scene.trajectory.acceleration(0.0)))
+        at_rest = kernel.from_rest and not (np.any(scene.trajectory.velocity(0.0))
+                                            or np.any(scene.trajectory.acceleration(0.0)))
         start = (1, np.zeros(scene.n_cables)) if at_rest else "not-a-knot"  # from rest: zero rate at t = 0
         self._spline = CubicSpline(times, commands, axis=0, bc_type=(start, "not-a-knot"))
         self._rate = self._spline.derivative()
@@ -197,7 +369,7 @@ class TensionAwareController:
         """Tabulated command and its rate at time t [m, m/s]."""
         if self._spline is None:
             raise RuntimeError(f"{type(self).__name__}.reset(scene, initial_paid_out) must be called first")
-        return np.asarray(self._spline(t)), np.asarray(self._rate(t))
+        return np.asarray(self._spline(t), dtype=float), np.asarray(self._rate(t), dtype=float)
 
     def command(self, measurement: Measurement) -> WinchCommand:
         lengths, rates = self.feed_forward(measurement.time)
@@ -205,22 +377,24 @@ class TensionAwareController:
 
 
 class ClosedLoopTensionAwareController(TensionAwareController):
-    """Tension-aware feed-forward plus PI feedback on the low-pass filtered platform position error.
+    """Tension-aware feed-forward plus PI feedback on the low-pass filtered platform pose error.
 
     The feedback is :class:`controllers.feedback.FilteredPositionPI` (see there why the
     error is filtered and how a retried step is handled): the position error e = r_ref - r
-    (x, z), filtered by a second-order Butterworth low-pass (cut-off ``cutoff`` [Hz]),
-    turned into length corrections dlambda = U (k_p e_f + k_i integral(e_f) dt) with the
-    ideal inverse-kinematics Jacobian U, fading in over ``start_time``.
+    (and with ``rotation`` the rotation error), filtered by a second-order Butterworth low-pass
+    (cut-off ``cutoff`` [Hz]), turned into length corrections dlambda = U (k_p e_f + k_i integral(e_f) dt)
+    with the ideal inverse-kinematics Jacobian U, fading in over ``start_time``.
 
     Parameters
     ----------
     proportional_gain : float [-]
     integral_gain : float [1/s]
-    cutoff : float [Hz]
-        Cut-off frequency of the error filter (> 0).
     start_time : float [s]
         The feedback (and its integral) fades in over this time from t = 0.
+    cutoff : float [Hz]
+        Cut-off frequency of the error filter (> 0).
+    rotation : bool
+        Feed the rotation error back too (:class:`~controllers.feedback.FilteredPositionPI`).
     dynamic, table_period, ...
         As :class:`TensionAwareController`.
     """
@@ -231,28 +405,14 @@ class ClosedLoopTensionAwareController(TensionAwareController):
     FILTER_DAMPING = FilteredPositionPI.FILTER_DAMPING
 
     def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, start_time: float = 0.5,
-                 cutoff: float = 5.0, **kwargs):
+                 cutoff: float = 5.0, rotation: bool = False, **kwargs):
         super().__init__(**kwargs)
-        self.feedback = FilteredPositionPI(proportional_gain, integral_gain, cutoff, start_time)
-        self.start_time = self.feedback.start_time
-        self.cutoff = self.feedback.cutoff
-        self.proportional_gain = self.feedback.proportional_gain
-        self.integral_gain = self.feedback.integral_gain
-        self.name = ("closed_loop_" + self.name)
+        self.feedback = FilteredPositionPI(proportional_gain, integral_gain, cutoff, start_time, rotation)
+        self.name = "closed_loop_" + self.name
 
     def reset(self, scene, initial_paid_out) -> None:
         super().reset(scene, initial_paid_out)
-        self._scene = scene
         self.feedback.reset(scene)
-
-    @property
-    def _integral(self) -> np.ndarray:
-        """Integral of the filtered position error at the last call [m s], shape (2,)."""
-        return self.feedback.integral
-
-    def _jacobian(self, pose: np.ndarray) -> np.ndarray:
-        """d(lambda)/d(position) of the ideal cables at ``pose``, shape (m, 2) (:meth:`FilteredPositionPI.jacobian`)."""
-        return self.feedback.jacobian(pose)
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if measurement.platform_pose is None:

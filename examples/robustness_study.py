@@ -19,7 +19,7 @@ Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, w
 this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after
 the first second. About 10 min of CPU time (ILC's 10 trials per plant are most of it); the spatial part
 about 8 min more. The model-based feed-forward (``model_feed_forward``, ``closed_loop_model_feed_forward``)
-runs as well with its kind (:data:`cdpr_exu.studies.robustness.KINDS`) added to :data:`PLANAR`.
+runs as well with its kind (a name of :data:`controllers.registry.CONTROLLERS`) added to :data:`PLANAR`.
 
 Run::
 

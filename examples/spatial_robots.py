@@ -13,10 +13,10 @@ minutes on one core (the chain version's statics, ``tension_aware_chain``, take 
 
 from pathlib import Path
 
-from cdpr_exu.cli.compare import print_spatial_controller_row
+from cdpr_exu.cli.compare import print_controller_row
 from cdpr_exu.post.plots import plot_rest
 from cdpr_exu.run.rest import solve_rest
-from cdpr_exu.studies.comparison import compare_spatial
+from cdpr_exu.studies.comparison import compare_controllers
 from cdpr_exu.scenes.scene import load_scene
 
 RESULTS = Path("results/spatial")
@@ -31,8 +31,8 @@ def main() -> None:
     rows = ["| robot | controller | max position error [mm] | RMS position error [mm] | max rotation error [deg] "
             "| min element tension [N] |", "|---|---|---|---|---|---|"]
     for name in ("spatial-cogiro", "spatial-ipanema"):
-        summaries = compare_spatial(load_scene(name), out=RESULTS / name / "compare",
-                                    report=print_spatial_controller_row)
+        summaries = compare_controllers(load_scene(name), out=RESULTS / name / "compare",
+                                        report=print_controller_row)
         for controller, s in summaries.items():
             rows.append(f"| {name} | {controller} | {1000 * s['max_position_error_m']:.3f} | "
                         f"{1000 * s['rms_position_error_m']:.3f} | {s['max_rotation_error_deg']:.4f} | "

@@ -137,9 +137,9 @@ def test_a_calibrated_start_moves_the_commands_by_the_ideal_change_from_the_meas
     np.testing.assert_allclose(later.paid_out, relative_later - (ideal[0] - ideal[1]), atol=1e-12)
     with pytest.raises(SceneError, match="start must be one of"):
         TensionAwareController(start="rest")
-    from controllers.spatial_tension_aware import SpatialTensionAwareController  # the same rule, today's defaults
-
-    assert [SpatialTensionAwareController(statics=s, start=r).name for s, r in (("catenary", None), ("chain", None),
+    # one class for both dimensions: a start given names the controller, today's default (spatial catenary:
+    # "relative") does not
+    assert [TensionAwareController(statics=s, start=r).name for s, r in (("catenary", None), ("chain", None),
             ("chain", "calibrated"))] == ["tension_aware", "tension_aware_chain", "tension_aware_chain_calibrated"]
 
 
@@ -267,7 +267,7 @@ def test_the_closed_loop_filter_does_not_pass_a_jolt_straight_to_the_winches():
     jolted = command(1.0, 0.01)
     again = command(1.0, 0.01)  # the same step, retried
     feed_forward = controller.feed_forward(1.0)[0]
-    unfiltered = np.abs(controller._jacobian(scene.trajectory.pose(1.0)) @ np.array([0.02, 0.0])).max()
+    unfiltered = np.abs(controller.feedback.jacobian(scene.trajectory.pose(1.0)) @ np.array([0.02, 0.0])).max()
     assert np.abs(jolted - feed_forward).max() < 0.01 * unfiltered
     np.testing.assert_array_equal(jolted, again)
     np.testing.assert_allclose(on_track, controller.feed_forward(times[-1])[0], atol=1e-12)
@@ -347,3 +347,55 @@ def test_the_ideal_ik_table_lookup_is_np_interp_on_every_column():
     for t in np.concatenate([rng.uniform(-1.0, 11.0, 2000), times[::17], [0.0, 10.0]]):
         expected = np.array([np.interp(t, times, column) for column in table.T])
         assert np.array_equal(table_lookup(t, times, table), expected)
+
+
+# ----------------------------------------------------------------------------- the registry (issue 24)
+
+SPATIAL = load_scene("spatial-ipanema")
+
+
+@pytest.mark.parametrize("scene, names", [
+    (PAPER, ["ideal_ik", "tension_aware", "tension_aware_chordal", "tension_aware_dynamic_chordal",
+             "tension_aware_chain", "closed_loop_tension_aware", "model_feed_forward",
+             "closed_loop_model_feed_forward", "ilc"]),
+    (SPATIAL, ["ideal_ik", "tension_aware", "tension_aware_chain", "closed_loop_tension_aware"])], ids=["planar", "spatial"])
+def test_the_registry_gives_each_dimension_its_controllers_in_the_order_compare_runs_them(scene, names):
+    from cdpr_exu.studies.learning import learners
+    from controllers.registry import CONTROLLERS, controllers_for
+
+    assert controllers_for(scene) == names
+    for name in names:
+        controller = CONTROLLERS[name](scene, **({"learner": learners(scene)} if CONTROLLERS[name].learns else {}))
+        assert callable(controller.reset) and callable(controller.command)
+        if not CONTROLLERS[name].learns:  # a learned controller is named by its learner
+            assert controller.name.startswith(name.replace("_chordal", "").replace("_dynamic", ""))
+
+
+@pytest.mark.parametrize("name", ["tension_aware_chordal", "tension_aware_dynamic_chordal", "model_feed_forward",
+                                  "closed_loop_model_feed_forward", "ilc"])
+def test_the_registry_refuses_a_controller_on_a_dimension_it_has_no_physics_for_naming_both(name):
+    from cdpr_exu.core.errors import SceneError
+    from cdpr_exu.studies.comparison import compare_controllers
+    from controllers.registry import CONTROLLERS
+
+    with pytest.raises(SceneError, match=rf"controller '{name}' has no spatial \(3-D\) version: it runs on 2-D scenes"):
+        CONTROLLERS[name](SPATIAL)
+    with pytest.raises(SceneError, match=rf"controller '{name}' has no spatial"):  # before any run
+        compare_controllers(SPATIAL, ["ideal_ik", name])
+
+
+def test_the_chordal_correction_is_refused_on_a_spatial_scene_naming_it():
+    from cdpr_exu.core.errors import SceneError
+
+    with pytest.raises(SceneError, match="chordal_correction .* is spatial"):
+        TensionAwareController(chordal_correction=True).reset(SPATIAL, SPATIAL.unstrained_lengths)
+
+
+@pytest.mark.parametrize("scene", [PAPER, SPATIAL], ids=["planar", "spatial"])
+def test_a_tension_aware_reference_that_needs_a_pushing_cable_is_refused_naming_the_time(scene):
+    """One controller for both dimensions: a reference above the exits is refused before the run."""
+    pose = np.array(scene.trajectory.pose(0.0), dtype=float)
+    pose[scene.space.vertical] = 5.0  # far above every exit
+    held = scene.with_changes(trajectory=HoldTrajectory(tuple(pose), space=scene.space))
+    with pytest.raises(UnreachableError, match="t = 0.000 s"):
+        TensionAwareController().reset(held, ideal_paid_out(scene, scene.trajectory.pose(np.zeros(1)))[0][0])

@@ -9,7 +9,7 @@ import pytest
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.studies.comparison import compare_controllers, smooth_start
-from cdpr_exu.studies.learning import closed_loop_model_feed_forward_controller
+from cdpr_exu.studies.learning import learners
 from controllers.base import Measurement
 from controllers.feedback import ClosedLoopController, FilteredPositionPI
 from controllers.ideal_ik import IdealIKController
@@ -84,7 +84,7 @@ def test_bad_feedback_options_are_refused_by_name():
     with pytest.raises(SceneError, match="expected_positions"):
         CommandTable(table.times, table.changes, expected_positions=np.zeros((4, 2)))
     with pytest.raises(SceneError, match="rule"):
-        closed_loop_model_feed_forward_controller(rule=10)
+        learners(MISMATCH, rule=10)(True)
     # A feed-forward that expects no path cannot be followed: refused at reset, before any step.
     loop = ClosedLoopController("loop", IdealIKController(), FilteredPositionPI())
     with pytest.raises(SceneError, match="follow"):

@@ -14,7 +14,7 @@ PURE = ("cdpr_exu.core.geometry", "cdpr_exu.space", "cdpr_exu.core.output", "cdp
         "cdpr_exu.statics.statics", "cdpr_exu.statics.chain_statics", "cdpr_exu.statics.workspace",
         "cdpr_exu.statics.kinematics", "cdpr_exu.statics.tension_distribution",
         "cdpr_exu.results.result", "cdpr_exu.results.energy", "controllers.ideal_ik", "controllers.tension_aware",
-        "controllers.spatial_tension_aware", "controllers.ilc")
+        "controllers.feedback", "controllers.registry", "controllers.ilc")
 
 
 def test_the_maths_scenes_results_and_controllers_never_load_exudyn():
@@ -27,7 +27,7 @@ def test_the_maths_scenes_results_and_controllers_never_load_exudyn():
 def test_the_controllers_import_nothing_that_imports_them():
     # controllers/ may use cdpr_exu's maths; the run layer uses the controllers. A controller
     # module that pulled in cdpr_exu.run (or the package's lazy exports) would close a cycle.
-    code = ("import sys\nimport controllers.ideal_ik, controllers.tension_aware, controllers.spatial_tension_aware, controllers.ilc\n"
+    code = ("import sys\nimport controllers.ideal_ik, controllers.tension_aware, controllers.registry, controllers.ilc\n"
             "print(sorted(m for m in sys.modules if m.startswith(('cdpr_exu.run', 'cdpr_exu.studies', "
             "'cdpr_exu.builder'))))")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)

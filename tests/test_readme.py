@@ -44,9 +44,10 @@ def test_scene_reference_says_point_to_point_poses_are_x_z_rotation():
 
 
 def test_controllers_table_says_how_the_closed_loop_is_built():
-    from cdpr_exu.studies.comparison import CONTROLLERS
+    from cdpr_exu.scenes.scene import load_scene
+    from controllers.registry import CONTROLLERS
 
-    controller = CONTROLLERS["closed_loop_tension_aware"]()
+    controller = CONTROLLERS["closed_loop_tension_aware"](load_scene("paper-circle"))
     row = next(line for line in README.splitlines() if line.startswith("| `closed_loop_tension_aware`"))
     assert "tension_aware_dynamic_chordal" in row
     assert controller.dynamic and controller.chordal_correction

@@ -186,7 +186,7 @@ def test_the_package_exports_what_a_user_needs_and_imports_without_exudyn():
         assert name in cdpr_exu.__all__ and name in dir(cdpr_exu), name
     for name in cdpr_exu.__all__:  # every advertised name resolves
         assert getattr(cdpr_exu, name) is not None, name
-    controller = cdpr_exu.CONTROLLERS["closed_loop_tension_aware"]()  # the README example's form
+    controller = cdpr_exu.CONTROLLERS["closed_loop_tension_aware"](cdpr_exu.load_scene("paper-circle"))  # the README's form
     assert isinstance(controller, cdpr_exu.ClosedLoopTensionAwareController)
     with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
         cdpr_exu.no_such_name  # noqa: B018

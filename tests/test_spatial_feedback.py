@@ -13,7 +13,8 @@ from cdpr_exu.space import SPACE
 from controllers.base import START_BLEND_TIME, WinchCommand, quintic_blend
 from controllers.feedback import ClosedLoopController
 from controllers.ideal_ik import IdealIKController
-from controllers.spatial_feedback import SpatialPositionPI
+from controllers.feedback import FilteredPositionPI, _rotation_coordinates
+from controllers.registry import CONTROLLERS, SPATIAL_LOOP
 from cdpr_exu.statics.statics import catenary_platform, solve_statics
 
 def four_cable(n_elements=10, **solver):
@@ -150,7 +151,7 @@ def test_the_spatial_loop_removes_most_of_what_ideal_ik_misses():
     end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
     scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.5, space=SPACE))
     open_loop = simulate(scene, IdealIKController()).summary(2.25)
-    closed = simulate(scene, ClosedLoopController("closed", IdealIKController(), SpatialPositionPI(),
+    closed = simulate(scene, ClosedLoopController("closed", IdealIKController(), FilteredPositionPI(**SPATIAL_LOOP),
                                                           follow="reference")).summary(2.25)
     # measured 0.75 s after the move: 0.231 mm and 0.021 deg open loop, 1.7e-3 mm and 5.6e-4 deg
     # closed (during the move the loop lags: 0.098 mm against 0.234 mm)
@@ -160,25 +161,30 @@ def test_the_spatial_loop_removes_most_of_what_ideal_ik_misses():
     assert closed["min_element_tension_N"] > 0.0 and closed["status"] == "completed"
 
 
-def test_the_spatial_jacobian_is_the_change_of_the_straight_lengths():
-    scene = load_scene("spatial-cogiro")
-    feedback = SpatialPositionPI()
+@pytest.mark.parametrize("name, pose", [("paper-circle", [0.1, -1.0, 0.05]),
+                                        ("spatial-cogiro", [0.1, -0.05, 2.3, 0.02, -0.01, 0.03])])
+def test_the_loop_jacobian_is_the_change_of_the_straight_lengths(name, pose):
+    """One loop for both dimensions: its Jacobian's columns are the ideal lengths' change under a small move
+    of the platform along each position axis and a small global rotation applied before R."""
+    scene = load_scene(name)
+    space, size = scene.space, scene.space.position_size
+    feedback = FilteredPositionPI(rotation=True)
     feedback.reset(scene)
-    pose = np.array([0.1, -0.05, 2.3, 0.02, -0.01, 0.03])
+    pose = np.array(pose)
     jacobian = feedback.jacobian(pose)
-    from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
+    assert jacobian.shape == (scene.n_cables, space.pose_size)
+
+    def moved(step):
+        turned = pose.copy()
+        turned[:size] += step[:size]
+        turned[size:] = _rotation_coordinates(space.rotation_matrix(step[size:]) @ space.rotation_matrix(pose[size:]))
+        return ideal_paid_out(scene, turned[None, :])[0][0]
 
     h = 1e-6
-    for k in range(6):  # a small global move: translation, or rotation phi applied before R
-        step = np.zeros(6)
+    for k in range(space.pose_size):
+        step = np.zeros(space.pose_size)
         step[k] = h
-        moved = pose.copy()
-        moved[:3] += step[:3]
-        moved[3:] = rotation_vector(rotation_from_vector(step[3:]) @ rotation_from_vector(pose[3:]))
-        back = pose.copy()
-        back[:3] -= step[:3]
-        back[3:] = rotation_vector(rotation_from_vector(-step[3:]) @ rotation_from_vector(pose[3:]))
-        numeric = (ideal_paid_out(scene, moved)[0] - ideal_paid_out(scene, back)[0]) / (2 * h)
+        numeric = (moved(step) - moved(-step)) / (2 * h)
         assert np.abs(jacobian[:, k] - numeric).max() < 1e-7
 
 
@@ -205,8 +211,7 @@ def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_contr
     platform weighs 25 kg (IPAnema): the tension-aware lengths leave the platform off the
     reference, the loop around them brings it back."""
     from cdpr_exu.scenes.scene import ControllerModel
-    from controllers.spatial_feedback import spatial_closed_loop_tension_aware
-    from controllers.spatial_tension_aware import SpatialTensionAwareController
+    from controllers.tension_aware import TensionAwareController
 
     scene = ipanema(end_time=3.0)
     YOUNG = 1.3 * scene.cables[0].youngs_modulus
@@ -214,8 +219,8 @@ def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_contr
     end = start + np.array([0.2, 0.1, 0.0, 0.0, 0.0, 0.0])
     scene = replace(scene, trajectory=PointToPointTrajectory(tuple(start), tuple(end), duration=1.5, space=SPACE),
                     controller_model=ControllerModel(platform={"mass": 20.0}, cable={"youngs_modulus": YOUNG}))
-    open_loop = simulate(scene, SpatialTensionAwareController()).summary(2.25)
-    closed = simulate(scene, spatial_closed_loop_tension_aware()).summary(2.25)
+    open_loop = simulate(scene, TensionAwareController()).summary(2.25)
+    closed = simulate(scene, CONTROLLERS["closed_loop_tension_aware"](scene)).summary(2.25)
     # measured 0.75 s after the move: 6.6 um and 1.3e-3 deg open loop, 0.75 um and 4.4e-5 deg closed
     message = f"open {open_loop['max_position_error_m']:.3e} m, closed {closed['max_position_error_m']:.3e} m"
     assert closed["max_position_error_m"] < open_loop["max_position_error_m"] / 4.0, message

@@ -165,14 +165,14 @@ def test_a_reference_that_starts_above_the_exits_is_refused_saying_so():
 
 def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_ideal_ik():
     from controllers.ideal_ik import IdealIKController
-    from controllers.spatial_tension_aware import SpatialTensionAwareController
+    from controllers.tension_aware import TensionAwareController
 
     scene = load_scene("spatial-ipanema")
     scene = replace(scene, cables=tuple(replace(c, n_elements=10) for c in scene.cables),
                     solver=replace(scene.solver, end_time=4.0))
     ideal = simulate(scene, IdealIKController()).summary(1.0)
-    aware = simulate(scene, SpatialTensionAwareController()).summary(1.0)
-    chain = simulate(scene, SpatialTensionAwareController(statics="chain")).summary(1.0)
+    aware = simulate(scene, TensionAwareController()).summary(1.0)
+    chain = simulate(scene, TensionAwareController(statics="chain")).summary(1.0)
     # measured 0.40 mm and 0.020 mm: sag and stretch are what ideal IK misses; what is left is
     # the lumped chain's own discretisation and dynamics
     assert aware["max_position_error_m"] < ideal["max_position_error_m"] / 10.0
@@ -188,26 +188,24 @@ def test_the_tension_aware_controllers_follow_the_reference_far_closer_than_idea
 
 
 def test_the_chain_version_runs_over_swivel_pulleys_and_follows_the_ramp_closer_than_ideal_ik():
-    from cdpr_exu.studies.comparison import spatial_controller_names
     from controllers.ideal_ik import IdealIKController
-    from controllers.spatial_tension_aware import SpatialTensionAwareController
+    from controllers.registry import controllers_for
+    from controllers.tension_aware import TensionAwareController
 
     swivel = load_scene("spatial-four-cable-swivel")
-    assert "tension_aware_chain" in spatial_controller_names(swivel)
-    assert "tension_aware_chain" in spatial_controller_names(load_scene("spatial-cogiro"))
-    with pytest.raises(SceneError, match="statics"):
-        SpatialTensionAwareController(statics="rope")
+    assert "tension_aware_chain" in controllers_for(swivel)
+    assert "tension_aware_chain" in controllers_for(load_scene("spatial-cogiro"))
     # The circle's ramp (0.8 s of its 1 s), slow enough to be nearly static: the held chains run over the
     # discs with their bending, which the catenaries lack (they hang 22 mm lower on this robot).
     scene = replace(swivel, solver=replace(swivel.solver, end_time=0.8))
-    controller = SpatialTensionAwareController(statics="chain")
+    controller = TensionAwareController(statics="chain")
     controller.reset(scene, scene.unstrained_lengths)
     # it starts from the rest the robot starts in: the first lengths are the paid-out ones, but for the
     # reference's 11 um offset from that rest (measured 4.6 um)
-    assert np.abs(controller.inverses[0].paid_out - scene.unstrained_lengths).max() < 2e-5
-    assert all(np.all(np.isfinite(inverse.swivel_angles)) for inverse in controller.inverses)
+    assert np.abs(controller.equilibria[0].paid_out - scene.unstrained_lengths).max() < 2e-5
+    assert all(np.all(np.isfinite(inverse.swivel_angles)) for inverse in controller.equilibria)
     ideal = simulate(scene, IdealIKController())
-    chain = simulate(scene, SpatialTensionAwareController(statics="chain"))
+    chain = simulate(scene, TensionAwareController(statics="chain"))
     assert chain.status == "completed" and chain.controller == "tension_aware_chain"
     # measured: max 0.86 mm against ideal IK's 3.86 mm (later the paying-out cables' winch lines go slack
     # below the inlets at 1 rad/s, a dynamic lag both share: docs/spatial.md)
@@ -447,12 +445,14 @@ def test_ctrl_c_in_a_spatial_comparison_keeps_the_controllers_done_and_the_parti
                 os.kill(os.getpid(), signal.SIGINT)  # the run's handler stops the integration after this step
             return super().command(measurement)
 
-    monkeypatch.setitem(comparison.SPATIAL_CONTROLLERS, "ctrl_c", CtrlC)
+    from controllers.registry import CONTROLLERS, ControllerKind
+
+    monkeypatch.setitem(CONTROLLERS, "ctrl_c", ControllerKind("ctrl_c", {3: lambda scene: CtrlC()}))
     scene = four_cable(end_time=0.3)
     scene = replace(scene, trajectory=HoldTrajectory(tuple(start_pose(scene)), space=SPACE))
     out = tmp_path / "compare"
     with pytest.raises(RunInterrupted):
-        comparison.compare_spatial(scene, ["ideal_ik", "ctrl_c"], out, after=0.0)
+        comparison.compare_controllers(scene, ["ideal_ik", "ctrl_c"], out=out, after=0.0)
     summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
     assert list(summary["controllers"]) == ["ideal_ik", "ctrl_c"]
     assert summary["controllers"]["ideal_ik"]["status"] == "completed"

@@ -5,7 +5,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cdpr_exu.studies.comparison import CONTROLLERS
+from cdpr_exu.studies.learning import learners
+from controllers.registry import CONTROLLERS
 from cdpr_exu.core.errors import UnreachableError
 from cdpr_exu.exits import Pulley
 from cdpr_exu.scenes.scene import CableSpec, Effects, PlatformSpec, Scene, SolverSpec, load_scene
@@ -25,7 +26,8 @@ def _moving_to(end, **changes):
 def test_a_reference_above_the_pulleys_is_refused_before_the_run_for_every_controller(controller):
     scene = _moving_to((0.0, 1.0, 0.0))
     with pytest.raises(UnreachableError, match=r"at t = \d+\.\d+ s .*cannot hold the platform's weight") as err:
-        simulate(scene, CONTROLLERS[controller]())
+        options = {"learner": learners(scene)} if CONTROLLERS[controller].learns else {}
+        simulate(scene, CONTROLLERS[controller](scene, **options))
     assert "platform.mass" in str(err.value) and "(x [m], z [m], rotation [rad])" in str(err.value)
 
 

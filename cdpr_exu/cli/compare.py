@@ -18,25 +18,18 @@ from cdpr_exu.core.validation import non_negative
 from cdpr_exu.results.result import raise_warnings, status_text
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.statics.workspace import check_reference
-from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, compare_spatial,
-                                         markdown_table, smooth_start, spatial_comparison_table)
+from cdpr_exu.studies.comparison import (COMPARISON_RAMP_TIME, CONTROLLERS, compare_controllers, comparison_format,
+                                         smooth_start)
 from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule
 
 
 def print_controller_row(name: str, summary: dict) -> None:
-    """The line ``cdpr compare`` prints as a controller's run on a planar scene ends: its max and RMS
-    position error [mm] and its status."""
-    def mm(value):
-        return "     n/a" if value is None else f"{1000 * value:8.2f}"
+    """The line ``cdpr compare`` prints as a controller's run ends: its max and RMS position error [mm] and
+    its status (with the warnings a real robot cannot have)."""
+    def mm(value):  # sub-millimetre errors (spatial robots) with their micrometres
+        return "     n/a" if value is None else f"{1000 * value:8.2f}" if value >= 1e-3 else f"{1000 * value:8.4f}"
     print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
-          f"RMS {mm(summary['rms_position_error_m'])} mm   {summary['status']}")
-
-
-def print_spatial_controller_row(name: str, summary: dict) -> None:
-    """The line ``cdpr compare`` prints as a controller's run on a spatial scene ends: its max position
-    error [mm] and its status."""
-    worst = summary["max_position_error_m"]
-    print(f"  {name:16s} max {'n/a' if worst is None else f'{1000 * worst:.4f}'} mm   {status_text(summary)}")
+          f"RMS {mm(summary['rms_position_error_m'])} mm   {status_text(summary)}")
 
 
 def print_progress(line: str) -> None:
@@ -57,22 +50,6 @@ def _show(scene, summaries: dict, table, args: argparse.Namespace) -> list[str]:
     return [name for name, summary in summaries.items() if summary.get("status") != "completed"]
 
 
-def _compare_spatial(scene, args: argparse.Namespace) -> int:
-    """``cdpr compare`` on a spatial scene (:func:`cdpr_exu.studies.comparison.compare_spatial`)."""
-    if args.end_time is not None:
-        scene = replace(scene, solver=replace(scene.solver, end_time=args.end_time))
-    if scene.trajectory is None:
-        raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr compare` needs one")
-    check_reference(scene)
-    names = args.controllers.split(",") if args.controllers else None
-    if not args.quiet:
-        print(f"{scene.name}: comparing controllers on the spatial robot (errors after {args.after} s)")
-    summaries = compare_spatial(scene, names, args.out, args.after,
-                                report=None if args.quiet else print_spatial_controller_row)
-    failed = _show(scene, summaries, spatial_comparison_table, args)
-    return EXIT_RUN_FAILED if failed else EXIT_OK
-
-
 def _check_time_options(args: argparse.Namespace) -> None:
     """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run)."""
     non_negative("--after", args.after)
@@ -88,8 +65,6 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         print(f"{scene.name}: the circle starts smoothly from rest over {args.ramp_time} s "
               "(--ramp-time 0 keeps the scene's start at full speed)")
     scene = started
-    if scene.dimension == 3:  # one comparison when the controllers are one (issue 24, slice 8)
-        return _compare_spatial(scene, args)
     if args.end_time is not None:
         scene = scene.with_changes(solver=replace(scene.solver, end_time=args.end_time))
     # A reference no controller can follow is bad input (exit 2), not six failed runs.
@@ -100,11 +75,11 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         raise SceneError(f"--trials / --min-improvement: {err}") from None
     names = args.controllers.split(",") if args.controllers else None
     if not args.quiet:
-        print(f"{scene.name}: comparing controllers (errors after {args.after} s)")
+        print(f"{scene.name}: comparing controllers on the {scene.space.name} robot (errors after {args.after} s)")
     summaries = compare_controllers(scene, names, out=args.out, after=args.after, progress=False, learning_rule=rule,
                                     report=None if args.quiet else print_controller_row,
                                     learning_report=None if args.quiet else print_progress)
-    failed = _show(scene, summaries, markdown_table, args)
+    failed = _show(scene, summaries, comparison_format(scene).table, args)
     if failed:
         print(f"cdpr compare: {len(failed)} of {len(summaries)} controllers did not complete: {', '.join(failed)}",
               file=sys.stderr)

@@ -1,7 +1,7 @@
 """Controller comparison: the same scene under every controller, tabulated and plotted.
 
 ``cdpr compare paper-circle --out results/controllers`` runs the scene under each
-controller of :data:`CONTROLLERS`, writes ``summary.json`` (keyed by controller name),
+controller the registry has for it (:data:`controllers.registry.CONTROLLERS`, :func:`~controllers.registry.controllers_for`), writes ``summary.json`` (keyed by controller name),
 ``comparison.md`` (a Markdown table), a ``pose.csv`` per controller and the figures
 ``comparison_paths.png`` and ``comparison_errors.png``; each controller's wall time and
 real-time factor go to ``timing.json``, so that the other files are the same from run to run. Errors are actual - reference,
@@ -14,8 +14,9 @@ that throws the cables slack (0.12 s on ideal IK with tension-only cables, 299 N
 without saying anything about how well a controller tracks. The scene written with the
 results (``scene.toml``) records the start used.
 
-A spatial scene runs under :data:`SPATIAL_CONTROLLERS` (:func:`compare_spatial`): ``summary.json``,
-``comparison.md`` (:func:`spatial_comparison_table`) and an ``overview_<controller>.png`` each.
+A spatial scene runs through the same :func:`compare_controllers` and writes ``summary.json``,
+``comparison.md`` (:func:`spatial_comparison_table`) and an ``overview_<controller>.png`` each
+(:func:`comparison_format`).
 """
 
 from __future__ import annotations
@@ -26,11 +27,9 @@ from typing import Callable
 
 import numpy as np
 
-from controllers.ideal_ik import IdealIKController
-from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
-from controllers.spatial_feedback import spatial_closed_loop_tension_aware
-from controllers.spatial_tension_aware import SpatialTensionAwareController
+from controllers.registry import CONTROLLERS, controllers_for
 
+from cdpr_exu.space import PLANE, SPACE
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, write_pose_csv,
                                   write_summary)
@@ -38,28 +37,7 @@ from cdpr_exu.results.result import POSE_COLUMNS, Result, provenance, warning_fl
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import Scene, save_scene
 from cdpr_exu.scenes.trajectories import CircleTrajectory
-from cdpr_exu.studies.learning import (DEFAULT_RULE, StoppingRule, closed_loop_model_feed_forward_controller,
-                                      ilc_controller, model_feed_forward_controller)
-
-#: The controllers compared by default, by name, each a factory.
-CONTROLLERS: dict[str, Callable[[], object]] = {
-    "ideal_ik": IdealIKController,
-    "tension_aware": TensionAwareController,
-    "tension_aware_chordal": lambda: TensionAwareController(chordal_correction=True),
-    "tension_aware_dynamic_chordal": lambda: TensionAwareController(dynamic=True, chordal_correction=True),
-    "tension_aware_chain": lambda: TensionAwareController(statics="chain"),
-    "closed_loop_tension_aware": lambda: ClosedLoopTensionAwareController(dynamic=True, chordal_correction=True),
-    "model_feed_forward": model_feed_forward_controller,
-    "closed_loop_model_feed_forward": closed_loop_model_feed_forward_controller,
-    "ilc": ilc_controller,
-}
-#: Controllers that learn over trials before their run (cdpr_exu.studies.learning), made with the
-#: comparison's stopping rule and progress report.
-LEARNING_CONTROLLERS: dict[str, Callable[..., object]] = {
-    "model_feed_forward": model_feed_forward_controller,
-    "closed_loop_model_feed_forward": closed_loop_model_feed_forward_controller,
-    "ilc": ilc_controller,
-}
+from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule, learners
 
 #: Ramp time [s] of the smooth start `cdpr compare` gives a circle that starts at full speed.
 COMPARISON_RAMP_TIME = 1.0
@@ -96,32 +74,42 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
                         learning_rule: StoppingRule = DEFAULT_RULE,
                         report: Callable[[str, dict], None] | None = None,
                         learning_report: Callable[[str], None] | None = None) -> dict[str, dict]:
-    """Run ``scene`` under each named controller; returns their summaries by name.
+    """Run ``scene`` (planar or spatial) under each named controller; returns their summaries by name.
 
-    A controller that refuses the reference (e.g. a pose that needs a pushing cable)
-    or whose run fails is recorded with its status; the others still run. The
-    learning controllers (:data:`LEARNING_CONTROLLERS`) run their trials first, as
-    ``learning_rule`` says (their per-trial errors go into the summary as ``trials``).
-    ``report(name, summary)`` is called as each controller's run ends (not for a refused
-    one), ``learning_report`` with each line of the learning controllers' progress
-    (:class:`cdpr_exu.studies.learning.Learner`); ``cdpr compare`` prints both.
+    ``names`` default to :func:`controllers.registry.controllers_for` the scene. An unknown name, or a
+    controller with no physics in the scene's dimension, is refused before any run. A controller
+    that refuses the reference (e.g. a pose that needs a pushing cable) or whose run fails is
+    recorded with its status; the others still run. The learning controllers run their trials
+    first, as ``learning_rule`` says (their per-trial errors go into the summary as ``learning``).
+    ``report(name, summary)`` is called as each controller's run ends (not for a refused one),
+    ``learning_report`` with each line of the learning controllers' progress
+    (:class:`cdpr_exu.studies.learning.Learner`); ``cdpr compare`` prints both. On Ctrl-C (inside a
+    run or between two) the controllers done so far and the interrupted one's partial run are
+    written before the interrupt goes on. What is written is the scene's :func:`comparison_format`.
     """
-    names = list(names or CONTROLLERS)
+    names = list(names or controllers_for(scene))
     unknown = [n for n in names if n not in CONTROLLERS]
     if unknown:
         raise SceneError(f"unknown controller(s) {unknown}; known: {list(CONTROLLERS)}")
+    for name in names:
+        CONTROLLERS[name].check(scene)
+    output = comparison_format(scene)
+    if out is not None:  # an earlier comparison's files go before the first of this one is written
+        clear_outputs(check_output_folder(out, command="compare"), "compare")
     summaries: dict[str, dict] = {}
     results: dict[str, Result] = {}
     try:
         for name in names:
-            if name in LEARNING_CONTROLLERS:
-                controller = LEARNING_CONTROLLERS[name](learning_rule, after=after, report=learning_report, plant=scene)
-            else:
-                controller = CONTROLLERS[name]()
+            kind = CONTROLLERS[name]
+            options = {"learner": learners(scene, learning_rule, after=after, report=learning_report)} if kind.learns else {}
+            controller = kind(scene, **options)
             try:
                 result = simulate(scene, controller, progress=progress)
             except SolverFailure as err:
                 result = err.partial_result
+                if result is None:  # it failed before its first step (settling the robot)
+                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
+                    continue
             except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
                 results[name] = err.partial_result
                 summaries[name] = {**err.partial_result.summary(after=after), "controller": name}
@@ -135,29 +123,21 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
             learning = getattr(getattr(controller, "learner", None), "learning", None)
             if learning is not None:
                 summary["learning"] = learning.to_dict()
-            slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
-            summary["slack_time_s"] = max(slack) if slack else None
-            if "tension_limit_violations" in summary:
-                summary["tension_limit_violation_count"] = len(summary["tension_limit_violations"])
-            summaries[name] = summary
+            summaries[name] = output.summary(summary)
             if report is not None:
                 report(name, summary)
     except KeyboardInterrupt:  # Ctrl-C, inside a run or between two: keep the controllers done so far
         if out is not None and summaries:
-            _write(scene, summaries, {k: r for k, r in results.items() if k in summaries}, Path(out), after)
+            output.write(scene, summaries, {k: r for k, r in results.items() if k in summaries}, Path(out), after)
         raise
-    base = summaries.get("ideal_ik", {}).get("max_position_error_m")
-    if base is not None:
-        for summary in summaries.values():
-            if (summary.get("max_position_error_m") or 0.0) > 0:
-                summary["error_reduction_vs_ideal_ik"] = base / summary["max_position_error_m"]
+    output.compared(summaries)
     if out is not None:
-        _write(scene, summaries, results, Path(out), after)
+        output.write(scene, summaries, results, Path(out), after)
     return summaries
 
 
 def markdown_table(summaries: dict[str, dict]) -> str:
-    """The comparison as a Markdown table."""
+    """The comparison of a planar scene as a Markdown table."""
     columns = _COLUMNS
     if any("tension_limit_violation_count" in s for s in summaries.values()):  # a scene with tension limits
         columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
@@ -175,47 +155,13 @@ def markdown_table(summaries: dict[str, dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    from cdpr_exu.post.plots import plot_comparison
-
-    clear_outputs(check_output_folder(out, command="compare"), "compare")  # no file of an earlier comparison stays
-    save_scene(scene, out / "scene.toml")
-    document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
-                "controllers": summaries, **provenance()}
-    write_summary(out, document)
-    (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
-                                       + markdown_table(summaries))
-    for name, result in results.items():
-        write_pose_csv(out / f"pose_{name}.csv", result.time, result.pose, result.reference,
-                       POSE_COLUMNS[result.space])
-    if results:
-        plot_comparison(scene, results, out)
-
-
-# --------------------------------------------------------------------------- spatial scenes
-
-#: The controllers that run on spatial scenes, by name (``cdpr compare`` on a spatial scene).
-SPATIAL_CONTROLLERS = {
-    "ideal_ik": IdealIKController,
-    "tension_aware": SpatialTensionAwareController,
-    "tension_aware_chain": lambda: SpatialTensionAwareController(statics="chain"),
-    "closed_loop_tension_aware": spatial_closed_loop_tension_aware,
-}
-
-
-def spatial_controller_names(scene: Scene) -> list[str]:
-    """The controllers ``cdpr compare`` runs on ``scene`` by default: all of :data:`SPATIAL_CONTROLLERS` (over
-    swivel pulleys too: the chain version's held chains run over the disc, their winch ends moved as the run's)."""
-    return list(SPATIAL_CONTROLLERS)
-
-
 _SPATIAL_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("rms_position_error_m", "RMS pos. error [mm]", 1000.0),
             ("max_rotation_error_deg", "max rotation error [deg]", 1.0),
             ("min_element_tension_N", "min tension [N]", 1.0), ("max_element_tension_N", "max tension [N]", 1.0))
 
 
 def spatial_comparison_table(summaries: dict) -> str:
-    """The spatial comparison as a Markdown table (errors after the summaries' ``after``); a scene
+    """The comparison of a spatial scene as a Markdown table (errors after the summaries' ``after``); a scene
     with tension limits gets a column counting the violations, as the planar table does."""
     columns = _SPATIAL_COLUMNS
     if any("tension_limit_violations" in s for s in summaries.values()):
@@ -234,60 +180,79 @@ def spatial_comparison_table(summaries: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def compare_spatial(scene: Scene, names: list[str] | None = None, out: str | Path | None = None,
-                    after: float = 1.0, report: Callable[[str, dict], None] | None = None) -> dict[str, dict]:
-    """Run a spatial scene under each named controller; write summary.json, comparison.md and each
-    controller's overview figure to ``out``. Returns the summaries by name; ``report(name, summary)``
-    is called as each run ends (``cdpr compare`` prints it).
+class _PlanarComparison:
+    """What a comparison of a planar scene writes (``results/controllers``...): summaries with the longest slack
+    time and the error reduction against ideal IK, ``scene.toml``, ``summary.json``, ``comparison.md``, a
+    ``pose_<controller>.csv`` each and the figures of :func:`cdpr_exu.post.plots.plot_comparison`."""
 
-    As the planar comparison: a run that fails is recorded with its status and partial
-    figures, a controller that refuses the scene with ``refused: ...``, and the others still
-    run; on Ctrl-C (inside a run or between two) the controllers done so far and the
-    interrupted one's partial run are written before the interrupt goes on.
-    """
-    names = list(names or spatial_controller_names(scene))
-    unknown = [n for n in names if n not in SPATIAL_CONTROLLERS]
-    if unknown:
-        raise SceneError(f"unknown controller(s) {unknown} for a spatial scene; known: {list(SPATIAL_CONTROLLERS)}")
-    if out is not None:  # an earlier comparison's files go before the first of this one is written
+    table = staticmethod(markdown_table)
 
-        clear_outputs(check_output_folder(out, command="compare"), "compare")
-    summaries, results = {}, {}
-    try:
-        for name in names:
-            try:
-                result = simulate(scene, SPATIAL_CONTROLLERS[name]())
-            except SolverFailure as err:
-                result = err.partial_result
-                if result is None:  # it failed before its first step (settling the robot)
-                    summaries[name] = {"controller": name, "status": f"failed: {err}"}
-                    continue
-            except RunInterrupted as err:  # Ctrl-C inside a run: keep this one's part too
-                results[name] = err.partial_result
-                summaries[name] = err.partial_result.summary(after)
-                raise
-            except CdprError as err:  # a controller that refuses the scene is a result of the comparison too
-                summaries[name] = {"controller": name, "status": f"refused: {err}"}
-                continue
-            results[name], summaries[name] = result, result.summary(after)
-            if report is not None:
-                report(name, summaries[name])
-    except KeyboardInterrupt:  # keep what was computed, then let the interrupt go on
-        if out is not None and summaries:
-            _write_spatial_comparison(scene, summaries, results, Path(out), after)
-        raise
-    if out is not None:
-        _write_spatial_comparison(scene, summaries, results, Path(out), after)
-    return summaries
+    @staticmethod
+    def summary(summary: dict) -> dict:
+        slack = [s for s in summary["slack_time_per_cable_s"] if s is not None]
+        summary["slack_time_s"] = max(slack) if slack else None
+        if "tension_limit_violations" in summary:
+            summary["tension_limit_violation_count"] = len(summary["tension_limit_violations"])
+        return summary
+
+    @staticmethod
+    def compared(summaries: dict) -> None:
+        base = summaries.get("ideal_ik", {}).get("max_position_error_m")
+        if base is not None:
+            for summary in summaries.values():
+                if (summary.get("max_position_error_m") or 0.0) > 0:
+                    summary["error_reduction_vs_ideal_ik"] = base / summary["max_position_error_m"]
+
+    @staticmethod
+    def write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
+        from cdpr_exu.post.plots import plot_comparison
+
+        clear_outputs(check_output_folder(out, command="compare"), "compare")  # no file of an earlier comparison stays
+        save_scene(scene, out / "scene.toml")
+        document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
+                    "controllers": summaries, **provenance()}
+        write_summary(out, document)
+        (out / "comparison.md").write_text(f"{scene.name}: errors after {after} s (actual - reference)\n\n"
+                                           + markdown_table(summaries))
+        for name, result in results.items():
+            write_pose_csv(out / f"pose_{name}.csv", result.time, result.pose, result.reference,
+                           POSE_COLUMNS[result.space])
+        if results:
+            plot_comparison(scene, results, out)
 
 
-def _write_spatial_comparison(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
-    """Write summary.json, comparison.md and each run's overview_<controller>.png into ``out``."""
-    from cdpr_exu.post.plots import plot_spatial_run
+class _SpatialComparison:
+    """What a comparison of a spatial scene writes (``results/spatial/<scene>/compare``): the runs' summaries,
+    ``summary.json``, ``comparison.md`` (:func:`spatial_comparison_table`) and an ``overview_<controller>.png``
+    each (:func:`cdpr_exu.post.plots.plot_spatial_run`)."""
 
-    out.mkdir(parents=True, exist_ok=True)
-    write_summary(out, {"scene": scene.name, "dimension": 3, "errors_measured_after_s": after,
-                        "error_convention": "actual - reference", "controllers": summaries, **provenance()})
-    (out / "comparison.md").write_text(spatial_comparison_table(summaries))
-    for name, result in results.items():
-        plot_spatial_run(result, out / f"overview_{name}.png", after)
+    table = staticmethod(spatial_comparison_table)
+
+    @staticmethod
+    def summary(summary: dict) -> dict:
+        return summary
+
+    @staticmethod
+    def compared(summaries: dict) -> None:
+        """Nothing: the table computes the ratio to ideal IK."""
+
+    @staticmethod
+    def write(scene: Scene, summaries: dict, results: dict, out: Path, after: float) -> None:
+        from cdpr_exu.post.plots import plot_spatial_run
+
+        out.mkdir(parents=True, exist_ok=True)
+        write_summary(out, {"scene": scene.name, "dimension": scene.space.dimension, "errors_measured_after_s": after,
+                            "error_convention": "actual - reference", "controllers": summaries, **provenance()})
+        (out / "comparison.md").write_text(spatial_comparison_table(summaries))
+        for name, result in results.items():
+            plot_spatial_run(result, out / f"overview_{name}.png", after)
+
+
+#: What a comparison writes, by the scene's space: the files of each are the committed results' (results/
+#: controllers*, results/spatial/*/compare), kept byte for byte; one format for both is a regeneration of them.
+_FORMATS = {PLANE: _PlanarComparison, SPACE: _SpatialComparison}
+
+
+def comparison_format(scene: Scene):
+    """What a comparison of ``scene`` writes and tabulates: ``.table(summaries)`` (Markdown) among them."""
+    return _FORMATS[scene.space]

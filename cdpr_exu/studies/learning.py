@@ -51,10 +51,8 @@ from typing import Callable
 
 import numpy as np
 
-from controllers.ilc import (CommandTable, LearnedController, LearningLaw, ReplayController, StoppingRule, fade_in,
-                             ideal_changes, position_jacobian)
-
-from controllers.feedback import ClosedLoopController, FilteredPositionPI
+from controllers.ilc import (CommandTable, LearningLaw, ReplayController, StoppingRule, fade_in, ideal_changes,
+                             position_jacobian)
 
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.results.result import Result
@@ -366,39 +364,11 @@ class Learner:
         return self.learning.table
 
 
-def ilc_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *, after: float = 1.0,
-                   report: Callable[[str], None] | None = None, plant: Scene | None = None) -> LearnedController:
-    """``ilc`` for ``cdpr compare``: trials on ``plant`` (the compared scene), then a run that
-    replays the best trial's commands."""
-    return LearnedController("ilc", Learner(False, law, rule, after=after, report=report, plant=plant))
-
-
-def model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
-                                  after: float = 1.0, report: Callable[[str], None] | None = None,
-                                  plant: Scene | None = None) -> LearnedController:
-    """``model_feed_forward`` for ``cdpr compare``: trials on :meth:`Scene.controller_scene` of the compared
-    scene, then the plant runs open loop with the best trial's commands."""
-    return LearnedController("model_feed_forward", Learner(True, law, rule, after=after, report=report,
-                                                           plant=plant))
-
-
-def closed_loop_model_feed_forward_controller(rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
-                                              after: float = 1.0, report: Callable[[str], None] | None = None,
-                                              feedback: FilteredPositionPI | None = None,
-                                              follow: str = "expected",
-                                              plant: Scene | None = None) -> ClosedLoopController:
-    """``closed_loop_model_feed_forward`` for ``cdpr compare``: the lengths learned on
-    :meth:`Scene.controller_scene` of the compared scene (as ``model_feed_forward``), with the
-    filtered PI position loop (:class:`~controllers.feedback.FilteredPositionPI`, the
-    gains of ``closed_loop_tension_aware`` by default) around them on the plant.
-
-    The learned lengths already carry the cables' dynamics as the model has them (their
-    sag, inertia and drag over the pulleys). The loop holds the platform to the path they
-    gave on the model (``follow = "expected"``, :class:`~controllers.feedback.ClosedLoopController`),
-    so that it is left with what the model gets wrong; ``follow = "reference"`` holds it
-    to the reference instead."""
-    if feedback is None:
-        feedback = FilteredPositionPI()
-    feed_forward = LearnedController("model_feed_forward", Learner(True, law, rule, after=after, report=report,
-                                                                   plant=plant))
-    return ClosedLoopController("closed_loop_model_feed_forward", feed_forward, feedback, follow)
+def learners(plant: Scene | None = None, rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
+             after: float = 1.0, report: Callable[[str], None] | None = None) -> Callable[[bool], Learner]:
+    """The ``learner`` of the registry's learning kinds for ``cdpr compare`` (:data:`controllers.registry.CONTROLLERS`):
+    ``learner(on_model)`` is a :class:`Learner` with ``rule``, ``law``, ``after`` and ``report`` that learns on
+    :meth:`Scene.controller_scene` of ``plant`` (``model_feed_forward`` and the closed loop around its lengths,
+    which holds the platform to the path they gave on the model, ``follow = "expected"``), or on ``plant``
+    itself (``ilc``), before the run replays the best trial's commands."""
+    return lambda on_model: Learner(on_model, law, rule, after=after, report=report, plant=plant)

@@ -44,11 +44,6 @@ ERRORS = ("platform_mass", "cable_density", "cable_stiffness")
 COLUMNS = (*ERRORS, "controller", "status", "completed", "max_position_error_m", "rms_position_error_m",
            "max_error_vs_ideal_ik", "min_element_tension_N", "slack_time_s", "elements_pushed", "failure_time_s")
 
-#: The kinds of controller a study runs; each row names one with its options (:func:`make_controller`).
-KINDS = ("ideal_ik", "tension_aware", "closed_loop_tension_aware", "model_feed_forward",
-         "closed_loop_model_feed_forward", "ilc")
-
-
 def error_grid(platform_mass=(-0.2, 0.0, 0.2), cable_density=(-0.2, 0.0, 0.2), cable_stiffness=(0.0,)) -> list[dict]:
     """Every combination of the relative errors, as ``{error: value}`` dicts (:data:`ERRORS`)."""
     return [dict(zip(ERRORS, values)) for values in itertools.product(platform_mass, cable_density, cable_stiffness)]
@@ -85,33 +80,21 @@ def perturbed(model, platform_mass: float = 0.0, cable_density: float = 0.0, cab
 
 
 def make_controller(kind: str, plant, options: Mapping[str, Any] | None = None, after: float = 1.0):
-    """A controller of ``kind`` (:data:`KINDS`) for a run of ``plant``, planar or spatial, with ``options``.
+    """A controller of ``kind`` (a name of :data:`controllers.registry.CONTROLLERS`) for a run of ``plant``,
+    planar or spatial, with ``options`` (the kind's factory's: ``statics``, ``start``, the loop's gains...);
+    the learning kinds learn with the comparison's stopping rule, on ``plant`` itself.
 
-    ``tension_aware`` takes the tension-aware controller's options (``statics``, ``start``, ...);
-    ``closed_loop_tension_aware`` the comparison's closed loop (planar: with ``dynamic`` and
-    ``chordal_correction``) and the loop's gains; the learning kinds (planar) learn with the
-    comparison's stopping rule, ``ilc`` on ``plant`` itself.
+    Raises
+    ------
+    SceneError
+        For an unknown kind, or one with no physics in ``plant``'s dimension (naming both).
     """
-    from controllers.ideal_ik import IdealIKController
-    from controllers.spatial_feedback import spatial_closed_loop_tension_aware
-    from controllers.spatial_tension_aware import SpatialTensionAwareController
-    from controllers.tension_aware import ClosedLoopTensionAwareController, TensionAwareController
-    from cdpr_exu.studies.comparison import LEARNING_CONTROLLERS
-    from cdpr_exu.studies.learning import DEFAULT_RULE
+    from controllers.registry import controller_kind
+    from cdpr_exu.studies.learning import learners
 
-    options = dict(options or {})
-    planar = plant.dimension == 2
-    if kind == "ideal_ik":
-        return IdealIKController()
-    if kind == "tension_aware":
-        return (TensionAwareController if planar else SpatialTensionAwareController)(**options)
-    if kind == "closed_loop_tension_aware":
-        if planar:
-            return ClosedLoopTensionAwareController(**{"dynamic": True, "chordal_correction": True, **options})
-        return spatial_closed_loop_tension_aware(**options)
-    if kind in LEARNING_CONTROLLERS and planar:
-        return LEARNING_CONTROLLERS[kind](DEFAULT_RULE, after=after, plant=plant, **options)
-    raise SceneError(f"kind must be one of {KINDS} (the learning ones on planar scenes), got {kind!r}")
+    controller = controller_kind(kind)
+    extra = {"learner": learners(plant, after=after)} if controller.learns else {}
+    return controller(plant, **extra, **dict(options or {}))
 
 
 def run_point(plant_data: dict, kind: str, options: dict | None = None, after: float = 1.0) -> dict[str, Any]:

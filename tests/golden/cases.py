@@ -157,9 +157,10 @@ def planar_mismatch_tension_aware():
 
 
 def _planar_controller(name, end_time=1.5):
-    from cdpr_exu.studies.comparison import CONTROLLERS
+    from controllers.registry import CONTROLLERS
 
-    return _planar_run(_comparison_scene(end_time=end_time), CONTROLLERS[name]())
+    scene = _comparison_scene(end_time=end_time)
+    return _planar_run(scene, CONTROLLERS[name](scene))
 
 
 @case
@@ -192,28 +193,28 @@ def planar_controller_closed_loop_tension_aware():
     return _planar_controller("closed_loop_tension_aware")
 
 
-def _learning(factory_name):
-    from cdpr_exu.studies import learning
+def _learning(name):
+    from cdpr_exu.studies.learning import learners
     from controllers.ilc import StoppingRule
+    from controllers.registry import CONTROLLERS
 
     scene = _comparison_scene(end_time=1.5)
-    controller = getattr(learning, factory_name)(StoppingRule(max_trials=2), plant=scene)
-    return _planar_run(scene, controller)
+    return _planar_run(scene, CONTROLLERS[name](scene, learner=learners(scene, StoppingRule(max_trials=2))))
 
 
 @case
 def planar_controller_ilc():
-    return _learning("ilc_controller")
+    return _learning("ilc")
 
 
 @case
 def planar_controller_model_feed_forward():
-    return _learning("model_feed_forward_controller")
+    return _learning("model_feed_forward")
 
 
 @case
 def planar_controller_closed_loop_model_feed_forward():
-    return _learning("closed_loop_model_feed_forward_controller")
+    return _learning("closed_loop_model_feed_forward")
 
 
 # --------------------------------------------------------------------------- planar rest and statics
@@ -303,9 +304,10 @@ def spatial_swivel_ideal_ik():
 
 
 def _spatial_controller(scene_name, name, end_time=0.6):
-    from cdpr_exu.studies.comparison import SPATIAL_CONTROLLERS
+    from controllers.registry import CONTROLLERS
 
-    return _spatial_run(_spatial(scene_name, end_time), SPATIAL_CONTROLLERS[name]())
+    scene = _spatial(scene_name, end_time)
+    return _spatial_run(scene, CONTROLLERS[name](scene))
 
 
 @case
