@@ -47,7 +47,6 @@ from cdpr_exu.core.validation import finite, real_array, shown, vector
 from cdpr_exu.exits import Exit
 from cdpr_exu.physics import swivel_pulley as sp
 from cdpr_exu.statics.statics import catenary_platform, chain_element_mass, node_masses_along, solve_statics
-from cdpr_exu.scenes.contact_models import CONTACT_MODELS
 from cdpr_exu.space import space_of
 from cdpr_exu.statics.chain_kernels import PlanarChains, SpatialChains, planar_energy, planar_forces
 from cdpr_exu.statics.kinematics import initial_cable_nodes, straight_cable_nodes
@@ -271,7 +270,7 @@ def _planar_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
     if not effects.cable_mass or not effects.axial_elasticity:
         raise SceneError("chain statics needs effects.cable_mass and effects.axial_elasticity "
                          f"(the scene's preset is {shown(effects.preset)}); use the catenary statics instead")
-    if scene.contact_model not in (None, CONTACT_MODELS["node"]):
+    if scene.contact_model is not None and not scene.contact_model.exudyn_items:  # the node contact, as Exudyn's items
         raise SceneError("chain statics models the node contact on pulleys only, got "
                          f"effects.pulley_contact_model = {shown(effects.pulley_contact_model)}")
     if anchor_spring_factor is not None:
