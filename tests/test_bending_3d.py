@@ -9,7 +9,7 @@ import exudyn.itemInterface as eii
 from cdpr_exu.physics.bending import bending_force_kernel, bending_jacobian, cable_joints
 from cdpr_exu.physics.bending_3d import (ISOTROPIC_BEND, SERIES_BELOW, add_spatial_bending_damping_force,
                                          add_spatial_bending_damping_jacobian, angle_factor,
-                                         bending_damping_dissipation, chain_joints, relative_angular_velocity,
+                                         bending_damping_dissipation, relative_angular_velocity,
                                          spatial_bending_energy, spatial_bending_force, spatial_bending_pattern,
                                          spatial_bending_stiffness)
 from cdpr_exu.builder.cable import add_cable, add_cable_forces
@@ -29,7 +29,7 @@ def _force(p, joints, k):
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_force_is_minus_the_gradient_of_the_energy(seed):
     p = _curve(seed)
-    joints = chain_joints([p.size // 3])
+    joints = cable_joints([p.size // 3])
     k = np.full(len(joints), 1.96)
     h = 1e-7
     numeric = np.array([-(spatial_bending_energy(p + h * e, joints, k) - spatial_bending_energy(p - h * e, joints, k))
@@ -42,7 +42,7 @@ def test_force_is_minus_the_gradient_of_the_energy(seed):
 def test_sparse_stiffness_matches_central_differences_of_the_force(seed):
     p = _curve(seed)
     n = p.size
-    joints = chain_joints([n // 3])
+    joints = cable_joints([n // 3])
     k = np.full(len(joints), 1.96)
     rows, columns = spatial_bending_pattern(joints)
     stiffness = np.zeros((n, n))
@@ -60,7 +60,7 @@ def test_a_cable_bent_in_a_vertical_plane_feels_the_planar_models_force():
     spatial = np.column_stack([planar[:, 0], np.zeros(7), planar[:, 1]]).ravel()  # (x, z) -> (x, 0, z)
     k = np.full(5, 1.96)
     force_2d = bending_force_kernel(planar.ravel(), np.zeros(14), cable_joints([7]), k, np.zeros(5), np.zeros(14))
-    force_3d = _force(spatial, chain_joints([7]), k).reshape(-1, 3)
+    force_3d = _force(spatial, cable_joints([7]), k).reshape(-1, 3)
     np.testing.assert_allclose(force_3d[:, [0, 2]], force_2d.reshape(-1, 2), atol=1e-12)
     assert np.all(force_3d[:, 1] == 0.0)
 
@@ -69,8 +69,8 @@ def test_the_force_is_linear_in_the_angle_and_smooth_at_a_straight_cable():
     """k theta at the joint: a tip displaced by eps (theta ~ eps) feels k eps / l^2 = eps (k = l = 1)."""
     for eps in (1e-3, 1e-6, 1e-9):
         p = np.array([0.0, 0, 0, 1, 0, 0, 2, eps, 0])
-        assert _force(p, chain_joints([3]), np.array([1.0]))[7] == pytest.approx(-eps, rel=1e-5)
-    assert np.all(_force(np.array([0.0, 0, 0, 1, 0, 0, 2, 0, 0]), chain_joints([3]), np.array([1.0])) == 0.0)
+        assert _force(p, cable_joints([3]), np.array([1.0]))[7] == pytest.approx(-eps, rel=1e-5)
+    assert np.all(_force(np.array([0.0, 0, 0, 1, 0, 0, 2, 0, 0]), cable_joints([3]), np.array([1.0])) == 0.0)
     x = SERIES_BELOW  # the series and the closed form meet there
     series, closed = angle_factor(1.0 - x * (1 - 1e-9)), angle_factor(1.0 - x * (1 + 1e-9))
     assert series[0] == pytest.approx(closed[0], rel=1e-9) and series[1] == pytest.approx(closed[1], rel=1e-5)
@@ -78,7 +78,7 @@ def test_the_force_is_linear_in_the_angle_and_smooth_at_a_straight_cable():
 
 def test_a_rigid_rotation_rotates_the_force_and_keeps_the_energy():
     p = _curve(3)
-    joints = chain_joints([p.size // 3])
+    joints = cable_joints([p.size // 3])
     k = np.full(len(joints), 1.0)
     angle = 0.7
     rotation = np.array([[1, 0, 0], [0, np.cos(angle), -np.sin(angle)], [0, np.sin(angle), np.cos(angle)]])
@@ -165,7 +165,7 @@ def _bent_joint(theta):
 def test_the_bending_damper_force_is_minus_the_velocity_gradient_of_its_rayleigh_function(seed, bend):
     p = _curve(seed)
     v = np.random.default_rng(10 + seed).normal(0.0, 1.0, p.size)
-    joints = chain_joints([p.size // 3])
+    joints = cable_joints([p.size // 3])
     c = np.full(len(joints), 1.96)
     h = 1e-3  # R is quadratic in v: central differences are exact up to round-off
     numeric = np.array([-(bending_damping_dissipation(p, v + h * e, joints, c, bend)
@@ -179,7 +179,7 @@ def test_the_bending_damper_force_is_minus_the_velocity_gradient_of_its_rayleigh
 def test_the_bending_damper_jacobians_match_central_differences_in_positions_and_velocities(seed, bend):
     p = _curve(seed)
     v = np.random.default_rng(20 + seed).normal(0.0, 1.0, p.size)
-    joints = chain_joints([p.size // 3])
+    joints = cable_joints([p.size // 3])
     c = np.full(len(joints), 1.96)
     stiffness, damping = _damper_matrices(p, v, joints, c, bend)
     h = 1e-7
@@ -197,7 +197,7 @@ def test_the_bending_damper_jacobians_match_central_differences_in_positions_and
 @pytest.mark.parametrize("theta_deg", [10.0, 30.0, 60.0])
 def test_the_bending_damper_ignores_translation_and_turning_about_the_joint_normal(theta_deg):
     p = _bent_joint(np.radians(theta_deg))
-    joints, c = chain_joints([3]), np.array([2.0])
+    joints, c = cable_joints([3]), np.array([2.0])
     points = p.reshape(-1, 3)
     for velocity in (np.tile([0.3, -1.2, 0.7], 3), np.cross([0.0, 0.0, 1.5], points - [0.4, 0.2, 0.0]).ravel()):
         for bend in (np.inf, ISOTROPIC_BEND):
@@ -212,7 +212,7 @@ def test_turning_a_bent_joint_about_an_axis_in_its_plane_is_damped_eps_squared_o
     c Omega^2 sin^2(theta) eps^2 / (sin^2(theta) + eps^2) with the isotropic bend eps."""
     theta = np.radians(theta_deg)
     p = _bent_joint(theta)
-    joints, c, omega = chain_joints([3]), np.array([2.0]), 1.5
+    joints, c, omega = cable_joints([3]), np.array([2.0]), 1.5
     for axis in ([1.0, 0.0, 0.0], [np.cos(theta), np.sin(theta), 0.0], [0.0, 1.0, 0.0]):
         velocity = np.cross(omega * np.asarray(axis), p.reshape(-1, 3)).ravel()
         relative = relative_angular_velocity(p, velocity, 0, 1, 2)
@@ -236,11 +236,11 @@ def test_a_cable_moving_in_a_vertical_plane_feels_the_planar_bending_damper(bend
     c = np.full(5, 1.96)
     force_2d = bending_force_kernel(planar.ravel(), velocity_2d.ravel(), cable_joints([7]), np.zeros(5), c,
                                     np.zeros(14))
-    force_3d = _damper_force(spatial, velocity, chain_joints([7]), c, bend).reshape(-1, 3)
+    force_3d = _damper_force(spatial, velocity, cable_joints([7]), c, bend).reshape(-1, 3)
     np.testing.assert_allclose(force_3d[:, [0, 2]], force_2d.reshape(-1, 2), atol=1e-12 * np.abs(force_2d).max())
     assert np.abs(force_3d[:, 1]).max() < 1e-14 * np.abs(force_2d).max()
     k_2d, d_2d = bending_jacobian(planar.ravel(), velocity_2d.ravel(), cable_joints([7]), np.zeros(5), c)
-    k_3d, d_3d = _damper_matrices(spatial, velocity, chain_joints([7]), c, bend)
+    k_3d, d_3d = _damper_matrices(spatial, velocity, cable_joints([7]), c, bend)
     in_plane = np.ravel(np.column_stack([np.arange(0, 21, 3), np.arange(2, 21, 3)]))  # x0, z0, x1, z1, ...
     np.testing.assert_allclose(k_3d[np.ix_(in_plane, in_plane)], k_2d, atol=1e-11 * np.abs(k_2d).max())
     np.testing.assert_allclose(d_3d[np.ix_(in_plane, in_plane)], d_2d, atol=1e-12 * np.abs(d_2d).max())
@@ -250,7 +250,7 @@ def test_the_bending_damper_is_smooth_at_a_straight_cable():
     """Force and Jacobians of a joint bent by delta (in either plane) tend to the straight joint's
     linearly in delta: no kink where the bending plane is undefined. With the isotropic bend eps
     the slope of K is about 1 / eps^2 times larger (measured 1.3e4 against 20 here)."""
-    joints, c = chain_joints([3]), np.array([2.0])
+    joints, c = cable_joints([3]), np.array([2.0])
     velocity = np.array([0.1, -0.4, 0.3, 0.2, 0.5, -0.1, -0.3, 0.2, 0.6])
     straight = _bent_joint(0.0)
     at = {bend: (_damper_force(straight, velocity, joints, c, bend), *_damper_matrices(straight, velocity, joints, c, bend))

@@ -28,6 +28,7 @@ import numpy as np
 
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.physics import bending_3d
+from cdpr_exu.physics.bending import cable_joints
 from cdpr_exu.physics.axial import CutSlopes, cable_elements
 
 
@@ -143,7 +144,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         for coordinate in range(3):
             held = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=nodes[0], coordinate=coordinate))
             holds.append(mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_marker, held])))
-    joints = bending_3d.chain_joints([len(nodes)])
+    joints = cable_joints([len(nodes)])
     reference = positions.ravel().copy()
     bending = bending_stiffness > 0.0 and len(joints) > 0
     if not bending and not tension_only:

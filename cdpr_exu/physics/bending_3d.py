@@ -395,12 +395,3 @@ def relative_angular_velocity(positions, velocities, a, b, c) -> np.ndarray:
     w1 = np.cross(e1, v[b] - v[a]) / (e1 @ e1)
     w2 = np.cross(e2, v[c] - v[b]) / (e2 @ e2)
     return w2 - w1
-
-
-def chain_joints(nodes_per_cable) -> np.ndarray:
-    """Joints (a, b, c) of cables whose nodes are numbered one after another, shape (J, 3)."""
-    joints, start = [], 0
-    for count in nodes_per_cable:
-        joints.extend((start + j, start + j + 1, start + j + 2) for j in range(count - 2))
-        start += count
-    return np.asarray(joints, dtype=np.int64).reshape(-1, 3)

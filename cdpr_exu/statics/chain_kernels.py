@@ -238,7 +238,7 @@ class SpatialChains(ChainIndex):
         self.weights = np.zeros(self.n_points)
         self.weights[:n_chain] = self.masses * robot.gravity
         self.axial_pattern = axial_3d.tension_only_pattern(self.elements)
-        self.joints = bending_3d.chain_joints(self.counts)
+        self.joints = bending.cable_joints(self.counts)
         if not np.any(self.joint_k > 0):
             self.joints, self.joint_k = self.joints[:0], self.joint_k[:0]
         self.pattern = bending_3d.spatial_bending_pattern(self.joints)
