@@ -9,6 +9,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 import pytest
 
+from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics.axial import TAUT_BAND, cable_elements, slack_axial_force
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.physics import axial_3d
@@ -42,7 +43,7 @@ def _force(p, v, elements, rest, k, c):
 
 
 def _dense(p, v, elements, rest, k, c, f_q, f_q_t, cut_slopes=False):
-    rows, columns = axial_3d.tension_only_pattern(elements)
+    rows, columns = block_pattern(elements, 3)
     values = axial_3d.tension_only_triplet_values(p, v, elements, rest, k, c, np.zeros(len(elements)), f_q, f_q_t,
                                                   np.zeros(rows.size), cut_slopes)
     matrix = np.zeros((p.size, p.size))

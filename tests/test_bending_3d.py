@@ -6,11 +6,12 @@ import pytest
 
 import exudyn.itemInterface as eii
 
+from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics.bending import bending_force_kernel, bending_jacobian, cable_joints
 from cdpr_exu.physics.bending_3d import (ISOTROPIC_BEND, SERIES_BELOW, add_spatial_bending_damping_force,
                                          add_spatial_bending_damping_jacobian, angle_factor,
                                          bending_damping_dissipation, relative_angular_velocity,
-                                         spatial_bending_energy, spatial_bending_force, spatial_bending_pattern,
+                                         spatial_bending_energy, spatial_bending_force,
                                          spatial_bending_stiffness)
 from cdpr_exu.builder.cable import add_cable, add_cable_forces
 from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
@@ -44,7 +45,7 @@ def test_sparse_stiffness_matches_central_differences_of_the_force(seed):
     n = p.size
     joints = cable_joints([n // 3])
     k = np.full(len(joints), 1.96)
-    rows, columns = spatial_bending_pattern(joints)
+    rows, columns = block_pattern(joints, 3)
     stiffness = np.zeros((n, n))
     np.add.at(stiffness, (rows, columns), spatial_bending_stiffness(p, joints, k, 1.0, np.zeros(rows.size)))
     h = 1e-7
@@ -145,7 +146,7 @@ def _damper_force(p, v, joints, c, bend):
 
 def _damper_matrices(p, v, joints, c, bend):
     """K = -df/dq and D = -df/dv as dense matrices, from the sparse triplets."""
-    rows, columns = spatial_bending_pattern(joints)
+    rows, columns = block_pattern(joints, 3)
     matrices = []
     for factors in ((1.0, 0.0), (0.0, 1.0)):
         matrix = np.zeros((p.size, p.size))

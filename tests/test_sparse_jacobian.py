@@ -5,6 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics import axial
 from cdpr_exu.physics import bending
 from cdpr_exu.builder.model import build_model
@@ -34,7 +35,7 @@ def test_bending_triplets_assemble_to_the_dense_jacobian(seed):
     dense = np.zeros((size, size))
     bending.bending_jacobian_kernel(positions, velocities, joints, stiffness, damping, 0.7, 0.003,
                                     np.empty(0), dense, np.empty((0, 0)))
-    rows, columns = bending.bending_triplet_pattern(joints)
+    rows, columns = block_pattern(joints, 2)
     values = bending.bending_triplet_values(positions, velocities, joints, stiffness, damping, 0.7, 0.003,
                                             np.zeros(rows.size))
     # The same floating-point terms summed in another order: round-off only.

@@ -21,6 +21,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
+from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics import axial
 from cdpr_exu.physics import bending
 from cdpr_exu.physics import cable_forces
@@ -284,7 +285,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
 
 def _bending_blocks(spring):
     """Sparse pattern and value filler of the bending joints' 6 x 6 blocks."""
-    rows, columns = bending.bending_triplet_pattern(spring.joints)
+    rows, columns = block_pattern(spring.joints, 2)
 
     def fill(positions, velocities, factor_position, factor_velocity, out_values):
         bending.bending_triplet_values(positions, velocities, spring.joints, spring.stiffness, spring.damping,

@@ -26,6 +26,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
+from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.physics import bending_3d
 from cdpr_exu.physics.bending import cable_joints
@@ -164,8 +165,8 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         rest = axial_k = axial_c = np.zeros(0)
     rest_rate = np.zeros(len(elements))
     size = reference.size
-    bending_rows, bending_columns = bending_3d.spatial_bending_pattern(bending_joints)
-    axial_rows, axial_columns = axial_3d.tension_only_pattern(elements)
+    bending_rows, bending_columns = block_pattern(bending_joints, 3)
+    axial_rows, axial_columns = block_pattern(elements, 3)
     split = bending_rows.size
     triplets = np.zeros((split + axial_rows.size, 3))
     triplets[:, 0] = np.concatenate([bending_rows, axial_rows])

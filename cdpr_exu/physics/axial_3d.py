@@ -127,24 +127,10 @@ def tension_only_energy(positions, elements, rest_length, stiffness):
 
 
 @njit(cache=True)
-def tension_only_pattern(elements):
-    """Rows and columns of the triplets: the 6 x 6 block on (p_a, p_b) per element, shape (36 E,) each."""
-    n = elements.shape[0]
-    rows = np.empty(TRIPLETS_PER_ELEMENT * n, dtype=np.int64)
-    columns = np.empty(TRIPLETS_PER_ELEMENT * n, dtype=np.int64)
-    for e in range(n):
-        for i in range(6):
-            for j in range(6):
-                rows[36 * e + 6 * i + j] = 3 * elements[e, i // 3] + i % 3
-                columns[36 * e + 6 * i + j] = 3 * elements[e, j // 3] + j % 3
-    return rows, columns
-
-
-@njit(cache=True)
 def tension_only_triplet_values(positions, velocities, elements, rest_length, stiffness, damping, rest_rate,
                                 factor_position, factor_velocity, out_values, cut_slopes=False):
     """``factor_position * K + factor_velocity * D`` (K = -df/dq, D = -df/dv) at
-    :func:`tension_only_pattern`'s places; overwrites ``out_values`` (36 E,). With ``cut_slopes``
+    :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places; overwrites ``out_values`` (36 E,). With ``cut_slopes``
     a damper-cut element keeps its taut slopes (:func:`cdpr_exu.physics.axial.newton_slopes`)."""
     out_values[:] = 0.0
     u = np.empty(3)

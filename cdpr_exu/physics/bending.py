@@ -195,27 +195,9 @@ def bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
 
 
 @njit(cache=True)
-def bending_triplet_pattern(joints):
-    """Rows and columns of the sparse Jacobian triplets of the joints: 36 per joint, shape (36 J,) each."""
-    n = joints.shape[0]
-    rows = np.empty(36 * n, dtype=np.int64)
-    columns = np.empty(36 * n, dtype=np.int64)
-    index = np.empty(6, dtype=np.int64)
-    for j in range(n):
-        for node in range(3):
-            index[2 * node] = 2 * joints[j, node]
-            index[2 * node + 1] = 2 * joints[j, node] + 1
-        for i in range(6):
-            for m in range(6):
-                rows[36 * j + 6 * i + m] = index[i]
-                columns[36 * j + 6 * i + m] = index[m]
-    return rows, columns
-
-
-@njit(cache=True)
 def bending_triplet_values(positions, velocities, joints, stiffness, damping, factor_position, factor_velocity,
                            out_values):
-    """Values of ``factor_position * K + factor_velocity * D`` at :func:`bending_triplet_pattern`'s
+    """Values of ``factor_position * K + factor_velocity * D`` at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s
     places (overwrites ``out_values``, shape (36 J,)): the same numbers the dense kernel adds, in
     36-entry blocks per joint, so the Jacobian costs O(J) instead of O(N^2)."""
     grad = np.empty(6)

@@ -138,22 +138,8 @@ def spatial_bending_energy(positions, joints, stiffness):
 
 
 @njit(cache=True)
-def spatial_bending_pattern(joints):
-    """Rows and columns of the stiffness triplets: 81 per joint, shape (81 J,) each."""
-    n = joints.shape[0]
-    rows = np.empty(81 * n, dtype=np.int64)
-    columns = np.empty(81 * n, dtype=np.int64)
-    for j in range(n):
-        for i in range(9):
-            for m in range(9):
-                rows[81 * j + 9 * i + m] = 3 * joints[j, i // 3] + i % 3
-                columns[81 * j + 9 * i + m] = 3 * joints[j, m // 3] + m % 3
-    return rows, columns
-
-
-@njit(cache=True)
 def spatial_bending_stiffness(positions, joints, stiffness, factor, out_values):
-    """``factor * K`` (K = -df/dq [N/m]) at :func:`spatial_bending_pattern`'s places (overwrites ``out_values``)."""
+    """``factor * K`` (K = -df/dq [N/m]) at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places (overwrites ``out_values``)."""
     grad = np.empty(9)
     hess = np.empty((9, 9))
     for j in range(joints.shape[0]):
@@ -342,7 +328,7 @@ def add_spatial_bending_damping_force(positions, velocities, joints, damping, is
 def add_spatial_bending_damping_jacobian(positions, velocities, joints, damping, isotropic_bend, factor_position,
                                          factor_velocity, out_values):
     """Add ``factor_position * K + factor_velocity * D`` of the bending dampers (K = -df/dq [N/m],
-    D = -df/dv [N s/m]) to ``out_values`` at :func:`spatial_bending_pattern`'s places."""
+    D = -df/dv [N s/m]) to ``out_values`` at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places."""
     segment = np.empty(6)
     jacobian_q = np.empty((6, 6))
     jacobian_v = np.empty((6, 6))

@@ -34,12 +34,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics.axial import tension_law
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import per_item, points_per_item, shown, whole_array
 
 __all__ = ["CONTACT_ONSET_DEPTH", "NodePulleyContact", "node_contact_force_kernel",
-           "node_contact_triplet_pattern", "node_contact_triplet_values"]
+           "node_contact_triplet_values"]
 
 #: Penetration [m] over which the contact force switches on (C1 smoothstep): a hundredth
 #: of the 1 mm accuracy the accuracy study aims at.
@@ -112,22 +113,9 @@ def _node_block(positions, velocities, node, cx, cy, radius, stiffness, damping,
 
 
 @njit(cache=True)
-def node_contact_triplet_pattern(nodes):
-    """Rows and columns of the contact nodes' sparse Jacobian triplets: 4 per node, shape (4 C,) each."""
-    rows = np.empty(4 * nodes.shape[0], dtype=np.int64)
-    columns = np.empty(4 * nodes.shape[0], dtype=np.int64)
-    for k in range(nodes.shape[0]):
-        for i in range(2):
-            for j in range(2):
-                rows[4 * k + 2 * i + j] = 2 * nodes[k] + i
-                columns[4 * k + 2 * i + j] = 2 * nodes[k] + j
-    return rows, columns
-
-
-@njit(cache=True)
 def node_contact_triplet_values(positions, velocities, nodes, centers, radii, stiffness, damping, band,
                                 factor_position, factor_velocity, out_values):
-    """Values of ``factor_position * K + factor_velocity * D`` at :func:`node_contact_triplet_pattern`'s
+    """Values of ``factor_position * K + factor_velocity * D`` at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s
     places (overwrites ``out_values``, shape (4 C,))."""
     out_values[:] = 0.0
     block = np.empty((2, 2))
@@ -200,7 +188,7 @@ class NodePulleyContact:
 
     def triplet_pattern(self):
         """Rows and columns of the sparse Jacobian, shape (4 C,) each."""
-        return node_contact_triplet_pattern(self.nodes)
+        return block_pattern(self.nodes.reshape(-1, 1), 2)
 
     def triplet_values(self, positions, velocities, factor_position, factor_velocity, out_values):
         """Values at :meth:`triplet_pattern`'s places (overwrites ``out_values``)."""

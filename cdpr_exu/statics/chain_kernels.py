@@ -20,6 +20,7 @@ import numpy as np
 import scipy.sparse as sparse
 from numba import njit
 
+from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.core.errors import UnreachableError
 from cdpr_exu.core.geometry import rotation_from_vector, skew
 from cdpr_exu.physics import axial_3d, bending, bending_3d
@@ -237,11 +238,11 @@ class SpatialChains(ChainIndex):
         self.local = np.array([c.anchor for c in robot.cables], dtype=float)
         self.weights = np.zeros(self.n_points)
         self.weights[:n_chain] = self.masses * robot.gravity
-        self.axial_pattern = axial_3d.tension_only_pattern(self.elements)
+        self.axial_pattern = block_pattern(self.elements, 3)
         self.joints = bending.cable_joints(self.counts)
         if not np.any(self.joint_k > 0):
             self.joints, self.joint_k = self.joints[:0], self.joint_k[:0]
-        self.pattern = bending_3d.spatial_bending_pattern(self.joints)
+        self.pattern = block_pattern(self.joints, 3)
         self.penalty_k = (np.array([robot.anchor_spring_factor * c.axial_stiffness for c in robot.cables])
                           if self.penalty else np.zeros(0))
         # each swivel pulley: its cable's nodes (all may touch it), the contact's sparse pattern in
@@ -315,7 +316,7 @@ class SpatialChains(ChainIndex):
         flat = p.ravel().copy()
         length, t, force = self._axial(p)
         # axial: the force along each element, and its 6 x 6 block [[B, -B], [-B, B]] in the
-        # order of axial_3d.tension_only_pattern; a tension-only element's slope is its law's
+        # order of sparse_blocks.block_pattern; a tension-only element's slope is its law's
         np.subtract.at(G, 3 * self.elements[:, 0][:, None] + np.arange(3), force[:, None] * t)
         np.add.at(G, 3 * self.elements[:, 1][:, None] + np.arange(3), force[:, None] * t)
         tt = t[:, :, None] * t[:, None, :]
