@@ -108,6 +108,12 @@ class Space:
         ``J_l(theta) theta'`` in space (the rotation vector's rate is not the angular velocity)."""
         raise NotImplementedError
 
+    def rotation_rate(self, rotation, angular_velocity) -> np.ndarray:
+        """The rotation's time derivative (..., rotation_size) [rad/s] for an angular velocity in the fixed
+        frame (same shape) [rad/s]: the inverse of :meth:`angular_velocity` (in space
+        ``J_l(theta)^-1 omega``), so that a measured velocity is the pose's rate in both spaces."""
+        raise NotImplementedError
+
     def anchor_points(self, pose, anchors) -> np.ndarray:
         """World positions of the platform anchors ``r + R b_i``: pose (pose_size,) or (N, pose_size),
         anchors (m, d) in the platform frame -> (m, d) or (N, m, d) [m]."""
@@ -171,6 +177,9 @@ class PlanarSpace(Space):
     def angular_velocity(self, rotation, rotation_rate) -> np.ndarray:
         return np.asarray(rotation_rate, dtype=float)
 
+    def rotation_rate(self, rotation, angular_velocity) -> np.ndarray:
+        return np.asarray(angular_velocity, dtype=float)
+
     def anchor_points(self, pose, anchors) -> np.ndarray:
         return geometry.anchor_points(pose, anchors)
 
@@ -217,6 +226,11 @@ class SpatialSpace(Space):
         rotation, rate = np.asarray(rotation, dtype=float), np.asarray(rotation_rate, dtype=float)
         jacobians = geometry.left_jacobians(rotation).reshape(-1, 3, 3)
         return np.einsum("nij,nj->ni", jacobians, rate.reshape(-1, 3)).reshape(rate.shape)
+
+    def rotation_rate(self, rotation, angular_velocity) -> np.ndarray:
+        rotation, omega = np.asarray(rotation, dtype=float), np.asarray(angular_velocity, dtype=float)
+        jacobians = geometry.left_jacobians(rotation).reshape(-1, 3, 3)
+        return np.linalg.solve(jacobians, omega.reshape(-1, 3, 1)).reshape(omega.shape)
 
     def anchor_points(self, pose, anchors) -> np.ndarray:
         return geometry.spatial_anchor_points(pose, anchors)

@@ -48,10 +48,10 @@ class Measurement:
         planar robot; (x, y, z, rotation vector) on a spatial one (the rotation vector
         of the platform's rotation matrix, zero for a point mass).
     platform_velocity : ndarray, shape (3,) or (6,), or None [m/s, rad/s]
-        Its velocity: (vx, vz, angular rate) planar, the pose's time derivative; (vx, vy,
-        vz, angular velocity in the global frame) spatial, which is *not* the pose's time
-        derivative (the rotation vector's rate, which the spatial trajectories give, is
-        ``J_l(theta)^-1`` times the angular velocity; zero for a point mass).
+        Its velocity, the pose's time derivative in both spaces: (vx, vz, angular rate) planar;
+        (vx, vy, vz, rate of the rotation vector) spatial, which is ``J_l(theta)^-1`` times the
+        angular velocity in the fixed frame (:meth:`cdpr_exu.space.Space.rotation_rate`; zero for a
+        point mass), as the spatial trajectories give their rates.
     cable_tensions : ndarray, shape (m,) or None [N]
         Tension at the platform end of each cable, only for ``uses_tension``.
     state_time : float or None [s]

@@ -77,3 +77,20 @@ def test_the_inertia_is_a_moment_in_the_plane_and_three_principal_moments_in_spa
     with pytest.raises(SceneError, match="platform.inertia must be positive"):
         SPACE.inertia("platform.inertia", [1.0, 0.0, 1.0], rigid=True)
     assert PLANE.is_rigid(point_mass=True) and SPACE.is_rigid(point_mass=False) and not SPACE.is_rigid(point_mass=True)
+
+
+def test_the_rotation_rate_inverts_the_angular_velocity_in_both_spaces():
+    """``rotation_rate`` is ``angular_velocity``'s inverse (identity in the plane, J_l^-1 in space), and in
+    space it is the rotation vector's time derivative: a central difference of theta(t) agrees with it."""
+    rng = np.random.default_rng(3)
+    for space, size in ((PLANE, 1), (SPACE, 3)):
+        theta, rate = rng.normal(size=(5, size)), rng.normal(size=(5, size))
+        omega = space.angular_velocity(theta, rate)
+        np.testing.assert_allclose(space.rotation_rate(theta, omega), rate, rtol=1e-12, atol=1e-12)
+    # a rotation turning at a constant body-fixed angular velocity: theta(t) = log(R0 exp(t w_body))
+    r0 = geometry.rotation_from_vector([0.3, -0.5, 0.8])
+    w_body, t, h = np.array([0.4, 1.1, -0.7]), 0.37, 1e-5
+    theta = [geometry.rotation_vector(r0 @ geometry.rotation_from_vector(s * w_body)) for s in (t - h, t, t + h)]
+    omega_fixed = r0 @ geometry.rotation_from_vector(t * w_body) @ w_body
+    # the central difference is exact to O(h^2) ~ 1e-10 rad/s here
+    np.testing.assert_allclose(SPACE.rotation_rate(theta[1], omega_fixed), (theta[2] - theta[0]) / (2 * h), atol=1e-8)

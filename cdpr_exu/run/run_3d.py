@@ -165,7 +165,7 @@ class Run3D:
     the winches follow the command before every step (:class:`_SpatialWinches`); after every step that
     reaches an output time the state is recorded with the step's own time (and the step that ends the run),
     and every step is checked (:class:`_SpatialMonitor`). A controller's measurement is the platform's pose
-    (x, y, z, rotation vector), velocity (linear, global angular) and each cable's last element's axial
+    (x, y, z, rotation vector), its rate (the pose's time derivative) and each cable's last element's axial
     force [N] at the start of the step (``Measurement.state_time``).
 
     Raises
@@ -200,14 +200,16 @@ class Run3D:
         self.start = _time.perf_counter()
 
     def measured_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """The platform's pose (x, y, z, rotation vector) [m, rad] and velocity (linear, global angular)
-        [m/s, rad/s] now, each shape (6,)."""
+        """The platform's pose (x, y, z, rotation vector) [m, rad] and its time derivative [m/s, rad/s] now
+        (the rotation vector's rate from Exudyn's angular velocity, :meth:`Space.rotation_rate`, as planar
+        runs give the pose's rate), each shape (6,)."""
         mbs, items = self.model.mbs, self.model.items
         position, rotation = platform_pose(mbs, items)
         velocity = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.Velocity))
         angular = (np.zeros(3) if items.is_point_mass else
                    np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.AngularVelocity)))
-        return np.concatenate([position, rotation_vector(rotation)]), np.concatenate([velocity, angular])
+        theta = rotation_vector(rotation)
+        return np.concatenate([position, theta]), np.concatenate([velocity, self.scene.space.rotation_rate(theta, angular)])
 
     def initial_pose(self) -> np.ndarray:
         """The pose the controller starts from: where the robot rests (x, y, z, rotation vector), shape (6,)."""
