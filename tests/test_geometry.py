@@ -34,3 +34,12 @@ def test_rotation_vector_and_matrix_are_inverse_and_left_jacobian_is_their_deriv
         change = (rotation_from_vector(theta + h * e) - rotation_from_vector(theta - h * e)) / (2 * h) @ rotation.T
         axial = 0.5 * np.array([change[2, 1] - change[1, 2], change[0, 2] - change[2, 0], change[1, 0] - change[0, 1]])
         np.testing.assert_allclose(axial, left_jacobian(theta) @ e, atol=1e-8)
+
+
+def test_a_platform_is_a_point_mass_only_when_every_anchor_is_exactly_at_its_centre():
+    """One rule for the scene, the catenary statics and the chain statics (they used three: exact zeros,
+    ``not any`` and ``np.allclose``, which took anchors 1e-9 m off the centre for a point mass)."""
+    from cdpr_exu.core.geometry import all_at_centre
+
+    assert all_at_centre([[0.0, 0.0, 0.0], [-0.0, 0.0, 0.0]]) and all_at_centre(np.zeros((4, 2)))
+    assert not all_at_centre([[0.0, 0.0, 0.0], [0.0, 1e-9, 0.0]])

@@ -78,6 +78,7 @@ from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.validation import non_negative, real_array, shown
 
 __all__ = [
+    "all_at_centre",
     "planar_exit",
     "above_exits",
     "PulleyExit",
@@ -108,6 +109,12 @@ _WRAP_ROUNDING = 1e-9
 # ----------------------------------------------------------------------------------
 # argument checks
 # ----------------------------------------------------------------------------------
+def all_at_centre(anchors) -> bool:
+    """True when every anchor (rows of 2 or 3 coordinates [m], any nesting) sits exactly at the centre of mass:
+    a point-mass platform, with no rotation to balance. The one rule for scenes, statics and the builder."""
+    return not np.any(np.asarray(anchors, dtype=float))
+
+
 def finite_array(name, value, last_dims=None):
     """Return ``value`` as a finite float array, or raise SceneError naming it."""
     try:

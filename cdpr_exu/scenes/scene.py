@@ -33,7 +33,7 @@ import numpy as np
 import tomli_w
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError, UnreachableError
-from cdpr_exu.core.geometry import above_exits
+from cdpr_exu.core.geometry import all_at_centre, above_exits
 from cdpr_exu.core.validation import entries, finite, from_table, non_negative, positive, shown
 from cdpr_exu.exits import EXIT_KINDS, Exit, PointExit, Pulley, exit_from_dict
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
@@ -318,7 +318,7 @@ class PlatformSpec:
     @property
     def is_point_mass(self) -> bool:
         """True when every anchor sits at the centre of mass."""
-        return all(v == 0.0 for anchor in self.anchors for v in anchor)
+        return all_at_centre(self.anchors)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (TOML-ready): the fields given or taken by default (None left out)."""

@@ -42,7 +42,7 @@ import scipy.sparse as sparse
 import scipy.sparse.linalg as sparse_linalg
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import rotation_from_vector, rotation_matrix, rotation_vector
+from cdpr_exu.core.geometry import all_at_centre, rotation_from_vector, rotation_matrix, rotation_vector
 from cdpr_exu.core.validation import finite, real_array, shown, vector
 from cdpr_exu.exits import Exit
 from cdpr_exu.physics import swivel_pulley as sp
@@ -226,7 +226,7 @@ class ChainRobot:
     @property
     def is_point_mass(self) -> bool:
         """True when every anchor sits at the centre of mass (no rotation to balance)."""
-        return all(np.allclose(c.anchor, 0.0) for c in self.cables)
+        return all_at_centre([c.anchor for c in self.cables])
 
     @property
     def swivel_cables(self) -> list:

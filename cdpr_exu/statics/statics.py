@@ -59,6 +59,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.core.geometry import all_at_centre
 from cdpr_exu.core.geometry import (left_jacobian, perpendicular, planar_cross, rotation_from_vector, rotation_matrix,
                                     rotation_vector, skew, swivel_pulley_exit)
 from cdpr_exu.core.validation import finite, non_negative, positive, real_array, shown, vector
@@ -242,7 +243,7 @@ class SuspendedPlatform:
     @property
     def is_point_mass(self):
         """True when every anchor is at the centre of mass."""
-        return all(not any(c.anchor) for c in self.cables)
+        return all_at_centre([c.anchor for c in self.cables])
 
     @property
     def degrees_of_freedom(self):
