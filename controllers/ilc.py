@@ -9,7 +9,8 @@ iterative learning control", IEEE Control Systems 26(3), 2006):
     c_{k+1} = Q(c_k + gamma J(t) e_k(t + tau)),    lambda_k(t) = lambda_0(t) + w(t) c_k(t)
 
 * lambda_0 : the ideal inverse kinematics (:mod:`controllers.ideal_ik`), the first trial;
-* J(t), shape (m, 2) [m/m] : the ideal cables' length change per platform position change
+* J(t), shape (m, d) [m/m] : the ideal cables' length change per platform position change
+  (d = 2 in the plane, 3 in space: the one kinematics' length Jacobian, its position columns)
   at the reference pose (rotation held), so that a correction J d moves the platform by
   about d;
 * gamma [-] : the learning gain;
@@ -104,8 +105,8 @@ class CommandTable:
         Increasing, from 0.
     changes : ndarray, shape (N, m) [m]
         Paid-out length of each winch minus what it paid out at t = 0 (zero in the first row).
-    expected_positions : ndarray, shape (N, 2), or None [m]
-        The platform position (x, z) these commands gave where they were learned (the
+    expected_positions : ndarray, shape (N, d), or None [m]
+        The platform position ((x, z) or (x, y, z)) these commands gave where they were learned (the
         controller's model, for model-based feed-forward), if known: what a feedback
         around them should expect of a plant that matches the model.
     """
@@ -125,8 +126,8 @@ class CommandTable:
         object.__setattr__(self, "changes", changes)
         if self.expected_positions is not None:
             expected = np.asarray(self.expected_positions, dtype=float)
-            if expected.shape != (len(times), 2) or not np.all(np.isfinite(expected)):
-                raise SceneError(f"expected_positions must be finite, shape ({len(times)}, 2), "
+            if expected.ndim != 2 or expected.shape[0] != len(times) or not np.all(np.isfinite(expected)):
+                raise SceneError(f"expected_positions must be finite, shape ({len(times)}, d), "
                                  f"got shape {expected.shape}")
             object.__setattr__(self, "expected_positions", expected)
 
@@ -172,7 +173,7 @@ class ReplayController:
         self._expected = None if expected is None else CubicSpline(self.table.times, expected, axis=0)
 
     def expected_position(self, time: float) -> np.ndarray | None:
-        """The platform position (x, z) [m] the table's commands gave where they were learned, at
+        """The platform position ((x, z) or (x, y, z)) [m] the table's commands gave where they were learned, at
         ``time`` [s]; None if the table does not say."""
         if self._spline is None:
             raise RuntimeError(f"{type(self).__name__}.reset(scene, initial_paid_out) must be called first")
@@ -241,9 +242,9 @@ class LearningLaw:
             Uniform grid from 0.
         correction : ndarray, shape (N, m) [m]
             This trial's correction c_k (before the fade).
-        errors : ndarray, shape (N, 2) [m]
-            This trial's position error r_ref - r on ``times``.
-        jacobians : ndarray, shape (N, m, 2) [m/m]
+        errors : ndarray, shape (N, d) [m]
+            This trial's position error r_ref - r on ``times`` (d: 2 planar, 3 spatial).
+        jacobians : ndarray, shape (N, m, d) [m/m]
             :func:`position_jacobian` at the reference poses.
 
         Returns

@@ -4,7 +4,7 @@ Each kind is a name (the one reports, ``cdpr compare --controllers``, robustness
 results folders use) and a factory per dimension its physics exists in: ``CONTROLLERS[name](scene,
 **options)`` makes the controller for a run of ``scene``, or refuses, naming the controller and the
 scene's dimension, a kind that has no physics there (the chordal correction of the planar pulley's
-polygon, the learning controllers, on a spatial scene), before any run. :func:`controllers_for` is
+polygon, on a spatial scene), before any run. :func:`controllers_for` is
 the list ``cdpr compare`` runs on a scene by default: every kind its dimension has, in the
 registry's order.
 
@@ -80,15 +80,16 @@ class ControllerKind:
         return self.factories[scene.space.dimension](scene, **options)
 
 
-def _learned(name: str, on_model: bool, loop: bool = False) -> Callable[..., object]:
+def _learned(name: str, on_model: bool, loop: bool = False, gains: Mapping | None = None) -> Callable[..., object]:
     """The factory of a learning kind: its commands learned by ``learner(on_model)`` (on the controllers'
-    model, or on the robot itself for ILC), with the filtered PI loop around them for ``loop``."""
+    model, or on the robot itself for ILC), with the filtered PI loop (``gains``: its options) around them
+    for ``loop``."""
     def make(scene, learner, **loop_options):
         learned = LearnedController("model_feed_forward" if loop else name, learner(on_model))
         if not loop:
             return learned
         feedback = loop_options.pop("feedback", None)
-        return ClosedLoopController(name, learned, FilteredPositionPI() if feedback is None else feedback,
+        return ClosedLoopController(name, learned, FilteredPositionPI(**(gains or {})) if feedback is None else feedback,
                                     **loop_options)
     return make
 
@@ -112,10 +113,14 @@ CONTROLLERS: dict[str, ControllerKind] = _kinds(
                    {2: lambda scene, **o: ClosedLoopTensionAwareController(**{"dynamic": True,
                                                                              "chordal_correction": True, **o}),
                     3: lambda scene, **o: ClosedLoopTensionAwareController(**{**SPATIAL_LOOP, **o})}),
-    ControllerKind("model_feed_forward", {2: _learned("model_feed_forward", on_model=True)}, learns=True),
+    ControllerKind("model_feed_forward", dict.fromkeys((2, 3), _learned("model_feed_forward", on_model=True)),
+                   learns=True),
     ControllerKind("closed_loop_model_feed_forward",
-                   {2: _learned("closed_loop_model_feed_forward", on_model=True, loop=True)}, learns=True),
-    ControllerKind("ilc", {2: _learned("ilc", on_model=False)}, learns=True),
+                   {2: _learned("closed_loop_model_feed_forward", on_model=True, loop=True),
+                    3: _learned("closed_loop_model_feed_forward", on_model=True, loop=True,
+                                gains={**SPATIAL_LOOP, "rotation": False})},  # the learned path is positions
+                   learns=True),
+    ControllerKind("ilc", dict.fromkeys((2, 3), _learned("ilc", on_model=False)), learns=True),
 )
 
 

@@ -5,7 +5,7 @@ Run:  python examples/spatial_robots.py
 Writes ``results/spatial/<scene>/static/`` (``cdpr static``: summary.json and the 3-D rest
 figure of spatial-four-cable, spatial-cogiro and spatial-ipanema) and
 ``results/spatial/<scene>/compare/`` (``cdpr compare``: summary.json, comparison.md and an
-overview figure per controller, for spatial-cogiro and spatial-ipanema), and the table
+overview figure per controller of :data:`CONTROLLERS`, for spatial-cogiro and spatial-ipanema), and the table
 ``results/spatial/controllers.md`` that the README and docs/spatial.md show. About two
 minutes on one core (the chain version's statics, ``tension_aware_chain``, take about
 20 s of it on CoGiRo and 14 s on IPAnema).
@@ -20,6 +20,9 @@ from cdpr_exu.studies.comparison import compare_controllers
 from cdpr_exu.scenes.scene import load_scene
 
 RESULTS = Path("results/spatial")
+#: The controllers of the table: the learning ones (ilc, model_feed_forward and its closed loop), which
+#: run on spatial scenes too, are left out here (their trials on spatial-cogiro-mismatch: tests/test_learning.py).
+CONTROLLERS = ["ideal_ik", "tension_aware", "tension_aware_chain", "closed_loop_tension_aware"]
 
 
 def main() -> None:
@@ -31,7 +34,7 @@ def main() -> None:
     rows = ["| robot | controller | max position error [mm] | RMS position error [mm] | max rotation error [deg] "
             "| min element tension [N] |", "|---|---|---|---|---|---|"]
     for name in ("spatial-cogiro", "spatial-ipanema"):
-        summaries = compare_controllers(load_scene(name), out=RESULTS / name / "compare",
+        summaries = compare_controllers(load_scene(name), CONTROLLERS, out=RESULTS / name / "compare",
                                         report=print_controller_row)
         for controller, s in summaries.items():
             rows.append(f"| {name} | {controller} | {1000 * s['max_position_error_m']:.3f} | "

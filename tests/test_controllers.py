@@ -358,7 +358,8 @@ SPATIAL = load_scene("spatial-ipanema")
     (PAPER, ["ideal_ik", "tension_aware", "tension_aware_chordal", "tension_aware_dynamic_chordal",
              "tension_aware_chain", "closed_loop_tension_aware", "model_feed_forward",
              "closed_loop_model_feed_forward", "ilc"]),
-    (SPATIAL, ["ideal_ik", "tension_aware", "tension_aware_chain", "closed_loop_tension_aware"])], ids=["planar", "spatial"])
+    (SPATIAL, ["ideal_ik", "tension_aware", "tension_aware_chain", "closed_loop_tension_aware", "model_feed_forward",
+               "closed_loop_model_feed_forward", "ilc"])], ids=["planar", "spatial"])
 def test_the_registry_gives_each_dimension_its_controllers_in_the_order_compare_runs_them(scene, names):
     from cdpr_exu.studies.learning import learners
     from controllers.registry import CONTROLLERS, controllers_for
@@ -371,8 +372,7 @@ def test_the_registry_gives_each_dimension_its_controllers_in_the_order_compare_
             assert controller.name.startswith(name.replace("_chordal", "").replace("_dynamic", ""))
 
 
-@pytest.mark.parametrize("name", ["tension_aware_chordal", "tension_aware_dynamic_chordal", "model_feed_forward",
-                                  "closed_loop_model_feed_forward", "ilc"])
+@pytest.mark.parametrize("name", ["tension_aware_chordal", "tension_aware_dynamic_chordal"])
 def test_the_registry_refuses_a_controller_on_a_dimension_it_has_no_physics_for_naming_both(name):
     from cdpr_exu.core.errors import SceneError
     from cdpr_exu.studies.comparison import compare_controllers

@@ -217,13 +217,15 @@ def test_the_chain_version_runs_over_swivel_pulleys_and_follows_the_ramp_closer_
 def test_cdpr_compare_on_a_spatial_scene_writes_the_table_and_each_controller(tmp_path):
     out = tmp_path / "compare"
     done = subprocess.run([sys.executable, "-m", "cdpr_exu.cli", "compare", "spatial-ipanema", "--end-time", "2",
-                           "--out", str(out), "-q"], capture_output=True, text=True, timeout=300)
+                           "--trials", "2", "--out", str(out), "-q"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     summary = json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
+    # every controller of the registry but the planar pulley's chordal ones, the learning ones included
     assert set(summary["controllers"]) == {"ideal_ik", "tension_aware", "tension_aware_chain",
-                                           "closed_loop_tension_aware"}
-    assert summary["controllers"]["tension_aware_chain"]["status"] == "completed"
-    assert summary["controllers"]["closed_loop_tension_aware"]["status"] == "completed"
+                                           "closed_loop_tension_aware", "model_feed_forward",
+                                           "closed_loop_model_feed_forward", "ilc"}
+    assert all(s["status"] == "completed" for s in summary["controllers"].values())
+    assert len(summary["controllers"]["ilc"]["learning"]["trials"]) == 2
     assert "| tension_aware |" in (out / "comparison.md").read_text()
     assert (out / "overview_tension_aware.png").exists()
 

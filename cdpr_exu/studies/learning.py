@@ -131,8 +131,9 @@ def command_grid(scene: Scene) -> np.ndarray:
 
 
 def position_errors(result: Result, times: np.ndarray) -> np.ndarray:
-    """Position error r_ref - r of ``result`` on ``times`` (linear interpolation), shape (N, 2) [m]."""
-    error = result.reference[:, :2] - result.pose[:, :2]
+    """Position error r_ref - r of ``result`` on ``times`` (linear interpolation), shape (N, d) [m] (d: the
+    position's size in the run's space)."""
+    error = -result.position_error
     return np.column_stack([np.interp(times, result.time, column) for column in error.T])
 
 
@@ -211,7 +212,7 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
         if on_trial is not None:
             on_trial(trial)
         if best is None or trial.max_position_error_m < best[0].max_position_error_m:
-            expected = np.column_stack([np.interp(times, result.time, column) for column in result.pose[:, :2].T])
+            expected = np.column_stack([np.interp(times, result.time, column) for column in result.position.T])
             best = (trial, replace(table, expected_positions=expected), result)
         stop_reason = rule.reason_to_stop([t.max_position_error_m for t in trials])
         if stop_reason is not None:
@@ -227,8 +228,8 @@ class PositionResponse:
     Attributes
     ----------
     frequencies : ndarray, shape (F,) [Hz]
-    response : ndarray, shape (F, 2, 2) [m/m], complex
-        Row: platform x, z; column: commanded x, z.
+    response : ndarray, shape (F, d, d) [m/m], complex
+        Row: the platform's position coordinate ((x, z) or (x, y, z)); column: the commanded one.
     """
 
     frequencies: np.ndarray
@@ -240,15 +241,15 @@ class PositionResponse:
         Below 1 where the learning law (without Q) shrinks the error at that frequency every trial.
         """
         phase = np.exp(2j * np.pi * self.frequencies * lead)[:, None, None]
-        return np.linalg.svd(np.eye(2) - gain * phase * self.response, compute_uv=False)[:, 0]
+        return np.linalg.svd(np.eye(self.response.shape[-1]) - gain * phase * self.response, compute_uv=False)[:, 0]
 
 
 def measure_response(model: Scene, amplitude: float = 4e-3, max_frequency: float = 5.0, *, after: float = 1.0,
                      seed: int = 1) -> PositionResponse:
-    """Measure the platform's position response to small length changes along the reference (3 runs).
+    """Measure the platform's position response to small length changes along the reference (d + 1 runs).
 
     The ideal-IK lengths are run once as they are, then with J(t) p(t) added, p a
-    random-phase multisine along x and then along z (``amplitude`` RMS [m], faded in from
+    random-phase multisine along each position coordinate in turn (``amplitude`` RMS [m], faded in from
     0.5 to 1 s; frequencies the multiples of 1 / (end_time - after) up to
     ``max_frequency`` [Hz]). The Fourier transforms over t >= ``after`` of the position
     change and of p give G at those frequencies, a linear time-invariant summary of a
@@ -273,15 +274,15 @@ def measure_response(model: Scene, amplitude: float = 4e-3, max_frequency: float
     rest = positions(baseline)
     rng = np.random.default_rng(seed)
     commands, changes = [], []
-    for axis in range(2):
+    for axis in range(model.space.position_size):
         p = sum(np.sin(2 * np.pi * f * times + rng.uniform(0.0, 2 * np.pi)) for f in frequencies)
         p = amplitude * p / np.std(p) * fade_in(times - 0.5, 0.5)
-        command = np.zeros((len(times), 2))
+        command = np.zeros((len(times), model.space.position_size))
         command[:, axis] = p
         commands.append(command)
         changes.append(positions(baseline + np.einsum("nij,nj->ni", jacobians, command)) - rest)
     bins = np.rint(frequencies * period).astype(int)
-    u = np.stack([np.fft.rfft(c[window], axis=0)[bins] for c in commands], axis=-1)  # (F, 2, 2 experiments)
+    u = np.stack([np.fft.rfft(c[window], axis=0)[bins] for c in commands], axis=-1)  # (F, d, d experiments)
     y = np.stack([np.fft.rfft(c[window], axis=0)[bins] for c in changes], axis=-1)
     return PositionResponse(frequencies, y @ np.linalg.inv(u))
 
