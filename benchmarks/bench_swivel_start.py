@@ -34,7 +34,7 @@ RESULTS = Path(__file__).resolve().parent / "results" / "swivel_start.md"
 def _built(scene, tension_only):
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
-                                scene_chain_spec(scene, tension_only=tension_only), swivels=scene.swivel_exits)
+                                scene_chain_spec(scene, tension_only=tension_only), exits=scene.exits)
     mbs.Assemble()
     return mbs, items
 

@@ -178,19 +178,18 @@ class _SpatialEquilibria:
 
         platform = statics.catenary_platform(scene)
         robot = chain_statics.chain_robot(scene)
-        over_swivel = [cable.pulley is not None for cable in robot.cables]
+        wraps = [exit_.wraps for exit_ in scene.exits]  # over a swivel pulley: held below it, on its axis
         inverse_statics = chain_statics.InverseChainStatics(robot)
         catenary_rest = statics.solve_statics(platform, initial)
         started = chain_statics.robot_paid_out(robot, initial)
         rest = chain_statics.solve_chain_statics(started, *chain_statics.catenary_start(started, catenary_rest))
-        # the straight distances change as the paid-out lengths: from the exit point, or the swivel pulley's inlet
-        exits = np.array([cable.pulley.inlet_array if swivel else cable.exit_point
-                          for cable, swivel in zip(robot.cables, over_swivel)])
+        # the straight distances change as the paid-out lengths: from each exit's fixed point (a swivel's inlet)
+        exits = scene.exit_points
         anchors = np.array([c.anchor for c in robot.cables])
         state = {"tensions": rest.tensions_at_anchor, "horizontal": np.array([c.catenary.horizontal_tension
                                                                              for c in catenary_rest.cables]),
                  "previous": None}
-        if any(over_swivel):
+        if any(wraps):
             # Over swivel pulleys the first sample starts from the rest the robot starts in, not from the
             # catenaries: these hang lower (no bending over the disc: 22 mm on spatial-four-cable-swivel), and
             # their nodes cannot start a chain that runs up the axis and over the disc
@@ -210,7 +209,7 @@ class _SpatialEquilibria:
             nodes = []
             for i, (cable, chain, length, point) in enumerate(zip(platform.cables, robot.cables,
                                                                   inverse.unstrained_lengths, points)):
-                if over_swivel[i]:
+                if wraps[i]:
                     nodes.append(state["previous"][0].nodes[i])
                     continue
                 shape, _ = statics.forward_cable(cable, length, point)

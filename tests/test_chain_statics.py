@@ -344,7 +344,7 @@ def _swivel_scene(asymmetric=True, rigid=False):
 def _exudyn_robot(scene, anchor_spring_factor=None, tension_only=False):
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
-                                scene_chain_spec(scene, anchor_spring_factor, tension_only), swivels=scene.swivel_exits)
+                                scene_chain_spec(scene, anchor_spring_factor, tension_only), exits=scene.exits)
     mbs.Assemble()
     return mbs, items
 

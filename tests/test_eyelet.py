@@ -5,15 +5,13 @@ refuses a cable that leaves it more than ``max_angle`` away from its guide's axi
 down). Nothing in cdpr_exu knows it: the registry entry ``EXIT_KINDS["eyelet"] = Eyelet``
 is all it takes for planar and spatial scene files to use it (``[[exits]]`` with
 ``kind = "eyelet"``), for the scene to validate and save it, and for the ideal kinematics to
-compute its cables' lengths.
-
-TODO (issue 24, slice 9, the one builder): run a planar and a spatial scene with eyelets in
-Exudyn. The builders still ask a scene's exits for their point and radius only; once the
-builder asks the exit for its items, this file adds the runs.
+compute its cables' lengths, and for :func:`cdpr_exu.simulate` to run its scenes in Exudyn
+(the builders, the rest and the run sides ask each exit, never its kind).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, Mapping
@@ -21,6 +19,7 @@ from typing import Any, ClassVar, Mapping
 import numpy as np
 import pytest
 
+import cdpr_exu
 from cdpr_exu.statics.kinematics import ideal_paid_out
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import PulleyExit, finite_array
@@ -30,6 +29,14 @@ from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 
 # Straight cables: their lengths are distances, exact to a few ulp of metre-sized lengths.
 ROUNDING = 1e-12
+# A run over eyelets against the same run over point exits: the eyelet's straight cable (a difference and a
+# norm) and the point exit's kernel (the swivel pulley's at radius 0 in space) agree to a few ulp; the
+# implicit integrator carries that round-off without amplifying it. Bounds: 1e-12 m (the issue's bound on
+# moved numbers) on poses, nodes and paid-out lengths (measured: 0 in the plane, where both kernels are the
+# same arithmetic, 4.4e-15 m in space), and 1e-9 of the run's largest tension on tensions (stiff cables:
+# EA ~ 1e7 N turns 4e-15 m over a 0.3 m element into ~1e-7 N; measured 1.4e-8 N of 449 N, 3e-11).
+RUN_ROUNDING_M = 1e-12
+RUN_ROUNDING_TENSION = 1e-9
 
 
 @dataclass(frozen=True)
@@ -192,3 +199,68 @@ def test_an_eyelet_refuses_a_cable_beyond_its_guide_and_names_itself_in_the_scen
 def test_without_its_registry_entry_the_kind_is_unknown():
     with pytest.raises(SceneError, match=r"exits\[0\]\.kind must be 'point' or 'swivel', got 'eyelet'"):
         _scene(SPATIAL)
+
+
+def _over_eyelets(scene, max_angle: float, trajectory=None):
+    """``scene`` with an eyelet (guide radius 2 cm, ``max_angle``) at each of its point exits, in the exits form."""
+    data = {key: value for key, value in scene.to_dict().items() if key not in ("cable_exit", "pulleys", "pulley")}
+    data["dimension"] = scene.dimension
+    data["exits"] = [{"kind": "eyelet", "point": list(exit_.point), "guide_radius": 0.02, "max_angle": max_angle}
+                     for exit_ in scene.exits]
+    if trajectory is not None:
+        data["trajectory"] = trajectory
+    return scene_from_dict(data)
+
+
+def _short(name: str, end_time: float):
+    scene = cdpr_exu.load_scene(name)
+    assert {exit_.kind for exit_ in scene.exits} == {"point"}
+    return scene.with_changes(solver=dataclasses.replace(scene.solver, end_time=end_time))
+
+
+# The shipped scenes over point exits, one per dimension: the planar catenary held at its winches (15 elements
+# per cable, 2 cables, hold) and the CoGiRo-class robot (8 cables of 20 elements, its circle).
+SHIPPED_POINT_EXITS = {"planar": "paper-catenary-fixed", "spatial": "spatial-cogiro"}
+
+
+@pytest.mark.parametrize("name", SHIPPED_POINT_EXITS.values(), ids=SHIPPED_POINT_EXITS.keys())
+def test_a_shipped_scene_over_eyelets_runs_in_exudyn_as_over_its_point_exits(eyelets, name):
+    """An eyelet whose cable stays within its guide angle is a fixed point: the run is the point-exit run."""
+    scene = _short(name, 0.05)
+    over_eyelets = _over_eyelets(scene, math.radians(89.0))
+    point, eyelet = cdpr_exu.simulate(scene), cdpr_exu.simulate(over_eyelets)
+    assert type(eyelet) is type(point) and eyelet.status == point.status == "completed"
+    assert eyelet.dimension == scene.dimension and eyelet.steps == point.steps > 0
+    assert np.array_equal(eyelet.time, point.time) and np.array_equal(eyelet.reference, point.reference)
+    assert eyelet.pose == pytest.approx(point.pose, abs=RUN_ROUNDING_M, rel=0)
+    assert eyelet.paid_out == pytest.approx(point.paid_out, abs=RUN_ROUNDING_M, rel=0)
+    for ours, theirs in zip(eyelet.nodes, point.nodes, strict=True):
+        assert ours == pytest.approx(theirs, abs=RUN_ROUNDING_M, rel=0)
+    largest = max(float(np.max(np.abs(t))) for t in point.tensions)
+    for ours, theirs in zip(eyelet.tensions, point.tensions, strict=True):
+        assert ours == pytest.approx(theirs, abs=RUN_ROUNDING_TENSION * largest, rel=0)
+    # the platform hangs on its cables (each holds more than 1 N at the end, 1 kg planar, tonnes in space):
+    # the comparison is not of two idle runs
+    assert min(float(np.max(t[-1])) for t in point.tensions) > 1.0
+
+
+@pytest.mark.parametrize("name", SHIPPED_POINT_EXITS.values(), ids=SHIPPED_POINT_EXITS.keys())
+def test_a_reference_leaving_an_eyelets_guide_angle_is_refused_before_the_run(eyelets, name):
+    """Held 0.5 m aside (+x), a cable leaves its eyelet further from the vertical than any did at the start."""
+    scene = _short(name, 0.05)
+    start = np.asarray(scene.trajectory.pose(0.0), dtype=float)
+    aside = start + 0.5 * np.eye(len(start))[0]
+
+    def steepest(pose):  # the largest angle [rad] of a cable from the downward vertical at its exit
+        offsets = scene.space.anchor_points(pose, np.asarray(scene.platform.anchors)) - scene.exit_points
+        return float(np.max(np.arccos(-offsets[:, -1] / np.linalg.norm(offsets, axis=-1))))
+
+    assert steepest(aside) > steepest(start)
+    max_angle = 0.5 * (steepest(start) + steepest(aside))  # the start within the guides, the pose aside not
+    runs = _over_eyelets(scene, max_angle)
+    refused = _over_eyelets(scene, max_angle, {"kind": "hold", "pose": aside.tolist()})
+    calls: list[float] = []
+    with pytest.raises(UnreachableError, match=r"cannot be reached over exits\[\d\].*more than its max_angle"):
+        cdpr_exu.simulate(refused, progress=lambda t, wall: calls.append(t))
+    assert calls == []  # refused before a step
+    assert cdpr_exu.simulate(runs).status == "completed"  # the same eyelets along the shipped reference

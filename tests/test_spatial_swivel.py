@@ -25,13 +25,13 @@ def without_bending(scene, n_elements=None):
 
 def test_the_swivel_scene_loads_and_round_trips_through_toml(tmp_path):
     scene = load_scene(NAME)
-    assert all(isinstance(e, Swivel) and e.radius == 0.1 for e in scene.exits) and scene.swivel_exits == scene.exits
-    assert scene.exit_points[0].tolist() == list(scene.exits[0].inlet) and scene.pulley_radii.tolist() == [0.1] * 4
+    assert all(isinstance(e, Swivel) and e.radius == 0.1 for e in scene.exits) and all(e.wraps for e in scene.exits)
+    assert scene.exit_points[0].tolist() == list(scene.exits[0].inlet) and [e.radius for e in scene.exits] == [0.1] * 4
     again = load_scene(save_scene(scene, tmp_path / "scene.toml"))
     assert again == scene
     # a point-exit scene: point exits written and read, no swivels
     plain = load_scene("spatial-four-cable")
-    assert not any(plain.swivel_exits) and all(e["kind"] == "point" for e in plain.to_dict()["exits"])
+    assert not any(e.wraps for e in plain.exits) and all(e["kind"] == "point" for e in plain.to_dict()["exits"])
     assert load_scene(save_scene(plain, tmp_path / "plain.toml")) == plain
 
 
@@ -130,7 +130,7 @@ def pushed_swivel_robot():
     scene = replace(scene, effects=replace(scene.effects, bending_damping=False))
     mbs = exu.SystemContainer().AddSystem()
     items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
-                                scene_chain_spec(scene, tension_only=False), swivels=scene.swivel_exits)
+                                scene_chain_spec(scene, tension_only=False), exits=scene.exits)
     mbs.Assemble()
     settle(mbs, items)
     for chain in items.chains:  # axial damping off: nothing dissipates but the integrator
@@ -219,7 +219,7 @@ def test_a_swivel_robot_starts_on_its_chain_statics_and_the_dynamic_settle_is_th
     def built():
         mbs = exu.SystemContainer().AddSystem()
         items = build_spatial_robot(mbs, catenary_platform(scene), scene.unstrained_lengths,
-                                    scene_chain_spec(scene, tension_only=False), swivels=scene.swivel_exits)
+                                    scene_chain_spec(scene, tension_only=False), exits=scene.exits)
         mbs.Assemble()
         return mbs, items
 

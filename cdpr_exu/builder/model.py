@@ -302,8 +302,7 @@ def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems
         bx, bz = scene.platform.anchors[i]
         anchor_marker = mbs.AddMarker(_eii.MarkerBodyRigid(bodyNumber=platform.body, localPosition=[bx, bz, 0.0]))
         exit_ = scene.exits[i]
-        side = getattr(exit_, "side", -1)  # a point exit has no side: its sheave has no radius
-        rope = add_rope(mbs, rope_cable, exit_.point, radius, side, anchor_marker,
+        rope = add_rope(mbs, rope_cable, exit_.point, radius, exit_.side, anchor_marker,
                         hang - np.array([0.0, segment]), ground_coordinate, scene.effects)
         drive = mbs.AddObject(_eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
                                                             offset=0.0))

@@ -38,7 +38,7 @@ Platform
 
 Swivel pulleys
 --------------
-A cable whose exit is a swivel pulley (``swivels[i]``, a
+A cable whose exit is a swivel pulley (``exits[i]``, a
 :class:`cdpr_exu.exits.swivel.Swivel`) is a fixed-length chain that starts at
 its winch end, held on the pulley's vertical axis ``winch_line`` below the inlet, runs
 up the axis, wraps over the disc and hangs to the anchor: its elements keep their
@@ -75,13 +75,14 @@ from exudyn.rigidBodyUtilities import RigidBodyInertia
 
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import non_negative, positive, shown
+from cdpr_exu.exits import PointExit
 
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # the disc and its angle psi
 from cdpr_exu.statics.statics import (PlatformEquilibrium, SuspendedPlatform, catenary_platform, chain_element_mass,
                                       checked_unstrained_lengths, node_masses_along, solve_statics)
-from cdpr_exu.statics.chain_statics import swivel_chain_start, winch_line_elements
+from cdpr_exu.statics.chain_statics import chain_over
 
 
 @dataclass(frozen=True)
@@ -194,11 +195,11 @@ class SpatialRobotItems:
     initial : PlatformEquilibrium
         The catenary equilibrium the robot was started on.
     swivels : list of (SwivelItems or None)
-        Each cable's swivel pulley in Exudyn (None: a point exit).
+        Each cable's swivel pulley in Exudyn (None: the cable leaves from its exit's point).
     swivel_pulleys : list of (SwivelPulley or None)
         Their physics (:class:`cdpr_exu.physics.swivel_pulley.SwivelPulley`).
     winch_elements : ndarray of int, shape (n_cables,)
-        Elements of each chain below the inlet (0 for a point exit): node
+        Elements of each chain below the inlet (0 where nothing wraps): node
         ``winch_elements[i]`` started at the inlet.
     """
 
@@ -220,30 +221,16 @@ class SpatialRobotItems:
     winch_elements: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     bending_dampings: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
-    def has_swivel(self, cable):
-        """True when ``cable`` leaves over a swivel pulley."""
-        return bool(self.swivels) and self.swivels[cable] is not None
-
     @property
     def is_point_mass(self):
         return self.platform.is_point_mass
 
 
-def _chain_positions(equilibrium_cable, length, n_elements):
-    """Straight unstrained reference (exit first) and the catenary's node positions, shape (n + 1, 3) each."""
-    exit_point = equilibrium_cable.exit_point
-    towards = equilibrium_cable.anchor_point - exit_point
-    direction = towards / max(float(np.linalg.norm(towards)), 1e-300)
-    arc_from_exit = np.linspace(0.0, length, n_elements + 1)
-    reference = exit_point + np.outer(arc_from_exit, direction)
-    current = equilibrium_cable.points(length - arc_from_exit)
-    current[0] = exit_point  # the catenary ends there to round-off; the held node must sit exactly on it
-    return reference, current
 
 
 
 
-def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None, swivels=None):
+def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None, exits=None):
     """Add the robot to ``mbs``: chains, platform, spherical joints, gravity.
 
     Parameters
@@ -257,10 +244,11 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     initial : PlatformEquilibrium, optional
         Start configuration: platform pose and cable shapes; default the catenary
         statics of these lengths (:func:`solve_statics`).
-    swivels : sequence of (Swivel or None), optional
-        Each cable's swivel pulley (its contact, swivel inertia and bearing, winch line;
-        see the module notes), None for a point exit; the platform's cable must then
-        have the same ``pulley_radius`` and its ``exit_point`` at the inlet.
+    exits : sequence of Exit, optional
+        Each cable's exit (:mod:`cdpr_exu.exits`; default: each leaves from its platform cable's
+        exit point). Where the cable wraps over it (a swivel pulley: its contact, swivel inertia
+        and bearing, winch line; see the module notes) the platform's cable must have the same
+        ``pulley_radius`` and its ``exit_point`` at the exit's point.
 
     Returns
     -------
@@ -289,13 +277,12 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         raise SceneError(f"initial must be a PlatformEquilibrium of this platform's {len(platform.cables)} cables, "
                          f"got {shown(initial)}")
 
-    swivels = [None] * len(platform.cables) if swivels is None else list(swivels)
-    if len(swivels) != len(platform.cables):
-        raise SceneError(f"swivels must give one entry (or None) per cable ({len(platform.cables)}), got {len(swivels)}")
-    for i, (cable, swivel) in enumerate(zip(platform.cables, swivels)):
-        radius = 0.0 if swivel is None else swivel.radius
-        if cable.pulley_radius != radius or (swivel is not None and tuple(swivel.inlet) != cable.point):
-            raise SceneError(f"swivels[{i}] does not match cables[{i}] of the platform (pulley_radius "
+    exits = [PointExit(cable.point) for cable in platform.cables] if exits is None else list(exits)
+    if len(exits) != len(platform.cables):
+        raise SceneError(f"exits must give one exit per cable ({len(platform.cables)}), got {len(exits)}")
+    for i, (cable, exit_) in enumerate(zip(platform.cables, exits)):
+        if cable.pulley_radius != exit_.radius or tuple(exit_.point) != tuple(cable.point):
+            raise SceneError(f"exits[{i}] does not match cables[{i}] of the platform (pulley_radius "
                              f"{shown(cable.pulley_radius)} m, exit point {cable.point})")
 
     n = chain.n_elements
@@ -306,28 +293,20 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
     bending_dampings = chain.bending_damping_constant / element_lengths
 
     chains, node_masses, swivel_items, swivel_pulleys, winch_elements = [], [], [], [], []
-    for cable, length, equilibrium_cable, k, c, k_theta, c_theta, swivel in zip(
+    for cable, length, equilibrium_cable, k, c, k_theta, c_theta, exit_ in zip(
             platform.cables, lengths, initial.cables, axial_stiffnesses, axial_dampings, bending_stiffnesses,
-            bending_dampings, swivels):
+            bending_dampings, exits):
         element_mass = chain_element_mass(cable, length, n, gravity)
-        below = 0 if swivel is None else winch_line_elements(swivel.winch_line, length / n)
+        below, reference, current, pulley = chain_over(exit_, equilibrium_cable, length, n)
         masses = node_masses_along(n + below, element_mass, chain.mass_lumping)
-        if swivel is None:
-            reference, current = _chain_positions(equilibrium_cable, length, n)
-        else:
-            reference, current = swivel_chain_start(equilibrium_cable, length, n, below, swivel.contact_stiffness)
         items = add_spatial_chain(mbs, reference, masses, float(k), float(c), float(k_theta), gravity=gravity,
                                   hold_first=True, tension_only=chain.tension_only, bending_damping=float(c_theta))
         for node, displacement in zip(items.nodes, current - reference):
             mbs.SetNodeParameter(node, "initialCoordinates", [float(x) for x in displacement])
-        if swivel is None:
-            swivel_items.append(None)
-            swivel_pulleys.append(None)
-        else:
-            pulley = swivel.pulley()
-            anchor = equilibrium_cable.anchor_point - np.asarray(swivel.inlet)
-            swivel_items.append(add_swivel_pulley(mbs, items, pulley, psi=float(np.arctan2(anchor[1], anchor[0]))))
-            swivel_pulleys.append(pulley)
+        swivel_pulleys.append(pulley)
+        anchor = equilibrium_cable.anchor_point - np.asarray(exit_.point)
+        swivel_items.append(None if pulley is None else  # the disc the cable wraps over, at its anchor's azimuth
+                            add_swivel_pulley(mbs, items, pulley, psi=float(np.arctan2(anchor[1], anchor[0]))))
         chains.append(items)
         node_masses.append(masses)
         winch_elements.append(below)
@@ -529,6 +508,6 @@ def build_model_3d(scene, sparse_jacobian: bool | None = None) -> Model3D:  # no
     start = solve_statics(platform, lengths)
     container = exu.SystemContainer()
     mbs = container.AddSystem()
-    items = build_spatial_robot(mbs, platform, lengths, scene_chain_spec(scene), initial=start, swivels=scene.swivel_exits)
+    items = build_spatial_robot(mbs, platform, lengths, scene_chain_spec(scene), initial=start, exits=scene.exits)
     mbs.Assemble()
     return Model3D(scene, container, mbs, items, lengths)

@@ -57,6 +57,9 @@ class Exit:
 
     point: tuple
     radius: float
+    #: The side a planar cable hangs from its exit's winch line, -1 (left) or 1 (right): a pulley's own; a
+    #: kind that does not wrap hangs on the left, as the planar point exits always did.
+    side = -1
 
     @property
     def dimension(self) -> int:

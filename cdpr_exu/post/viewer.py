@@ -292,7 +292,7 @@ def thin_polyline(points: np.ndarray, min_segment: float) -> np.ndarray:
 def scene_extent(scene: Scene) -> float:
     """Size of the robot: the larger side of the box around pulleys and start pose [m]."""
     centers = np.vstack([scene.exit_points, [scene.platform.initial_pose[:2]]])
-    radius = max(scene.pulley_radii)
+    radius = max(exit_.radius for exit_ in scene.exits)
     return float(np.max(np.ptp(centers, axis=0)) + 2.0 * radius) or 1.0
 
 

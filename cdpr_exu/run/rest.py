@@ -321,7 +321,7 @@ def bending_text(scene: Scene, catenary, what: str) -> str:
     stiffness = cable.youngs_modulus * cable.second_moment
     tension = float(np.max(catenary.tensions_at_anchor))
     length = math.sqrt(stiffness / tension) if tension > 0.0 else math.inf
-    radii = scene.pulley_radii[scene.pulley_radii > 0.0]
+    radii = np.array([exit_.radius for exit_ in scene.exits if exit_.wraps])
     scale, name = ((float(radii.min()), "the pulleys' radius") if radii.size
                    else (float(scene.unstrained_lengths.min()), "the shortest cable"))
     return (f"{what} is the cables' bending: E J = {stiffness:.3g} N m^2 (cables[0].youngs_modulus = "
@@ -753,8 +753,8 @@ def _solve_from_catenaries(scene: Scene, **relaxation) -> Rest:
     rigid = not platform.is_point_mass
     chain = scene_chain_spec(scene, anchor_spring_factor=PENALTY if rigid else None, tension_only=False)
     mbs = exu.SystemContainer().AddSystem()
-    swivels = any(scene.swivel_exits)
-    items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary, swivels=scene.swivel_exits)
+    swivels = any(exit_.wraps for exit_ in scene.exits)
+    items = build_spatial_robot(mbs, platform, lengths, chain, initial=catenary, exits=scene.exits)
     mbs.Assemble()
     if swivels:
         start_at_rest(mbs, items)  # Exudyn's static solver does not converge from the catenary start over a swivel pulley

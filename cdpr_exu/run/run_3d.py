@@ -64,8 +64,9 @@ class _SpatialWinches:
         """
         mbs, items = self.mbs, self.items
         self.rate = np.array(rates, dtype=float)
-        for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
-            if items.has_swivel(i):  # the winch end moves along the swivel axis: up when paying out
+        for i, (cable, exit_, chain, length, rate) in enumerate(zip(self.scene.cables, self.scene.exits, items.chains,
+                                                                    lengths, rates)):
+            if exit_.wraps:  # the winch end moves along the swivel axis: up when paying out
                 if length != self.applied[i]:
                     mbs.SetObjectParameter(chain.holds[2], "offset", float(length - items.unstrained_lengths[i]))
                     self.applied[i] = length
@@ -142,11 +143,11 @@ def _warn_outside_measured_region(scene: Scene) -> None:
     """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
     outside the region where runs over a swivel pulley were measured to keep their energy."""
     solver = scene.solver
-    for swivel, cable in zip(scene.swivel_exits, scene.cables):
-        if swivel is None:
+    for exit_, cable in zip(scene.exits, scene.cables):
+        if not exit_.wraps:
             continue
         for concern in stability_concerns(solver.newton == "modified", solver.spectral_radius, solver.newton_tolerance,
-                                          cable.element_length, swivel.radius):
+                                          cable.element_length, exit_.radius):
             warnings.warn(concern, SwivelStabilityWarning, stacklevel=4)  # simulate()'s caller
         return
 
@@ -177,7 +178,7 @@ class Run3D:
     def __init__(self, scene: Scene, model: Model3D):
         self.scene, self.model = scene, model
         mbs, items = model.mbs, model.items
-        if any(scene.swivel_exits):
+        if any(exit_.wraps for exit_ in scene.exits):
             _warn_outside_measured_region(scene)
             try:
                 start_at_rest(mbs, items)  # the chain statics' equilibrium (the dynamic settle only if they fail)
@@ -245,7 +246,7 @@ class Run3D:
         self.record(0.0)
         self.next = 1
         mbs, items = self.model.mbs, self.model.items
-        self.stop_reason = (_rest_above_exits(self.scene, mbs, items) if any(self.scene.swivel_exits) else None) \
+        self.stop_reason = (_rest_above_exits(self.scene, mbs, items) if any(exit_.wraps for exit_ in self.scene.exits) else None) \
             or self.monitor.problem(0.0, *platform_pose(mbs, items))
         self.start = _time.perf_counter()
 

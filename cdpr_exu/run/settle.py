@@ -148,8 +148,7 @@ def chain_statics_robot(mbs, items) -> ChainRobot:
             element_length=float(items.unstrained_lengths[i]) / chain.n_elements,
             axial_stiffness=float(items.axial_stiffnesses[i]), bending_stiffness=float(items.bending_stiffnesses[i]),
             slack=chain.tension_only, anchor=cable.anchor,
-            pulley=items.swivel_pulleys[i] if items.has_swivel(i) else None,
-            winch_elements=int(items.winch_elements[i]) if items.has_swivel(i) else 0))
+            pulley=items.swivel_pulleys[i], winch_elements=int(items.winch_elements[i])))
     return ChainRobot(tuple(cables), platform.mass, platform.gravity, chain.anchor_spring_factor)
 
 

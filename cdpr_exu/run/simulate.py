@@ -72,7 +72,7 @@ class _Monitor:
                                     for i in lumped]) if lumped else np.zeros(0)
         if self.check_pulleys and lumped:
             self.centers = scene.exit_points[lumped][self.element_cable]
-            self.radii = scene.pulley_radii[lumped][self.element_cable]
+            self.radii = np.array([exit_.radius for exit_ in scene.exits])[lumped][self.element_cable]
         self.platform_index = indices["platform"]
         self.reference_pose = reference[self.platform_index]
         # No pose of a platform hung on these cables lies farther from every pulley

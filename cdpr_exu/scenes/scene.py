@@ -902,12 +902,6 @@ class Scene:
         return np.array([exit_.point for exit_ in self.exits], dtype=float)
 
     @property
-    def pulley_radii(self) -> np.ndarray:
-        """Each exit's radius [m], 0 where the cable leaves from a point, shape (m,) (the ideal kinematics'
-        ``pulley_radii``)."""
-        return np.array([exit_.radius for exit_ in self.exits], dtype=float)
-
-    @property
     def exit_tops(self) -> np.ndarray:
         """Height [m] of the highest point each cable can leave its exit from, shape (m,)
         (:attr:`cdpr_exu.exits.base.Exit.top`)."""
@@ -951,15 +945,6 @@ class Scene:
     def with_changes(self, **changes: Any) -> "Scene":
         """A copy with top-level fields replaced (validated again)."""
         return replace(self, **changes)
-
-    # Transitional: the spatial twins' helpers, until their consumers are one (issue 24) ---------
-    @property
-    def swivel_exits(self) -> tuple:
-        """Each cable's exit where the cable wraps over it (a swivel pulley in space), else None, shape (m,).
-
-        Transitional: removed when the spatial builder, rest and run take the exits (issue 24, slice 9).
-        """
-        return tuple(exit_ if exit_.wraps else None for exit_ in self.exits)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (TOML-ready) of the scene: the planar form for a planar scene whose exits are

@@ -294,18 +294,16 @@ def _spatial_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
     effects = scene.effects
     platform = catenary_platform(scene)  # what the builder builds from: weights, EA, gravity
     gravity = platform.gravity
-    swivels = scene.swivel_exits
-    if catenary is None and any(s is not None for s in swivels):
+    if catenary is None and any(exit_.wraps for exit_ in scene.exits):
         catenary = solve_statics(platform, scene.unstrained_lengths)
     cables = []
-    for i, (spec, cable, swivel) in enumerate(zip(scene.cables, platform.cables, swivels)):
+    for i, (spec, cable, exit_) in enumerate(zip(scene.cables, platform.cables, scene.exits)):
         n, length = spec.n_elements, spec.unstrained_length
         l0 = length / n
-        below, held, pulley = 0, cable.exit_point, None
-        if swivel is not None:
-            below = winch_line_elements(swivel.winch_line, l0)
-            held = swivel_chain_start(catenary.cables[i], length, n, below, swivel.contact_stiffness)[1][0]
-            pulley = swivel.pulley()
+        below, held, pulley = 0, cable.exit_point, None  # held at the exit's point (no catenary needed)
+        if exit_.wraps:  # held below it, on its winch line
+            below, _, start, pulley = chain_over(exit_, catenary.cables[i], length, n)
+            held = start[0]
         # the builder's lumping (:func:`cdpr_exu.builder.robot_3d.build_spatial_robot`), to the last bit
         masses = (node_masses_along(n + below, chain_element_mass(cable, length, n, gravity), spec.mass_lumping)
                   if gravity > 0 else np.zeros(n + below + 1))
@@ -375,6 +373,27 @@ class ChainEquilibrium:
     def tensions_at_anchor(self) -> np.ndarray:
         """Norm of each cable's force on the platform, shape (m,) [N]."""
         return np.linalg.norm(self.forces_on_platform, axis=1)
+
+
+def chain_over(exit_: Exit, equilibrium_cable, length: float, n_elements: int):
+    """How a spatial chain of ``n_elements`` from ``exit_`` to its anchor starts, as the builder builds it and
+    the chain statics hold it: the elements below the exit (its winch line), the straight unstrained reference
+    and the catenary's node positions (the held winch end first, shape (k + n + 1, 3) each [m]), and the
+    physics of the disc the cable wraps over (:class:`~cdpr_exu.physics.swivel_pulley.SwivelPulley`; None
+    where it leaves from the exit's point, held there). An exit that wraps gives its ``winch_line`` [m],
+    ``contact_stiffness`` [N/m] and ``pulley()`` (:class:`~cdpr_exu.exits.swivel.Swivel`)."""
+    if exit_.wraps:
+        below = winch_line_elements(exit_.winch_line, length / n_elements)
+        return (below, *swivel_chain_start(equilibrium_cable, length, n_elements, below, exit_.contact_stiffness),
+                exit_.pulley())
+    exit_point = equilibrium_cable.exit_point
+    towards = equilibrium_cable.anchor_point - exit_point
+    direction = towards / max(float(np.linalg.norm(towards)), 1e-300)
+    arc_from_exit = np.linspace(0.0, length, n_elements + 1)
+    reference = exit_point + np.outer(arc_from_exit, direction)
+    current = equilibrium_cable.points(length - arc_from_exit)
+    current[0] = exit_point  # the catenary ends there to round-off; the held node must sit exactly on it
+    return 0, reference, current, None
 
 
 def winch_line_elements(winch_line: float, element_length: float) -> int:
