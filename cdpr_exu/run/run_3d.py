@@ -62,7 +62,8 @@ class _SpatialWinches:
         out without stretching is not damped (without the offset the paper's damping
         constant on a CoGiRo cable paid out at 0.25 m/s pulls with 740 N).
         """
-        mbs, items = self.mbs, self.items
+        mbs, items, gravity = self.mbs, self.items, self.gravity
+        set_object, set_load = mbs.SetObjectParameter, mbs.SetLoadParameter
         self.rate = np.array(rates, dtype=float)
         for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
             if items.has_swivel(i):  # the winch end moves along the swivel axis: up when paying out
@@ -73,7 +74,7 @@ class _SpatialWinches:
             if chain.tension_only:  # the arrays the cable's numba kernels read
                 chain.axial_rest_rate[:] = float(rate) / self.n
             for spring in chain.springs:
-                mbs.SetObjectParameter(spring, "velocityOffset", float(rate) / self.n)
+                set_object(spring, "velocityOffset", float(rate) / self.n)
             if length == self.applied[i]:
                 continue
             element = float(length) / self.n
@@ -84,14 +85,13 @@ class _SpatialWinches:
                 chain.axial_stiffness[:] = stiffness
                 chain.axial_damping[:] = damping
             for spring in chain.springs:
-                mbs.SetObjectParameter(spring, "referenceLength", element)
-                mbs.SetObjectParameter(spring, "stiffness", stiffness)
-                mbs.SetObjectParameter(spring, "damping", damping)
-            masses = items.node_masses[i] * (float(length) / items.unstrained_lengths[i])  # rho l_e per node
-            for body, load, mass in zip(chain.masses, chain.loads or [None] * len(masses), masses):
-                mbs.SetObjectParameter(body, "mass", float(mass))
-                if load is not None:
-                    mbs.SetLoadParameter(load, "loadVector", [0.0, 0.0, -float(mass) * self.gravity])
+                set_object(spring, "referenceLength", element)
+                set_object(spring, "stiffness", stiffness)
+                set_object(spring, "damping", damping)
+            # rho l_e per node, as plain floats at once (Exudyn's setters take no arrays: one call per item)
+            masses = (items.node_masses[i] * (float(length) / items.unstrained_lengths[i])).tolist()
+            for body, mass in zip(chain.masses, masses):
+                set_object(body, "mass", mass)
             if chain.bending_stiffness is not None:
                 chain.bending_stiffness[:] = items.bending_stiffnesses[i] * items.unstrained_lengths[i] / self.n / element
             if chain.bending_damping is not None:
