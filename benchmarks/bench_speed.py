@@ -28,7 +28,7 @@ import sys
 from pathlib import Path
 
 PLANAR = [("paper-circle", n, 1e-2) for n in (30, 60, 120)] + [("paper-circle", None, None)]
-SPATIAL = [("spatial-cogiro", None, None), ("spatial-ipanema", None, None), ("spatial-four-cable", None, None),
+SPATIAL = [("spatial-cogiro", None, None), ("spatial-ipanema", None, None), ("spatial-cogiro-mismatch", None, None),
            ("spatial-four-cable-swivel", None, None)]
 
 
