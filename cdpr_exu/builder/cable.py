@@ -309,9 +309,9 @@ def _slack_blocks(elements, rest, axial_k, axial_c, kink, cut):
 def _state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
     """The displacements q and velocities q_t [m, m/s] of the ``ObjectGenericODE2`` ``item``, read from the
     system's state vectors (``systemData``): the numbers Exudyn hands its user functions as lists (the
-    current state), without converting the lists (x1.2-1.3 of a paper-circle run, issue 25). ``where``
-    keeps the object's place in those vectors (a slice where it is one block), found at the first call,
-    once the system is assembled."""
+    current state), without converting the lists (x1.09 of the CPU time of a paper-circle run at 60
+    elements and 1e-2 s, issue 25). ``where`` keeps the object's place in those vectors (a slice where
+    it is one block), found at the first call, once the system is assembled."""
     data = mbs.systemData
     if not where:
         index = np.asarray(data.GetObjectLTGODE2(item), dtype=np.int64)

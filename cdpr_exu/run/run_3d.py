@@ -47,7 +47,6 @@ class _SpatialWinches:
     def __init__(self, mbs, scene: Scene, items, lengths: np.ndarray):
         self.mbs, self.scene, self.items = mbs, scene, items
         self.n = scene.cables[0].n_elements
-        self.gravity = scene.gravity if (scene.effects.gravity and scene.effects.cable_mass) else 0.0
         self.applied = np.array(lengths, dtype=float)
         self.rate = np.zeros(len(self.applied))  # the winches' rate [m/s]: the last command's, as planar runs
 
@@ -62,8 +61,8 @@ class _SpatialWinches:
         out without stretching is not damped (without the offset the paper's damping
         constant on a CoGiRo cable paid out at 0.25 m/s pulls with 740 N).
         """
-        mbs, items, gravity = self.mbs, self.items, self.gravity
-        set_object, set_load = mbs.SetObjectParameter, mbs.SetLoadParameter
+        mbs, items = self.mbs, self.items
+        set_object = mbs.SetObjectParameter
         self.rate = np.array(rates, dtype=float)
         for i, (cable, chain, length, rate) in enumerate(zip(self.scene.cables, items.chains, lengths, rates)):
             if items.has_swivel(i):  # the winch end moves along the swivel axis: up when paying out
@@ -88,7 +87,8 @@ class _SpatialWinches:
                 set_object(spring, "referenceLength", element)
                 set_object(spring, "stiffness", stiffness)
                 set_object(spring, "damping", damping)
-            # rho l_e per node, as plain floats at once (Exudyn's setters take no arrays: one call per item)
+            # rho l_e per node, as plain floats at once (Exudyn's setters take no arrays: one call per item);
+            # each node's weight follows its mass (a LoadMassProportional, builder.chain_3d)
             masses = (items.node_masses[i] * (float(length) / items.unstrained_lengths[i])).tolist()
             for body, mass in zip(chain.masses, masses):
                 set_object(body, "mass", mass)
