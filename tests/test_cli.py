@@ -27,6 +27,8 @@ def test_run_writes_result_summary_solution_and_figures(tmp_path):
         assert key in summary, key
     timing = json.loads((out / "timing.json").read_text())  # what changes from run to run lives apart
     assert {"wall_time_s", "real_time_factor", "date"} <= set(timing) <= set(TIMING_KEYS) and timing["wall_time_s"] > 0
+    # issue 25: the solve's CPU time beside its wall time, printed too (the speed checks read it)
+    assert timing["cpu_time_s"] > 0 and "cpu_time_s" not in summary and "simulated / wall / CPU" in done.stdout
     assert summary["simulated_time_s"] == pytest.approx(0.3)
     assert summary["error_convention"] == "actual - reference"
     for name in ("result.npz", "pose.csv", "solution.sol", "scene.toml", "overview.png", "snapshots.png",

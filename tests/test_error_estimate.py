@@ -99,7 +99,9 @@ def test_cli_run_reports_the_estimate_in_strict_json(tmp_path):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["error_estimate"]["companion_n_elements"] == 30
     assert summary["error_estimate"]["max_position_error_m"] > 0
-    assert "companion_wall_time_s" in json.loads((tmp_path / "timing.json").read_text())
+    timing = json.loads((tmp_path / "timing.json").read_text())
+    assert timing["companion_wall_time_s"] > 0 and timing["companion_cpu_time_s"] > 0  # the companion's, apart
+    assert "companion_cpu_time_s" not in summary and "companion_cpu_time_s" not in summary["error_estimate"]
 
 
 def test_cli_tolerance_prints_the_choice_and_bad_values_exit_2(tmp_path):

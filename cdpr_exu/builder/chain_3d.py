@@ -130,9 +130,10 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         node = mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point)))
         masses.append(mbs.AddObject(eii.ObjectMassPoint(mass=float(mass), nodeNumber=node)))
         marker = mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node))
-        if gravity:
-            loads.append(mbs.AddLoad(eii.LoadForceVector(markerNumber=marker,
-                                                         loadVector=[0.0, 0.0, -float(mass) * gravity])))
+        if gravity:  # the node's weight follows its mass as a winch pays the cable out (run_3d)
+            loads.append(mbs.AddLoad(eii.LoadMassProportional(
+                markerNumber=mbs.AddMarker(eii.MarkerBodyMass(bodyNumber=masses[-1])),
+                loadVector=[0.0, 0.0, -gravity])))
         nodes.append(node)
         markers.append(marker)
     for i in range(0 if tension_only else len(nodes) - 1):

@@ -384,11 +384,11 @@ def anchor_forces(mbs, items):
                      for joint in items.joints])
 
 
-def element_forces(mbs, items, cable, current=True, positions=None):
+def element_forces(mbs, items, cable, current=True, positions=None, velocities=None):
     """Axial force of each element of one cable [N], shape (n,), exit first (tension > 0).
 
-    ``positions`` (n + 1, 3) [m]: the cable's node positions when the caller has read them
-    already (:func:`chain_positions` of the same configuration), else read here.
+    ``positions`` (n + 1, 3) [m] and ``velocities`` (n + 1, 3) [m/s]: the cable's node positions and
+    velocities when the caller has read them already (of the same configuration), else read here.
 
     As the model computes it: Exudyn's spring-damper k (l - l0) + c (dl/dt - dl0/dt) with
     the parameters the connectors hold now (``velocityOffset`` = dl0/dt while a winch pays
@@ -399,8 +399,8 @@ def element_forces(mbs, items, cable, current=True, positions=None):
     chain = items.chains[cable]
     configuration = _configuration(current)
     positions = (chain_positions(mbs, items, cable, current) if positions is None else np.asarray(positions)).ravel()
-    v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
-                        for node in chain.nodes])
+    v = (np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
+                         for node in chain.nodes]) if velocities is None else np.asarray(velocities).ravel())
     if chain.tension_only:
         return axial_3d.tension_only_tensions(positions, v, chain.axial_elements, chain.axial_rest_length,
                                               chain.axial_stiffness, chain.axial_damping, chain.axial_rest_rate,

@@ -91,7 +91,8 @@ def _print_summary(summary: dict, settled: dict, space: Space, out: Path | None)
         ("min tension per cable", " / ".join(_figure(v, 1, "N") for v in summary["min_tension_per_cable_N"]), ""),
         ("slack time per cable", " / ".join(_figure(v, 1, "s") for v in summary["slack_time_per_cable_s"]), ""),
         ("max pulley penetration", _figure(summary["max_pulley_penetration_m"], 1000, "mm", 3), ""),
-        ("simulated / wall time", f"{summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s",
+        ("simulated / wall / CPU", f"{summary['simulated_time_s']:.2f} s / {summary['wall_time_s']:.2f} s / "
+                                    f"{summary['cpu_time_s']:.2f} s",
          "n/a" if factor is None else f"{factor:.1f}x real time"),
         ("steps / Newton iterations", f"{summary['steps']} / {summary['newton_iterations']}", ""),
     ]

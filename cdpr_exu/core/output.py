@@ -22,7 +22,7 @@ from cdpr_exu.core.errors import OutputError
 
 #: Keys of a summary that change from run to run on the same machine (wall clock).
 TIMING_KEYS: tuple[str, ...] = ("wall_time_s", "real_time_factor", "date", "cpu_time_s",
-                                "companion_wall_time_s")
+                                "companion_wall_time_s", "companion_cpu_time_s")
 
 
 def strict(value: Any) -> Any:

@@ -68,6 +68,8 @@ class Result:
         Deepest node penetration into each cable's pulley (0 if none); None where the exits
         have no contact to penetrate (spatial runs).
     wall_time : float [s]
+    cpu_time : float [s]
+        Process CPU time of the solve (the same span as ``wall_time``).
     steps : int
         Time steps completed.
     newton_iterations : int
@@ -94,6 +96,7 @@ class Result:
     node_velocities: list[np.ndarray] | None = None
     pulley_penetration: np.ndarray | None = None
     wall_time: float = 0.0
+    cpu_time: float = 0.0
     steps: int = 0
     newton_iterations: int = 0
     status: str = "completed"
@@ -194,6 +197,7 @@ class Result:
             **safety,
             "max_pulley_penetration_m": None if self.pulley_penetration is None else _nan_max(self.pulley_penetration),
             "wall_time_s": self.wall_time,
+            "cpu_time_s": self.cpu_time,
             "simulated_time_s": self.simulated_time,
             "real_time_factor": self.simulated_time / self.wall_time if self.wall_time > 0 else None,
             "steps": int(self.steps),
@@ -260,7 +264,9 @@ class Result:
             info = json.loads(str(data["info"]))
             timing = path.parent / "timing.json"
             if "wall_time" not in info and timing.is_file():
-                info["wall_time"] = json.loads(timing.read_text()).get("wall_time_s") or 0.0
+                times = json.loads(timing.read_text())
+                info["wall_time"] = times.get("wall_time_s") or 0.0
+                info["cpu_time"] = times.get("cpu_time_s") or 0.0
             m = sum(1 for k in data.files if k.startswith("nodes_"))
 
             def optional(name):
@@ -274,7 +280,7 @@ class Result:
                 node_velocities=([data[f"node_velocities_{i}"] for i in range(m)]
                                  if "node_velocities_0" in data.files else None),
                 pulley_penetration=optional("pulley_penetration"),
-                wall_time=info.get("wall_time", 0.0), steps=info["steps"],
+                wall_time=info.get("wall_time", 0.0), cpu_time=info.get("cpu_time", 0.0), steps=info["steps"],
                 newton_iterations=info["newton_iterations"], status=info["status"],
                 failure_time=info["failure_time"], metadata=info.get("metadata", {}),
                 winch_reservoir=optional("winch_reservoir"),

@@ -71,7 +71,8 @@ class ErrorEstimate:
     after_s : float [s]
     note : str
         How the estimate was made, or why there is none.
-    companion_wall_time_s : float [s]
+    companion_wall_time_s, companion_cpu_time_s : float [s]
+        Wall and process CPU time of the companion run (its simulate() call).
     """
 
     max_position_error_m: float | None
@@ -80,11 +81,12 @@ class ErrorEstimate:
     after_s: float
     note: str
     companion_wall_time_s: float = 0.0
+    companion_cpu_time_s: float = 0.0
 
     def to_dict(self) -> dict:
         return {"max_position_error_m": self.max_position_error_m, "companion_n_elements": self.companion_n_elements,
                 "order": self.order, "after_s": self.after_s, "note": self.note,
-                "companion_wall_time_s": self.companion_wall_time_s}
+                "companion_wall_time_s": self.companion_wall_time_s, "companion_cpu_time_s": self.companion_cpu_time_s}
 
 
 def richardson_factor(ratio: float, order: float = ORDER) -> float:
@@ -159,14 +161,14 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     n_companion = companion_elements(scene)
     companion_scene = _with_elements(scene, n_companion)
     controller = (controller_factory or IdealIKController)()
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     try:
         companion = simulate(companion_scene, controller)
     except RunInterrupted:  # Ctrl-C is the user's, not a failed companion
         raise
     except (SolverFailure, CdprError) as err:
         return _not_applicable(f"the companion run at {n_companion} elements did not complete: {str(err)[:200]}")
-    wall = time.perf_counter() - start
+    wall, cpu = time.perf_counter() - start, time.process_time() - cpu_start
     if companion.time[-1] < result.time[-1] - 1e-9:
         return _not_applicable("the companion run ended before this run")
     difference = path_distance(result, companion, after)
@@ -175,7 +177,7 @@ def estimate_error(scene, result, controller_factory: Callable | None = None, af
     note = (f"Richardson from a companion run at {n_companion} elements per cable (this run: {n}), the error "
             f"assumed of order {ORDER:g} in the number of elements: {richardson_factor(ratio):.3g} times the "
             f"largest distance between the two paths after {after} s ({1000 * difference:.3g} mm)")
-    return ErrorEstimate(estimate, n_companion, ORDER, after, note, wall)
+    return ErrorEstimate(estimate, n_companion, ORDER, after, note, wall, cpu)
 
 
 def estimate_line(estimate: ErrorEstimate) -> str:
@@ -186,11 +188,12 @@ def estimate_line(estimate: ErrorEstimate) -> str:
 
 def summary_entry(estimate: ErrorEstimate) -> dict:
     """The strict-JSON entries of ``summary.json`` for an estimate: ``error_estimate`` and, when a
-    companion run was made, its wall time (which :func:`cdpr_exu.core.output.write_summary` puts
+    companion run was made, its wall and CPU times (which :func:`cdpr_exu.core.output.write_summary` puts
     into ``timing.json``)."""
-    data = {"error_estimate": {k: v for k, v in estimate.to_dict().items() if k != "companion_wall_time_s"}}
+    timing = ("companion_wall_time_s", "companion_cpu_time_s")
+    data = {"error_estimate": {k: v for k, v in estimate.to_dict().items() if k not in timing}}
     if estimate.companion_n_elements is not None:
-        data["companion_wall_time_s"] = estimate.companion_wall_time_s
+        data.update({k: getattr(estimate, k) for k in timing})
     return data
 
 

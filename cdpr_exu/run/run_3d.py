@@ -28,7 +28,7 @@ import exudyn as exu
 import numpy as np
 
 from controllers.base import Controller, Measurement
-from cdpr_exu.builder.robot_3d import Model3D, chain_positions, element_forces, platform_pose
+from cdpr_exu.builder.robot_3d import Model3D, element_forces, platform_pose
 from cdpr_exu.core.errors import SolverFailure
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
@@ -47,7 +47,6 @@ class _SpatialWinches:
     def __init__(self, mbs, scene: Scene, items, lengths: np.ndarray):
         self.mbs, self.scene, self.items = mbs, scene, items
         self.n = scene.cables[0].n_elements
-        self.gravity = scene.gravity if (scene.effects.gravity and scene.effects.cable_mass) else 0.0
         self.applied = np.array(lengths, dtype=float)
         self.rate = np.zeros(len(self.applied))  # the winches' rate [m/s]: the last command's, as planar runs
 
@@ -63,6 +62,7 @@ class _SpatialWinches:
         constant on a CoGiRo cable paid out at 0.25 m/s pulls with 740 N).
         """
         mbs, items = self.mbs, self.items
+        set_object = mbs.SetObjectParameter
         self.rate = np.array(rates, dtype=float)
         for i, (cable, exit_, chain, length, rate) in enumerate(zip(self.scene.cables, self.scene.exits, items.chains,
                                                                     lengths, rates)):
@@ -74,7 +74,7 @@ class _SpatialWinches:
             if chain.tension_only:  # the arrays the cable's numba kernels read
                 chain.axial_rest_rate[:] = float(rate) / self.n
             for spring in chain.springs:
-                mbs.SetObjectParameter(spring, "velocityOffset", float(rate) / self.n)
+                set_object(spring, "velocityOffset", float(rate) / self.n)
             if length == self.applied[i]:
                 continue
             element = float(length) / self.n
@@ -85,14 +85,14 @@ class _SpatialWinches:
                 chain.axial_stiffness[:] = stiffness
                 chain.axial_damping[:] = damping
             for spring in chain.springs:
-                mbs.SetObjectParameter(spring, "referenceLength", element)
-                mbs.SetObjectParameter(spring, "stiffness", stiffness)
-                mbs.SetObjectParameter(spring, "damping", damping)
-            masses = items.node_masses[i] * (float(length) / items.unstrained_lengths[i])  # rho l_e per node
-            for body, load, mass in zip(chain.masses, chain.loads or [None] * len(masses), masses):
-                mbs.SetObjectParameter(body, "mass", float(mass))
-                if load is not None:
-                    mbs.SetLoadParameter(load, "loadVector", [0.0, 0.0, -float(mass) * self.gravity])
+                set_object(spring, "referenceLength", element)
+                set_object(spring, "stiffness", stiffness)
+                set_object(spring, "damping", damping)
+            # rho l_e per node, as plain floats at once (Exudyn's setters take no arrays: one call per item);
+            # each node's weight follows its mass (a LoadMassProportional, builder.chain_3d)
+            masses = (items.node_masses[i] * (float(length) / items.unstrained_lengths[i])).tolist()
+            for body, mass in zip(chain.masses, masses):
+                set_object(body, "mass", mass)
             if chain.bending_stiffness is not None:
                 chain.bending_stiffness[:] = items.bending_stiffnesses[i] * items.unstrained_lengths[i] / self.n / element
             if chain.bending_damping is not None:
@@ -192,6 +192,9 @@ class Run3D:
         m = scene.n_cables
         self.times, self.poses, self.paid, self.nodes, self.tensions = [], [], [], [[] for _ in range(m)], \
             [[] for _ in range(m)]
+        # each cable's node coordinates in the system's state vectors: a sample reads those vectors once
+        self.coordinates = [np.concatenate([np.arange(3) + mbs.GetNodeODE2Index(node) for node in chain.nodes])
+                            for chain in items.chains]
         self.kinematic = scene.winch.kind == "kinematic"
         self.next, self.step_start, self.reached_time = 0, 0.0, 0.0
         self.stop_reason: str | None = None
@@ -229,15 +232,19 @@ class Run3D:
                            state_time=self.step_start)
 
     def record(self, t: float) -> None:
+        """Store the state now: the platform's pose, the paid-out lengths, each cable's nodes and element
+        forces (the state vectors read once, not node by node: 336 Exudyn calls per sample on CoGiRo)."""
         mbs, items = self.model.mbs, self.model.items
         position, rotation = platform_pose(mbs, items)
         self.times.append(t)
         self.poses.append(np.concatenate([position, rotation_vector(rotation)]))
         self.paid.append(self.winches.applied.copy())
-        for i in range(self.scene.n_cables):
-            positions = chain_positions(mbs, items, i)
+        q, v = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
+        for i, (chain, index) in enumerate(zip(items.chains, self.coordinates)):
+            positions = (chain.reference + q[index]).reshape(-1, 3)
             self.nodes[i].append(positions)
-            self.tensions[i].append(element_forces(mbs, items, i, positions=positions))  # spring and damper
+            self.tensions[i].append(element_forces(mbs, items, i, positions=positions,
+                                                   velocities=v[index]))  # spring and damper
 
     def begin(self, controller: Controller, report) -> None:
         """Record the start; a start no run can come back from (over swivel pulleys, a rest held up by the
