@@ -130,8 +130,8 @@ def tension_only_energy(positions, elements, rest_length, stiffness):
 def tension_only_triplet_values(positions, velocities, elements, rest_length, stiffness, damping, rest_rate,
                                 factor_position, factor_velocity, out_values, cut_slopes=False):
     """``factor_position * K + factor_velocity * D`` (K = -df/dq, D = -df/dv) at
-    :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places; overwrites ``out_values`` (36 E,). With ``cut_slopes``
-    a damper-cut element keeps its taut slopes (:func:`cdpr_exu.physics.axial.newton_slopes`)."""
+    :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places; overwrites ``out_values`` (36 E,).
+    With ``cut_slopes`` a damper-cut element keeps its taut slopes (:func:`cdpr_exu.physics.axial.newton_slopes`)."""
     out_values[:] = 0.0
     u = np.empty(3)
     dv = np.empty(3)

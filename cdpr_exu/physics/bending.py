@@ -197,8 +197,8 @@ def bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
 @njit(cache=True)
 def bending_triplet_values(positions, velocities, joints, stiffness, damping, factor_position, factor_velocity,
                            out_values):
-    """Values of ``factor_position * K + factor_velocity * D`` at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s
-    places (overwrites ``out_values``, shape (36 J,)): the same numbers the dense kernel adds, in
+    """Values of ``factor_position * K + factor_velocity * D`` at
+    :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places (overwrites ``out_values``, shape (36 J,)): the same numbers the dense kernel adds, in
     36-entry blocks per joint, so the Jacobian costs O(J) instead of O(N^2)."""
     grad = np.empty(6)
     hess = np.empty((6, 6))

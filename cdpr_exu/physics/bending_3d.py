@@ -139,7 +139,8 @@ def spatial_bending_energy(positions, joints, stiffness):
 
 @njit(cache=True)
 def spatial_bending_stiffness(positions, joints, stiffness, factor, out_values):
-    """``factor * K`` (K = -df/dq [N/m]) at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places (overwrites ``out_values``)."""
+    """``factor * K`` (K = -df/dq [N/m]) at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places
+    (overwrites ``out_values``)."""
     grad = np.empty(9)
     hess = np.empty((9, 9))
     for j in range(joints.shape[0]):

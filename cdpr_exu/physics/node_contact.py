@@ -115,8 +115,8 @@ def _node_block(positions, velocities, node, cx, cy, radius, stiffness, damping,
 @njit(cache=True)
 def node_contact_triplet_values(positions, velocities, nodes, centers, radii, stiffness, damping, band,
                                 factor_position, factor_velocity, out_values):
-    """Values of ``factor_position * K + factor_velocity * D`` at :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s
-    places (overwrites ``out_values``, shape (4 C,))."""
+    """Values of ``factor_position * K + factor_velocity * D`` at
+    :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places (overwrites ``out_values``, shape (4 C,))."""
     out_values[:] = 0.0
     block = np.empty((2, 2))
     for k in range(nodes.shape[0]):

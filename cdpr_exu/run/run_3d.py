@@ -213,7 +213,8 @@ class Run3D:
         angular = (np.zeros(3) if items.is_point_mass else
                    np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.AngularVelocity)))
         theta = rotation_vector(rotation)
-        return np.concatenate([position, theta]), np.concatenate([velocity, self.scene.space.rotation_rate(theta, angular)])
+        rate = self.scene.space.rotation_rate(theta, angular)
+        return np.concatenate([position, theta]), np.concatenate([velocity, rate])
 
     def initial_pose(self) -> np.ndarray:
         """The pose the controller starts from: where the robot rests (x, y, z, rotation vector), shape (6,)."""
