@@ -142,8 +142,10 @@ class FilteredPositionPI:
                         f"below the required {loop_design.REQUIRED_MARGINS[0]:g} dB and "
                         f"{loop_design.REQUIRED_MARGINS[1]:g} deg")
                 if self.margin_check == "refuse":
-                    raise SceneError(f"{text}: lower the gains, or margin_check='feed_forward' runs the feed-forward alone")
-                warnings.warn(f"{text}: the run uses the feed-forward alone", loop_design.PoorMarginsWarning, stacklevel=2)
+                    raise SceneError(f"{text}: lower the gains, or margin_check='feed_forward' runs the feed-forward "
+                                     "alone")
+                warnings.warn(f"{text}: the run uses the feed-forward alone", loop_design.PoorMarginsWarning,
+                              stacklevel=2)
                 self.off = True
         size = self.error_size(scene)
         # (time, filtered error, its rate, integral of the filtered error): one entry per call.

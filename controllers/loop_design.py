@@ -437,7 +437,8 @@ def design_gains(cases, delay: float, frequency: float, gain_margin_db: float = 
 
 def worst(margins) -> Margins:
     """The worst of several :class:`Margins` (over poses): each margin's smallest, the peak's largest."""
-    return Margins(*(min(getattr(m, k) for m in margins) for k in ("gain_margin_db", "phase_margin_deg", "disk_margin")),
+    return Margins(*(min(getattr(m, k) for m in margins)
+                     for k in ("gain_margin_db", "phase_margin_deg", "disk_margin")),
                    max(m.sensitivity_peak for m in margins), min(m.min_damping for m in margins),
                    all(m.stable for m in margins))
 
