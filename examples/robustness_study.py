@@ -82,7 +82,8 @@ def margins_rows(cases, grid, gains: dict, rows, delay: float) -> list[dict]:
         label = "closed_loop_tension_aware" + ("" if name == "today" else f"_{name}")
         run = runs.get((*(point[e] for e in ERRORS), label), {})
         table.append({**{e: point[e] for e in ERRORS}, "gains": name, **asdict(chosen), **asdict(margins),
-                      "run": "completed" if run.get("completed") else f"failed at {run.get('failure_time_s', 0.0):.1f} s",
+                      "run": ("completed" if run.get("completed") else f"failed at {run.get('failure_time_s') or 0.0:.1f} s"
+                              if run else "not run"),
                       "max_position_error_m": run.get("max_position_error_m") if run.get("completed") else None,
                       "max_error_vs_ideal_ik": run.get("max_error_vs_ideal_ik")})
     return table
