@@ -12,6 +12,12 @@ to its anchor, and their moments), so that a length change U d moves the platfor
 
 e_f the filtered error and w(t) a quintic fade-in from 0 at t = 0 to 1 at ``start_time``.
 
+Before a run (``margin_check``), a loop whose robot :mod:`controllers.loop_design` models (planar, two
+cables, the position fed back) has its gain and phase margins computed on the controllers' model
+(:func:`~controllers.loop_design.check_loop`, about 6 s); below :data:`~controllers.loop_design.REQUIRED_MARGINS`
+(6 dB, 30 deg) it refuses the run, naming the gains and the margins, or runs without its correction (the
+feed-forward alone) and warns (:class:`~controllers.loop_design.PoorMarginsWarning`).
+
 Why the filter: with tension-only cables, an unfiltered loop (k_p = 2) passed the
 platform's jolts straight into the winch command (command accelerations up to
 1300 m/s^2 measured, against 5 m/s^2 open loop); a winch element that then went slack
@@ -33,6 +39,7 @@ feedback is left with the model's mismatch alone. Plain NumPy; no Exudyn.
 
 from __future__ import annotations
 
+import warnings
 from typing import Callable
 
 import numpy as np
@@ -42,7 +49,12 @@ from cdpr_exu.core.geometry import rotation_vector
 from cdpr_exu.core.validation import shown
 from cdpr_exu.statics.kinematics import length_jacobian
 
+from . import loop_design
 from .base import Measurement, WinchCommand, quintic_blend
+
+#: What a loop short of :data:`~controllers.loop_design.REQUIRED_MARGINS` does at ``reset``: "off", not checked;
+#: "refuse", a SceneError; "feed_forward", no correction in that run, and a warning.
+MARGIN_CHECKS = ("off", "refuse", "feed_forward")
 
 
 def _rotation_coordinates(matrix: np.ndarray) -> np.ndarray:
@@ -73,17 +85,22 @@ class FilteredPositionPI:
         step late; with the planar gains the IPAnema circle oscillated from 1 s and the run failed at 2 s
         (217 mm).
 
+    margin_check : {"off", "refuse", "feed_forward"}
+        What a loop short of the required margins does at ``reset`` (see above; :data:`MARGIN_CHECKS`). "off"
+        (no check) keeps today's runs: today's planar gains keep 28 deg on the paper's circle at t = 1 s.
+
     Raises
     ------
     SceneError
-        If an option is not finite or out of its range; the message names it.
+        If an option is not finite or out of its range; the message names it. At ``reset``, with
+        ``margin_check = "refuse"``, if the loop keeps less than the required margins on the scene.
     """
 
     #: Damping ratio of the second-order error filter (Butterworth).
     FILTER_DAMPING = np.sqrt(0.5)
 
     def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, cutoff: float = 5.0,
-                 start_time: float = 0.5, rotation: bool = False):
+                 start_time: float = 0.5, rotation: bool = False, margin_check: str = "off"):
         for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
             if not np.isfinite(value) or value < 0:
                 raise SceneError(f"{name} must be zero or positive, got {shown(value)}")
@@ -91,16 +108,45 @@ class FilteredPositionPI:
             raise SceneError(f"start_time must be zero or positive, got {shown(start_time)}")
         if not np.isfinite(cutoff) or cutoff <= 0:
             raise SceneError(f"cutoff must be positive [Hz], got {shown(cutoff)}")
+        if margin_check not in MARGIN_CHECKS:
+            raise SceneError(f"margin_check must be one of {MARGIN_CHECKS}, got {shown(margin_check)}")
         self.proportional_gain = float(proportional_gain)
         self.integral_gain = float(integral_gain)
         self.cutoff = float(cutoff)
         self.start_time = float(start_time)
         self.rotation = bool(rotation)
+        self.margin_check = margin_check
         self._scene = None
+        #: The worst margins over the run's poses found at the last ``reset`` (None: not checked).
+        self.margins = None
+        #: Whether the loop is off for this run (its margins fell short with ``margin_check = "feed_forward"``).
+        self.off = False
 
     def reset(self, scene) -> None:
-        """Start a run of ``scene`` with the filter and the integral at zero."""
-        self._scene = scene
+        """Start a run of ``scene`` with the filter and the integral at zero, its margins checked (``margin_check``).
+
+        Raises
+        ------
+        SceneError
+            With ``margin_check = "refuse"``, for a loop short of the required margins, naming its gains and margins.
+        """
+        self._scene, self.margins, self.off = scene, None, False
+        if self.margin_check != "off" and loop_design.models(scene) and not self._with_rotation(scene):
+            gains = loop_design.LoopGains(self.proportional_gain, self.integral_gain, self.cutoff)
+            self.margins = loop_design.check_loop(scene, gains)
+            if not loop_design.meets(self.margins):
+                m = self.margins
+                text = (f"the position loop (k_p {gains.proportional_gain:g}, k_i {gains.integral_gain:g} /s, f_c "
+                        f"{gains.cutoff:g} Hz) keeps a gain margin of {m.gain_margin_db:.1f} dB and a phase margin of "
+                        f"{m.phase_margin_deg:.1f} deg{'' if m.stable else ' (unstable)'} on scene {scene.name!r}, "
+                        f"below the required {loop_design.REQUIRED_MARGINS[0]:g} dB and "
+                        f"{loop_design.REQUIRED_MARGINS[1]:g} deg")
+                if self.margin_check == "refuse":
+                    raise SceneError(f"{text}: lower the gains, or margin_check='feed_forward' runs the feed-forward "
+                                     "alone")
+                warnings.warn(f"{text}: the run uses the feed-forward alone", loop_design.PoorMarginsWarning,
+                              stacklevel=2)
+                self.off = True
         size = self.error_size(scene)
         # (time, filtered error, its rate, integral of the filtered error): one entry per call.
         self._history = [(0.0, np.zeros(size), np.zeros(size), np.zeros(size))]
@@ -190,6 +236,8 @@ class FilteredPositionPI:
             raise RuntimeError(f"{type(self).__name__}.reset(scene) must be called first")
         if measurement.platform_pose is None:
             raise SceneError("the position feedback needs the measured platform pose")
+        if self.off:
+            return np.zeros(self._scene.n_cables)
         measured_at = measurement.time if measurement.state_time is None else measurement.state_time
         if target is None:
             goal = self.target(measured_at)

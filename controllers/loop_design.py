@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.errors import CdprWarning, SceneError
 from cdpr_exu.core.validation import shown
 
 #: Step of the central differences, relative to the shortest element [-].
@@ -52,6 +52,17 @@ MARGIN_FREQUENCIES = np.logspace(-2, np.log10(2000.0), 633)
 
 #: Damping ratio of the error filter (Butterworth), as FilteredPositionPI's.
 FILTER_DAMPING = float(np.sqrt(0.5))
+
+#: The margins a loop must keep on its model before a run (issue 27) [dB, deg]: below them
+#: :class:`~controllers.feedback.FilteredPositionPI` refuses the run or runs its feed-forward alone.
+REQUIRED_MARGINS = (6.0, 30.0)
+
+#: Reference poses a loop is checked at before a run, evenly over the run (about 1.5 s each).
+CHECK_POSES = 4
+
+
+class PoorMarginsWarning(CdprWarning):
+    """A position loop keeps less than :data:`REQUIRED_MARGINS` on its model: the run goes on without it."""
 
 
 # --------------------------------------------------------------------------- adapters
@@ -117,6 +128,11 @@ class LinearRobot:
         return ct.ss(A, B, C, 0.0)
 
 
+def models(scene) -> bool:
+    """Whether :func:`linearise` models ``scene``'s robot: planar, with two cables."""
+    return scene.dimension == 2 and scene.n_cables == 2
+
+
 def linearise(scene, pose, acceleration=None) -> LinearRobot:
     """Linearise a planar scene's robot about the equilibrium that holds its centre at ``pose``.
 
@@ -138,7 +154,7 @@ def linearise(scene, pose, acceleration=None) -> LinearRobot:
     """
     from cdpr_exu.statics.chain_statics import chain_forces
 
-    if scene.dimension != 2 or scene.n_cables != 2:
+    if not models(scene):
         raise SceneError(f"the loop design handles planar two-cable robots, got dimension {scene.dimension} "
                          f"with {scene.n_cables} cables")
     pose = np.asarray(pose, dtype=float)
@@ -368,7 +384,8 @@ def loop_cases(model, plants, times, omega=MARGIN_FREQUENCIES) -> list[tuple]:
     return cases
 
 
-def design_gains(cases, delay: float, frequency: float, gain_margin_db: float = 6.0, phase_margin_deg: float = 30.0,
+def design_gains(cases, delay: float, frequency: float, gain_margin_db: float = REQUIRED_MARGINS[0],
+                 phase_margin_deg: float = REQUIRED_MARGINS[1],
                  candidates=None, omega=MARGIN_FREQUENCIES) -> tuple[LoopGains, float]:
     """The gains that meet the margins on every case and track best at ``frequency``.
 
@@ -416,3 +433,34 @@ def design_gains(cases, delay: float, frequency: float, gain_margin_db: float = 
                for _, _, robot, jacobian, response in cases):
             return gains, worst
     raise SceneError(f"no candidate gains meet {gain_margin_db} dB and {phase_margin_deg} deg on every case")
+
+
+def worst(margins) -> Margins:
+    """The worst of several :class:`Margins` (over poses): each margin's smallest, the peak's largest."""
+    return Margins(*(min(getattr(m, k) for m in margins)
+                     for k in ("gain_margin_db", "phase_margin_deg", "disk_margin")),
+                   max(m.sensitivity_peak for m in margins), min(m.min_damping for m in margins),
+                   all(m.stable for m in margins))
+
+
+def check_loop(scene, gains: LoopGains, poses: int = CHECK_POSES) -> Margins:
+    """The worst margins of ``gains``' loop on ``scene``'s robot at ``poses`` reference poses evenly over its run.
+
+    The loop acts one solver step late; each pose is linearised with its reference acceleration's load.
+    About 1.5 s per pose on the paper's robot.
+
+    Raises
+    ------
+    SceneError
+        For a robot :func:`linearise` does not model.
+    """
+    end = scene.solver.end_time
+    times = end * (np.arange(poses) + 0.5) / poses
+    cases = loop_cases(scene, [scene], times)
+    return worst([loop_margins(robot, jacobian, gains, scene.solver.step_size, response=response)
+                  for _, _, robot, jacobian, response in cases])
+
+
+def meets(margins: Margins, required=REQUIRED_MARGINS) -> bool:
+    """Whether ``margins`` are stable with at least the ``required`` (gain [dB], phase [deg]) margins."""
+    return margins.stable and margins.gain_margin_db >= required[0] and margins.phase_margin_deg >= required[1]

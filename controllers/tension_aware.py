@@ -394,6 +394,9 @@ class ClosedLoopTensionAwareController(TensionAwareController):
         Cut-off frequency of the error filter (> 0).
     rotation : bool
         Feed the rotation error back too (:class:`~controllers.feedback.FilteredPositionPI`).
+    margin_check : {"off", "refuse", "feed_forward"}
+        A loop short of the required margins on the scene, before the run
+        (:class:`~controllers.feedback.FilteredPositionPI`): not checked, refused, or the feed-forward alone.
     dynamic, table_period, ...
         As :class:`TensionAwareController`.
     """
@@ -404,9 +407,9 @@ class ClosedLoopTensionAwareController(TensionAwareController):
     FILTER_DAMPING = FilteredPositionPI.FILTER_DAMPING
 
     def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, start_time: float = 0.5,
-                 cutoff: float = 5.0, rotation: bool = False, **kwargs):
+                 cutoff: float = 5.0, rotation: bool = False, margin_check: str = "off", **kwargs):
         super().__init__(**kwargs)
-        self.feedback = FilteredPositionPI(proportional_gain, integral_gain, cutoff, start_time, rotation)
+        self.feedback = FilteredPositionPI(proportional_gain, integral_gain, cutoff, start_time, rotation, margin_check)
         self.name = "closed_loop_" + self.name
 
     def reset(self, scene, initial_paid_out) -> None:

@@ -2,13 +2,15 @@
 
 Issue 27. The controllers' model is the paper's robot (``paper-circle``, its circle started from rest over
 1 s as ``cdpr compare`` does); each plant is that model with its platform's mass (and inertia) and its cables'
-density off by -20, 0 or +20 % (:mod:`cdpr_exu.studies.robustness`). Three steps, one command:
+density off by -20, 0 or +20 % (3 x 3), and, one at a time at the nominal mass and density, its cables'
+Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr_exu.studies.robustness`):
+13 plants. Three steps, one command:
 
 1. The position loop of ``closed_loop_tension_aware`` linearised on every plant at 8 poses of one turn
    (:mod:`controllers.loop_design`), with today's gains (k_p = 2, k_i = 40 /s, f_c = 5 Hz), and gains chosen
    from those margins: >= 6 dB and >= 30 deg on every plant and pose, the smallest sensitivity at the
    circle's own frequency. ``margins.md`` and ``margins.json``: the worst margins over the poses per plant,
-   beside what the real run did.
+   beside what the real run did (docs/robustness.md reads them).
 2. Every controller on every plant (``robustness.md``, ``robustness.csv``, ``robustness.json``, a heat map
    per controller ``robustness_<controller>.png``), into ``results/robustness/planar/``.
 3. The spatial CoGiRo-class robot (``spatial-cogiro``) under the chain correction's three starts
@@ -18,8 +20,9 @@ density off by -20, 0 or +20 % (:mod:`cdpr_exu.studies.robustness`). Three steps
 Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
 this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after
 the first second. About 10 min of CPU time (ILC's 10 trials per plant are most of it); the spatial part
-about 8 min more. The model-based feed-forward (``model_feed_forward``, ``closed_loop_model_feed_forward``)
-runs as well with its kind (a name of :data:`controllers.registry.CONTROLLERS`) added to :data:`PLANAR`.
+about 8 min more; the 4 stiffness and exit plants add about 40 %. The model-based feed-forward
+(``model_feed_forward``, ``closed_loop_model_feed_forward``) runs as well with its kind (a name of
+:data:`controllers.registry.CONTROLLERS`) added to :data:`PLANAR`.
 
 Run::
 
@@ -37,7 +40,7 @@ import numpy as np
 from cdpr_exu.core.output import write_summary
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.studies.comparison import smooth_start
-from cdpr_exu.studies.robustness import ROBUSTNESS_FILES, error_grid, perturbed, run_robustness
+from cdpr_exu.studies.robustness import ERRORS, ROBUSTNESS_FILES, error_grid, perturbed, run_robustness
 from controllers import loop_design
 
 OUT = Path(__file__).resolve().parents[1] / "results" / "robustness"
@@ -59,35 +62,42 @@ SPATIAL = {f"tension_aware{'_chain' if statics == 'chain' else ''}_{start}": ("t
 #: Poses the loop is linearised at: 8 over one turn of the circle, after the 1 s ramp.
 POSES = 8
 
+#: The grid: mass x density, then stiffness and exit position one at a time
+#: (:data:`~cdpr_exu.studies.robustness.ERRORS`).
+GRID = [*error_grid(), *error_grid((0.0,), (0.0,), cable_stiffness=(-0.2, 0.2)),
+        *error_grid((0.0,), (0.0,), exit_offset=(-0.003, 0.003))]
+
+#: A plant's errors as the tables show them.
+LABELS = {"platform_mass": ("mass", "{:+.0%}"), "cable_density": ("density", "{:+.0%}"),
+          "cable_stiffness": ("stiffness", "{:+.0%}"), "exit_offset": ("exits [mm]", "{:+.0f}")}
+
 
 def margins_rows(cases, grid, gains: dict, rows, delay: float) -> list[dict]:
     """Per gains and plant: the worst margins over the poses, and what the real run did."""
-    runs = {(r["platform_mass"], r["cable_density"], r["controller"]): r for r in rows}
+    runs = {(*(r[e] for e in ERRORS), r["controller"]): r for r in rows}
     table = []
     for (name, chosen), (index, point) in ((g, p) for g in gains.items() for p in enumerate(grid)):
-        margins = [loop_design.loop_margins(robot, jacobian, chosen, delay, response=response)
-                   for i, _, robot, jacobian, response in cases if i == index]
+        margins = loop_design.worst([loop_design.loop_margins(robot, jacobian, chosen, delay, response=response)
+                                     for i, _, robot, jacobian, response in cases if i == index])
         label = "closed_loop_tension_aware" + ("" if name == "today" else f"_{name}")
-        run = runs.get((point["platform_mass"], point["cable_density"], label), {})
-        table.append({"platform_mass": point["platform_mass"], "cable_density": point["cable_density"],
-                      "gains": name, **asdict(chosen),
-                      **{key: min(getattr(m, key) for m in margins)
-                         for key in ("gain_margin_db", "phase_margin_deg", "disk_margin", "min_damping")},
-                      "sensitivity_peak": max(m.sensitivity_peak for m in margins),
-                      "stable": all(m.stable for m in margins),
-                      "run": "completed" if run.get("completed") else f"failed at {run.get('failure_time_s', 0.0):.1f} s",
+        run = runs.get((*(point[e] for e in ERRORS), label), {})
+        table.append({**{e: point[e] for e in ERRORS}, "gains": name, **asdict(chosen), **asdict(margins),
+                      "run": ("completed" if run.get("completed") else f"failed at {run.get('failure_time_s') or 0.0:.1f} s"
+                              if run else "not run"),
                       "max_position_error_m": run.get("max_position_error_m") if run.get("completed") else None,
                       "max_error_vs_ideal_ik": run.get("max_error_vs_ideal_ik")})
     return table
 
 
 def margins_markdown(table) -> str:
-    lines = ["| mass | density | gains (k_p, k_i [1/s], f_c [Hz]) | gain margin [dB] | phase margin [deg] | disk margin "
-             "| sensitivity peak | min pole damping | linear model | run | max error [mm] | vs ideal IK |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| " + " | ".join(label for label, _ in LABELS.values()) + " | gains (k_p, k_i [1/s], f_c [Hz]) | "
+             "gain margin [dB] | phase margin [deg] | disk margin | sensitivity peak | min pole damping | linear model "
+             "| run | max error [mm] | vs ideal IK |", "|---" * (len(LABELS) + 10) + "|"]
     for r in table:
         error, ratio = r["max_position_error_m"], r["max_error_vs_ideal_ik"]
-        lines.append(f"| {r['platform_mass']:+.0%} | {r['cable_density']:+.0%} | {r['gains']} ({r['proportional_gain']:g}, "
+        plant = " | ".join(form.format(r[e] * (1000.0 if e == "exit_offset" else 1.0))
+                           for e, (_, form) in LABELS.items())
+        lines.append(f"| {plant} | {r['gains']} ({r['proportional_gain']:g}, "
                      f"{r['integral_gain']:g}, {r['cutoff']:g}) | {r['gain_margin_db']:.1f} | {r['phase_margin_deg']:.1f} | "
                      f"{r['disk_margin']:.2f} | {r['sensitivity_peak']:.2f} | {r['min_damping']:.3f} | "
                      f"{'stable' if r['stable'] else 'UNSTABLE'} | {r['run']} | "
@@ -106,7 +116,7 @@ def main() -> None:
             (OUT / folder / ROBUSTNESS_FILES["rows"]).unlink(missing_ok=True)
 
     model = smooth_start(load_scene("paper-circle"))
-    grid, delay = error_grid(), model.solver.step_size
+    grid, delay = GRID, model.solver.step_size
     turn = 2 * np.pi / model.trajectory.angular_rate
     cases = loop_design.loop_cases(model, [perturbed(model, **point) for point in grid],
                                    1.0 + turn * np.arange(POSES) / POSES)

@@ -138,7 +138,7 @@ def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], 
 
 def plot_robustness(rows: Sequence[Mapping[str, Any]], out: str | Path) -> dict[str, Path]:
     """A heat map per controller of a robustness study (:mod:`cdpr_exu.studies.robustness`) over its
-    platform mass and cable density errors (at the nominal stiffness): the max position error and its ratio to
+    platform mass and cable density errors (at the nominal stiffness and exits): the max position error and its ratio to
     ideal IK's;
     ``robustness_<controller>.png``, returned by name."""
     axes = [SimpleNamespace(path=name, values=tuple(sorted({row[name] for row in rows})))  # as a study's Variation
@@ -147,7 +147,8 @@ def plot_robustness(rows: Sequence[Mapping[str, Any]], out: str | Path) -> dict[
                   ("max_error_vs_ideal_ik", 1.0, "ideal IK's max error / this one's"))
     written = {}
     for name in dict.fromkeys(row["controller"] for row in rows):
-        mine = [row for row in rows if row["controller"] == name and not row.get("cable_stiffness")]
+        mine = [row for row in rows if row["controller"] == name
+                and not (row.get("cable_stiffness") or row.get("exit_offset"))]
         written[f"robustness_{name}"] = _plot_heatmap(mine, axes, Path(out) / f"robustness_{name}.png", quantities,
                                                       f"{name} on plants off its model")
     return written

@@ -2,9 +2,9 @@
 
 The controllers' model is a scene's :meth:`~cdpr_exu.scenes.scene.Scene.controller_scene`; each
 plant of the grid is that model with relative errors on its platform's mass (and inertia, the
-same shape), its cables' linear density and their Young's modulus (:func:`perturbed`), and it
-carries the model back as its ``[controller_model]``, so that the controllers plan on the model
-and the run simulates the plant. Planar and spatial scenes alike: one run is
+same shape), its cables' linear density and their Young's modulus, and its pulleys moved apart by a few
+millimetres (:func:`perturbed`), and it carries the model back as its ``[controller_model]``, so that the
+controllers plan on the model and the run simulates the plant. Planar and spatial scenes alike: one run is
 :func:`cdpr_exu.run.simulate.simulate`.
 
 Each (grid point, controller) is one run on the process pool or Dask cluster of
@@ -37,35 +37,53 @@ from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, executor_for, prog
 ROBUSTNESS_FILES = {"rows": "rows.jsonl", "csv": "robustness.csv", "json": "robustness.json",
                     "table": "robustness.md", "scene": "base_scene.toml"}
 
-#: The model errors a grid point gives (relative, plant = model x (1 + error)).
-ERRORS = ("platform_mass", "cable_density", "cable_stiffness")
+#: The model errors a grid point gives: relative (plant = model x (1 + error)) but ``exit_offset`` [m], how far
+#: each pulley's centre lies further out (away from the pulleys' middle, horizontally) than the model's.
+ERRORS = ("platform_mass", "cable_density", "cable_stiffness", "exit_offset")
 
 #: The columns of a row, in order.
 COLUMNS = (*ERRORS, "controller", "status", "completed", "max_position_error_m", "rms_position_error_m",
            "max_error_vs_ideal_ik", "min_element_tension_N", "slack_time_s", "elements_pushed", "failure_time_s")
 
-def error_grid(platform_mass=(-0.2, 0.0, 0.2), cable_density=(-0.2, 0.0, 0.2), cable_stiffness=(0.0,)) -> list[dict]:
-    """Every combination of the relative errors, as ``{error: value}`` dicts (:data:`ERRORS`)."""
-    return [dict(zip(ERRORS, values)) for values in itertools.product(platform_mass, cable_density, cable_stiffness)]
+def error_grid(platform_mass=(-0.2, 0.0, 0.2), cable_density=(-0.2, 0.0, 0.2), cable_stiffness=(0.0,),
+               exit_offset=(0.0,)) -> list[dict]:
+    """Every combination of the errors, as ``{error: value}`` dicts (:data:`ERRORS`)."""
+    return [dict(zip(ERRORS, values))
+            for values in itertools.product(platform_mass, cable_density, cable_stiffness, exit_offset)]
 
 
-def perturbed(model, platform_mass: float = 0.0, cable_density: float = 0.0, cable_stiffness: float = 0.0):
+def perturbed(model, platform_mass: float = 0.0, cable_density: float = 0.0, cable_stiffness: float = 0.0,
+              exit_offset: float = 0.0):
     """The plant: ``model`` with relative errors on its platform's mass and inertia, its cables' linear
-    density and Young's modulus, carrying ``model``'s values as its controller model.
+    density and Young's modulus, and its pulleys' centres ``exit_offset`` [m] further out (horizontally, away
+    from their middle), carrying ``model``'s values as its controller model.
 
     Raises
     ------
     SceneError
-        For an error at or below -1 (naming it), or a plant that is no valid robot.
+        For a relative error at or below -1 or an offset that is not finite (naming it), an offset on exits
+        that are not pulleys (the controllers' model can move pulleys only), or a plant that is no valid robot.
     """
+    import math
     from dataclasses import replace
 
+    from cdpr_exu.exits import Pulley
     from cdpr_exu.scenes.scene import ControllerModel
 
     for name, value in (("platform_mass", platform_mass), ("cable_density", cable_density),
                         ("cable_stiffness", cable_stiffness)):
         if not isinstance(value, (int, float)) or not value > -1.0:
             raise SceneError(f"{name} must be a relative error above -1, got {value!r}")
+    if not isinstance(exit_offset, (int, float)) or not math.isfinite(exit_offset):
+        raise SceneError(f"exit_offset must be a finite distance [m], got {exit_offset!r}")
+    exits, pulleys = model.exits, ()
+    if exit_offset:
+        if not all(isinstance(e, Pulley) for e in exits):
+            raise SceneError(f"exit_offset moves pulleys; scene {model.name!r} has {[e.kind for e in exits]} exits")
+        middle = sum(e.center[0] for e in exits) / len(exits)
+        exits = tuple(replace(e, center=(e.center[0] + math.copysign(1.0, e.center[0] - middle) * exit_offset,
+                                         e.center[1])) for e in exits)
+        pulleys = tuple({"center": e.center} for e in model.exits)
     platform, scale = model.platform, 1.0 + platform_mass
     inertia = platform.inertia
     changes = {"mass": platform.mass * scale}
@@ -73,10 +91,10 @@ def perturbed(model, platform_mass: float = 0.0, cable_density: float = 0.0, cab
         changes["inertia"] = inertia * scale if isinstance(inertia, (int, float)) else tuple(v * scale for v in inertia)
     believed = ControllerModel(platform={"mass": platform.mass, **({} if inertia is None else {"inertia": inertia})},
                                cables=tuple({"linear_density": c.linear_density, "youngs_modulus": c.youngs_modulus}
-                                            for c in model.cables))
+                                            for c in model.cables), pulleys=pulleys)
     cables = tuple(replace(c, linear_density=c.linear_density * (1.0 + cable_density),
                            youngs_modulus=c.youngs_modulus * (1.0 + cable_stiffness)) for c in model.cables)
-    return replace(model, platform=replace(platform, **changes), cables=cables, controller_model=believed)
+    return replace(model, platform=replace(platform, **changes), cables=cables, exits=exits, controller_model=believed)
 
 
 def make_controller(kind: str, plant, options: Mapping[str, Any] | None = None, after: float = 1.0):
@@ -147,7 +165,7 @@ def read_rows(out) -> list[dict]:
 
 
 def _key(row: Mapping[str, Any]) -> tuple:
-    return (*(float(row[e]) for e in ERRORS), str(row["controller"]))
+    return (*(float(row.get(e, 0.0)) for e in ERRORS), str(row["controller"]))
 
 
 def run_robustness(scene, controllers: Mapping[str, tuple[str, dict]], grid: Sequence[Mapping[str, float]],
@@ -239,7 +257,9 @@ def write_robustness(out, rows: Sequence[Mapping[str, Any]], scene, after: float
         writer.writerows([csv_cell(row.get(c)) for c in COLUMNS] for row in rows)
     document = {"scene": scene.name, "errors_measured_after_s": after, "error_convention": "actual - reference",
                 "model_error": "plant = the controllers' model x (1 + error): platform mass and inertia, cable "
-                               "linear density, cable Young's modulus", "columns": list(COLUMNS),
+                               "linear density, cable Young's modulus; each pulley's centre exit_offset [m] "
+                               "further out",
+                "columns": list(COLUMNS),
                 "rows": [dict(r) for r in rows], **provenance()}
     paths["json"] = write_summary(out, document, name=ROBUSTNESS_FILES["json"])
     paths["table"].write_text(robustness_table(rows))
@@ -258,7 +278,7 @@ def robustness_table(rows: Sequence[Mapping[str, Any]]) -> str:
     for row in rows:
         groups.setdefault(str(row["controller"]), []).append(row)
     lines = ["| controller | completed | worst max error [mm] | worst RMS error [mm] | vs ideal IK (worst - best) | "
-             "lowest tension [N] | longest slack [s] | pushed | not completed at (mass, density, stiffness) |",
+             "lowest tension [N] | longest slack [s] | pushed | not completed at (mass, density, stiffness, exit [m]) |",
              "|---|---|---|---|---|---|---|---|---|"]
 
     def pick(group, key, how):
@@ -276,7 +296,7 @@ def robustness_table(rows: Sequence[Mapping[str, Any]]) -> str:
             value = pick(group, key, how)
             cells.append("" if value is None else f"{value:.2f}")
         cells.append(str(sum(bool(r.get("elements_pushed")) for r in group)))
-        cells.append("; ".join("(" + ", ".join(f"{r[e]:+g}" for e in ERRORS) + ")" for r in group
+        cells.append("; ".join("(" + ", ".join(f"{r.get(e, 0.0):+g}" for e in ERRORS) + ")" for r in group
                                if not r.get("completed")))
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
