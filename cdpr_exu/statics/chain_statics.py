@@ -47,7 +47,7 @@ from cdpr_exu.core.validation import finite, real_array, shown, vector
 from cdpr_exu.exits import Exit
 from cdpr_exu.physics import swivel_pulley as sp
 from cdpr_exu.statics.statics import catenary_platform, chain_element_mass, node_masses_along, solve_statics
-from cdpr_exu.space import space_of
+from cdpr_exu.space import PLANE, SPACE, space_of
 from cdpr_exu.statics.chain_kernels import PlanarChains, SpatialChains, planar_energy, planar_forces
 from cdpr_exu.statics.kinematics import initial_cable_nodes, straight_cable_nodes
 
@@ -261,7 +261,7 @@ def chain_robot(scene, anchor_spring_factor: float | None = None, tension_only: 
         raise SceneError("chain statics models the exact-angle bending only, "
                          f"got effects.bending_model = {shown(effects.bending_model)}")
     slack = bool(effects.slack if tension_only is None else tension_only)
-    return _SCENE_CABLES[scene.space.dimension](scene, slack, anchor_spring_factor, catenary)
+    return _METHODS[scene.space].cables(scene, slack, anchor_spring_factor, catenary)
 
 
 def _planar_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
@@ -313,10 +313,6 @@ def _spatial_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
             bending_stiffness=spec.youngs_modulus * spec.second_moment / l0 if effects.bending else 0.0,
             slack=slack, anchor=cable.anchor, pulley=pulley, winch_elements=below))
     return ChainRobot(tuple(cables), scene.platform.mass, gravity, anchor_spring_factor)
-
-
-#: Each dimension's cables from a scene, by the scene's Space.
-_SCENE_CABLES = {2: _planar_robot, 3: _spatial_robot}
 
 
 @dataclass(frozen=True, eq=False)
@@ -1395,7 +1391,7 @@ def solve_chain_statics(robot: ChainRobot, nodes, position, rotation=None, swive
     SceneError
         On malformed input, or a planar robot.
     """
-    return _FORWARD[robot.space.dimension](robot, nodes, position, rotation, swivel_angles, **kwargs)
+    return _METHODS[robot.space].forward(robot, nodes, position, rotation, swivel_angles, **kwargs)
 
 
 def chain_rest(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
@@ -1411,7 +1407,7 @@ def chain_rest(scene, anchor_spring_factor: float | None = None, tension_only: b
     SceneError
         For a planar scene (:func:`solve_chain_statics`).
     """
-    return _REST[scene.space.dimension](scene, anchor_spring_factor, tension_only, **kwargs)
+    return _METHODS[scene.space].rest(scene, anchor_spring_factor, tension_only, **kwargs)
 
 
 def _no_planar_forward(*args, **kwargs):
@@ -1434,7 +1430,7 @@ class InverseChainStatics:
         if not isinstance(robot, ChainRobot):
             raise SceneError(f"robot must be a ChainRobot, got {shown(robot)}")
         self.robot = robot
-        self._solve = _INVERSE[robot.space.dimension](robot)
+        self._solve = _METHODS[robot.space].inverse(robot)
 
     def solve(self, pose, tension_guess=None, *, guess: ChainEquilibrium | None = None, lengths=None, nodes=None,
               swivel_angles=None, free_rotation=None, external_wrench=None, tolerance: float | None = None,
@@ -1543,7 +1539,16 @@ def _spatial_inverse_solver(robot: ChainRobot):
     return solve
 
 
-#: Each dimension's kernels, by the robot's (the scene's) Space.
-_FORWARD = {2: _no_planar_forward, 3: _spatial_forward}
-_REST = {2: _no_planar_forward, 3: _spatial_rest}
-_INVERSE = {2: _planar_inverse_solver, 3: _spatial_inverse_solver}
+@dataclass(frozen=True)
+class _Methods:
+    """One dimension's chain statics: its cables from a scene, forward solve, rest and inverse solver."""
+
+    cables: object
+    forward: object
+    rest: object
+    inverse: object
+
+
+#: Each dimension's chain statics, by the robot's (the scene's) Space: the one place they are chosen.
+_METHODS = {PLANE: _Methods(_planar_robot, _no_planar_forward, _no_planar_forward, _planar_inverse_solver),
+            SPACE: _Methods(_spatial_robot, _spatial_forward, _spatial_rest, _spatial_inverse_solver)}
