@@ -20,19 +20,23 @@ from controllers.base import Measurement, WinchCommand
 
 
 class DirectIK:
-    """Ideal IK evaluated at each step: paid out = initial + l(ref(t)) - l(ref(0)) [m], rate dl/dt [m/s]."""
+    """Ideal IK evaluated at each step: paid out = initial + l(p(t)) - l(p(0)) [m], rate dl/dt [m/s], for a
+    motion ``p`` (``motion(t) -> (pose, rate)``; default the scene's reference)."""
 
     name = "direct_ik"
     uses_pose = False
     uses_tension = False
 
-    def reset(self, scene, initial_paid_out) -> None:
+    def __init__(self, motion=None):
+        self.motion = motion
+
+    def reset(self, scene, initial_paid_out, **kwargs) -> None:
         self.scene, self.initial = scene, np.asarray(initial_paid_out, dtype=float)
-        self.start = ideal_paid_out(scene, scene.trajectory.pose(np.zeros(1)))[0][0]
+        self.motion = self.motion or (lambda t: (scene.trajectory.pose(t), scene.trajectory.velocity(t)))
+        self.start = ideal_paid_out(scene, *self.motion(np.zeros(1)))[0][0]
 
     def command(self, measurement: Measurement) -> WinchCommand:
-        t = np.array([measurement.time])
-        lengths, rates = ideal_paid_out(self.scene, self.scene.trajectory.pose(t), self.scene.trajectory.velocity(t))
+        lengths, rates = ideal_paid_out(self.scene, *self.motion(np.array([measurement.time])))
         return WinchCommand(self.initial + lengths[0] - self.start, rates[0])
 
 
@@ -59,28 +63,21 @@ def _smooth(t, start, duration):
     return tau**3 * (10 - 15 * tau + 6 * tau**2), 30 * tau**2 * (1 - tau) ** 2 / duration
 
 
-class Watcher:
-    """Ideal IK of its own motion (``motion(t) -> (pose, rate)``, the scene's reference by default) that also
-    reads the measured pose: keeps (state time, pose, velocity) of every step."""
+class Watcher(DirectIK):
+    """:class:`DirectIK` that also reads the measured pose: keeps (state time, pose, velocity) of every step."""
 
     name = "watcher"
     uses_pose = True
-    uses_tension = False
-
-    def __init__(self, motion=None):
-        self.motion = motion
 
     def reset(self, scene, initial_paid_out, **kwargs) -> None:
-        self.scene, self.initial, self.seen = scene, np.asarray(initial_paid_out, dtype=float), []
-        self.motion = self.motion or (lambda t: (scene.trajectory.pose(t), scene.trajectory.velocity(t)))
-        self.start = ideal_paid_out(scene, *self.motion(np.zeros(1)))[0][0]
+        super().reset(scene, initial_paid_out)
+        self.seen = []
 
     def command(self, measurement: Measurement) -> WinchCommand:
         if measurement.state_time is not None:
             self.seen.append((measurement.state_time, measurement.platform_pose.copy(),
                               measurement.platform_velocity.copy()))
-        lengths, rates = ideal_paid_out(self.scene, *self.motion(np.array([measurement.time])))
-        return WinchCommand(self.initial + lengths[0] - self.start, rates[0])
+        return super().command(measurement)
 
 
 @pytest.mark.parametrize("name", ["paper-circle-slow", "spatial-cogiro"])
