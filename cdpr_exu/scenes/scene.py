@@ -38,7 +38,7 @@ from cdpr_exu.core.validation import entries, finite, from_table, non_negative, 
 from cdpr_exu.exits import EXIT_KINDS, Exit, PointExit, Pulley, exit_from_dict
 from cdpr_exu.scenes.contact_models import CONTACT_MODELS, PulleyContactModel
 from cdpr_exu.scenes.trajectories import HoldTrajectory, Trajectory, trajectory_from_dict
-from cdpr_exu.space import DIMENSIONS, PLANE, Space, space_of
+from cdpr_exu.space import DIMENSIONS, PLANE, SPACE, Space, space_of
 from cdpr_exu.statics.statics import catenary_platform
 
 # --------------------------------------------------------------------------- checks
@@ -240,9 +240,9 @@ class CableSpec:
 #: (Table 2: its moment of inertia J_MP, the start of its runs, the rectangle its figures draw). In
 #: space: a point mass has no inertia (a rigid platform must give its principal moments), a spatial
 #: robot starts at its rest (``cdpr static`` finds it; no initial pose is taken), and no rectangle.
-PLATFORM_DEFAULTS: dict[int, dict[str, Any]] = {
-    2: {"inertia": 0.0271, "point_mass_inertia": 0.0271, "initial_pose": (0.0, -2.0, 0.0), "size": (0.3, 0.2)},
-    3: {"inertia": None, "point_mass_inertia": (0.0, 0.0, 0.0), "initial_pose": None, "size": None},
+PLATFORM_DEFAULTS: dict[Space, dict[str, Any]] = {
+    PLANE: {"inertia": 0.0271, "point_mass_inertia": 0.0271, "initial_pose": (0.0, -2.0, 0.0), "size": (0.3, 0.2)},
+    SPACE: {"inertia": None, "point_mass_inertia": (0.0, 0.0, 0.0), "initial_pose": None, "size": None},
 }
 
 
@@ -289,7 +289,7 @@ class PlatformSpec:
                                     for i, a in enumerate(self.anchors)))
         rigid = space.is_rigid(self.is_point_mass)
         _set(self, "mass", (positive if rigid else non_negative)("platform.mass", self.mass, "kg"))
-        defaults = PLATFORM_DEFAULTS[space.dimension]
+        defaults = PLATFORM_DEFAULTS[space]
         inertia = self.inertia
         if inertia is None:
             inertia = defaults["point_mass_inertia" if self.is_point_mass else "inertia"]
@@ -801,7 +801,7 @@ class Scene:
             raise SceneError(f"description must be a string, got {shown(self.description)}")
         space = space_of(self.dimension)
         _set(self, "dimension", space.dimension)
-        rules = DIMENSION_RULES[space.dimension]
+        rules = DIMENSION_RULES[space]
         for name, kind in (("cables", CableSpec), ("exits", Exit)):
             parts = getattr(self, name)
             if isinstance(parts, (str, bytes, Mapping)) or not hasattr(parts, "__iter__"):
@@ -1039,8 +1039,9 @@ class DimensionRules:
     """What a scene of one dimension takes where the two dimensions still differ: what its builder
     builds (``check`` refuses the rest, naming the field), the platform fields a scene file must give
     (besides a rigid platform's inertia) and whether it must give ``[trajectory]`` (a spatial scene
-    without one has a static mode only). Transitional: one builder (issue 24, slice 9) removes these
-    differences.
+    without one has a static mode only). They are the two item families' own limits
+    (:mod:`cdpr_exu.builder.model`, :mod:`cdpr_exu.builder.robot_3d`), checked here so that a scene
+    is refused before anything is built.
     """
 
     check: Callable[[Scene], None]
@@ -1048,10 +1049,10 @@ class DimensionRules:
     trajectory_required: bool
 
 
-#: The rules of each dimension (:class:`DimensionRules`), by dimension.
-DIMENSION_RULES: dict[int, DimensionRules] = {
-    2: DimensionRules(_planar_rules, ("mass", "anchors", "initial_pose"), trajectory_required=True),
-    3: DimensionRules(_spatial_rules, ("mass", "anchors"), trajectory_required=False),
+#: The rules of each dimension (:class:`DimensionRules`), by the scene's Space.
+DIMENSION_RULES: dict[Space, DimensionRules] = {
+    PLANE: DimensionRules(_planar_rules, ("mass", "anchors", "initial_pose"), trajectory_required=True),
+    SPACE: DimensionRules(_spatial_rules, ("mass", "anchors"), trajectory_required=False),
 }
 
 
@@ -1140,7 +1141,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
         raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
     data = dict(data)
     space = space_of(data.get("dimension", 2))
-    rules = DIMENSION_RULES[space.dimension]
+    rules = DIMENSION_RULES[space]
     planar_form = space is PLANE and "exits" not in data
     known = PLANAR_FORM_FIELDS if planar_form else EXITS_FORM_FIELDS
     unknown = set(data) - known
@@ -1211,7 +1212,7 @@ def _exits_form_exits(data: Mapping[str, Any], space: Space) -> tuple[tuple[Exit
     required = {"cables": "[[cables]] (one per cable, at least its unstrained_length)",
                 "exits": "[[exits]] (one per cable, each with its kind and its fields)",
                 "platform": "[platform] (its mass and anchors)"}
-    if DIMENSION_RULES[space.dimension].trajectory_required:
+    if DIMENSION_RULES[space].trajectory_required:
         required["trajectory"] = REQUIRED_TABLES["trajectory"]
     return exits, missing, required
 

@@ -57,7 +57,7 @@ from cdpr_exu.core.errors import CoarseOutputWarning, SceneError
 from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
-from cdpr_exu.space import PLANE, Space
+from cdpr_exu.space import PLANE, SPACE, Space
 from cdpr_exu.scenes.trajectories import HoldTrajectory
 from cdpr_exu.studies.study import apply_parameters, executor_for, progress_bar, recorded_run
 
@@ -271,8 +271,8 @@ SPATIAL_QUICK_GRID = AccuracyGrid(
 )
 
 
-#: The default grids (quick, full) of each dimension.
-GRIDS = {2: (QUICK_GRID, FULL_GRID), 3: (SPATIAL_QUICK_GRID, SPATIAL_FULL_GRID)}
+#: The default grids (quick, full) of each dimension, by the scene's Space.
+GRIDS = {PLANE: (QUICK_GRID, FULL_GRID), SPACE: (SPATIAL_QUICK_GRID, SPATIAL_FULL_GRID)}
 
 
 def grid_for(scene, quick: bool = False) -> AccuracyGrid:
@@ -284,7 +284,7 @@ def grid_for(scene, quick: bool = False) -> AccuracyGrid:
     that brings its coarsest cable to the fewest elements its exit takes
     (:func:`fewest_elements`), e.g. 4, 8 and 16 to 48, 96 and 192.
     """
-    grid = GRIDS[scene.dimension][0 if quick else 1]
+    grid = GRIDS[scene.space][0 if quick else 1]
     factor = math.ceil(fewest_elements(scene) / min(grid.n_elements))
     if factor <= 1:
         return grid
