@@ -10,12 +10,8 @@ import numpy as np
 
 from cdpr_exu.physics.bending import (
     BendingSpringDamper,
-    bending_force,
-    bending_force_and_jacobian,
     bending_force_kernel,
-    bending_jacobian,
     bending_jacobian_kernel,
-    bending_jacobian_weighted,
     cable_joints,
 )
 
@@ -121,38 +117,30 @@ def main():
     out, out_k, out_d = np.empty(n), np.empty((n, n)), np.empty((n, n))
 
     # agreement before timing (same formulas, different summation order: round-off only)
-    force_numba, k_numba, d_numba = bending_force_and_jacobian(*args)
+    springs = BendingSpringDamper(n // 2, joints, stiffness, damping)
+    force_numba, k_numba, d_numba = springs.force_and_jacobian(positions, velocities)
     k_numpy, d_numpy = numpy_jacobian(*args)
     assert np.allclose(force_numba, numpy_force(*args), rtol=1e-12, atol=1e-12)
     assert np.allclose(k_numba, k_numpy, rtol=1e-12, atol=1e-10)
     assert np.allclose(d_numba, d_numpy, rtol=1e-12, atol=1e-12)
 
     empty_vector = np.empty(0)
-    springs = BendingSpringDamper(n // 2, joints, stiffness, damping)
     timings = {
         "force, NumPy reference": lambda: numpy_force(*args),
-        "force, numba wrapper (out=)": lambda: bending_force(*args, out=out),
         "force, BendingSpringDamper.force": lambda: springs.force(positions, velocities),
         "force, numba kernel": lambda: bending_force_kernel(*args, out),
         "jacobian K, D, NumPy reference": lambda: numpy_jacobian(*args),
-        "jacobian K, D, numba wrapper (out=)": lambda: bending_jacobian(*args, out_k=out_k, out_d=out_d),
         "jacobian K, D, BendingSpringDamper": lambda: springs.jacobian(positions, velocities),
-        "jacobian fK+fD, BendingSpringDamper": lambda: springs.jacobian_weighted(positions, velocities, 1.0, 0.01),
         "force+K+D, BendingSpringDamper": lambda: springs.force_and_jacobian(positions, velocities),
         "jacobian K, D, numba kernel": lambda: bending_jacobian_kernel(
             *args, 1.0, 0.0, empty_vector, out_k, out_d),
-        "jacobian fK+fD, numba wrapper (out=)": lambda: bending_jacobian_weighted(*args, 1.0, 0.01, out=out_k),
-        "force+K+D, numba wrapper (out=)": lambda: bending_force_and_jacobian(
-            *args, out_force=out, out_k=out_k, out_d=out_d),
     }
     results = {name: per_call_seconds(function) for name, function in timings.items()}
     print(f"2 cables x 16 nodes: {n} coordinates, {len(joints)} joints")
     for name, seconds in results.items():
         print(f"  {name:40s} {seconds * 1e6:9.2f} us")
     print("ratios NumPy / numba:")
-    for what, numba_name in [("force", "force, numba wrapper (out=)"),
-                             ("force", "force, BendingSpringDamper.force"), ("force", "force, numba kernel"),
-                             ("jacobian K, D", "jacobian K, D, numba wrapper (out=)"),
+    for what, numba_name in [("force", "force, BendingSpringDamper.force"), ("force", "force, numba kernel"),
                              ("jacobian K, D", "jacobian K, D, BendingSpringDamper"),
                              ("jacobian K, D", "jacobian K, D, numba kernel")]:
         ratio = results[f"{what}, NumPy reference"] / results[numba_name]

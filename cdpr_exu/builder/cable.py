@@ -414,7 +414,7 @@ def _linear_bending_matrices(cables: list[CableSpec], counts: list[int], joints:
     lengths = np.concatenate([np.full(n - 2, c.element_length) for c, n in zip(cables, counts)])
     n_nodes = reference.size // 2
     k_matrix = bending.curvature_stiffness_matrix(n_nodes, joints, stiffness, lengths)
-    d_matrix = bending.curvature_damping_matrix(n_nodes, joints, damping, lengths)
+    d_matrix = bending.curvature_stiffness_matrix(n_nodes, joints, damping, lengths)
     return {"stiffnessMatrix": k_matrix, "dampingMatrix": d_matrix, "forceVector": -k_matrix @ reference}
 
 

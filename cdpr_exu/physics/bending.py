@@ -27,13 +27,8 @@ Coordinates are flat, ``(2 n_nodes,)``, ordered ``x0, y0, x1, y1, ...`` as in an
 Also here: the linear curvature-vector spring ``(k / l^2) |p_a - 2 p_b + p_c|^2 / 2``, a
 cheaper small-angle alternative with constant matrices (see ``curvature_stiffness_matrix``).
 
-Three levels of API, from safest to fastest:
-- the functions ``bending_force``, ``bending_jacobian``, ... validate every argument on each
-  call (about 15-25 us for 2 x 16 nodes) and allocate unless given ``out=`` arrays;
-- ``BendingSpringDamper`` validates joints and parameters once, owns the output buffers and
-  only checks the coordinate arrays per call: the one to use in Exudyn user functions;
-- the numba kernels (``*_kernel``) do no checks at all.
-This module does not import Exudyn.
+``BendingSpringDamper`` validates joints and parameters once and owns its output buffers;
+the numba kernels (``*_kernel``) do no checks. This module does not import Exudyn.
 """
 
 import numpy as np
@@ -47,12 +42,7 @@ __all__ = [
     "cable_joints",
     "bending_angles",
     "bending_energy",
-    "bending_force",
-    "bending_jacobian",
-    "bending_force_and_jacobian",
-    "bending_jacobian_weighted",
     "curvature_stiffness_matrix",
-    "curvature_damping_matrix",
     "bending_force_kernel",
     "bending_jacobian_kernel",
 ]
@@ -115,7 +105,7 @@ def _joint_geometry(positions, velocities, a, b, c, grad, hess):
 
 @njit(cache=True)
 def bending_force_kernel(positions, velocities, joints, stiffness, damping, out):
-    """Unchecked kernel of ``bending_force``: overwrites ``out`` (2N,) with the force [N]."""
+    """Unchecked kernel of ``BendingSpringDamper.force``: overwrites ``out`` (2N,) with the force [N]."""
     out[:] = 0.0
     grad = np.empty(6)
     no_hess = np.empty((0, 0))
@@ -247,26 +237,7 @@ def _as_per_joint(name, values, n_joints):
     return array
 
 
-def _check_output(name, out, shape):
-    if out is None:
-        return np.empty(shape)
-    if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == shape
-            and out.flags.c_contiguous and out.flags.writeable):
-        raise SceneError(f"{name} must be a writeable C-contiguous float64 array of shape {shape}")
-    return out
-
-
-def _validate(positions, velocities, joints, stiffness, damping):
-    positions = flat_coordinates("positions", positions)
-    velocities = flat_coordinates("velocities", velocities, positions.shape[0])
-    joints = _as_joints(joints, positions.shape[0] // 2)
-    stiffness = _as_per_joint("stiffness", stiffness, joints.shape[0])
-    damping = _as_per_joint("damping", damping, joints.shape[0])
-    return positions, velocities, joints, stiffness, damping
-
-
 _EMPTY_VECTOR = np.empty(0)
-_EMPTY_MATRIX = np.empty((0, 0))
 
 
 # --------------------------------------------------------------------------- public API
@@ -342,112 +313,6 @@ def bending_energy(positions, joints, stiffness):
     return 0.5 * float(np.dot(stiffness, dtheta * dtheta))
 
 
-def bending_force(positions, velocities, joints, stiffness, damping, out=None):
-    """Generalized bending force on the node coordinates (right-hand side).
-
-    ``f = -sum_j (k_j dtheta_j + c_j dtheta_dot_j) grad_q(dtheta_j)``.
-
-    Parameters
-    ----------
-    positions : array_like, shape (2 n_nodes,) [m]
-        Current node positions x0, y0, x1, y1, ... (not Exudyn displacements).
-    velocities : array_like, shape (2 n_nodes,) [m/s]
-    joints : array_like of int, shape (n_joints, 3)
-        Node triplets (a, b, c); may span several cables.
-    stiffness : float or array_like, shape (n_joints,) [N m/rad]
-    damping : float or array_like, shape (n_joints,) [N m s/rad]
-    out : ndarray, shape (2 n_nodes,), float64, C-contiguous, optional
-        Overwritten with the result and returned (no allocation).
-
-    Returns
-    -------
-    force : ndarray, shape (2 n_nodes,) [N]
-
-    Raises
-    ------
-    SceneError
-        On a bad shape, a node index out of range or a repeated node in an element.
-    """
-    positions, velocities, joints, stiffness, damping = _validate(
-        positions, velocities, joints, stiffness, damping)
-    out = _check_output("out", out, positions.shape)
-    return bending_force_kernel(positions, velocities, joints, stiffness, damping, out)
-
-
-def bending_jacobian(positions, velocities, joints, stiffness, damping, out_k=None, out_d=None):
-    """Tangent stiffness ``K = -df/dq`` and tangent damping ``D = -df/dv`` of the bending force.
-
-    Parameters are those of ``bending_force``; ``out_k`` and ``out_d`` are optional
-    (2 n_nodes, 2 n_nodes) float64 C-contiguous arrays, overwritten and returned.
-
-    Returns
-    -------
-    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m]
-        ``sum_j G (k G + c H v)^T + (k dtheta + c dtheta_dot) H``; not symmetric if c != 0.
-    D : ndarray, shape (2 n_nodes, 2 n_nodes) [N s/m]
-        ``sum_j c G G^T``.
-    """
-    _, out_k, out_d = bending_force_and_jacobian(
-        positions, velocities, joints, stiffness, damping, out_force=_EMPTY_VECTOR,
-        out_k=out_k, out_d=out_d)
-    return out_k, out_d
-
-
-def bending_force_and_jacobian(positions, velocities, joints, stiffness, damping,
-                               out_force=None, out_k=None, out_d=None):
-    """Force, K and D of ``bending_force`` and ``bending_jacobian`` in one pass.
-
-    Returns
-    -------
-    force : ndarray, shape (2 n_nodes,) [N]
-    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m]
-    D : ndarray, shape (2 n_nodes, 2 n_nodes) [N s/m]
-    """
-    positions, velocities, joints, stiffness, damping = _validate(
-        positions, velocities, joints, stiffness, damping)
-    n = positions.shape[0]
-    if out_force is not _EMPTY_VECTOR:
-        out_force = _check_output("out_force", out_force, (n,))
-    out_k = _check_output("out_k", out_k, (n, n))
-    out_d = _check_output("out_d", out_d, (n, n))
-    bending_jacobian_kernel(positions, velocities, joints, stiffness, damping, 1.0, 0.0,
-                            out_force, out_k, out_d)
-    return out_force, out_k, out_d
-
-
-def bending_jacobian_weighted(positions, velocities, joints, stiffness, damping,
-                              factor_position, factor_velocity, out=None):
-    """``factor_position * K + factor_velocity * D``: what an Exudyn jacobianUserFunction returns.
-
-    For ``ObjectGenericODE2`` the user Jacobian is the derivative of the left-hand side
-    (i.e. of ``-f``) w.r.t. q times ``fODE2`` plus w.r.t. q_t times ``fODE2_t``, which is
-    ``fODE2 * K + fODE2_t * D`` here.
-
-    Parameters
-    ----------
-    positions, velocities, joints, stiffness, damping
-        As in ``bending_force``.
-    factor_position : float
-        Weight of K (Exudyn's ``fODE2``).
-    factor_velocity : float [s]
-        Weight of D (Exudyn's ``fODE2_t``).
-    out : ndarray, shape (2 n_nodes, 2 n_nodes), optional
-        Overwritten and returned.
-
-    Returns
-    -------
-    jacobian : ndarray, shape (2 n_nodes, 2 n_nodes)
-    """
-    positions, velocities, joints, stiffness, damping = _validate(
-        positions, velocities, joints, stiffness, damping)
-    n = positions.shape[0]
-    out = _check_output("out", out, (n, n))
-    bending_jacobian_kernel(positions, velocities, joints, stiffness, damping,
-                            float(factor_position), float(factor_velocity),
-                            _EMPTY_VECTOR, out, _EMPTY_MATRIX)
-    return out
-
-
 def curvature_stiffness_matrix(n_nodes, joints, stiffness, element_length):
     """Constant matrix of the linear curvature-vector spring ``(k / l^2) |p_a - 2 p_b + p_c|^2 / 2``.
 
@@ -467,7 +332,8 @@ def curvature_stiffness_matrix(n_nodes, joints, stiffness, element_length):
 
     Returns
     -------
-    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m], symmetric positive semi-definite
+    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m], symmetric positive semi-definite; with the
+        damping c_theta in place of ``stiffness``, the constant damping matrix D [N s/m].
     """
     n_nodes = int(n_nodes)
     if n_nodes < 0:
@@ -488,23 +354,6 @@ def curvature_stiffness_matrix(n_nodes, joints, stiffness, element_length):
                 for axis in range(2):
                     matrix[2 * joints[j, r] + axis, 2 * joints[j, s] + axis] += value
     return matrix
-
-
-def curvature_damping_matrix(n_nodes, joints, damping, element_length):
-    """Constant damping matrix of the curvature-vector spring: ``curvature_stiffness_matrix`` with c.
-
-    Parameters
-    ----------
-    n_nodes : int
-    joints : array_like of int, shape (n_joints, 3)
-    damping : float or array_like, shape (n_joints,) [N m s/rad]
-    element_length : float or array_like, shape (n_joints,) [m]
-
-    Returns
-    -------
-    D : ndarray, shape (2 n_nodes, 2 n_nodes) [N s/m]; the damping force is ``-D v``.
-    """
-    return curvature_stiffness_matrix(n_nodes, joints, damping, element_length)
 
 
 class BendingSpringDamper:
@@ -542,7 +391,6 @@ class BendingSpringDamper:
         self._force_with_jacobian = np.empty(n)
         self._stiffness_matrix = np.empty((n, n))
         self._damping_matrix = np.empty((n, n))
-        self._weighted = np.empty((n, n))
 
     def _coordinates(self, name, values):
         if not (type(values) is np.ndarray and values.dtype == np.float64 and values.flags.c_contiguous):
@@ -552,13 +400,15 @@ class BendingSpringDamper:
         return values
 
     def force(self, positions, velocities):
-        """Generalized bending force (2 n_nodes,) [N]; see ``bending_force``."""
+        """Generalized bending force (2 n_nodes,) [N], ``-sum_j (k_j dtheta_j + c_j dtheta_dot_j)
+        grad_q(dtheta_j)``, at positions (not Exudyn displacements) and velocities (2 n_nodes,)."""
         return bending_force_kernel(self._coordinates("positions", positions),
                                     self._coordinates("velocities", velocities),
                                     self.joints, self.stiffness, self.damping, self._force)
 
     def jacobian(self, positions, velocities):
-        """``(K, D)``, each (2 n_nodes, 2 n_nodes): K = -df/dq [N/m], D = -df/dv [N s/m]."""
+        """``(K, D)``, each (2 n_nodes, 2 n_nodes): K = -df/dq [N/m] (not symmetric if c != 0),
+        D = -df/dv [N s/m]."""
         bending_jacobian_kernel(self._coordinates("positions", positions),
                                 self._coordinates("velocities", velocities),
                                 self.joints, self.stiffness, self.damping, 1.0, 0.0,
@@ -566,22 +416,12 @@ class BendingSpringDamper:
         return self._stiffness_matrix, self._damping_matrix
 
     def force_and_jacobian(self, positions, velocities):
-        """``(f, K, D)`` in one pass; see ``bending_force_and_jacobian``."""
+        """``(f, K, D)`` of :meth:`force` and :meth:`jacobian` in one pass."""
         bending_jacobian_kernel(self._coordinates("positions", positions),
                                 self._coordinates("velocities", velocities),
                                 self.joints, self.stiffness, self.damping, 1.0, 0.0,
                                 self._force_with_jacobian, self._stiffness_matrix, self._damping_matrix)
         return self._force_with_jacobian, self._stiffness_matrix, self._damping_matrix
-
-    def jacobian_weighted(self, positions, velocities, factor_position, factor_velocity):
-        """``factor_position * K + factor_velocity * D`` (2 n_nodes, 2 n_nodes): Exudyn's
-        ``jacobianUserFunction`` result with ``fODE2``, ``fODE2_t``."""
-        bending_jacobian_kernel(self._coordinates("positions", positions),
-                                self._coordinates("velocities", velocities),
-                                self.joints, self.stiffness, self.damping,
-                                float(factor_position), float(factor_velocity),
-                                _EMPTY_VECTOR, self._weighted, _EMPTY_MATRIX)
-        return self._weighted
 
     def energy(self, positions):
         """Elastic bending energy [J]; see ``bending_energy``."""

@@ -38,10 +38,8 @@ Coordinates are flat arrays ``x0, y0, x1, y1, ...`` [m, m/s] over a global node 
 in an Exudyn ``ObjectGenericODE2`` over ``NodePoint2D`` nodes); each segment carries its
 own pulley (centre, radius, k_p, c_p), so the segments of all cables share one call.
 
-Three levels of API, as in :mod:`cdpr_exu.physics.bending`: the functions ``segment_contact_force``
-and ``segment_contact_jacobian`` validate every argument; :class:`SegmentPulleyContact`
-validates once and owns its buffers (the one for Exudyn user functions); the kernels
-``*_kernel`` do no checks. This module does not import Exudyn.
+:class:`SegmentPulleyContact` validates once; the kernels ``*_kernel`` do no checks. This
+module does not import Exudyn.
 """
 
 from __future__ import annotations
@@ -50,14 +48,11 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import flat_coordinates, per_item, points_per_item, whole_array
+from cdpr_exu.core.validation import per_item, points_per_item, whole_array
 
 __all__ = [
     "SegmentPulleyContact",
     "contact_segments",
-    "segment_contact_state",
-    "segment_contact_force",
-    "segment_contact_jacobian",
     "segment_contact_force_kernel",
     "segment_contact_jacobian_kernel",
 ]
@@ -222,23 +217,6 @@ def segment_contact_jacobian_kernel(positions, velocities, segments, centers, ra
     return out
 
 
-@njit(cache=True)
-def segment_contact_state_kernel(positions, velocities, segments, centers, radii, stiffness, damping,
-                                 out_t, out_depth, out_force):
-    """Per segment: clamped parameter t [-], penetration r - d (0 outside) [m], normal force F [N]."""
-    for k in range(segments.shape[0]):
-        t, interior, px, py, ex, ey, d, nx, ny, vn, s = _closest_point(
-            positions, velocities, segments[k, 0], segments[k, 1], centers[k, 0], centers[k, 1])
-        out_t[k] = t
-        depth = radii[k] - d
-        if depth <= 0.0:
-            out_depth[k] = 0.0
-            out_force[k] = 0.0
-        else:
-            out_depth[k] = depth
-            out_force[k] = max(stiffness[k] * depth - damping[k] * vn, 0.0)
-
-
 # --------------------------------------------------------------------------- validation
 
 def _segments(segments, n_nodes):
@@ -293,10 +271,8 @@ class SegmentPulleyContact:
     damping : float or array_like, shape (S,) [N s/m]
         Normal damping c_p.
 
-    Notes
-    -----
-    ``force`` and ``add_force`` / ``add_jacobian`` accumulate into arrays the caller owns
-    (the cables' generic object adds bending, slack and contact into one buffer).
+    ``add_force`` and ``add_jacobian`` accumulate into arrays the caller owns (the cables'
+    generic object adds bending, slack and contact into one buffer).
     """
 
     def __init__(self, n_nodes, segments, centers, radii, stiffness, damping):
@@ -328,81 +304,3 @@ class SegmentPulleyContact:
         return segment_contact_jacobian_kernel(
             self._check("positions", positions), self._check("velocities", velocities), self.segments, self.centers,
             self.radii, self.stiffness, self.damping, float(factor_position), float(factor_velocity), out)
-
-    def force(self, positions, velocities):
-        """Contact forces alone, (2 n_nodes,) [N] (a new array)."""
-        return self.add_force(positions, velocities, np.zeros(self.n_coordinates))
-
-    def state(self, positions, velocities):
-        """``(t, depth, force)`` per segment, each (S,): see :func:`segment_contact_state`."""
-        n = self.segments.shape[0]
-        out = (np.empty(n), np.empty(n), np.empty(n))
-        segment_contact_state_kernel(self._check("positions", positions), self._check("velocities", velocities),
-                                     self.segments, self.centers, self.radii, self.stiffness, self.damping, *out)
-        return out
-
-
-def segment_contact_state(positions, velocities, segments, centers, radii, stiffness, damping):
-    """Closest-point parameter, penetration and normal force of each segment.
-
-    Parameters are those of :func:`segment_contact_force`.
-
-    Returns
-    -------
-    t : ndarray, shape (S,) [-]
-        Clamped parameter of the closest point (0 at node a, 1 at node b).
-    depth : ndarray, shape (S,) [m]
-        r - d, 0 when the segment is outside the disc.
-    force : ndarray, shape (S,) [N]
-        Normal force max(0, k_p depth - c_p v_n) (0 outside).
-    """
-    positions = flat_coordinates("positions", positions)
-    contact = SegmentPulleyContact(positions.shape[0] // 2, segments, centers, radii, stiffness, damping)
-    return contact.state(positions, flat_coordinates("velocities", velocities, positions.shape[0]))
-
-
-def segment_contact_force(positions, velocities, segments, centers, radii, stiffness, damping):
-    """Generalized rim-contact force of the segments on the node coordinates.
-
-    Parameters
-    ----------
-    positions : array_like, shape (2 n_nodes,) [m]
-        Current node positions x0, y0, x1, y1, ... (not Exudyn displacements).
-    velocities : array_like, shape (2 n_nodes,) [m/s]
-    segments : array_like of int, shape (S, 2)
-        Node pairs (a, b).
-    centers : array_like, shape (2,) or (S, 2) [m]
-    radii : float or array_like, shape (S,) [m]
-    stiffness : float or array_like, shape (S,) [N/m]
-    damping : float or array_like, shape (S,) [N s/m]
-
-    Returns
-    -------
-    force : ndarray, shape (2 n_nodes,) [N]
-
-    Raises
-    ------
-    SceneError
-        On a bad shape, a node index out of range or a negative parameter.
-    """
-    positions = flat_coordinates("positions", positions)
-    contact = SegmentPulleyContact(positions.shape[0] // 2, segments, centers, radii, stiffness, damping)
-    return contact.force(positions, flat_coordinates("velocities", velocities, positions.shape[0]))
-
-
-def segment_contact_jacobian(positions, velocities, segments, centers, radii, stiffness, damping):
-    """Tangent stiffness ``K = -df/dq`` and damping ``D = -df/dv`` of :func:`segment_contact_force`.
-
-    Returns
-    -------
-    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m]
-        Symmetric when c_p = 0 (the force is then the gradient of a potential).
-    D : ndarray, shape (2 n_nodes, 2 n_nodes) [N s/m]
-    """
-    positions = flat_coordinates("positions", positions)
-    velocities = flat_coordinates("velocities", velocities, positions.shape[0])
-    contact = SegmentPulleyContact(positions.shape[0] // 2, segments, centers, radii, stiffness, damping)
-    n = positions.shape[0]
-    k_matrix = contact.add_jacobian(positions, velocities, 1.0, 0.0, np.zeros((n, n)))
-    d_matrix = contact.add_jacobian(positions, velocities, 0.0, 1.0, np.zeros((n, n)))
-    return k_matrix, d_matrix
