@@ -1,14 +1,11 @@
 """Adds one lumped-mass cable to an Exudyn system, effect by effect (paper sec. 2.1).
 
-A cable of n elements has n + 1 mass points, node 0 at the winch end and node n at
-the platform anchor. Each element is an axial spring-damper (k_i, c_i); each interior
-node carries a rotational spring-damper (k_theta, c_theta) on the relative angle of
-its two elements. The axial items are Exudyn's built-in C++ spring-dampers; the
-bending of all cables is one ``ObjectGenericODE2`` whose force and analytic Jacobian
-are numba kernels (:mod:`cdpr_exu.physics.bending`): one Python call per Newton iteration for
-the whole robot. The same object carries the tension-only elements (``Effects.slack``,
-:mod:`cdpr_exu.physics.axial`) and the pulley contact on element segments
-(``Effects.pulley_contact_model = "segment"``, :mod:`cdpr_exu.physics.segment_contact`).
+A cable of n elements has n + 1 mass points, node 0 at the winch end and node n at the
+platform anchor. Each element is an axial spring-damper (Exudyn's); each interior node a
+rotational spring-damper on the relative angle of its two elements. The bending of all cables
+is one ``ObjectGenericODE2`` with numba force and Jacobian (:mod:`cdpr_exu.physics.bending`),
+one Python call per Newton iteration for the whole robot; it also carries the tension-only
+elements (:mod:`cdpr_exu.physics.axial`) and the smooth node or segment pulley contacts.
 
 Exudyn items live in its x-y plane: the paper's (x, z) maps to Exudyn's (x, y).
 """
@@ -34,21 +31,9 @@ from cdpr_exu.physics.segment_contact import SegmentPulleyContact
 
 @dataclass
 class CableItems:
-    """Exudyn indices of one cable's items.
-
-    Attributes
-    ----------
-    nodes : list of int
-        ``NodePoint2D`` indices, winch end first, length n + 1.
-    markers : list of int
-        ``MarkerNodePosition`` of each node.
-    reference : ndarray, shape (n + 1, 2) [m]
-        Reference (initial) node positions in the x-z plane.
-    springs : list of int
-        Axial ``ObjectConnectorSpringDamper`` indices, length n (empty if elasticity is off).
-    loads : list of int
-        Gravity ``LoadForceVector`` indices.
-    """
+    """Exudyn indices of one cable's items: ``nodes`` (``NodePoint2D``, winch end first, n + 1)
+    and their ``markers``, axial ``springs`` (n, or distance constraints; empty with slack), gravity
+    ``loads``; ``reference`` (n + 1, 2) [m] the initial node positions, ``masses`` (n + 1,) [kg]."""
 
     nodes: list[int]
     markers: list[int]
@@ -62,21 +47,8 @@ def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effec
               gravity: float) -> CableItems:
     """Add the mass points, axial spring-dampers and gravity loads of one cable.
 
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-    cable : CableSpec
-    nodes_xz : ndarray, shape (n + 1, 2) [m]
-        Initial node positions (x, z), winch end first; each element should start at
-        its unstrained length.
-    effects : Effects
-        Which items to add (axial damping, gravity).
-    gravity : float [m/s^2]
-        Magnitude of gravity along -z.
-
-    Returns
-    -------
-    CableItems
+    ``nodes_xz`` (n + 1, 2) [m]: initial node positions (x, z), winch end first, each element at
+    its unstrained length; ``gravity`` [m/s^2] along -z.
     """
     nodes_xz = np.asarray(nodes_xz, dtype=float)
     masses = cable.node_masses()
@@ -112,13 +84,10 @@ def _add_gravity(mbs: exu.MainSystem, items: CableItems, masses: np.ndarray, eff
 
 @dataclass
 class CableForceItems:
-    """The one ``ObjectGenericODE2`` that carries the cables' numba-computed forces.
-
-    It holds the exact-angle bending springs (``Effects.bending``), with
-    ``Effects.slack`` the tension-only axial elements, and with segment pulley contact
-    the rim contacts of ``contact_segments`` (global node pairs, shape (S, 2), into the
-    object's node list; ``contact`` their :class:`SegmentPulleyContact`). ``user_functions``
-    keeps the Python callables alive as long as the model.
+    """The one ``ObjectGenericODE2`` that carries the cables' numba-computed forces: bending
+    ``joints``, ``slack_elements``, the segment contacts ``contact_segments`` (S, 2) (global node
+    pairs; ``contact`` their :class:`SegmentPulleyContact`) and the smooth ``node_contact``.
+    ``user_functions`` keeps the Python callables alive as long as the model.
     """
 
     object: int
@@ -132,12 +101,9 @@ class CableForceItems:
     #: The tension-only elements' rest lengths, stiffnesses and dampings [m, N/m, N s/m], shape (E,):
     #: the arrays the force kernels read (a winch's rope reservoir changes its first element's).
     slack_arrays: tuple = ()
-    #: The smooth node rim contacts (``Effects.pulley_contact_model = "node_smooth"``), or None.
     node_contact: NodePulleyContact | None = None
-    #: One entry: the strain within which a tension-only element counts as on its rest length for
-    #: Newton's Jacobian (the taut slopes, :func:`cdpr_exu.physics.axial._element_block`): 0 as
-    #: built; ``simulate`` and the run to rest set it to ``axial.ROUNDOFF_STRAIN`` before their
-    #: first step and back to 0 after it (:func:`arm_first_step_kink`).
+    #: One entry: the kink strain of :func:`cdpr_exu.physics.axial._element_block`, set for a
+    #: run's first step only (:func:`arm_first_step_kink`).
     first_step_kink: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
 
@@ -158,35 +124,24 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
                      contact_elements: list[np.ndarray] | None = None,
                      sparse_jacobian: bool = True,
                      contact_nodes: list[np.ndarray] | None = None) -> CableForceItems | None:
-    """Add the bending (with slack, the axial; with segment contact, the pulley) forces of all cables as one object.
+    """Add the bending, tension-only and smooth contact forces of all cables as one object.
 
     Parameters
     ----------
-    mbs : exudyn.MainSystem
-    cables : list of CableSpec
     items : list of CableItems
-        The cables' nodes, in the same order.
-    effects : Effects
+        The cables' nodes, in the order of ``cables``.
     pulleys : list of Pulley, optional
-        Pulley of each cable; needed with ``contact_elements``.
-    contact_elements : list of ndarray of int, optional
-        Cable-local indices of the elements (element j joins nodes j and j + 1) that get
-        a segment rim contact with their cable's pulley (``Effects.pulley_contact_model =
-        "segment"``); None or all empty: no segment contact and no cost for it.
+        Pulley of each cable; needed with contacts.
+    contact_elements, contact_nodes : list of ndarray of int, optional
+        Per cable, the cable-local elements (element j joins nodes j and j + 1) that get a segment
+        rim contact ("segment") and the nodes that get a smooth node contact ("node_smooth",
+        :mod:`cdpr_exu.physics.node_contact`); None or all empty: none, and no cost for it.
     sparse_jacobian : bool
-        Return the Jacobian as sparse triplets (36 per bending joint, 16 per tension-only
-        element, 4 per contact node: cost linear in the number of nodes) instead of a
-        dense (2N, 2N) matrix. With segment contact the dense form is kept.
-    contact_nodes : list of ndarray of int, optional
-        Cable-local indices of the nodes that get a rim contact with their cable's pulley
-        (``Effects.pulley_contact_model = "node_smooth"``, :mod:`cdpr_exu.physics.node_contact`); None or
-        all empty: no node contact and no cost for it.
+        Return the Jacobian as sparse triplets (cost linear in the number of nodes) instead of a
+        dense (2N, 2N) matrix; with segment contact the dense form is kept.
 
-    Returns None when neither ``effects.bending`` nor ``effects.slack`` is on and there
-    is no segment contact (then no item and no cost). The force user function receives
-    Exudyn's displacement coordinates ``q``; the reference positions are added here. Its
-    Jacobian is analytic (numba kernels), ``fODE2 * K + fODE2_t * D`` with K = -df/dq,
-    D = -df/dq_t.
+    Returns None when no effect needs the object. The Jacobian is analytic, ``fODE2 * K +
+    fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
     """
     counts = [len(it.nodes) for it in items]
     contact = _segment_contact(counts, pulleys, contact_elements)
@@ -309,10 +264,9 @@ def _slack_blocks(elements, rest, axial_k, axial_c, kink, cut):
 
 def _state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
     """The displacements q and velocities q_t [m, m/s] of the ``ObjectGenericODE2`` ``item``, read from the
-    system's state vectors (``systemData``): the numbers Exudyn hands its user functions as lists (the
-    current state), without converting the lists (x1.09 of the CPU time of a paper-circle run at 60
-    elements and 1e-2 s, issue 25). ``where`` keeps the object's place in those vectors (a slice where
-    it is one block), found at the first call, once the system is assembled."""
+    system's state vectors (``systemData``) rather than converted from the lists Exudyn hands its user
+    functions (measured x1.09 of a paper-circle run's CPU time). ``where`` caches the object's place in
+    those vectors (a slice where it is one block), found at the first call."""
     data = mbs.systemData
     if not where:
         index = np.asarray(data.GetObjectLTGODE2(item), dtype=np.int64)
@@ -322,14 +276,9 @@ def _state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _sparse_jacobian_function(blocks, reference, positions, where):
-    """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets (an
-    ``exu.MatrixContainer``) in a fixed pattern.
-
-    ``blocks`` lists ``(rows, columns, fill)`` per force (bending joints, tension-only
-    elements, contact nodes): the places of its triplets and a numba-backed function
-    ``fill(positions, velocities, f_q, f_q_t, out_values)`` that writes their values;
-    ``where`` as :func:`_state`.
-    """
+    """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets in a fixed pattern:
+    ``blocks`` lists ``(rows, columns, fill)`` per force, ``fill(positions, velocities, f_q, f_q_t,
+    out_values)`` writing the values; ``where`` as :func:`_state`."""
     size = reference.size
     bounds = np.cumsum([0] + [rows.size for rows, _, _ in blocks])
     triplets = np.zeros((int(bounds[-1]), 3))
@@ -422,20 +371,10 @@ def element_tensions(cable: CableSpec, positions: np.ndarray, velocities: np.nda
                      effects: Effects, rest_length: np.ndarray | None = None) -> np.ndarray:
     """Axial force of each element, as the spring-dampers compute it (tension > 0).
 
-    Parameters
-    ----------
-    cable : CableSpec
-    positions, velocities : ndarray, shape (..., n + 1, 2) [m, m/s]
-    effects : Effects
-        With ``slack``, the tension-only law of :func:`cdpr_exu.physics.axial.tension_law`.
-    rest_length : ndarray, shape (..., n), optional [m]
-        Rest length of each element when it differs from the nominal one (the winch
-        element holding slack rope, :func:`cdpr_exu.builder.winch.reservoir_split`); stiffness
-        and damping scale as 1 / rest length.
-
-    Returns
-    -------
-    ndarray, shape (..., n) [N]
+    ``positions``, ``velocities`` (..., n + 1, 2) [m, m/s] -> (..., n) [N]; with ``effects.slack``
+    the tension-only law of :func:`cdpr_exu.physics.axial.tension_law`. ``rest_length`` (..., n) [m]:
+    each element's when it differs from the nominal one (the winch element holding slack rope,
+    :func:`cdpr_exu.builder.winch.reservoir_split`); stiffness and damping scale as 1 / rest length.
     """
     delta = np.diff(positions, axis=-2)
     delta_rate = np.diff(velocities, axis=-2)
@@ -461,19 +400,9 @@ INEXTENSIBLE_STIFFNESS_FACTOR = 1.0e3
 
 @dataclass
 class RopeItems:
-    """A massless cable: one Exudyn ``ObjectConnectorReevingSystemSprings``.
-
-    Attributes
-    ----------
-    rope : int
-        The reeving-system object (winch point, pulley sheave, platform anchor).
-    drum_node : int
-        A one-coordinate node whose prescribed value is the paid-out length change.
-    drum_marker : int
-        Its coordinate marker.
-    winch_point : ndarray, shape (2,) [m]
-        Fixed start of the rope below the pulley (x, z).
-    """
+    """A massless cable: the ``ObjectConnectorReevingSystemSprings`` ``rope`` (winch point, pulley
+    sheave, platform anchor), the one-coordinate ``drum_node`` (its prescribed value is the paid-out
+    length change) and its ``drum_marker``; ``winch_point`` (2,) [m] the rope's fixed start (x, z)."""
 
     rope: int
     drum_node: int
@@ -493,20 +422,9 @@ def add_rope(mbs: exu.MainSystem, cable: CableSpec, pulley_center, pulley_radius
     length change lambda - lambda(0) is a prescribed coordinate that Exudyn adds to the
     rope's reference length.
 
-    Parameters
-    ----------
-    cable : CableSpec
-        Unstrained length, EA and dn A of the rope.
-    pulley_center : (x, z) [m]
-    pulley_radius : float [m]
-        0 for a point exit.
-    side : {-1, +1}
-    anchor_marker : int
-        ``MarkerBodyRigid`` of the platform anchor.
-    winch_point : (x, z) [m]
-        Fixed start of the rope, below the pulley on the winch side.
-    ground_coordinate_marker : int
-        A coordinate marker that is always 0 (closes the coordinate pair).
+    ``pulley_center``, ``winch_point`` (x, z) [m] (the rope's fixed start below the pulley);
+    ``pulley_radius`` [m] (0 for a point exit); ``anchor_marker`` the platform anchor's
+    ``MarkerBodyRigid``; ``ground_coordinate_marker`` a coordinate marker that is always 0.
     """
     winch_point = np.asarray(winch_point, dtype=float)
     winch_ground = mbs.AddObject(eii.ObjectGround(referencePosition=[winch_point[0], winch_point[1], 0.0]))

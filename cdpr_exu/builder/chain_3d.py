@@ -1,21 +1,11 @@
 """A spatial cable in Exudyn: 3-D mass points, axial spring-dampers and exact-angle bending.
 
-:func:`add_spatial_chain` adds one chain of ``NodePoint`` + ``ObjectMassPoint`` items
-joined by Exudyn's ``ObjectConnectorSpringDamper`` (axial, k = E A / l0, c = d_n A / l0),
-with gravity along -z and the bending springs of :mod:`cdpr_exu.physics.bending_3d` in
-one ``ObjectGenericODE2`` whose Jacobian is sparse triplets. Its first node can be held
-(three coordinate constraints). Units SI; z up.
-
-With ``bending_damping > 0`` the joints also get the bending dampers of
-:mod:`cdpr_exu.physics.bending_3d` (on the neighbouring segments' relative angular
-velocity), in the same force function and the same 81 triplets per joint (their
-Jacobian has a velocity part, Exudyn's ``factorODE2_t``); without it they cost nothing.
-
-With ``tension_only=True`` there are no Exudyn spring-dampers: the axial elements are
-the tension-only ones of :mod:`cdpr_exu.physics.axial_3d` (a cable cannot push; a slack
-element carries nothing, not even damping) and join the bending springs in the one
-``ObjectGenericODE2`` (one force function, one sparse Jacobian summing both), which then
-exists even without bending.
+:func:`add_spatial_chain` adds one chain of ``NodePoint`` + ``ObjectMassPoint`` items joined by
+Exudyn's ``ObjectConnectorSpringDamper`` (k = E A / l0, c = d_n A / l0), gravity along -z, and
+one ``ObjectGenericODE2`` with a sparse triplet Jacobian for the forces of
+:mod:`cdpr_exu.physics.bending_3d` (bending springs, and dampers when ``bending_damping > 0``)
+and, with ``tension_only``, the tension-only elements of :mod:`cdpr_exu.physics.axial_3d` in
+place of Exudyn's spring-dampers (which push when compressed). Units SI; z up.
 """
 
 from __future__ import annotations
@@ -37,37 +27,16 @@ from cdpr_exu.physics.axial import CutSlopes, cable_elements
 class SpatialChainItems:
     """Item indices of a spatial chain.
 
-    Attributes
-    ----------
-    nodes, masses, markers, springs : list of int
-    bending : int or None
-        The ``ObjectGenericODE2`` of the bending springs (None without bending).
-    reference : ndarray, shape (3N,) [m]
-        Reference positions of the nodes (Exudyn's coordinates are displacements from them).
-    joints : ndarray of int, shape (J, 3)
-    user_functions : tuple
-        Keeps the Python callables alive as long as the model.
-    loads : list of int
-        The nodes' gravity ``LoadForceVector`` items (empty without gravity).
-    holds : list of int
-        The three ``ObjectConnectorCoordinate`` items that hold the first node (x, y, z;
-        empty if it is free); their ``offset`` moves it (a winch on a swivel axis).
-    bending_stiffness : ndarray, shape (J,) [N m/rad] or None
-        The joints' stiffnesses, the very array the bending force reads (a winch that
-        changes the cable's length scales it in place).
-    bending_damping : ndarray, shape (J,) [N m s/rad] or None
-        The joints' bending dampers, read the same way (None: no damper, no cost).
-    generic : int or None
-        The chain's ``ObjectGenericODE2`` (bending and/or tension-only axial elements; the
-        same as ``bending`` when there is bending), None when there is none.
-    axial_elements : ndarray of int, shape (n, 2) or None
-        With ``tension_only``: the node pairs of the tension-only elements (None with
-        Exudyn's spring-dampers, which are in ``springs``).
-    axial_rest_length, axial_stiffness, axial_damping, axial_rest_rate : ndarray, shape (n,) or None
-        With ``tension_only``: the very arrays the force and Jacobian functions read
-        [m, N/m, N s/m, m/s]; change them in place between steps (a winch paying out cable
-        scales them, and sets the rest length's rate so that the damper acts on the
-        strain rate). None with Exudyn's spring-dampers.
+    ``nodes``, ``masses``, ``markers``, ``springs`` (Exudyn's axial spring-dampers), ``loads``
+    (gravity) and ``holds`` (the three ``ObjectConnectorCoordinate`` holding the first node, whose
+    ``offset`` moves it: a winch on a swivel axis) are item indices; ``reference`` (3N,) [m] the
+    nodes' reference positions; ``joints`` (J, 3) the bending joints. ``generic`` is the chain's
+    ``ObjectGenericODE2`` (None when it has none), ``bending`` the same when it bends;
+    ``user_functions`` keeps its Python callables alive. ``bending_stiffness`` and
+    ``bending_damping`` (J,) [N m/rad, N m s/rad], and with tension-only elements
+    ``axial_elements`` (n, 2), ``axial_rest_length``, ``axial_stiffness``, ``axial_damping`` and
+    ``axial_rest_rate`` (n,) [m, N/m, N s/m, m/s], are the very arrays the force functions read
+    (None when absent): a winch paying out cable changes them in place between steps.
     """
 
     nodes: list
@@ -106,23 +75,17 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     positions : ndarray, shape (N, 3) [m]
     node_masses : ndarray, shape (N,) [kg]
     axial_stiffness, axial_damping : float [N/m, N s/m]
-        Of each element (E A / l0 and d_n A / l0 of its unstrained length l0).
-    bending_stiffness : float [N m/rad]
-        Of each joint (0: no bending object at all).
+        Of each element (E A / l0 and d_n A / l0).
+    bending_stiffness, bending_damping : float [N m/rad, N m s/rad]
+        Of each joint (0: none; dampers need bending).
     gravity : float [m/s^2]
         Along -z.
     hold_first : bool
         Hold the first node in place.
     tension_only : bool
-        Tension-only axial elements (:mod:`cdpr_exu.physics.axial_3d`) in the chain's
-        ``ObjectGenericODE2`` instead of Exudyn's ``ObjectConnectorSpringDamper``
-        (``springs`` stays empty; the arrays the kernels read are in the returned
-        items' ``axial_rest_length``, ``axial_stiffness``, ``axial_damping``).
-    bending_damping : float [N m s/rad]
-        Of each joint (d_n J / l0, the planar model's c_theta); 0: no dampers. Needs bending.
+        Tension-only axial elements in the generic object instead of Exudyn's spring-dampers.
     isotropic_bend : float or None
-        The dampers' ``isotropic_bend`` (:func:`cdpr_exu.physics.bending_3d.add_spatial_bending_damping_force`);
-        None: :data:`cdpr_exu.physics.bending_3d.ISOTROPIC_BEND`.
+        The dampers' eps (None: :data:`cdpr_exu.physics.bending_3d.ISOTROPIC_BEND`).
     """
     positions = np.asarray(positions, dtype=float)
     nodes, masses, markers, springs, loads, holds = [], [], [], [], [], []
@@ -220,12 +183,8 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
 def chain_energy(items: SpatialChainItems, node_masses: np.ndarray, q: np.ndarray, v: np.ndarray,
                  axial_stiffness: float, bending_stiffness: float, gravity: float = 9.81) -> float:
     """Mechanical energy [J] of the chain at displacements ``q`` and velocities ``v`` (3N,):
-    kinetic, gravity (z up), axial springs and bending springs.
-
-    With tension-only elements the axial energy is that of their law
-    (:func:`cdpr_exu.physics.axial_3d.tension_only_energy`: zero below the rest length)
-    with the items' current ``axial_rest_length`` and ``axial_stiffness`` (``axial_stiffness``
-    here is then not used)."""
+    kinetic, gravity (z up), axial and bending springs (tension-only elements: the energy of
+    their law with the items' own arrays, and ``axial_stiffness`` is not used)."""
     positions = items.reference + q
     points = positions.reshape(-1, 3)
     energy = 0.5 * float(np.sum(node_masses * np.sum(v.reshape(-1, 3) ** 2, axis=1)))

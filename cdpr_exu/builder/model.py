@@ -11,7 +11,7 @@ Only the items of the effects the scene switches on are added (see
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import exudyn as exu
 import exudyn.itemInterface as eii
@@ -32,36 +32,13 @@ from cdpr_exu.space import PLANE, SPACE
 
 @dataclass
 class Model:
-    """An assembled Exudyn system of a scene, with the indices of its items.
+    """An assembled Exudyn system of a planar scene, with the indices of its items.
 
-    Attributes
-    ----------
-    scene : Scene
-    system_container : exudyn.SystemContainer
-    mbs : exudyn.MainSystem
-    cables : list of CableItems
-    platform : PlatformItems
-    winches : list of WinchItems
-    cable_forces : CableForceItems or None
-        The generic object of bending and slack-axial forces.
-    contacts : list of list of int
-        Exudyn contact objects of each cable with its pulley
-        (``effects.pulley_contact_model = "node"`` only).
-    contact_nodes : list of ndarray of int
-        Cable-local indices of the nodes that carry a rim contact (node contact: in
-        Exudyn's items with "node", in ``cable_forces`` with "node_smooth").
-    contact_elements : list of ndarray of int
-        Cable-local indices of the elements (element j joins nodes j and j + 1) that
-        carry a segment contact (``effects.pulley_contact_model = "segment"``); their
-        forces live in ``cable_forces``.
-    initial_paid_out : ndarray, shape (m,) [m]
-        Paid-out length lambda_i(0) of the initial configuration: the unstrained cable
-        between the pulley's hang point and the anchor (over a pulley, the cable less
-        its straight hanging part; with a point exit, the whole cable).
-    ropes : list of RopeItems
-        The massless ropes (``effects.cable_mass`` off); then ``cables`` is empty.
-    servos : list of ServoItems
-        The winch drums of a servo winch (``winch.kind = "servo"``).
+    Per cable: ``contacts`` its Exudyn contact objects (contact model "node"), ``contact_nodes``
+    and ``contact_elements`` the cable-local nodes and elements that carry a rim contact (the
+    smooth and segment ones live in ``cable_forces``). ``initial_paid_out`` (m,) [m]: lambda_i(0),
+    the unstrained cable between the pulley's hang point and the anchor. ``ropes``: the massless
+    ropes (``effects.cable_mass`` off; ``cables`` is then empty); ``servos``: a servo winch's drums.
     """
 
     scene: Scene
@@ -96,13 +73,8 @@ class Model:
         }
 
     def coordinate_indices(self) -> dict[str, np.ndarray]:
-        """Positions of the model's nodes in Exudyn's ODE2 coordinate vector.
-
-        Returns
-        -------
-        dict
-            ``"platform"``: shape (3,), (x, z, rotation); ``"cable_i"``: shape (n + 1, 2).
-        """
+        """Positions of the model's nodes in Exudyn's ODE2 coordinate vector: ``"platform"`` (3,)
+        (x, z, rotation) and ``"cable_i"`` (n + 1, 2)."""
         mbs = self.mbs
         out = {"platform": mbs.GetNodeODE2Index(self.platform.node) + np.arange(3)}
         for i, cable in enumerate(self.cables):
@@ -117,13 +89,8 @@ def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
     pulley, wrapped over it and hanging to the winch, every element at its unstrained
     length. With a point exit: straight from the pulley centre to the anchor.
 
-    With segment contact (``effects.pulley_contact_model = "segment"``) the nodes on the
-    rim of the pulley radius r would make every wrapped element a chord cutting
-    r - sqrt(r^2 - l0i^2 / 4) into the disc (30 mm for the paper's 0.25 m elements),
-    which the segment contact would fire out at the first step. The nodes are then
-    placed the same way on a circle of radius sqrt(r^2 + l0i^2 / 4): the wrap becomes
-    the polygon circumscribed about the pulley, every chord touching the rim, and the
-    winch line moves out by the difference (30 mm for the paper's cable).
+    Segment contact wraps the nodes on the contact model's ``wrap_radius`` instead, so that no
+    chord starts inside the disc (the polygon circumscribed about the pulley).
     """
     cable, pulley = scene.cables[cable_index], scene.exits[cable_index]
     anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
@@ -143,10 +110,6 @@ def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 
     This range is taken over the reference trajectory sampled at 200 times, widened
     by ``margin_elements`` elements and 5 % of the cable for sag, stretch and the
     difference between controllers.
-
-    Returns
-    -------
-    ndarray of int
     """
     cable, pulley = scene.cables[cable_index], scene.exits[cable_index]
     times = np.linspace(0.0, scene.solver.end_time, 200)
@@ -165,10 +128,8 @@ def _check_elements_fit_the_pulley(scene: Scene, cable_index: int, nodes_xz: np.
     """Refuse a cable whose straight elements cut deep into the pulley from the start.
 
     With node contact an element much longer than the pulley radius spans the wrap as a
-    chord through the disc, and the cable then slips through the pulley. Segment contact
-    pushes the chords themselves out of the disc: no element length is refused then
-    (``effects.pulley_contact_model = "segment"``; the coarsest cables are limited by
-    :func:`cdpr_exu.statics.workspace.check_reference` instead).
+    chord through the disc, and the cable then slips through the pulley; segment contact
+    pushes the chords out, so nothing is refused then.
     """
     from cdpr_exu.core.geometry import segment_penetration
 
@@ -270,42 +231,21 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
 MIN_WINCH_SEGMENT = 0.25
 
 
-def rope_geometry(scene: Scene, cable_index: int, anchor) -> tuple[np.ndarray, float, float]:
-    """Hang point, sheave radius and ideal paid-out length of a massless rope.
-
-    Returns
-    -------
-    hang : ndarray, shape (2,) [m]
-        Where the rope leaves its vertical winch line (the pulley centre for a point exit).
-    radius : float [m]
-        Sheave radius given to Exudyn (0 for a point exit).
-    paid_out : float [m]
-        Ideal length from the hang point to the anchor.
-    """
-    exit_ = scene.exits[cable_index]
-    return exit_.hang_point, exit_.radius, float(exit_.cable_length(np.asarray(anchor)))
-
-
 def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems, ground_coordinate: int) -> Model:
     """Massless cables: one reeving-system rope per cable, winch point -> pulley -> anchor."""
-    from dataclasses import replace as _replace
-
-    import exudyn.itemInterface as _eii
-
     anchors = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))
     ropes, winches, paid_out = [], [], []
-    for i, cable in enumerate(scene.cables):
-        hang, radius, length = rope_geometry(scene, i, anchors[i])
+    for i, (cable, exit_) in enumerate(zip(scene.cables, scene.exits)):
+        hang, length = exit_.hang_point, float(exit_.cable_length(np.asarray(anchors[i])))  # from the hang point
         hanging = cable.unstrained_length - length
         segment = max(hanging, MIN_WINCH_SEGMENT)
-        rope_cable = _replace(cable, unstrained_length=cable.unstrained_length + segment - hanging)
+        rope_cable = replace(cable, unstrained_length=cable.unstrained_length + segment - hanging)
         bx, bz = scene.platform.anchors[i]
-        anchor_marker = mbs.AddMarker(_eii.MarkerBodyRigid(bodyNumber=platform.body, localPosition=[bx, bz, 0.0]))
-        exit_ = scene.exits[i]
-        rope = add_rope(mbs, rope_cable, exit_.point, radius, exit_.side, anchor_marker,
+        anchor_marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=platform.body, localPosition=[bx, bz, 0.0]))
+        rope = add_rope(mbs, rope_cable, exit_.point, exit_.radius, exit_.side, anchor_marker,
                         hang - np.array([0.0, segment]), ground_coordinate, scene.effects)
-        drive = mbs.AddObject(_eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
-                                                            offset=0.0))
+        drive = mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
+                                                           offset=0.0))
         winches.append(WinchItems(-1, drive, float(hang[1] - hanging)))
         ropes.append(rope)
         paid_out.append(length)

@@ -1,67 +1,34 @@
-"""The spatial robot's item family in Exudyn (the 3-D :class:`Model` of a scene, :func:`build_model_3d`): lumped spatial chains from held exit points to a 6-DOF (or point-mass) platform.
+"""The spatial robot's item family in Exudyn (the 3-D :class:`Model` of a scene, :func:`build_model_3d`).
 
-Each cable is a chain of :mod:`cdpr_exu.builder.chain_3d` (``NodePoint`` +
-``ObjectMassPoint`` nodes, Exudyn's ``ObjectConnectorSpringDamper`` between them,
-exact-angle bending in one ``ObjectGenericODE2``, gravity along -z), its first node
-held at the cable's exit point (a point exit, no pulley). Its last node is joined to
-the platform's anchor by an ``ObjectJointSpherical`` (the three translations; a
-spherical joint transmits no moment, like a cable end on a swivel eye), or, when
-``ChainSpec3D.anchor_spring_factor`` is given, by a stiff
-``ObjectConnectorCartesianSpringDamper`` (a penalty spherical joint). With
-``ChainSpec3D.tension_only`` the axial elements are tension-only
-(:mod:`cdpr_exu.physics.axial_3d`, in the chain's ``ObjectGenericODE2``) instead of
-Exudyn's spring-dampers, which push when compressed.
+Each cable is a chain of :mod:`cdpr_exu.builder.chain_3d`, its first node held at the cable's
+exit point (or at its winch end on a swivel pulley's axis). Its last node is joined to the
+platform's anchor by an ``ObjectJointSpherical`` (no moment, like a cable end on a swivel eye),
+or, with ``ChainSpec3D.anchor_spring_factor``, by a stiff ``ObjectConnectorCartesianSpringDamper``
+(a penalty spherical joint).
 
-Why the penalty joint exists (measured): Exudyn's static solver does not converge
-when an ``ObjectJointSpherical`` holds a rigid body's ``MarkerBodyPosition`` and the
-body must turn. From the catenary pose, 3e-4 rad from the answer (5 elements per
-cable), the first Newton step turned the platform by 1e-2 rad and the iteration
-diverged, with Exudyn's analytic and with its system-wide numerical Jacobian, for
-Euler-parameter, rotation-vector and Tait-Bryan nodes alike. A bare rigid body hung
-on four springs fixed straight to it converged in 3 steps; the same body with each
-spring joined to it through a mass point and a spherical joint diverged. It behaves
-as if the joint's geometric stiffness (the derivative of ``C_q^T lambda`` in the
-body's rotation, the pendulum stiffness of a hanging body) were missing from the
-static Jacobian. The dynamic solver, whose Jacobian the mass matrix dominates, runs
+Why the penalty joint exists (measured): Exudyn's static solver does not converge when an
+``ObjectJointSpherical`` holds a rigid body's ``MarkerBodyPosition`` and the body must turn
+(from 3e-4 rad off the answer the first Newton step turned the platform by 1e-2 rad and
+diverged, with analytic or numerical Jacobians, for every rotation parametrisation), as if the
+joint's geometric stiffness were missing from the static Jacobian. The dynamic solver runs
 with the exact joint; a point-mass platform solves statically with it.
 
-Platform
---------
-* a **point mass** (every anchor at the centre): ``NodePoint`` + ``ObjectMassPoint``;
-* a **rigid body**: ``NodeRigidBodyEP`` + ``ObjectRigidBody`` (``mbs.CreateRigidBody``
-  with Euler parameters), anchors as ``MarkerBodyPosition``. Euler parameters are
-  free of singularities and work with both solvers this project uses, the implicit
-  generalised-alpha integrator and ``SolveStatic``; their unit-norm condition is one
-  algebraic equation Exudyn adds itself. The alternatives: ``NodeRigidBodyRotVecLG``
-  is meant for Exudyn's explicit Lie-group integrators (its documentation), and
-  Tait-Bryan angles (``NodeRigidBodyRxyz``) are singular at a pitch of 90 degrees.
+The platform is a point mass (every anchor at the centre: ``NodePoint`` + ``ObjectMassPoint``)
+or a rigid body with Euler parameters (``mbs.CreateRigidBody``): free of singularities and
+fit for both the generalised-alpha integrator and ``SolveStatic``
+(``NodeRigidBodyRotVecLG`` is meant for Exudyn's explicit Lie-group integrators; Tait-Bryan
+angles are singular at a pitch of 90 degrees).
 
-Swivel pulleys
---------------
-A cable whose exit is a swivel pulley (``exits[i]``, a
-:class:`cdpr_exu.exits.swivel.Swivel`) is a fixed-length chain that starts at
-its winch end, held on the pulley's vertical axis ``winch_line`` below the inlet, runs
-up the axis, wraps over the disc and hangs to the anchor: its elements keep their
-length ``L / n`` (``L`` the unstrained length from the inlet, the catenary statics'),
-the winch line getting ``round(winch_line n / L)`` more of them. The disc and its swivel
-angle psi are :func:`cdpr_exu.builder.swivel_chain.add_swivel_pulley`'s (every node of
-the chain may touch it: the cable runs over the disc as the winch moves). The winch
-moves the held end along the axis (``SpatialChainItems.holds``), as the planar winch
-moves its node along the winch line, so cable flows over the pulley. The chain starts
-on the catenary statics' shape: the winch line stretched under the tension at the
-tangent point less its own weight, the wrap on the groove bottom, psi at the anchor's
-azimuth. From there :func:`cdpr_exu.run.settle.start_at_rest` brings the robot to its static equilibrium by the
-chain statics (:mod:`cdpr_exu.statics.chain_statics`, on the same discrete model,
-:func:`chain_statics_robot`): Exudyn's static solver does not converge from that start.
+A cable over a swivel pulley (:class:`cdpr_exu.exits.swivel.Swivel`) is a fixed-length chain
+from its winch end on the pulley's vertical axis, over the disc
+(:func:`cdpr_exu.builder.swivel_chain.add_swivel_pulley`) to the anchor; the winch moves the
+held end along the axis (``SpatialChainItems.holds``) so that cable flows over the pulley. It
+starts on the catenary statics' shape, and :func:`cdpr_exu.run.settle.start_at_rest` brings it
+to rest by the chain statics (Exudyn's static solver does not converge from there).
 
-Units SI, z up, gravity along -z. The parameters are those of
-:mod:`cdpr_exu.statics.statics` (:class:`SuspendedPlatform`, the unstrained
-lengths), plus the discretisation and the cable's damping and bending
-(:class:`ChainSpec3D`); the chain's mass per length is ``weight_per_length /
-gravity``. The chains start on the catenary statics' solution (or any
-:class:`PlatformEquilibrium`, eg one under an extra load, to start the robot swinging):
-their reference configuration is straight and unstrained (element length ``L / n``),
-their initial displacements put the nodes on the catenary.
+Units SI, z up, gravity along -z. The chains start on the catenary statics' solution (or any
+:class:`PlatformEquilibrium`): their reference configuration is straight and unstrained
+(element length ``L / n``), their initial displacements put the nodes on the catenary.
 """
 
 from __future__ import annotations
@@ -172,35 +139,14 @@ def scene_chain_spec(scene, anchor_spring_factor: float | None = None,
 class SpatialRobotItems:
     """Item indices and data of a spatial robot in an Exudyn ``MainSystem``.
 
-    Attributes
-    ----------
-    platform : SuspendedPlatform
-    unstrained_lengths : ndarray, shape (n_cables,) [m]
-    chain : ChainSpec3D
-    chains : list of SpatialChainItems
-        One per cable, node 0 at the exit point.
-    node_masses : list of ndarray
-        Lumped masses of each chain's nodes [kg].
-    axial_stiffnesses, axial_dampings, bending_stiffnesses : ndarray, shape (n_cables,)
-        Per element [N/m], [N s/m] and per joint [N m/rad].
-    bending_dampings : ndarray, shape (n_cables,)
-        Per joint [N m s/rad] (zeros without bending damping).
-    platform_node : int
-        ``NodePoint`` (point mass) or ``NodeRigidBodyEP`` (rigid body).
-    platform_body : int
-        ``ObjectMassPoint`` or ``ObjectRigidBody``.
-    anchor_markers, joints : list of int
-        Platform markers at the anchors and the spherical joints (or penalty
-        spring-dampers), one per cable.
-    initial : PlatformEquilibrium
-        The catenary equilibrium the robot was started on.
-    swivels : list of (SwivelItems or None)
-        Each cable's swivel pulley in Exudyn (None: the cable leaves from its exit's point).
-    swivel_pulleys : list of (SwivelPulley or None)
-        Their physics (:class:`cdpr_exu.physics.swivel_pulley.SwivelPulley`).
-    winch_elements : ndarray of int, shape (n_cables,)
-        Elements of each chain below the inlet (0 where nothing wraps): node
-        ``winch_elements[i]`` started at the inlet.
+    ``chains`` (one :class:`SpatialChainItems` per cable, node 0 held) and ``node_masses`` [kg];
+    per cable, ``axial_stiffnesses`` and ``axial_dampings`` of each element [N/m, N s/m],
+    ``bending_stiffnesses`` and ``bending_dampings`` of each joint [N m/rad, N m s/rad];
+    ``platform_node`` and ``platform_body`` (point mass or rigid body), ``anchor_markers`` and
+    ``joints`` (spherical or penalty), one per cable; ``initial`` the equilibrium it started on;
+    ``swivels`` and ``swivel_pulleys`` each cable's swivel in Exudyn and its physics (None for
+    a point exit); ``winch_elements`` the elements of each chain below the inlet (node
+    ``winch_elements[i]`` started at the inlet; 0 where nothing wraps).
     """
 
     platform: SuspendedPlatform
@@ -224,10 +170,6 @@ class SpatialRobotItems:
     @property
     def is_point_mass(self):
         return self.platform.is_point_mass
-
-
-
-
 
 
 def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None, exits=None):
@@ -342,9 +284,6 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
                              swivel_items, swivel_pulleys, np.array(winch_elements, dtype=int), bending_dampings)
 
 
-# ---------------------------------------------------------------------------
-# reading the state
-# ---------------------------------------------------------------------------
 def _configuration(current):
     return exu.ConfigurationType.Current if current else exu.ConfigurationType.Initial
 
