@@ -192,7 +192,7 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
         items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
         attach_cable(mbs, platform, i, items.markers[-1], cable, explicit=scene.solver.integrator != "generalized_alpha")
         servo = scene.winch.kind == "servo"
-        winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], float(nodes_xz[0, 1]), drive_height=not servo))
+        winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], drive_height=not servo))
         if servo:
             servos.append(add_servo_drum(mbs, winches[-1], items.nodes[0], scene.winch))
         if on_segments:  # forces in the cables' generic object (add_cable_forces): no Exudyn contact items
@@ -246,7 +246,7 @@ def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems
                         hang - np.array([0.0, segment]), ground_coordinate, scene.effects)
         drive = mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
                                                            offset=0.0))
-        winches.append(WinchItems(-1, drive, float(hang[1] - hanging)))
+        winches.append(WinchItems(-1, drive))
         ropes.append(rope)
         paid_out.append(length)
     mbs.Assemble()

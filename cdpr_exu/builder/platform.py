@@ -31,15 +31,8 @@ class PlatformItems:
 
 def add_platform(mbs: exu.MainSystem, platform: PlatformSpec, effects: Effects,
                  gravity: float) -> PlatformItems:
-    """Add the platform body at its initial pose, its anchor markers and its weight.
-
-    Parameters
-    ----------
-    platform : PlatformSpec
-    effects : Effects
-    gravity : float [m/s^2]
-        Magnitude of gravity along -z.
-    """
+    """Add the platform body at its initial pose, its anchor markers and its weight (``gravity``
+    [m/s^2] along -z)."""
     x, z, rotation = platform.initial_pose
     node = mbs.AddNode(eii.NodeRigidBody2D(referenceCoordinates=[x, z, rotation]))
     body = mbs.AddObject(eii.ObjectRigidBody2D(mass=platform.mass, inertia=platform.inertia,
@@ -67,20 +60,10 @@ def explicit_joint_spring(cable: CableSpec) -> tuple[float, float]:
     of stiffness k = 10 k_i in x and z (3.1e6 N/m for the paper's cable), critically
     damped on the last node's mass m_n: c = 2 sqrt(k m_n) (740 N s/m for the paper).
 
-    Why 10 k_i: the spring is in series with the last element, so it adds a tenth of
-    one element's compliance, 1/(10 n) of the cable's (0.7 % of the paper cable's
-    stretch, about 1 micrometre at its tensions), and a pin joint's answer is kept to
-    that. Why not stiffer: the explicit step must resolve the spring's mode,
-    h < 2.8 / (c / m_n) = 1.4 / omega with omega = sqrt(k / m_n) (8.5e3 rad/s for the
-    paper, h < 1.6e-4 s); the cable's own axial damping already limits the step to
-    about 1e-7 s, and with the damping scaled by 1e-3 the contact stiffness (1e7 N/m
-    on 0.0875 kg nodes, h < 2.6e-4 s) still does; a 1000 k_i spring would take that
-    role (h < 1.6e-5 s) and make the comparison about the joint, not the cable.
-
-    Returns
-    -------
-    stiffness : float [N/m]
-    damping : float [N s/m]
+    Why 10 k_i: in series with the last element it adds 1/(10 n) of the cable's compliance
+    (about 1 micrometre for the paper's cable), while its mode (h < 1.4 / sqrt(k / m_n),
+    1.6e-4 s for the paper) stays slower than the cable's own limits on the explicit step, so
+    the comparison stays about the cable, not the joint. Returns (stiffness [N/m], damping [N s/m]).
     """
     stiffness = EXPLICIT_JOINT_STIFFNESS_FACTOR * cable.axial_stiffness
     node_mass = float(cable.node_masses()[-1])
@@ -89,20 +72,10 @@ def explicit_joint_spring(cable: CableSpec) -> tuple[float, float]:
 
 def attach_cable(mbs: exu.MainSystem, items: PlatformItems, anchor_index: int, node_marker: int,
                  cable: CableSpec | None = None, explicit: bool = False) -> int:
-    """Join a cable's last node to anchor ``anchor_index``.
+    """Join a cable's last node to anchor ``anchor_index``; returns the joint's object index.
 
-    Parameters
-    ----------
-    cable : CableSpec, optional
-        The cable; needed when ``explicit``.
-    explicit : bool
-        False: a revolute joint (the implicit solver's exact pin). True: the stiff
-        spring-damper of :func:`explicit_joint_spring`, for explicit solvers.
-
-    Returns
-    -------
-    int
-        Index of the joint (or spring-damper) object.
+    ``explicit``: the stiff spring-damper of :func:`explicit_joint_spring` (which needs ``cable``)
+    for explicit solvers instead of a revolute joint (the implicit solver's exact pin).
     """
     markers = [items.anchor_markers[anchor_index], node_marker]
     if explicit:

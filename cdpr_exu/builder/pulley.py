@@ -32,24 +32,9 @@ def add_pulley_ground(mbs: exu.MainSystem, pulley: Pulley) -> int:
 
 def add_pulley_contact(mbs: exu.MainSystem, pulley: Pulley, pulley_marker: int,
                        node_markers: list[int], node_positions: np.ndarray) -> list[int]:
-    """Add a rim contact between the pulley and each listed cable node.
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-    pulley : Pulley
-    pulley_marker : int
-        Ground rigid marker at the pulley centre (:func:`add_pulley_ground`).
-    node_markers : list of int
-        Position markers of the nodes that can reach this pulley.
-    node_positions : ndarray, shape (len(node_markers), 2) [m]
-        Their initial positions, to initialise the contact gap.
-
-    Returns
-    -------
-    list of int
-        Indices of the contact objects.
-    """
+    """Add a rim contact between the pulley (``pulley_marker`` at its centre, :func:`add_pulley_ground`)
+    and each listed cable node; ``node_positions`` (len(node_markers), 2) [m] initialise the contact
+    gaps. Returns the contact objects' indices."""
     contacts = []
     center = np.asarray(pulley.center)
     for marker, position in zip(node_markers, np.asarray(node_positions, dtype=float)):

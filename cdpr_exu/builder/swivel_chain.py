@@ -23,21 +23,10 @@ from cdpr_exu.builder.chain_3d import SpatialChainItems
 
 @dataclass
 class SwivelItems:
-    """Item indices of a swivel pulley in Exudyn.
-
-    Attributes
-    ----------
-    node : int
-        The ``NodeGenericODE2`` of psi.
-    obj : int
-        The ``ObjectGenericODE2`` over the chain's nodes and psi.
-    psi_reference : float [rad]
-        Reference value of psi (Exudyn's coordinate is the displacement from it).
-    contact_nodes : ndarray of int64, shape (C,)
-        Chain nodes that can touch the pulley.
-    user_functions : tuple
-        Keeps the Python callables alive as long as the model.
-    """
+    """Item indices of a swivel pulley in Exudyn: the ``NodeGenericODE2`` ``node`` of psi, the
+    ``ObjectGenericODE2`` ``obj`` over the chain's nodes and psi, ``psi_reference`` [rad] (Exudyn's
+    coordinate is the displacement from it), the ``contact_nodes`` (C,) that can touch the pulley;
+    ``user_functions`` keeps the Python callables alive as long as the model."""
 
     node: int
     obj: int
@@ -57,15 +46,8 @@ def add_swivel_pulley(mbs: exu.MainSystem, chain: SpatialChainItems, pulley: sp.
                       psi_rate: float = 0.0, contact_nodes=None) -> SwivelItems:
     """Add a swivel pulley under the nodes of ``chain``.
 
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-    chain : SpatialChainItems
-    pulley : SwivelPulley
-    psi, psi_rate : float [rad, rad/s]
-        Initial swivel angle and rate.
-    contact_nodes : array_like of int, shape (C,), optional
-        Chain nodes (0-based within the chain) that can touch the pulley; all by default.
+    ``psi``, ``psi_rate`` [rad, rad/s]: the initial swivel angle and rate; ``contact_nodes`` (C,):
+    the chain nodes (0-based) that can touch the pulley, all by default.
     """
     n_points = len(chain.nodes)
     nodes = (np.arange(n_points) if contact_nodes is None else np.asarray(contact_nodes)).astype(np.int64)

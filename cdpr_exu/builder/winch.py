@@ -21,43 +21,25 @@ from cdpr_exu.scenes.scene import WinchSpec
 
 @dataclass
 class WinchItems:
-    """The two coordinate constraints on a cable's winch node.
-
-    Attributes
-    ----------
-    horizontal, vertical : int
-        ``ObjectConnectorCoordinate`` indices prescribing x and z of node 0.
-    initial_height : float [m]
-        z of node 0 at t = 0 (its Exudyn reference coordinate).
-    """
+    """The ``ObjectConnectorCoordinate`` constraints prescribing x and z of a cable's winch node."""
 
     horizontal: int
     vertical: int
-    initial_height: float
 
 
-def add_winch(mbs: exu.MainSystem, ground_coordinate_marker: int, node: int, initial_height: float,
-              drive_height: bool = True) -> WinchItems:
-    """Prescribe the winch node: x held, z driven by the offset set per step.
+def add_winch(mbs: exu.MainSystem, ground_coordinate_marker: int, node: int, drive_height: bool = True) -> WinchItems:
+    """Prescribe the winch node ``node`` (node 0): x held, z driven by the offset set per step.
 
     With ``drive_height`` False only x is held (a servo drum then drives z, see
     :func:`add_servo_drum`) and ``vertical`` is -1 until the drum is added.
-
-    Parameters
-    ----------
-    ground_coordinate_marker : int
-        A ``MarkerNodeCoordinate`` on a ground node (its coordinate is always 0).
-    node : int
-        The cable's node 0 (``NodePoint2D``).
-    initial_height : float [m]
-        z of node 0 at t = 0.
+    ``ground_coordinate_marker``: a ``MarkerNodeCoordinate`` on a ground node (always 0).
     """
     constraints = []
     for coordinate in ((0, 1) if drive_height else (0,)):
         marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node, coordinate=coordinate))
         constraints.append(mbs.AddObject(eii.ObjectConnectorCoordinate(
             markerNumbers=[ground_coordinate_marker, marker], offset=0.0)))
-    return WinchItems(constraints[0], constraints[1] if drive_height else -1, initial_height)
+    return WinchItems(constraints[0], constraints[1] if drive_height else -1)
 
 
 def set_paid_out_length(mbs: exu.MainSystem, winch: WinchItems, paid_out: float, initial_paid_out: float) -> None:
@@ -75,11 +57,7 @@ def servo_gains(spec: WinchSpec) -> np.ndarray:
     The drum seen along the cable is a mass m = J / r^2 driven by the motor force
     u = torque / r: s'' = u / m (the cable tension is a disturbance, fed forward and
     removed by the integral). With the state x = (integral of e, e, e'), e = s - s_cmd,
-    u = u_ff - K x.
-
-    Returns
-    -------
-    ndarray, shape (3,) [N/(m s), N/m, N s/m]
+    u = u_ff - K x. Returns K, shape (3,) [N/(m s), N/m, N s/m].
     """
     import control
 
@@ -99,15 +77,8 @@ def servo_gains(spec: WinchSpec) -> np.ndarray:
 
 @dataclass
 class ServoItems:
-    """The drum of a servo winch: a one-coordinate node s (paid-out change) [m].
-
-    Attributes
-    ----------
-    drum_node : int
-    load : int
-        ``LoadCoordinate`` of the motor force on the drum coordinate [N].
-    gains : ndarray, shape (3,)
-    """
+    """The drum of a servo winch: a one-coordinate node s (paid-out change) [m], the ``LoadCoordinate``
+    ``load`` of the motor force on it [N] and the servo ``gains`` (3,)."""
 
     drum_node: int
     load: int
@@ -152,45 +123,29 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
                     rest_length: float, threshold: float = RESERVOIR_THRESHOLD) -> tuple[float, float]:
     """Split a winch command between moving the winch node and the slack rope at the drum.
 
-    A slack cable cannot keep its rope off the winch: rope paid out while nothing pulls
-    it away, or falling faster than the winch hauls in, piles up at the drum. In the
-    lumped model the winch node would instead run into the next node, and the first
-    element would collapse (and Newton with it when the cable snaps taut). So the winch
-    node never moves where its element would be shorter than ``threshold`` of its
-    nominal length: the rope that does not go into the node's motion is kept as
-    *surplus* at the drum, added to the first element's rest length. Hauling in a slack
-    cable takes up the surplus first, but no more of it than the element's slack and
-    :data:`TAUT_MARGIN` (reeling in more at once would stretch the element by the excess within
-    one step: the 240-element circle's winch element snapped taut at 0.37 % strain where its
-    steps ran longer; reeling in exactly the slack leaves the element on the law's kink, where
-    Newton converges slowly: the same circle at 1e-2 s took 3505 steps instead of 1727); once the cable is taut again (the first element at
-    or beyond its rest length, surplus included), the surplus is rope of that taut element
-    and hauling in moves the node. (Taking it up by shrinking the rest length of a taut
-    element instead strains that one element at the haul-in rate over its length; with
-    the paper's Kelvin-Voigt time constant d_n / E = 1 s the element then lags the
-    command by 1 s times the haul-in speed, 5 % of a 240th of the paper's cable, which
-    the run monitor refused.) Rope is conserved: ``node_offset + surplus == paid_out_change``.
+    A slack cable's rope paid out while nothing pulls it away piles up at the drum; in the
+    lumped model the winch node would instead run into the next node and collapse the first
+    element. So the node never moves where its element would be shorter than ``threshold`` of
+    its nominal length: the rest is kept as *surplus* at the drum, added to the first element's
+    rest length. Hauling in a slack cable takes up the surplus first, but no more than the
+    element's slack and :data:`TAUT_MARGIN` (more at once snaps the element taut within one
+    step; exactly the slack leaves it on the law's kink, where Newton converges slowly); once
+    the cable is taut again the surplus is rope of that taut element and hauling in moves the
+    node (shrinking a taut element's rest length instead would make it lag the command by its
+    Kelvin-Voigt time constant). Rope is conserved: ``node_offset + surplus == paid_out_change``.
 
     Parameters
     ----------
     paid_out_change : float [m]
-        The command: paid-out length minus its initial value (positive: paid out, the
-        node moves up the winch line towards the pulley).
-    node_offset : float [m]
-        The winch node's current offset up the winch line.
-    surplus : float [m]
-        The rope held at the drum so far (>= 0).
-    element_length : float [m]
-        The first element's current length |p_1 - p_0|.
-    rest_length : float [m]
-        Its nominal rest length (without the surplus).
+        The command: paid-out length minus its initial value (positive: the node moves up).
+    node_offset, surplus : float [m]
+        The winch node's current offset up the winch line and the rope held at the drum (>= 0).
+    element_length, rest_length : float [m]
+        The first element's current length |p_1 - p_0| and nominal rest length (no surplus).
     threshold : float
         Shortest length of the first element, as a fraction of ``rest_length``.
 
-    Returns
-    -------
-    (node_offset, surplus) : floats [m]
-        The new offset of the winch node and the new surplus (>= 0).
+    Returns the new ``(node_offset, surplus)`` [m].
     """
     wanted = paid_out_change - surplus  # where the node goes if the surplus stays
     slack = rest_length + surplus - element_length  # how much shorter than its rest length the element is
@@ -207,16 +162,11 @@ def reservoir_split(paid_out_change: float, node_offset: float, surplus: float, 
 class RopeReservoir:
     """The slack rope held at each winch drum, and the first elements it lengthens.
 
-    Attributes
-    ----------
-    first_elements : ndarray of int, shape (m,)
-        Index of each cable's winch element in the tension-only element arrays.
-    nominal_rest_length, axial_rigidity, damping_rigidity : ndarray, shape (m,) [m, N, N s]
-        The winch element's unstrained length, E A and d_n A: its stiffness and damping
-        are E A / l and d_n A / l for its current rest length l.
-    rest_length, stiffness, damping : ndarray
-        The arrays the force kernel reads (changed in place).
-    surplus, node_offset, max_surplus : ndarray, shape (m,) [m]
+    Per cable (m,): ``first_elements`` the winch element's index in the tension-only arrays,
+    ``nominal_rest_length``, ``axial_rigidity`` and ``damping_rigidity`` its l0, E A and d_n A
+    [m, N, N s] (stiffness E A / l, damping d_n A / l for its current rest length l), and
+    ``surplus``, ``node_offset``, ``max_surplus`` [m]. ``rest_length``, ``stiffness`` and
+    ``damping`` are the arrays the force kernel reads (changed in place).
     """
 
     first_elements: np.ndarray

@@ -32,18 +32,10 @@ __all__ = ["Exit", "EXIT_KINDS", "exit_from_dict"]
 class Exit:
     """Where a cable leaves the frame (the protocol every exit kind implements).
 
-    Class attributes
-    ----------------
-    kind : str
-        The name of the kind in scene files (``kind = "pulley"``) and in :data:`EXIT_KINDS`.
-    dimensions : tuple of int
-        The dimensions the kind exists in: (2,), (3,) or (2, 3).
-    required_fields : dict of str to str
-        The fields a scene file must give, with their units (no default would be the robot
-        its author meant); the loader names each one left out.
-    path_head : str
-        The name its own messages give the exit's fields (``"pulley.radius"``); the loader
-        replaces it with the exit's place in the scene (``"pulleys[1].radius"``).
+    Class attributes: ``kind`` (its name in scene files and :data:`EXIT_KINDS`), ``dimensions``
+    it exists in, ``required_fields`` a scene file must give (with units; the loader names each
+    one left out), ``path_head`` (the name its own messages give its fields, ``"pulley.radius"``,
+    which the loader replaces with the exit's place, ``"exits[1].radius"``).
 
     Every kind has a ``point`` (its fixed point, shape (d,) [m]: a pulley's centre, a swivel's
     inlet, a point exit's point) and a ``radius`` [m] the cable wraps over (0: it leaves from
@@ -58,7 +50,7 @@ class Exit:
     point: tuple
     radius: float
     #: The side a planar cable hangs from its exit's winch line, -1 (left) or 1 (right): a pulley's own; a
-    #: kind that does not wrap hangs on the left, as the planar point exits always did.
+    #: kind that does not wrap hangs on the left.
     side = -1
 
     @property

@@ -1,13 +1,9 @@
 """A point exit: the cable leaves the frame at a fixed point, in the plane or in space.
 
 No pulley: the cable runs straight from the point to its anchor, nothing wraps, and there is
-no contact. In a planar scene (``cable_exit = "point"``, or ``[[exits]]`` with ``kind =
-"point"``) the cable's winch end is held at the point (fixed winches); in a spatial scene
-the winch pays the cable out through it.
-
-Its ideal cable is computed by the kernel of its space (:mod:`cdpr_exu.core.geometry`): the
-planar pulley's of radius 0 in the plane, the swivel pulley's of radius 0 in space, so that
-each dimension's numbers are what they were before exits were objects.
+no contact. In a planar scene the cable's winch end is held at the point (fixed winches); in
+a spatial scene the winch pays the cable out through it. Its ideal cable is its space's pulley
+kernel at radius 0 (:mod:`cdpr_exu.core.geometry`).
 """
 
 from __future__ import annotations
@@ -24,31 +20,18 @@ from cdpr_exu.exits.base import Exit
 
 __all__ = ["PointExit"]
 
-#: The labels of a point's coordinates, by its size.
 _LABELS = {2: "x, z", 3: "x, y, z"}
 
-
 #: The ideal cable's kernel of a point exit, by the size of its point: the planar pulley's at radius 0, hung
-#: on its left (side -1, as the planar point exits always were), and the swivel pulley's at radius 0.
+#: on its left (side -1), and the swivel pulley's at radius 0.
 _KERNELS = {2: lambda point, anchor_points, azimuth_hint: planar_exit(point, 0.0, -1, anchor_points),
             3: lambda point, anchor_points, azimuth_hint: swivel_pulley_exit(point, 0.0, anchor_points, azimuth_hint)}
 
 
 @dataclass(frozen=True)
 class PointExit(Exit):
-    """A fixed exit point: the cable leaves the frame at ``point``.
-
-    Parameters
-    ----------
-    point : (x, z) or (x, y, z) [m]
-        The exit point, world frame; its size is its scene's dimension.
-
-    Raises
-    ------
-    SceneError
-        If ``point`` is not two or three finite numbers (naming ``point_exit.point``, which the
-        loader names ``exits[i].point``).
-    """
+    """A fixed exit point: the cable leaves the frame at ``point`` (x, z) or (x, y, z) [m], world frame
+    (its size is its scene's dimension); anything but two or three finite numbers is refused."""
 
     kind: ClassVar[str] = "point"
     dimensions: ClassVar[tuple[int, ...]] = (2, 3)

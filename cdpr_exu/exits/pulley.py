@@ -37,15 +37,8 @@ class Pulley(Exit):
     side : {-1, +1}
         -1: the cable hangs on the pulley's left (x < x_c) and wraps clockwise over the top,
         +1: on its right (counter-clockwise).
-    contact_stiffness : float [N/m]
-        Penalty stiffness k_p of the rim contact.
-    contact_damping : float [N s/m]
-        Damping c_p on the normal velocity of a node in contact.
-
-    Raises
-    ------
-    SceneError
-        Naming the field (``pulley.radius``; the loader names it ``pulleys[i].radius``).
+    contact_stiffness, contact_damping : float [N/m, N s/m]
+        Penalty stiffness k_p of the rim contact and damping c_p on a node's normal velocity.
     """
 
     kind: ClassVar[str] = "pulley"

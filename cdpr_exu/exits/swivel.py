@@ -37,25 +37,12 @@ class Swivel(Exit):
         ``radius`` from the axis, at the inlet's height).
     radius : float [m]
         Groove-bottom radius r_p of the disc.
-    contact_stiffness : float [N/m]
-        Penalty stiffness k_p of the node-on-disc contact.
-    contact_damping : float [N s/m]
-        Damping on the penetration rate (0: none).
-    swivel_inertia : float [kg m^2]
-        J_s of the turning part about the axis.
-    bearing_damping : float [N m s]
-        Viscous torque d_s psi_dot of the swivel bearing.
-    groove_radius, flange_height : float [m]
-        The groove's sideways curvature radius and the height of its flanks.
+    contact_stiffness, contact_damping, swivel_inertia, bearing_damping, groove_radius, flange_height
+        As :class:`cdpr_exu.physics.swivel_pulley.SwivelPulley`'s.
     winch_line : float [m]
         Unstrained cable between the winch end (held on the axis below the inlet) and
         the inlet at the start; the winch can pay out at most this much less a
         margin of two elements during a run.
-
-    Raises
-    ------
-    SceneError
-        Naming the field (``swivel.radius``; the loader names it ``exits[i].radius``).
     """
 
     kind: ClassVar[str] = "swivel"

@@ -49,22 +49,9 @@ ROUNDOFF_STRAIN = 1.0e-12
 
 @njit(cache=True)
 def tension_law(extension, rate, stiffness, damping, band):
-    """Tension of a tension-only element and its derivatives.
-
-    Parameters
-    ----------
-    extension : float [m]
-        s = l - l0 (negative: shorter than the rest length, slack).
-    rate : float [m/s]
-        ds/dt.
-    stiffness, damping : float [N/m, N s/m]
-    band : float [m]
-        Extension over which the element goes from slack to taut (C1 smoothstep).
-
-    Returns
-    -------
-    (tension, d tension / d extension, d tension / d rate) : floats [N, N/m, N s/m]
-        The tension is never negative; zero below the rest length.
+    """Tension [N] of a tension-only element at extension s = l - l0 [m] and rate ds/dt [m/s], and its
+    slopes in both [N/m, N s/m]; ``band`` [m] the extension over which it goes from slack to taut (C1
+    smoothstep). Never negative; zero below the rest length.
     """
     if extension <= 0.0:
         return 0.0, 0.0, 0.0
@@ -109,24 +96,16 @@ CUT_SLOPE_ITERATIONS = 15
 class CutSlopes:
     """When Newton's Jacobian gives a damper-cut tension-only element its taut slopes.
 
-    In an implicit step a Newton update of the positions by dq changes the velocities by
-    gamma / (beta h) dq (200 dq / s at h = 1e-2 s), so the damper of a Kelvin-Voigt cable
-    (retardation c / k of about 1 s) sees a change some hundred times larger than the
-    spring: an iterate that shortens a taut element by a few nanometres cuts its force to
-    zero (k s + c ds/dt <= 0), and with the law's zero slopes there the next Jacobian has
-    no axial term for it. On the spatial four-cable move at 32 elements this happened in
-    17 % of the force evaluations; Newton took 18 to 70 iterations per step and cut the
-    steps, although every converged state kept its elements above 4.9 N. A cut element
-    that keeps its taut slopes (:func:`newton_slopes`) is pulled back by the next iterate,
-    and wherever the converged state is taut the Jacobian there is exact.
-
-    An element that the converged state truly cuts (a cable snapped slack faster than it
-    relaxes, as the winch lines of the planar circle's abrupt start are) then converges
-    only linearly: with the rule throughout, the paper circle took 152 816 steps instead
-    of 5 376. So the rule holds for the first :data:`CUT_SLOPE_ITERATIONS` force evaluations
-    of each attempt at a step (at one time ``t``; a retried, shorter step starts again);
-    after them the Jacobian is the law's own. The force is never changed: what Newton
-    converges to is the same law, to its tolerance.
+    In an implicit step a Newton update dq changes the velocities by gamma / (beta h) dq, so
+    the damper of a Kelvin-Voigt cable sees a change some hundred times larger than the spring:
+    an iterate that shortens a taut element by nanometres cuts its force to zero (k s + c ds/dt
+    <= 0), and with the law's zero slopes the next Jacobian has no axial term for it (measured:
+    18 to 70 iterations per step on the spatial four-cable move). A cut element that keeps its
+    taut slopes (:func:`newton_slopes`) is pulled back by the next iterate. An element the
+    converged state truly cuts then converges only linearly (the paper circle took 28 times the
+    steps), so the rule holds for the first :data:`CUT_SLOPE_ITERATIONS` force evaluations of
+    each attempt at a step (at one time ``t``); after them the Jacobian is the law's own. The
+    force is never changed.
     """
 
     def __init__(self, iterations: int = CUT_SLOPE_ITERATIONS):
@@ -150,14 +129,8 @@ class CutSlopes:
 def slack_axial_force(positions, velocities, elements, rest_length, stiffness, damping, out):
     """Add the tension-only axial forces to ``out`` (2N,) [N] and return it.
 
-    Parameters
-    ----------
-    positions, velocities : ndarray, shape (2N,) [m, m/s]
-    elements : ndarray of int, shape (E, 2)
-        Node pairs (a, b) of each element.
-    rest_length, stiffness, damping : ndarray, shape (E,) [m, N/m, N s/m]
-    out : ndarray, shape (2N,)
-        Accumulated into (not zeroed).
+    ``positions``, ``velocities`` (2N,) [m, m/s]; ``elements`` (E, 2) node pairs; ``rest_length``,
+    ``stiffness``, ``damping`` (E,) [m, N/m, N s/m]. ``out`` is accumulated into, not zeroed.
     """
     for e in range(elements.shape[0]):
         a, b = elements[e, 0], elements[e, 1]
@@ -180,18 +153,13 @@ def _element_block(positions, velocities, a, b, rest_length, stiffness, damping,
     element into ``block``; the (a, a) block is the same, (a, b) and (b, a) its negative.
     Returns False (block untouched) when the element carries no force (slack).
 
-    With ``kink_strain`` > 0 (the run's first step only, :data:`ROUNDOFF_STRAIN`), an
-    element within that strain of its rest length, as every element of a cable placed
-    straight at zero strain is at t = 0, sits on the kink of the law, where its slopes are
-    0 on one side and (k, c) on the other: its block takes the taut slopes (k, c) and no
-    geometric term, though it carries no force. With the slack side's zero slopes, the
-    first Jacobian of such a start holds no axial term at all, and the first Newton
-    iterate moves every node as a free mass (strains of 20-40 %, a residual of 4e6 N on
-    240 elements per cable). Later in a run (``kink_strain`` = 0) only an element exactly
-    on its rest length keeps the taut slopes (a section carried along bit for bit, as the
-    winch line is in the first steps; without it 120 and 240 elements at 1e-2 s fail
-    again): an element passing *near* its rest length with a taut Jacobian stalled Newton
-    (the held catenary scene failed at 5.9e-5 s with 1e-12 throughout).
+    With ``kink_strain`` > 0 (the run's first step only, :data:`ROUNDOFF_STRAIN`), an element
+    within that strain of its rest length (every element of a cable placed straight at zero
+    strain, at t = 0) sits on the law's kink: its block takes the taut slopes (k, c) and no
+    geometric term, though it carries no force; with the slack side's zero slopes the first
+    Newton iterate would move every node as a free mass. Later (``kink_strain`` = 0) only an
+    element exactly on its rest length keeps the taut slopes: one passing *near* it with a
+    taut Jacobian stalled Newton (measured on the held catenary scene).
 
     With ``cut_slopes`` a damper-cut element keeps its taut slopes (:func:`newton_slopes`).
     """
@@ -278,16 +246,7 @@ def slack_triplet_values(positions, velocities, elements, rest_length, stiffness
 
 
 def cable_elements(nodes_per_cable) -> np.ndarray:
-    """Element node pairs (a, b) for cables whose nodes are numbered one after another.
-
-    Parameters
-    ----------
-    nodes_per_cable : sequence of int
-
-    Returns
-    -------
-    ndarray of int64, shape (E, 2)
-    """
+    """Element node pairs (a, b), shape (E, 2), for cables whose nodes are numbered one after another."""
     pairs, start = [], 0
     for count in nodes_per_cable:
         pairs.extend((start + j, start + j + 1) for j in range(count - 1))

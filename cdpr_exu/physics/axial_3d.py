@@ -1,22 +1,13 @@
 """Tension-only (slack) axial spring-dampers of spatial lumped-mass cables: numba kernels.
 
-The spatial counterpart of :mod:`cdpr_exu.physics.axial`, with the same law
-(:func:`cdpr_exu.physics.axial.tension_law`, imported, not copied): element e between nodes
-a and b pulls them together along u = (p_b - p_a) / l with
+The spatial counterpart of :mod:`cdpr_exu.physics.axial`, with its law
+(:func:`cdpr_exu.physics.axial.tension_law`) on s = l - l0 and ds/dt = u . (v_b - v_a) - dl0/dt,
+u = (p_b - p_a) / l. Above the band a taut element is exactly Exudyn's
+``ObjectConnectorSpringDamper``, its ``velocityOffset`` the rest length's rate ``rest_rate``
+(nonzero while a winch pays the cable out: the damper acts on the strain rate).
 
-    T = g(s) max(0, k s + c ds/dt),   s = l - l0,   ds/dt = u . (v_b - v_a) - dl0/dt,
-
-g a C1 smoothstep from 0 at the rest length to 1 at a strain of
-:data:`cdpr_exu.physics.axial.TAUT_BAND`. Below the rest length there is no force at all, not
-even damping. Above the band a taut element is exactly Exudyn's
-``ObjectConnectorSpringDamper`` (k (l - l0) + c (dl/dt - dl0/dt) along the element, its
-``velocityOffset`` the rest length's rate ``rest_rate``, nonzero while a winch pays the
-cable out: the damper acts on the strain rate).
-
-The left-hand-side Jacobians K = -df/dq and D = -df/dv are handed to Exudyn as
-``f_q K + f_q_t D`` (the convention of :mod:`cdpr_exu.physics.bending_3d` and of the
-planar :mod:`cdpr_exu.builder.cable`), as sparse triplets in a fixed pattern: one 6 x 6 block
-per element on the coordinates (p_a, p_b). With G the (b, b) block,
+The Jacobian ``f_q K + f_q_t D`` (K = -df/dq, D = -df/dv) goes to Exudyn as sparse triplets,
+one 6 x 6 block per element on (p_a, p_b). With G the (b, b) block,
 
     G_ij = f_q [u_i (k' u_j + c' w_j) + T (delta_ij - u_i u_j) / l] + f_q_t c' u_i u_j,
     w = (dv - u ds/dt) / l = d(ds/dt)/dp_b,
@@ -33,10 +24,6 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu.physics.axial import TAUT_BAND, newton_slopes, tension_law
-
-#: Triplets per element: the 6 x 6 block on (p_a, p_b).
-TRIPLETS_PER_ELEMENT = 36
-
 
 @njit(cache=True)
 def _element_state(positions, velocities, a, b, u, dv):
@@ -72,15 +59,9 @@ def tension_only_tensions(positions, velocities, elements, rest_length, stiffnes
 def tension_only_force(positions, velocities, elements, rest_length, stiffness, damping, rest_rate, out):
     """Add the tension-only axial forces [N] to ``out`` (3N,) (accumulated, not zeroed) and return it.
 
-    Parameters
-    ----------
-    positions, velocities : ndarray, shape (3N,) [m, m/s]
-    elements : ndarray of int, shape (E, 2)
-        Node pairs (a, b).
-    rest_length, stiffness, damping : ndarray, shape (E,) [m, N/m, N s/m]
-    rest_rate : ndarray, shape (E,) [m/s]
-        dl0/dt of each element (0 but while a winch changes the cable's length).
-    out : ndarray, shape (3N,)
+    ``positions``, ``velocities`` (3N,) [m, m/s]; ``elements`` (E, 2) node pairs; ``rest_length``,
+    ``stiffness``, ``damping``, ``rest_rate`` (E,) [m, N/m, N s/m, m/s] (dl0/dt: 0 but while a winch
+    changes the cable's length).
     """
     u = np.empty(3)
     dv = np.empty(3)

@@ -8,9 +8,8 @@ for a cable that stays in a plane). Written through c = cos(theta),
     f = -dU/dq = k phi(c) dc/dq,      phi(c) = theta / sin(theta) = arccos(c) / sqrt(1 - c^2),
 
 which stays smooth at a straight cable (phi -> 1 + (1 - c)/3 + ...), where arccos itself
-is not differentiable. The stiffness matrix is K = -df/dq = -k (phi'(c) g g^T + phi(c) H)
-with g, H the gradient and Hessian of c; it is handed to Exudyn as sparse triplets,
-81 per joint, in a fixed pattern.
+is not differentiable. K = -df/dq = -k (phi'(c) g g^T + phi(c) H), g and H the gradient and
+Hessian of c, goes to Exudyn as sparse triplets, 81 per joint.
 
 Bending dampers (:func:`add_spatial_bending_damping_force`, the planar model's c_theta =
 d_n J / l0 per joint) act on the relative angular velocity of the two segments,
@@ -19,15 +18,12 @@ dw = w2 - w1 with w_i = e_i x de_i/dt / |e_i|^2, through the Rayleigh function
     R = (c/2) dw^T M dw,   M = (eps^2 I + kappa kappa^T) / (|kappa|^2 + eps^2),   kappa = u1 x u2,
 
 u_i = e_i / |e_i| (|kappa| = sin(theta)), and the force -dR/dv. Along the joint plane's
-normal dw is the rate of the angle theta; in the plane it is what a rigid rotation about an
-in-plane axis also makes (|dw| = Omega sin(theta)): a point-mass joint cannot tell the two
-apart. M keeps the normal part whole and weights the in-plane part by eps^2 / (sin^2(theta)
-+ eps^2): a straight cable (theta << eps) has the isotropic damper (c/2)|dw|^2, smooth, with
-no plane to choose; a bent joint (theta >> eps) damps only the rate of its angle, so a
-turning pulley's wrap is damped eps^2 / sin^2(theta) less than by (c/2)|dw|^2 (eps =
-:data:`ISOTROPIC_BEND`; ``isotropic_bend = inf`` gives M = I). A cable moving in one plane
-feels exactly the planar damper c dtheta/dt. The Jacobians in positions and velocities are
-analytic, added to the bending springs' 81 triplets per joint (docs/spatial.md).
+normal dw is the rate of theta; in the plane it is also what a rigid rotation about an
+in-plane axis makes (|dw| = Omega sin(theta)), which a point-mass joint cannot tell apart.
+M keeps the normal part whole and weights the in-plane part by eps^2 / (sin^2(theta) + eps^2)
+(eps = :data:`ISOTROPIC_BEND`; ``inf`` gives M = I): a straight cable has the isotropic damper,
+with no plane to choose; a bent joint damps only the rate of its angle. A cable moving in one
+plane feels exactly the planar damper c dtheta/dt. The Jacobians are analytic (docs/spatial.md).
 
 Coordinates: flat arrays (x0, y0, z0, x1, ...) [m]; spatial scenes have z up.
 """
@@ -372,13 +368,3 @@ def bending_damping_dissipation(positions, velocities, joints, damping, isotropi
                                isotropic_bend, segment, none, none, vectors, no_matrices)
     return power
 
-
-def relative_angular_velocity(positions, velocities, a, b, c) -> np.ndarray:
-    """w2 - w1 [rad/s], shape (3,): the angular velocities w_i = e_i x de_i/dt / |e_i|^2 of the
-    segments e1 = p_b - p_a and e2 = p_c - p_b of the joint (a, b, c), a damper candidate."""
-    p = np.asarray(positions, dtype=float).reshape(-1, 3)
-    v = np.asarray(velocities, dtype=float).reshape(-1, 3)
-    e1, e2 = p[b] - p[a], p[c] - p[b]
-    w1 = np.cross(e1, v[b] - v[a]) / (e1 @ e1)
-    w2 = np.cross(e2, v[c] - v[b]) / (e2 @ e2)
-    return w2 - w1

@@ -1,12 +1,7 @@
 """The cables' Python-side forces (exact-angle bending and tension-only axial elements) in
-one numba call each for the force and its Jacobian.
-
-Exudyn calls the cables' ``ObjectGenericODE2`` force function once per Newton iteration
-and its Jacobian function once per Jacobian update. Calling the bending and the
-tension-only kernels separately from Python, with their argument checks, cost about
-11 us per force call on the paper circle (2 x 16 nodes); one call of one compiled
-function does the same arithmetic in the same order (so the same bits) for a few
-microseconds (``benchmarks/bench_accuracy_speed.py``).
+one numba call each for the force and its Jacobian, which Exudyn calls once per Newton
+iteration and per Jacobian update: the same arithmetic as the separate kernels, in the same
+order (so the same bits), without their Python-side calls.
 
 No Exudyn here: coordinates are flat arrays (x0, y0, x1, y1, ...) [m, m/s].
 """
@@ -24,16 +19,10 @@ def cable_force(reference, q, q_t, positions, joints, stiffness, damping, elemen
                 axial_stiffness, axial_damping, out):
     """Bending plus tension-only axial force of the cables, shape (2N,) [N], into ``out``.
 
-    Parameters
-    ----------
-    reference, q : ndarray, shape (2N,) [m]
-        Exudyn's reference positions and displacements; ``positions`` (2N,) receives their sum.
-    q_t : ndarray, shape (2N,) [m/s]
-    joints, stiffness, damping : the bending joints (J, 3) and their k_theta, d_theta (J,)
-        [N m/rad, N m s/rad] (:func:`cdpr_exu.physics.bending.bending_force_kernel`).
-    elements, rest_length, axial_stiffness, axial_damping : the tension-only elements (E, 2)
-        and their l0, k, c (E,) [m, N/m, N s/m] (:func:`cdpr_exu.physics.axial.slack_axial_force`);
-        E = 0 for push-capable cables (Exudyn's own spring-dampers).
+    ``reference``, ``q`` (2N,) [m]: Exudyn's reference positions and displacements (``positions``
+    receives their sum); ``q_t`` (2N,) [m/s]; the bending ``joints`` (J, 3) with their ``stiffness``
+    and ``damping`` (J,) [N m/rad, N m s/rad]; the tension-only ``elements`` (E, 2) with their l0,
+    k, c (E,) [m, N/m, N s/m] (E = 0 for push-capable cables, Exudyn's own spring-dampers).
     """
     for i in range(positions.shape[0]):
         positions[i] = reference[i] + q[i]

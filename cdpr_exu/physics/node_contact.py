@@ -11,22 +11,14 @@ elements (:func:`cdpr_exu.physics.axial.tension_law`, with the penetration as th
 and, for b -> 0, the law of Exudyn's ``ObjectContactSphereSphere`` (contact model "node"):
 spring and damper in compression, never pulling the node into the pulley.
 
-It was built to answer one question of the speed work (issue 14): does contact that
-Newton sees as a smooth force beat Exudyn's contact items, which switch contact on and
-off in *discontinuous iterations* after Newton has converged (1.5 per step on the paper
-circle at 60 elements and a 1e-2 s step)? Measured there
-(``benchmarks/bench_contact_models.py``, docs/accuracy.md): it does not. The contact is
-stiff (k_p = 1e7 N/m against 22 g nodes: omega h = 200 at that step), and a Newton
-iteration that starts outside the disc overshoots deep into it; with the contact status
-frozen, as Exudyn's items do it, Newton solves a fixed problem instead. So
-``Effects.pulley_contact_model = "node_smooth"`` is an option, not the default.
+Measured (``benchmarks/bench_contact_models.py``, docs/accuracy.md), this smooth force does
+not beat Exudyn's contact items, which freeze the contact status within Newton's iteration:
+the contact is stiff (omega h = 200 on the paper circle at 1e-2 s), and an iteration that
+starts outside the disc overshoots deep into it. So ``pulley_contact_model = "node_smooth"``
+is an option, not the default. The Jacobian is analytic (2 x 2 per node, sparse triplets).
 
-The force is C1 in the coordinates, with an analytic Jacobian (2 x 2 per node, handed
-to Exudyn as sparse triplets).
-
-Coordinates are flat arrays ``x0, y0, x1, y1, ...`` [m, m/s] over a global node list,
-as in :mod:`cdpr_exu.physics.segment_contact`; each contact node carries its own pulley.
-This module does not import Exudyn.
+Coordinates are flat arrays ``x0, y0, x1, y1, ...`` [m, m/s] over a global node list; each
+contact node carries its own pulley. This module does not import Exudyn.
 """
 
 from __future__ import annotations
@@ -65,17 +57,8 @@ def _node_state(positions, velocities, node, cx, cy):
 def node_contact_force_kernel(positions, velocities, nodes, centers, radii, stiffness, damping, band, out):
     """Add the rim-contact forces of ``nodes`` to ``out`` (2N,) [N] and return it (unchecked).
 
-    Parameters
-    ----------
-    positions, velocities : ndarray, shape (2N,) [m, m/s]
-    nodes : ndarray of int64, shape (C,)
-        Global indices of the contact nodes.
-    centers : ndarray, shape (C, 2) [m]
-    radii, stiffness, damping : ndarray, shape (C,) [m, N/m, N s/m]
-    band : float [m]
-        Onset band b.
-    out : ndarray, shape (2N,)
-        Accumulated into (not zeroed).
+    ``positions``, ``velocities`` (2N,) [m, m/s]; ``nodes`` (C,) global indices, ``centers`` (C, 2) [m],
+    ``radii``, ``stiffness``, ``damping`` (C,) [m, N/m, N s/m] as :class:`NodePulleyContact`'s.
     """
     for k in range(nodes.shape[0]):
         node = nodes[k]

@@ -21,18 +21,12 @@ the pulley; a contact that separates faster than k_p (r - d) / c_p simply lets g
 **Endpoints.** Each listed segment counts its own closest point with full weight. When
 the closest points of both segments next to a node clamp to that node (t = 1 on one, t = 0
 on the other: a corner pointing into the disc), the node is pushed by both, i.e. with
-2 k_p. This is deliberate: (1) the spring part is then the gradient of the potential
+2 k_p. This is deliberate: the spring part is then the gradient of the potential
 V = sum_s k_p (r - d_s)_+^2 / 2 (envelope theorem: dd/dp_a = (1 - t) n, dd/dp_b = t n),
-so the force is continuous and its stiffness symmetric; (2) no rule that counts such a
-node once can be continuous: just outside that configuration both feet lie inside their
-segments, arbitrarily close to the node, each must count fully (a chord cutting the disc
-must be pushed out), and their sum tends to twice the node's force; weighting a clamped
-endpoint by 1/2, or counting it once, makes the force jump by k_p times the node's
-penetration when a foot crosses the node, an impact for Newton's iteration. In a wrap the
-feet lie inside the chords and the nodes outside the disc; the doubled corner only arises
-for a cable kinked into the pulley, where it halves the corner's penetration. (On the
-paper's circle, 10 s sampled every 2 ms, no active contact ever sat at a segment end:
-0 of 20 000 at 15 elements per cable, 0 of 15 000 at 7.)
+continuous with a symmetric stiffness, and no rule that counts such a node once can be
+continuous (just outside that configuration both feet lie inside their segments and each
+must count fully). The doubled corner only arises for a cable kinked into the pulley; on
+the paper's circle no active contact ever sat at a segment end.
 
 Coordinates are flat arrays ``x0, y0, x1, y1, ...`` [m, m/s] over a global node list (as
 in an Exudyn ``ObjectGenericODE2`` over ``NodePoint2D`` nodes); each segment carries its
@@ -99,16 +93,8 @@ def _closest_point(positions, velocities, a, b, cx, cy):
 def segment_contact_force_kernel(positions, velocities, segments, centers, radii, stiffness, damping, out):
     """Add the segment contact forces to ``out`` (2N,) [N] and return it (unchecked).
 
-    Parameters
-    ----------
-    positions, velocities : ndarray, shape (2N,) [m, m/s]
-    segments : ndarray of int64, shape (S, 2)
-        Global node pairs (a, b).
-    centers : ndarray, shape (S, 2) [m]
-        Pulley centre of each segment.
-    radii, stiffness, damping : ndarray, shape (S,) [m, N/m, N s/m]
-    out : ndarray, shape (2N,)
-        Accumulated into (not zeroed).
+    ``positions``, ``velocities`` (2N,) [m, m/s]; ``segments`` (S, 2), ``centers`` (S, 2) [m], ``radii``,
+    ``stiffness``, ``damping`` (S,) [m, N/m, N s/m] as :class:`SegmentPulleyContact`'s.
     """
     for k in range(segments.shape[0]):
         a = segments[k, 0]

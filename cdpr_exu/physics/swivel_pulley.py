@@ -21,10 +21,8 @@ and rises to flanks of height h:
 
 g(s) ~ s^2 / (2 r_g) near the groove's middle, so the sideways force comes from the
 contact force itself (a sideways spring switched on and off with contact is not
-conservative, docs/spatial.md). The unbounded parabola s^2 / (2 r_g) of the prototype
-reaches out of the pulley: with r_g = 1 cm, a node 1 m below the rim on a cable that leaves
-the disc plane by 10 degrees has s^2 / (2 r_g) = 1.5 m against d - r_p = 0.9 m, and would be
-"in contact"; the flanks of height h bound it: only nodes within h of the rim can touch.
+conservative, docs/spatial.md). The flanks of height h bound g, so that only nodes within h
+of the rim can touch (an unbounded s^2 / (2 r_g) reaches nodes far below the rim).
 
 The normal force is the planar node contact's law (:mod:`cdpr_exu.physics.node_contact`,
 :func:`cdpr_exu.physics.axial.tension_law`): F = S(delta / b) max(0, k_p delta + c_p d(delta)/dt),
@@ -237,26 +235,14 @@ class SwivelStabilityWarning(CdprWarning):
 
 def stability_concerns(modified_newton: bool, spectral_radius: float, newton_tolerance: float,
                        element_length: float, radius: float) -> list[str]:
-    """Why a run without the energy guard lies outside the measured region, one message per setting.
+    """Why a run without the energy guard lies outside the measured region, one message per setting
+    (empty inside it; ``element_length``, ``radius`` [m]).
 
     Measured to hold (benchmarks/results/swivel_pulley.md, J_s 1e-6 to 1 kg m^2, d_s 0 to
     0.1 N m s, steps 5e-3 and 2e-3 s): full Newton at spectral radius <= 0.5, relative
     tolerance <= :data:`SAFE_NEWTON_TOLERANCE` and elements up to :data:`SAFE_ELEMENT_FRACTION`
-    of the radius; and the planar runs' defaults, modified Newton at spectral radius 0 and
-    tolerance 1e-6, with elements up to the radius. Measured to gain energy: spectral
-    radius 1 (even in a planar hang), full Newton at 1e-8 or 1e-6, and full Newton with
-    elements as long as the radius.
-
-    Parameters
-    ----------
-    modified_newton : bool
-    spectral_radius, newton_tolerance : float
-    element_length, radius : float [m]
-
-    Returns
-    -------
-    list of str
-        Empty inside the measured region.
+    of the radius; and modified Newton at spectral radius 0 and tolerance 1e-6, with elements
+    up to the radius. The messages say what was measured to gain energy.
     """
     concerns = []
     if spectral_radius > 0.5:
@@ -285,23 +271,14 @@ class SwivelPulley:
     Parameters
     ----------
     inlet : (x, y, z) [m]
-        Inlet point A on the swivel axis, at the height of the disc centre; the winch side
-        of the cable runs along the vertical through it, the centre is A + r_p e_r(psi).
-    radius : float [m]
-        Groove-bottom radius r_p of the disc.
-    groove_radius : float [m]
-        Sideways curvature radius r_g of the groove bottom (the groove's cross-section).
-    flange_height : float [m]
-        Height h the groove's flanks rise above its bottom; nodes further than h from the
-        rim never touch the pulley.
-    contact_stiffness : float [N/m]
-        Penalty stiffness k_p.
-    contact_damping : float [N s/m]
-        Damping c_p on the penetration rate (0: none).
-    swivel_inertia : float [kg m^2]
-        J_s of the turning part about the axis.
-    bearing_damping : float [N m s]
-        Viscous torque d_s psi_dot of the swivel bearing.
+        Inlet point A on the swivel axis, at the height of the disc centre (see the module notes).
+    radius, groove_radius, flange_height : float [m]
+        Groove-bottom radius r_p of the disc, sideways curvature radius r_g of the groove bottom,
+        height h of its flanks (nodes further than h from the rim never touch).
+    contact_stiffness, contact_damping : float [N/m, N s/m]
+        Penalty stiffness k_p and damping c_p on the penetration rate (0: none).
+    swivel_inertia, bearing_damping : float [kg m^2, N m s]
+        J_s of the turning part about the axis and the bearing's viscous torque d_s psi_dot.
     onset_band : float [m]
         Penetration over which contact switches on (C1 smoothstep).
     """
