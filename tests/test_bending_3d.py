@@ -241,7 +241,8 @@ def test_a_cable_moving_in_a_vertical_plane_feels_the_planar_bending_damper(bend
     force_3d = _damper_force(spatial, velocity, cable_joints([7]), c, bend).reshape(-1, 3)
     np.testing.assert_allclose(force_3d[:, [0, 2]], force_2d.reshape(-1, 2), atol=1e-12 * np.abs(force_2d).max())
     assert np.abs(force_3d[:, 1]).max() < 1e-14 * np.abs(force_2d).max()
-    k_2d, d_2d = BendingSpringDamper(7, cable_joints([7]), np.zeros(5), c).jacobian(planar.ravel(), velocity_2d.ravel())
+    planar_dampers = BendingSpringDamper(7, cable_joints([7]), np.zeros(5), c)
+    k_2d, d_2d = planar_dampers.jacobian(planar.ravel(), velocity_2d.ravel())
     k_3d, d_3d = _damper_matrices(spatial, velocity, cable_joints([7]), c, bend)
     in_plane = np.ravel(np.column_stack([np.arange(0, 21, 3), np.arange(2, 21, 3)]))  # x0, z0, x1, z1, ...
     np.testing.assert_allclose(k_3d[np.ix_(in_plane, in_plane)], k_2d, atol=1e-11 * np.abs(k_2d).max())

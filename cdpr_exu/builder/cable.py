@@ -152,10 +152,9 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     size = reference.size
     if effects.bending:
         joints = bending.cable_joints(counts)
-        stiffness = np.concatenate([np.full(n - 2, c.bending_stiffness) for c, n in zip(cables, counts)])
-        damping = np.concatenate([
-            np.full(n - 2, c.bending_damping if effects.bending_damping else 0.0) for c, n in zip(cables, counts)
-        ])
+        stiffness = _per_item(cables, counts, 2, lambda c: c.bending_stiffness)
+        damping = _per_item(cables, counts, 2,
+                            lambda c: c.bending_damping if effects.bending_damping else 0.0)
     else:
         joints, stiffness, damping = np.zeros((0, 3), np.int64), np.zeros(0), np.zeros(0)
     linear = effects.bending and effects.bending_model == "linear"
@@ -166,11 +165,9 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         spring = bending.BendingSpringDamper(size // 2, joints, stiffness, damping)
     if effects.slack:
         elements = axial.cable_elements(counts)
-        rest = np.concatenate([np.full(n - 1, c.element_length) for c, n in zip(cables, counts)])
-        axial_k = np.concatenate([np.full(n - 1, c.axial_stiffness) for c, n in zip(cables, counts)])
-        axial_c = np.concatenate([
-            np.full(n - 1, c.axial_damping if effects.axial_damping else 0.0) for c, n in zip(cables, counts)
-        ])
+        rest = _per_item(cables, counts, 1, lambda c: c.element_length)
+        axial_k = _per_item(cables, counts, 1, lambda c: c.axial_stiffness)
+        axial_c = _per_item(cables, counts, 1, lambda c: c.axial_damping if effects.axial_damping else 0.0)
     else:
         elements = np.zeros((0, 2), np.int64)
         rest, axial_k, axial_c = np.zeros(0), np.zeros(0), np.zeros(0)
@@ -240,6 +237,11 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
                            segments, contact, (rest, axial_k, axial_c) if effects.slack else (), node_contact, kink)
 
 
+def _per_item(cables: list[CableSpec], counts: list[int], fewer: int, value) -> np.ndarray:
+    """``value(cable)`` for each of the n - ``fewer`` joints (2) or elements (1) of each cable of n nodes."""
+    return np.concatenate([np.full(n - fewer, value(c)) for c, n in zip(cables, counts)])
+
+
 def _bending_blocks(spring):
     """Sparse pattern and value filler of the bending joints' 6 x 6 blocks."""
     rows, columns = block_pattern(spring.joints, 2)
@@ -299,40 +301,40 @@ def _sparse_jacobian_function(blocks, reference, positions, where):
     return jacobian_function
 
 
+def _pulley_arrays(counts: list[int], pulleys: list[Pulley] | None, per_cable: list[np.ndarray] | None,
+                   refusal: str) -> tuple | None:
+    """The global node indices of ``per_cable``'s cable-local indices and their pulleys' centres, radii,
+    contact stiffnesses and dampings, one per index; None when there are none."""
+    if per_cable is None or not any(len(n) for n in per_cable):
+        return None
+    if pulleys is None or len(pulleys) != len(counts) or len(per_cable) != len(counts):
+        raise ValueError(refusal)
+    first = np.cumsum([0] + list(counts[:-1]))
+    indices = np.concatenate([start + np.asarray(n, dtype=np.int64) for start, n in zip(first, per_cable)])
+    return (indices, *[np.repeat(np.array([getattr(p, name) for p in pulleys], dtype=float),
+                                 [len(n) for n in per_cable], axis=0)
+                       for name in ("center", "radius", "contact_stiffness", "contact_damping")])
+
+
 def _node_contact(counts: list[int], pulleys: list[Pulley] | None,
                   contact_nodes: list[np.ndarray] | None) -> NodePulleyContact | None:
     """The node rim contacts of the listed nodes with their cables' pulleys (None if none)."""
-    if contact_nodes is None or not any(len(n) for n in contact_nodes):
+    arrays = _pulley_arrays(counts, pulleys, contact_nodes,
+                            "node contact needs one pulley and one list of contact nodes per cable")
+    if arrays is None:
         return None
-    if pulleys is None or len(pulleys) != len(counts) or len(contact_nodes) != len(counts):
-        raise ValueError("node contact needs one pulley and one list of contact nodes per cable")
-    first = np.cumsum([0] + list(counts[:-1]))
-    nodes = np.concatenate([start + np.asarray(n, dtype=np.int64) for start, n in zip(first, contact_nodes)])
-    per_node = [np.repeat(np.array([getattr(p, name) for p in pulleys], dtype=float),
-                          [len(n) for n in contact_nodes], axis=0)
-                for name in ("center", "radius", "contact_stiffness", "contact_damping")]
-    return NodePulleyContact(sum(counts), nodes, *per_node, band=node_contact_module.CONTACT_ONSET_DEPTH)
+    return NodePulleyContact(sum(counts), *arrays, band=node_contact_module.CONTACT_ONSET_DEPTH)
 
 
 def _segment_contact(counts: list[int], pulleys: list[Pulley] | None,
                      contact_elements: list[np.ndarray] | None) -> SegmentPulleyContact | None:
     """The segment rim contacts of the listed elements with their cables' pulleys (None if none)."""
-    if contact_elements is None or not any(len(e) for e in contact_elements):
+    arrays = _pulley_arrays(counts, pulleys, contact_elements,
+                            "segment contact needs one pulley and one list of contact elements per cable")
+    if arrays is None:
         return None
-    if pulleys is None or len(pulleys) != len(counts) or len(contact_elements) != len(counts):
-        raise ValueError("segment contact needs one pulley and one list of contact elements per cable")
-    segments, centers, radii, stiffness, damping = [], [], [], [], []
-    first = 0
-    for count, pulley, elements in zip(counts, pulleys, contact_elements):
-        elements = np.asarray(elements, dtype=np.int64)
-        segments.append(np.column_stack([first + elements, first + elements + 1]))
-        centers.append(np.tile(pulley.center, (len(elements), 1)))
-        radii.append(np.full(len(elements), pulley.radius))
-        stiffness.append(np.full(len(elements), pulley.contact_stiffness))
-        damping.append(np.full(len(elements), pulley.contact_damping))
-        first += count
-    return SegmentPulleyContact(first, np.concatenate(segments), np.concatenate(centers), np.concatenate(radii),
-                                np.concatenate(stiffness), np.concatenate(damping))
+    first, *per_segment = arrays
+    return SegmentPulleyContact(sum(counts), np.column_stack([first, first + 1]), *per_segment)
 
 
 def _sparse(matrix: np.ndarray) -> exu.MatrixContainer:
@@ -360,7 +362,7 @@ def _linear_bending_matrices(cables: list[CableSpec], counts: list[int], joints:
     dict
         ``stiffnessMatrix``, ``dampingMatrix`` (2N, 2N) [N/m, N s/m] and ``forceVector`` (2N,) [N].
     """
-    lengths = np.concatenate([np.full(n - 2, c.element_length) for c, n in zip(cables, counts)])
+    lengths = _per_item(cables, counts, 2, lambda c: c.element_length)
     n_nodes = reference.size // 2
     k_matrix = bending.curvature_stiffness_matrix(n_nodes, joints, stiffness, lengths)
     d_matrix = bending.curvature_stiffness_matrix(n_nodes, joints, damping, lengths)

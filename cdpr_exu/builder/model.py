@@ -184,7 +184,7 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
     contact = scene.contact_model
     on_segments = contact is not None and contact.on_segments
     cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
-    contact_elements = []  # cable-local element indices per cable (segment contact only)
+    contact_elements = []
     for i, (cable, exit_) in enumerate(zip(scene.cables, scene.exits)):
         nodes_xz = initial_nodes(scene, i)
         if exit_.wraps:
@@ -195,24 +195,16 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
         winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], drive_height=not servo))
         if servo:
             servos.append(add_servo_drum(mbs, winches[-1], items.nodes[0], scene.winch))
-        if on_segments:  # forces in the cables' generic object (add_cable_forces): no Exudyn contact items
+        candidates = np.zeros(0, dtype=int) if contact is None else contact_candidates(scene, i)
+        contact_elements.append(contact_segments(candidates, cable.n_elements) if on_segments
+                                else np.zeros(0, dtype=np.int64))
+        contact_nodes.append(np.zeros(0, dtype=int) if on_segments else candidates)
+        if contact is not None and contact.exudyn_items:
+            pulley_marker = add_pulley_ground(mbs, exit_)
+            contacts.append(add_pulley_contact(mbs, exit_, pulley_marker,
+                                               [items.markers[j] for j in candidates], nodes_xz[candidates]))
+        else:  # no contact, or its forces in the cables' generic object (add_cable_forces)
             contacts.append([])
-            contact_nodes.append(np.zeros(0, dtype=int))
-            contact_elements.append(contact_segments(contact_candidates(scene, i), cable.n_elements))
-        elif contact is not None:
-            contact_elements.append(np.zeros(0, dtype=np.int64))
-            candidates = contact_candidates(scene, i)
-            if contact.exudyn_items:
-                pulley_marker = add_pulley_ground(mbs, exit_)
-                contacts.append(add_pulley_contact(mbs, exit_, pulley_marker,
-                                                   [items.markers[j] for j in candidates], nodes_xz[candidates]))
-            else:  # forces in the cables' generic object (add_cable_forces)
-                contacts.append([])
-            contact_nodes.append(candidates)
-        else:
-            contact_elements.append(np.zeros(0, dtype=np.int64))
-            contacts.append([])
-            contact_nodes.append(np.zeros(0, dtype=int))
         paid_out.append(exit_.paid_out_length(cable.unstrained_length, nodes_xz[0]))
         cables.append(items)
     if sparse_jacobian is None:
@@ -236,16 +228,17 @@ def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems
     anchors = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))
     ropes, winches, paid_out = [], [], []
     for i, (cable, exit_) in enumerate(zip(scene.cables, scene.exits)):
-        hang, length = exit_.hang_point, float(exit_.cable_length(np.asarray(anchors[i])))  # from the hang point
+        hang, length = exit_.hang_point, float(exit_.cable_length(np.asarray(anchors[i])))
         hanging = cable.unstrained_length - length
         segment = max(hanging, MIN_WINCH_SEGMENT)
         rope_cable = replace(cable, unstrained_length=cable.unstrained_length + segment - hanging)
         bx, bz = scene.platform.anchors[i]
-        anchor_marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=platform.body, localPosition=[bx, bz, 0.0]))
+        anchor_marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=platform.body,
+                                                          localPosition=[bx, bz, 0.0]))
         rope = add_rope(mbs, rope_cable, exit_.point, exit_.radius, exit_.side, anchor_marker,
                         hang - np.array([0.0, segment]), ground_coordinate, scene.effects)
-        drive = mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate, rope.drum_marker],
-                                                           offset=0.0))
+        drive = mbs.AddObject(eii.ObjectConnectorCoordinate(
+            markerNumbers=[ground_coordinate, rope.drum_marker], offset=0.0))
         winches.append(WinchItems(-1, drive))
         ropes.append(rope)
         paid_out.append(length)

@@ -288,6 +288,13 @@ def _configuration(current):
     return exu.ConfigurationType.Current if current else exu.ConfigurationType.Initial
 
 
+def _chain_state(mbs, chain, configuration, rate=False):
+    """A chain's displacements (or, with ``rate``, velocities), flat (3N,) [m or m/s]."""
+    variable = exu.OutputVariableType.Coordinates_t if rate else exu.OutputVariableType.Coordinates
+    return np.concatenate([mbs.GetNodeOutput(node, variable, configuration=configuration)
+                           for node in chain.nodes])
+
+
 def platform_pose(mbs, items, current=True):
     """Platform position [m] shape (3,) and rotation matrix shape (3, 3) (identity for a point mass)."""
     configuration = _configuration(current)
@@ -304,9 +311,7 @@ def chain_positions(mbs, items, cable, current=True):
     """Node positions of one cable, exit first, shape (n + 1, 3) [m]."""
     chain = items.chains[cable]
     configuration = _configuration(current)
-    q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
-                        for node in chain.nodes])
-    return (chain.reference + q).reshape(-1, 3)
+    return (chain.reference + _chain_state(mbs, chain, configuration)).reshape(-1, 3)
 
 
 def anchor_forces(mbs, items):
@@ -338,8 +343,8 @@ def element_forces(mbs, items, cable, current=True, positions=None, velocities=N
     chain = items.chains[cable]
     configuration = _configuration(current)
     positions = (chain_positions(mbs, items, cable, current) if positions is None else np.asarray(positions)).ravel()
-    v = (np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
-                         for node in chain.nodes]) if velocities is None else np.asarray(velocities).ravel())
+    v = (_chain_state(mbs, chain, configuration, rate=True) if velocities is None
+         else np.asarray(velocities).ravel())
     if chain.tension_only:
         return axial_3d.tension_only_tensions(positions, v, chain.axial_elements, chain.axial_rest_length,
                                               chain.axial_stiffness, chain.axial_damping, chain.axial_rest_rate,
@@ -368,10 +373,7 @@ def robot_energy(mbs, items, current=True):
     energy = 0.0
     for chain, masses, k, k_theta in zip(items.chains, items.node_masses, items.axial_stiffnesses,
                                          items.bending_stiffnesses):
-        q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
-                            for node in chain.nodes])
-        v = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates_t,
-                                              configuration=configuration) for node in chain.nodes])
+        q, v = _chain_state(mbs, chain, configuration), _chain_state(mbs, chain, configuration, rate=True)
         energy += chain_energy(chain, masses, q, v, float(k), float(k_theta), gravity)
     for swivel, pulley in zip(items.swivels, items.swivel_pulleys):
         if swivel is not None:
@@ -397,8 +399,7 @@ def _swivel_energy(mbs, items, swivel, pulley, configuration):
     """Contact potential and J_s psi_dot^2 / 2 of one swivel pulley [J]."""
     cable = items.swivels.index(swivel)
     chain = items.chains[cable]
-    q = np.concatenate([mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates, configuration=configuration)
-                        for node in chain.nodes])
+    q = _chain_state(mbs, chain, configuration)
     psi = mbs.GetNodeOutput(swivel.node, exu.OutputVariableType.Coordinates, configuration=configuration)
     rate = mbs.GetNodeOutput(swivel.node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
     return swivel_energy(swivel, chain, pulley, q, float(np.ravel(psi)[0]), float(np.ravel(rate)[0]))

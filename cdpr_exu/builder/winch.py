@@ -27,7 +27,8 @@ class WinchItems:
     vertical: int
 
 
-def add_winch(mbs: exu.MainSystem, ground_coordinate_marker: int, node: int, drive_height: bool = True) -> WinchItems:
+def add_winch(mbs: exu.MainSystem, ground_coordinate_marker: int, node: int,
+              drive_height: bool = True) -> WinchItems:
     """Prescribe the winch node ``node`` (node 0): x held, z driven by the offset set per step.
 
     With ``drive_height`` False only x is held (a servo drum then drives z, see

@@ -243,19 +243,8 @@ _EMPTY_VECTOR = np.empty(0)
 # --------------------------------------------------------------------------- public API
 
 def cable_joints(nodes_per_cable):
-    """Joint triplets of cables whose nodes are numbered consecutively, cable after cable.
-
-    Parameters
-    ----------
-    nodes_per_cable : sequence of int
-        Number of nodes of each cable; cable ``i`` occupies the global nodes following
-        those of cable ``i - 1``.
-
-    Returns
-    -------
-    joints : ndarray of int64, shape (sum(n_i - 2), 3)
-        ``(b - 1, b, b + 1)`` for every interior node ``b`` of every cable.
-    """
+    """Joint triplets ``(b - 1, b, b + 1)``, shape (sum(n_i - 2), 3), of every interior node ``b`` of
+    cables of ``nodes_per_cable`` nodes each, numbered consecutively, cable after cable."""
     rows = []
     first = 0
     for n in whole_array("nodes_per_cable", nodes_per_cable).reshape(-1):
@@ -271,20 +260,8 @@ def cable_joints(nodes_per_cable):
 
 
 def bending_angles(positions, joints):
-    """Relative angle of each joint, ``atan2(e1 x e2, e1 . e2)``.
-
-    Parameters
-    ----------
-    positions : array_like, shape (2 n_nodes,) [m]
-        Node positions x0, y0, x1, y1, ...
-    joints : array_like of int, shape (n_joints, 3)
-        Node triplets (a, b, c).
-
-    Returns
-    -------
-    dtheta : ndarray, shape (n_joints,) [rad], in (-pi, pi]
-        Positive when the cable turns counter-clockwise from a-b to b-c.
-    """
+    """Relative angle (n_joints,) [rad] in (-pi, pi] of each joint (a, b, c), ``atan2(e1 x e2, e1 . e2)``,
+    at node positions (2 n_nodes,) [m]: positive when the cable turns counter-clockwise from a-b to b-c."""
     positions = flat_coordinates("positions", positions)
     joints = _as_joints(joints, positions.shape[0] // 2)
     p = positions.reshape(-1, 2)
@@ -296,18 +273,7 @@ def bending_angles(positions, joints):
 
 
 def bending_energy(positions, joints, stiffness):
-    """Elastic bending energy ``sum_j k_j dtheta_j^2 / 2``.
-
-    Parameters
-    ----------
-    positions : array_like, shape (2 n_nodes,) [m]
-    joints : array_like of int, shape (n_joints, 3)
-    stiffness : float or array_like, shape (n_joints,) [N m/rad]
-
-    Returns
-    -------
-    energy : float [J]
-    """
+    """Elastic bending energy ``sum_j k_j dtheta_j^2 / 2`` [J], k (n_joints,) or scalar [N m/rad]."""
     dtheta = bending_angles(positions, joints)
     stiffness = _as_per_joint("stiffness", stiffness, dtheta.shape[0])
     return 0.5 * float(np.dot(stiffness, dtheta * dtheta))
@@ -320,20 +286,9 @@ def curvature_stiffness_matrix(n_nodes, joints, stiffness, element_length):
     the energy tends to ``k dtheta^2 / 2``; at large angles (wrapped joints) it differs.
     The force is ``-K q``: zero for any straight, evenly spaced cable.
 
-    Parameters
-    ----------
-    n_nodes : int
-        Total number of nodes (all cables).
-    joints : array_like of int, shape (n_joints, 3)
-    stiffness : float or array_like, shape (n_joints,) [N m/rad]
-        Bending stiffness k of each joint.
-    element_length : float or array_like, shape (n_joints,) [m]
-        Reference element length l of each joint.
-
-    Returns
-    -------
-    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m], symmetric positive semi-definite; with the
-        damping c_theta in place of ``stiffness``, the constant damping matrix D [N s/m].
+    ``stiffness`` k [N m/rad] and ``element_length`` l [m] per joint (or scalars); ``n_nodes`` of all
+    cables. Returns K (2 n_nodes, 2 n_nodes) [N/m], symmetric positive semi-definite; with the damping
+    c_theta in place of ``stiffness``, the constant damping matrix D [N s/m].
     """
     n_nodes = int(n_nodes)
     if n_nodes < 0:
@@ -362,19 +317,9 @@ class BendingSpringDamper:
     Joints, stiffness and damping are checked and stored when made; each call only checks
     the coordinate arrays and runs the numba kernel into buffers owned by the object.
 
-    Parameters
-    ----------
-    n_nodes : int
-        Total number of nodes (all cables), so coordinates have shape (2 n_nodes,).
-    joints : array_like of int, shape (n_joints, 3)
-        Node triplets (a, b, c), e.g. from ``cable_joints``.
-    stiffness : float or array_like, shape (n_joints,) [N m/rad]
-    damping : float or array_like, shape (n_joints,) [N m s/rad]
-
-    Notes
-    -----
-    The returned arrays are the object's buffers, overwritten by the next call of the
-    same method: copy them if they must be kept (Exudyn copies what a user function returns).
+    ``n_nodes`` of all cables (coordinates (2 n_nodes,)); ``joints`` (n_joints, 3) node triplets (a, b, c);
+    ``stiffness`` and ``damping`` per joint or scalars [N m/rad, N m s/rad]. The returned arrays are the
+    object's buffers, overwritten by the next call of the same method.
     """
 
     def __init__(self, n_nodes, joints, stiffness, damping):

@@ -129,18 +129,9 @@ def node_contact_jacobian_kernel(positions, velocities, nodes, centers, radii, s
 class NodePulleyContact:
     """Rim contacts of a set of nodes with their pulleys, validated once, for the hot path.
 
-    Parameters
-    ----------
-    n_nodes : int
-        Total number of nodes, so coordinates have shape (2 n_nodes,).
-    nodes : array_like of int, shape (C,)
-        Global indices of the contact nodes.
-    centers : array_like, shape (2,) or (C, 2) [m]
-        Pulley centre of each contact.
-    radii, stiffness, damping : float or array_like, shape (C,) [m, N/m, N s/m]
-        Pulley radius r_p, penalty stiffness k_p and normal damping c_p.
-    band : float [m]
-        Onset band b (default :data:`CONTACT_ONSET_DEPTH`; 0 gives the sharp law).
+    ``n_nodes`` of all cables (coordinates (2 n_nodes,)); ``nodes`` (C,) global contact nodes;
+    ``centers`` (2,) or (C, 2) [m]; ``radii`` r_p, ``stiffness`` k_p and ``damping`` c_p per node or
+    scalars [m, N/m, N s/m]; ``band`` [m] the onset band b (0 gives the sharp law).
     """
 
     def __init__(self, n_nodes, nodes, centers, radii, stiffness, damping, band=CONTACT_ONSET_DEPTH):

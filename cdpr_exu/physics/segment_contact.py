@@ -220,20 +220,10 @@ def _segments(segments, n_nodes):
 # --------------------------------------------------------------------------- public API
 
 def contact_segments(candidate_nodes, n_elements: int) -> np.ndarray:
-    """Elements of one cable that touch a candidate node (cable-local element indices).
+    """Elements of one cable that touch a candidate node (cable-local, sorted, unique int64).
 
     Element j joins nodes j and j + 1; a node that can reach the pulley brings both its
     elements, so the segments of the wrap and the ones leaving it are all listed.
-
-    Parameters
-    ----------
-    candidate_nodes : array_like of int
-        Cable-local node indices (e.g. :func:`cdpr_exu.builder.model.contact_candidates`).
-    n_elements : int
-
-    Returns
-    -------
-    ndarray of int64, sorted, unique
     """
     nodes = np.asarray(whole_array("candidate_nodes", candidate_nodes), dtype=np.int64).reshape(-1)
     elements = np.concatenate([nodes - 1, nodes])
@@ -243,19 +233,9 @@ def contact_segments(candidate_nodes, n_elements: int) -> np.ndarray:
 class SegmentPulleyContact:
     """Rim contacts of a set of segments with their pulleys, validated once, for the hot path.
 
-    Parameters
-    ----------
-    n_nodes : int
-        Total number of nodes, so coordinates have shape (2 n_nodes,).
-    segments : array_like of int, shape (S, 2)
-        Global node pairs (a, b).
-    centers : array_like, shape (2,) or (S, 2) [m]
-        Pulley centre (one for all segments, or one per segment).
-    radii : float or array_like, shape (S,) [m]
-    stiffness : float or array_like, shape (S,) [N/m]
-        Penalty stiffness k_p.
-    damping : float or array_like, shape (S,) [N s/m]
-        Normal damping c_p.
+    ``n_nodes`` of all cables (coordinates (2 n_nodes,)); ``segments`` (S, 2) global node pairs;
+    ``centers`` (2,) or (S, 2) [m]; ``radii``, ``stiffness`` k_p and ``damping`` c_p per segment or
+    scalars [m, N/m, N s/m].
 
     ``add_force`` and ``add_jacobian`` accumulate into arrays the caller owns (the cables'
     generic object adds bending, slack and contact into one buffer).
