@@ -13,9 +13,8 @@ only place that branches on the dimension (:func:`space_of`).
 * **Spatial** (:data:`SPACE`): z up, gravity along -z. A pose is ``(x, y, z, theta)``
   [m, rad], ``theta`` the platform's rotation vector, ``R = exp([theta]x)``.
 
-Each space computes with its own kernels of :mod:`cdpr_exu.core.geometry` (the planar ones
-and the spatial ones, each bit for bit what it was before the space existed): planar numbers
-never go through 3-D arithmetic.
+Each space computes with its own kernels of :mod:`cdpr_exu.core.geometry`: planar numbers never
+go through 3-D arithmetic.
 
 The planar robot embeds in space as ``(x, z, phi) -> (x, 0, z, 0, -phi, 0)``: its plane is
 the x-z plane, and a counter-clockwise turn seen with x to the right and z up is a turn
@@ -36,22 +35,10 @@ __all__ = ["Space", "PLANE", "SPACE", "space_of", "DIMENSIONS"]
 class Space:
     """What a pose, a position and a rotation are in one dimension (see the module notes).
 
-    Attributes
-    ----------
-    dimension : int
-        2 (the paper's plane) or 3.
-    name : str
-        "planar" or "spatial" (for messages).
-    position_labels, rotation_labels, pose_labels : tuple of str
-        The names of a position's, a rotation's and a pose's entries, in order (for tables,
-        CSV headers and figures).
-    position_size, rotation_size, pose_size : int
-        Entries of a position (2 | 3), a rotation (1 | 3) and a pose (3 | 6).
-    wrench_size : int
-        Entries of a wrench on the platform (force and moment): the pose size.
-    pose_units : tuple of str
-    vertical : int
-        Index of the vertical (up) axis in a position: 1 (z of (x, z)) or 2 (z of (x, y, z)).
+    ``dimension`` 2 or 3, ``name`` "planar" or "spatial" (for messages); ``position_labels``,
+    ``rotation_labels``, ``pose_labels`` name the entries in order (tables, CSV headers, figures),
+    whose counts are ``position_size`` (2 | 3), ``rotation_size`` (1 | 3), ``pose_size`` and
+    ``wrench_size`` (3 | 6), units ``pose_units``; ``vertical`` is the index of the up axis in a position.
     """
 
     dimension: int

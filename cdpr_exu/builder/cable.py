@@ -355,12 +355,8 @@ def _linear_bending_matrices(cables: list[CableSpec], counts: list[int], joints:
     positions p = q_ref + q, while Exudyn multiplies K by the displacement q; the force
     vector ``-K q_ref`` supplies the rest, so any straight, evenly spaced cable is free of
     bending, whatever the (wrapped) reference configuration. For equal element lengths
-    its moment is k_theta sin(theta) instead of k_theta theta: 17 % less at 60 degrees.
-
-    Returns
-    -------
-    dict
-        ``stiffnessMatrix``, ``dampingMatrix`` (2N, 2N) [N/m, N s/m] and ``forceVector`` (2N,) [N].
+    its moment is k_theta sin(theta) instead of k_theta theta: 17 % less at 60 degrees. Returns the
+    ``stiffnessMatrix``, ``dampingMatrix`` (2N, 2N) [N/m, N s/m] and ``forceVector`` (2N,) [N].
     """
     lengths = _per_item(cables, counts, 2, lambda c: c.element_length)
     n_nodes = reference.size // 2

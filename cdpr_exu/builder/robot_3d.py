@@ -70,20 +70,15 @@ class ChainSpec3D:
         the segments' relative angular velocity (:mod:`cdpr_exu.physics.bending_3d`); 0 for
         none. Needs ``flexural_rigidity > 0``.
     anchor_spring_factor : float or None
-        None: the cable ends are held at the anchors by ``ObjectJointSpherical``
-        (exact). A number ``f > 0``: by an ``ObjectConnectorCartesianSpringDamper`` of
-        stiffness ``f EA / l_e`` in x, y, z, in series with the last element, which
-        adds ``1 / (f n)`` of the cable's compliance (1000: a 20-element cable
-        stretches 5e-5 of its stretch more). Needed for Exudyn's static solver on a
-        rigid platform (see the module notes).
+        None: the cable ends are held at the anchors by ``ObjectJointSpherical`` (exact). A
+        number ``f > 0``: by a penalty spring of stiffness ``f EA / l_e`` in x, y, z, which adds
+        ``1 / (f n)`` of the cable's compliance; needed for Exudyn's static solver on a rigid
+        platform (see the module notes).
     tension_only : bool
-        Tension-only axial elements (a cable cannot push; a slack element carries
-        nothing, :mod:`cdpr_exu.physics.axial_3d`) instead of Exudyn's
-        ``ObjectConnectorSpringDamper``; a taut element is the same spring-damper.
+        Tension-only axial elements (:mod:`cdpr_exu.physics.axial_3d`) instead of Exudyn's
+        ``ObjectConnectorSpringDamper``.
     mass_lumping : {"consistent", "paper"}
-        As the planar cable's (:class:`cdpr_exu.scenes.scene.CableSpec`): "consistent" puts
-        half of each element's mass on each of its nodes; "paper" puts it on its far
-        (platform-side) node, the held exit node getting half an element.
+        As the planar cable's (:class:`cdpr_exu.scenes.scene.CableSpec`).
     """
 
     n_elements: int = 20
@@ -175,31 +170,11 @@ class SpatialRobotItems:
 def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=None, exits=None):
     """Add the robot to ``mbs``: chains, platform, spherical joints, gravity.
 
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-    platform : SuspendedPlatform
-        Its ``inertia`` must be positive for a rigid body.
-    unstrained_lengths : array_like, shape (n_cables,) [m]
-    chain : ChainSpec3D, optional
-        Default ``ChainSpec3D()`` (20 elements, no damping, no bending).
-    initial : PlatformEquilibrium, optional
-        Start configuration: platform pose and cable shapes; default the catenary
-        statics of these lengths (:func:`solve_statics`).
-    exits : sequence of Exit, optional
-        Each cable's exit (:mod:`cdpr_exu.exits`; default: each leaves from its platform cable's
-        exit point). Where the cable wraps over it (a swivel pulley: its contact, swivel inertia
-        and bearing, winch line; see the module notes) the platform's cable must have the same
-        ``pulley_radius`` and its ``exit_point`` at the exit's point.
-
-    Returns
-    -------
-    SpatialRobotItems
-
-    Raises
-    ------
-    SceneError
-        Naming the field, before anything is added to ``mbs``.
+    ``unstrained_lengths`` (n_cables,) [m]; ``chain`` default ``ChainSpec3D()``; ``initial`` the start
+    (platform pose and cable shapes), default the catenary statics of these lengths; ``exits`` each
+    cable's exit (default: a point exit at its platform cable's exit point), matching the platform
+    cable's ``pulley_radius`` and exit point. Bad input raises SceneError naming the field, before
+    anything is added to ``mbs``.
     """
     if not isinstance(platform, SuspendedPlatform):
         raise SceneError(f"platform must be a SuspendedPlatform, got {shown(platform)}")
@@ -317,11 +292,9 @@ def chain_positions(mbs, items, cable, current=True):
 def anchor_forces(mbs, items):
     """Force each cable exerts on the platform at its anchor, shape (n_cables, 3) [N]: the joint reactions.
 
-    The reaction of each spherical joint (or penalty joint) on the platform: the last
-    element's axial force, the bending shear of the last joints and the anchor node's
-    weight and inertia together (with bending on, the shear is not small: 0.2 N of 9 N
-    on the paper's cable). Exudyn reports the spherical joint's force as the force on
-    the platform, and the penalty spring's with the opposite sign.
+    The last element's axial force, the bending shear of the last joints (0.2 N of 9 N on the paper's
+    cable) and the anchor node's weight and inertia together. Exudyn reports the spherical joint's
+    force as the force on the platform, and the penalty spring's with the opposite sign.
     """
     sign = 1.0 if items.chain.anchor_spring_factor is None else -1.0
     return np.array([sign * np.asarray(mbs.GetObjectOutput(joint, exu.OutputVariableType.Force))
@@ -331,14 +304,10 @@ def anchor_forces(mbs, items):
 def element_forces(mbs, items, cable, current=True, positions=None, velocities=None):
     """Axial force of each element of one cable [N], shape (n,), exit first (tension > 0).
 
-    ``positions`` (n + 1, 3) [m] and ``velocities`` (n + 1, 3) [m/s]: the cable's node positions and
-    velocities when the caller has read them already (of the same configuration), else read here.
-
-    As the model computes it: Exudyn's spring-damper k (l - l0) + c (dl/dt - dl0/dt) with
-    the parameters the connectors hold now (``velocityOffset`` = dl0/dt while a winch pays
-    the cable out; negative when compressed), or, with
-    ``tension_only``, the tension-only law with the arrays the chain's force reads
-    (never negative).
+    ``positions``, ``velocities`` (n + 1, 3) [m, m/s]: the cable's nodes when the caller has read them
+    already, else read here. As the model computes it: Exudyn's spring-damper k (l - l0) + c (dl/dt -
+    dl0/dt) with the parameters the connectors hold now (negative when compressed), or the
+    tension-only law with the arrays the chain's force reads.
     """
     chain = items.chains[cable]
     configuration = _configuration(current)
@@ -434,15 +403,8 @@ class Model3D:
 
 
 def build_model_3d(scene, sparse_jacobian: bool | None = None) -> Model3D:  # noqa: ARG001 - the planar builder's
-    """The scene's lumped robot in a new Exudyn system, assembled in its catenary equilibrium: what a run
-    integrates and a replay rebuilds (the start over swivel pulleys, :func:`cdpr_exu.run.settle.start_at_rest`,
-    moves only the initial coordinates). ``sparse_jacobian`` is the planar builder's choice.
-
-    Raises
-    ------
-    UnreachableError
-        If no static equilibrium of the scene's lengths exists to start from.
-    """
+    """The scene's lumped robot in a new Exudyn system, assembled in its catenary equilibrium
+    (UnreachableError if there is none). ``sparse_jacobian`` is the planar builder's choice."""
     platform = catenary_platform(scene)
     lengths = scene.unstrained_lengths
     start = solve_statics(platform, lengths)

@@ -83,10 +83,8 @@ def tension_only_energy(positions, elements, rest_length, stiffness):
     """Elastic energy [J] of the elements: the potential of the undamped law, k int_0^s g(x) x dx.
 
     Zero at and below the rest length; inside the band (x = s / b, b = TAUT_BAND l0)
-    k b^2 (3 x^4 / 4 - 2 x^5 / 5); above it k (s^2 - b^2) / 2 + 0.35 k b^2, which differs
-    from Exudyn's spring energy k s^2 / 2 by 0.15 k b^2 (1.5e-11 k l0^2). The damper's
-    force has no potential; with damping the law's cut-off max(0, k s + c ds/dt) also
-    acts on the elastic part, which this energy does not see.
+    k b^2 (3 x^4 / 4 - 2 x^5 / 5); above it k (s^2 - b^2) / 2 + 0.35 k b^2, 0.15 k b^2 more
+    than Exudyn's spring energy k s^2 / 2. It does not see the damped law's cut-off.
     """
     energy = 0.0
     for e in range(elements.shape[0]):

@@ -17,20 +17,9 @@ __all__ = ["block_pattern"]
 
 @njit(cache=True)
 def block_pattern(items, dimension):
-    """Rows and columns of the dense block of each item over its nodes' coordinates.
-
-    Parameters
-    ----------
-    items : ndarray of int64, shape (N, k)
-        The nodes each item acts on (node ``i``'s coordinates are ``d i .. d i + d - 1``).
-    dimension : int
-        Coordinates per node, d (2 in the plane, 3 in space).
-
-    Returns
-    -------
-    rows, columns : ndarray of int64, shape (N (k d)^2,) each
-        Block of item ``j`` at ``[j (k d)^2, (j + 1) (k d)^2)``, row-major.
-    """
+    """Rows and columns, shape (N (k d)^2,) each, of the dense block of each of the ``items`` (N, k) (the
+    nodes each acts on) over its nodes' coordinates, d = ``dimension`` per node (node ``i``'s are
+    ``d i .. d i + d - 1``): item ``j``'s block at ``[j (k d)^2, (j + 1) (k d)^2)``, row-major."""
     n, k = items.shape[0], items.shape[1]
     size = k * dimension
     rows = np.empty(n * size * size, dtype=np.int64)

@@ -52,9 +52,8 @@ from cdpr_exu.core.errors import CdprWarning, SceneError
 from cdpr_exu.core.validation import non_negative, positive, shown, vector
 
 __all__ = ["SAFE_ELEMENT_FRACTION", "SAFE_NEWTON_TOLERANCE", "SwivelPulley", "SwivelStabilityWarning",
-           "stability_concerns",
-           "swivel_contact_force", "swivel_contact_energy",
-           "swivel_contact_pattern", "swivel_contact_values", "swivel_penetration", "exit_azimuth"]
+           "stability_concerns", "swivel_contact_force", "swivel_contact_energy", "swivel_contact_pattern",
+           "swivel_contact_values", "swivel_penetration", "exit_azimuth"]
 
 #: Below this in-plane distance from the disc centre [m] the normal is undefined: no force.
 _MIN_DISTANCE = 1.0e-12
@@ -115,22 +114,9 @@ def swivel_contact_force(positions, velocities, psi, psi_rate, nodes, inlet, rad
                          flange_height, stiffness, damping, band, out):
     """Add the contact forces on ``nodes`` and the torque on psi to ``out`` and return it.
 
-    Parameters
-    ----------
-    positions, velocities : ndarray, shape (3N,) [m, m/s]
-    psi, psi_rate : float [rad, rad/s]
-        Swivel angle and its rate.
-    nodes : ndarray of int64, shape (C,)
-        Nodes that can touch the pulley.
-    inlet : ndarray, shape (3,) [m]
-        Inlet point A on the swivel axis (the disc centre is A + r_p e_r(psi)).
-    radius, groove_radius, flange_height : float [m]
-    stiffness, damping : float [N/m, N s/m]
-        Penalty stiffness k_p and damping c_p on the penetration rate.
-    band : float [m]
-        Onset band b of the smoothstep.
-    out : ndarray, shape (3N + 1,) [N, N m]
-        Node forces, then the torque on psi (last entry); accumulated into, not zeroed.
+    ``positions``, ``velocities`` (3N,) [m, m/s]; ``psi``, ``psi_rate`` [rad, rad/s]; ``nodes`` (C,) that
+    can touch the pulley; ``inlet`` (3,) [m] and the rest as :class:`SwivelPulley`'s (``band`` its
+    ``onset_band``). ``out`` (3N + 1,) [N, N m]: node forces, then the torque on psi; accumulated into.
     """
     grad = np.empty(4)
     no_hess = np.empty((0, 0))
