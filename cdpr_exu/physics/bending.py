@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import flat_coordinates, real_array, shown, whole_array
+from cdpr_exu.core.validation import flat_coordinates, per_item, whole_array
 
 __all__ = [
     "BendingSpringDamper",
@@ -222,21 +222,6 @@ def _as_joints(joints, n_nodes):
     return array
 
 
-def _as_per_joint(name, values, n_joints):
-    array = real_array(name, values)
-    if np.any(array < 0):
-        raise SceneError(f"{name} must be zero or positive, got {shown(values)}")
-    if array.ndim == 0:
-        array = np.full(n_joints, float(array))
-    elif array.shape != (n_joints,):
-        raise SceneError(f"{name} must be a scalar or have shape ({n_joints},); got shape {array.shape}")
-    else:
-        array = np.ascontiguousarray(array)
-    if not np.isfinite(array).all():
-        raise SceneError(f"{name} must be finite; got {array}")
-    return array
-
-
 _EMPTY_VECTOR = np.empty(0)
 
 
@@ -275,7 +260,7 @@ def bending_angles(positions, joints):
 def bending_energy(positions, joints, stiffness):
     """Elastic bending energy ``sum_j k_j dtheta_j^2 / 2`` [J], k (n_joints,) or scalar [N m/rad]."""
     dtheta = bending_angles(positions, joints)
-    stiffness = _as_per_joint("stiffness", stiffness, dtheta.shape[0])
+    stiffness = per_item("stiffness", stiffness, dtheta.shape[0])
     return 0.5 * float(np.dot(stiffness, dtheta * dtheta))
 
 
@@ -294,10 +279,8 @@ def curvature_stiffness_matrix(n_nodes, joints, stiffness, element_length):
     if n_nodes < 0:
         raise SceneError(f"n_nodes must be >= 0; got {n_nodes}")
     joints = _as_joints(joints, n_nodes)
-    stiffness = _as_per_joint("stiffness", stiffness, joints.shape[0])
-    element_length = _as_per_joint("element_length", element_length, joints.shape[0])
-    if np.any(element_length <= 0.0):
-        raise SceneError(f"element_length must be > 0; got {element_length}")
+    stiffness = per_item("stiffness", stiffness, joints.shape[0])
+    element_length = per_item("element_length", element_length, joints.shape[0], positive=True)
     coefficient = stiffness / element_length**2
     matrix = np.zeros((2 * n_nodes, 2 * n_nodes))
     weights = np.array([1.0, -2.0, 1.0])
@@ -329,8 +312,8 @@ class BendingSpringDamper:
         self.n_nodes = n_nodes
         self.n_coordinates = 2 * n_nodes
         self.joints = _as_joints(joints, n_nodes)
-        self.stiffness = _as_per_joint("stiffness", stiffness, self.joints.shape[0])
-        self.damping = _as_per_joint("damping", damping, self.joints.shape[0])
+        self.stiffness = per_item("stiffness", stiffness, self.joints.shape[0])
+        self.damping = per_item("damping", damping, self.joints.shape[0])
         n = self.n_coordinates
         self._force = np.empty(n)
         self._force_with_jacobian = np.empty(n)
