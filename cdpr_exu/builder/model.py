@@ -164,12 +164,7 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
     (exact bending, tension-only elements) as sparse triplets, whose cost grows with the
     number of elements rather than its square; False keeps the dense (2N)^2 matrix (the
     same numbers to round-off); None (default) chooses sparse above
-    :data:`SPARSE_JACOBIAN_MIN_NODES` nodes.
-
-    Raises
-    ------
-    UnreachableError
-        If the reference trajectory leaves the reachable workspace.
+    :data:`SPARSE_JACOBIAN_MIN_NODES` nodes. UnreachableError if the reference leaves the workspace.
     """
     check_reference(scene)  # a reference the cables cannot reach or hold is refused before anything is built
     system_container = exu.SystemContainer()

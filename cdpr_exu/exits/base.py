@@ -139,14 +139,8 @@ EXIT_KINDS: dict[str, type[Exit]] = {}
 
 def exit_from_dict(data: Any, path: str, space) -> Exit:
     """The exit of one ``[[exits]]`` table in ``space`` (:class:`~cdpr_exu.space.Space`), by its ``kind``
-    (``"point"`` when absent), naming ``path`` (e.g. ``"exits[2]"``) in its messages.
-
-    Raises
-    ------
-    SceneError
-        For a table that is none, an unknown kind or one that does not exist in ``space``, and
-        for a bad field of the kind.
-    """
+    (``"point"`` when absent), naming ``path`` (e.g. ``"exits[2]"``) in its messages: SceneError for a
+    table that is none, an unknown kind or one that does not exist in ``space``, and a bad field."""
     if not isinstance(data, Mapping):
         raise SceneError(f"{path} must be a table, got {shown(data)}")
     data = dict(data)

@@ -37,15 +37,8 @@ from numba import njit
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import flat_coordinates, per_item, whole_array
 
-__all__ = [
-    "BendingSpringDamper",
-    "cable_joints",
-    "bending_angles",
-    "bending_energy",
-    "curvature_stiffness_matrix",
-    "bending_force_kernel",
-    "bending_jacobian_kernel",
-]
+__all__ = ["BendingSpringDamper", "cable_joints", "bending_angles", "bending_energy",
+           "curvature_stiffness_matrix", "bending_force_kernel", "bending_jacobian_kernel"]
 
 
 # --------------------------------------------------------------------------- kernels

@@ -169,8 +169,3 @@ class NodePulleyContact:
         return node_contact_triplet_values(positions, velocities, self.nodes, self.centers, self.radii,
                                            self.stiffness, self.damping, self.band, float(factor_position),
                                            float(factor_velocity), out_values)
-
-    def force(self, positions, velocities):
-        """Contact forces alone, (2 n_nodes,) [N] (a new array)."""
-        return self.add_force(np.ascontiguousarray(positions, dtype=np.float64),
-                              np.ascontiguousarray(velocities, dtype=np.float64), np.zeros(self.n_coordinates))

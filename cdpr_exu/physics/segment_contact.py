@@ -44,12 +44,8 @@ from numba import njit
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import per_item, points_per_item, whole_array
 
-__all__ = [
-    "SegmentPulleyContact",
-    "contact_segments",
-    "segment_contact_force_kernel",
-    "segment_contact_jacobian_kernel",
-]
+__all__ = ["SegmentPulleyContact", "contact_segments", "segment_contact_force_kernel",
+           "segment_contact_jacobian_kernel"]
 
 #: Below this distance from the centre [m] the normal is undefined: the segment passes
 #: through the pulley centre, far beyond any penetration a run may survive.
