@@ -71,25 +71,27 @@ def _learned(name: str, on_model: bool, loop: bool = False, gains: Mapping | Non
     return make
 
 
+def _preset(cls, **preset) -> Callable[..., object]:
+    """The factory of ``cls`` with ``preset`` options, which a run's options override."""
+    return lambda scene, **options: cls(**{**preset, **options})
+
+
 def _kinds(*kinds: ControllerKind) -> dict[str, ControllerKind]:
     return {kind.name: kind for kind in kinds}
 
 
 #: Every kind of controller, by name, in the order ``cdpr compare`` runs them.
 CONTROLLERS: dict[str, ControllerKind] = _kinds(
-    ControllerKind("ideal_ik", {2: lambda scene: IdealIKController(), 3: lambda scene: IdealIKController()}),
-    ControllerKind("tension_aware", {2: lambda scene, **o: TensionAwareController(**o),
-                                     3: lambda scene, **o: TensionAwareController(**o)}),
-    ControllerKind("tension_aware_chordal",
-                   {2: lambda scene, **o: TensionAwareController(**{"chordal_correction": True, **o})}),
+    ControllerKind("ideal_ik", dict.fromkeys((2, 3), lambda scene: IdealIKController())),
+    ControllerKind("tension_aware", dict.fromkeys((2, 3), _preset(TensionAwareController))),
+    ControllerKind("tension_aware_chordal", {2: _preset(TensionAwareController, chordal_correction=True)}),
     ControllerKind("tension_aware_dynamic_chordal",
-                   {2: lambda scene, **o: TensionAwareController(**{"dynamic": True, "chordal_correction": True, **o})}),
-    ControllerKind("tension_aware_chain", {2: lambda scene, **o: TensionAwareController(**{"statics": "chain", **o}),
-                                           3: lambda scene, **o: TensionAwareController(**{"statics": "chain", **o})}),
+                   {2: _preset(TensionAwareController, dynamic=True, chordal_correction=True)}),
+    ControllerKind("tension_aware_chain",
+                   dict.fromkeys((2, 3), _preset(TensionAwareController, statics="chain"))),
     ControllerKind("closed_loop_tension_aware",
-                   {2: lambda scene, **o: ClosedLoopTensionAwareController(**{"dynamic": True,
-                                                                             "chordal_correction": True, **o}),
-                    3: lambda scene, **o: ClosedLoopTensionAwareController(**{**SPATIAL_LOOP, **o})}),
+                   {2: _preset(ClosedLoopTensionAwareController, dynamic=True, chordal_correction=True),
+                    3: _preset(ClosedLoopTensionAwareController, **SPATIAL_LOOP)}),
     ControllerKind("model_feed_forward", dict.fromkeys((2, 3), _learned("model_feed_forward", on_model=True)),
                    learns=True),
     ControllerKind("closed_loop_model_feed_forward",

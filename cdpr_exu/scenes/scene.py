@@ -447,6 +447,7 @@ class SolverSpec:
     Parameters
     ----------
     end_time, step_size, output_period : float [s]
+        The run's end, the time step and the sampling period of the stored result.
     spectral_radius : float
         rho_inf of generalized-alpha, in [0, 1]. The default 0 damps the stiff, over-damped
         axial modes fully; 0.5 lets their damping force ring (-20 N tensions on the paper
