@@ -93,6 +93,8 @@ def _chain_equilibrium(chain, platform, pose, wrench, previous):
     start = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
     return chain_statics.solve_inverse_chain_statics(chain, (*pose[:2], start.rotation), external_wrench=wrench,
                                                      tension_guess=[c.tension_at_anchor for c in start.cables])
+
+
 class _SpatialEquilibria:
     """The spatial robot's equilibria: the tensions nearest the previous sample's."""
 

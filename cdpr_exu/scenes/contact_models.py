@@ -13,10 +13,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+
 @dataclass(frozen=True)
 class PulleyContactModel:
-    """What one pulley contact model needs: Exudyn's contact items on the nodes (``exudyn_items``; else
-    the forces live in the cables' numba object), contact on the segments, or the smooth node contact."""
+    """What one pulley contact model needs: Exudyn's contact items on the nodes (``exudyn_items``; else the
+    forces live in the cables' numba object), on the segments (``on_segments``) or ``smooth_nodes``."""
 
     name: str
     exudyn_items: bool

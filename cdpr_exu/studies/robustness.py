@@ -34,6 +34,7 @@ ERRORS = ("platform_mass", "cable_density", "cable_stiffness", "exit_offset")
 COLUMNS = (*ERRORS, "controller", "status", "completed", "max_position_error_m", "rms_position_error_m",
            "max_error_vs_ideal_ik", "min_element_tension_N", "slack_time_s", "elements_pushed", "failure_time_s")
 
+
 def error_grid(platform_mass=(-0.2, 0.0, 0.2), cable_density=(-0.2, 0.0, 0.2), cable_stiffness=(0.0,),
                exit_offset=(0.0,)) -> list[dict]:
     """Every combination of the errors, as ``{error: value}`` dicts (:data:`ERRORS`)."""
