@@ -1,19 +1,11 @@
 """The narrow interface between the simulated robot and its controllers.
 
-A controller never sees Exudyn: it receives a :class:`Measurement` (time, winch
-state and, where it declares that it uses them, the platform pose and the cable
-tensions) and returns a :class:`WinchCommand`. The simulation asks for a command
-once per time step, not once per Newton iteration.
-
-The winch variable is the *paid-out length* lambda_i [m]: the unstrained cable length
-between the point where cable i leaves its winch-side vertical line on the pulley
-(the hang point) and the platform anchor. Hauling in decreases it. The simulation
-tells each controller what was paid out at t = 0 (``reset``).
-
-Every controller starts the same way (:class:`SmoothStart`, applied by the run): its
-commands begin at what the winches paid out at t = 0 and take up the controller's own
-commands over :data:`START_BLEND_TIME`. A reference that starts from rest (a circle
-with ``ramp_time`` > 0) then gives commands that start with zero rate and acceleration.
+A controller never sees Exudyn: once per time step (not per Newton iteration) it receives
+a :class:`Measurement` (time, winch state and, where it declares that it uses them, the
+platform pose and the cable tensions) and returns a :class:`WinchCommand`. The winch
+variable is the *paid-out length* lambda_i [m], the unstrained cable beyond the hang point
+(:mod:`cdpr_exu.core.geometry`); hauling in decreases it. Every run wraps its controller in
+:class:`SmoothStart`.
 """
 
 from __future__ import annotations
@@ -37,26 +29,19 @@ class Measurement:
     ----------
     time : float [s]
         The time the command is for (the end of the step being solved).
-    paid_out : ndarray, shape (m,) [m]
-        Current paid-out length of each winch.
-    paid_out_rate : ndarray, shape (m,) [m/s]
-        The winches' rate, the same rule on planar and spatial robots: the last command's
-        rate (kinematic winches; zero before the first command), or the drum's measured
-        rate (planar servo winches).
+    paid_out, paid_out_rate : ndarray, shape (m,) [m, m/s]
+        Each winch's paid-out length and rate: the last command's rate (kinematic winches;
+        zero before the first command), or the drum's measured one (servo winches).
     platform_pose : ndarray, shape (3,) or (6,), or None [m, rad]
-        Measured pose, only for controllers with ``uses_pose``: (x, z, rotation) on a
-        planar robot; (x, y, z, rotation vector) on a spatial one (the rotation vector
-        of the platform's rotation matrix, zero for a point mass).
+        Only for ``uses_pose``: (x, z, rotation) planar; (x, y, z, rotation vector) spatial.
     platform_velocity : ndarray, shape (3,) or (6,), or None [m/s, rad/s]
-        Its velocity, the pose's time derivative in both spaces: (vx, vz, angular rate) planar;
-        (vx, vy, vz, rate of the rotation vector) spatial, which is ``J_l(theta)^-1`` times the
-        angular velocity in the fixed frame (:meth:`cdpr_exu.space.Space.rotation_rate`; zero for a
-        point mass), as the spatial trajectories give their rates.
+        The pose's time derivative (spatial: the rotation vector's rate,
+        :meth:`cdpr_exu.space.Space.rotation_rate`).
     cable_tensions : ndarray, shape (m,) or None [N]
-        Tension at the platform end of each cable, only for ``uses_tension``.
+        At the platform end of each cable, only for ``uses_tension``.
     state_time : float or None [s]
-        The time the pose, velocity and tensions were measured at: the start of the step
-        being solved (the state the solver has), one step before ``time``. None: ``time``.
+        When the pose, velocity and tensions were measured: the start of the step being
+        solved, one step before ``time``. None: ``time``.
     """
 
     time: float
@@ -70,15 +55,7 @@ class Measurement:
 
 @dataclass(frozen=True)
 class WinchCommand:
-    """Winch set-points for one time step.
-
-    Attributes
-    ----------
-    paid_out : ndarray, shape (m,) [m]
-        Commanded paid-out length of each winch.
-    paid_out_rate : ndarray, shape (m,) [m/s]
-        Its time derivative (feed-forward velocity).
-    """
+    """Winch set-points for one time step: paid-out lengths (m,) [m] and their rates (m,) [m/s]."""
 
     paid_out: np.ndarray
     paid_out_rate: np.ndarray
@@ -86,60 +63,35 @@ class WinchCommand:
 
 @runtime_checkable
 class Controller(Protocol):
-    """Maps measurements to winch commands.
-
-    Attributes
-    ----------
-    name : str
-        Short name used in reports and tables.
-    uses_pose, uses_tension : bool
-        Whether :meth:`command` reads the platform pose or the cable tensions.
-    """
+    """Maps measurements to winch commands; ``name`` in reports, ``uses_pose`` and ``uses_tension`` say what
+    :meth:`command` reads."""
 
     name: str
     uses_pose: bool
     uses_tension: bool
 
     def reset(self, scene, initial_paid_out) -> None:
-        """Prepare for a run of ``scene`` (precompute command tables).
-
-        ``initial_paid_out`` (shape (m,) [m]) is what the winches have paid out at t = 0.
-        """
+        """Prepare for a run of ``scene``; ``initial_paid_out`` (m,) [m]: what was paid out at t = 0."""
 
     def command(self, measurement: Measurement) -> WinchCommand:
         """The winch command for ``measurement.time``."""
 
 
 def quintic_blend(tau):
-    """The rest-to-rest quintic s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 and its first derivative.
-
-    Clamped to 0 before tau = 0 and 1 after tau = 1; s' and s'' vanish at both ends.
-    """
+    """The rest-to-rest quintic s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, clamped to [0, 1], and s'."""
     tau = np.clip(np.asarray(tau, dtype=float), 0.0, 1.0)
     return tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2), 30.0 * tau**2 * (1.0 - tau) ** 2
 
 
-#: Where a model-based open-loop command starts from (``start`` of the tension-aware controllers):
-#: "absolute", the model's lengths L(t) themselves (:class:`SmoothStart` blends in their offset from the
-#: paid-out lengths p0); "relative", p0 + L(t) - L(0), the model's change since the reference's start;
-#: "calibrated", that change counted from the pose p the robot is measured at when the run starts (the
-#: rest a real robot starts from): p0 + L(t) - L(0) - (l(p) - l(r(0))), l the ideal lengths, r the reference
-#: position with the measured rotation.
+#: Where a model-based open-loop command starts from: "absolute", the model's lengths L(t) (the run's
+#: SmoothStart blends in their offset from the paid-out p0); "relative", p0 + L(t) - L(0); "calibrated",
+#: that change counted from the pose p measured at the start: p0 + L(t) - L(0) - (l(p) - l(r(0))), l the
+#: ideal lengths.
 STARTS = ("absolute", "relative", "calibrated")
 
 
 class CommandStart:
-    """The ``start`` rule of a model-based open-loop command (:data:`STARTS`).
-
-    Parameters
-    ----------
-    start : {"absolute", "relative", "calibrated"}
-
-    Raises
-    ------
-    SceneError
-        If ``start`` is not one of :data:`STARTS`.
-    """
+    """The ``start`` rule of a model-based open-loop command, one of :data:`STARTS` (else SceneError)."""
 
     def __init__(self, start: str = "absolute") -> None:
         if start not in STARTS:
@@ -151,19 +103,18 @@ class CommandStart:
 
     @property
     def uses_pose(self) -> bool:
-        """True for "calibrated": it reads the measured pose once, at t = 0."""
+        """True for "calibrated" (it reads the pose at t = 0)."""
         return self.start == "calibrated"
 
     def commands(self, scene, lengths: np.ndarray, initial_paid_out) -> np.ndarray:
-        """The tabulated commands, shape (N, m) [m], from the model's ``lengths`` (N, m) along the reference."""
+        """The commands (N, m) [m] from the model's ``lengths`` (N, m) along the reference."""
         self._scene, self._offset = scene, None
         if self.start == "absolute":
             return lengths
         return np.asarray(initial_paid_out, dtype=float) + lengths - lengths[0]
 
     def offset(self, measurement: Measurement):
-        """What "calibrated" takes off the commands, l(p) - l(r(0)) [m], p the pose of the first measurement
-        (kept); 0 for the other rules."""
+        """What "calibrated" takes off the commands, l(p) - l(r(0)) [m] (p measured first); 0 otherwise."""
         if self.start != "calibrated":
             return 0.0
         if self._offset is None:
@@ -172,8 +123,7 @@ class CommandStart:
 
             if measurement.platform_pose is None:
                 raise SceneError("start = 'calibrated' needs the measured pose at the start")
-            # the centre moved from where it was measured to the reference's start, the rotation held (a
-            # two-cable planar robot does not command it), as the position loop's Jacobian does
+            # the centre moved to the reference's start, the rotation held (as the position loop's Jacobian)
             poses = np.array([measurement.platform_pose, measurement.platform_pose], dtype=float)
             size = self._scene.space.position_size
             poses[1, :size] = np.asarray(self._scene.trajectory.pose(0.0), dtype=float)[:size]
@@ -183,26 +133,12 @@ class CommandStart:
 
 
 class SmoothStart:
-    """A controller whose commands start at what the winches paid out at t = 0.
+    """A controller whose commands start at what the winches paid out at t = 0, p0.
 
-    The run wraps every controller in it. With c(t) the controller's command and p0 the
-    paid-out lengths at t = 0, the command is
-
-        c(t) + (1 - s(t / T)) (p0 - c(0)),
-
-    s the quintic blend over T = ``duration``: the offset between where the cables start
-    (straight, as built) and where the controller wants them at t = 0 (e.g. the
-    tension-aware lengths, with sag and stretch) is taken up with zero rate and
-    acceleration at both ends. A controller whose command starts at p0 (ideal inverse
-    kinematics) is unchanged, so the paper's abrupt start stays the paper's. The rate
-    and acceleration of the command at t = 0 are those of c: zero for a reference that
-    starts from rest.
-
-    Parameters
-    ----------
-    controller : Controller
-    duration : float [s]
-        The blend time T (> 0).
+    The command is c(t) + (1 - s(t / T)) (p0 - c(0)), s the quintic blend over T = ``duration``
+    [s]: the offset between the straight cables as built and where the controller wants them
+    (e.g. with sag and stretch) is taken up with zero rate and acceleration at both ends. A
+    controller that starts at p0 (ideal IK) is unchanged, so the paper's abrupt start stays.
     """
 
     def __init__(self, controller: Controller, duration: float = START_BLEND_TIME) -> None:
@@ -216,11 +152,8 @@ class SmoothStart:
         self._offset = None
 
     def reset(self, scene, initial_paid_out, initial_pose=None) -> None:
-        """Reset the controller and measure its command at t = 0 against ``initial_paid_out``.
-
-        The command at t = 0 is asked with the platform at rest at ``initial_pose`` (shape (3,)
-        planar or (6,) spatial [m, rad]; by default ``scene.platform.initial_pose``).
-        """
+        """Reset the controller and measure its command at t = 0, the platform at rest at ``initial_pose``
+        [m, rad] (default ``scene.platform.initial_pose``), against ``initial_paid_out``."""
         initial = np.asarray(initial_paid_out, dtype=float)
         self.controller.reset(scene, initial.copy())
         m = initial.size
@@ -230,9 +163,7 @@ class SmoothStart:
             velocity = np.zeros_like(pose)
         first = self.controller.command(Measurement(0.0, initial.copy(), np.zeros(m), pose, velocity, None))
         offset = initial - np.asarray(first.paid_out, dtype=float)
-        # Below 1e-12 m the offset is the round-off of a controller's own "initial + change"
-        # (ideal IK): dropped, so that a controller that starts where the winches are keeps
-        # its commands bit for bit.
+        # below 1e-12 m the offset is round-off (ideal IK's "initial + change"): its commands stay bit for bit
         self._offset = np.where(np.abs(offset) < 1e-12, 0.0, offset)
 
     def command(self, measurement: Measurement) -> WinchCommand:
@@ -240,7 +171,7 @@ class SmoothStart:
             raise RuntimeError("SmoothStart.reset(scene, initial_paid_out) must be called before command()")
         command = self.controller.command(measurement)
         if measurement.time >= self.duration or not self._offset.any():
-            # the blend is over (s = 1, s' = 0) or there is nothing to blend: c(t) itself
+            # the blend is over, or there is nothing to blend
             return WinchCommand(np.asarray(command.paid_out, dtype=float), np.asarray(command.paid_out_rate, dtype=float))
         blend, rate = quintic_blend(measurement.time / self.duration)
         return WinchCommand(np.asarray(command.paid_out, dtype=float) + (1.0 - blend) * self._offset,

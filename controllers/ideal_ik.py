@@ -1,10 +1,5 @@
-"""Joint-space control from the ideal inverse kinematics (the paper's scheme).
-
-The cables are taken as straight, massless and inextensible: the paid-out length of
-cable i is the straight length from its pulley's tangent point to the anchor plus the
-arc it wraps on the pulley, evaluated on the reference pose. The winch follows it
-open-loop; sag and stretch are ignored, which is the error the paper measures.
-"""
+"""Joint-space control from the ideal inverse kinematics (the paper's scheme): the ideal cable lengths
+of the reference pose, open loop; sag and stretch are ignored, which is the error the paper measures."""
 
 from __future__ import annotations
 
@@ -16,12 +11,8 @@ from .base import Measurement, WinchCommand
 
 
 def table_lookup(t: float, times: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """Row of ``table`` (shape (K, m)) at time ``t`` [s], linear between ``times`` (shape (K,), increasing).
-
-    ``np.interp`` on every column, in one pass: the same formula, so the same bits
-    (``fp[j] + slope (t - xp[j])``, the end values outside the table, the table's
-    value where ``t`` hits a sample).
-    """
+    """Row of ``table`` (K, m) at time ``t`` [s], linear between ``times`` (K,): ``np.interp`` on every
+    column in one pass, the same formula and so the same bits."""
     j = int(np.searchsorted(times, t, side="right")) - 1
     if j < 0:
         return table[0].copy()
@@ -34,13 +25,8 @@ def table_lookup(t: float, times: np.ndarray, table: np.ndarray) -> np.ndarray:
 
 
 class IdealIKController:
-    """Open-loop winch lengths from ideal (straight, massless, inextensible) cables.
-
-    As in the paper, the ideal length is imposed as a velocity (flow) source: the
-    command is the initial paid-out length plus the change of the ideal length since
-    t = 0. The table is computed once per run on the solver's step grid and read by
-    linear interpolation, so a step costs no inverse kinematics.
-    """
+    """Open-loop winch lengths from ideal cables: the initial paid-out length plus the ideal length's change
+    since t = 0 (the paper's flow source), tabulated on the step grid once per run."""
 
     name = "ideal_ik"
     uses_pose = False

@@ -1,37 +1,17 @@
 """Iterative learning control (ILC) of the winch lengths, and the open-loop replay of learned commands.
 
-A repeated task (the same reference, run after run) lets a controller learn from the
-error of its last trial. Trial k runs the robot open loop with the paid-out lengths
-lambda_k(t); the measured platform position error e_k(t) = r_ref(t) - r_k(t) [m]
-updates the lengths for the next trial (Bristow, Tharayil and Alleyne, "A survey of
-iterative learning control", IEEE Control Systems 26(3), 2006):
+Trial k runs the robot open loop with lambda_k(t); its position error e_k = r_ref - r_k [m]
+updates the lengths (Bristow, Tharayil and Alleyne, IEEE Control Systems 26(3), 2006):
 
     c_{k+1} = Q(c_k + gamma J(t) e_k(t + tau)),    lambda_k(t) = lambda_0(t) + w(t) c_k(t)
 
-* lambda_0 : the ideal inverse kinematics (:mod:`controllers.ideal_ik`), the first trial;
-* J(t), shape (m, d) [m/m] : the ideal cables' length change per platform position change
-  (d = 2 in the plane, 3 in space: the one kinematics' length Jacobian, its position columns)
-  at the reference pose (rotation held), so that a correction J d moves the platform by
-  about d;
-* gamma [-] : the learning gain;
-* tau [s] : a time advance (lead) of the error, which the non-causal update can afford:
-  the platform answers a length change late;
-* Q : a zero-phase low-pass (a Butterworth filter run forwards and backwards,
-  :func:`scipy.signal.filtfilt`): it stops the learning where the robot's response
-  differs too much from J^-1 for the update to converge (its pendulum, rotation and cable
-  modes), at the price of a small residual error there;
-* w(t) : a smooth (quintic) fade-in from 0 at t = 0 to 1 at ``fade_time``: the
-  correction starts at zero, so the learned commands keep the start of lambda_0 and
-  never jump. The error before ``fade_time`` is weighted by w too.
-
-How gamma, tau and the cut-off were chosen (from the frequency response of the
-controller's model, measured on the simulator) is in :mod:`cdpr_exu.studies.learning`.
-A :class:`StoppingRule` ends the trials when the maximum error stops falling.
-
-:class:`ReplayController` replays a table of learned commands open loop through the
-:class:`~controllers.base.Controller` interface; :class:`LearnedController` asks an
-injected learner (which runs the trials; controllers never run simulations themselves)
-for that table when it is reset. Plain NumPy/SciPy; no Exudyn.
+lambda_0 the ideal inverse kinematics (the first trial); J (m, d) [m/m] the ideal length
+Jacobian's position columns at the reference pose; gamma the gain; tau a lead (the platform
+answers late; the update is not causal); Q a zero-phase Butterworth low-pass that stops the
+learning where the response differs too much from J^-1 to converge; w(t) a quintic fade-in
+over ``fade_time`` so the commands keep lambda_0's start. How gamma, tau and the cut-off were
+chosen: :mod:`cdpr_exu.studies.learning`. :class:`LearnedController` asks an injected learner
+for its table (controllers never run simulations). Plain NumPy/SciPy.
 """
 
 from __future__ import annotations
@@ -47,44 +27,18 @@ from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import shown
 from cdpr_exu.statics.kinematics import ideal_paid_out, length_jacobian
 
-from .base import Measurement, WinchCommand
+from .base import Measurement, WinchCommand, quintic_blend
 
 
 def fade_in(times: np.ndarray, fade_time: float) -> np.ndarray:
-    """Quintic fade from 0 at t = 0 to 1 at ``fade_time`` [s] (zero slope and curvature at both ends).
-
-    Parameters
-    ----------
-    times : ndarray, shape (N,) [s]
-    fade_time : float [s]; 0 gives ones.
-
-    Returns
-    -------
-    ndarray, shape (N,) [-]
-    """
+    """Quintic fade (N,) from 0 at t = 0 to 1 at ``fade_time`` [s] (0: ones) on ``times`` (N,) [s]."""
     times = np.asarray(times, dtype=float)
-    if fade_time <= 0:
-        return np.ones_like(times)
-    s = np.clip(times / fade_time, 0.0, 1.0)
-    return s**3 * (10.0 - 15.0 * s + 6.0 * s**2)
+    return np.ones_like(times) if fade_time <= 0 else quintic_blend(times / fade_time)[0]
 
 
 def position_jacobian(scene, poses: np.ndarray) -> np.ndarray:
-    """Length change of each ideal cable per platform position change, rotation held.
-
-    Moving the anchors by d changes the ideal paid-out length of cable i by u_i . d,
-    u_i the unit vector from the cable's exit point to its anchor: the position columns of
-    :func:`cdpr_exu.statics.kinematics.length_jacobian`.
-
-    Parameters
-    ----------
-    scene : cdpr_exu.scenes.scene.Scene
-    poses : ndarray, shape (N, pose_size) [m, rad]
-
-    Returns
-    -------
-    ndarray, shape (N, m, position_size) [m/m]
-    """
+    """Length change of each ideal cable per platform position change at ``poses`` (N, w), rotation held:
+    the position columns of :func:`cdpr_exu.statics.kinematics.length_jacobian`, shape (N, m, d) [m/m]."""
     poses = np.atleast_2d(np.asarray(poses, dtype=float))
     return length_jacobian(scene, poses)[..., :scene.space.position_size]
 
@@ -97,19 +51,9 @@ def ideal_changes(scene, times: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CommandTable:
-    """Winch commands as changes of the paid-out lengths since t = 0, on a time grid.
-
-    Attributes
-    ----------
-    times : ndarray, shape (N,) [s]
-        Increasing, from 0.
-    changes : ndarray, shape (N, m) [m]
-        Paid-out length of each winch minus what it paid out at t = 0 (zero in the first row).
-    expected_positions : ndarray, shape (N, d), or None [m]
-        The platform position ((x, z) or (x, y, z)) these commands gave where they were learned (the
-        controller's model, for model-based feed-forward), if known: what a feedback
-        around them should expect of a plant that matches the model.
-    """
+    """Winch commands as changes (N, m) [m] of the paid-out lengths since t = 0 on ``times`` (N,) [s],
+    increasing from 0; ``expected_positions`` (N, d) [m]: the positions they gave where they were learned,
+    if known (what a feedback around them should expect)."""
 
     times: np.ndarray
     changes: np.ndarray
@@ -140,14 +84,7 @@ class CommandTable:
 
 
 class ReplayController:
-    """Open-loop replay of a :class:`CommandTable` (cubic spline; its derivative is the rate).
-
-    Parameters
-    ----------
-    table : CommandTable
-    name : str
-        Name in reports.
-    """
+    """Open-loop replay of a :class:`CommandTable` (cubic spline; its derivative is the rate)."""
 
     uses_pose = False
     uses_tension = False
@@ -173,8 +110,7 @@ class ReplayController:
         self._expected = None if expected is None else CubicSpline(self.table.times, expected, axis=0)
 
     def expected_position(self, time: float) -> np.ndarray | None:
-        """The platform position ((x, z) or (x, y, z)) [m] the table's commands gave where they were learned, at
-        ``time`` [s]; None if the table does not say."""
+        """The position [m] the commands gave where they were learned, at ``time`` [s]; None if unknown."""
         if self._spline is None:
             raise RuntimeError(f"{type(self).__name__}.reset(scene, initial_paid_out) must be called first")
         return None if self._expected is None else np.asarray(self._expected(time))
@@ -188,21 +124,8 @@ class ReplayController:
 
 @dataclass(frozen=True)
 class LearningLaw:
-    """The ILC update c_{k+1} = Q(c_k + gamma J e_k(t + tau)) (see the module notes).
-
-    Parameters
-    ----------
-    gain : float [-]
-        Learning gain gamma, in (0, 2).
-    lead : float [s]
-        Time advance tau of the error, >= 0.
-    cutoff : float [Hz]
-        Cut-off of the zero-phase Butterworth low-pass Q.
-    filter_order : int
-        Order of the Butterworth filter (run twice by filtfilt: twice the roll-off).
-    fade_time : float [s]
-        Duration of the fade-in w(t) of the correction and of the error weight.
-    """
+    """The ILC update (module notes): ``gain`` gamma in (0, 2), ``lead`` tau >= 0 [s], Q's ``cutoff`` [Hz] and
+    Butterworth ``filter_order`` (run twice by filtfilt), the fade-in's ``fade_time`` [s]."""
 
     gain: float = 0.5
     lead: float = 0.0
@@ -234,23 +157,8 @@ class LearningLaw:
 
     def update(self, times: np.ndarray, correction: np.ndarray, errors: np.ndarray,
                jacobians: np.ndarray) -> np.ndarray:
-        """The next trial's correction c_{k+1}.
-
-        Parameters
-        ----------
-        times : ndarray, shape (N,) [s]
-            Uniform grid from 0.
-        correction : ndarray, shape (N, m) [m]
-            This trial's correction c_k (before the fade).
-        errors : ndarray, shape (N, d) [m]
-            This trial's position error r_ref - r on ``times`` (d: 2 planar, 3 spatial).
-        jacobians : ndarray, shape (N, m, d) [m/m]
-            :func:`position_jacobian` at the reference poses.
-
-        Returns
-        -------
-        ndarray, shape (N, m) [m]
-        """
+        """The next correction c_{k+1} (N, m) [m] from c_k (N, m) [m] (before the fade), the position errors
+        r_ref - r (N, d) [m] on the uniform ``times`` (N,) [s] and :func:`position_jacobian` (N, m, d)."""
         times = np.asarray(times, dtype=float)
         weighted = fade_in(times, self.fade_time)[:, None] * np.asarray(errors, dtype=float)
         if self.lead > 0:  # e(t + tau); held at its last value beyond the end
@@ -267,19 +175,8 @@ class LearningLaw:
 
 @dataclass(frozen=True)
 class StoppingRule:
-    """When to stop learning.
-
-    Trials stop after ``max_trials``, or as soon as the maximum position error of a
-    trial has fallen by less than ``min_improvement`` (a fraction) from the previous
-    trial's, or has risen. The best trial's commands are the ones kept.
-
-    Parameters
-    ----------
-    max_trials : int
-        Most trials, the first (ideal IK) included, >= 1.
-    min_improvement : float [-]
-        In [0, 1).
-    """
+    """When to stop learning: after ``max_trials`` (>= 1, the first included), or once a trial's max error
+    has risen or fallen by less than the fraction ``min_improvement`` (in [0, 1))."""
 
     max_trials: int = 10
     min_improvement: float = 0.02
@@ -306,15 +203,7 @@ class StoppingRule:
 
 
 class LearnedController(ReplayController):
-    """Open-loop replay of commands that an injected learner computes when the run is reset.
-
-    Parameters
-    ----------
-    name : str
-    learner : callable
-        ``learner(scene, initial_paid_out) -> CommandTable``; it may run trials on a
-        simulator (the caller supplies it: controllers never run simulations).
-    """
+    """Open-loop replay of what ``learner(scene, initial_paid_out) -> CommandTable`` computes at reset."""
 
     def __init__(self, name: str, learner: Callable):
         if not callable(learner):

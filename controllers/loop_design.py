@@ -1,36 +1,21 @@
 """The position loop of :class:`~controllers.feedback.FilteredPositionPI`, linearised: margins, poles, gains.
 
-The loop measures the platform position r (x, z) one solver step h late, filters the error
-e = r_ref - r with a second-order Butterworth low-pass F (cut-off f_c) and commands the
-length change dlambda = U (k_p + k_i / s) F(s) e, U the ideal inverse-kinematics Jacobian of
-the controllers' model at the reference pose (:meth:`FilteredPositionPI.jacobian`).
-
-Plant (:func:`linearise`): the simulator's own lumped cables (:mod:`cdpr_exu.statics.chain_statics`:
-nodes with the cable's mass, axial springs, exact-angle bending, node contact on the pulleys,
-gravity) and the rigid platform, at the equilibrium that holds the reference pose under the
-weight and the platform's inertial load -M a of the reference acceleration (a frozen pose:
-the cables' own accelerations and the velocity terms are left out). About it
+The loop measures the position r (x, z) one solver step h late and commands
+dlambda = U (k_p + k_i / s) F(s) e, F the Butterworth filter, U the ideal Jacobian of the
+controllers' model at the reference pose. The plant (:func:`linearise`) is the simulator's
+own lumped cables (:mod:`cdpr_exu.statics.chain_statics`) and the rigid platform, at the
+equilibrium holding the reference pose under the weight and the inertial load -M a:
 
     M q'' + C q' + K q = B0 dlambda + B1 dlambda',
 
-q the interior nodes' coordinates and the platform pose (x, z, rotation); M the lumped node
-masses and the platform's mass and inertia (the anchor nodes ride on the platform); K = -dQ/dq
-the tangent stiffness by central differences of :func:`~cdpr_exu.statics.chain_statics.chain_forces`
-(axial, geometric, bending, contact); C the axial Kelvin-Voigt and bending dampers; B0, B1 how
-a winch that pays out moves the first element. The cables' transverse modes are in it: on
-the paper's robot the first sits near 2 Hz, inside the loop's band. Not in it: slack (every
-element taut), the moving pose's velocity terms, the start-up fade-in (the loop at full gain)
-and the pulley contact's damping.
-
-Margins (:func:`loop_margins`, python-control): the 2 x 2 loop L = G U K broken at the
-measured error. Loop-at-a-time gain and phase margins (each loop with the other closed,
-:func:`control.stability_margins` on its frequency response, the delay exp(-s h) exact), the
-balanced disk margin of the unstructured sensitivity, alpha = 1 / max sigma_max(S - I/2)
-(conservative: python-control's structured one needs slycot), and the closed-loop poles
-(the delay as a Pade approximant of order 3: below 1e-6 rad of phase error at 10 Hz and 2 ms).
-
-Plain NumPy/SciPy and python-control; no Exudyn. Its uses of the statics and kinematics go
-through :func:`_equilibrium` and :func:`ideal_jacobian` (one adapter each).
+q the interior nodes and the platform pose; K = -dQ/dq by central differences of
+:func:`~cdpr_exu.statics.chain_statics.chain_forces`; C the axial and bending dampers; B0, B1
+the winches. The cables' transverse modes are in it (the paper robot's first near 2 Hz,
+inside the loop's band); slack, velocity terms, the fade-in and the contact's damping are
+not. Margins (:func:`loop_margins`, python-control): loop-at-a-time gain and phase margins
+of L = G U K (the delay exact), the balanced disk margin of the unstructured sensitivity
+(conservative: the structured one needs slycot), and the closed-loop poles (the delay a Pade
+approximant of order 3: below 1e-6 rad of phase error at 10 Hz and 2 ms).
 """
 
 from __future__ import annotations
@@ -46,15 +31,13 @@ from cdpr_exu.core.validation import shown
 #: Step of the central differences, relative to the shortest element [-].
 DIFFERENCE_STEP = 1e-7
 
-#: Frequencies the margins are evaluated at [rad/s]: 0.01 to 2000 rad/s, 120 per decade (the margins
-#: agree with 3000 points to 1e-8 dB and deg on the paper's loop, at a fifth of the cost).
+#: Frequencies the margins are evaluated at [rad/s], 120 per decade (3000 points agree to 1e-8 dB and deg).
 MARGIN_FREQUENCIES = np.logspace(-2, np.log10(2000.0), 633)
 
-#: Damping ratio of the error filter (Butterworth), as FilteredPositionPI's.
+#: Damping ratio of the position loop's error filter (Butterworth).
 FILTER_DAMPING = float(np.sqrt(0.5))
 
-#: The margins a loop must keep on its model before a run (issue 27) [dB, deg]: below them
-#: :class:`~controllers.feedback.FilteredPositionPI` refuses the run or runs its feed-forward alone.
+#: The margins a loop must keep on its model before a run [dB, deg].
 REQUIRED_MARGINS = (6.0, 30.0)
 
 #: Reference poses a loop is checked at before a run, evenly over the run (about 1.5 s each).
@@ -63,9 +46,6 @@ CHECK_POSES = 4
 
 class PoorMarginsWarning(CdprWarning):
     """A position loop keeps less than :data:`REQUIRED_MARGINS` on its model: the run goes on without it."""
-
-
-# --------------------------------------------------------------------------- adapters
 
 
 def _equilibrium(scene, pose, wrench):
@@ -85,21 +65,10 @@ def ideal_jacobian(scene, pose) -> np.ndarray:
     return np.stack([exit_.unit_vector for exit_ in cable_exits(scene, np.asarray(pose, dtype=float))], axis=-2)
 
 
-# --------------------------------------------------------------------------- the linearised robot
-
-
 @dataclass(frozen=True)
 class LinearRobot:
-    """The robot linearised at one pose: M q'' + C q' + K q = B0 dlambda + B1 dlambda'.
-
-    Attributes
-    ----------
-    mass, damping, stiffness : ndarray, shape (n, n) [kg, N s/m, N/m]
-    input_stiffness, input_damping : ndarray, shape (n, m) [N/m, N s/m]
-        B0, B1: generalised force per metre and per metre per second paid out.
-    platform : int
-        Row of q where the platform's (x, z, rotation) start.
-    """
+    """The robot linearised at one pose: M, C, K (n, n) [kg, N s/m, N/m], B0, B1 (n, m) [N/m, N s/m] (force
+    per metre and per metre per second paid out); ``platform``: the row of q where (x, z, rotation) start."""
 
     mass: np.ndarray
     damping: np.ndarray
@@ -134,16 +103,8 @@ def models(scene) -> bool:
 
 
 def linearise(scene, pose, acceleration=None) -> LinearRobot:
-    """Linearise a planar scene's robot about the equilibrium that holds its centre at ``pose``.
-
-    Parameters
-    ----------
-    scene : cdpr_exu.scenes.scene.Scene
-        Planar, two cables, with cable mass and axial elasticity (the chain statics').
-    pose : array_like, shape (2,) or (3,) [m, m, rad]
-        The centre's position (the rotation is what equilibrium gives).
-    acceleration : array_like, shape (2,) or (3,), optional [m/s^2]
-        The reference's acceleration there: its inertial load -M a joins the weight.
+    """Linearise a planar two-cable robot about the equilibrium holding its centre at ``pose[:2]`` [m] (the
+    rotation the balance's) under the weight and the load -M ``acceleration`` [m/s^2].
 
     Raises
     ------
@@ -229,20 +190,9 @@ def _node_damping(scene, X, counts) -> np.ndarray:
     return CX
 
 
-# --------------------------------------------------------------------------- the loop
-
-
 @dataclass(frozen=True)
 class LoopGains:
-    """The gains of a :class:`~controllers.feedback.FilteredPositionPI` loop.
-
-    Attributes
-    ----------
-    proportional_gain : float [-]
-    integral_gain : float [1/s]
-    cutoff : float [Hz]
-        Cut-off of the Butterworth error filter.
-    """
+    """The gains of a :class:`~controllers.feedback.FilteredPositionPI` loop [-, 1/s, Hz]."""
 
     proportional_gain: float = 2.0
     integral_gain: float = 40.0
@@ -283,16 +233,12 @@ class Margins:
     Attributes
     ----------
     gain_margin_db, phase_margin_deg : float [dB, deg]
-        The smaller of the two loops' (x, z), each with the other closed; inf without a crossing.
+        The smaller of the two loops', each with the other closed; inf without a crossing.
     disk_margin : float [-]
-        Balanced disk margin alpha of the unstructured sensitivity: both loops may change gain within
-        [(2 - alpha)/(2 + alpha), (2 + alpha)/(2 - alpha)] and phase by +-2 atan(alpha/2) at once.
-    sensitivity_peak : float [-]
-        max over frequency of sigma_max((I + L)^-1).
-    min_damping : float [-]
-        Smallest damping ratio of the closed-loop poles below 50 Hz (negative: unstable).
-    stable : bool
-        Every closed-loop pole in the left half plane.
+        alpha: both loops may change gain within [(2 - alpha)/(2 + alpha), (2 + alpha)/(2 - alpha)]
+        and phase by +-2 atan(alpha/2) at once.
+    sensitivity_peak, min_damping : float [-]
+        Max of sigma_max((I + L)^-1); smallest damping ratio of the poles below 50 Hz.
     """
 
     gain_margin_db: float
@@ -309,8 +255,7 @@ class Margins:
 
 
 def _siso_margins(response, omega) -> tuple[float, float]:
-    """(gain margin [dB], phase margin [deg]) of a SISO loop from its frequency response: the smallest
-    distance in dB to a -180 degree crossing, above or below, and the smallest phase margin."""
+    """(gain margin [dB], phase margin [deg]) of a SISO loop's frequency response, the smallest of each."""
     import control as ct
 
     gm, pm, _, _, _, _ = ct.stability_margins(ct.frd(response, omega), returnall=True)
@@ -320,7 +265,7 @@ def _siso_margins(response, omega) -> tuple[float, float]:
 
 
 def _disk_margin(L) -> float:
-    """Balanced disk margin alpha = 1 / max sigma_max(S - I/2) of L (F, 2, 2), the sensitivity unstructured."""
+    """Balanced disk margin alpha = 1 / max sigma_max(S - I/2) of L (F, 2, 2)."""
     eye = np.eye(2)[None]
     return 1.0 / float(np.linalg.svd(np.linalg.inv(eye + L) - 0.5 * eye, compute_uv=False)[:, 0].max())
 
@@ -334,21 +279,8 @@ def _loop_at_a_time(L, omega) -> tuple[float, float]:
 
 def loop_margins(robot: LinearRobot, jacobian, gains: LoopGains, delay: float,
                  omega=MARGIN_FREQUENCIES, response=None) -> Margins:
-    """Margins and closed-loop stability of the position loop on ``robot``.
-
-    Parameters
-    ----------
-    robot : LinearRobot
-        The plant (:func:`linearise`), which may differ from the model the loop was made on.
-    jacobian : ndarray, shape (m, 2)
-        U of the controllers' model at the reference pose (:func:`ideal_jacobian`).
-    gains : LoopGains
-    delay : float [s]
-        The measurement's age when the command acts: the solver step.
-    omega : ndarray [rad/s]
-    response : ndarray, shape (F, 2, 2), optional
-        G(j omega) U, if already computed.
-    """
+    """Margins and closed-loop stability of the position loop on ``robot`` (the plant, which may differ from
+    the model whose U (m, 2) is ``jacobian``); ``delay`` [s]: the solver step; ``response``: G U if known."""
     import control as ct
 
     plant = robot.response(omega) @ jacobian if response is None else response
@@ -362,19 +294,9 @@ def loop_margins(robot: LinearRobot, jacobian, gains: LoopGains, delay: float,
                    float(np.min(-slow.real / np.abs(slow))), stable)
 
 
-# --------------------------------------------------------------------------- across plants and poses
-
-
 def loop_cases(model, plants, times, omega=MARGIN_FREQUENCIES) -> list[tuple]:
-    """(plant index, time, LinearRobot, U, G U) for each plant linearised at the reference poses of ``times``.
-
-    Parameters
-    ----------
-    model : Scene
-        The controllers' model: its reference and Jacobian U are the loop's.
-    plants : sequence of Scene
-    times : array_like [s]
-    """
+    """(plant index, time, LinearRobot, U, G U) for each plant linearised at the reference poses of ``times``
+    [s] of ``model`` (whose U is the loop's)."""
     cases = []
     for (index, plant), t in itertools.product(enumerate(plants), np.asarray(times, dtype=float)):
         pose = model.trajectory.pose(t)
@@ -387,24 +309,12 @@ def loop_cases(model, plants, times, omega=MARGIN_FREQUENCIES) -> list[tuple]:
 def design_gains(cases, delay: float, frequency: float, gain_margin_db: float = REQUIRED_MARGINS[0],
                  phase_margin_deg: float = REQUIRED_MARGINS[1],
                  candidates=None, omega=MARGIN_FREQUENCIES) -> tuple[LoopGains, float]:
-    """The gains that meet the margins on every case and track best at ``frequency``.
+    """The gains that meet the margins on every case of :func:`loop_cases` and track best at ``frequency``.
 
-    Every candidate (default: k_p 0.5-3, k_i 0-40 /s, f_c 1-5 Hz) is kept only if, on every case
-    of :func:`loop_cases`, the closed loop is stable with at least the gain and phase margins asked
-    for; of those, the one with the smallest worst sensitivity sigma_max(S(j 2 pi f)) at the
-    reference's own frequency ``frequency`` [Hz] (the part of the feed-forward's error the loop
-    leaves there). The margins are read from the frequency response first and the poles checked on
-    the winner only (a candidate whose poles fail is dropped and the next one taken).
-
-    Returns
-    -------
-    (LoopGains, float)
-        The gains and their worst sensitivity at ``frequency``.
-
-    Raises
-    ------
-    SceneError
-        If no candidate meets the margins.
+    Of the candidates (default: k_p 0.5-3, k_i 0-40 /s, f_c 1-5 Hz) stable with the margins on
+    every case, the one with the smallest worst sensitivity sigma_max(S(j 2 pi f)) at the
+    reference's ``frequency`` [Hz]; returns it and that sensitivity. The margins are read from
+    the frequency response, the poles checked on the winner. SceneError if none meets them.
     """
     if candidates is None:
         candidates = [LoopGains(p, i, c) for p, i, c in itertools.product(
@@ -444,16 +354,8 @@ def worst(margins) -> Margins:
 
 
 def check_loop(scene, gains: LoopGains, poses: int = CHECK_POSES) -> Margins:
-    """The worst margins of ``gains``' loop on ``scene``'s robot at ``poses`` reference poses evenly over its run.
-
-    The loop acts one solver step late; each pose is linearised with its reference acceleration's load.
-    About 1.5 s per pose on the paper's robot.
-
-    Raises
-    ------
-    SceneError
-        For a robot :func:`linearise` does not model.
-    """
+    """The worst margins of ``gains``' loop on ``scene``'s robot at ``poses`` reference poses over its run
+    (one step late; about 1.5 s per pose); SceneError for a robot :func:`linearise` does not model."""
     end = scene.solver.end_time
     times = end * (np.arange(poses) + 0.5) / poses
     cases = loop_cases(scene, [scene], times)

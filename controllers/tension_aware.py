@@ -1,48 +1,19 @@
 """Tension-aware winch commands: sag and stretch compensation from the cables' statics, planar and spatial.
 
-For each sample of the reference the controller finds the platform's kineto-static equilibrium on
-the cables (:func:`cdpr_exu.statics.statics.solve_inverse_statics` on elastic catenaries, or
-:mod:`cdpr_exu.statics.chain_statics` on the simulator's own lumped chains): the cable tensions and
-the unstrained lengths that put the platform on the reference. Those lengths are the command. One
-class for both dimensions; what differs is the equilibrium each space has, behind one interface
-(:data:`EQUILIBRIA`, chosen by the scene's :class:`~cdpr_exu.space.Space`):
-
-* **planar**: the platform's rotation is the one its balance imposes (two cables), and the lengths
-  include the wrap on the pulley;
-* **spatial**: the tensions nearest the previous sample's, starting from the tensions the robot has
-  at rest with the lengths it starts with (an over-constrained robot so keeps the internal tension
-  it started with); the platform's angular acceleration is left out of the inertial load.
-
-Options:
-
-* ``dynamic`` adds the platform's inertial load -M a of the reference acceleration (dynamic
-  feed-forward; the cables' own inertia is neglected). Default: off planar, on spatial (today's);
-* ``chordal_correction=True`` (planar) corrects for the lumped model's polygon of chords over the
-  pulley, which needs less cable than the arc (up to 3 cm with the paper's 0.25 m elements on a
-  0.25 m pulley): the command is the length of the straight discretised chain (the chord walk of
-  :func:`cdpr_exu.statics.kinematics.initial_cable_nodes`) plus the catenary's sag and stretch
-  correction. A real cable has no such polygon: it compensates the simulator's discretisation;
-* ``statics="chain"`` solves each equilibrium on the simulator's own lumped cables (nodes' weight,
-  exact-angle bending, planar: the nodes' contact on the pulleys), which have the polygon and the
-  bending where the cable leaves the pulley; about 5 ms per tabulated pose (the catenary: 3 ms).
-  In space the pose given decouples the cables: one small Newton solve per held chain inside a
-  Gauss-Newton on the lengths (the platform's six balance equations), started from the previous
-  sample's lengths plus the change of the straight exit-to-anchor distance (the first sample from
-  the catenary inverse). Over a swivel pulley the held chain runs from its winch end up the axis
-  and over the disc, psi solved with it; the straight distance is the inlet's, and the first sample
-  starts from the robot's rest (the catenaries, without the bending over the disc, hang 22 mm lower
-  on spatial-four-cable-swivel);
-* ``start`` (:data:`controllers.base.STARTS`): default today's, "absolute" (the lengths themselves;
-  the run blends their offset from the paid-out lengths in, :class:`controllers.base.SmoothStart`),
-  but the spatial catenary's "relative" (the paid-out lengths plus the lengths' change, which
-  cancels the catenary's 1e-5 m offset from the simulator's chains on IPAnema);
-* :class:`ClosedLoopTensionAwareController` adds a PI correction from the measured platform pose
-  (:class:`controllers.feedback.FilteredPositionPI`).
-
-The commands are tabulated once per run on a coarse time grid and interpolated with a cubic
-spline, so they and their rates are continuous.
-
-Plain NumPy/SciPy; no Exudyn. Units SI.
+For each sample of the reference the controller solves the platform's kineto-static
+equilibrium on elastic catenaries (:mod:`cdpr_exu.statics.statics`) or on the simulator's own
+lumped chains (``statics="chain"``, :mod:`cdpr_exu.statics.chain_statics`: the polygon over the
+pulley and the bending where the cable leaves it; 5 ms per pose against 3 ms); its unstrained
+lengths are the command, tabulated on a coarse grid and interpolated by a cubic spline. What
+differs by dimension is behind one interface (:data:`EQUILIBRIA`): planar, the rotation is the
+one the balance imposes; spatial, the tensions nearest the previous sample's, from those at
+rest (an over-constrained robot keeps its internal tension), and the spatial chain statics
+steps the lengths by the change of the straight exit-to-anchor distances. ``dynamic`` adds the
+inertial load -M a of the reference; ``chordal_correction`` (planar) corrects for the lumped
+model's polygon of chords over the pulley, which needs up to 3 cm less cable than the arc with
+the paper's elements (it compensates the simulator's discretisation, not a real cable);
+``start``: :data:`controllers.base.STARTS` (the spatial catenary's default "relative" cancels
+its 1e-5 m offset from the chains on IPAnema). Plain NumPy/SciPy.
 """
 
 from __future__ import annotations
@@ -63,12 +34,8 @@ from .feedback import FilteredPositionPI
 
 
 def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
-    """Paid-out length of each straight, inextensible lumped chain reaching ``anchors``, shape (m,) [m] (planar).
-
-    The chain of n elements of length l0/n is laid from the anchor back over the pulley
-    with exact chords (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`); what is not
-    hanging below the hang point is paid out.
-    """
+    """Paid-out length (m,) [m] of each straight, inextensible planar chain laid from ``anchors`` back over
+    its pulley with exact chords (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`)."""
     lengths = []
     for i, (cable, pulley) in enumerate(zip(scene.cables, scene.exits)):
         nodes = initial_cable_nodes(pulley.center, pulley.radius, pulley.side, anchors[i],
@@ -77,17 +44,14 @@ def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
     return np.asarray(lengths)
 
 
-#: Cable models the equilibria can be solved with: "catenary" (continuous elastic
-#: catenaries, :mod:`cdpr_exu.statics.statics`) or "chain" (the simulator's own lumped chains,
-#: :mod:`cdpr_exu.statics.chain_statics`).
+#: Cable models the equilibria can be solved with (module notes).
 STATICS_MODELS = ("catenary", "chain")
 
 
 class _PlanarEquilibria:
-    """The planar robot's equilibria (:data:`PLANE`): the platform's rotation is the one its balance takes."""
+    """The planar robot's equilibria: the platform's rotation is the one its balance takes."""
 
-    #: Today's defaults of the options left at None: no inertial load, a table spaced by the reference's speed,
-    #: the commands the lengths themselves, a spline with zero rate where the reference starts from rest.
+    #: Today's defaults of the options left at None
     dynamic = False
     table_spacing = 2e-3
     starts = {"catenary": "absolute", "chain": "absolute"}
@@ -129,11 +93,12 @@ def _chain_equilibrium(chain, platform, pose, wrench, previous):
     start = statics.solve_inverse_statics(platform, pose[:2], external_wrench=wrench)
     return chain_statics.solve_inverse_chain_statics(chain, (*pose[:2], start.rotation), external_wrench=wrench,
                                                      tension_guess=[c.tension_at_anchor for c in start.cables])
-class _SpatialEquilibria:
-    """The spatial robot's equilibria (:data:`SPACE`): the tensions nearest the previous sample's."""
 
-    #: Today's defaults of the options left at None: the inertial load always, a fixed table period, the
-    #: catenary's commands relative to the paid-out lengths, a not-a-knot spline at both ends.
+
+class _SpatialEquilibria:
+    """The spatial robot's equilibria: the tensions nearest the previous sample's."""
+
+    #: Today's defaults of the options left at None
     dynamic = True
     table_spacing = 0.0
     starts = {"catenary": "relative", "chain": "absolute"}
@@ -141,7 +106,7 @@ class _SpatialEquilibria:
 
     @staticmethod
     def _inertial(controller, mass, acceleration):
-        """The d'Alembert wrench of the reference's acceleration (the platform's, -M a), shape (6,)."""
+        """The d'Alembert wrench -M a (6,) of the reference's acceleration (angular left out)."""
         return np.concatenate([-mass * acceleration[:3] if controller.dynamic else np.zeros(3), np.zeros(3)])
 
     @staticmethod
@@ -173,7 +138,8 @@ class _SpatialEquilibria:
 
     @staticmethod
     def _chain_solver(controller, scene, initial):
-        """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued."""
+        """pose, acceleration -> lengths [m] on the lumped chains, the anchor tensions continued: one Newton
+        solve per held chain inside a Gauss-Newton on the lengths (the platform's balance)."""
         from cdpr_exu.core.geometry import rotation_from_vector
 
         platform = statics.catenary_platform(scene)
@@ -190,9 +156,8 @@ class _SpatialEquilibria:
                                                                              for c in catenary_rest.cables]),
                  "previous": None}
         if any(wraps):
-            # Over swivel pulleys the first sample starts from the rest the robot starts in, not from the
-            # catenaries: these hang lower (no bending over the disc: 22 mm on spatial-four-cable-swivel), and
-            # their nodes cannot start a chain that runs up the axis and over the disc
+            # over swivel pulleys the first sample starts from the rest: the catenaries hang lower (no bending
+            # over the disc: 22 mm on spatial-four-cable-swivel) and cannot start a chain up the axis
             state["previous"] = (replace(rest, paid_out=np.array(initial, dtype=float), iterations=0),
                                  np.linalg.norm(exits - rest.position - anchors @ rest.rotation.T, axis=1))
 
@@ -201,8 +166,7 @@ class _SpatialEquilibria:
             return pose[:3] + anchors @ rotation.T
 
         def catenary_guess(pose, inertial):
-            """Lengths and nodes of the catenary inverse at ``pose`` (a start far from any previous sample);
-            a chain over a swivel pulley keeps the previous sample's nodes."""
+            """Lengths and nodes of the catenary inverse at ``pose`` (a swivel's chain keeps its nodes)."""
             inverse = statics.solve_inverse_statics(platform, pose, inertial, initial_guess=state["horizontal"])
             state["horizontal"] = inverse.horizontal_tensions
             points = anchor_points_at(pose)
@@ -242,37 +206,29 @@ class _SpatialEquilibria:
         return solve
 
 
-#: The equilibria of each space: one interface (``solver`` and today's defaults), a kernel per dimension.
+#: The equilibria of each space: ``solver`` and today's defaults.
 EQUILIBRIA = {PLANE: _PlanarEquilibria, SPACE: _SpatialEquilibria}
 
 
 class TensionAwareController:
     """Open-loop unstrained lengths from the equilibrium of each reference pose, planar or spatial.
 
+    Options left at None take the space's defaults (:data:`EQUILIBRIA`); see the module notes.
+
     Parameters
     ----------
-    dynamic : bool, optional
-        Add the inertial load -M a of the reference acceleration (dynamic feed-forward). Default: today's
-        (:data:`EQUILIBRIA`: off planar, on spatial).
     table_period : float [s]
-        Time grid of the equilibrium table (interpolated by a cubic spline; where a planar
-        reference starts from rest, the spline starts with zero rate).
-    chordal_correction : bool
-        Correct for the planar lumped model's polygon over the pulley (see the module notes).
-    statics : {"catenary", "chain"}
-        The cable model of the equilibria (see the module notes).
+        Time grid of the equilibrium table (a planar reference from rest: zero rate at t = 0).
     table_spacing : float [m], optional
-        Where the reference is slow, the table period grows until the reference moves
-        this far in one period (at most 0.25 s); 0 keeps ``table_period``. Default: today's
-        (2 mm planar, 0 spatial).
+        Where the reference is slow, the period grows until it moves this far in one (at
+        most 0.25 s); 0 keeps ``table_period``.
     start : {"absolute", "relative", "calibrated"}, optional
-        Where the commands start from (:data:`controllers.base.STARTS`); default today's (see the module
-        notes). A start given names the controller (``tension_aware_relative``...).
+        A start given names the controller (``tension_aware_relative``...).
 
     Raises
     ------
     SceneError
-        If an option is out of its range (naming it); at ``reset``, for an option the scene's space
+        If an option is out of its range (naming it); at ``reset``, for one the scene's space
         has no physics for (``chordal_correction`` on a spatial scene).
     """
 
@@ -313,17 +269,9 @@ class TensionAwareController:
         return kernel
 
     def compensated_lengths(self, scene, times: np.ndarray, initial_paid_out=None) -> np.ndarray:
-        """Unstrained paid-out lengths that hold the platform on the reference at ``times``, shape (N, m) [m].
-
-        ``initial_paid_out`` (m,) [m]: what the winches paid out at t = 0 (the spatial equilibria start
-        from the robot's rest with it).
-
-        Raises
-        ------
-        UnreachableError
-            If a reference pose needs a cable to push or has no equilibrium; the message
-            names the time.
-        """
+        """Unstrained paid-out lengths (N, m) [m] that hold the platform on the reference at ``times`` (the
+        spatial ones from the rest with ``initial_paid_out``); UnreachableError naming the time of a pose
+        with no equilibrium."""
         solve = self._resolve(scene).solver(self, scene, initial_paid_out)
         poses = np.atleast_2d(scene.trajectory.pose(times))
         accelerations = np.atleast_2d(scene.trajectory.acceleration(times))
@@ -339,8 +287,7 @@ class TensionAwareController:
         return lengths
 
     def _period(self, scene) -> float:
-        """Table period [s]: ``table_period``, or longer where the reference moves less
-        than ``table_spacing`` in it (slow references need fewer equilibria)."""
+        """Table period [s]: ``table_period``, longer where the reference moves under ``table_spacing``."""
         if self.table_spacing == 0:
             return self.table_period
         times = np.linspace(0.0, scene.solver.end_time, 400)
@@ -376,35 +323,10 @@ class TensionAwareController:
 
 
 class ClosedLoopTensionAwareController(TensionAwareController):
-    """Tension-aware feed-forward plus PI feedback on the low-pass filtered platform pose error.
-
-    The feedback is :class:`controllers.feedback.FilteredPositionPI` (see there why the
-    error is filtered and how a retried step is handled): the position error e = r_ref - r
-    (and with ``rotation`` the rotation error), filtered by a second-order Butterworth low-pass
-    (cut-off ``cutoff`` [Hz]), turned into length corrections dlambda = U (k_p e_f + k_i integral(e_f) dt)
-    with the ideal inverse-kinematics Jacobian U, fading in over ``start_time``.
-
-    Parameters
-    ----------
-    proportional_gain : float [-]
-    integral_gain : float [1/s]
-    start_time : float [s]
-        The feedback (and its integral) fades in over this time from t = 0.
-    cutoff : float [Hz]
-        Cut-off frequency of the error filter (> 0).
-    rotation : bool
-        Feed the rotation error back too (:class:`~controllers.feedback.FilteredPositionPI`).
-    margin_check : {"off", "refuse", "feed_forward"}
-        A loop short of the required margins on the scene, before the run
-        (:class:`~controllers.feedback.FilteredPositionPI`): not checked, refused, or the feed-forward alone.
-    dynamic, table_period, ...
-        As :class:`TensionAwareController`.
-    """
+    """Tension-aware feed-forward plus the PI feedback of :class:`controllers.feedback.FilteredPositionPI`
+    (its options; the others as :class:`TensionAwareController`)."""
 
     uses_pose = True
-
-    #: Damping ratio of the second-order error filter (Butterworth).
-    FILTER_DAMPING = FilteredPositionPI.FILTER_DAMPING
 
     def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, start_time: float = 0.5,
                  cutoff: float = 5.0, rotation: bool = False, margin_check: str = "off", **kwargs):

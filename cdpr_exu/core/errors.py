@@ -57,11 +57,9 @@ class CoarseOutputWarning(CdprWarning):
 
 
 class SuspectAnswerWarning(CdprWarning):
-    """A computation completed, but its answer is one a cable robot could hardly give: far from an
-    independent answer to the same question, or held by elements that push."""
+    """A computation completed, but its answer is far from an independent one, or held by pushing elements."""
 
 
 class UnphysicalResultWarning(CdprWarning):
-    """A run recorded what no real cable robot can do: elements that push (compression in a cable), or a
-    platform above its exits, where only pushing cables could hold it. Its summary says so too
-    (``elements_pushed``, ``platform_above_exits``, ``warnings``)."""
+    """A run recorded what no real cable robot can do: elements that push, or a platform above its exits
+    (its summary says so too)."""

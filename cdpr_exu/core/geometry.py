@@ -1,70 +1,35 @@
-"""Geometry of a cable robot: poses, rotations, anchor points, pulley exits.
+"""Geometry of a cable robot: poses, rotations, anchor points, pulley exits (one home each).
 
-One home for each geometric concept, used by the builder, the statics, the chain
-statics, the controllers and the plots. Pure NumPy/SciPy; no Exudyn. Units SI.
-
-Spatial robots (z up, gravity along -z) turn their platform by a rotation vector
-``theta`` [rad], ``R = exp([theta]x)`` (:func:`rotation_from_vector`), the planar
-robot by the angle ``phi`` below (:func:`rotation_matrix`).
-
-Frame
------
-A planar robot lives in the paper's vertical x-z plane with gravity along -z (the
-builder maps it onto Exudyn's x-y plane: Exudyn's y is the paper's z). A platform
-pose is ``(x, z, phi)`` [m, m, rad], ``phi`` positive counter-clockwise, and a
-platform anchor is ``p_i = r + R(phi) b_i`` (paper eq. 16) with
-``R = [[cos, -sin], [sin, cos]]``.
+Pure NumPy; no Exudyn. Units SI. A planar robot lives in the paper's vertical x-z plane
+(the builder maps it onto Exudyn's x-y plane: Exudyn's y is the paper's z); its pose is
+``(x, z, phi)`` [m, m, rad], ``phi`` counter-clockwise, and an anchor is
+``p_i = r + R(phi) b_i`` (paper eq. 16). A spatial robot (z up) turns its platform by a
+rotation vector ``theta`` [rad], ``R = exp([theta]x)``.
 
 Pulley convention
 -----------------
-Each cable comes from its winch straight up the vertical line ``x = c_x + s r_p``
-(``s = -1``: the cable hangs on the left side of the pulley, ``s = +1``: on the right),
-leaves that line at the *hang point* ``h = (c_x + s r_p, c_z)``, wraps over the top of
-the pulley (centre ``c``, radius ``r_p``) by the *wrap angle*, leaves the rim at the
-tangent point ``t`` and runs straight to the platform anchor ``p``. In the paper,
-pulley 1 at (-1.75, 0) has ``s = -1`` and pulley 2 at (1.75, 0) has ``s = +1``: the
-cables hang on the outer sides. ``r_p = 0`` is a point exit at ``c`` (no wrap).
-
-The *ideal cable length* is the length of that path from the hang point to the anchor,
-``|p - t| + r_p * wrap``; the vertical part down to the winch is a constant offset. The
-*paid-out length* lambda of a winch is the cable beyond the hang point: a cable of
-unstrained length ``L0`` has its winch end at ``h - (0, L0 - lambda)``.
-
-The exits of a scene are objects (:mod:`cdpr_exu.exits`: a planar pulley, a swivel pulley,
-a point exit); the kernels here compute their ideal cables, so that every number is made
-once: :func:`planar_exit` (a planar point exit is its radius 0) and :func:`swivel_pulley_exit`.
+Each cable comes from its winch up the vertical line ``x = c_x + s r_p`` (``s = -1``: on
+the pulley's left, ``+1``: right), leaves it at the *hang point* ``h = (c_x + s r_p, c_z)``,
+wraps over the top of the pulley (centre ``c``, radius ``r_p``) by the *wrap angle*, leaves
+the rim at the tangent point ``t`` and runs straight to the anchor ``p``. The paper's
+pulleys at (-1.75, 0) and (1.75, 0) have ``s = -1`` and ``+1`` (cables on the outer sides).
+``r_p = 0`` is a point exit. The *ideal cable length* is ``|p - t| + r_p * wrap``; the
+*paid-out length* lambda is the cable beyond the hang point: a cable of unstrained length
+``L0`` has its winch end at ``h - (0, L0 - lambda)``.
 
 Swivel pulley
 -------------
-A swivel pulley turns about the vertical axis through its **inlet** ``e`` (3,): the
-point where the cable leaves the axis and starts to wrap on the disc. The winch side
-of the cable hangs straight down that axis to the winch, as in the planar model,
-where it hangs down the vertical winch line (above). The disc, of
-radius ``r_p``, lies in the vertical plane through the axis and the anchor ``p``; its
-centre is at ``e + r_p e_rho``, ``r_p`` from the axis towards the anchor.
-
-* The **azimuth** ``psi`` of the pulley is the direction of ``p`` seen from the axis,
-  ``atan2(p_y - e_y, p_x - e_x)``; ``e_rho = (cos psi, sin psi, 0)``.
-* In that plane, with coordinates ``(rho, z) = ((p - e) . e_rho, p_z - e_z)``, the
-  cable is exactly the planar one: the planar pulley (:func:`pulley_exit`) with centre
-  ``(r_p, 0)``, radius ``r_p`` and ``side = -1``. Its hang point ``(c_x + s r_p, c_z)
-  = (0, 0)`` is the inlet, its vertical winch line ``x = 0`` is the swivel axis, and
-  the cable wraps from the axis over the top of the disc towards the anchor. The
-  tangent point, wrap angle, free length and ideal cable length
-  ``L = r_p * wrap + |p - t|`` (from the inlet) are the planar ones, mapped back
-  with ``(rho, z) -> e + rho e_rho + z e_z``. ``r_p = 0`` gives ``L = |p - e|``.
-* Since ``rho >= 0``, the anchor is never beyond the planar pulley's outer vertical
-  line: every anchor outside the disc is reachable, above the inlet too (wrap below
-  pi / 2), and below it (wrap up to 3 pi / 2 when the anchor is under the disc).
-  Only a cable coming *down* to the pulley from a winch above is not covered: that
-  is the mirror image ``z -> -z`` of this geometry and no scene needs it yet.
-* **Anchor on the axis** (``rho`` below 1e-12 of ``|p - e| + r_p``): the azimuth is
-  undefined. The cable length does not depend on it, but for ``r_p > 0`` the
-  direction of the cable does. The azimuth is then kept from the previous pose of
-  the same call (a trajectory passing under a pulley) or taken from
-  ``azimuth_hint``; with neither, the pose is refused (``UnreachableError``). For a
-  point exit (``r_p = 0``) the cable is vertical whatever the azimuth, which is
-  then reported as the hint, the previous one, or 0.
+A swivel pulley turns about the vertical axis through its **inlet** ``e`` (3,), where the
+cable leaves the axis (it hangs down the axis to its winch) onto the disc, which lies in
+the vertical plane through the axis and the anchor. Its **azimuth** is
+``psi = atan2(p_y - e_y, p_x - e_x)``. In that plane, with ``(rho, z) = ((p - e) . e_rho,
+p_z - e_z)``, the cable is the planar one of a pulley at ``(r_p, 0)``, radius ``r_p``,
+``side = -1`` (its hang point is the inlet), mapped back by ``(rho, z) -> e + rho e_rho + z e_z``.
+As ``rho >= 0`` every anchor outside the disc is reachable (wrap up to 3 pi / 2); a winch
+above the pulley (the mirror image) is not covered. An anchor on the axis (``rho`` below
+1e-12 of ``|p - e| + r_p``) has no azimuth: the previous pose's of the same call, else
+``azimuth_hint``, is kept; with neither the pose is refused for ``r_p > 0`` (a point exit's
+vertical cable takes 0).
 """
 
 from __future__ import annotations
@@ -77,41 +42,12 @@ import numpy as np
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.validation import non_negative, real_array, shown
 
-__all__ = [
-    "all_at_centre",
-    "planar_exit",
-    "above_exits",
-    "PulleyExit",
-    "rotation_matrix",
-    "rotation_from_vector",
-    "rotation_vector",
-    "left_jacobian",
-    "skew",
-    "planar_cross",
-    "perpendicular",
-    "anchor_points",
-    "anchor_velocities",
-    "pulley_exit",
-    "penetration",
-    "segment_penetration",
-    "rotation_matrices",
-    "left_jacobians",
-    "spatial_anchor_points",
-    "spatial_anchor_velocities",
-    "SwivelExit",
-    "swivel_pulley_exit",
-]
-
 # A wrap angle this far below zero is rounding, not geometry [rad].
 _WRAP_ROUNDING = 1e-9
 
 
-# ----------------------------------------------------------------------------------
-# argument checks
-# ----------------------------------------------------------------------------------
 def all_at_centre(anchors) -> bool:
-    """True when every anchor (rows of 2 or 3 coordinates [m], any nesting) sits exactly at the centre of mass:
-    a point-mass platform, with no rotation to balance. The one rule for scenes, statics and the builder."""
+    """True when every anchor [m] sits exactly at the centre of mass: a point-mass platform."""
     return not np.any(np.asarray(anchors, dtype=float))
 
 
@@ -150,21 +86,8 @@ def check_side(name, side):
     return int(side_float)
 
 
-# ----------------------------------------------------------------------------------
-# small helpers
-# ----------------------------------------------------------------------------------
 def rotation_matrix(phi):
-    """Planar rotation matrix ``R(phi) = [[cos, -sin], [sin, cos]]``.
-
-    Parameters
-    ----------
-    phi : float or ndarray, shape (...) [rad]
-        Rotation angle, positive counter-clockwise in the x-z plane.
-
-    Returns
-    -------
-    ndarray, shape (..., 2, 2)
-    """
+    """Planar rotation matrix ``R(phi) = [[cos, -sin], [sin, cos]]`` (..., 2, 2) of ``phi`` (...) [rad]."""
     if isinstance(phi, (float, int)) and not isinstance(phi, bool) and math.isfinite(phi):
         c, s = math.cos(phi), math.sin(phi)  # one angle: the statics' Newton loops call this often
         return np.array([[c, -s], [s, c]])
@@ -174,19 +97,7 @@ def rotation_matrix(phi):
 
 
 def planar_cross(a, b):
-    """Scalar planar cross product ``a_x b_z - a_z b_x`` (moment about the out-of-plane axis).
-
-    Positive for a counter-clockwise moment, consistent with the platform angle ``phi``.
-
-    Parameters
-    ----------
-    a, b : ndarray, shape (..., 2)
-        Planar vectors, broadcast against each other.
-
-    Returns
-    -------
-    ndarray, shape (...)
-    """
+    """Planar cross product ``a_x b_z - a_z b_x`` of (..., 2) vectors, (...): counter-clockwise positive."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
@@ -206,14 +117,8 @@ def rotated_anchors(pose, anchors):
 
 
 def check_pose_and_anchors(pose, anchors, pose_rate=None, sizes=(3, 2), pose_name="pose"):
-    """Pose(s) (w,) or (N, w) and anchors (m, d), ``sizes`` = (w, d): (3, 2) in the plane, (6, 3) in space;
-    finite. With ``pose_rate``, also the rate, of the pose's shape. Returns them as float arrays.
-
-    Raises
-    ------
-    SceneError
-        Naming the argument whose shape is wrong or value not finite.
-    """
+    """Pose(s) (w,) or (N, w), anchors (m, d) and optionally ``pose_rate`` (the pose's shape) as finite float
+    arrays, ``sizes`` = (w, d): (3, 2) planar, (6, 3) spatial; SceneError naming a wrong one."""
     width, d = sizes
     pose = finite_array(pose_name, pose, (width,))
     if pose.ndim > 2:
@@ -230,69 +135,38 @@ def check_pose_and_anchors(pose, anchors, pose_rate=None, sizes=(3, 2), pose_nam
 
 
 def anchor_points(pose, anchors):
-    """World positions of the platform anchors, ``p_i = r + R(phi) b_i`` (paper eq. 16).
-
-    Parameters
-    ----------
-    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
-        Platform pose(s) ``(x, z, phi)``.
-    anchors : array_like, shape (m, 2) [m]
-        Anchor points ``b_i`` in the platform frame.
-
-    Returns
-    -------
-    ndarray, shape (m, 2) or (N, m, 2) [m]
-
-    Raises
-    ------
-    SceneError
-        If a shape is wrong or a value is not finite.
-    """
+    """World positions ``p_i = r + R(phi) b_i`` (paper eq. 16), shape (m, 2) or (N, m, 2) [m], of the
+    anchors (m, 2) [m] at pose(s) ``(x, z, phi)`` (3,) or (N, 3) [m, m, rad]."""
     pose, anchors = check_pose_and_anchors(pose, anchors)
     return pose[..., None, :2] + rotated_anchors(pose, anchors)
 
 
 def anchor_velocities(pose, pose_rate, anchors):
-    """World velocities of the platform anchors, ``v_i = rdot + phidot * perp(R(phi) b_i)``.
-
-    Parameters
-    ----------
-    pose : array_like, shape (3,) or (N, 3) [m, m, rad]
-        Platform pose(s) ``(x, z, phi)``.
-    pose_rate : array_like, same shape as ``pose`` [m/s, m/s, rad/s]
-        Pose rate(s) ``(xdot, zdot, phidot)``.
-    anchors : array_like, shape (m, 2) [m]
-        Anchor points ``b_i`` in the platform frame.
-
-    Returns
-    -------
-    ndarray, shape (m, 2) or (N, m, 2) [m/s]
-    """
+    """World velocities ``v_i = rdot + phidot * perp(R(phi) b_i)``, shape (m, 2) or (N, m, 2) [m/s], for
+    ``pose`` (3,) or (N, 3) [m, m, rad], its rate (same shape) [m/s, m/s, rad/s] and anchors (m, 2) [m]."""
     pose, anchors, pose_rate = check_pose_and_anchors(pose, anchors, pose_rate)
     arm = rotated_anchors(pose, anchors)
     return pose_rate[..., None, :2] + pose_rate[..., 2][..., None, None] * perpendicular(arm)
 
 
-# ----------------------------------------------------------------------------------
-# one cable over one pulley
-# ----------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)  # array fields: compare them field by field
 class PulleyExit:
     """Where and how an ideal (straight, massless) cable leaves a pulley towards its anchor.
 
+    Scalars and (d,) vectors for one anchor, (N,) and (N, d) arrays for N.
+
     Attributes
     ----------
-    tangent_point : ndarray, shape (2,) or (N, 2) [m]
-        Point ``t`` where the cable leaves the rim (the centre for a point exit).
-    wrap_angle : float or ndarray, shape (N,) [rad]
-        Arc over the top of the pulley from the hang point to ``t``; in ``[0, 3 pi / 2)``.
-        Above ``pi`` when the anchor is below the pulley on its inner side; 0 for a
-        point exit.
-    free_length : float or ndarray, shape (N,) [m]
+    tangent_point : [m]
+        Where the cable leaves the rim (the centre, or a swivel's inlet, for a point exit).
+    wrap_angle : [rad]
+        Arc over the top of the pulley from the hang point to ``t``, in ``[0, 3 pi / 2)``
+        (above pi for an anchor below the pulley on its inner side).
+    free_length : [m]
         Straight length ``|p - t|``.
-    unit_vector : ndarray, shape (2,) or (N, 2)
-        Unit vector from ``t`` towards the anchor ``p`` (opposite to the pull on the platform).
-    arc_length : float or ndarray, shape (N,) [m]
+    unit_vector : [-]
+        From ``t`` towards the anchor (opposite to the pull on the platform).
+    arc_length : [m]
         Wrapped length ``r_p * wrap_angle``.
     """
 
@@ -349,9 +223,8 @@ def exit_arrays(center, radius, side, anchor):
 
 
 def planar_exit(center, radius, side, anchor) -> PulleyExit:
-    """The :class:`PulleyExit` of :func:`exit_arrays` for a checked pulley (``center`` (2,) [m], float
-    ``radius`` [m], ``side`` -1 or +1) and anchor(s) (2,) or (N, 2) [m], checked here: scalars for one
-    anchor. The one kernel of every planar exit (a point exit is radius 0)."""
+    """The :class:`PulleyExit` of a checked pulley (``center`` (2,) [m], ``radius`` [m], ``side`` -1 or +1) to
+    anchor(s) (2,) or (N, 2) [m], checked here: the kernel of every planar exit (a point exit: radius 0)."""
     anchor = finite_array("anchor", anchor, (2,))
     tangent_point, wrap, free_length, unit_vector = exit_arrays(np.asarray(center), radius, side, anchor)
     if anchor.ndim == 1:
@@ -361,39 +234,20 @@ def planar_exit(center, radius, side, anchor) -> PulleyExit:
 
 
 def pulley_exit(center, radius, side, anchor):
-    """Tangent point, wrap angle and free length of a cable running over a pulley to an anchor.
+    """The :class:`PulleyExit` of a cable over the pulley (``center`` (2,) [m], ``radius`` >= 0 [m], ``side``
+    -1 or +1) to anchor(s) ``p`` (2,) or (N, 2) [m], every argument checked.
 
-    Parameters
-    ----------
-    center : array_like, shape (2,) [m]
-        Pulley centre ``c``.
-    radius : float [m]
-        Pulley radius ``r_p >= 0``; 0 is a point exit at ``c``.
-    side : {-1, +1}
-        Side on which the cable hangs towards its winch (-1 left, +1 right).
-    anchor : array_like, shape (2,) or (N, 2) [m]
-        Platform anchor(s) ``p`` in the world frame.
-
-    Returns
-    -------
-    PulleyExit
-        Fields of shape (2,) and scalars, or (N, 2) and (N,) for N anchors.
+    With ``beta`` the direction of ``p - c`` and ``alpha = arccos(r_p / |p - c|)``, the tangent
+    point is at rim angle ``beta - s alpha``. The paper's cable 1 (``c = (-1.75, 0)``, ``r_p =
+    0.25``, ``s = -1``, ``p = (-0.15, -1.9)``) wraps about 145.7 degrees, free length 2.471 m.
 
     Raises
     ------
     SceneError
-        If an argument is malformed or not finite, or ``side`` is not -1 or +1.
+        For a malformed or non-finite argument, or ``side`` not -1 or +1.
     UnreachableError
-        If an anchor is inside the pulley disc (or on the point exit), or above the
-        pulley on the outer side of the vertical cable line (negative wrap).
-
-    Notes
-    -----
-    With ``beta`` the direction of ``p - c`` and ``alpha = arccos(r_p / |p - c|)``, the
-    tangent point is at rim angle ``beta - s alpha``; the wrap angle is measured from the
-    hang point over the top of the pulley. For the paper's cable 1 (``c = (-1.75, 0)``,
-    ``r_p = 0.25``, ``s = -1``, ``p = (-0.15, -1.9)``) the wrap is about 145.7 degrees and
-    the free length about 2.471 m.
+        For an anchor inside the disc (or on the point exit), or above the pulley on the
+        outer side of its vertical cable line (negative wrap).
     """
     center = finite_array("center", center, (2,))
     if center.ndim != 1:
@@ -402,9 +256,6 @@ def pulley_exit(center, radius, side, anchor):
                        anchor)
 
 
-# ----------------------------------------------------------------------------------
-# spatial rotations (rotation vector, SO(3))
-# ----------------------------------------------------------------------------------
 def skew(vector_):
     """``[v]x``, the matrix of ``v x ...``, shape (3, 3)."""
     x, y, z = vector_
@@ -462,42 +313,16 @@ def rotation_angles_deg(rotation: np.ndarray) -> np.ndarray:
     return np.degrees([roll, pitch, yaw])
 
 
-# ----------------------------------------------------------------------------------
-# one cable over one swivel pulley (spatial)
-# ----------------------------------------------------------------------------------
 ON_AXIS = 1e-12
 """An anchor closer to the swivel axis than this fraction of its distance (plus r_p) is on the axis."""
 
 
 @dataclass(frozen=True, eq=False)  # array fields
 class SwivelExit(PulleyExit):
-    """Where and how an ideal cable leaves a swivel pulley towards its anchor: a
-    :class:`~cdpr_exu.core.geometry.PulleyExit` in 3-D, with the pulley's azimuth.
-
-    Attributes
-    ----------
-    azimuth : float or ndarray, shape (N,) [rad]
-        Direction of the anchor seen from the swivel axis, ``atan2(dy, dx)``.
-    tangent_point : ndarray, shape (3,) or (N, 3) [m]
-        Where the cable leaves the rim (the inlet for a point exit).
-    wrap_angle : float or ndarray, shape (N,) [rad]
-        Arc from the inlet over the top of the disc to the tangent point, in ``[0, 3 pi / 2)``.
-    free_length : float or ndarray, shape (N,) [m]
-        Straight length ``|p - t|``.
-    unit_vector : ndarray, shape (3,) or (N, 3)
-        Unit vector from the tangent point towards the anchor (opposite to the pull on the platform).
-    arc_length : float or ndarray, shape (N,) [m]
-        Wrapped length ``r_p * wrap_angle``.
-    """
+    """A :class:`PulleyExit` in 3-D over a swivel pulley, with its ``azimuth`` [rad] (scalar or (N,)):
+    the direction of the anchor seen from the swivel axis, ``atan2(dy, dx)``."""
 
     azimuth: float | np.ndarray
-
-
-def point3(name, value):
-    array = finite_array(name, value, (3,))
-    if array.ndim != 1:
-        raise SceneError(f"{name} must have shape (3,), got shape {array.shape}")
-    return array
 
 
 def _fill_azimuths(azimuth, on_axis, azimuth_hint, radius, anchor, inlet):
@@ -523,8 +348,30 @@ def _fill_azimuths(azimuth, on_axis, azimuth_hint, radius, anchor, inlet):
     return flat_azimuth.reshape(azimuth.shape)
 
 
-def swivel_exit_arrays(inlet, radius, anchor, azimuth_hint=None):
-    """Vectorised core of :func:`swivel_pulley_exit` on checked arguments; anchor (..., 3)."""
+def swivel_pulley_exit(inlet, radius, anchor, azimuth_hint=None):
+    """The :class:`SwivelExit` of a cable over a swivel pulley (``inlet`` (3,) [m], ``radius`` >= 0 [m], 0 a
+    point exit) to anchor(s) (3,) or (N, 3) [m]; ``azimuth_hint`` [rad] for an anchor on the axis.
+
+    The planar cable of :func:`planar_exit` in the plane of the azimuth (module notes; Pott,
+    "Cable-Driven Parallel Robots", Springer 2018, pulley kinematics).
+
+    Raises
+    ------
+    SceneError
+        For a malformed or non-finite argument, or a negative ``radius``.
+    UnreachableError
+        For an anchor inside the disc (or on a point exit), or on the axis of a pulley of
+        positive radius with no azimuth to keep.
+    """
+    inlet = finite_array("inlet", inlet, (3,))
+    if inlet.ndim != 1:
+        raise SceneError(f"inlet must have shape (3,), got shape {inlet.shape}")
+    radius = non_negative("radius", radius)
+    anchor = finite_array("anchor", anchor, (3,))
+    if anchor.ndim > 2:
+        raise SceneError(f"anchor must have shape (3,) or (N, 3), got shape {anchor.shape}")
+    if azimuth_hint is not None:
+        azimuth_hint = float(finite_array("azimuth_hint", azimuth_hint))
     delta = anchor - inlet
     distance = np.linalg.norm(delta, axis=-1)
     if radius == 0.0 and np.any(distance == 0.0):
@@ -562,60 +409,8 @@ def swivel_exit_arrays(inlet, radius, anchor, azimuth_hint=None):
     )
 
 
-def swivel_pulley_exit(inlet, radius, anchor, azimuth_hint=None):
-    """Azimuth, tangent point, wrap and free length of an ideal cable over a swivel pulley to an anchor.
-
-    Parameters
-    ----------
-    inlet : array_like, shape (3,) [m]
-        Point where the cable leaves the vertical swivel axis onto the disc (it hangs
-        down the axis to its winch).
-    radius : float [m]
-        Disc radius ``r_p >= 0``; 0 is a point exit at the inlet.
-    anchor : array_like, shape (3,) or (N, 3) [m]
-        Platform anchor(s) in the world frame.
-    azimuth_hint : float [rad], optional
-        Azimuth to use for an anchor on the swivel axis when no earlier anchor of
-        this call is off the axis (see the module notes).
-
-    Returns
-    -------
-    SwivelExit
-        Scalars and (3,) vectors, or (N,) and (N, 3) arrays for N anchors.
-
-    Raises
-    ------
-    SceneError
-        If an argument is malformed or not finite, or ``radius`` is negative.
-    UnreachableError
-        If an anchor is inside the disc (or on a point exit), or on the axis of a
-        pulley of positive radius with no azimuth to keep.
-
-    Notes
-    -----
-    The cable lies in the vertical plane of azimuth ``psi`` through the axis, where
-    it is the planar cable of :func:`planar_exit` (centre ``(r_p, 0)``,
-    side -1, hang point at the inlet; Pott, "Cable-Driven Parallel Robots: Theory
-    and Application", Springer 2018, pulley kinematics).
-    """
-    inlet = point3("inlet", inlet)
-    radius = non_negative("radius", radius)
-    anchor = finite_array("anchor", anchor, (3,))
-    if anchor.ndim > 2:
-        raise SceneError(f"anchor must have shape (3,) or (N, 3), got shape {anchor.shape}")
-    if azimuth_hint is not None:
-        azimuth_hint = float(finite_array("azimuth_hint", azimuth_hint))
-    return swivel_exit_arrays(inlet, radius, anchor, azimuth_hint)
-
-
-# ----------------------------------------------------------------------------------
-# the spatial platform: anchors, their velocities (the planar ones are above)
-# ----------------------------------------------------------------------------------
 def rotation_matrices(rotation_vectors):
-    """``R = exp([theta]x)`` for rotation vectors (..., 3) [rad] -> (..., 3, 3).
-
-    Each is :func:`rotation_from_vector`.
-    """
+    """:func:`rotation_from_vector` of rotation vectors (..., 3) [rad], shape (..., 3, 3)."""
     theta = np.asarray(rotation_vectors, dtype=float)
     flat = theta.reshape(-1, 3)
     return np.array([rotation_from_vector(t) for t in flat]).reshape(theta.shape[:-1] + (3, 3))
@@ -633,71 +428,28 @@ def spatial_arms(pose, anchors):
 
 
 def spatial_anchor_points(pose, anchors):
-    """World positions of the platform anchors, ``p_i = r + R(theta) b_i``.
-
-    Parameters
-    ----------
-    pose : array_like, shape (6,) or (N, 6) [m, rad]
-        Platform pose(s) ``(r, theta)``.
-    anchors : array_like, shape (m, 3) [m]
-        Anchor points ``b_i`` in the platform frame.
-
-    Returns
-    -------
-    ndarray, shape (m, 3) or (N, m, 3) [m]
-    """
+    """World positions ``p_i = r + R(theta) b_i``, shape (m, 3) or (N, m, 3) [m], of the anchors (m, 3) [m]
+    at pose(s) ``(r, theta)`` (6,) or (N, 6) [m, rad]."""
     pose, anchors = check_pose_and_anchors(pose, anchors, sizes=(6, 3))
     return pose[..., None, :3] + spatial_arms(pose, anchors)
 
 
 def spatial_anchor_velocities(pose, pose_rate, anchors):
-    """World velocities of the platform anchors, ``v_i = dr/dt + omega x (R b_i)``, ``omega = J_l(theta) dtheta/dt``.
-
-    Parameters
-    ----------
-    pose : array_like, shape (6,) or (N, 6) [m, rad]
-        Platform pose(s) ``(r, theta)``.
-    pose_rate : array_like, same shape as ``pose`` [m/s, rad/s]
-        Rate(s) of the pose, ``(dr/dt, dtheta/dt)`` (the rotation vector's rate, not
-        the angular velocity).
-    anchors : array_like, shape (m, 3) [m]
-
-    Returns
-    -------
-    ndarray, shape (m, 3) or (N, m, 3) [m/s]
-    """
+    """World velocities ``v_i = dr/dt + omega x (R b_i)``, ``omega = J_l(theta) dtheta/dt``, shape (m, 3) or
+    (N, m, 3) [m/s], for ``pose`` (6,) or (N, 6), its rate ``(dr/dt, dtheta/dt)`` [m/s, rad/s] (the rotation
+    vector's, not the angular velocity) and anchors (m, 3) [m]."""
     pose, anchors, pose_rate = check_pose_and_anchors(pose, anchors, pose_rate, (6, 3))
     omega = np.einsum("...jk,...k->...j", left_jacobians(pose[..., 3:6]), pose_rate[..., 3:6])
     return pose_rate[..., None, :3] + np.cross(omega[..., None, :], spatial_arms(pose, anchors))
 
 
-# ----------------------------------------------------------------------------------
-# a platform above its exits
-# ----------------------------------------------------------------------------------
 def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None:
-    """Why no cable can hold the platform up, or None: every anchor at or above the top of its exit.
+    """Why no cable can hold the platform up (every anchor at or above its exit's top), or None.
 
-    A cable pulls its anchor towards the point where it leaves its exit, which lies no
-    higher than the exit's top (the top of a pulley's rim, an exit point itself). When
-    every anchor is at or above its exit's top, no cable pulls the platform upwards, and
-    as cables cannot push, none holds its weight. One test for planar and spatial robots.
-
-    Parameters
-    ----------
-    anchor_heights : array_like, shape (m,) [m]
-        Height of each cable's anchor (z, the vertical axis of both dimensions).
-    exit_tops : array_like, shape (m,) [m]
-        Height of the top of each cable's exit (:attr:`cdpr_exu.exits.base.Exit.top`; a swivel pulley's
-        inlet height plus its radius; an exit point's height).
-    exits : str
-        The scene field of the exits, for the message (``"pulleys"`` or ``"exits"``).
-
-    Returns
-    -------
-    str or None
-        ``"every anchor is at or above the top of its exit (platform.anchors[0] at z = 0.4 m,
-        pulleys[0] up to z = 0.25 m; ...): no cable can hold a platform above its exits, as
-        cables cannot push"``; None if some anchor lies below its exit's top.
+    A cable pulls its anchor towards where it leaves its exit, no higher than the exit's top
+    (:attr:`cdpr_exu.exits.base.Exit.top`); with every anchor at or above it, no cable pulls
+    upwards. ``anchor_heights`` and ``exit_tops`` (m,) [m]; ``exits`` names the scene field in
+    the message.
     """
     heights, tops = np.asarray(anchor_heights, dtype=float), np.asarray(exit_tops, dtype=float)
     if heights.shape != tops.shape or np.any(heights < tops):
@@ -708,37 +460,15 @@ def above_exits(anchor_heights, exit_tops, exits: str = "pulleys") -> str | None
             "exits, as cables cannot push")
 
 
-# ----------------------------------------------------------------------------------
-# how deep the lumped cable cuts into a pulley
-# ----------------------------------------------------------------------------------
 def penetration(pulley, positions: np.ndarray) -> np.ndarray:
-    """Depth by which each node lies inside the disc of ``pulley`` (its ``center`` and ``radius``; 0 outside) [m].
-
-    Parameters
-    ----------
-    positions : ndarray, shape (..., 2) [m]
-
-    Returns
-    -------
-    ndarray, shape (...) [m]
-    """
+    """Depth [m] by which each node (..., 2) [m] lies inside the disc of ``pulley`` (0 outside), (...)."""
     distance = np.linalg.norm(np.asarray(positions) - np.asarray(pulley.center), axis=-1)
     return np.maximum(pulley.radius - distance, 0.0)
 
 
 def segment_penetration(pulley, positions: np.ndarray) -> np.ndarray:
-    """Depth by which each element (the segment between two nodes) cuts into the disc of ``pulley`` [m].
-
-    Parameters
-    ----------
-    positions : ndarray, shape (n + 1, 2) [m]
-        Node positions of one cable.
-
-    Returns
-    -------
-    ndarray, shape (n,) [m]
-        r_p minus the distance of the segment from the pulley centre, 0 if outside.
-    """
+    """Depth [m] by which each element of one cable (nodes (n + 1, 2) [m]) cuts into the disc of ``pulley``:
+    r_p minus the segment's distance from the centre, 0 outside, shape (n,)."""
     positions = np.asarray(positions, dtype=float)
     center = np.asarray(pulley.center)
     a, b = positions[:-1], positions[1:]

@@ -1,10 +1,6 @@
-"""Files that programs read: strict JSON, CSV cells, stable archives, and output folders.
-
-Every JSON file the project writes goes through :func:`write_json`: ``NaN`` and
-infinities become ``null`` (strict parsers reject the bare tokens), NumPy scalars and
-arrays become plain numbers and lists. CSV cells for "not applicable" are empty, never
-``nan``. Wall-clock figures go into ``timing.json`` beside ``summary.json``, so that
-everything else a run writes is identical from one run to the next.
+"""Files that programs read: strict JSON (NaN and infinities as ``null``), CSV cells ("not applicable"
+empty, never ``nan``), stable archives, and output folders. Wall-clock figures go into ``timing.json``,
+so that everything else a run writes is identical from one run to the next.
 """
 
 from __future__ import annotations
@@ -72,7 +68,7 @@ def csv_cell(value: Any) -> str:
 
 def value_text(value: Any) -> str:
     """A value as a study's table, CSV and figures show it: ``true``/``false``, a float with all its
-    digits (empty when not finite: "not applicable", never "nan"), empty for None, else ``str``."""
+    digits, empty for None or not finite, else ``str``."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
@@ -81,7 +77,7 @@ def value_text(value: Any) -> str:
 
 
 def finite_number(value: Any) -> bool:
-    """True for an int or a float that is finite (a study's figure that exists; None and NaN do not)."""
+    """True for a finite int or float (None and NaN are not)."""
     return isinstance(value, (int, float)) and math.isfinite(value)
 
 
@@ -92,8 +88,7 @@ def fixed(value: float, digits: int = 2) -> str:
 
 
 def length_text(metres: float | None) -> str:
-    """A length [m] as printed: millimetres with two decimals from 0.1 mm on, micrometres to three
-    significant digits below (never "0.00 mm" for a micrometre); "n/a" for None."""
+    """A length [m] as printed: mm with two decimals from 0.1 mm on, um to three digits below; None "n/a"."""
     if metres is None:
         return "n/a"
     if abs(metres) >= 1e-4:
@@ -102,15 +97,8 @@ def length_text(metres: float | None) -> str:
 
 
 def split_timing(summary: Any, keep: Sequence[str] = ()) -> tuple[Any, Any]:
-    """Split a summary into (stable figures, timing figures that change from run to run).
-
-    The :data:`TIMING_KEYS` go to the timing part at any depth, under the same keys and list
-    positions (a comparison's ``controllers.ideal_ik.wall_time_s``, a study's
-    ``rows[3].real_time_factor``), so that no wall-clock figure hides in a nested table.
-    ``keep`` names timing keys that stay in the stable part because they are what the
-    file is about (the accuracy study's cost columns). The timing part is empty where
-    there is none.
-    """
+    """Split a summary into (stable figures, the :data:`TIMING_KEYS` at any depth, under the same keys and
+    list positions); ``keep``: timing keys that stay because they are the file's subject."""
     if isinstance(summary, Mapping):
         stable, timing = {}, {}
         for key, value in summary.items():
@@ -130,9 +118,8 @@ def split_timing(summary: Any, keep: Sequence[str] = ()) -> tuple[Any, Any]:
 
 def write_summary(folder: str | Path, summary: Mapping[str, Any], name: str = "summary.json", *,
                   timing_name: str = "timing.json", keep: Sequence[str] = ()) -> Path:
-    """Write ``summary`` into ``folder``: the stable part as ``name``, wall-clock figures (at any depth,
-    :func:`split_timing`) as ``timing_name`` (git-ignored under results/); ``keep``: timing keys the stable
-    file keeps because they are its subject."""
+    """Write ``summary`` into ``folder``: the stable part as ``name``, the wall-clock figures
+    (:func:`split_timing`) as ``timing_name`` (git-ignored under results/)."""
     folder = Path(folder)
     stable, timing = split_timing(summary, keep)
     if timing:
@@ -163,16 +150,8 @@ SPATIAL_POSE_COLUMNS: tuple[str, ...] = ("x_m", "y_m", "z_m", "rotation_x_rad", 
 
 
 def write_pose_csv(path: str | Path, time: Any, pose: Any, reference: Any, columns: Sequence[str]) -> Path:
-    """Write a run's platform path as CSV: time, the pose, the reference pose, units in the header.
-
-    Parameters
-    ----------
-    path : path
-    time : array_like, shape (N,) [s]
-    pose, reference : array_like, shape (N, len(columns))
-    columns : names of the pose columns with their unit last (:data:`PLANAR_POSE_COLUMNS`,
-        :data:`SPATIAL_POSE_COLUMNS`); the reference's are the same with ``_ref`` before the unit.
-    """
+    """Write a run's platform path as CSV: ``time`` (N,) [s], ``pose`` and ``reference`` (N, len(columns)),
+    under ``columns`` (unit last; the reference's with ``_ref`` before the unit)."""
     path = Path(path)
     references = [f"{name.rsplit('_', 1)[0]}_ref_{name.rsplit('_', 1)[1]}" for name in columns]
     header = ",".join(["time_s", *columns, *references])
@@ -183,12 +162,8 @@ def write_pose_csv(path: str | Path, time: Any, pose: Any, reference: Any, colum
 
 
 def undate_solution_file(path: str | Path) -> None:
-    """Blank the date in the header of Exudyn's solution file, so it is stable from run to run.
-
-    The binary header and footer hold the start and end times as ``YYYY-MM-DD,HH:MM:SS``;
-    they are overwritten in place with zeros of the same length (the file stays readable
-    by SolutionViewer).
-    """
+    """Blank the ``YYYY-MM-DD,HH:MM:SS`` dates in the header and footer of Exudyn's solution file (zeros of
+    the same length: SolutionViewer still reads it), so it is stable from run to run."""
     path = Path(path)
     data = bytearray(path.read_bytes())
     pattern = re.compile(rb"\d{4}-\d{2}-\d{2},\d{2}:\d{2}:\d{2}")
@@ -198,11 +173,8 @@ def undate_solution_file(path: str | Path) -> None:
     path.write_bytes(bytes(data))
 
 
-#: What each command writes into its output folder: file names and ``glob`` patterns. Before it
-#: writes, a command removes these (:func:`clear_outputs`), so that no file of the run it replaces
-#: stays beside its own (a spatial run into a planar run's folder kept that run's scene.toml,
-#: solution.sol and figures, and `cdpr view` replayed the old run); every other file is left alone
-#: (results/paper_circle/variants.* of examples/paper_reproduction.py, a user's notes).
+#: What each command writes into its output folder (names and ``glob`` patterns), removed before it writes
+#: (:func:`clear_outputs`) so that no file of the run it replaces stays; other files are left alone.
 COMMAND_OUTPUTS: dict[str, tuple[str, ...]] = {
     "run": ("scene.toml", "result.npz", "pose.csv", "summary.json", "timing.json", "solution.sol",
             "overview.png", "snapshots.png", "path.png", "rotation.png", "errors.png", "tensions.png",
@@ -228,17 +200,8 @@ COMMAND_MARKERS: dict[str, tuple[str, ...]] = {
 def check_output_folder(path: str | Path | None, option: str = "--out", command: str | None = None) -> Path | None:
     """Make sure ``path`` can be the output folder, before any work starts; create it.
 
-    With ``command`` (a key of :data:`COMMAND_OUTPUTS`), a folder that holds another
-    command's output (one of its :data:`COMMAND_MARKERS`) is refused: the two commands'
-    files would lie side by side, and what reads the folder (``cdpr view``, a reader of
-    summary.json) would mix them. A folder of the same command's earlier output is
-    accepted; the command clears those files before it writes (:func:`clear_outputs`).
-
-    Raises
-    ------
-    OutputError
-        If ``path`` (or one of its parents) is an existing file, cannot be created, or holds
-        another command's output.
+    OutputError if ``path`` (or a parent) is a file, cannot be created, or, with ``command``,
+    holds another command's output (:data:`COMMAND_MARKERS`: the two would be mixed).
     """
     if path is None:
         return None
@@ -263,13 +226,7 @@ def check_output_folder(path: str | Path | None, option: str = "--out", command:
 
 
 def clear_outputs(folder: str | Path, command: str) -> list[Path]:
-    """Remove the files ``command`` writes (:data:`COMMAND_OUTPUTS`) from ``folder``; returns them.
-
-    Called by each command just before it writes its first file, so that a new run leaves
-    none of the run it replaces (a figure that the new run does not draw, a
-    ``pose_<controller>.csv`` of a controller it did not run). Other files, and folders,
-    are left alone.
-    """
+    """Remove the files ``command`` writes (:data:`COMMAND_OUTPUTS`) from ``folder``; returns them."""
     folder = Path(folder)
     removed = []
     for pattern in COMMAND_OUTPUTS[command]:

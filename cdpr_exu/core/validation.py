@@ -1,9 +1,8 @@
 """Argument checks shared by the scene, the catenary and the statics.
 
-Each returns the value as a float or raises :class:`~cdpr_exu.core.errors.SceneError`
-naming the parameter and the offending value. Numbers must be numbers: text (``"1.0"``)
-and booleans (``true`` is no length) are refused, not converted, wherever a number is
-expected (:func:`is_number`), in scalars and in arrays alike.
+Each returns the checked value or raises :class:`~cdpr_exu.core.errors.SceneError` naming the
+parameter and the value. Text (``"1.0"``) and booleans are refused, not converted, wherever a
+number is expected (:func:`is_number`), in scalars and arrays alike.
 """
 
 from __future__ import annotations
@@ -13,14 +12,13 @@ import math
 import numbers
 from typing import Any, Mapping
 
+import numpy as np
+
 from cdpr_exu.core.errors import SceneError
 
 
 def plain(value: Any) -> Any:
-    """``value`` with NumPy scalars as Python numbers and NumPy arrays as lists, recursively (tuples
-    stay tuples, mappings become dicts); anything else unchanged."""
-    import numpy as np
-
+    """``value`` with NumPy scalars as Python numbers and arrays as lists, recursively (tuples kept)."""
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
@@ -35,17 +33,13 @@ def plain(value: Any) -> Any:
 
 
 def shown(value: Any) -> str:
-    """``value`` as a message shows it: plain numbers (``-2.0``, never ``np.float64(-2.0)``), arrays as
-    lists (``[1.0, 2.0]``, never ``array([1., 2.])``), text quoted (``'abc'``): the repr of :func:`plain`."""
+    """``value`` as a message shows it: the repr of :func:`plain` (``-2.0``, never ``np.float64(-2.0)``)."""
     return repr(plain(value))
 
 
 def is_number(value: Any) -> bool:
-    """True for a real number as TOML, Python and NumPy give one: an int, a float, a NumPy
-    integer or float scalar, or a one-element NumPy array of those. False for text
-    (``"1.0"``), booleans, None and everything else."""
-    import numpy as np
-
+    """True for an int, a float, a NumPy integer or float scalar or one-element array; False for text,
+    booleans, None and everything else."""
     if isinstance(value, (bool, np.bool_)):
         return False
     if isinstance(value, numbers.Real):
@@ -54,10 +48,7 @@ def is_number(value: Any) -> bool:
 
 
 def _refuse_non_numbers(value: Any, message: str) -> None:
-    """Raise SceneError(``message``) if ``value`` (a number, a nested list or an array) holds
-    anything but numbers: text, booleans, None, tables."""
-    import numpy as np
-
+    """Raise SceneError(``message``) if ``value`` (a number, nested list or array) holds anything else."""
     if isinstance(value, np.ndarray):
         if value.dtype.kind in "iuf":
             return
@@ -77,8 +68,7 @@ def _unit(unit: str) -> str:
 
 
 def finite(name: str, value: Any, unit: str = "") -> float:
-    """``value`` as a finite float; text and booleans are refused, not converted. ``unit`` (e.g. ``"kg"``)
-    is named in the message: "platform.mass must be a real number [kg], got '2.5'"."""
+    """``value`` as a finite float (``unit``, e.g. ``"kg"``, named in the message)."""
     if not is_number(value):
         raise SceneError(f"{name} must be a real number{_unit(unit)}, got {shown(value)}")
     number = float(value)
@@ -88,7 +78,7 @@ def finite(name: str, value: Any, unit: str = "") -> float:
 
 
 def positive(name: str, value: Any, unit: str = "") -> float:
-    """``value`` as a finite float > 0 ("platform.mass must be positive [kg], got -2.5")."""
+    """``value`` as a finite float > 0."""
     number = finite(name, value, unit)
     if number <= 0.0:
         raise SceneError(f"{name} must be positive{_unit(unit)}, got {shown(value)}")
@@ -105,8 +95,6 @@ def non_negative(name: str, value: Any, unit: str = "") -> float:
 
 def real_array(name: str, value: Any, *, require_finite: bool = True):
     """``value`` as a float ndarray (any shape); text, booleans, objects and NaN/inf are refused."""
-    import numpy as np
-
     _refuse_non_numbers(value, f"{name} must be real numbers, got {shown(value)}")
     try:
         array = np.asarray(value, dtype=np.float64)
@@ -119,8 +107,6 @@ def real_array(name: str, value: Any, *, require_finite: bool = True):
 
 def whole_array(name: str, value: Any):
     """``value`` as an int64 ndarray whose entries are whole numbers (2.5 is refused, not truncated)."""
-    import numpy as np
-
     array = real_array(name, value)
     if not np.all(array == np.round(array)):
         raise SceneError(f"{name} must be whole numbers, got {shown(value)}")
@@ -128,12 +114,7 @@ def whole_array(name: str, value: Any):
 
 
 def flat_coordinates(name: str, value: Any, n_coordinates: int | None = None):
-    """``value`` as a C-contiguous float64 array of planar coordinates ``x0, y0, x1, y1, ...``.
-
-    Shape (2 n_nodes,); with ``n_coordinates`` given, exactly that many entries.
-    """
-    import numpy as np
-
+    """``value`` as a C-contiguous float64 array (2 n_nodes,) ``x0, y0, x1, ...`` (``n_coordinates`` long)."""
     array = np.ascontiguousarray(real_array(name, value), dtype=np.float64)
     if array.ndim != 1 or array.shape[0] % 2 != 0:
         raise SceneError(f"{name} must be a flat array (2 n_nodes,) x0, y0, x1, ...; got shape {array.shape}")
@@ -143,8 +124,7 @@ def flat_coordinates(name: str, value: Any, n_coordinates: int | None = None):
 
 
 def entries(path: str, value: Any, length: int, unit: str = "") -> tuple[float, ...]:
-    """``value`` as a tuple of ``length`` finite floats, or SceneError naming ``path`` (``unit`` is named in
-    the messages): a scene field such as a pulley's centre or a platform's pose."""
+    """``value`` as a tuple of ``length`` finite floats (a scene field such as a pulley's centre)."""
     units = f" [{unit}]" if unit else ""
     if isinstance(value, (str, bytes, Mapping)):
         raise SceneError(f"{path} must be a list of {length} numbers{units}, got {shown(value)}")
@@ -158,12 +138,7 @@ def entries(path: str, value: Any, length: int, unit: str = "") -> tuple[float, 
 
 
 def vector(name: str, value: Any, length: int, meaning: str = ""):
-    """``value`` as a finite float ndarray of shape ``(length,)``.
-
-    ``meaning`` describes the entries in the message, e.g. ``" (x, z) [m]"``.
-    """
-    import numpy as np
-
+    """``value`` as a finite float ndarray (length,); ``meaning`` (e.g. ``" (x, z) [m]"``) in the message."""
     _refuse_non_numbers(value, f"{name} must be {length} numbers{meaning}, got {shown(value)}")
     try:
         array = np.asarray(value, dtype=np.float64)
@@ -175,12 +150,7 @@ def vector(name: str, value: Any, length: int, meaning: str = ""):
 
 
 def per_item(name: str, values: Any, count: int, positive: bool = False):
-    """One finite, non-negative (or positive) value per item: a scalar is repeated.
-
-    Returns a contiguous float64 ndarray, shape (count,); raises SceneError naming ``name``.
-    """
-    import numpy as np
-
+    """One finite, non-negative (or positive) value per item, a scalar repeated: float64 (count,)."""
     array = real_array(name, values)
     if array.ndim == 0:
         array = np.full(count, float(array))
@@ -194,8 +164,6 @@ def per_item(name: str, values: Any, count: int, positive: bool = False):
 
 def points_per_item(name: str, values: Any, count: int):
     """One finite planar point per item, shape (count, 2) [m]: a single (2,) point is repeated."""
-    import numpy as np
-
     array = np.asarray(real_array(name, values), dtype=np.float64)
     if array.shape == (2,):
         array = np.tile(array, (count, 1))
@@ -205,9 +173,8 @@ def points_per_item(name: str, values: Any, count: int):
 
 
 def from_table(cls: type, data: Any, path: str, head: str) -> Any:
-    """Make the dataclass ``cls`` from the table ``data`` (a scene file's), or SceneError naming ``path``:
-    refuses a table that is none and unknown fields, and names the fields of its own messages (which
-    name them under ``head``, e.g. ``pulley.radius``) under ``path`` (``pulleys[1].radius``)."""
+    """The dataclass ``cls`` from a scene file's table ``data``, unknown fields refused; its messages name
+    fields under ``path`` (``pulleys[1].radius``), not ``head`` (``pulley.radius``)."""
     if not isinstance(data, Mapping):
         raise SceneError(f"{path} must be a table, got {shown(data)}")
     known = {f.name for f in dataclasses.fields(cls)}

@@ -1,20 +1,12 @@
 """Scenes: the frozen, validated description of one CDPR simulation, planar or spatial.
 
 A :class:`Scene` is a tree of frozen dataclasses (cables, exits, platform, winch, effects,
-solver settings and the reference trajectory) with its ``dimension``: 2, the paper's
-vertical x-z plane (positions are ``(x, z)`` pairs; only the Exudyn builder maps them onto
-Exudyn's x-y plane, paper z -> Exudyn y), or 3, space with z up. Gravity acts along -z in
-both. The scene's :class:`~cdpr_exu.space.Space` is made from its dimension once; its
-exits are objects (:mod:`cdpr_exu.exits`). It is validated when it is made: a bad field
-raises :class:`~cdpr_exu.core.errors.SceneError` naming the field and its value, before
-any simulation starts.
-
-Scenes load from and save to TOML (:func:`load_scene`, :func:`save_scene`), in either form:
-``[[exits]]``, a table per cable with its ``kind`` (the spatial scenes' form, ``dimension = 3``,
-and a planar one's), or the planar form, ``[[pulleys]]`` and ``cable_exit`` (the README's
-scene reference and docs/spatial.md show both).
-
-Units are SI throughout (m, kg, s, N, rad).
+solver settings, reference trajectory) with its ``dimension``: 2, the paper's vertical x-z
+plane (``(x, z)`` pairs; only the builder maps them onto Exudyn's x-y plane, paper z ->
+Exudyn y), or 3, space with z up; gravity along -z in both. A bad field raises
+:class:`~cdpr_exu.core.errors.SceneError` naming it, before any simulation. Scenes load from
+and save to TOML in either form: ``[[exits]]`` (a table per cable with its ``kind``) or the
+planar ``[[pulleys]]`` and ``cable_exit`` (README's scene reference). Units SI.
 """
 
 from __future__ import annotations
@@ -51,16 +43,13 @@ def _choice(path: str, value: Any, choices: tuple[str, ...]) -> str:
 
 
 def _whole(path: str, value: Any, low: int, high: int) -> int:
-    """Return ``value`` as an int in [low, high], or raise SceneError naming ``path``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
         raise SceneError(f"{path} must be a whole number from {low} to {high}, got {shown(value)}")
     return int(value)
 
 
-#: Most elements per cable a scene may ask for (the paper uses 15). The cables'
-#: bending object carries dense (2 n_nodes)^2 matrices over all cables: 300 elements
-#: on each of 2 cables are 1204 coordinates, 12 MB per matrix, and cost about 50 s
-#: per simulated second; a few thousand would exhaust memory instead of failing.
+#: Most elements per cable (the paper uses 15): the bending object's dense (2 n_nodes)^2 matrices
+#: are 12 MB at 300 on each of 2 cables (about 50 s per simulated second); thousands exhaust memory.
 MAX_ELEMENTS = 300
 #: Most time steps of a run (Exudyn counts steps in a 32-bit integer).
 MAX_STEPS = 1.0e9
@@ -69,15 +58,14 @@ MAX_NEWTON_ITERATIONS = 1000
 
 
 def check_weight(mass: float, gravity: float) -> None:
-    """Refuse a platform whose weight, ``mass`` [kg] x ``gravity`` [m/s^2], is out of floating-point range
-    (naming platform.mass and gravity; each alone is finite)."""
+    """Refuse a platform weight ``mass`` [kg] x ``gravity`` [m/s^2] out of floating-point range."""
     if not math.isfinite(mass * gravity):
         raise SceneError(f"platform.mass = {shown(mass)} kg and gravity = {shown(gravity)} m/s^2 give a weight of "
                          f"{shown(mass * gravity)} N, out of floating-point range")
 
 
 def _set(obj: Any, name: str, value: Any) -> None:
-    """Normalise a field of a frozen dataclass inside ``__post_init__``."""
+    """Set a field of a frozen dataclass inside ``__post_init__``."""
     object.__setattr__(obj, name, value)
 
 
@@ -103,13 +91,11 @@ class CableSpec:
     n_elements : int
         Number of elements n (at least 2), each of unstrained length l0 / n.
     mass_lumping : {"consistent", "paper"}
-        "consistent": each node carries half the mass of each element it touches;
-        "paper": each element's whole mass sits at its far (platform-side) node.
+        "consistent": half of each element's mass on each of its nodes; "paper": all of it
+        on its far (platform-side) node (:meth:`node_masses`).
     min_tension, max_tension : float or None [N]
-        The cable's tension limits t_min and t_max (None: no limit). A reference the
-        limits cannot hold is refused before the run
-        (:func:`cdpr_exu.statics.workspace.check_reference`); a run reports every element
-        tension outside them (``tension_limit_violations`` in its summary).
+        Tension limits (None: none). A reference they cannot hold is refused before the run;
+        a run reports every element tension outside them.
     """
 
     unstrained_length: float = 3.75
@@ -122,7 +108,6 @@ class CableSpec:
     min_tension: float | None = None
     max_tension: float | None = None
 
-    #: Most elements a cable may have (:data:`MAX_ELEMENTS`).
     max_elements: ClassVar[int] = MAX_ELEMENTS
 
     def __post_init__(self) -> None:
@@ -149,7 +134,7 @@ class CableSpec:
 
     def _check_derived(self) -> None:
         """Refuse fields whose derived element properties overflow or underflow (e.g. radius 1e300)."""
-        causes = {  # derived quantity: the fields it grows with, the likeliest culprit first
+        causes = {  # derived quantity: the fields it grows with
             "area": ("radius",), "second_moment": ("radius",),
             "element_mass": ("linear_density", "unstrained_length"),
             "axial_stiffness": ("youngs_modulus", "radius", "unstrained_length"),
@@ -168,7 +153,7 @@ class CableSpec:
                 raise SceneError(f"{given} give(s) an element {name.replace('_', ' ')} of {shown(value)}, "
                                  "out of floating-point range")
 
-    # Derived quantities of the paper's Table 2 -------------------------------------
+    # Derived quantities of the paper's Table 2
     @property
     def area(self) -> float:
         """Unstrained cross-section A0 = pi r^2 [m^2]."""
@@ -222,10 +207,8 @@ class CableSpec:
     def node_masses(self) -> np.ndarray:
         """Masses of the n + 1 nodes, winch end first, shape (n + 1,) [kg].
 
-        The consistent lumping puts m_i / 2 on both ends of each element. The paper's
-        lumping puts m_i on the far node of each element; the winch node, whose motion
-        is prescribed, then gets m_i / 2 so that it is not massless (its mass never
-        enters the platform's dynamics).
+        The paper's lumping gives the winch node (prescribed motion) m_i / 2 so that it is
+        not massless; its mass never enters the platform's dynamics.
         """
         n, m = self.n_elements, self.element_mass
         masses = np.full(n + 1, m)
@@ -236,10 +219,8 @@ class CableSpec:
         return masses
 
 
-#: What a platform that leaves a field out gets, by its dimension. In the plane: the paper's platform
-#: (Table 2: its moment of inertia J_MP, the start of its runs, the rectangle its figures draw). In
-#: space: a point mass has no inertia (a rigid platform must give its principal moments), a spatial
-#: robot starts at its rest (``cdpr static`` finds it; no initial pose is taken), and no rectangle.
+#: What a platform that leaves a field out gets, by its Space: planar, the paper's (Table 2); spatial, no
+#: inertia for a point mass (a rigid one must give it), no initial pose (the run starts at its rest).
 PLATFORM_DEFAULTS: dict[Space, dict[str, Any]] = {
     PLANE: {"inertia": 0.0271, "point_mass_inertia": 0.0271, "initial_pose": (0.0, -2.0, 0.0), "size": (0.3, 0.2)},
     SPACE: {"inertia": None, "point_mass_inertia": (0.0, 0.0, 0.0), "initial_pose": None, "size": None},
@@ -248,28 +229,23 @@ PLATFORM_DEFAULTS: dict[Space, dict[str, Any]] = {
 
 @dataclass(frozen=True)
 class PlatformSpec:
-    """The platform (paper sec. 2.3): a rigid body the cables hold, planar or spatial.
+    """The platform (paper sec. 2.3), planar or spatial as its anchors: ``(x, z)`` pairs or ``(x, y, z)``.
 
-    Its dimension is that of its anchors: ``(x, z)`` pairs make a planar platform, ``(x, y, z)``
-    points a spatial one (:attr:`space`); its scene must be of that dimension. A field left out
-    (None) takes :data:`PLATFORM_DEFAULTS` of that dimension.
+    A field left out (None) takes :data:`PLATFORM_DEFAULTS` of its :attr:`space`.
 
     Parameters
     ----------
     mass : float [kg]
         Positive for a rigid platform; a spatial point mass may weigh nothing.
     inertia : float, or (float, float, float) [kg m^2]
-        Planar: the moment of inertia J_MP about the centre of mass, out of the plane (positive).
-        Spatial: the principal moments about the centre of mass along the platform axes
-        (positive for a rigid platform; left out, zero for a point mass).
-    anchors : sequence of (x, z) or of (x, y, z) [m]
-        Cable anchor points b_i in the platform frame (centre of mass at 0), one per cable,
-        shape (m, d). All zero for a point-mass platform.
+        Planar: J_MP about the centre of mass; spatial: the principal moments along the
+        platform axes (zero for a point mass).
+    anchors : sequence of (x, z) or (x, y, z) [m]
+        Anchor points b_i in the platform frame, shape (m, d); all zero for a point mass.
     initial_pose : (x, z, rotation) [m, m, rad], or None
-        Planar: the pose at t = 0, rotation positive counter-clockwise (paper eq. 17).
-        Spatial: None, the start is the rest.
+        Planar: the pose at t = 0 (paper eq. 17). Spatial: None, the start is the rest.
     size : (width, height) [m], or None
-        Rectangle drawn in planar figures and animations (no effect on the dynamics).
+        Rectangle drawn in planar figures (no effect on the dynamics).
     """
 
     mass: float = 2.5
@@ -312,7 +288,7 @@ class PlatformSpec:
 
     @property
     def space(self) -> Space:
-        """The :class:`~cdpr_exu.space.Space` of the platform: that of its anchors."""
+        """The :class:`~cdpr_exu.space.Space` of its anchors."""
         return space_of(len(self.anchors[0]))
 
     @property
@@ -321,7 +297,7 @@ class PlatformSpec:
         return all_at_centre(self.anchors)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-data form (TOML-ready): the fields given or taken by default (None left out)."""
+        """Plain-data form (TOML-ready), None left out."""
         return {f.name: _listify(getattr(self, f.name)) for f in fields(self) if getattr(self, f.name) is not None}
 
 
@@ -332,19 +308,13 @@ class WinchSpec:
     Parameters
     ----------
     kind : {"kinematic", "servo", "fixed"}
-        "kinematic": node 0 follows the commanded paid-out length exactly, moving along
-        the vertical line below the pulley (the paper's flow source along -z).
-        "servo": a drum of inertia ``drum_inertia`` and radius ``drum_radius`` reels the
-        cable; a motor torque from state feedback with integral action (gains designed
-        with python-control for ``servo_bandwidth``) tracks the command, and the cable
-        tension loads the drum. "fixed": node 0 is held where it starts (static scenes).
-    drum_radius : float [m]
-    drum_inertia : float [kg m^2]
-        Drum and motor inertia about the drum axis.
+        "kinematic": node 0 follows the command exactly along the vertical line below the
+        pulley (the paper's flow source). "servo": a drum (``drum_inertia`` [kg m^2], drum and
+        motor, ``drum_radius`` [m]) reels the cable under a motor torque from state feedback
+        with integral action, loaded by the cable tension. "fixed": node 0 held (static scenes).
     servo_design : {"pole_placement", "lqr"}
-        Pole placement puts the three closed-loop poles near -servo_bandwidth; LQR
-        weights position error against motor force for about that bandwidth.
-    servo_bandwidth : float [rad/s]
+        Pole placement puts the three closed-loop poles near -``servo_bandwidth`` [rad/s];
+        LQR weights position error against motor force for about that bandwidth.
     """
 
     kind: str = "kinematic"
@@ -366,11 +336,9 @@ class WinchSpec:
         return self.drum_inertia / self.drum_radius**2
 
 
-#: The model ladder: which effects each preset switches on. A cable cannot push, so the
-#: lumped-mass presets ("full", the default, and "catenary") have tension-only elements;
-#: "paper" is the paper's model as published, whose axial spring-dampers also push when
-#: compressed (kept to reproduce it). "ideal" and "elastic" are the massless references
-#: of inverse kinematics (ropes that may push; a run reports it when they do).
+#: The model ladder: which effects each preset switches on. "full" and "catenary" have tension-only
+#: elements; "paper" is the paper's as published (its spring-dampers push when compressed); "ideal" and
+#: "elastic" are the massless references of inverse kinematics (a run reports ropes that push).
 PRESETS: dict[str, dict[str, bool]] = {
     "ideal": dict(
         cable_mass=False, axial_elasticity=False, axial_damping=False, bending=False,
@@ -395,9 +363,7 @@ PRESETS: dict[str, dict[str, bool]] = {
 }
 
 
-#: Where the pulley contact acts: on the nodes (Exudyn's sphere contact items), on the
-#: element segments, or on the nodes with a smooth onset in the cables' numba object
-#: (:mod:`cdpr_exu.scenes.contact_models`).
+#: Where the pulley contact acts (:mod:`cdpr_exu.scenes.contact_models`).
 PULLEY_CONTACT_MODELS = tuple(CONTACT_MODELS)
 
 
@@ -408,34 +374,21 @@ class Effects:
     Parameters
     ----------
     preset : str
-        Name of the preset the flags started from (see :data:`PRESETS`), for reports:
-        "ideal" (massless inextensible ropes), "elastic" (massless elastic ropes),
-        "catenary" (lumped mass and elasticity, no bending), "full" (the paper's model with
-        tension-only elements, the default), "paper" (the paper's model as published: its
-        spring-dampers push when compressed, which a real cable cannot).
+        The preset the flags started from (:data:`PRESETS`), for reports.
     cable_mass, axial_elasticity, axial_damping, bending, bending_damping,
     pulley_contact, slack, gravity : bool
-        Switches of the individual effects. Without ``cable_mass`` each cable is one
-        massless rope over its pulley (Exudyn's reeving system); without
-        ``axial_elasticity`` the elements (or the rope) are inextensible. ``slack``
-        (on in every preset but "paper") makes the elements (or the rope) tension-only:
-        a cable cannot push.
+        Switches of the effects. Without ``cable_mass`` each cable is one massless rope
+        (Exudyn's reeving system); without ``axial_elasticity`` it is inextensible;
+        ``slack`` makes the elements (or the rope) tension-only.
     bending_model : {"exact", "linear"}
-        Formulation of the bending spring: "exact" is the paper's relative joint angle;
-        "linear" the curvature-vector spring (k_theta / l0i^2) |p_a - 2 p_b + p_c|^2 / 2
-        with constant matrices, cheaper but with moment k_theta sin(theta) (see
-        docs/accuracy.md for how far it moves the answer).
+        "exact": the paper's relative joint angle; "linear": the curvature-vector spring
+        (k_theta / l0i^2) |p_a - 2 p_b + p_c|^2 / 2, cheaper, with moment k_theta sin(theta)
+        (docs/accuracy.md).
     pulley_contact_model : {"node", "segment", "node_smooth"}
-        Where the pulley rim contact acts (with ``pulley_contact``): "node" pushes each
-        node that enters the disc back out (Exudyn's sphere contact, k_p [N/m] times the
-        penetration [m] plus c_p [N s/m] on the normal velocity [m/s], switched on and off
-        in Exudyn's discontinuous iterations); "node_smooth" is the same law switched on
-        smoothly over the first 1e-5 m of penetration, computed in the cables' numba
-        object (:mod:`cdpr_exu.physics.node_contact`; measured slower, see docs/accuracy.md);
-        "segment" does the same for the point of each element closest to the pulley
-        centre, shared by the element's two nodes (:mod:`cdpr_exu.physics.segment_contact`), so
-        that straight elements cannot cut the disc as chords and coarser cables can run
-        over the pulley.
+        Where the rim contact acts (:mod:`cdpr_exu.scenes.contact_models`): k_p [N/m] times the
+        penetration plus c_p [N s/m] on the normal velocity, on each node, on each element's
+        point closest to the centre (straight elements cannot cut the disc as chords), or on
+        the nodes with a smooth onset over the first 1e-5 m.
     """
 
     preset: str = "full"
@@ -474,9 +427,8 @@ class Effects:
     def from_preset(cls, preset: str = "full", **overrides: Any) -> "Effects":
         """Effects of a named preset, with single effects overridden.
 
-        Inextensible lumped cables (``axial_elasticity = False`` with ``cable_mass``) have
-        no springs to make tension-only, so a preset's ``slack`` is dropped for them unless
-        it is asked for explicitly (which is refused).
+        Inextensible lumped cables have no springs to make tension-only: a preset's ``slack``
+        is dropped for them unless asked for (then refused).
         """
         _choice("effects.preset", preset, tuple(PRESETS))
         unknown = set(overrides) - {f.name for f in fields(cls)}
@@ -494,43 +446,29 @@ class SolverSpec:
 
     Parameters
     ----------
-    end_time : float [s]
-    step_size : float [s]
+    end_time, step_size, output_period : float [s]
+        The run's end, the time step and the sampling period of the stored result.
     spectral_radius : float
-        Spectral radius at infinity rho_inf of generalized-alpha, in [0, 1]. The default
-        0 damps the stiff, heavily over-damped axial modes fully; 0.5 lets their damping
-        force ring from step to step (negative tensions of -20 N on the paper scene, with
-        the same path to 1 mm); 1 conserves energy but leaves them undamped.
+        rho_inf of generalized-alpha, in [0, 1]. The default 0 damps the stiff, over-damped
+        axial modes fully; 0.5 lets their damping force ring (-20 N tensions on the paper
+        scene); 1 conserves energy but leaves them undamped.
     newton : {"modified", "full"}
-        Modified Newton (Jacobian updated once per step) or full Newton.
-    output_period : float [s]
-        Sampling period of the stored result.
+        Modified Newton (Jacobian once per step) or full Newton.
     max_newton_iterations : int
-        Newton iterations per step before the step counts as failed (1 to
-        :data:`MAX_NEWTON_ITERATIONS`).
+        Per step before it counts as failed (1 to :data:`MAX_NEWTON_ITERATIONS`).
     integrator : {"generalized_alpha", "rk44"}
-        "generalized_alpha": Exudyn's implicit solver (the project's). "rk44": Exudyn's
-        explicit classical Runge-Kutta, for comparison only: it needs steps below about
-        1e-7 s on the paper's cable (c_i / m_i = 3.6e6 1/s), and the cable ends are then
-        joined to the platform by stiff spring-dampers (see :mod:`cdpr_exu.builder.platform`).
-        ``spectral_radius``, ``newton`` and ``max_newton_iterations`` do not apply to it.
+        Exudyn's implicit solver (the project's), or its explicit Runge-Kutta for comparison
+        only: it needs steps below about 1e-7 s on the paper's cable (c_i / m_i = 3.6e6 1/s),
+        and takes no spectral radius or Newton settings.
     initial_accelerations : bool
-        Start generalized-alpha from the consistent initial accelerations (Exudyn's
-        ``computeInitialAccelerations``) instead of zero. Off by default: on a cable that
-        starts straight, the free nodes' consistent acceleration (-g) is cut off by the
-        Kelvin-Voigt damping within microseconds, and carried into the first step it
-        injects an energy jolt (13 J on the paper scene at 1.7e-2 s steps). On, the error
-        of a drop from rest is of second order in the step instead of first
-        (`benchmarks/bench_moordyn.py`: 0.19 mm instead of 0.84 mm at 2e-3 s).
+        Start from the consistent initial accelerations instead of zero. Off by default: on a
+        straight cable they are cut off by the damping within microseconds and inject an
+        energy jolt (13 J on the paper scene at 1.7e-2 s steps); on, a drop from rest is
+        second-order accurate (`benchmarks/bench_moordyn.py`: 0.19 instead of 0.84 mm).
     newton_tolerance : float
-        Newton's relative tolerance per step (Exudyn's ``newton.relativeTolerance``), in
-        (0, 1e-3]. The default 1e-6 (Exudyn's is 1e-8) matches the answers asked of this
-        model, millimetres: on the paper circle it moves the path by 0.14 micrometres at 15
-        elements and 33 micrometres at 60 elements and a 1e-2 s step, and cuts the Newton
-        iterations per step from 3.0 to 2.2 and from 12.3 to 8.7. On stiff massless ropes
-        Exudyn's 1e-8 sits at the residual's round-off and stalls Newton (the step then
-        shrinks up to 350-fold). Without bending the path over 10 s is sensitive to any
-        perturbation: 1e-8 and 1e-9 already differ by 1.7 cm there.
+        Relative Newton tolerance per step, in (0, 1e-3]. The default 1e-6 (Exudyn's 1e-8)
+        moves the paper circle by 0.14 um at 15 elements and cuts Newton iterations from 3.0
+        to 2.2 per step; on stiff massless ropes 1e-8 sits at round-off and stalls Newton.
     """
 
     end_time: float = 10.0
@@ -583,10 +521,8 @@ class SolverSpec:
 
 # --------------------------------------------------------------------------- controller model
 
-#: Fields the controllers' model may override, by part. Left out: where the platform
-#: starts and its drawing size (the run starts from the plant's state, which the
-#: controllers are told: the paid-out lengths at t = 0) and the tension limits (the
-#: robot's requirements, one set for plant and controllers).
+#: Fields the controllers' model may override, by part (not the start, which is the plant's, nor the
+#: tension limits, one set for plant and controllers).
 MODEL_FIELDS: dict[str, tuple[str, ...]] = {
     "cable": ("unstrained_length", "radius", "linear_density", "youngs_modulus", "damping_constant",
               "n_elements", "mass_lumping"),
@@ -596,7 +532,7 @@ MODEL_FIELDS: dict[str, tuple[str, ...]] = {
 
 
 def _overrides(path: str, data: Any, part: str) -> dict[str, Any]:
-    """A copy of one override table, refusing keys the controllers' model cannot override."""
+    """A copy of one override table, refusing keys the model cannot override."""
     if not isinstance(data, Mapping):
         raise SceneError(f"{path} must be a table, got {shown(data)}")
     known = MODEL_FIELDS[part]
@@ -608,7 +544,7 @@ def _overrides(path: str, data: Any, part: str) -> dict[str, Any]:
 
 
 def _tupled(value: Any) -> Any:
-    """Lists to tuples, recursively (so that overrides compare equal after a TOML round trip)."""
+    """Lists to tuples, recursively (overrides compare equal after a TOML round trip)."""
     if isinstance(value, (list, tuple)):
         return tuple(_tupled(v) for v in value)
     return value
@@ -616,11 +552,10 @@ def _tupled(value: Any) -> Any:
 
 @dataclass(frozen=True)
 class ControllerModel:
-    """What the controllers believe of the robot, where it differs from the simulated plant.
+    """What the controllers believe of the robot: overrides of the plant's parameters.
 
-    Overrides of the plant's parameters; everything not named is the plant's. A scene
-    with a controller model simulates its own parts (the plant) and hands the controllers
-    :meth:`Scene.controller_scene`, the plant with these overrides applied. In TOML::
+    The scene simulates its own parts and hands the controllers :meth:`Scene.controller_scene`,
+    the plant with these applied. In TOML::
 
         [controller_model.platform]   # the paper's platform, while the plant's is heavier
         mass = 2.5
@@ -632,17 +567,14 @@ class ControllerModel:
 
     Parameters
     ----------
-    cable : mapping
-        Overrides of every cable's :class:`CableSpec` fields (see :data:`MODEL_FIELDS`).
-    cables : sequence of mappings
-        Per-cable overrides (none, or one per cable), applied after ``cable``.
+    cable, cables : mapping, sequence of mappings
+        Overrides of every cable's fields (:data:`MODEL_FIELDS`), then per cable (none or one each).
     pulley, pulleys : mapping, sequence of mappings
-        The same for the fields of the scene's pulleys (:class:`~cdpr_exu.exits.pulley.Pulley`;
-        refused where the exits are not pulleys).
+        The same for the pulleys (refused where the exits are not pulleys).
     platform : mapping
-        Overrides of :class:`PlatformSpec` fields: mass [kg], inertia [kg m^2], anchors [m].
+        Overrides of the platform's mass [kg], inertia [kg m^2], anchors [m].
     gravity : float or None [m/s^2]
-        The gravitational acceleration the controllers assume (None: the plant's).
+        What the controllers assume (None: the plant's).
     """
 
     cable: Mapping[str, Any] = field(default_factory=dict)
@@ -670,14 +602,8 @@ class ControllerModel:
                     or self.gravity is not None)
 
     def apply(self, scene: "Scene") -> "Scene":
-        """``scene`` with these overrides applied (and no controller model of its own).
-
-        Raises
-        ------
-        SceneError
-            If an override is invalid or the per-cable lists do not match the cables;
-            the message names the ``controller_model`` field.
-        """
+        """``scene`` with these overrides applied (and no controller model of its own); SceneError naming the
+        ``controller_model`` field for an invalid override or per-cable lists that do not match the cables."""
         m = scene.n_cables
         for name in ("cables", "pulleys"):
             if getattr(self, name) and len(getattr(self, name)) != m:
@@ -716,7 +642,7 @@ class ControllerModel:
 
 
 def _override(part: Any, changes: Mapping[str, Any], path: str, head: str) -> Any:
-    """``part`` (a frozen spec) with ``changes``; an invalid value is named under controller_model."""
+    """``part`` with ``changes``; an invalid value is named under controller_model."""
     if not changes:
         return part
     try:
@@ -748,29 +674,17 @@ class Scene:
 
     Parameters
     ----------
-    name : str
-    description : str
     dimension : {2, 3}
-        2: the paper's vertical x-z plane; 3: space, z up. Gravity acts along -z in both.
-        The scene's :attr:`space` (:func:`cdpr_exu.space.space_of`) is made from it once.
-    cables : tuple of CableSpec
-        One per cable; cable i leaves the frame at ``exits[i]`` and holds ``platform.anchors[i]``.
-    exits : tuple of Exit
-        Where each cable leaves the frame (:mod:`cdpr_exu.exits`): planar pulleys or point
-        exits in the plane, point exits or swivel pulleys in space, or any registered kind.
-    platform : PlatformSpec
-        Of the scene's dimension (its anchors' size).
-    winch : WinchSpec
-    effects : Effects
-    solver : SolverSpec
+        2: the paper's vertical x-z plane; 3: space, z up; its :attr:`space` is made from it.
+    cables, exits : tuple of CableSpec, tuple of Exit
+        Cable i leaves the frame at ``exits[i]`` (:mod:`cdpr_exu.exits`) and holds ``platform.anchors[i]``.
     trajectory : Trajectory or None
-        Reference pose of the platform over time (default: hold a planar initial pose; a spatial
-        scene without one has a static mode only).
+        Reference pose over time (default: hold a planar initial pose; a spatial scene without
+        one has a static mode only).
     gravity : float [m/s^2]
-        Magnitude of the gravitational acceleration, acting along -z.
+        Magnitude, along -z.
     controller_model : ControllerModel or None
-        What the controllers believe where it differs from this (simulated) robot;
-        :meth:`controller_scene` applies it. None: the controllers know the plant.
+        What the controllers believe (:meth:`controller_scene`); None: they know the plant.
 
     Raises
     ------
@@ -851,15 +765,11 @@ class Scene:
 
     @property
     def space(self) -> Space:
-        """The :class:`~cdpr_exu.space.Space` of the scene: what a pose, a position and a rotation are."""
+        """The :class:`~cdpr_exu.space.Space` of the scene."""
         return space_of(self.dimension)
 
     def controller_scene(self) -> "Scene":
-        """The robot the controllers believe in: this scene with its controller model applied.
-
-        Without a controller model, the scene itself. The trajectory, solver settings,
-        effects and the initial pose are the plant's.
-        """
+        """The robot the controllers believe in: this scene with its controller model applied (if any)."""
         if self.controller_model is None:
             return self
         return self.controller_model.apply(self)
@@ -888,11 +798,10 @@ class Scene:
                     f"cables[{i}].unstrained_length = {cable.unstrained_length} m is shorter than the "
                     f"{needed:.4f} m needed to reach platform.initial_pose {pose}")
 
-    # Convenience -------------------------------------------------------------------
     @property
     def exits_table(self) -> str:
-        """The scene file's name of the exits (messages, :func:`save_scene`): ``"pulleys"`` for a planar scene
-        whose exits are all pulleys or all point exits (the planar form), else ``"exits"``."""
+        """The scene file's name of the exits: ``"pulleys"`` for a planar scene whose exits are all pulleys or
+        all point exits (the planar form), else ``"exits"``."""
         kinds = {exit_.kind for exit_ in self.exits}
         return "pulleys" if self.space is PLANE and kinds in ({"pulley"}, {"point"}) else "exits"
 
@@ -903,15 +812,12 @@ class Scene:
 
     @property
     def exit_tops(self) -> np.ndarray:
-        """Height [m] of the highest point each cable can leave its exit from, shape (m,)
-        (:attr:`cdpr_exu.exits.base.Exit.top`)."""
+        """Each exit's :attr:`~cdpr_exu.exits.base.Exit.top`, shape (m,) [m]."""
         return np.array([exit_.top for exit_ in self.exits], dtype=float)
 
     def above_exits(self, position, rotation=None) -> str | None:
-        """Why no cable can hold the platform with its centre of mass at ``position`` (d,) [m], its frame
-        turned by the rotation matrix ``rotation`` (d, d) (default: not turned): every anchor at or above
-        its exit's top (:func:`cdpr_exu.core.geometry.above_exits`); None if one is below, or the platform
-        has no weight."""
+        """:func:`cdpr_exu.core.geometry.above_exits` for the centre at ``position`` (d,) [m], the frame
+        turned by ``rotation`` (d, d) (default: not); None for a platform without weight."""
         if self.gravity == 0.0 or not self.effects.gravity:
             return None
         anchors, up = np.asarray(self.platform.anchors, dtype=float), self.space.vertical
@@ -920,7 +826,7 @@ class Scene:
 
     @property
     def pulley_contact(self) -> bool:
-        """True when the cables touch their pulleys: contact is on and a cable wraps over its exit."""
+        """True when contact is on and a cable wraps over its exit."""
         return self.effects.pulley_contact and any(exit_.wraps for exit_ in self.exits)
 
     @property
@@ -947,9 +853,8 @@ class Scene:
         return replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-data form (TOML-ready) of the scene: the planar form for a planar scene whose exits are
-        all pulleys or all point exits (:attr:`exits_table`), else the form with ``dimension`` and
-        ``[[exits]]``; :func:`scene_from_dict` reads either back to an equal scene."""
+        """Plain-data form (TOML-ready), in the form of :attr:`exits_table`; :func:`scene_from_dict` reads
+        it back to an equal scene."""
         cables = [{k: v for k, v in dataclasses.asdict(c).items() if v is not None} for c in self.cables]
         if self.exits_table == "pulleys":
             data: dict[str, Any] = {
@@ -979,7 +884,7 @@ class Scene:
 
 
 def _pulley_table(exit_: Exit) -> dict[str, Any]:
-    """An exit of a scene in the planar form as its ``[[pulleys]]`` table: a pulley's fields, a point exit's centre."""
+    """An exit as its ``[[pulleys]]`` table: a pulley's fields, a point exit's centre."""
     if exit_.wraps:
         return {name: value for name, value in exit_.to_dict().items() if name != "kind"}
     return {"center": list(exit_.point)}
@@ -992,9 +897,6 @@ def _listify(value: Any) -> Any:
     if isinstance(value, (tuple, list)):
         return [_listify(v) for v in value]
     return value
-
-
-# --------------------------------------------------------------------------- what each dimension takes
 
 
 def _planar_rules(scene: Scene) -> None:
@@ -1036,31 +938,23 @@ def _spatial_rules(scene: Scene) -> None:
 
 @dataclass(frozen=True)
 class DimensionRules:
-    """What a scene of one dimension takes where the two dimensions still differ: what its builder
-    builds (``check`` refuses the rest, naming the field), the platform fields a scene file must give
-    (besides a rigid platform's inertia) and whether it must give ``[trajectory]`` (a spatial scene
-    without one has a static mode only). They are the two item families' own limits
-    (:mod:`cdpr_exu.builder.model`, :mod:`cdpr_exu.builder.robot_3d`), checked here so that a scene
-    is refused before anything is built.
-    """
+    """What a scene of one dimension takes: what its item family builds (``check`` refuses the rest, naming
+    the field, before anything is built), the platform fields a scene file must give (besides a rigid
+    platform's inertia) and whether it must give ``[trajectory]``."""
 
     check: Callable[[Scene], None]
     platform_fields: tuple[str, ...]
     trajectory_required: bool
 
 
-#: The rules of each dimension (:class:`DimensionRules`), by the scene's Space.
 DIMENSION_RULES: dict[Space, DimensionRules] = {
     PLANE: DimensionRules(_planar_rules, ("mass", "anchors", "initial_pose"), trajectory_required=True),
     SPACE: DimensionRules(_spatial_rules, ("mass", "anchors"), trajectory_required=False),
 }
 
 
-# --------------------------------------------------------------------------- TOML
-
-
 def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
-    """Make the scene part ``cls`` from its table (:func:`~cdpr_exu.core.validation.from_table`), e.g. cables[1]."""
+    """The scene part ``cls`` from its table at ``path`` (e.g. cables[1])."""
     return from_table(cls, data, path, cls.__name__.replace("Spec", "").lower())
 
 
@@ -1076,29 +970,21 @@ def _per_cable(data: Mapping[str, Any], single: str, plural: str, defaults: list
     return [{**e, **shared} if plural not in data else {**shared, **dict(e)} for e in tables]
 
 
-#: The fields of cables and platforms a scene file (or its plain data) must give, with their units:
-#: the robot's lengths and masses, for which no default would be the robot its author meant. Which
-#: of them apply depends on the scene (a platform's inertia only where an anchor is off its centre of
-#: mass, its initial pose only in the plane); each exit kind names its own
-#: (:attr:`cdpr_exu.exits.base.Exit.required_fields`). Every other field keeps a documented default
-#: that is a model choice (the paper's cable material, elements, contact law, solver settings, effect flags).
+#: The fields of cables and platforms a scene must give, with their units: lengths and masses, for which
+#: no default would be the robot meant (each exit kind names its own; other defaults are model choices).
 REQUIRED_FIELDS: dict[str, str] = {
     "unstrained_length": "m", "mass": "kg", "inertia": "kg m^2", "anchors": "m", "initial_pose": "m, m, rad",
 }
 
 
 def missing_fields(path: str, given: Mapping[str, Any], names, units: Mapping[str, str] = REQUIRED_FIELDS) -> list[str]:
-    """The required ``names`` (keys of ``units``, by default :data:`REQUIRED_FIELDS`) that the table
-    ``given`` leaves out, each as a field path ``path.name`` with its unit, e.g. ``"platform.mass [kg]"``."""
+    """The required ``names`` the table ``given`` leaves out, as ``"platform.mass [kg]"``."""
     return [f"{path}.{name} [{units[name]}]" for name in names if name not in given]
 
 
 def refuse_missing(missing: list[str], source: str | None = None) -> None:
-    """Raise SceneError naming every required field a scene leaves out (see :func:`missing_fields`).
-
-    Called once the values given are checked, and before the scene's parts are put together
-    (so that no default stands in for a missing field in a later check or message).
-    """
+    """Raise SceneError naming every required field a scene leaves out (after the values given are
+    checked, before the parts are put together: no default stands in for a missing field)."""
     if missing:
         where = "scene" if source is None else f"scene {shown(source)}"
         raise SceneError(f"{where} lacks {', '.join(missing)}: a scene must give "
@@ -1107,7 +993,7 @@ def refuse_missing(missing: list[str], source: str | None = None) -> None:
 
 
 def _platform_missing(platform_data: Any, platform: PlatformSpec, rules: DimensionRules) -> list[str]:
-    """The required fields the ``[platform]`` table leaves out (the inertia where an anchor is off its centre)."""
+    """The required fields ``[platform]`` leaves out (the inertia where an anchor is off the centre)."""
     if not isinstance(platform_data, Mapping):
         return []
     names = rules.platform_fields + (() if platform.is_point_mass else ("inertia",))
@@ -1121,21 +1007,13 @@ EXITS_FORM_FIELDS = PLANAR_FORM_FIELDS - {"cable_exit", "pulley", "pulleys"} | {
 
 
 def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene:
-    """Make a validated Scene, planar or spatial, from plain data (as read from TOML).
+    """A validated Scene, planar or spatial (``dimension``, 2 when absent), from plain data (TOML's).
 
-    ``dimension`` (2 when absent) says which. A scene gives its exits in one of two forms:
-
-    * ``[[exits]]``, one table per cable with its ``kind`` (``"point"`` when absent; any kind
-      of :data:`cdpr_exu.exits.EXIT_KINDS` that exists in the dimension) and that kind's
-      fields, in both dimensions (the spatial scenes' form);
-    * the planar form: ``[[pulleys]]`` (centre, radius, side, contact) and ``cable_exit``
-      (``"pulley"``, the default, or ``"point"``: each cable leaves from its pulley's centre).
-
-    ``[cable]`` (and ``[pulley]``) tables hold values shared by every cable (pulley);
-    ``[[cables]]`` (``[[pulleys]]``) entries override them one by one. ``[effects]`` may
-    name a ``preset`` and override single effects. The values given are checked first; then
-    the tables and fields (:data:`REQUIRED_FIELDS`, each exit kind's) a scene must give are
-    required. ``source`` names the file in those messages.
+    Exits come as ``[[exits]]`` (one table per cable with its ``kind``, ``"point"`` when absent)
+    or in the planar form, ``[[pulleys]]`` and ``cable_exit`` (``"pulley"`` or ``"point"``: each
+    cable leaves from its pulley's centre). ``[cable]`` and ``[pulley]`` hold values shared by
+    every entry of ``[[cables]]`` and ``[[pulleys]]``; ``[effects]`` may name a ``preset``. The
+    values given are checked first, then the required tables and fields; ``source`` names the file.
     """
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
@@ -1152,7 +1030,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     cables = tuple(_build(CableSpec, c, f"cables[{i}]") for i, c in enumerate(cable_dicts))
     platform_data = data.get("platform", {})
     if isinstance(platform_data, Mapping) and "anchors" not in platform_data and not planar_form:
-        # a stand-in point mass of the scene's dimension, to check the values given: refused as missing below
+        # a stand-in point mass to check the values given: refused as missing below
         platform_data = {**platform_data, "anchors": [[0.0] * space.position_size] * max(1, len(exits))}
     platform = _build(PlatformSpec, platform_data, "platform")
     effects_data = data.get("effects", {})
@@ -1178,11 +1056,8 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
 
 
 def _planar_form_exits(data: Mapping[str, Any]) -> tuple[tuple[Exit, ...], list[str], dict[str, str]]:
-    """The exits of a scene in the planar form: its ``[[pulleys]]`` (with ``[pulley]``), each a
-    :class:`~cdpr_exu.exits.pulley.Pulley`, or for ``cable_exit = "point"`` a point exit at its centre.
-
-    Returns the exits, the required fields their tables leave out (:func:`missing_fields`) and the
-    tables the scene must give (:data:`REQUIRED_TABLES`)."""
+    """The planar form's exits (pulleys, or point exits at their centres), the required fields their tables
+    leave out and the tables the scene must give."""
     cable_exit = _choice("cable_exit", data.get("cable_exit", "pulley"), ("pulley", "point"))
     default = [_pulley_table(exit_) for exit_ in Scene.__dataclass_fields__["exits"].default]
     tables = _per_cable(data, "pulley", "pulleys", default)
@@ -1198,9 +1073,7 @@ def _planar_form_exits(data: Mapping[str, Any]) -> tuple[tuple[Exit, ...], list[
 
 
 def _exits_form_exits(data: Mapping[str, Any], space: Space) -> tuple[tuple[Exit, ...], list[str], dict[str, str]]:
-    """The exits of a scene's ``[[exits]]``: one :func:`~cdpr_exu.exits.base.exit_from_dict` per table.
-
-    Returns the exits, the required fields (each kind's) their tables leave out and the tables
+    """The exits of ``[[exits]]``, the required fields (each kind's) their tables leave out and the tables
     the scene must give."""
     tables = data.get("exits", [])
     if not isinstance(tables, list):
@@ -1225,18 +1098,14 @@ def tension_limits(cables) -> np.ndarray | None:
 
 
 def is_scene_file(source: str | Path) -> bool:
-    """True when ``source`` names a file (a ``.toml`` path, or anything that exists) rather than a shipped scene."""
+    """True when ``source`` names a file (a ``.toml`` path, or anything that exists), not a shipped scene."""
     path = Path(source)
     return path.suffix == ".toml" or path.exists()
 
 
 def read_scene_file(source: str | Path) -> dict[str, Any]:
-    """The plain data of the TOML scene file ``source``, or SceneError naming the file and what is wrong.
-
-    Refused: a folder, a missing or unreadable file, a file that is not UTF-8 text (TOML is UTF-8:
-    a Latin-1 or binary file), and text that is not valid TOML. An empty file is valid TOML (no
-    tables); the loaders then say which tables it lacks.
-    """
+    """The plain data of the TOML scene file ``source``; SceneError naming the file for a folder, a missing
+    or unreadable file, one that is not UTF-8 text, or text that is not TOML."""
     path = Path(source)
     if path.is_dir():
         raise SceneError(f"scene {shown(str(path))} is a directory; give a .toml scene file or a shipped "
@@ -1265,15 +1134,8 @@ def parse_scene_text(text: str, source: str | Path) -> dict[str, Any]:
 
 
 def load_scene(source: str | Path) -> Scene:
-    """Load a scene, planar or spatial, by shipped name (e.g. ``"paper-circle"``, ``"spatial-cogiro"``;
-    :func:`shipped_scenes`) or from a TOML file path (:func:`scene_from_dict` reads its plain data).
-
-    Raises
-    ------
-    SceneError
-        For a name no shipped scene has (:func:`unknown_scene`), for a file that cannot be read as a
-        scene (:func:`read_scene_file`), and for a bad scene.
-    """
+    """Load a scene by shipped name (e.g. ``"paper-circle"``, ``"spatial-cogiro"``) or TOML file path;
+    SceneError for an unknown name, a file that cannot be read, or a bad scene."""
     if is_scene_file(source):
         data = read_scene_file(source)
     else:
@@ -1284,7 +1146,7 @@ def load_scene(source: str | Path) -> Scene:
     return scene_from_dict(data, source=str(source))
 
 
-#: What a scene file in the planar form must say: no default would be the robot or the motion its author meant.
+#: The tables a scene file in the planar form must give.
 REQUIRED_TABLES: dict[str, str] = {
     "pulleys": "[[pulleys]] with each pulley's center (where the cables run)",
     "platform": "[platform] with its anchors and mass",
@@ -1293,7 +1155,7 @@ REQUIRED_TABLES: dict[str, str] = {
 
 
 def _check_required_tables(data: Mapping[str, Any], required: Mapping[str, str], source: str | None) -> None:
-    """Refuse a scene file that leaves out a table it cannot sensibly do without (``required``: name -> what to give)."""
+    """Refuse a scene file that leaves out a table of ``required`` (name -> what to give)."""
     missing = [name for name in required if name not in data]
     if missing:
         where = "scene" if source is None else f"scene {shown(source)}"
@@ -1302,7 +1164,6 @@ def _check_required_tables(data: Mapping[str, Any], required: Mapping[str, str],
                          + " (see the scene reference in the README)")
 
 
-#: Where the shipped spatial scenes live, inside the package's ``scenes`` folder.
 SPATIAL_FOLDER = "spatial"
 
 
@@ -1329,8 +1190,8 @@ def shipped_scene_text(name: str) -> str | None:
 
 
 def closest_names(name: str, names: list[str]) -> list[str]:
-    """The names a misspelt ``name`` most likely meant: those that contain it, else those whose
-    similarity (difflib's ratio) is at least 0.6 and within 0.1 of the best, the closest first."""
+    """The names a misspelt ``name`` likely meant: those that contain it, else those at least 0.6 similar
+    (difflib) and within 0.1 of the best, the closest first."""
     key = name.replace("_", "-").lower()
     if len(key) >= 3 and any(key in n for n in names):
         return [n for n in names if key in n]
@@ -1340,8 +1201,8 @@ def closest_names(name: str, names: list[str]) -> list[str]:
 
 
 def unknown_scene(source: str | Path) -> SceneError:
-    """The refusal of a scene name that no shipped scene has: it lists every shipped scene, planar and
-    spatial (``cdpr scenes``), after the likeliest (:func:`closest_names`), e.g. "did you mean 'spatial-cogiro'?"."""
+    """The refusal of an unknown scene name, listing the likeliest (:func:`closest_names`) and every shipped
+    scene."""
     name = str(source)
     planar, spatial = shipped_names(), shipped_names(SPATIAL_FOLDER)
     close = closest_names(name, planar + spatial)
@@ -1351,8 +1212,7 @@ def unknown_scene(source: str | Path) -> SceneError:
 
 
 def save_scene(scene: Scene, path: str | Path) -> Path:
-    """Write the scene as TOML, planar or spatial (:meth:`Scene.to_dict`); :func:`load_scene` reads it back
-    to an equal Scene."""
+    """Write the scene as TOML; :func:`load_scene` reads it back to an equal Scene."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(tomli_w.dumps(scene.to_dict()))

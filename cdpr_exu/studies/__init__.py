@@ -1,5 +1,1 @@
-"""Studies over many runs: parameter sweeps, the accuracy study, and the controller comparison.
-
-Data flows scene (``cdpr_exu.scenes``) -> model (``cdpr_exu.builder``) -> run (``cdpr_exu.run``)
--> result (``cdpr_exu.results``) -> studies and plots (``cdpr_exu.studies``, ``cdpr_exu.post``).
-"""
+"""Studies over many runs: parameter sweeps, accuracy, robustness, learning and the controller comparison."""

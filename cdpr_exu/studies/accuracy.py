@@ -1,42 +1,19 @@
 """Accuracy against cost: the model ladder over element counts and step sizes.
 
-One scene is run on every model of the ladder (the :data:`~cdpr_exu.scenes.scene.PRESETS`
-``ideal``, ``elastic``, ``catenary``, ``full``, and ``full`` with the linear
-curvature-vector bending), over the number of elements per cable and the time step,
-and every run is compared with a *reference*: the richest model (``full``) at the
-finest discretisation and step that still finish in reasonable time. Each run gives
-one row: its configuration, its status (a run the builder refuses or the monitor
-stops is a result too), its cost, and its errors against the reference:
+One scene (planar or spatial, under ideal inverse kinematics) is run on every model of
+the ladder (the presets, and ``full`` with the linear bending) over elements per cable and
+time steps, and each run is compared with a *reference*, ``full`` at the finest
+discretisation. A row holds the configuration, its status (a refused or stopped run is a
+result too), its cost and its errors against the reference: ``path`` (moving scenes) the
+platform position error from ``after`` seconds on (max and RMS), the largest rotation
+error and the tension error at the platform ends; ``final`` (a held pose, fixed winches)
+the same of the final state, and the final speed (whether the run came to rest). From
+the rows: the Pareto front, the cheapest configuration per tolerance, and what each
+effect changes and costs against ``full`` at the same discretisation.
 
-- ``path`` comparison (moving scenes): the platform position error
-  ``|p(t) - p_ref(t)|`` on the reference's output times from ``after`` seconds on
-  (the run interpolated onto them), its maximum and RMS; the largest rotation error;
-  the error of the cable tensions at the platform end (the last element's axial
-  force, or the massless rope's force), maximum and RMS over cables and times;
-- ``final`` comparison (static scenes: a held pose and fixed winches): the same
-  errors of the final state only, and the platform's final speed, which says whether
-  the run had come to rest.
-
-From the rows: the Pareto front of error against cost, the cheapest
-configuration meeting each tolerance, and what each effect changes and costs
-(each model and effect variant against ``full`` at the same discretisation).
-
-Cost: every run records its wall time (``wall_time_s``, the time integration as
-:func:`~cdpr_exu.run.simulate.simulate` measures it) and the CPU time of its
-single-threaded worker process over the whole run, model building included
-(``cpu_time_s``). The front, the tables and the figure use the CPU time (:data:`COST`):
-on an idle core the two agree, but on a shared machine the wall time of the same run
-varied by a factor of two with the load of other processes, the CPU time by a few
-per cent.
-
-Spatial scenes (``dimension = 3``) run through the same :func:`~cdpr_exu.run.simulate.simulate`
-under ideal inverse kinematics, on their own grids (:data:`SPATIAL_FULL_GRID`,
-:data:`SPATIAL_QUICK_GRID`: the ``catenary`` and ``full`` presets, as a spatial cable is
-lumped and elastic; fewer elements, as spatial runs cost more); the position error is
-the platform centre's 3-D distance and the rotation error the angle between the run's
-and the reference's orientation.
-
-Command line: ``cdpr study accuracy SCENE --out DIR [--quick]``.
+Cost (:data:`COST`) is the CPU time of the single-threaded worker over the whole run:
+on a shared machine the wall time of the same run varied twofold, the CPU time by a
+few per cent. Command line: ``cdpr study accuracy SCENE --out DIR [--quick]``.
 """
 
 from __future__ import annotations
@@ -54,14 +31,13 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from cdpr_exu.core.errors import CoarseOutputWarning, SceneError
-from cdpr_exu.core.output import check_output_folder, clear_outputs, write_npz, write_summary
+from cdpr_exu.core.output import (check_output_folder, clear_outputs, finite_number as _finite, write_npz,
+                                  write_summary)
 from cdpr_exu.results.result import provenance
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 from cdpr_exu.space import PLANE, SPACE, Space
 from cdpr_exu.scenes.trajectories import HoldTrajectory
 from cdpr_exu.studies.study import apply_parameters, executor_for, progress_bar, recorded_run
-
-# --------------------------------------------------------------------------- configurations
 
 #: Position tolerances of the tolerance table [m].
 TOLERANCES = (1.0e-3, 1.0e-2, 5.0e-2)
@@ -85,19 +61,8 @@ ACCURACY_FILES = {
 
 @dataclass(frozen=True)
 class Configuration:
-    """One run of the study: a model of the ladder and its discretisation.
-
-    Parameters
-    ----------
-    preset : str
-        Effects preset (see :data:`~cdpr_exu.scenes.scene.PRESETS`).
-    n_elements : int or None
-        Elements per cable; None for the massless presets (one rope per cable).
-    step_size : float [s]
-    overrides : tuple of (path, value)
-        Further parameter paths of :mod:`cdpr_exu.studies.study`, e.g.
-        ``(("effects.bending_model", "linear"),)`` or ``(("cables.mass_lumping", "paper"),)``.
-    """
+    """One run of the study: a preset, its elements per cable (None for the massless presets), its
+    ``step_size`` [s] and further ``(path, value)`` overrides (:mod:`cdpr_exu.studies.study`'s paths)."""
 
     preset: str
     n_elements: int | None
@@ -106,7 +71,7 @@ class Configuration:
 
     @property
     def model(self) -> str:
-        """The model's name: the preset and its overrides, e.g. ``full, linear bending``."""
+        """The preset and its overrides, e.g. ``full, linear bending``."""
         return model_name(self.preset, self.overrides)
 
     @property
@@ -116,12 +81,8 @@ class Configuration:
         return f"{self.model}{n} h={self.step_size:.0e}"
 
     def scene_data(self, base_data: Mapping[str, Any]) -> dict[str, Any]:
-        """Plain scene data of this configuration made from the base scene's (not validated).
-
-        The effects are the preset's with the ``effects.*`` overrides (the base scene's
-        own effects are replaced); other overrides are parameter paths of
-        :func:`~cdpr_exu.studies.study.apply_parameters`.
-        """
+        """Plain scene data (not validated) from the base scene's: the preset's effects with the ``effects.*``
+        overrides (the base's replaced), the other overrides applied as parameter paths."""
         assignments: list[tuple[str, Any]] = [("solver.step_size", self.step_size)]
         if self.n_elements is not None:
             assignments.append(("cables.n_elements", self.n_elements))
@@ -137,8 +98,7 @@ class Configuration:
 
 
 def model_name(preset: str, overrides: Sequence[tuple[str, Any]] = ()) -> str:
-    """Readable name of a preset with overrides (``full, linear bending``, ``full, segment contact``,
-    ``full, slack=false``)."""
+    """Readable name of a preset with overrides (``full, segment contact``, ``full, slack=false``)."""
     parts = [preset]
     for path, value in overrides:
         key = path.split(".")[-1]
@@ -161,16 +121,12 @@ class AccuracyGrid:
     Parameters
     ----------
     models : tuple of (preset, overrides)
-        The model ladder; massless presets are run once per step size.
-    n_elements : tuple of int
-        Elements per cable of the lumped models.
-    step_sizes : tuple of float [s]
+        The ladder; massless presets run once per step size.
     reference : Configuration
-        The configuration every run is compared with.
+        What every run is compared with.
     variants : tuple of overrides
-        Single-effect variants of ``full``, run at ``variant_resolution`` only.
-    variant_resolution : (n_elements, step_size)
-        Where the effects are compared with each other (every model is run there too).
+        Single-effect variants of ``full``, run at ``variant_resolution`` (n_elements, step_size
+        [s]) only, where every model runs too and the effects are compared.
     end_time : float or None [s]
         Overrides the scene's end time.
     after : float [s]
@@ -237,8 +193,7 @@ QUICK_GRID = AccuracyGrid(
 )
 
 
-#: The spatial ladder: a spatial scene's cables are lumped and elastic (``catenary`` and ``full``;
-#: the massless presets and the planar bending and contact models do not apply).
+#: The spatial ladder: a spatial scene's cables are lumped and elastic.
 SPATIAL_LADDER = (("catenary", ()), ("full", ()))
 
 #: Single-effect variants of the full model on a spatial scene.
@@ -249,8 +204,7 @@ SPATIAL_EFFECT_VARIANTS = (
     (("cables.mass_lumping", "paper"),),
 )
 
-#: The grid of a spatial study (spatial runs cost more: 4 to 16 elements, reference at 32 and 2e-3 s;
-#: 23 s of wall time on two workers for 2 s of the four-cable robot).
+#: The grid of a spatial study (spatial runs cost more: 23 s on two workers for 2 s of the four-cable robot).
 SPATIAL_FULL_GRID = AccuracyGrid(
     models=SPATIAL_LADDER,
     n_elements=(4, 6, 8, 12, 16),
@@ -260,7 +214,6 @@ SPATIAL_FULL_GRID = AccuracyGrid(
     variant_resolution=(8, 1.0e-2),
 )
 
-#: The quick spatial grid: the full model at 4 and 8 elements, 1e-2 s, against 16 elements; 1.5 s.
 SPATIAL_QUICK_GRID = AccuracyGrid(
     models=(("full", ()),),
     n_elements=(4, 8),
@@ -271,19 +224,13 @@ SPATIAL_QUICK_GRID = AccuracyGrid(
 )
 
 
-#: The default grids (quick, full) of each dimension, by the scene's Space.
+#: The default grids (quick, full) by the scene's Space.
 GRIDS = {PLANE: (QUICK_GRID, FULL_GRID), SPACE: (SPATIAL_QUICK_GRID, SPATIAL_FULL_GRID)}
 
 
 def grid_for(scene, quick: bool = False) -> AccuracyGrid:
-    """The default grid of ``scene``: :data:`FULL_GRID` / :data:`QUICK_GRID` for planar scenes,
-    :data:`SPATIAL_FULL_GRID` / :data:`SPATIAL_QUICK_GRID` for spatial ones.
-
-    Over swivel pulleys a cable needs its elements short beside the pulley's radius (the
-    scene refuses coarser ones): there the grid's element counts are scaled by the factor
-    that brings its coarsest cable to the fewest elements its exit takes
-    (:func:`fewest_elements`), e.g. 4, 8 and 16 to 48, 96 and 192.
-    """
+    """The default grid of ``scene`` (:data:`GRIDS`), its element counts scaled up where an exit takes no
+    fewer (:func:`fewest_elements`: over swivel pulleys, e.g. 4, 8 and 16 to 48, 96 and 192)."""
     grid = GRIDS[scene.space][0 if quick else 1]
     factor = math.ceil(fewest_elements(scene) / min(grid.n_elements))
     if factor <= 1:
@@ -295,29 +242,17 @@ def grid_for(scene, quick: bool = False) -> AccuracyGrid:
 
 
 def fewest_elements(scene) -> int:
-    """The fewest elements per cable the scene's exits take (:meth:`cdpr_exu.exits.base.Exit.fewest_elements`:
-    over a swivel pulley of radius r, elements no longer than ``SAFE_ELEMENT_FRACTION`` r; 1 elsewhere)."""
+    """The fewest elements per cable its exits take (:meth:`~cdpr_exu.exits.base.Exit.fewest_elements`)."""
     return max(exit_.fewest_elements(cable) for cable, exit_ in zip(scene.cables, scene.exits))
 
 
-# --------------------------------------------------------------------------- one run
-
-
 def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
-    """Simulate one configuration given as plain scene data; never raises.
+    """Simulate one configuration given as plain scene data (the study's worker); never raises.
 
-    The worker function of the study (top-level, plain data in and out): planar and spatial
-    scenes run :func:`~cdpr_exu.run.simulate.simulate` under ideal inverse kinematics.
-
-    Returns
-    -------
-    dict
-        ``status`` (``completed``, ``failed: ...``, ``refused: ...``), ``wall_time_s``,
-        ``cpu_time_s`` (of the whole run, model building included), ``simulated_time_s``, ``steps``, ``newton_iterations``, ``failure_time_s``, and
-        for runs that produced samples: ``time`` (N,) [s], ``pose`` (N, 3) [m, m, rad]
-        (spatial: (N, 6) [m, rad], centre and rotation vector), ``end_tensions`` (N, m)
-        [N] at the platform end of each cable, ``speed`` (N,) [m/s] of the platform
-        (spatial: by finite differences of the sampled positions).
+    Returns ``status``, ``wall_time_s``, ``cpu_time_s``, ``simulated_time_s``, ``steps``,
+    ``newton_iterations``, ``failure_time_s`` and, for runs with samples, ``time`` (N,) [s],
+    ``pose`` (N, 3 or 6) [m, rad], ``end_tensions`` (N, m) [N] at the platform ends and the
+    platform's ``speed`` (N,) [m/s] (spatial: from finite differences of the positions).
     """
     empty = {"wall_time_s": math.nan, "cpu_time_s": math.nan, "simulated_time_s": math.nan, "steps": 0,
              "newton_iterations": 0, "failure_time_s": math.nan}
@@ -349,9 +284,6 @@ def run_configuration(scene_data: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-# --------------------------------------------------------------------------- errors
-
-
 #: Error figures of every compared run, in column order.
 ERROR_FIGURES = ("position_error_max_m", "position_error_rms_m", "rotation_error_max_deg",
                  "tension_error_max_N", "tension_error_rms_N", "final_speed_m_s")
@@ -359,24 +291,11 @@ ERROR_FIGURES = ("position_error_max_m", "position_error_rms_m", "rotation_error
 
 def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: str = "path",
             after: float = 1.0, space: Space = PLANE) -> dict[str, float]:
-    """Errors of one run against the reference.
+    """The :data:`ERROR_FIGURES` [m, deg, N, m/s] of one run against the reference (outcomes of
+    :func:`run_configuration`); NaN where the run does not cover the compared times.
 
-    Parameters
-    ----------
-    run, reference : dict
-        Outcomes of :func:`run_configuration` with ``time``, ``pose``, ``end_tensions``.
-    comparison : {"path", "final"}
-        ``"path"``: on the reference's times from ``after`` on (the run interpolated
-        linearly onto them); ``"final"``: the last samples only.
-    after : float [s]
-    space : Space
-        What the poses are (the scene's :attr:`~cdpr_exu.scenes.scene.Scene.space`; default the plane).
-
-    Returns
-    -------
-    dict
-        The :data:`ERROR_FIGURES` [m, deg, N, m/s]; NaN if the run does not cover the
-        compared times.
+    ``comparison`` "path": on the reference's times from ``after`` [s] on, the run interpolated
+    linearly; "final": the last samples. ``space``: what the poses are.
     """
     nan = {name: math.nan for name in ERROR_FIGURES}
     if "time" not in run or len(run["time"]) == 0:
@@ -401,7 +320,6 @@ def compare(run: Mapping[str, Any], reference: Mapping[str, Any], comparison: st
         tension_error = tensions - np.asarray(reference["end_tensions"])[mask]
     else:
         raise SceneError(f"comparison must be 'path' or 'final', got {comparison!r}")
-    # the centre's error, the angle between the orientations
     position = np.linalg.norm((pose - reference_pose)[:, :space.position_size], axis=1)
     rotation = space.rotation_error_deg(pose, reference_pose)
     return {
@@ -444,31 +362,11 @@ def _usable(row: Mapping[str, Any], error: str) -> bool:
             and _finite(row.get(error)) and _finite(row.get(COST)))
 
 
-def _finite(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
-# --------------------------------------------------------------------------- the study
-
-
 @dataclass
 class AccuracyStudy:
-    """The outcome of :func:`run_accuracy_study`.
-
-    Attributes
-    ----------
-    rows : list of dict
-        One per configuration (the reference first): configuration, status, cost,
-        errors against the reference, and for the effects table the errors against
-        ``full`` at the variant resolution (``moved_*``).
-    reference : Configuration
-    comparison : {"path", "final"}
-    scene_name : str
-    end_time : float [s]
-    after : float [s]
-    series : dict
-        Time series of every run that produced samples, by run index (not written).
-    """
+    """The outcome of :func:`run_accuracy_study`: a row per configuration (the reference first; the
+    ``moved_*`` errors against ``full`` at the variant resolution) and the time ``series`` of every run
+    with samples, by run index (not written)."""
 
     rows: list[dict[str, Any]]
     reference: Configuration
@@ -479,8 +377,7 @@ class AccuracyStudy:
     grid: AccuracyGrid
     series: dict[int, dict[str, Any]] = field(default_factory=dict, repr=False)
 
-    #: The cost runs are judged by and the position tolerances of the tables (for the figure,
-    #: :func:`cdpr_exu.post.study_plots.plot_pareto`).
+    #: For the figure (:func:`cdpr_exu.post.study_plots.plot_pareto`).
     COST = COST
     TOLERANCES = TOLERANCES
 
@@ -498,12 +395,7 @@ class AccuracyStudy:
 
 
 def check_study_scene(scene) -> None:
-    """Refuse a scene the study cannot run, before any run: a spatial scene without a ``[trajectory]``.
-
-    Raises
-    ------
-    SceneError
-    """
+    """Refuse (SceneError) a scene without a ``[trajectory]``, before any run."""
     if scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr study accuracy` runs the scene's "
                          "reference (`cdpr static` gives a spatial scene's static mode)")
@@ -518,32 +410,12 @@ def _estimated_cost(configuration: Configuration) -> float:
 def run_accuracy_study(scene, grid: AccuracyGrid | None = None, *, out: str | Path | None = None,
                        workers: int | None = None, executor: Executor | None = None, progress: bool = True,
                        comparison: str | None = None) -> AccuracyStudy:
-    """Run ``scene`` on every configuration of ``grid`` and compare each with the reference.
+    """Run ``scene`` (a Scene, shipped name or TOML path) on every configuration of ``grid`` (default
+    :func:`grid_for` it) and compare each with the reference.
 
-    Parameters
-    ----------
-    scene : Scene, or a shipped scene name or TOML path
-    grid : AccuracyGrid, optional
-        Default: :func:`grid_for` the scene (the full planar or spatial grid).
-    out : path, optional
-        Folder for the CSV, JSON, tables, Pareto plot and the reference's series.
-    workers : int, optional
-        Single-threaded worker processes (default: one per core).
-    executor : concurrent.futures.Executor, optional
-        Where the runs go instead (not shut down here).
-    progress : bool
-        Progress bar on terminals.
-    comparison : {"path", "final"}, optional
-        Default: ``"final"`` for a static scene, else ``"path"``.
-
-    Returns
-    -------
-    AccuracyStudy
-
-    Raises
-    ------
-    SceneError
-        If the reference run does not complete: nothing can be compared then.
+    ``out``: folder for the files (:func:`write_accuracy_study`); ``workers``: single-threaded
+    processes (default one per core), or ``executor`` (not shut down here); ``comparison``:
+    default :func:`comparison_for` the scene. SceneError if the reference run does not complete.
     """
     base = load_scene(scene) if isinstance(scene, (str, Path)) else scene
     check_study_scene(base)
@@ -642,8 +514,6 @@ def _effects_columns(rows: list[dict[str, Any]], series: Mapping[int, Mapping[st
         row["cost_relative_to_full"] = row[COST] / full[COST]
 
 
-# --------------------------------------------------------------------------- files
-
 COLUMNS = ("run", "model", "preset", "overrides", "n_elements", "step_size_s", "is_reference", "status",
            "cpu_time_s", "wall_time_s", "real_time_factor", "simulated_time_s", "steps", "newton_iterations",
            "failure_time_s", *ERROR_FIGURES, "at_variant_resolution", "moved_position_max_m", "moved_position_rms_m",
@@ -687,12 +557,10 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
                  "n_elements": list(study.grid.n_elements), "step_sizes_s": list(study.grid.step_sizes),
                  "variants": [model_name("full", v) for v in study.grid.variants],
                  "variant_resolution": study.grid.variant_resolution},
-        "rows": [{c: (None if isinstance(row.get(c), float) and math.isnan(row[c]) else row.get(c)) for c in COLUMNS}
-                 for row in study.rows],
+        "rows": [{c: row.get(c) for c in COLUMNS} for row in study.rows],  # NaN as null (write_summary)
         **provenance(),
     }
-    # The date goes to timing.json; the measured times stay: error against CPU time is what the study is about,
-    # so accuracy.csv / .json, tables.md and pareto.png change with every rerun (README, "Outputs").
+    # the measured times stay: error against CPU time is the study's subject (README, "Outputs")
     write_summary(out, info, name=ACCURACY_FILES["json"], keep=("cpu_time_s", "wall_time_s", "real_time_factor"))
     paths["json"] = out / ACCURACY_FILES["json"]
     reference = study.series[reference_row["run"]]
@@ -704,9 +572,6 @@ def write_accuracy_study(study: AccuracyStudy, base_scene, out: str | Path) -> d
 
     paths["pareto"] = plot_pareto(study, out / ACCURACY_FILES["pareto"])
     return paths
-
-
-# --------------------------------------------------------------------------- tables
 
 
 def _mm(value: Any) -> str:

@@ -1,22 +1,11 @@
 """Controller comparison: the same scene under every controller, tabulated and plotted.
 
-``cdpr compare paper-circle --out results/controllers`` runs the scene under each
-controller the registry has for it (:data:`controllers.registry.CONTROLLERS`, :func:`~controllers.registry.controllers_for`), writes ``summary.json`` (keyed by controller name),
-``comparison.md`` (a Markdown table), a ``pose.csv`` per controller and the figures
-``comparison_paths.png`` and ``comparison_errors.png``; each controller's wall time and
-real-time factor go to ``timing.json``, so that the other files are the same from run to run. Errors are actual - reference,
-measured after the start-up (``--after``, default 1 s).
-
-By default the comparison starts a circle reference smoothly from rest
-(:data:`COMPARISON_RAMP_TIME`, ``--ramp-time``; 0 keeps the scene's own start): the
-paper's circle starts at full speed, a jolt that no real robot would be commanded and
-that throws the cables slack (0.12 s on ideal IK with tension-only cables, 299 N peaks)
-without saying anything about how well a controller tracks. The scene written with the
-results (``scene.toml``) records the start used.
-
-A spatial scene runs through the same :func:`compare_controllers` and writes ``summary.json``,
-``comparison.md`` (:func:`spatial_comparison_table`) and an ``overview_<controller>.png`` each
-(:func:`comparison_format`).
+``cdpr compare SCENE --out DIR`` runs the scene under each controller the registry has for
+it and writes what :func:`comparison_format` says (wall times to ``timing.json``, so the other
+files are the same from run to run); errors are actual - reference, after ``--after`` seconds.
+By default a circle that starts at full speed starts smoothly (:data:`COMPARISON_RAMP_TIME`):
+the paper's jolt throws the cables slack (0.12 s on ideal IK, 299 N peaks) without saying
+anything about how a controller tracks.
 """
 
 from __future__ import annotations
@@ -44,12 +33,8 @@ COMPARISON_RAMP_TIME = 1.0
 
 
 def smooth_start(scene: Scene, ramp_time: float = COMPARISON_RAMP_TIME) -> Scene:
-    """``scene`` with its circle reference starting smoothly from rest over ``ramp_time`` [s].
-
-    Only a circle (planar or spatial: one kind) that starts at full speed (``ramp_time = 0``) is changed; other
-    references (hold, point-to-point) already start from rest, and a circle with its own
-    ramp keeps it. ``ramp_time = 0`` returns the scene unchanged.
-    """
+    """``scene`` with a circle that starts at full speed ramped up over ``ramp_time`` [s] (0: unchanged);
+    other references start from rest already, and a circle keeps its own ramp."""
     if ramp_time < 0 or not np.isfinite(ramp_time):
         raise SceneError(f"ramp_time must be zero or positive [s], got {ramp_time!r}")
     trajectory = scene.trajectory
@@ -66,7 +51,7 @@ _COLUMNS = (
     ("max_abs_rotation_deg", "max \\|rotation\\| [deg]", 1.0),
     ("min_element_tension_N", "min tension [N]", 1.0),
     ("slack_time_s", "slack time [s]", 1.0),
-)  # no wall time: it changes from run to run, and the table is tracked (issue 23.18); it is in timing.json
+)  # no wall time: it changes from run to run (timing.json)
 
 
 def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: str | Path | None = None,
@@ -74,18 +59,14 @@ def compare_controllers(scene: Scene, names: list[str] | None = None, *, out: st
                         learning_rule: StoppingRule = DEFAULT_RULE,
                         report: Callable[[str, dict], None] | None = None,
                         learning_report: Callable[[str], None] | None = None) -> dict[str, dict]:
-    """Run ``scene`` (planar or spatial) under each named controller; returns their summaries by name.
+    """Run ``scene`` under each named controller (default :func:`controllers.registry.controllers_for` it);
+    returns their summaries by name.
 
-    ``names`` default to :func:`controllers.registry.controllers_for` the scene. An unknown name, or a
-    controller with no physics in the scene's dimension, is refused before any run. A controller
-    that refuses the reference (e.g. a pose that needs a pushing cable) or whose run fails is
-    recorded with its status; the others still run. The learning controllers run their trials
-    first, as ``learning_rule`` says (their per-trial errors go into the summary as ``learning``).
-    ``report(name, summary)`` is called as each controller's run ends (not for a refused one),
-    ``learning_report`` with each line of the learning controllers' progress
-    (:class:`cdpr_exu.studies.learning.Learner`); ``cdpr compare`` prints both. On Ctrl-C (inside a
-    run or between two) the controllers done so far and the interrupted one's partial run are
-    written before the interrupt goes on. What is written is the scene's :func:`comparison_format`.
+    An unknown name, or one with no physics in the scene's dimension, is refused before any
+    run; a controller that refuses the reference or fails is recorded with its status. Learning
+    controllers run their trials first (``learning_rule``; ``learning`` in the summary).
+    ``report(name, summary)`` is called as each run ends, ``learning_report`` with each line of
+    the learning. On Ctrl-C what is done so far is written before the interrupt goes on.
     """
     names = list(names or controllers_for(scene))
     unknown = [n for n in names if n not in CONTROLLERS]
@@ -161,8 +142,8 @@ _SPATIAL_COLUMNS = (("max_position_error_m", "max pos. error [mm]", 1000.0), ("r
 
 
 def spatial_comparison_table(summaries: dict) -> str:
-    """The comparison of a spatial scene as a Markdown table (errors after the summaries' ``after``); a scene
-    with tension limits gets a column counting the violations, as the planar table does."""
+    """The comparison of a spatial scene as a Markdown table (a column of tension-limit violations where
+    there are limits)."""
     columns = _SPATIAL_COLUMNS
     if any("tension_limit_violations" in s for s in summaries.values()):
         columns = (*columns, ("tension_limit_violation_count", "tension limit violations", 1.0))
@@ -181,9 +162,8 @@ def spatial_comparison_table(summaries: dict) -> str:
 
 
 class _PlanarComparison:
-    """What a comparison of a planar scene writes (``results/controllers``...): summaries with the longest slack
-    time and the error reduction against ideal IK, ``scene.toml``, ``summary.json``, ``comparison.md``, a
-    ``pose_<controller>.csv`` each and the figures of :func:`cdpr_exu.post.plots.plot_comparison`."""
+    """What a comparison of a planar scene writes: ``scene.toml``, ``summary.json``, ``comparison.md``, a
+    ``pose_<controller>.csv`` each and :func:`cdpr_exu.post.plots.plot_comparison`'s figures."""
 
     table = staticmethod(markdown_table)
 
@@ -222,9 +202,8 @@ class _PlanarComparison:
 
 
 class _SpatialComparison:
-    """What a comparison of a spatial scene writes (``results/spatial/<scene>/compare``): the runs' summaries,
-    ``summary.json``, ``comparison.md`` (:func:`spatial_comparison_table`) and an ``overview_<controller>.png``
-    each (:func:`cdpr_exu.post.plots.plot_spatial_run`)."""
+    """What a comparison of a spatial scene writes: ``summary.json``, ``comparison.md`` and an
+    ``overview_<controller>.png`` each."""
 
     table = staticmethod(spatial_comparison_table)
 
@@ -248,11 +227,10 @@ class _SpatialComparison:
             plot_spatial_run(result, out / f"overview_{name}.png", after)
 
 
-#: What a comparison writes, by the scene's space: the files of each are the committed results' (results/
-#: controllers*, results/spatial/*/compare), kept byte for byte; one format for both is a regeneration of them.
+#: What a comparison writes, by the scene's space (the committed results' formats, kept byte for byte).
 _FORMATS = {PLANE: _PlanarComparison, SPACE: _SpatialComparison}
 
 
 def comparison_format(scene: Scene):
-    """What a comparison of ``scene`` writes and tabulates: ``.table(summaries)`` (Markdown) among them."""
+    """What a comparison of ``scene`` writes and tabulates (``.table(summaries)``)."""
     return _FORMATS[scene.space]

@@ -1,24 +1,18 @@
 """Learning the winch lengths over repeated trials: iterative learning control and model-based feed-forward.
 
-:func:`learn_lengths` runs iterative learning control (:mod:`controllers.ilc`) on a
-scene: trial 1 replays the ideal inverse kinematics, each further trial the lengths
-updated from the last trial's position error, until the :class:`~controllers.ilc.StoppingRule`
-ends it. :func:`model_feed_forward` learns on the controller's *model* (a scene with the
-parameters the controller believes) and applies the learned lengths open loop to the
-*plant* (the scene simulated), with no trial on the plant.
+:func:`learn_lengths` runs iterative learning control (:mod:`controllers.ilc`) on a scene,
+from the ideal inverse kinematics until the stopping rule ends it. :func:`model_feed_forward`
+learns on the controller's *model* and runs the learned lengths open loop on the *plant*.
 
 How the default learning law was chosen (:data:`DEFAULT_LAW`)
 -------------------------------------------------------------
-Convergence of c_{k+1} = Q(c_k + gamma J e_k(t + tau)) is monotone (in the error's
-2-norm, for a linear time-invariant approximation) where the largest singular value of
-Q(omega) (I - gamma exp(i omega tau) G(i omega)) stays below 1, G the 2 x 2 response of
-the platform position to the position command J^-1 dlambda. :func:`measure_response`
-measured G on the controller's model (paper-circle, tension-only cables): small (4 mm
-RMS) random-phase multisines of 45 frequencies from 0.11 to 5 Hz, along x and then z,
-added through J to the ideal-IK lengths. |G_xx| and |G_zz| lie within 0.84..1.21 up to
-2 Hz with a phase lag up to 50 deg (mostly 10-20), the cross terms reach 0.35, |G_xx|
-falls to about 0.5 from 3.4 Hz. The largest singular value of
-I - gamma exp(i omega tau) G over the measured frequencies (``examples/learning_control.py``):
+c_{k+1} = Q(c_k + gamma J e_k(t + tau)) converges monotonically (for a linear time-invariant
+approximation) where the largest singular value of Q (I - gamma exp(i omega tau) G) stays
+below 1, G the response of the platform position to the command J^-1 dlambda.
+:func:`measure_response` measured G on paper-circle (4 mm RMS multisines, 0.11 to 5 Hz):
+|G_xx|, |G_zz| within 0.84..1.21 up to 2 Hz, lag up to 50 deg, cross terms up to 0.35, |G_xx|
+about 0.5 from 3.4 Hz. The largest singular value of I - gamma exp(i omega tau) G
+(``examples/learning_control.py``):
 
 ======= ========= ========== ========== ==========
 gamma   tau [s]   <= 1 Hz    <= 2 Hz    <= 5 Hz
@@ -31,17 +25,11 @@ gamma   tau [s]   <= 1 Hz    <= 2 Hz    <= 5 Hz
 0.7     0.06      0.61       0.88       1.24
 ======= ========= ========== ========== ==========
 
-gamma = 0.7 with a 20 ms lead keeps it at or below 0.8 over the measured band and
-shrinks the errors below 1 Hz (where most of the circle's error lives: harmonics of
-0.24 Hz) by about 0.56 per trial; gamma = 1 reaches 1 near 2 Hz. Q cuts off at 5 Hz,
-the end of the measured band (second-order Butterworth run forwards and backwards:
-|Q| = 0.5 at 5 Hz, 0.06 at 10 Hz where the cables' own modes begin). A 3 Hz cut-off was
-tried first: on the mismatch plant the max error then stalled at 4.2 mm after 12 trials,
-its residual spread over 1.7-4.5 Hz, where Q was holding the learning back. The error
-beyond the end of a trial, which the lead asks for, is held at its last value.
-A 10 % mismatch of platform mass and cable density moves G far less than the 0.2 margin.
-
-Plain NumPy plus runs of :func:`cdpr_exu.run.simulate.simulate`.
+gamma = 0.7 with a 20 ms lead keeps it at or below 0.8 over the band and shrinks the
+errors below 1 Hz (most of the circle's) by about 0.56 per trial. Q cuts off at 5 Hz, the
+band's end (|Q| = 0.06 at 10 Hz, where the cables' modes begin); at 3 Hz the mismatch
+plant's error stalled at 4.2 mm, its residual at 1.7-4.5 Hz. A 10 % mismatch of platform
+mass and cable density moves G far less than the 0.2 margin.
 """
 
 from __future__ import annotations
@@ -67,21 +55,9 @@ DEFAULT_RULE = StoppingRule(max_trials=10, min_improvement=0.02)
 
 @dataclass(frozen=True)
 class Trial:
-    """What one learning trial measured (errors after ``after`` seconds, actual - reference).
-
-    Attributes
-    ----------
-    number : int
-        1 for the first trial (the ideal inverse kinematics).
-    max_position_error_m, rms_position_error_m : float or None [m]
-    min_element_tension_N : float or None [N]
-        Lowest tension of any element over the measured window.
-    slack_time_s : float or None [s]
-        Longest time any cable had a slack element over the measured window.
-    max_correction_m : float [m]
-        Largest length correction of this trial's commands over the ideal IK.
-    status : str
-    """
+    """What one learning trial (1: the ideal IK) measured after ``after`` seconds: errors [m], the lowest
+    element tension [N], the longest slack time of a cable [s], and its largest correction over the
+    ideal IK [m]."""
 
     number: int
     max_position_error_m: float | None
@@ -97,19 +73,8 @@ class Trial:
 
 @dataclass
 class LearningRun:
-    """The trials of one learning and the commands it kept.
-
-    Attributes
-    ----------
-    trials : list of Trial
-    table : CommandTable
-        The commands of the best trial (lowest max error), with the platform positions
-        they gave on the learning's scene (``expected_positions``).
-    best_trial : int
-    stop_reason : str
-    result : Result
-        The best trial's run.
-    """
+    """The trials of one learning; ``table`` and ``result``: the best trial's (lowest max error) commands,
+    with the positions they gave (``expected_positions``), and run."""
 
     trials: list[Trial]
     table: CommandTable
@@ -131,8 +96,7 @@ def command_grid(scene: Scene) -> np.ndarray:
 
 
 def position_errors(result: Result, times: np.ndarray) -> np.ndarray:
-    """Position error r_ref - r of ``result`` on ``times`` (linear interpolation), shape (N, d) [m] (d: the
-    position's size in the run's space)."""
+    """Position error r_ref - r of ``result`` interpolated on ``times``, shape (N, d) [m]."""
     error = -result.position_error
     return np.column_stack([np.interp(times, result.time, column) for column in error.T])
 
@@ -145,8 +109,7 @@ def _trial(number: int, result: Result, correction: float, after: float) -> Tria
 
 
 def trial_line(trial: Trial) -> str:
-    """One line on a trial, as ``cdpr compare`` shows the learning's progress: its errors and
-    lowest tension, its largest correction [mm] and its status."""
+    """One line on a trial, as ``cdpr compare`` shows the learning's progress."""
     def mm(value):
         return "   n/a" if value is None else f"{1000 * value:6.2f}"
     tension = "n/a" if trial.min_element_tension_N is None else f"{trial.min_element_tension_N:.2f}"
@@ -154,36 +117,26 @@ def trial_line(trial: Trial) -> str:
             f"min tension {tension} N, correction {mm(trial.max_correction_m)} mm  {trial.status}")
 
 
+def _check_settings(law, rule) -> None:
+    if not isinstance(law, LearningLaw):
+        raise SceneError(f"law must be a LearningLaw, got {law!r}")
+    if not isinstance(rule, StoppingRule):
+        raise SceneError(f"rule must be a StoppingRule, got {rule!r}")
+
+
 def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRule = DEFAULT_RULE, *,
                   after: float = 1.0, on_trial: Callable[[Trial], None] | None = None) -> LearningRun:
-    """Iterative learning control of the winch lengths on ``scene`` (trials until ``rule`` stops them).
-
-    Parameters
-    ----------
-    scene : Scene
-        What the trials run on: the plant (ILC) or the controller's model (model-based feed-forward).
-    law : LearningLaw
-    rule : StoppingRule
-    after : float [s]
-        Errors judged by the stopping rule are measured from this time on.
-    on_trial : callable, optional
-        Called with each :class:`Trial` as it ends (the progress; :func:`trial_line` words it).
-
-    Returns
-    -------
-    LearningRun
+    """Iterative learning control of the winch lengths on ``scene`` (the plant, or the controller's model),
+    trials until ``rule`` stops them, errors from ``after`` [s] on; ``on_trial(trial)`` after each.
 
     Raises
     ------
     SceneError
         If ``law``, ``rule`` or ``after`` is not valid, before any trial.
     SolverFailure
-        If the very first trial fails (a later failure ends the learning instead).
+        If the first trial fails (a later failure ends the learning).
     """
-    if not isinstance(law, LearningLaw):
-        raise SceneError(f"law must be a LearningLaw, got {law!r}")
-    if not isinstance(rule, StoppingRule):
-        raise SceneError(f"rule must be a StoppingRule, got {rule!r}")
+    _check_settings(law, rule)
     if not np.isfinite(after) or not 0.0 <= after < scene.solver.end_time:
         raise SceneError(f"after must lie in [0, solver.end_time = {scene.solver.end_time}) s, got {after!r}")
     times = command_grid(scene)
@@ -196,21 +149,20 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
     stop_reason = ""
     while True:
         table = law.commands(times, baseline, correction)
+        failure = None
         try:
             result = simulate(scene, ReplayController(table, name=f"ilc_trial_{len(trials) + 1}"))
         except SolverFailure as err:
             if not trials:
                 raise
-            trial = _trial(len(trials) + 1, err.partial_result, float(np.abs(table.changes - baseline).max()), after)
-            trials.append(trial)
-            if on_trial is not None:
-                on_trial(trial)
-            stop_reason = f"trial {trial.number} failed: {err}"
-            break
+            result, failure = err.partial_result, err
         trial = _trial(len(trials) + 1, result, float(np.abs(table.changes - baseline).max()), after)
         trials.append(trial)
         if on_trial is not None:
             on_trial(trial)
+        if failure is not None:
+            stop_reason = f"trial {trial.number} failed: {failure}"
+            break
         if best is None or trial.max_position_error_m < best[0].max_position_error_m:
             expected = np.column_stack([np.interp(times, result.time, column) for column in result.position.T])
             best = (trial, replace(table, expected_positions=expected), result)
@@ -223,23 +175,15 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
 
 @dataclass(frozen=True)
 class PositionResponse:
-    """Measured frequency response of the platform position to the position command J^-1 dlambda.
-
-    Attributes
-    ----------
-    frequencies : ndarray, shape (F,) [Hz]
-    response : ndarray, shape (F, d, d) [m/m], complex
-        Row: the platform's position coordinate ((x, z) or (x, y, z)); column: the commanded one.
-    """
+    """Measured response (F, d, d) [m/m] of the platform position (rows) to the position command J^-1
+    dlambda (columns) at ``frequencies`` (F,) [Hz]."""
 
     frequencies: np.ndarray
     response: np.ndarray
 
     def contraction(self, gain: float, lead: float) -> np.ndarray:
-        """Largest singular value of I - gain exp(i omega lead) G at each frequency, shape (F,) [-].
-
-        Below 1 where the learning law (without Q) shrinks the error at that frequency every trial.
-        """
+        """Largest singular value of I - gain exp(i omega lead) G, shape (F,): below 1 where the law
+        (without Q) shrinks the error every trial."""
         phase = np.exp(2j * np.pi * self.frequencies * lead)[:, None, None]
         return np.linalg.svd(np.eye(self.response.shape[-1]) - gain * phase * self.response, compute_uv=False)[:, 0]
 
@@ -248,16 +192,10 @@ def measure_response(model: Scene, amplitude: float = 4e-3, max_frequency: float
                      seed: int = 1) -> PositionResponse:
     """Measure the platform's position response to small length changes along the reference (d + 1 runs).
 
-    The ideal-IK lengths are run once as they are, then with J(t) p(t) added, p a
-    random-phase multisine along each position coordinate in turn (``amplitude`` RMS [m], faded in from
-    0.5 to 1 s; frequencies the multiples of 1 / (end_time - after) up to
-    ``max_frequency`` [Hz]). The Fourier transforms over t >= ``after`` of the position
-    change and of p give G at those frequencies, a linear time-invariant summary of a
-    robot that is neither (its pose moves along the circle; its cables go slack).
-
-    Returns
-    -------
-    PositionResponse
+    The ideal-IK lengths run as they are, then with J(t) p(t) added, p a random-phase
+    multisine along each coordinate in turn (``amplitude`` RMS [m], faded in from 0.5 to 1 s,
+    multiples of 1 / (end_time - after) up to ``max_frequency`` [Hz]); the Fourier transforms
+    over t >= ``after`` give G, a linear time-invariant summary of a robot that is neither.
     """
     times = command_grid(model)
     window = times >= after - 1e-9
@@ -290,20 +228,8 @@ def measure_response(model: Scene, amplitude: float = 4e-3, max_frequency: float
 def model_feed_forward(model: Scene, plant: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRule = DEFAULT_RULE,
                        *, after: float = 1.0, on_trial: Callable[[Trial], None] | None = None
                        ) -> tuple[LearningRun, Result]:
-    """Learn the lengths on the controller's ``model``, then run the ``plant`` open loop with them.
-
-    Returns
-    -------
-    learning : LearningRun
-        The trials on the model.
-    result : Result
-        The plant's run under the learned commands (controller name "model_feed_forward").
-
-    Raises
-    ------
-    SceneError
-        If the model and the plant differ in their cables' number or their end time.
-    """
+    """Learn the lengths on the controller's ``model``; return that learning and the ``plant``'s open-loop
+    run with them. SceneError if the two differ in their number of cables or end time."""
     if model.n_cables != plant.n_cables or model.solver.end_time != plant.solver.end_time:
         raise SceneError("model and plant must have the same number of cables and solver.end_time")
     learning = learn_lengths(model, law, rule, after=after, on_trial=on_trial)
@@ -311,40 +237,19 @@ def model_feed_forward(model: Scene, plant: Scene, law: LearningLaw = DEFAULT_LA
 
 
 class Learner:
-    """Learns a :class:`~controllers.ilc.CommandTable` for a scene, for :class:`~controllers.ilc.LearnedController`.
-
-    Parameters
-    ----------
-    on_model : bool
-        False: the trials run on the compared scene itself (ILC on the plant). True:
-        on :meth:`Scene.controller_scene` of it (model-based feed-forward).
-    law : LearningLaw
-    rule : StoppingRule
-    after : float [s]
-        Errors judged by the stopping rule are measured from this time on.
-    report : callable, optional
-        Called with each line of the learning's progress (where it learns, each trial
-        (:func:`trial_line`), the trial kept); ``cdpr compare`` prints them.
-
-    Attributes
-    ----------
-    learning : LearningRun or None
-        The trials of the last call.
-    """
+    """Learns a :class:`~controllers.ilc.CommandTable` for :class:`~controllers.ilc.LearnedController`, on the
+    scene itself (ILC) or ``on_model``, its :meth:`Scene.controller_scene`; ``report`` gets each line of
+    the progress. ``learning``: the trials of the last call."""
 
     def __init__(self, on_model: bool, law: LearningLaw = DEFAULT_LAW, rule: StoppingRule = DEFAULT_RULE, *,
                  after: float = 1.0, report: Callable[[str], None] | None = None, plant: Scene | None = None):
-        if not isinstance(law, LearningLaw):
-            raise SceneError(f"law must be a LearningLaw, got {law!r}")
-        if not isinstance(rule, StoppingRule):
-            raise SceneError(f"rule must be a StoppingRule, got {rule!r}")
+        _check_settings(law, rule)
         self.on_model, self.law, self.rule, self.after, self.report = bool(on_model), law, rule, after, report
         self.plant = plant
         self.learning: LearningRun | None = None
 
     def __call__(self, scene: Scene, initial_paid_out: np.ndarray) -> CommandTable:  # noqa: ARG002 - same start
-        """Learn the commands; ``scene`` is what the run hands its controllers (the controllers'
-        model, :meth:`Scene.controller_scene`), so learning on the robot itself needs ``plant``."""
+        """Learn the commands; ``scene`` is the controllers' model: learning on the robot needs ``plant``."""
         if self.on_model:
             target = (self.plant if self.plant is not None else scene).controller_scene()
         elif self.plant is not None:
@@ -367,9 +272,6 @@ class Learner:
 
 def learners(plant: Scene | None = None, rule: StoppingRule = DEFAULT_RULE, law: LearningLaw = DEFAULT_LAW, *,
              after: float = 1.0, report: Callable[[str], None] | None = None) -> Callable[[bool], Learner]:
-    """The ``learner`` of the registry's learning kinds for ``cdpr compare`` (:data:`controllers.registry.CONTROLLERS`):
-    ``learner(on_model)`` is a :class:`Learner` with ``rule``, ``law``, ``after`` and ``report`` that learns on
-    :meth:`Scene.controller_scene` of ``plant`` (``model_feed_forward`` and the closed loop around its lengths,
-    which holds the platform to the path they gave on the model, ``follow = "expected"``), or on ``plant``
-    itself (``ilc``), before the run replays the best trial's commands."""
+    """The ``learner`` the registry's learning kinds take: ``learner(on_model)``, a :class:`Learner` of
+    ``plant`` with these settings."""
     return lambda on_model: Learner(on_model, law, rule, after=after, report=report, plant=plant)

@@ -1,23 +1,12 @@
 """Robustness as a measured property: controllers run on plants that differ from their model.
 
-The controllers' model is a scene's :meth:`~cdpr_exu.scenes.scene.Scene.controller_scene`; each
-plant of the grid is that model with relative errors on its platform's mass (and inertia, the
-same shape), its cables' linear density and their Young's modulus, and its pulleys moved apart by a few
-millimetres (:func:`perturbed`), and it carries the model back as its ``[controller_model]``, so that the
-controllers plan on the model and the run simulates the plant. Planar and spatial scenes alike: one run is
-:func:`cdpr_exu.run.simulate.simulate`.
-
-Each (grid point, controller) is one run on the process pool or Dask cluster of
-:mod:`cdpr_exu.studies.study`; each row is appended to ``rows.jsonl`` as it finishes, and a
-study started again skips the rows it finds there (it resumes). The table
-(``robustness.csv``, ``robustness.json``, ``robustness.md``) holds per grid point and
-controller: completed or not, the max and RMS position error and the max error's ratio to
-ideal IK's at the same grid point, the lowest element tension, the longest slack time and
-whether an element pushed; :func:`cdpr_exu.post.study_plots.plot_robustness` draws a heat map
-per controller.
-
-This module imports only the standard library and the study's helpers at its top, so that a
-spawned worker sets its thread limits before NumPy, Numba or Exudyn load.
+Each plant of the grid is the controllers' model (a scene's
+:meth:`~cdpr_exu.scenes.scene.Scene.controller_scene`) with relative errors on its platform's
+mass and inertia, its cables' linear density and Young's modulus, and its pulleys moved apart
+(:func:`perturbed`); it carries the model as its ``[controller_model]``, so the controllers plan
+on the model while the run simulates the plant. Each (grid point, controller) is one run on
+the pool of :mod:`cdpr_exu.studies.study`, appended to ``rows.jsonl`` as it finishes (a study
+started again resumes). Standard library only at the top, as :mod:`cdpr_exu.studies.study`.
 """
 
 from __future__ import annotations
@@ -37,13 +26,14 @@ from cdpr_exu.studies.study import SINGLE_THREAD_ENVIRONMENT, executor_for, prog
 ROBUSTNESS_FILES = {"rows": "rows.jsonl", "csv": "robustness.csv", "json": "robustness.json",
                     "table": "robustness.md", "scene": "base_scene.toml"}
 
-#: The model errors a grid point gives: relative (plant = model x (1 + error)) but ``exit_offset`` [m], how far
-#: each pulley's centre lies further out (away from the pulleys' middle, horizontally) than the model's.
+#: The model errors of a grid point: relative (plant = model x (1 + error)), but ``exit_offset`` [m], how far
+#: each pulley's centre lies further out horizontally.
 ERRORS = ("platform_mass", "cable_density", "cable_stiffness", "exit_offset")
 
 #: The columns of a row, in order.
 COLUMNS = (*ERRORS, "controller", "status", "completed", "max_position_error_m", "rms_position_error_m",
            "max_error_vs_ideal_ik", "min_element_tension_N", "slack_time_s", "elements_pushed", "failure_time_s")
+
 
 def error_grid(platform_mass=(-0.2, 0.0, 0.2), cable_density=(-0.2, 0.0, 0.2), cable_stiffness=(0.0,),
                exit_offset=(0.0,)) -> list[dict]:
@@ -54,16 +44,9 @@ def error_grid(platform_mass=(-0.2, 0.0, 0.2), cable_density=(-0.2, 0.0, 0.2), c
 
 def perturbed(model, platform_mass: float = 0.0, cable_density: float = 0.0, cable_stiffness: float = 0.0,
               exit_offset: float = 0.0):
-    """The plant: ``model`` with relative errors on its platform's mass and inertia, its cables' linear
-    density and Young's modulus, and its pulleys' centres ``exit_offset`` [m] further out (horizontally, away
-    from their middle), carrying ``model``'s values as its controller model.
-
-    Raises
-    ------
-    SceneError
-        For a relative error at or below -1 or an offset that is not finite (naming it), an offset on exits
-        that are not pulleys (the controllers' model can move pulleys only), or a plant that is no valid robot.
-    """
+    """The plant: ``model`` with the errors of :data:`ERRORS`, carrying ``model``'s values as its controller
+    model. SceneError for a relative error at or below -1 or an offset not finite (naming it), an offset on
+    exits that are not pulleys, or a plant that is no valid robot."""
     import math
     from dataclasses import replace
 
@@ -98,15 +81,9 @@ def perturbed(model, platform_mass: float = 0.0, cable_density: float = 0.0, cab
 
 
 def make_controller(kind: str, plant, options: Mapping[str, Any] | None = None, after: float = 1.0):
-    """A controller of ``kind`` (a name of :data:`controllers.registry.CONTROLLERS`) for a run of ``plant``,
-    planar or spatial, with ``options`` (the kind's factory's: ``statics``, ``start``, the loop's gains...);
-    the learning kinds learn with the comparison's stopping rule, on ``plant`` itself.
-
-    Raises
-    ------
-    SceneError
-        For an unknown kind, or one with no physics in ``plant``'s dimension (naming both).
-    """
+    """A controller of ``kind`` (:data:`controllers.registry.CONTROLLERS`) for a run of ``plant``, with the
+    kind's ``options``; learning kinds learn on ``plant``. SceneError for an unknown kind or one with no
+    physics in ``plant``'s dimension."""
     from controllers.registry import controller_kind
     from cdpr_exu.studies.learning import learners
 
@@ -116,15 +93,8 @@ def make_controller(kind: str, plant, options: Mapping[str, Any] | None = None, 
 
 
 def run_point(plant_data: dict, kind: str, options: dict | None = None, after: float = 1.0) -> dict[str, Any]:
-    """One run of a study: ``plant_data`` (:meth:`Scene.to_dict`) under a controller of ``kind``.
-
-    Top-level and picklable, plain data in and out; never raises for a refused or failed run.
-
-    Returns
-    -------
-    dict
-        ``status``, ``completed`` and the figures of :data:`COLUMNS` from the run's summary.
-    """
+    """A study's worker: ``plant_data`` under a controller of ``kind``; returns ``status``, ``completed`` and
+    the figures of :data:`COLUMNS`, never raising for a refused or failed run."""
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)
     from cdpr_exu.core.errors import SolverFailure
@@ -153,7 +123,7 @@ def run_point(plant_data: dict, kind: str, options: dict | None = None, after: f
 
 
 def read_rows(out) -> list[dict]:
-    """The rows a study already wrote to ``out/rows.jsonl`` (a line cut short by an interruption is dropped)."""
+    """The rows already in ``out/rows.jsonl`` (a line cut short by an interruption is dropped)."""
     path = Path(out) / ROBUSTNESS_FILES["rows"]
     rows = []
     for line in path.read_text().splitlines() if path.exists() else ():
@@ -171,29 +141,13 @@ def _key(row: Mapping[str, Any]) -> tuple:
 def run_robustness(scene, controllers: Mapping[str, tuple[str, dict]], grid: Sequence[Mapping[str, float]],
                    out: str | Path | None = None, *, after: float = 1.0, workers: int | None = None,
                    scheduler: str | None = None, executor=None, progress: bool = True) -> list[dict]:
-    """Run every controller on the plant of every grid point; one row each (resumable).
+    """Run every controller on the plant of every grid point (``{error: value}``); one row each, grid order
+    then controller order (:data:`COLUMNS`), errors from ``after`` [s] on.
 
-    Parameters
-    ----------
-    scene : Scene
-        Its controller scene is the controllers' model.
-    controllers : mapping
-        ``{label: (kind, options)}`` (:func:`make_controller`); ``ideal_ik`` is added when missing:
-        the ratios are to it.
-    grid : sequence of dict
-        ``{error: value}`` (:func:`error_grid`).
-    out : path, optional
-        Rows are appended to ``out/rows.jsonl`` as they finish, rows found there are not run
-        again, and the table and heat maps are written at the end (:func:`write_robustness`).
-    after : float [s]
-        Errors are measured from this time on.
-    workers, scheduler, executor
-        As :func:`cdpr_exu.studies.study.run_study`.
-
-    Returns
-    -------
-    list of dict
-        One row per grid point and controller, grid order then controller order (:data:`COLUMNS`).
+    ``controllers``: ``{label: (kind, options)}``, ``ideal_ik`` added (the ratios are to it).
+    With ``out``, rows go to ``rows.jsonl`` as they finish, rows found there are not run again,
+    and :func:`write_robustness` writes the rest at the end. ``workers``, ``scheduler``,
+    ``executor``: as :func:`cdpr_exu.studies.study.run_study`.
     """
     controllers = {"ideal_ik": ("ideal_ik", {}), **controllers}
     model = scene.controller_scene()
@@ -242,8 +196,7 @@ def run_robustness(scene, controllers: Mapping[str, tuple[str, dict]], grid: Seq
 
 
 def write_robustness(out, rows: Sequence[Mapping[str, Any]], scene, after: float = 1.0, plots: bool = True) -> dict:
-    """Write ``robustness.csv``, ``robustness.json`` (wall times to ``timing.json``), ``robustness.md``,
-    ``base_scene.toml`` and a heat map per controller into ``out``; returns the paths."""
+    """Write :data:`ROBUSTNESS_FILES` and a heat map per controller into ``out``; returns the paths."""
     from cdpr_exu.core.output import csv_cell, write_summary
     from cdpr_exu.results.result import provenance
     from cdpr_exu.scenes.scene import save_scene
@@ -271,9 +224,7 @@ def write_robustness(out, rows: Sequence[Mapping[str, Any]], scene, after: float
 
 
 def robustness_table(rows: Sequence[Mapping[str, Any]]) -> str:
-    """A Markdown table, one line per controller over the grid: runs completed, the worst max and RMS
-    error, the worst and best ratio to ideal IK, the lowest tension, the longest slack, pushing runs and
-    the grid points not completed."""
+    """A Markdown table, one line per controller over the grid."""
     groups: dict[str, list] = {}
     for row in rows:
         groups.setdefault(str(row["controller"]), []).append(row)

@@ -10,20 +10,15 @@ form (:meth:`~cdpr_exu.scenes.scene.Scene.to_dict`):
 - ``"solver.step_size=1e-3,2e-3"``, ``"effects.bending=true,false"``,
   ``"effects.preset=full,catenary"``, ``"trajectory.angular_rate=1,1.5"``.
 
-Values are TOML scalars (numbers, ``true``/``false``, strings; a bare word is taken as
-a string). By default the study runs the cartesian product of all values (a grid);
-``mode="zip"`` runs the i-th values of every parameter together.
+Values are TOML scalars (a bare word is a string). The study runs the cartesian product
+of the values, or with ``mode="zip"`` the i-th values together. Each run is one row: its
+parameters, its status (``"completed"``, ``"failed: ..."``, ``"refused: ..."``: recorded,
+never fatal) and the figures of :meth:`~cdpr_exu.results.result.Result.summary`. Runs go to
+any :class:`concurrent.futures.Executor`: a process pool of single-threaded processes by
+default, or a Dask cluster (``scheduler="tcp://host:8786"`` or ``"local"``).
 
-Every variation becomes one row: its parameters, its status (``"completed"``,
-``"failed: ..."`` when the solver failed, ``"refused: ..."`` when the scene is invalid
-or the reference unreachable), and the summary figures of
-:meth:`~cdpr_exu.results.result.Result.summary`. A failed or refused run is recorded, never
-fatal. Runs go to any :class:`concurrent.futures.Executor`: by default a process pool
-with one single-threaded process per core; a Dask cluster through
-``scheduler="tcp://host:8786"`` (or ``"local"``).
-
-This module imports only the standard library at its top, so that a spawned worker
-process can set its thread limits before NumPy, Numba or Exudyn load.
+Only the standard library is imported at the top, so that a spawned worker sets its thread
+limits before NumPy, Numba or Exudyn load.
 """
 
 from __future__ import annotations
@@ -89,20 +84,10 @@ _SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
 _MODES = ("grid", "zip")
 
 
-# --------------------------------------------------------------------------- parameters
-
-
 @dataclass(frozen=True)
 class Variation:
-    """One varied parameter: a path into the scene's plain data and its values.
-
-    Parameters
-    ----------
-    path : str
-        E.g. ``"cables.n_elements"``, ``"cables[1].radius"``, ``"effects.preset"``.
-    values : tuple
-        The values it takes (numbers, booleans or strings).
-    """
+    """One varied parameter: a path into the scene's plain data (``"cables[1].radius"``) and its values
+    (numbers, booleans or strings)."""
 
     path: str
     values: tuple
@@ -134,16 +119,8 @@ def _parse_value(text: str, path: str) -> Any:
 
 
 def parse_parameter(text: str) -> Variation:
-    """Read ``"PATH=V1,V2,..."`` into a :class:`Variation`.
-
-    Values are TOML scalars: ``5``, ``2.5``, ``1e-3``, ``true``, ``"full"`` or a bare
-    word ``full``. Quoted strings may contain commas.
-
-    Raises
-    ------
-    SceneError
-        If the text has no ``=``, the path is malformed or a value is not a scalar.
-    """
+    """Read ``"PATH=V1,V2,..."`` (TOML scalars or bare words; quoted strings may hold commas) into a
+    :class:`Variation`; SceneError without ``=``, for a malformed path or a value that is no scalar."""
     if not isinstance(text, str) or "=" not in text:
         raise SceneError(f"parameter {text!r} must read PATH=V1,V2,... (e.g. platform.mass=1,2.5,5)")
     path, _, values_text = text.partition("=")
@@ -217,14 +194,11 @@ def check_parameter_path(scene_data: Mapping[str, Any], path: str) -> None:
 
 
 def apply_parameters(scene_data: Mapping[str, Any], assignments: Iterable[tuple[str, Any]]) -> dict[str, Any]:
-    """A copy of the plain scene data with each ``(path, value)`` set.
+    """A copy of the plain scene data with each ``(path, value)`` set (not validated).
 
-    ``effects.preset`` is set first and resets the effect flags to the new preset's,
-    keeping the base scene's own deviations from its preset (and any effect varied
-    explicitly). Switching an effect off by a parameter also switches off the effects
-    that need it (:data:`DEPENDENT_EFFECTS`, e.g. ``effects.bending=false`` turns
-    ``bending_damping`` off) unless those are varied too. The result is not
-    validated: pass it to :func:`~cdpr_exu.scenes.scene.scene_from_dict`.
+    ``effects.preset`` is set first and resets the flags to the new preset's, keeping the
+    base's own deviations from its preset. Switching an effect off also switches off those
+    that need it (:data:`DEPENDENT_EFFECTS`) unless they are varied too.
     """
     data = copy.deepcopy(dict(scene_data))
     assignments = sorted(assignments, key=lambda a: a[0] != "effects.preset")
@@ -253,11 +227,8 @@ def _effects_for_preset(effects: Mapping[str, Any], preset: Any) -> dict[str, An
 
 
 def combinations(variations: Sequence[Variation], mode: str = "grid") -> list[tuple[tuple[str, Any], ...]]:
-    """The parameter assignments of every run, in order.
-
-    ``"grid"``: the cartesian product, the last parameter varying fastest.
-    ``"zip"``: the i-th values of every parameter together (equal lengths required).
-    """
+    """The parameter assignments of every run: ``"grid"``, the cartesian product (the last parameter
+    fastest); ``"zip"``, the i-th values together (equal lengths required)."""
     if mode not in _MODES:
         raise SceneError(f"mode must be 'grid' or 'zip', got {mode!r}")
     if not variations:
@@ -296,9 +267,6 @@ def as_variations(variations: Any) -> list[Variation]:
     return out
 
 
-# --------------------------------------------------------------------------- one run
-
-
 def _nan_figures() -> dict[str, Any]:
     return {name: float("nan") for name in FIGURES}
 
@@ -308,12 +276,8 @@ _WARMED: set[str] = set()
 
 
 def warm_up(scene) -> None:
-    """Run two steps of a planar or spatial ``scene`` once per process and model configuration, untimed.
-
-    The first run in a process loads Numba's compiled kernels and Exudyn's code
-    paths (0.2 to 1 s planar, about 2 s of CPU time spatial); without this, whichever
-    run a worker takes first would report that in its time.
-    """
+    """Run two steps of ``scene`` once per process and model configuration, untimed: the first run
+    in a process loads Numba's kernels and Exudyn's code paths (0.2 to 2 s), which no run's time holds."""
     from cdpr_exu.run.simulate import simulate
 
     effects = scene.to_dict()["effects"]
@@ -332,24 +296,12 @@ def warm_up(scene) -> None:
 
 
 def recorded_run(scene_data: Mapping[str, Any], quiet: tuple[type[Warning], ...] = ()):
-    """Build a scene from plain data and simulate it once warmed up (:func:`warm_up`); never raises for a
-    bad scene or a failed run. The one run of a study's workers (:func:`run_variation`,
-    :func:`cdpr_exu.studies.accuracy.run_configuration`), in a single thread per process.
+    """Build a scene from plain data and simulate it, warmed up, in a single thread; never raises for a
+    bad scene or a failed run (the one run of a study's workers). ``quiet``: warnings not shown.
 
-    Parameters
-    ----------
-    scene_data : dict
-        Plain scene data (as :meth:`Scene.to_dict` gives).
-    quiet : tuple of Warning classes
-        Warnings not shown while the scene is built.
-
-    Returns
-    -------
-    (scene, result, status, cpu_time_s)
-        ``status`` ``"completed"``, ``"failed: ..."`` (``result`` the partial result, or None when the run
-        produced none) or ``"refused: ..."`` (an invalid or unreachable scene: ``result`` None);
-        ``scene`` None where it could not be built; ``cpu_time_s`` [s] of the simulation, model building
-        included (NaN without one).
+    Returns ``(scene, result, status, cpu_time_s)``: ``status`` ``"completed"``, ``"failed: ..."``
+    (``result`` the partial one, or None) or ``"refused: ..."`` (``result`` None); ``scene`` None
+    where it could not be built; the CPU time [s] of the run, model building included (NaN without).
     """
     for name, value in SINGLE_THREAD_ENVIRONMENT.items():
         os.environ.setdefault(name, value)  # effective if the libraries are not loaded yet
@@ -377,24 +329,8 @@ def recorded_run(scene_data: Mapping[str, Any], quiet: tuple[type[Warning], ...]
 
 
 def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, Any]:
-    """Simulate one scene given as plain data; return its status and summary figures.
-
-    The worker function of a study: top-level and picklable, it takes and returns
-    plain data only. Never raises for a bad scene or a failed run (:func:`recorded_run`).
-
-    Parameters
-    ----------
-    scene_data : dict
-        Plain scene data (as :meth:`Scene.to_dict` gives).
-    after : float [s]
-        Errors are measured from this time on; from 0 if the run is not longer.
-
-    Returns
-    -------
-    dict
-        ``status`` (``"completed"``, ``"failed: ..."``, ``"refused: ..."``) and
-        the figures of :data:`FIGURES` (NaN for a refused run).
-    """
+    """A study's worker: simulate plain scene data (:func:`recorded_run`) and return ``status`` and the
+    :data:`FIGURES` (NaN for a refused run), errors from ``after`` [s] on (0 if the run is not longer)."""
     scene, result, status, _ = recorded_run(scene_data)
     if result is None:
         return {"status": status, **_nan_figures()}
@@ -404,9 +340,6 @@ def run_variation(scene_data: dict[str, Any], after: float = 1.0) -> dict[str, A
         value = summary.get(name)
         row[name] = float("nan") if value is None else value
     return row
-
-
-# --------------------------------------------------------------------------- the study
 
 
 @contextlib.contextmanager
@@ -459,8 +392,7 @@ def executor_for(executor: Executor | None, workers: int | None, scheduler: str 
                 yield client.get_executor()
         return
     workers = workers or os.cpu_count() or 1
-    # Spawned (not forked) processes start from a fresh interpreter with this
-    # environment, so BLAS, OpenMP and Numba load with one thread each.
+    # spawned processes start a fresh interpreter in this environment: one thread each for BLAS, OpenMP, Numba
     with _environment(SINGLE_THREAD_ENVIRONMENT):
         pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
         try:
@@ -473,7 +405,7 @@ def progress_bar(total: int, enabled: bool):
     """A tqdm bar over ``total`` runs, shown when ``enabled`` and the output is a terminal."""
     from tqdm import tqdm
 
-    # disable=None: no bar when the output is not a terminal (logs, CI).
+    # disable=None: no bar when the output is not a terminal
     return tqdm(total=total, unit="run", desc="study", disable=None if enabled else True, mininterval=0.25)
 
 
@@ -481,45 +413,32 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
               out: str | Path | None = None, progress: bool = True, after: float = 1.0, *,
               mode: str = "grid", workers: int | None = None, scheduler: str | None = None,
               plots: bool = True) -> list[dict[str, Any]]:
-    """Run ``base_scene`` once per combination of parameter values; one row per run.
+    """Run ``base_scene`` (a Scene, shipped name or TOML path) once per combination of parameter values.
 
     Parameters
     ----------
-    base_scene : Scene, or a shipped scene name or TOML path
     variations : sequence
-        ``"PATH=V1,V2"`` strings, :class:`Variation` objects, ``(path, values)``
-        pairs, or a dict ``{path: values}``.
+        ``"PATH=V1,V2"`` strings, :class:`Variation` objects, ``(path, values)`` pairs, or a dict.
     executor : concurrent.futures.Executor, optional
-        Where the runs go (not shut down here). Default: a process pool of
-        ``workers`` single-threaded processes, or the Dask cluster of ``scheduler``.
+        Where the runs go (not shut down here). Default: a process pool of ``workers``
+        single-threaded processes (default: cores), or the Dask cluster of ``scheduler``
+        (``"tcp://host:8786"``, the project installed on its workers, or ``"local"``).
     out : path, optional
-        Folder to write ``study.csv``, ``study.json``, ``base_scene.toml`` and plots.
-    progress : bool
-        Show a progress bar (runs done / total, simulated seconds per wall second)
-        when the output is a terminal.
+        Folder for :func:`write_study` (with the figures if ``plots``).
     after : float [s]
         Errors are measured from this time on (from 0 for runs not longer than it).
-    mode : {"grid", "zip"}
-        Cartesian product of the values, or the i-th values together.
-    workers : int, optional
-        Processes of the default pool (or of ``scheduler="local"``); default: cores.
-    scheduler : str, optional
-        ``"tcp://host:8786"``: run on that Dask scheduler's workers (the project must
-        be installed on them); ``"local"``: start a local Dask cluster.
-    plots : bool
-        Write the summary figures into ``out``.
 
     Returns
     -------
     list of dict
-        In the order of :func:`combinations`: the parameters (by path), ``run``,
-        ``status`` and the figures of :data:`FIGURES`.
+        In the order of :func:`combinations`: the parameters (by path), ``run``, ``status``
+        and the :data:`FIGURES`.
 
     Raises
     ------
     SceneError
-        Before any run, for an unknown parameter path, a malformed value or unequal
-        zipped lengths. Invalid values of a known path are recorded as refused runs.
+        Before any run, for an unknown path, a malformed value or unequal zipped lengths
+        (invalid values of a known path are recorded as refused runs).
     """
     from cdpr_exu.scenes.scene import Scene, load_scene, scene_from_dict
 
@@ -579,18 +498,8 @@ def run_study(base_scene: "Scene | str | Path", variations: Any, executor: Execu
     return rows
 
 
-# --------------------------------------------------------------------------- files
-
-
-def _json_value(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def study_columns(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation]) -> list[str]:
-    """CSV columns: the parameters first, then run, status and the figures; not the wall-clock figures
-    (:data:`cdpr_exu.core.output.TIMING_KEYS`), which go to ``timing.json`` (issue 23.18)."""
+    """CSV columns: the parameters, run, status and the figures, but the wall-clock ones (``timing.json``)."""
     from cdpr_exu.core.output import TIMING_KEYS
 
     columns = [v.path for v in variations] + ["run", "status", *(f for f in FIGURES if f not in TIMING_KEYS)]
@@ -623,7 +532,7 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
         "mode": mode,
         "errors_measured_after_s": after,
         "columns": columns,
-        "rows": [{k: _json_value(v) for k, v in row.items()} for row in rows],
+        "rows": [dict(row) for row in rows],  # NaN as null (write_summary)
         "base_scene": base_scene.to_dict(),
         **provenance(),
     }
@@ -636,14 +545,9 @@ def write_study(out: str | Path, rows: Sequence[Mapping[str, Any]], base_scene: 
     return paths
 
 
-# --------------------------------------------------------------------------- table
-
-
 def format_table(rows: Sequence[Mapping[str, Any]], variations: Sequence[Variation]) -> str:
-    """A plain-text table of a study: parameters, status, errors [mm], wall time [s].
-
-    The causes of failed and refused runs follow the table, once each.
-    """
+    """A plain-text table of a study (parameters, status, errors [mm], wall time [s]), then the causes of
+    failed and refused runs, once each."""
     from cdpr_exu.core.output import finite_number, value_text
 
     head = [v.path for v in variations] + ["run", "status", "max err [mm]", "rms err [mm]", "wall [s]",
