@@ -1135,7 +1135,7 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     ``[[cables]]`` (``[[pulleys]]``) entries override them one by one. ``[effects]`` may
     name a ``preset`` and override single effects. The values given are checked first; then
     the tables and fields (:data:`REQUIRED_FIELDS`, each exit kind's) a scene must give are
-    required. ``source`` names the file in those messages.
+    required. ``source`` names the file in those messages (and its folder is where a trajectory file is read).
     """
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
@@ -1164,7 +1164,8 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
         dimension=space.dimension, cables=cables, exits=exits, platform=platform,
         winch=_build(WinchSpec, data.get("winch", {}), "winch"), effects=effects,
         solver=_build(SolverSpec, data.get("solver", {}), "solver"),
-        trajectory=trajectory_from_dict(data["trajectory"], space) if "trajectory" in data else None,
+        trajectory=trajectory_from_dict(data["trajectory"], space, source and Path(source).parent)
+        if "trajectory" in data else None,
         controller_model=controller_model_from_dict(data["controller_model"]) if "controller_model" in data else None,
     )
     for key in ("name", "description", "gravity"):
