@@ -34,6 +34,7 @@ from cdpr_exu.scenes.trajectories import (
 )
 from cdpr_exu.space import PLANE, SPACE
 from cdpr_exu.statics.kinematics import ideal_paid_out
+from cdpr_exu.statics.workspace import reference_samples
 
 PAPER_CIRCLE = CircleTrajectory((0.0, -1.6))
 RAMPED_TILTED_CIRCLE = CircleTrajectory((0.1, -0.2, 1.5), radius=0.3, angular_rate=-0.7, rotation=(0.05, 0.0, 0.2),
@@ -473,6 +474,11 @@ def test_a_file_is_read_relative_to_the_scene_file_as_the_waypoints_it_holds(tmp
     scene = load_scene(scene_file)
     assert scene.trajectory == replace(SPATIAL_WAYPOINTS, times=(0.0, 1.5, 4.0))
     assert load_scene(save_scene(scene, tmp_path / "saved" / "scene.toml")) == scene  # saved as waypoints, no file
+    assert set(scene.trajectory.times) <= set(reference_samples(scene)[0])  # the workspace check samples each
+    # a run's own pose.csv reads back as the path its platform took
+    run = Path(__file__).resolve().parents[1] / "results" / "pick-and-place"
+    taken = trajectory_from_dict({"kind": "file", "path": "pose.csv"}, SPACE, run)
+    np.testing.assert_allclose(taken.poses, np.loadtxt(run / "pose.csv", delimiter=",", skiprows=1)[:, 1:7], rtol=1e-15)
 
 
 @pytest.mark.parametrize("name, text, message", [
