@@ -13,6 +13,7 @@ import json
 import zipfile
 from dataclasses import replace
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,8 +21,8 @@ import pytest
 from cdpr_exu.cli import main
 from cdpr_exu.core.errors import SceneError, SolverFailure
 from cdpr_exu.core.output import ZIP_DATE
-from cdpr_exu.physics import cogiro
 from cdpr_exu.run.rest import Rest, solve_rest
+from cdpr_exu.scenes.caspr import caspr_scene
 from cdpr_exu.scenes.scene import Effects, load_scene, scene_from_dict
 from test_spatial_scene import PLANAR_AS_SPATIAL
 
@@ -240,17 +241,19 @@ def test_without_bending_the_lumped_robot_rests_within_its_discretisation_error_
 
 def test_the_cogiro_scene_is_caspr_s_geometry_and_hangs_where_its_ideal_cables_put_it():
     scene = load_scene("spatial-cogiro")
-    # the TOML holds CASPR's numbers (cdpr_exu/physics/cogiro.py) to their 4 decimals
-    assert scene.exit_points == pytest.approx(cogiro.EXIT_POINTS, abs=1e-12)
-    assert np.asarray(scene.platform.anchors) == pytest.approx(cogiro.ANCHORS - cogiro.CENTER_OF_MASS, abs=5e-5)
+    # the TOML holds CASPR's numbers (tests/data/caspr/, read by cdpr import caspr) to their 4 decimals
+    caspr, _ = caspr_scene(*(Path(__file__).parent / "data" / "caspr" / f"CoGiRo_{part}.xml" for part in ("bodies", "cables")))
+    assert scene.exit_points == pytest.approx(caspr.exit_points, abs=1e-12)
+    assert np.asarray(scene.platform.anchors) == pytest.approx(np.asarray(caspr.platform.anchors), abs=5e-5)
     _, rest = shipped_rest("spatial-cogiro")
-    ideal = cogiro.INITIAL_POSE[:3] + cogiro.CENTER_OF_MASS
+    ideal = caspr.trajectory.pose(0.0)[:3]  # CASPR's initial pose, its centre of mass
     # Lengths are the ideal ones less their straight stretch, so only the sag (about 15 mm
     # mid-span, which shortens each chord by ~0.1 mm) moves the platform: it rises by 1.1 mm
     # (measured); 3 mm bounds that, while a wrong anchor or exit moves it by centimetres.
     assert rest.position == pytest.approx(ideal, abs=3e-3)
     assert np.linalg.norm(rest.rotation) < 1e-3
-    assert np.all((rest.anchor_tensions > cogiro.MIN_TENSION) & (rest.anchor_tensions < cogiro.MAX_TENSION))
+    low, high = caspr.tension_limits.T
+    assert np.all((rest.anchor_tensions > low) & (rest.anchor_tensions < high))
 
 
 def test_the_ipanema_scene_is_held_from_above_and_below_at_its_design_pose():

@@ -6,6 +6,7 @@ planar point masses on three and four cables. Pure maths, no Exudyn.
 """
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ from scipy.optimize import linprog, minimize
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.exits import PointExit, Swivel
-from cdpr_exu.physics import cogiro
+from cdpr_exu.scenes.caspr import caspr_scene
 from cdpr_exu.scenes.scene import CableSpec, PlatformSpec, Scene, WinchSpec, load_scene
 from cdpr_exu.statics.kinematics import structure_matrix
 from cdpr_exu.statics.tension_distribution import tension_distribution, tensions, weight_wrench
@@ -24,8 +25,12 @@ def with_limits(scene: Scene, min_tension: float, max_tension: float) -> Scene:
                                        for c in scene.cables))
 
 
+#: CoGiRo as CASPR publishes it (tests/data/caspr/, read by cdpr import caspr), and its bounds (force_min, force_max).
+CASPR_COGIRO, _ = caspr_scene(*(Path(__file__).parent / "data" / "caspr" / f"CoGiRo_{part}.xml"
+                                for part in ("bodies", "cables")))
+MIN_TENSION, MAX_TENSION = CASPR_COGIRO.tension_limits[0]
 #: CoGiRo within CASPR's bounds, over its point exits and over swivel pulleys of 0.1 m there (elements <= 5 cm).
-COGIRO = with_limits(load_scene("spatial-cogiro"), cogiro.MIN_TENSION, cogiro.MAX_TENSION)
+COGIRO = with_limits(load_scene("spatial-cogiro"), MIN_TENSION, MAX_TENSION)
 COGIRO_SWIVEL = replace(COGIRO, exits=tuple(Swivel(e.point, 0.1) for e in COGIRO.exits),
                         cables=tuple(replace(c, n_elements=200) for c in COGIRO.cables))
 #: Centre-of-mass poses at the positions of CASPR's CoGiRo_trajectories.xml ("long_stable"), with and without rotation.
@@ -112,11 +117,11 @@ def test_symmetric_robot_at_its_centre_gets_symmetric_tensions(point_mass):
 # CoGiRo
 # ----------------------------------------------------------------------------------
 def test_cogiro_data_is_caspr_s_frame_and_platform():
-    span = np.ptp(cogiro.EXIT_POINTS, axis=0)
+    span = np.ptp(CASPR_COGIRO.exit_points, axis=0)
     assert 14.9 < span[0] < 15.1 and 10.9 < span[1] < 11.1
-    assert np.all((cogiro.EXIT_POINTS[:, 2] > 5.38) & (cogiro.EXIT_POINTS[:, 2] < 5.43))
-    assert cogiro.MASS == 91.058 and (cogiro.MIN_TENSION, cogiro.MAX_TENSION) == (100.0, 5000.0)
-    np.testing.assert_allclose(COGIRO.exit_points, cogiro.EXIT_POINTS, atol=5e-5)  # the scene's are rounded to 0.1 mm
+    assert np.all((CASPR_COGIRO.exit_points[:, 2] > 5.38) & (CASPR_COGIRO.exit_points[:, 2] < 5.43))
+    assert CASPR_COGIRO.platform.mass == 91.058 and (MIN_TENSION, MAX_TENSION) == (100.0, 5000.0)
+    np.testing.assert_allclose(COGIRO.exit_points, CASPR_COGIRO.exit_points, atol=1e-12)  # CASPR gives 0.1 mm, as the scene
 
 
 @ROBOTS
@@ -126,7 +131,7 @@ def test_tension_distribution_balances_the_cogiro_weight_within_the_bounds(robot
         residual, weight = _balance(robot, pose, result)
         # the balance holds by construction (f = f_p + N lambda): round-off of tensions of 1e3 N, ~1e-13 relative
         assert np.linalg.norm(residual) <= 1e-9 * np.linalg.norm(weight)
-    assert np.all(held >= cogiro.MIN_TENSION) and np.all(held <= cogiro.MAX_TENSION)
+    assert np.all(held >= MIN_TENSION) and np.all(held <= MAX_TENSION)
 
 
 def test_tension_distribution_is_the_minimiser_of_the_distance_to_the_mid_tensions():
@@ -134,11 +139,11 @@ def test_tension_distribution_is_the_minimiser_of_the_distance_to_the_mid_tensio
     pose = COGIRO_POSES[2]
     matrix, wrench = structure_matrix(COGIRO, pose), weight_wrench(COGIRO)
     held = tensions(COGIRO, pose)
-    assert np.sum(np.isclose(held, cogiro.MIN_TENSION, rtol=0, atol=1e-9)) >= 1  # a bound is active here
-    middle = 0.5 * (cogiro.MIN_TENSION + cogiro.MAX_TENSION)
+    assert np.sum(np.isclose(held, MIN_TENSION, rtol=0, atol=1e-9)) >= 1  # a bound is active here
+    middle = 0.5 * (MIN_TENSION + MAX_TENSION)
     reference = minimize(lambda f: np.sum((f - middle) ** 2) / middle**2, np.full(8, middle), method="SLSQP",
                          jac=lambda f: 2.0 * (f - middle) / middle**2,
-                         bounds=[(cogiro.MIN_TENSION, cogiro.MAX_TENSION)] * 8,
+                         bounds=[(MIN_TENSION, MAX_TENSION)] * 8,
                          constraints={"type": "eq", "fun": lambda f: (matrix @ f + wrench) / 1e3,
                                       "jac": lambda f: matrix / 1e3},
                          options={"ftol": 1e-14, "maxiter": 500})
@@ -151,9 +156,9 @@ def test_tension_distribution_is_the_minimiser_of_the_distance_to_the_mid_tensio
 def test_tension_distribution_is_the_closed_form_one_where_no_bound_is_active():
     pose = COGIRO_POSES[0]
     matrix, wrench = structure_matrix(COGIRO, pose), weight_wrench(COGIRO)
-    middle = np.full(8, 0.5 * (cogiro.MIN_TENSION + cogiro.MAX_TENSION))
+    middle = np.full(8, 0.5 * (MIN_TENSION + MAX_TENSION))
     closed_form = middle - np.linalg.pinv(matrix) @ (wrench + matrix @ middle)
-    assert np.all((closed_form > cogiro.MIN_TENSION) & (closed_form < cogiro.MAX_TENSION))
+    assert np.all((closed_form > MIN_TENSION) & (closed_form < MAX_TENSION))
     # tensions of hundreds of newtons: round-off of the SVD and the pseudo-inverse, ~1e-12 N
     np.testing.assert_allclose(tensions(COGIRO, pose), closed_form, rtol=0, atol=1e-9)
 

@@ -4,17 +4,24 @@ What both spaces share is one test parametrised over the space (shapes, derivati
 finite differences, the ramp from rest, rest-to-rest moves, holds, dict round trips, field
 checks); what is a fact of one space is its own test (the paper's vertical circle, the
 horizontal spatial circle, the rotation vector's rate against the angular velocity). A toy kind
-registered at test time loads in a planar and a spatial scene.
+registered at test time loads in a planar and a spatial scene. Waypoints and trajectory files:
+the spline's facts, the refusals through ``cdpr run``, and a planar and a spatial robot that
+follow such a path on the real solver.
 """
 
+import re
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
 import pytest
+import tomli_w
 
+from cdpr_exu.cli import main
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.geometry import left_jacobian, rotation_from_vector, rotation_matrix, rotation_vector
+from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import load_scene, save_scene, scene_from_dict
 from cdpr_exu.scenes.trajectories import (
     TRAJECTORY_KINDS,
@@ -22,10 +29,12 @@ from cdpr_exu.scenes.trajectories import (
     HoldTrajectory,
     PointToPointTrajectory,
     Trajectory,
+    WaypointsTrajectory,
     trajectory_from_dict,
 )
 from cdpr_exu.space import PLANE, SPACE
 from cdpr_exu.statics.kinematics import ideal_paid_out
+from cdpr_exu.statics.workspace import reference_samples
 
 PAPER_CIRCLE = CircleTrajectory((0.0, -1.6))
 RAMPED_TILTED_CIRCLE = CircleTrajectory((0.1, -0.2, 1.5), radius=0.3, angular_rate=-0.7, rotation=(0.05, 0.0, 0.2),
@@ -33,6 +42,10 @@ RAMPED_TILTED_CIRCLE = CircleTrajectory((0.1, -0.2, 1.5), radius=0.3, angular_ra
 SPATIAL_MOVE = PointToPointTrajectory((0.0, 0.1, 1.0, 0.0, 0.1, 0.0), (0.3, -0.2, 1.4, 0.1, -0.1, 0.3), duration=1.5,
                                       start_time=0.5, space=SPACE)
 PLANAR_MOVE = PointToPointTrajectory((0.0, -2.0, 0.0), (0.3, -1.5, 0.2), duration=1.5, start_time=0.5)
+PLANAR_WAYPOINTS = WaypointsTrajectory((0.5, 1.5, 2.5, 4.5), ((0.0, -2.0, 0.0), (0.2, -1.8, 0.1), (0.3, -1.9, -0.05),
+                                                            (0.1, -2.0, 0.0)))
+SPATIAL_WAYPOINTS = WaypointsTrajectory((0.5, 2.0, 4.5), ((0.0, 0.1, 1.0, 0.0, 0.1, 0.0), (0.3, -0.2, 1.4, 0.1, -0.1, 0.3),
+                                                       (0.2, 0.0, 1.2, 0.0, 0.0, 0.1)), space=SPACE)
 TRAJECTORIES = {
     "planar_circle": PAPER_CIRCLE,
     "planar_circle_ramp_rotation": CircleTrajectory((0.1, -1.5), radius=0.3, angular_rate=-0.7, rotation=0.1,
@@ -40,10 +53,12 @@ TRAJECTORIES = {
     "planar_circle_rocking": CircleTrajectory((0.1, -1.5), radius=0.3, rotation=0.1, tilt=0.05),
     "planar_hold": HoldTrajectory((0.1, -2.0, 0.05)),
     "planar_point_to_point": PLANAR_MOVE,
+    "planar_waypoints": PLANAR_WAYPOINTS,
     "spatial_circle": CircleTrajectory((0.0, 0.0, 2.0), space=SPACE),
     "spatial_circle_ramp_tilt": RAMPED_TILTED_CIRCLE,
     "spatial_hold": HoldTrajectory((0.1, -0.1, 2.0, 0.05, 0.0, -0.02), space=SPACE),
     "spatial_point_to_point": SPATIAL_MOVE,
+    "spatial_waypoints": SPATIAL_WAYPOINTS,
 }
 SPACES = pytest.mark.parametrize("space", [PLANE, SPACE], ids=["planar", "spatial"])
 ALL = pytest.mark.parametrize("trajectory", list(TRAJECTORIES.values()), ids=list(TRAJECTORIES))
@@ -391,3 +406,136 @@ def test_a_kind_registered_at_test_time_loads_in_a_planar_and_a_spatial_scene(mo
         scene_from_dict(data)
     with pytest.raises(SceneError, match="trajectory.kind must be one of .*'bob'"):
         trajectory_from_dict({"kind": "wobble"}, scene.space)
+
+
+# ------------------------------------------------------------------ waypoints and trajectory files (issue 26)
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "pick_and_place" / "scene.toml"
+SPATIAL_HEADER = "time_s,x_m,y_m,z_m,rotation_x_rad,rotation_y_rad,rotation_z_rad"
+
+
+@pytest.mark.parametrize("path", [PLANAR_WAYPOINTS, SPATIAL_WAYPOINTS], ids=["planar", "spatial"])
+def test_the_spline_passes_every_waypoint_with_continuous_rates_and_starts_and_ends_at_rest(path):
+    times, poses = np.array(path.times), np.array(path.poses)
+    np.testing.assert_allclose(path.pose(times), poses, atol=1e-14)  # interpolation: round-off only
+    # left and right of each knot 1e-7 s apart: a jump would show at its full size; a continuous rate
+    # moves by |next derivative| * 2e-7 (< 1e-4 here), so 1e-4 separates the two
+    for rate in (path.velocity, path.acceleration):
+        np.testing.assert_allclose(rate(times - 1e-7), rate(times + 1e-7), atol=1e-4)
+    for t in (times[0], times[-1], times[0] - 1.0, times[-1] + 1.0):  # at rest at both ends and held outside
+        np.testing.assert_allclose(path.velocity(t), 0.0, atol=1e-12)
+        np.testing.assert_allclose(path.acceleration(t), 0.0, atol=1e-12)
+    np.testing.assert_array_equal(path.pose(times[-1] + 3.0), path.pose(times[-1]))
+
+
+@pytest.mark.parametrize("path", [PLANAR_WAYPOINTS, SPATIAL_WAYPOINTS], ids=["planar", "spatial"])
+def test_the_turning_times_are_the_waypoints_and_each_pose_entrys_extremes(path):
+    turning = path.turning_times(10.0)
+    assert set(path.times) <= set(turning)
+    inner = turning[(turning > path.times[0]) & (turning < path.times[-1]) & ~np.isin(turning, path.times)]
+    assert inner.size and np.all(np.min(np.abs(path.velocity(inner)), axis=1) < 1e-9)  # a rate's root each
+    # so the checked samples hold the extremes of every entry: a dense sampling finds none beyond them
+    dense = path.pose(np.linspace(0.0, 10.0, 20001))
+    checked = path.pose(turning)
+    assert np.all(dense.max(axis=0) <= checked.max(axis=0) + 1e-12)
+    assert np.all(dense.min(axis=0) >= checked.min(axis=0) - 1e-12)
+
+
+@pytest.mark.parametrize("data, message", [
+    ({"times": [0.0, 1.0, 1.0], "poses": [[0, -2, 0]] * 3}, r"trajectory.times must increase strictly: times\[2\]"),
+    ({"times": [0.0], "poses": [[0, -2, 0]]}, "trajectory.times must give at least 2 times"),
+    ({"times": [0.0, 1.0], "poses": [[0, -2, 0]]}, r"trajectory.poses must give one pose per time \(2\), got 1"),
+    ({"times": [0.0, np.nan], "poses": [[0, -2, 0]] * 2}, r"trajectory.times\[1\] must be finite"),
+    ({"times": [0.0, 1.0], "poses": [[0, -2, 0], [0, -2]]}, r"trajectory.poses\[1\] must have 3 entries"),
+    ({"times": [0.0, 1.0]}, "trajectory.poses is required for kind 'waypoints' .one pose per time"),
+    ({"times": "soon", "poses": []}, "trajectory.times must be a list"),
+])
+def test_bad_waypoints_are_refused_naming_the_field(data, message):
+    with pytest.raises(SceneError, match=message):
+        trajectory_from_dict({"kind": "waypoints", **data}, PLANE)
+
+
+def _file_scene(folder, csv_text: str, name: str = "spatial-cogiro", path: str = "path.csv") -> Path:
+    """A scene file in ``folder`` whose trajectory reads ``csv_text`` (written as ``path.csv``) beside it."""
+    (folder / "path.csv").write_text(csv_text)
+    data = load_scene(name).to_dict()
+    data["trajectory"] = {"kind": "file", "path": path}
+    scene = folder / "scene.toml"
+    scene.write_text(tomli_w.dumps(data))
+    return scene
+
+
+def test_a_file_is_read_relative_to_the_scene_file_as_the_waypoints_it_holds(tmp_path, monkeypatch):
+    rows = [(0.0, *SPATIAL_WAYPOINTS.poses[0]), (1.5, *SPATIAL_WAYPOINTS.poses[1]), (4.0, *SPATIAL_WAYPOINTS.poses[2])]
+    # a run's pose.csv names its columns so, reference columns after them (ignored)
+    text = SPATIAL_HEADER + ",x_ref_m\n" + "".join(",".join(map(str, row)) + ",9\n" for row in rows)
+    scene_file = _file_scene(tmp_path, text)
+    monkeypatch.chdir(tmp_path.parent)  # not the scene's folder: the path is read relative to the scene file
+    scene = load_scene(scene_file)
+    assert scene.trajectory == replace(SPATIAL_WAYPOINTS, times=(0.0, 1.5, 4.0))
+    assert load_scene(save_scene(scene, tmp_path / "saved" / "scene.toml")) == scene  # saved as waypoints, no file
+    assert set(scene.trajectory.times) <= set(reference_samples(scene)[0])  # the workspace check samples each
+    # a run's own pose.csv reads back as the path its platform took
+    run = Path(__file__).resolve().parents[1] / "results" / "pick-and-place"
+    taken = trajectory_from_dict({"kind": "file", "path": "pose.csv"}, SPACE, run)
+    np.testing.assert_allclose(taken.poses, np.loadtxt(run / "pose.csv", delimiter=",", skiprows=1)[:, 1:7], rtol=1e-15)
+
+
+@pytest.mark.parametrize("name, text, message", [
+    ("spatial-cogiro", "time_s,x_m,y_m,z_m,rotation_x_rad,rotation_y_rad\n0,0,0,2.3,0,0\n1,0,0,2.4,0,0\n",
+     r"trajectory.path 'path.csv' lacks the column\(s\) rotation_z_rad: a spatial trajectory file's header names"),
+    ("spatial-cogiro", "time_s,x_m,z_m,rotation_rad\n0,0,2.3,0\n1,0,2.4,0\n",
+     r"lacks the column\(s\) y_m, rotation_x_rad, rotation_y_rad, rotation_z_rad: .*\(6 pose columns"),
+    ("paper-circle", SPATIAL_HEADER + "\n0,0,0,-2,0,0,0\n1,0,0,-2,0,0,0\n", r"lacks the column\(s\) rotation_rad: a "
+     r"planar trajectory file's header names time_s, x_m, z_m, rotation_rad \(3 pose columns"),
+    ("spatial-cogiro", SPATIAL_HEADER + "\n0,0,0,2.3,0,0,0\n1,0,0,2.4,0,0,0\n1,0,0,2.5,0,0,0\n",
+     r"line k \+ 2 read as times\[k\].*times must increase strictly: times\[2\] = 1 s follows times\[1\] = 1 s"),
+    ("spatial-cogiro", SPATIAL_HEADER + "\n0,0,0,2.3,0,0,0\n1,0,0,nan,0,0,0\n",
+     r"trajectory.poses\[1\]\[2\] must be finite, got nan"),
+    ("spatial-cogiro", SPATIAL_HEADER + "\n0,0,0,2.3,0,0,0\ninf,0,0,2.3,0,0,0\n", r"trajectory.times\[1\] must be finite"),
+    ("spatial-cogiro", SPATIAL_HEADER + "\n0,0,0,2.3,0,0,0\n", "trajectory.times must give at least 2 times"),
+    ("spatial-cogiro", SPATIAL_HEADER + "\n0,0,0,2.3,0,0,0\n1,0,0,high,0,0,0\n",
+     r"trajectory.path 'path.csv', line 3: \['1', '0', '0', 'high', '0', '0', '0'\] does not give a number"),
+    ("spatial-cogiro", "", r"lacks the column\(s\) time_s, x_m"),
+], ids=["missing_column", "planar_file_spatial_scene", "spatial_file_planar_scene", "times_not_increasing", "nan",
+        "inf", "one_row", "text", "empty"])
+def test_cdpr_run_refuses_a_bad_trajectory_file_naming_it_and_writes_nothing(tmp_path, capsys, name, text, message):
+    out = tmp_path / "out"
+    assert main(["run", str(_file_scene(tmp_path, text, name)), "--out", str(out)]) == 2
+    assert re.search(message, capsys.readouterr().err) and not out.exists()
+
+
+def test_cdpr_run_refuses_a_trajectory_file_that_is_not_there_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", str(_file_scene(tmp_path, "", path="paths/none.csv")), "--out", str(out)]) == 2
+    assert re.search(r"trajectory.path 'paths/none.csv': cannot read .*none.csv: No such file", capsys.readouterr().err)
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_planar_robot_under_ideal_ik_follows_a_waypoints_path():
+    # a diamond through the paper circle's range (x +-0.3 m, z -2.0 .. -1.4 m) in 6 s, from the paper's start
+    corners = [(0.0, -2.0, 0.0), (0.3, -1.7, 0.0), (0.0, -1.4, 0.0), (-0.3, -1.7, 0.0), (0.0, -2.0, 0.0)]
+    scene = load_scene("paper-circle")
+    scene = scene.with_changes(trajectory=WaypointsTrajectory((0.0, 1.5, 3.0, 4.5, 6.0), tuple(corners)),
+                               solver=replace(scene.solver, end_time=6.0))
+    summary = simulate(scene).summary()
+    # What ideal IK leaves on this robot is the heavy cables' sag and the platform's swing: on the
+    # paper circle (0.6 m/s) 5.9 cm / 4.4 cm in x / z (results/paper_circle); on this path (up to
+    # 0.46 m/s, corners rounded by the spline) 3.6 cm / 2.6 cm measured. 5 cm bounds both, as on the
+    # circle, while a path followed wrongly (a wrong rate, a lag) would miss by the 0.3 m of a leg.
+    assert summary["status"] == "completed"
+    assert summary["max_abs_error_x_m"] < 0.05 and summary["max_abs_error_z_m"] < 0.05
+
+
+@pytest.mark.slow
+def test_the_cogiro_class_robot_follows_the_pick_and_place_path_from_its_file():
+    scene = load_scene(EXAMPLE)  # examples/pick_and_place: path.csv beside it
+    assert isinstance(scene.trajectory, WaypointsTrajectory) and len(scene.trajectory.times) == 41
+    summary = simulate(scene.with_changes(cables=tuple(replace(c, n_elements=10) for c in scene.cables))).summary()
+    # Ideal IK on spatial-cogiro's circle leaves 0.60 mm (sag and stretch, results/spatial); this path
+    # lifts, carries and lowers the platform by metres at up to 0.9 m/s^2: 1.49 mm measured with 20
+    # elements (results/pick-and-place), 1.47 mm with 10. 3 mm bounds it, 0.1 % of the 3 m path.
+    assert summary["status"] == "completed" and summary["max_position_error_m"] < 3e-3
+    assert summary["min_element_tension_N"] > 100.0  # CASPR's lower limit: taut throughout
+    assert summary["max_rotation_error_deg"] < 0.1

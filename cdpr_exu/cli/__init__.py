@@ -1,4 +1,4 @@
-"""The ``cdpr`` command line: one module per command (run, scenes, compare, study, view, static).
+"""The ``cdpr`` command line: one module per command (run, scenes, compare, study, view, static, import).
 
 The commands parse their options, call the library and print what the user sees; the
 library returns data and prints nothing. ``main`` is the console script's entry point.

@@ -196,9 +196,10 @@ def _elements_for(scene, tolerance: float, quiet: bool):
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    # the scene first (loaded once: its warnings are printed once), so that a refused one leaves no output folder
+    scene = _scene_with_overrides(args, load_scene(args.scene))
     out = check_output_folder(args.out, command="run")
     tolerance = None if args.tolerance is None else parse_length(args.tolerance)
-    scene = _scene_with_overrides(args, load_scene(args.scene))  # loaded once: its warnings are printed once
     if tolerance is not None:
         scene = _elements_for(scene, tolerance, args.quiet)
     run_scene(scene, out, quiet=args.quiet, figures=not args.no_figures,

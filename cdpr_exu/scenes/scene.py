@@ -1013,7 +1013,8 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
     or in the planar form, ``[[pulleys]]`` and ``cable_exit`` (``"pulley"`` or ``"point"``: each
     cable leaves from its pulley's centre). ``[cable]`` and ``[pulley]`` hold values shared by
     every entry of ``[[cables]]`` and ``[[pulleys]]``; ``[effects]`` may name a ``preset``. The
-    values given are checked first, then the required tables and fields; ``source`` names the file.
+    values given are checked first, then the required tables and fields; ``source`` names the file
+    (its folder is where a trajectory file is read).
     """
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be a table (mapping), got {shown(data)}")
@@ -1042,7 +1043,8 @@ def scene_from_dict(data: Mapping[str, Any], source: str | None = None) -> Scene
         dimension=space.dimension, cables=cables, exits=exits, platform=platform,
         winch=_build(WinchSpec, data.get("winch", {}), "winch"), effects=effects,
         solver=_build(SolverSpec, data.get("solver", {}), "solver"),
-        trajectory=trajectory_from_dict(data["trajectory"], space) if "trajectory" in data else None,
+        trajectory=trajectory_from_dict(data["trajectory"], space, source and Path(source).parent)
+        if "trajectory" in data else None,
         controller_model=controller_model_from_dict(data["controller_model"]) if "controller_model" in data else None,
     )
     for key in ("name", "description", "gravity"):

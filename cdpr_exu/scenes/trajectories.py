@@ -21,8 +21,8 @@ velocity, which is ``omega = J_l(theta) theta'`` in the fixed frame
 Kinds
 -----
 :data:`TRAJECTORY_KINDS` holds the kinds by name (``kind = "..."`` in a scene's
-``[trajectory]``): ``"hold"``, ``"point_to_point"`` and ``"circle"``, each written once for
-both spaces. A trajectory is a frozen dataclass whose fields are checked against its space
+``[trajectory]``): ``"hold"``, ``"point_to_point"``, ``"circle"``, ``"waypoints"`` (poses at
+times in the scene) and ``"file"`` (the same from a CSV file), each written once for both spaces. A trajectory is a frozen dataclass whose fields are checked against its space
 when it is made, and it round-trips through a plain dict (``to_dict`` /
 :func:`trajectory_from_dict`) for TOML. Adding a kind is one subclass of :class:`Trajectory`
 plus one entry ``TRAJECTORY_KINDS["name"] = Class``.
@@ -33,21 +33,27 @@ The paper's reference (scenario 1) is ``CircleTrajectory((0.0, -1.6))``:
 
 from __future__ import annotations
 
+import csv
 from abc import ABC, abstractmethod
 from dataclasses import KW_ONLY, dataclass, field, fields
+from pathlib import Path
 from typing import Any, ClassVar, Mapping
 
 import numpy as np
+from scipy.interpolate import BSpline, PPoly, make_interp_spline
 
 from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, SPATIAL_POSE_COLUMNS
 from cdpr_exu.core.validation import entries, finite, shown
-from cdpr_exu.space import PLANE, Space
+from cdpr_exu.space import PLANE, SPACE, Space
 
 __all__ = [
     "Trajectory",
     "CircleTrajectory",
     "HoldTrajectory",
     "PointToPointTrajectory",
+    "WaypointsTrajectory",
+    "FileTrajectory",
     "TRAJECTORY_KINDS",
     "trajectory_from_dict",
 ]
@@ -176,8 +182,9 @@ class Trajectory(ABC):
         return data
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], space: Space) -> "Trajectory":
-        """The trajectory of a ``[trajectory]`` table without its ``kind``, in ``space``.
+    def from_dict(cls, data: Mapping[str, Any], space: Space, folder: Path | None = None) -> "Trajectory":
+        """The trajectory of a ``[trajectory]`` table without its ``kind``, in ``space`` (``folder``: where a
+        kind reads the files the table names, the scene file's folder).
 
         Raises
         ------
@@ -433,18 +440,151 @@ class CircleTrajectory(Trajectory):
         return _stack(position + turn, scalar)
 
 
+def _listed(name: str, value, what: str) -> list:
+    """``value`` as a list, or SceneError naming ``name`` (a table or text is no list of ``what``)."""
+    if isinstance(value, (str, bytes, Mapping)) or not hasattr(value, "__len__"):
+        raise SceneError(f"{name} must be a list of {what}, got {shown(value)}")
+    return list(value)
+
+
+@dataclass(frozen=True)
+class WaypointsTrajectory(Trajectory):
+    """Poses at given times, joined by a quintic spline from rest to rest; holds outside ``times``.
+
+    The interpolant is the quintic B-spline through every waypoint with zero velocity and zero
+    acceleration at the first and the last (``scipy.interpolate.make_interp_spline``, k = 5).
+    Chosen over a clamped cubic spline because its acceleration is continuous also where the
+    motion leaves and reaches rest: a clamped cubic starts with zero velocity but a step in
+    acceleration, which the workspace check's ``M a_ref`` and a feed-forward controller would see.
+    Inside, pose to 4th derivative are continuous. The platform passes the inner waypoints
+    without stopping; between sparse waypoints a spline rounds corners and may overshoot, so give
+    them densely where the path must be straight (the workspace check samples every waypoint and
+    each pose entry's extremes exactly: :meth:`turning_times`). In space the rotation vector is
+    interpolated entry by entry, as ``point_to_point`` blends it.
+
+    Parameters
+    ----------
+    times : sequence of N float [s]
+        Strictly increasing, N >= 2; required.
+    poses : sequence of N poses of pose_size float [m, rad]
+        The pose at each time; required.
+    """
+
+    kind: ClassVar[str] = "waypoints"
+    required_fields: ClassVar[dict[str, str]] = {"times": "a list of at least 2 strictly increasing times [s]",
+                                                  "poses": "one pose per time"}
+
+    times: tuple
+    poses: tuple
+
+    def __post_init__(self):
+        super().__post_init__()
+        times = _listed("trajectory.times", self.times, "at least 2 strictly increasing times [s]")
+        if len(times) < 2:
+            raise SceneError(f"trajectory.times must give at least 2 times [s], got {shown(self.times)}")
+        times = entries("trajectory.times", times, len(times), "s")
+        later = np.flatnonzero(np.diff(times) <= 0.0)
+        if later.size:
+            k = int(later[0]) + 1
+            raise SceneError(f"trajectory.times must increase strictly: times[{k}] = {times[k]:g} s follows "
+                             f"times[{k - 1}] = {times[k - 1]:g} s")
+        poses = _listed("trajectory.poses", self.poses, "poses, one per time")
+        if len(poses) != len(times):
+            raise SceneError(f"trajectory.poses must give one pose per time ({len(times)}), got {len(poses)}")
+        _set(self, "times", times)
+        _set(self, "poses", tuple(_pose(f"trajectory.poses[{k}]", pose, self.space) for k, pose in enumerate(poses)))
+        rest = [(1, np.zeros(self.space.pose_size)), (2, np.zeros(self.space.pose_size))]
+        _set(self, "_spline", make_interp_spline(times, np.array(self.poses), k=5, bc_type=(rest, rest)))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": "waypoints", "times": list(self.times), "poses": [list(pose) for pose in self.poses]}
+
+    def _at(self, t, order: int):
+        return self._spline(np.clip(np.asarray(t, dtype=float), self.times[0], self.times[-1]), order)
+
+    def pose(self, t):
+        return self._at(t, 0)
+
+    def velocity(self, t):
+        return self._at(t, 1)
+
+    def acceleration(self, t):
+        return self._at(t, 2)
+
+    def turning_times(self, end_time: float) -> np.ndarray:
+        """The waypoints' times and the times between them where a pose entry is extreme [s] (its rate's roots)."""
+        knots, coefficients, degree = self._spline.tck
+        roots = [PPoly.from_spline(BSpline(knots, column, degree).derivative()).roots(extrapolate=False)
+                 for column in coefficients.T]
+        times = np.concatenate([self.times, *roots])
+        return times[np.isfinite(times)]  # a pose entry that stands still has no roots, but NaN
+
+
+#: The columns of a trajectory file by space: ``time_s`` first, then the pose as a run's ``pose.csv`` names it.
+FILE_COLUMNS: dict[Space, tuple[str, ...]] = {PLANE: ("time_s",) + PLANAR_POSE_COLUMNS,
+                                              SPACE: ("time_s",) + SPATIAL_POSE_COLUMNS}
+
+
+class FileTrajectory(WaypointsTrajectory):
+    """``kind = "file"``: the waypoints of :class:`WaypointsTrajectory` read from a CSV file.
+
+    The table's one key, ``path``, names the file, relative to the scene file's folder. Its
+    header names the columns, each with its unit in the name as a run's ``pose.csv`` has them
+    (:data:`FILE_COLUMNS`): ``time_s, x_m, z_m, rotation_rad`` in the plane, ``time_s, x_m, y_m,
+    z_m, rotation_x_rad, rotation_y_rad, rotation_z_rad`` in space (the rotation vector); other
+    columns are ignored (a run's ``pose.csv`` reads back as its platform's path). One row per
+    waypoint. The file is read once, when the scene is loaded, into a
+    :class:`WaypointsTrajectory`: a scene saved then (a run folder's ``scene.toml``) holds the
+    waypoints themselves and reruns without the file.
+    """
+
+    kind: ClassVar[str] = "file"
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], space: Space, folder: Path | None = None) -> WaypointsTrajectory:
+        """The waypoints of the file ``data["path"]``; SceneError naming the file, the line and the column."""
+        columns = FILE_COLUMNS[space]
+        if set(data) != {"path"} or not isinstance(data["path"], str):
+            raise SceneError(f"trajectory of kind 'file' takes one key, path (a CSV file of {', '.join(columns)}, "
+                             f"relative to the scene file), got {shown(dict(data))}")
+        path, where = Path(folder or ".") / data["path"], f"trajectory.path {shown(data['path'])}"
+        try:
+            lines = list(csv.reader(path.read_text(encoding="utf-8").splitlines()))
+        except (OSError, UnicodeDecodeError) as err:
+            raise SceneError(f"{where}: cannot read {path}: {getattr(err, 'strerror', None) or err}") from None
+        header = [name.strip() for name in lines[0]] if lines else []
+        missing = [name for name in columns if name not in header]
+        if missing:
+            raise SceneError(f"{where} lacks the column(s) {', '.join(missing)}: a {space.name} trajectory file's "
+                             f"header names {', '.join(columns)} ({space.pose_size} pose columns; units s, m, rad), "
+                             f"got {shown(header)}")
+        index, rows = [header.index(name) for name in columns], []
+        for number, line in enumerate(lines[1:], 2):
+            try:
+                rows += [[float(line[i]) for i in index]] if line else []
+            except (ValueError, IndexError):
+                raise SceneError(f"{where}, line {number}: {shown(line)} does not give a number in each of "
+                                 f"{', '.join(columns)}") from None
+        try:
+            return WaypointsTrajectory(tuple(row[0] for row in rows), tuple(row[1:] for row in rows), space=space)
+        except SceneError as err:
+            raise SceneError(f"{where} (the row on line k + 2 read as times[k] and poses[k]): {err}") from None
+
+
 # ----------------------------------------------------------------------------------
 # the registry
 # ----------------------------------------------------------------------------------
 #: The trajectory kinds by name (``kind = "..."`` in a scene's ``[trajectory]``).
 TRAJECTORY_KINDS: dict[str, type[Trajectory]] = {
     "circle": CircleTrajectory,
+    "file": FileTrajectory,
     "hold": HoldTrajectory,
     "point_to_point": PointToPointTrajectory,
+    "waypoints": WaypointsTrajectory,
 }
 
 
-def trajectory_from_dict(data: Any, space: Space) -> Trajectory:
+def trajectory_from_dict(data: Any, space: Space, folder: Path | None = None) -> Trajectory:
     """Build a trajectory of ``space`` from a dict with a ``kind`` key, as written by ``to_dict``.
 
     Parameters
@@ -452,9 +592,12 @@ def trajectory_from_dict(data: Any, space: Space) -> Trajectory:
     data : mapping
         ``{"kind": <a name in TRAJECTORY_KINDS>, <fields>}``. Required: ``center``
         (circle), ``pose`` (hold; the key is ``pose``, not the field name ``held_pose``),
-        ``start`` and ``end`` (point_to_point); other missing fields take their defaults.
+        ``start`` and ``end`` (point_to_point), ``times`` and ``poses`` (waypoints), ``path``
+        (file); other missing fields take their defaults.
     space : Space
         The scene's space (:data:`~cdpr_exu.space.PLANE` or :data:`~cdpr_exu.space.SPACE`).
+    folder : path, optional
+        Where relative file names are read from (the scene file's folder; default the working one).
 
     Returns
     -------
@@ -472,4 +615,4 @@ def trajectory_from_dict(data: Any, space: Space) -> Trajectory:
     kind = values.pop("kind", None)
     if not isinstance(kind, str) or kind not in TRAJECTORY_KINDS:
         raise SceneError(f"trajectory.kind must be one of {sorted(TRAJECTORY_KINDS)}, got {shown(kind)}")
-    return TRAJECTORY_KINDS[kind].from_dict(values, space)
+    return TRAJECTORY_KINDS[kind].from_dict(values, space, folder)
