@@ -3,7 +3,7 @@
 ``spatial-cogiro`` (8 steel cables of 0.14 kg/m, EA = 2.83 MN, on a 91 kg platform under a 15 x 11 x 5.4 m
 frame) within CASPR's tension limits for CoGiRo (100-5000 N, :mod:`cdpr_exu.physics.cogiro`), at the
 scene's initial orientation (unrotated), on a grid of 0.5 m over the frame (x -7..7 m, y -5..5 m,
-z 0.5..4.5 m: 5481 positions): where straight massless cables hold the platform, where elastic catenaries
+z 0.5..5 m, the exits at 5.4 m: 6090 positions): where straight massless cables hold the platform, where elastic catenaries
 with the cables' weight do (:mod:`cdpr_exu.statics.feasibility`), with the scene's cables and with cables
 4 times heavier. Writes ``results/workspace/steel/`` and ``results/workspace/heavy_4x/`` (the files of
 ``cdpr workspace``: workspace.csv, summary.json, summary.md, slices.png, view3d.png, scene.toml, grid.json)
@@ -11,10 +11,10 @@ and ``results/workspace/summary.md`` (the two cases side by side).
 
 The same from the command line (one case)::
 
-    cdpr workspace spatial-cogiro --grid x=-7:7:29 --grid y=-5:5:21 --grid z=0.5:4.5:9 \\
+    cdpr workspace spatial-cogiro --grid x=-7:7:29 --grid y=-5:5:21 --grid z=0.5:5:10 \\
         --min-tension 100 --max-tension 5000 --out results/workspace/steel
 
-Run (about 2 min on 2 cores; an interrupted run resumes, ``--fresh`` starts over)::
+Run (about 4 min of CPU time, 2 processes; an interrupted run resumes, ``--fresh`` starts over)::
 
     python examples/workspace_study.py [--workers N] [--fresh]
 """
@@ -32,7 +32,7 @@ from cdpr_exu.statics.feasibility import tension_bounds
 from cdpr_exu.studies.workspace_grid import WORKSPACE_FILES, make_grid, run_workspace, summarise
 
 OUT = Path(__file__).resolve().parents[1] / "results" / "workspace"
-GRID = ["x=-7:7:29", "y=-5:5:21", "z=0.5:4.5:9"]
+GRID = ["x=-7:7:29", "y=-5:5:21", "z=0.5:5:10"]
 #: Each case's folder and the factor on the cables' linear density.
 CASES = {"steel": 1.0, "heavy_4x": 4.0}
 

@@ -11,7 +11,7 @@ from cdpr_exu.cli.workspace import EPILOG
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.statics.feasibility import tension_bounds
-from cdpr_exu.studies.workspace_grid import MAX_GRID_BYTES, make_grid, read_rows, run_workspace
+from cdpr_exu.studies.workspace_grid import MAX_GRID_BYTES, make_grid, run_workspace
 
 PAPER = load_scene("paper-circle")
 COGIRO = load_scene("spatial-cogiro")
@@ -59,7 +59,7 @@ def test_an_interrupted_grid_resumes_where_it_stopped(tmp_path):
     (tmp_path / "points.jsonl").write_text("\n".join(lines[:-5]) + "\n" + lines[-5][:20])  # 5 rows lost, 1 cut short
     pool = CountingPool()
     again = run_workspace(COGIRO, grid, limits, tmp_path, executor=pool, progress=False, chunk=4)
-    assert pool.checked == 5 and again == first and len(read_rows(tmp_path)) == 15
+    assert pool.checked == 5 and again == first and len((tmp_path / "points.jsonl").read_text().splitlines()) == 15
     assert (tmp_path / "view3d.png").exists() is False  # two varied axes: slices only
     with pytest.raises(Exception, match="holds the rows of another grid"):
         run_workspace(COGIRO, make_grid(COGIRO, ["x=-4:4:3"]), limits, tmp_path, executor=pool, progress=False)
@@ -85,6 +85,7 @@ def test_a_spatial_grid_over_three_axes_and_two_orientations(tmp_path):
     (["--grid", "q=0:1:5"], "grid 'q=0:1:5': the axis must be one of x, z"),
     (["--grid", "x=0:1:5", "--grid", "x=0"], "grid x: given twice"),
     (["--grid", "x=-1:1:20000", "--grid", "z=-3:-1:20000"], "GiB allowed"),
+    (["--grid", "x=-1:1:1000000000"], "GiB allowed"),  # refused before its values are made
     (["--grid", "x=0:1:5", "--orientation", "nan"], "orientation"),
     (["--grid", "x=0:1:5", "--orientation", "a"], "orientation 'a' must be numbers"),
 ])

@@ -19,6 +19,7 @@ import itertools
 import json
 import math
 import os
+from collections import Counter
 from concurrent.futures import as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,36 +36,24 @@ MAX_GRID_BYTES = 2**30
 #: Memory of one value of a row held in Python [bytes] (a float object, its slot in a dict, its share of
 #: the keys): the grid's estimate is rows x columns x this.
 BYTES_PER_VALUE = 100
-#: Per-cable columns of a row, each followed by the cable's number (1..m).
-CABLE_COLUMNS = ("massless_tension_N", "catenary_anchor_tension_N", "catenary_exit_tension_N", "massless_length_m",
-                 "catenary_unstrained_length_m", "catenary_sag_m")
+#: Per-cable columns of a row ({} the cable's number, 1..m).
+CABLE_COLUMNS = ("massless_tension_{}_N", "catenary_anchor_tension_{}_N", "catenary_exit_tension_{}_N",
+                 "massless_length_{}_m", "catenary_unstrained_length_{}_m", "catenary_sag_{}_m")
 
 
 @dataclass(frozen=True)
 class WorkspaceGrid:
-    """Platform positions (every combination of the axes' values) and the orientations that must all hold.
-
-    Attributes
-    ----------
-    labels : tuple of str
-        The space's position labels (x, z or x, y, z), in order.
-    values : tuple of tuple of float [m]
-        Each axis's values (one value: the axis is fixed).
-    orientations : tuple of tuple of float [rad]
-        Each the space's rotation (one angle planar, a rotation vector spatial).
-    """
+    """Platform positions, every combination of the values [m] of each position axis (``labels``: the space's,
+    in order; one value: the axis is fixed), and the ``orientations`` [rad] (each the space's rotation as a
+    tuple) that must all hold."""
 
     labels: tuple
     values: tuple
     orientations: tuple
 
     @property
-    def shape(self) -> tuple:
-        return tuple(len(v) for v in self.values)
-
-    @property
     def size(self) -> int:
-        return math.prod(self.shape)
+        return math.prod(len(v) for v in self.values)
 
     @property
     def varied(self) -> tuple:
@@ -86,76 +75,63 @@ class WorkspaceGrid:
 def start_pose(scene) -> list:
     """The pose the grid's fixed axes and orientation default to [m, rad]: ``platform.initial_pose``, else the
     reference's at t = 0, else the origin unrotated."""
-    import numpy as np
-
-    if scene.platform.initial_pose is not None:
-        return list(scene.platform.initial_pose)
-    if scene.trajectory is not None:
-        return np.asarray(scene.trajectory.pose(0.0), dtype=float).tolist()
-    return [0.0] * scene.space.pose_size
+    if scene.platform.initial_pose is not None or scene.trajectory is None:
+        return list(scene.platform.initial_pose or [0.0] * scene.space.pose_size)
+    return [float(v) for v in scene.trajectory.pose(0.0)]
 
 
 def _axis(text: str, labels: Sequence[str]) -> tuple[str, tuple]:
-    """``"x=-1:1:21"`` (21 values from -1 to 1 m) or ``"x=0.5"`` (one value) -> (label, values)."""
+    """``"x=-1:1:21"`` (21 values from -1 to 1 m) or ``"x=0.5"`` -> (label, (start, stop, count))."""
     label, _, spec = str(text).partition("=")
-    label = label.strip()
+    label, parts = label.strip(), spec.split(":")
     if label not in labels:
         raise SceneError(f"grid {text!r}: the axis must be one of {', '.join(labels)} (write e.g. {labels[0]}=-1:1:21)")
-    parts = spec.split(":")
     try:
-        numbers = [float(p) for p in parts[:2]] + [int(p) for p in parts[2:]]
-    except ValueError:
-        numbers = None
-    if numbers is None or len(parts) not in (1, 3) or not all(math.isfinite(v) for v in numbers):
+        start, stop, count = (float(parts[0]), float(parts[0]), 1) if len(parts) == 1 else (
+            float(parts[0]), float(parts[1]), int(parts[2]))
+    except (ValueError, IndexError):
+        start = math.nan
+    if len(parts) not in (1, 3) or not math.isfinite(start) or not math.isfinite(stop):
         raise SceneError(f"grid {label}: {spec!r} must read START:STOP:COUNT or one value, finite numbers [m]")
-    if len(parts) == 1:
-        return label, (numbers[0],)
-    start, stop, count = numbers
     if count < 1 or (count > 1 and not start < stop):
         raise SceneError(f"grid {label}: {spec!r} is empty; it needs COUNT >= 1 and START < STOP (COUNT > 1)")
-    return label, tuple(start + (stop - start) * k / max(count - 1, 1) for k in range(count))
+    return label, (start, stop, count)
 
 
 def make_grid(scene, axes: Sequence[str], orientations: Sequence[Sequence[float]] | None = None) -> WorkspaceGrid:
     """The grid of ``axes`` (``"LABEL=START:STOP:COUNT"`` or ``"LABEL=VALUE"``; an axis not given stays at
     :func:`start_pose`'s) at ``orientations`` (each a sequence: the angle [rad] planar, the rotation vector
-    [rad] spatial; default the start pose's), checked before anything runs.
-
-    Raises
-    ------
-    SceneError
-        Naming the axis: an unknown label, a malformed, non-finite or empty range, an axis given twice, no
-        axis; naming ``orientation``: a malformed one; naming ``grid``: rows beyond :data:`MAX_GRID_BYTES`.
-    """
+    [rad] spatial; default the start pose's). Raises SceneError before anything is allocated, naming the axis
+    (unknown, malformed, not finite, empty, given twice), ``orientation[k]`` or ``grid`` (rows beyond
+    :data:`MAX_GRID_BYTES`)."""
     space = scene.space
     labels, start = space.position_labels, start_pose(scene)
     if not axes:
         raise SceneError(f"grid: give at least one axis (e.g. {labels[0]}=-1:1:21)")
-    given = dict.fromkeys(labels)
+    given = {}
     for text in axes:
-        label, values = _axis(text, labels)
-        if given[label] is not None:
+        label, spec = _axis(text, labels)
+        if label in given:
             raise SceneError(f"grid {label}: given twice; give each axis once")
-        given[label] = values
-    values = tuple(given[label] or (float(start[i]),) for i, label in enumerate(labels))
+        given[label] = spec
+    specs = [given.get(label, (float(start[i]),) * 2 + (1,)) for i, label in enumerate(labels)]
     rotations = orientations or [start[space.position_size:]]
     rotations = [space.rotation(f"orientation[{k}]", r[0] if len(r) == 1 else r) for k, r in enumerate(rotations)]
-    turned = tuple(tuple(r) if isinstance(r, tuple) else (r,) for r in rotations)
-    grid = WorkspaceGrid(labels, values, turned)
-    needed = grid.size * len(turned) * len(columns(labels, scene.n_cables)) * BYTES_PER_VALUE
+    size = math.prod(count for *_, count in specs) * len(rotations)
+    needed = size * len(columns(labels, scene.n_cables)) * BYTES_PER_VALUE
     if needed > MAX_GRID_BYTES:
-        raise SceneError(f"grid: {grid.size} positions x {len(turned)} orientations need about {needed / 2**30:.1f} "
-                         f"GiB for their rows, beyond the {MAX_GRID_BYTES / 2**30:g} GiB allowed; use fewer points")
-    return grid
+        raise SceneError(f"grid: {size} positions and orientations need about {needed / 2**30:.1f} GiB for their "
+                         f"rows, beyond the {MAX_GRID_BYTES / 2**30:g} GiB allowed; use fewer points")
+    values = tuple(tuple(a + (b - a) * k / max(n - 1, 1) for k in range(n)) for a, b, n in specs)
+    return WorkspaceGrid(labels, values, tuple(tuple(r) if isinstance(r, tuple) else (r,) for r in rotations))
 
 
 # --------------------------------------------------------------------------- the workers
 
 
 def evaluate_points(scene_data: dict, limits: list, tasks: list) -> list[dict]:
-    """Both models at each ``(position index, orientation index, pose)`` of ``tasks``: one row each (plain data).
-
-    The worker function: top-level and picklable, it takes and returns plain data."""
+    """Both models at each ``(position index, orientation index, pose)`` of ``tasks``: one row each. The worker:
+    top-level and picklable, it takes and returns plain data."""
     import numpy as np
 
     from cdpr_exu.scenes.scene import scene_from_dict
@@ -174,63 +150,28 @@ def evaluate_points(scene_data: dict, limits: list, tasks: list) -> list[dict]:
         values = (massless.anchor_tensions, catenary.anchor_tensions, catenary.exit_tensions, massless.lengths,
                   catenary.lengths, catenary.sags)
         for column, value in zip(CABLE_COLUMNS, values):
-            row.update({_cable_column(column, i): None if value is None else float(value[i - 1])
-                        for i in range(1, scene.n_cables + 1)})
+            row.update({column.format(i + 1): None if value is None else float(value[i]) for i in range(scene.n_cables)})
         rows.append(row)
     return rows
 
 
-def _cable_column(column: str, number: int) -> str:
-    name, unit = column.rsplit("_", 1)
-    return f"{name}_{number}_{unit}"
-
-
 def columns(labels: Sequence[str], n_cables: int) -> list[str]:
     """The columns of a row, in order (the per-cable ones numbered 1..m before their unit)."""
-    per_cable = [_cable_column(c, i) for c in CABLE_COLUMNS for i in range(1, n_cables + 1)]
+    per_cable = [c.format(i) for c in CABLE_COLUMNS for i in range(1, n_cables + 1)]
     return ["point", "orientation", *labels, "massless_status", "catenary_status", "catenary_iterations", *per_cable]
 
 
 # --------------------------------------------------------------------------- the grid
 
 
-def read_rows(out) -> list[dict]:
-    """The rows a grid already wrote to ``out/points.jsonl`` (a line cut short by an interruption is dropped)."""
-    path = Path(out) / WORKSPACE_FILES["rows"]
-    rows = []
-    for line in path.read_text().splitlines() if path.exists() else ():
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError:
-            continue
-    return rows
-
-
 def run_workspace(scene, grid: WorkspaceGrid, limits, out=None, *, workers: int | None = None,
                   scheduler: str | None = None, executor=None, progress: bool = True, chunk: int = 50) -> list[dict]:
-    """Check every position and orientation of ``grid`` under both models; one row each (resumable).
-
-    Parameters
-    ----------
-    scene : Scene
-    grid : WorkspaceGrid
-        (:func:`make_grid`).
-    limits : array_like, shape (m, 2) [N]
-        Each cable's (t_min, t_max) (:func:`cdpr_exu.statics.feasibility.tension_bounds`).
-    out : path, optional
-        Rows are appended to ``out/points.jsonl`` as their chunk finishes, rows found there are not checked
-        again (the folder must hold this grid's ``grid.json``, else it is refused), and the table, summary and
-        figures are written at the end (:func:`write_workspace`).
-    workers, scheduler, executor
-        As :func:`cdpr_exu.studies.study.run_study`.
-    chunk : int
-        Positions and orientations per task.
-
-    Returns
-    -------
-    list of dict
-        Position order, then orientation order (:func:`columns`).
-    """
+    """Check every position and orientation of ``grid`` (:func:`make_grid`) under both models within ``limits``
+    (m, 2) [N] (:func:`~cdpr_exu.statics.feasibility.tension_bounds`), ``chunk`` per task; one row each, position
+    order then orientation order (:func:`columns`). With ``out``, rows are appended to ``points.jsonl`` as their
+    chunk finishes and those found there are not checked again (``grid.json`` must be this grid's, else refused);
+    the files are written at the end (:func:`write_workspace`). ``workers``, ``scheduler``, ``executor``: as
+    :func:`cdpr_exu.studies.study.run_study`."""
     from cdpr_exu.core.output import json_text, strict
 
     limits = [[float(low), float(high)] for low, high in limits]
@@ -245,9 +186,14 @@ def run_workspace(scene, grid: WorkspaceGrid, limits, out=None, *, workers: int 
                               "another folder, or remove its points.jsonl to start afresh")
         out.mkdir(parents=True, exist_ok=True)
         found.write_text(spec)
-        done = {(r["point"], r["orientation"]): r for r in read_rows(out)}
-        journal = "".join(json.dumps(r, allow_nan=False) + "\n" for r in done.values())
-        (out / WORKSPACE_FILES["rows"]).write_text(journal)  # without a line an interruption cut short
+        journal = out / WORKSPACE_FILES["rows"]
+        for line in journal.read_text().splitlines() if journal.exists() else ():
+            try:
+                row = json.loads(line)
+            except json.JSONDecodeError:
+                continue  # a line an interruption cut short: rewritten without it below
+            done[(row["point"], row["orientation"])] = row
+        journal.write_text("".join(json.dumps(r, allow_nan=False) + "\n" for r in done.values()))
     tasks = [(p, o, [*position, *rotation]) for p, position in enumerate(grid.positions())
              for o, rotation in enumerate(grid.orientations) if (p, o) not in done]
     chunks = [tasks[k:k + chunk] for k in range(0, len(tasks), chunk)]
@@ -282,14 +228,14 @@ def held_positions(rows: Sequence[dict], grid: WorkspaceGrid) -> dict[str, list[
 
 
 def summarise(rows: Sequence[dict], grid: WorkspaceGrid) -> dict[str, Any]:
-    """The volume each model holds [m^k], the positions held by one model only, and the share of the massless
-    workspace the catenary model keeps (None when the massless model holds nothing)."""
+    """The positions and volume [m^k] each model holds, the share of the massless workspace the catenary model
+    keeps (None when the massless model holds nothing), the positions only the catenary model holds (at least:
+    it searches only near the massless tensions) and the count of each status."""
     held = held_positions(rows, grid)
     both = sum(a and b for a, b in zip(held["massless"], held["catenary"]))
     counts = {model: sum(flags) for model, flags in held.items()}
     unit = f"m^{len(grid.varied)}"
-    statuses = {model: {s: sum(r[f"{model}_status"] == s for r in rows) for s in sorted({r[f"{model}_status"] for r in rows})}
-                for model in held}
+    statuses = {model: dict(sorted(Counter(r[f"{model}_status"] for r in rows).items())) for model in held}
     return {"positions": grid.size, "orientations": len(grid.orientations), "cell": grid.cell, "unit": unit,
             "held_positions": counts, "held_volume": {m: c * grid.cell for m, c in counts.items()},
             "held_by_both": both, "catenary_only": counts["catenary"] - both,
@@ -298,7 +244,7 @@ def summarise(rows: Sequence[dict], grid: WorkspaceGrid) -> dict[str, Any]:
 
 
 def summary_markdown(name: str, summary: dict, limits) -> str:
-    """The summary as a short Markdown table."""
+    """The summary as Markdown."""
     unit, volume, kept = summary["unit"], summary["held_volume"], summary["catenary_keeps"]
     lines = [f"# Workspace of {name}", "",
              f"{summary['positions']} positions x {summary['orientations']} orientation(s), {summary['cell']:.4g} "
@@ -306,7 +252,7 @@ def summary_markdown(name: str, summary: dict, limits) -> str:
              f"| model | positions held | {'volume' if unit == 'm^3' else 'size'} [{unit}] |", "|---|---|---|"]
     lines += [f"| {m} | {summary['held_positions'][m]} | {volume[m]:.4g} |" for m in ("massless", "catenary")]
     lines += ["", f"The catenary model keeps {'n/a' if kept is None else f'{100 * kept:.1f} %'} of the massless "
-              f"workspace ({summary['catenary_only']} positions held by the catenary model only)."]
+              f"workspace; at least {summary['catenary_only']} positions are held by the catenary model only."]
     return "\n".join(lines) + "\n"
 
 
@@ -322,9 +268,7 @@ def write_workspace(out, rows: Sequence[dict], scene, grid: WorkspaceGrid, limit
     paths = {"scene": save_scene(scene, out / WORKSPACE_FILES["scene"]), "csv": out / WORKSPACE_FILES["csv"],
              "table": out / WORKSPACE_FILES["table"]}
     with open(paths["csv"], "w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(names)
-        writer.writerows([csv_cell(row.get(c)) for c in names] for row in rows)
+        csv.writer(handle).writerows([names, *([csv_cell(row.get(c)) for c in names] for row in rows)])
     summary = summarise(rows, grid)
     paths["json"] = write_json(out / WORKSPACE_FILES["json"], {"scene": scene.name, "limits_N": limits,
                                                                **grid.to_dict(), **summary})
