@@ -107,3 +107,11 @@ def test_the_grid_estimates_its_memory_before_it_allocates():
         make_grid(COGIRO, ["x=-7:7:1000", "y=-5:5:1000", "z=0:5:1000"])  # 1e9 positions: refused at once
     grid = make_grid(COGIRO, ["x=-7:7:100", "y=-5:5:100"])
     assert grid.size * 100 * 56 < MAX_GRID_BYTES and grid.values[2] == (2.265,)  # z stays at the start pose
+
+
+@pytest.mark.slow
+def test_a_local_dask_cluster_gives_the_rows_of_a_thread_pool():
+    pytest.importorskip("dask.distributed")
+    grid, limits = make_grid(PAPER, ["x=-1:1:3", "z=-3:-1:3"]), tension_bounds(PAPER, 1.0, 40.0)
+    on_dask = run_workspace(PAPER, grid, limits, scheduler="local", workers=1, progress=False, chunk=4)
+    assert on_dask == run_workspace(PAPER, grid, limits, executor=ThreadPoolExecutor(1), progress=False)
