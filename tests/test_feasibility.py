@@ -115,6 +115,18 @@ def test_the_catenary_lengths_hold_the_platform_at_the_pose_in_the_forward_stati
     assert np.all(held.sags > 0.0)
 
 
+def test_sagging_cables_hold_a_position_where_massless_ones_would_need_less_than_t_min():
+    """spatial-cogiro with 4 times heavier cables at the frame's side: the massless model needs a cable below
+    100 N; the catenaries hold the platform (the forward statics of their lengths rests there, 1e-6 m)."""
+    scene = replace(COGIRO, cables=tuple(replace(c, linear_density=4.0 * c.linear_density) for c in COGIRO.cables))
+    pose = np.array([-7.0, -3.0, 4.5, 0.0, 0.0, 0.0])
+    assert massless_holding(scene, pose, COGIRO_LIMITS).status == "outside_limits"
+    held = catenary_holding(scene, pose, COGIRO_LIMITS)
+    assert held.held and held.anchor_tensions.min() >= 100.0
+    np.testing.assert_allclose(solve_statics(catenary_platform(scene), held.lengths, initial_pose=pose).pose, pose,
+                               atol=1e-6)
+
+
 def test_heavier_cables_hold_the_platform_at_fewer_positions():
     """The paper's robot (two 0.35 kg/m cables over pulleys, 2.5 kg) within 1-40 N, over a grid of the plane:
     a catenary's tension at its exit exceeds the anchor's by about its weight (13 N for 3.75 m), so the

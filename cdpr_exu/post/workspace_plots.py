@@ -37,7 +37,7 @@ def plot_workspace(labels: Sequence[str], values: Sequence[Sequence[float]], hel
     grids = {model: np.asarray(flags, dtype=float).reshape(shape) for model, flags in held.items()}
     first, second, third = (varied + [None])[:3]
     levels = [None] if third is None else sorted({round(k) for k in np.linspace(0, shape[third] - 1, MAX_SLICES)})
-    figure = new_figure(10.0, 0.9 + 3.6 * len(levels), columns=2, lines=len(levels), wspace=0.8, hspace=0.7, top=0.6)
+    figure = new_figure(10.0, 0.9 + 3.6 * len(levels), columns=2, lines=len(levels), wspace=0.8, hspace=0.7, top=0.9)
     figure.suptitle(f"{name}: positions held within the tension limits (dashed: the massless model's boundary)")
     for line, level in zip(figure.subplots(len(levels), 2, squeeze=False), levels):
         index = [0] * len(shape)
