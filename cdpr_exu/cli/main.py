@@ -13,14 +13,14 @@ import argparse
 import sys
 import warnings
 
-from cdpr_exu.cli import compare, import_caspr, run, scenes, static, study, view
+from cdpr_exu.cli import compare, import_caspr, run, scenes, static, study, view, workspace
 from cdpr_exu.core.errors import (EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_RUN_FAILED, CdprError,
                                   CdprWarning, RunInterrupted, SolverFailure)
 
 #: The command modules, in the order ``cdpr --help`` lists their commands: each has
 #: ``add_commands(subparsers)``, which adds parsers whose ``func`` takes the parsed arguments
 #: and returns an exit code.
-COMMAND_MODULES = (run, scenes, compare, study, view, static, import_caspr)
+COMMAND_MODULES = (run, scenes, compare, study, view, static, workspace, import_caspr)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -186,6 +186,7 @@ COMMAND_OUTPUTS: dict[str, tuple[str, ...]] = {
     "study accuracy": ("base_scene.toml", "accuracy.csv", "accuracy.json", "timing.json", "tables.md", "pareto.png",
                        "reference.npz"),
     "animate --frames-dir": ("frame_*.png",),
+    "workspace": ("workspace.csv", "summary.json", "summary.md", "slices.png", "view3d.png"),  # resumes: keeps points.jsonl
 }
 #: Files that only one command writes: a folder holding one of them holds that command's output.
 COMMAND_MARKERS: dict[str, tuple[str, ...]] = {
@@ -194,6 +195,7 @@ COMMAND_MARKERS: dict[str, tuple[str, ...]] = {
     "static": ("rest.npz", "rest_profile.png"),
     "study sweep": ("study.json", "study.csv"),
     "study accuracy": ("accuracy.json", "accuracy.csv"),
+    "workspace": ("points.jsonl", "workspace.csv"),
 }
 
 
