@@ -2,20 +2,24 @@
 [t_min, t_max], where an answer is known. Pure maths, no Exudyn."""
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.exits import PointExit
-from cdpr_exu.physics import cogiro
+from cdpr_exu.scenes.caspr import caspr_scene
 from cdpr_exu.scenes.scene import CableSpec, PlatformSpec, Scene, WinchSpec, load_scene
 from cdpr_exu.statics.feasibility import catenary_holding, massless_holding, tension_bounds
 from cdpr_exu.statics.statics import catenary_platform, solve_statics
 from cdpr_exu.statics.tension_distribution import tensions
 
 COGIRO = load_scene("spatial-cogiro")
-COGIRO_LIMITS = tension_bounds(COGIRO, cogiro.MIN_TENSION, cogiro.MAX_TENSION)
+#: CASPR's CoGiRo bounds (force_min, force_max: tests/data/caspr/, read by cdpr import caspr) [N].
+CASPR_COGIRO, _ = caspr_scene(*(Path(__file__).parent / "data" / "caspr" / f"CoGiRo_{part}.xml"
+                                for part in ("bodies", "cables")))
+COGIRO_LIMITS = tension_bounds(COGIRO, *CASPR_COGIRO.tension_limits[0])
 GRAVITY = 9.81
 
 
