@@ -48,28 +48,20 @@ STANDARD_GRAVITY = 9.81
 """Default gravitational acceleration [m/s^2]."""
 
 DEFAULT_MAX_STRAIN = 0.1
-"""Largest cable strain ``T / EA`` a solution may have before it counts as unreachable.
-
-Linear elasticity is meaningless well before 10 % strain for any real cable (steel
-yields near 0.5 %), and an elastic cable can otherwise reach any span by stretching,
-so some limit must define "unreachable". Pass ``max_strain`` or ``max_tension`` to
-the solvers to use a tighter, physical limit (eg the cable's breaking load).
-"""
+"""Largest strain ``T / EA`` before a span counts as unreachable (an elastic cable reaches any span by
+stretching; steel yields near 0.5 %). ``max_strain`` or ``max_tension`` give a tighter, physical limit."""
 
 _RELATIVE_TOLERANCE = 1e-12
 _VERTICAL_TOLERANCE = 1e-12
 _MAX_NEWTON_ITERATIONS = 200
 
 
-# ---------------------------------------------------------------------------
-# validation helpers
-# ---------------------------------------------------------------------------
 def _span_vector(span):
     return vector("span", span, 2, " (dx, dz) [m]")
 
 
-def _strain_limits(axial_stiffness, max_strain, max_tension):
-    """Largest admissible end tension [N] from a strain and an optional tension limit."""
+def tension_limit(axial_stiffness, max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
+    """Largest admissible tension [N] of a cable of ``EA`` [N]: ``max_strain EA``, or ``max_tension`` if lower."""
     max_strain = positive("max_strain", max_strain)
     limit = max_strain * axial_stiffness
     if max_tension is not None:
@@ -77,22 +69,10 @@ def _strain_limits(axial_stiffness, max_strain, max_tension):
     return limit
 
 
-# ---------------------------------------------------------------------------
-# parameters and results
-# ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class CatenaryCable:
-    """A suspended elastic cable: unstrained length, weight and axial stiffness.
-
-    Parameters
-    ----------
-    unstrained_length : float [m]
-        Length of the cable at zero tension, ``L > 0``.
-    weight_per_length : float [N/m]
-        Weight per unstrained length, ``w = linear_density * g >= 0``; 0 is the
-        massless (straight linear spring) limit.
-    axial_stiffness : float [N]
-        ``EA``, Young's modulus times cross-section area, ``> 0``.
+    """A suspended elastic cable: unstrained length ``L > 0`` [m], weight per unstrained length
+    ``w >= 0`` [N/m] (0: the massless, straight linear spring) and axial stiffness ``EA > 0`` [N].
 
     Raises
     ------
@@ -105,57 +85,9 @@ class CatenaryCable:
     axial_stiffness: float
 
     def __post_init__(self):
-        object.__setattr__(
-            self, "unstrained_length", positive("unstrained_length", self.unstrained_length)
-        )
-        object.__setattr__(
-            self,
-            "weight_per_length",
-            non_negative("weight_per_length", self.weight_per_length),
-        )
-        object.__setattr__(
-            self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness)
-        )
-
-    @classmethod
-    def from_material(
-        cls, unstrained_length, radius, youngs_modulus, linear_density, gravity=STANDARD_GRAVITY
-    ):
-        """Make a cable of circular solid section from its material data.
-
-        Parameters
-        ----------
-        unstrained_length : float [m]
-        radius : float [m]
-            Cable radius; the section area is ``pi radius^2``.
-        youngs_modulus : float [Pa]
-        linear_density : float [kg/m]
-            Mass per unstrained length.
-        gravity : float [m/s^2], optional
-            Gravitational acceleration, default 9.81.
-
-        Returns
-        -------
-        CatenaryCable
-        """
-        radius = positive("radius", radius)
-        youngs_modulus = positive("youngs_modulus", youngs_modulus)
-        linear_density = non_negative("linear_density", linear_density)
-        gravity = non_negative("gravity", gravity)
-        return cls(
-            unstrained_length=unstrained_length,
-            weight_per_length=linear_density * gravity,
-            axial_stiffness=youngs_modulus * math.pi * radius**2,
-        )
-
-    def with_length(self, unstrained_length):
-        """The same cable with another unstrained length [m]."""
-        return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
-
-    @property
-    def weight(self):
-        """Total weight of the cable ``w L`` [N]."""
-        return self.weight_per_length * self.unstrained_length
+        for name, check in (("unstrained_length", positive), ("weight_per_length", non_negative),
+                            ("axial_stiffness", positive)):
+            object.__setattr__(self, name, check(name, getattr(self, name)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,9 +136,6 @@ class CatenaryState:
         return -1.0 if self.span[0] < 0.0 else 1.0
 
 
-# ---------------------------------------------------------------------------
-# the core: span and its Jacobian from (H, V_B), cancellation-free
-# ---------------------------------------------------------------------------
 def _log1p_ratio(y):
     """``log(1 + y) / y``, 1 at ``y = 0``, 0 at ``y = inf``."""
     if y == 0.0:
@@ -357,25 +286,8 @@ def _make_state(cable, H, V_B, sign_x, slack_span=None):
 
 
 def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizontal_sign=1.0):
-    """The catenary that a given end force produces: span, forces and lengths.
-
-    This is the explicit direction of the catenary equations: from ``(H, V_B)`` and
-    the cable, the span follows in closed form.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    horizontal_tension : float [N]
-        ``H >= 0``.
-    vertical_tension_b : float [N]
-        ``V_B``, the upward force the support at B exerts on the cable.
-    horizontal_sign : {+1, -1}, optional
-        +1 for B to the right of A (``dx >= 0``), -1 for B to the left.
-
-    Returns
-    -------
-    CatenaryState
-    """
+    """The :class:`CatenaryState` a given end force produces (the span in closed form): ``H >= 0`` [N],
+    ``V_B`` [N], ``horizontal_sign`` +1 for B right of A (``dx >= 0``), -1 for B left of it."""
     H = non_negative("horizontal_tension", horizontal_tension)
     V_B = finite("vertical_tension_b", vertical_tension_b)
     if horizontal_sign not in (1, -1, 1.0, -1.0):
@@ -383,9 +295,6 @@ def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizon
     return _make_state(cable, H, V_B, float(horizontal_sign))
 
 
-# ---------------------------------------------------------------------------
-# forward problem: forces from span and unstrained length
-# ---------------------------------------------------------------------------
 def _vertical_solution(L, w, EA, dz):
     """``V_B`` of a vertical cable (H = 0) with span ``(0, dz)``: closed form.
 
@@ -563,32 +472,16 @@ def solve_forward(
     max_strain=DEFAULT_MAX_STRAIN,
     max_tension=None,
 ):
-    """End forces of a cable of given unstrained length hung across a given span.
+    """The :class:`CatenaryState` of a cable of given unstrained length hung across ``span`` (2,) [m]
+    (``p_B - p_A``, any signs).
 
-    Solves Irvine's two equations for ``(H, V_B)`` by Newton's method with the
-    analytic Jacobian, with steps limited to keep ``H`` positive and a backtracking
-    line search, from the Peyrot-Goulois / MoorPy initial guess. Should Newton
-    stall (near the singular corner of a just-taut, nearly vertical cable whose
-    lower end is at zero tension), a nested bracketing solve, which always converges,
-    takes over. Vertical spans (``|dx| <= 1e-12 L``) and massless cables (``w == 0``)
-    are solved in closed form.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    span : array_like, shape (2,) [m]
-        ``p_B - p_A``, any signs.
-    initial_guess : tuple (H, V_B) [N], optional
-        Start the Newton iteration here (eg the previous solution along a path),
-        in the frame where ``dx >= 0``.
-    max_strain : float, optional
-        Largest admissible ``T / EA`` anywhere on the cable (default 0.1).
-    max_tension : float [N], optional
-        Largest admissible tension, in addition to ``max_strain``.
-
-    Returns
-    -------
-    CatenaryState
+    Newton's method on Irvine's two equations in ``(H, V_B)``, steps limited to keep ``H`` positive,
+    a backtracking line search, from ``initial_guess`` (``(H, V_B)`` [N] in the frame where
+    ``dx >= 0``, eg the previous solution along a path) or the Peyrot-Goulois / MoorPy guess.
+    Should Newton stall (a just-taut, nearly vertical cable whose lower end is at zero tension),
+    a nested bracketing solve, which always converges, takes over. Vertical spans
+    (``|dx| <= 1e-12 L``) and massless cables are solved in closed form. ``max_strain`` (of
+    ``T / EA``) and ``max_tension`` [N] bound the tension (:func:`tension_limit`).
 
     Raises
     ------
@@ -602,15 +495,15 @@ def solve_forward(
     if not isinstance(cable, CatenaryCable):
         raise SceneError(f"cable must be a CatenaryCable, got {shown(cable)}")
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
-    tension_limit = _strain_limits(EA, max_strain, max_tension)
+    limit = tension_limit(EA, max_strain, max_tension)
     sign_x = -1.0 if span[0] < 0.0 else 1.0
     dx, dz = abs(float(span[0])), float(span[1])
     chord = math.hypot(dx, dz)
-    reach = L * (1.0 + tension_limit / EA)  # stretched length <= reach, chord <= it
+    reach = L * (1.0 + limit / EA)  # stretched length <= reach, chord <= it
     if chord > reach:
         raise UnreachableError(
             f"span ({span[0]:g}, {span[1]:g}) m is {chord:g} m long, beyond the reach "
-            f"{reach:g} m of unstrained_length {L:g} m at tension limit {tension_limit:g} N"
+            f"{reach:g} m of unstrained_length {L:g} m at tension limit {limit:g} N"
         )
 
     slack_span = None
@@ -633,17 +526,14 @@ def solve_forward(
         H, V_B = _solve_span(L, w, EA, dx, dz, guess)
 
     state = _make_state(cable, H, V_B, sign_x, slack_span)
-    if state.max_tension > tension_limit:
+    if state.max_tension > limit:
         raise UnreachableError(
             f"span ({span[0]:g}, {span[1]:g}) m with unstrained_length {L:g} m needs "
-            f"tension {state.max_tension:g} N, above the limit {tension_limit:g} N"
+            f"tension {state.max_tension:g} N, above the limit {limit:g} N"
         )
     return state
 
 
-# ---------------------------------------------------------------------------
-# inverse problem: unstrained length from span and horizontal tension
-# ---------------------------------------------------------------------------
 def _inextensible_length(w, H, dx, dz):
     """Inextensible catenary through the span with horizontal tension H: (L, V_B).
 
@@ -668,28 +558,12 @@ def solve_inverse(
     max_strain=DEFAULT_MAX_STRAIN,
     max_tension=None,
 ):
-    """Unstrained length that hangs across a span with a given horizontal tension.
+    """Unstrained length [m] and :class:`CatenaryState` of the cable (``w >= 0`` [N/m], ``EA > 0`` [N]) that
+    hangs across ``span`` (2,) [m] (``dx != 0``: a vertical cable has ``H = 0``) with horizontal tension
+    ``H > 0`` [N]; the tension limit as in :func:`solve_forward`.
 
-    Starts from the closed-form inextensible catenary and corrects it for the
-    stretch by Newton's method in ``(L, V_B)`` with the analytic Jacobian.
-
-    Parameters
-    ----------
-    span : array_like, shape (2,) [m]
-        ``p_B - p_A``; ``dx`` must be nonzero (a vertical cable has ``H = 0``).
-    weight_per_length : float [N/m]
-        ``w >= 0``.
-    axial_stiffness : float [N]
-        ``EA > 0``.
-    horizontal_tension : float [N]
-        ``H > 0``.
-    max_strain, max_tension : float, optional
-        Tension limit, as in `solve_forward`.
-
-    Returns
-    -------
-    unstrained_length : float [m]
-    state : CatenaryState
+    The closed-form inextensible catenary, corrected for the stretch by Newton's method in
+    ``(L, V_B)`` with the analytic Jacobian.
 
     Raises
     ------
@@ -702,7 +576,7 @@ def solve_inverse(
     w = non_negative("weight_per_length", weight_per_length)
     EA = positive("axial_stiffness", axial_stiffness)
     H = positive("horizontal_tension", horizontal_tension)
-    tension_limit = _strain_limits(EA, max_strain, max_tension)
+    limit = tension_limit(EA, max_strain, max_tension)
     sign_x = -1.0 if span[0] < 0.0 else 1.0
     dx, dz = abs(float(span[0])), float(span[1])
     if dx == 0.0:
@@ -731,10 +605,10 @@ def solve_inverse(
 
     cable = CatenaryCable(L, w, EA)
     state = _make_state(cable, H, V_B, sign_x)
-    if state.max_tension > tension_limit:
+    if state.max_tension > limit:
         raise UnreachableError(
             f"span ({span[0]:g}, {span[1]:g}) m with horizontal_tension {H:g} N needs "
-            f"tension {state.max_tension:g} N, above the limit {tension_limit:g} N"
+            f"tension {state.max_tension:g} N, above the limit {limit:g} N"
         )
     return L, state
 
@@ -761,27 +635,10 @@ def _newton_inverse(w, EA, H, dx, dz, L, V_B):
     )
 
 
-# ---------------------------------------------------------------------------
-# geometry and stiffness of a solved state
-# ---------------------------------------------------------------------------
 def profile(cable, state, s):
-    """Points of the loaded cable at given unstrained arc lengths, relative to A.
-
-    Closed form of the elastic catenary profile: the span formula with ``L``
-    replaced by ``s`` and ``V_B`` by ``V(s) = V_A + w s``.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    state : CatenaryState
-        A solution for this cable.
-    s : array_like, shape (n,) [m]
-        Unstrained arc lengths from A, in ``[0, L]``.
-
-    Returns
-    -------
-    points : ndarray, shape (n, 2) [m]
-        ``(x, z)`` of the cable at ``s``, relative to A.
+    """Points ``(x, z)`` (n, 2) [m] relative to A of the loaded cable (``state`` a solution of ``cable``) at
+    unstrained arc lengths ``s`` (n,) [m] from A, in ``[0, L]``: the span formula with ``L`` replaced by
+    ``s`` and ``V_B`` by ``V(s) = V_A + w s``.
 
     Raises
     ------
@@ -805,27 +662,12 @@ def profile(cable, state, s):
 
 
 def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_sign=1.0):
-    """Span of the catenary from its end force, and its derivatives.
+    """Span ``p_B - p_A`` (2,) [m] of the catenary from its end force (as :func:`state_from_end_forces`), and
+    ``d(span)/d(H, V_B, L)`` (2, 3) [m/N, m/N, -].
 
-    Parameters
-    ----------
-    cable : CatenaryCable
-    horizontal_tension : float [N]
-        ``H >= 0``.
-    vertical_tension_b : float [N]
-        ``V_B``.
-    horizontal_sign : {+1, -1}, optional
-        Side of B relative to A, as in `state_from_end_forces`.
-
-    Returns
-    -------
-    span : ndarray, shape (2,) [m]
-        ``p_B - p_A``.
-    jacobian : ndarray, shape (2, 3)
-        ``d(span)/d(H, V_B, L)`` [m/N, m/N, -]. The last column adds unstrained
-        length at end A with ``(H, V_B)`` fixed: the new piece continues the cable
-        along its direction at A. Entry ``[0, 0]`` is ``inf`` for a slack vertical
-        cable (a U of zero width: no horizontal stiffness).
+    The last column adds unstrained length at end A with ``(H, V_B)`` fixed: the new piece continues
+    the cable along its direction at A. Entry ``[0, 0]`` is ``inf`` for a slack vertical cable (a U
+    of zero width: no horizontal stiffness).
     """
     if not isinstance(cable, CatenaryCable):
         raise SceneError(f"cable must be a CatenaryCable, got {shown(cable)}")
@@ -849,26 +691,6 @@ def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_
     return span, jacobian
 
 
-def span_jacobian(cable, state):
-    """``d(span)/d(H, V_B)``: flexibility of the catenary in its end-force parameters.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    state : CatenaryState
-
-    Returns
-    -------
-    ndarray, shape (2, 2) [m/N]
-        Rows ``(dx, dz)`` of the signed span, columns ``(H, V_B)``. Entry ``[0, 0]``
-        is ``inf`` for a slack vertical cable (zero horizontal stiffness).
-    """
-    _, jacobian = span_and_jacobian(
-        cable, state.horizontal_tension, state.vertical_tension_b, state.horizontal_sign
-    )
-    return jacobian[:, :2]
-
-
 def end_stiffness(cable, state):
     """``d(force on B)/d(p_B)`` at fixed A, which also equals ``d(force on A)/d(p_A)``.
 
@@ -876,16 +698,7 @@ def end_stiffness(cable, state):
     ``S = diag(-sign_x, -1)`` at B; the span moves with ``p_B``, so
     ``d(force on B)/d(p_B) = -S' J^-1 S'`` with ``S' = diag(sign_x, 1)`` and
     ``J = d(dx_mirrored, dz)/d(H, V_B)``. The matrix is symmetric and negative
-    (semi-)definite: ``K = -end_stiffness`` is the usual positive tangent stiffness.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    state : CatenaryState
-
-    Returns
-    -------
-    ndarray, shape (2, 2) [N/m]
+    (semi-)definite: ``K = -end_stiffness`` is the usual positive tangent stiffness. Shape (2, 2) [N/m].
     """
     w = cable.weight_per_length
     H, V_B = state.horizontal_tension, state.vertical_tension_b
@@ -908,7 +721,3 @@ def end_stiffness(cable, state):
     mirror = np.diag([sign, 1.0])
     return -mirror @ inverse @ mirror
 
-
-def stretched_length(cable, state):
-    """Arc length of the loaded cable [m]: ``L + (1/EA) integral of T ds``."""
-    return state.stretched_length

@@ -456,9 +456,7 @@ def _anchor_azimuth(equilibrium_cable) -> float:
     return sp.exit_azimuth(equilibrium_cable.anchor_point, equilibrium_cable.inlet)
 
 
-# ---------------------------------------------------------------------------
-# shared: the descent step, the line search, the rounding floor
-# ---------------------------------------------------------------------------
+# --- shared: the descent step, the line search, the rounding floor
 def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
     """Newton's step -H^-1 g, with H shifted by a multiple of the identity until it is a descent direction.
 
@@ -516,11 +514,7 @@ def rounding_floor(stiffness, points) -> float:
     return 16.0 * np.finfo(float).eps * float(np.max(stiffness)) * float(np.abs(points).max())
 
 
-# ---------------------------------------------------------------------------
-# the plane: numba kernels (exact-angle bending, rim contact), nodes and paid-out lengths at a pose
-# ---------------------------------------------------------------------------
-
-
+# --- the plane: nodes and paid-out lengths at a pose
 def _positions(robot, layout, position, rotation, v, paid_out):
     """All node positions, shape (n_nodes, 2) [m], and the rotation [rad]."""
     if layout.free_rotation:
@@ -827,9 +821,7 @@ def _planar_solve(robot: ChainRobot, position, rotation=0.0, *, free_rotation=No
                             rotation_vector=np.array([rotation]))
 
 
-# ---------------------------------------------------------------------------
-# space: the potential of the 3-D chains (bending, tension-only law, swivel groove), pose and swivels free
-# ---------------------------------------------------------------------------
+# --- space: the potential of the 3-D chains (bending, tension-only law, swivel groove), pose and swivels free
 def catenary_start(robot: ChainRobot, equilibrium):
     """Start of the iteration: the nodes on the catenary statics' cables, as the builder starts its chains.
 
@@ -955,9 +947,7 @@ def _spatial_rest(scene, anchor_spring_factor: float | None = None, tension_only
 _NO_SWIVEL = np.zeros(0)
 
 
-# ---------------------------------------------------------------------------
-# the inverse: lengths whose chains hold a pose
-# ---------------------------------------------------------------------------
+# --- the inverse: lengths whose chains hold a pose
 def cable_paid_out(cable: ChainCable, length: float) -> ChainCable:
     """``cable`` paid out to the unstrained ``length`` [m], as the run's variable-length winch changes it
     (:class:`cdpr_exu.run.run_3d._SpatialWinches`): at a point exit the same n elements of length
@@ -1345,9 +1335,7 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
                            f"(imbalance {residual:.3g} N after {iteration} iterations)")
 
 
-# ---------------------------------------------------------------------------
-# the drivers: one interface, the kernel chosen by the robot's Space
-# ---------------------------------------------------------------------------
+# --- the drivers: one interface, the kernel chosen by the robot's Space
 def solve_chain_statics(robot: ChainRobot, nodes, position, rotation=None, swivel_angles=None,
                         **kwargs) -> ChainEquilibrium:
     """The rest of the chains and platform for the cables' unstrained lengths (the forward chain statics).

@@ -128,9 +128,7 @@ def length_jacobian(scene, poses: np.ndarray) -> np.ndarray:
     return -np.swapaxes(structure_matrix(scene, poses), -1, -2)
 
 
-# ----------------------------------------------------------------------------------
-# initial cable configurations
-# ----------------------------------------------------------------------------------
+# --- initial cable configurations
 def straight_cable_nodes(start, end, n_elements):
     """Evenly spaced nodes on the segment from ``start`` to ``end``.
 

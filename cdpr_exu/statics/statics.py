@@ -16,18 +16,15 @@ position is solved. The two dimensions keep their own floating-point kernels (th
 kernels :class:`_PlanarStatics` and :class:`_SpatialStatics`, chosen by the platform's space):
 the residual, the pose Jacobian, the straight-cable start and the inverse differ per dimension.
 
-**Cables.** Each cable is an elastic catenary (:mod:`cdpr_exu.physics.catenary`: weight,
-axial elasticity, no bending) from its anchor (end A) to its exit (end B), chosen by the exit
-(:func:`forward_cable`, :func:`inverse_cable`):
+**Cables.** Each cable is an elastic catenary (:mod:`cdpr_exu.physics.catenary`) from its anchor
+(end A) to its exit (end B), solved as the exit asks (:func:`forward_cable`, :func:`inverse_cable`):
 
-* planar, a fixed exit point; or a planar pulley: the cable comes up from its winch along
+* planar, a fixed exit point; or a planar pulley: the cable comes up its winch line
   ``x = c_x + side r_p``, wraps over the top and leaves the rim tangentially; its unstrained
-  length counts from the hang point ``(c_x + side r_p, c_z)`` and includes the wrap.
-  Frictionless (uniform tension along the wrap, whose unstrained length is
-  ``r_p wrap / (1 + T / EA)``); the wrap's weight is carried by the pulley (at most ``w r_p``
-  of tension, 7e-6 m of stretch for the paper's cable; a slight non-conservativeness, 2.5e-6
-  relative asymmetry of the stiffness); rigid rim, no pulley inertia. A platform under the
-  inner rim of a pulley cannot be held (:class:`UnreachableError`);
+  length counts from the hang point ``(c_x + side r_p, c_z)``. Frictionless (uniform tension
+  along the wrap, of unstrained length ``r_p wrap / (1 + T / EA)``); the wrap's weight is
+  carried by the pulley (at most ``w r_p`` of tension: 7e-6 m of stretch for the paper's cable,
+  2.5e-6 relative asymmetry of the stiffness); rigid rim, no pulley inertia;
 * spatial, a point exit: the cable hangs in the vertical plane through its ends, the planar
   catenary rotated back to 3-D (MoorPy's trick). With ``u`` the horizontal direction from
   the anchor to the exit and ``h`` the horizontal span, its end stiffness is
@@ -37,17 +34,10 @@ axial elasticity, no bending) from its anchor (end A) to its exit (end B), chose
   anchor, where the cable is the planar pulley cable (centre ``(r_p, 0)``, side -1, hang
   point at the inlet); its stiffness ``Q K2 Q^T + (f_rho / rho) (P_h - e_rho e_rho^T)``.
 
-**Solvers.** The forward problem is an energy minimum (cables conservative, weight ``M g z``):
-Newton's method with the analytic stiffness and a line search on the energy
-(:func:`minimise_energy`), started from :func:`straight_cable_pose` (straight, massless,
-elastic cables that may go slack), every evaluation solving each cable warm-started from the
-previous iterate; statically indeterminate robots need no tension distribution (the cables'
-elasticity picks the equilibrium). The inverse: planar, a square Newton iteration in the
-horizontal tensions (and the rotation a rigid platform on two cables takes), started from
-straight massless cables, with a weight continuation as the last resort; spatial, the
-horizontal tensions nearest a guess (least squares) that balance the platform, by
-Gauss-Newton. Horizontal tension cannot parametrise a vertical cable, so the inverse needs
-every cable off the vertical. Both accept an external wrench (eg :func:`inertial_wrench`).
+**Solvers.** The forward problem is an energy minimum (:func:`solve_statics`); statically
+indeterminate robots need no tension distribution (the cables' elasticity picks the equilibrium).
+The inverse (:func:`solve_inverse_statics`) is parametrised by the horizontal tensions, so it
+needs every cable off the vertical. Both accept an external wrench (eg :func:`inertial_wrench`).
 """
 
 from __future__ import annotations
@@ -66,7 +56,7 @@ from cdpr_exu.core.validation import finite, non_negative, positive, real_array,
 from cdpr_exu.exits import Exit, Pulley
 from cdpr_exu.physics.catenary import (DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState,
                                        end_stiffness, profile, solve_forward, solve_inverse, span_and_jacobian,
-                                       state_from_end_forces)
+                                       state_from_end_forces, tension_limit)
 from cdpr_exu.space import PLANE, SPACE, Space, space_of
 
 _RELATIVE_TOLERANCE = 1e-12
@@ -77,9 +67,6 @@ _HORIZONTAL = np.diag([1.0, 1.0, 0.0])
 _PLANE_X = np.array([1.0, 0.0])
 
 
-# ---------------------------------------------------------------------------
-# parameters
-# ---------------------------------------------------------------------------
 def _point(name, value, size=None):
     """A point as a tuple of floats: (x, z) or (x, y, z) [m], its size given or read from ``value``."""
     if size is None:
@@ -90,24 +77,13 @@ def _point(name, value, size=None):
 
 @dataclass(frozen=True)
 class SuspendedCable:
-    """One cable of the platform: its material, its anchor and its exit.
+    """One cable of the platform: its weight per unstrained length ``w >= 0`` [N/m], ``EA > 0`` [N], its anchor
+    (platform frame, centre of mass at 0; default the centre) and its exit.
 
-    Parameters
-    ----------
-    weight_per_length : float [N/m]
-        ``w >= 0``, weight per unstrained length.
-    axial_stiffness : float [N]
-        ``EA > 0``.
-    anchor : (x, z) or (x, y, z) [m], optional
-        Anchor on the platform, platform frame (centre of mass at 0); default the centre.
-    exit_point : (x, z) or (x, y, z) [m], optional
-        Fixed exit point, world frame; its size is the cable's dimension. Give exactly one of
-        ``exit_point`` and ``pulley``.
-    pulley : Exit, optional
-        The exit the cable leaves from (:mod:`cdpr_exu.exits`): a planar
-        :class:`~cdpr_exu.exits.pulley.Pulley` or a :class:`~cdpr_exu.exits.swivel.Swivel`, or
-        an exit the cable does not wrap (a point exit), taken as the fixed ``exit_point`` at
-        its point.
+    Give exactly one of ``exit_point`` (world frame, (x, z) or (x, y, z) [m]: its size is the cable's
+    dimension) and ``pulley``, the :class:`~cdpr_exu.exits.Exit` the cable leaves from: a planar
+    :class:`~cdpr_exu.exits.pulley.Pulley`, a :class:`~cdpr_exu.exits.swivel.Swivel`, or an exit the
+    cable does not wrap, taken as the ``exit_point`` at its point.
     """
 
     weight_per_length: float
@@ -158,39 +134,21 @@ class SuspendedCable:
         return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
 
 
-def _swivel_plane_cable(weight_per_length, axial_stiffness, radius) -> SuspendedCable:
-    """The planar cable of a swivel pulley of radius ``radius`` [m], in the vertical plane through its axis
-    and the anchor: over a pulley of centre (r_p, 0), hung on its left (side -1), so that its hang point
-    is the inlet at the plane's origin and its winch line the swivel axis (:mod:`cdpr_exu.core.geometry`,
-    "Swivel pulley"); the anchor at the platform's reference point."""
-    radius = float(radius)
-    return SuspendedCable(weight_per_length, axial_stiffness, anchor=(0.0, 0.0), pulley=Pulley((radius, 0.0), radius, -1))
-
-
 @dataclass(frozen=True)
 class SuspendedPlatform:
-    """A platform hung on catenary cables, in the plane or in space (the cables' space).
+    """A platform hung on catenary cables (all planar or all spatial), of mass ``M >= 0`` [kg] whose weight
+    ``M g`` (``gravity`` [m/s^2], default 9.81) acts at its centre of mass along -z.
 
-    Parameters
-    ----------
-    cables : sequence of SuspendedCable
-        All planar or all spatial.
-    mass : float [kg]
-        ``M >= 0``; its weight ``M g`` acts at the centre of mass, along -z.
-    gravity : float [m/s^2], optional
-        Default 9.81.
-    inertia : float or (float, float, float) [kg m^2], optional
-        About the centre of mass: planar, the moment about the plane's normal; spatial, the
-        principal moments along the platform axes. Default 0; only :func:`inertial_wrench`
-        and the dynamics use it.
+    ``inertia`` [kg m^2] about the centre of mass: planar the moment about the plane's normal, spatial
+    the principal moments along the platform axes; default 0 (only :func:`inertial_wrench` uses it).
 
     Raises
     ------
     SceneError
-        Naming the field: no cables, cables of two dimensions, a negative mass, two cables
-        sharing an exit point, two cables of a rigid platform sharing an anchor, too few
-        cables to hang it (a point mass needs one, a rigid body two), or, in space, anchors
-        all on one line through the centre of mass (it would turn freely about it).
+        Naming the field: no cables, cables of two dimensions, a negative mass, two cables sharing an
+        exit point, two cables of a rigid platform sharing an anchor, too few cables to hang it (a point
+        mass needs one, a rigid body two), or, in space, anchors all on one line through the centre of
+        mass (it would turn freely about it).
     """
 
     cables: tuple
@@ -255,22 +213,12 @@ class SuspendedPlatform:
         """Anchors in the platform frame, shape (n_cables, d) [m]."""
         return np.array([c.anchor for c in self.cables])
 
-    @property
-    def hang_points(self):
-        """Where each cable's unstrained length counts from, shape (n_cables, d) [m]."""
-        return np.array([c.hang_point for c in self.cables])
-
 
 def catenary_platform(scene) -> SuspendedPlatform:
-    """The catenary-statics model of a scene's robot, planar or spatial: each cable's weight per length
-    ``rho0 g`` [N/m] (0 without cable mass or gravity), its ``EA`` [N], anchor and exit, the platform's
-    mass, gravity (0 when off) and inertia.
+    """The catenary-statics model of a scene's robot: each cable's ``w = rho0 g`` [N/m] (0 without cable
+    mass or gravity), ``EA``, anchor and exit, the platform's mass, gravity (0 when off) and inertia.
 
-    Raises
-    ------
-    SceneError
-        If a weight per length overflows, or the platform cannot hang (:class:`SuspendedPlatform`).
-    """
+    Raises :class:`SceneError` if a weight per length overflows or the platform cannot hang."""
     gravity = scene.gravity if scene.effects.gravity else 0.0
     weighs = scene.effects.cable_mass and scene.effects.gravity
     weights = [c.linear_density * gravity if weighs else 0.0 for c in scene.cables]
@@ -323,35 +271,29 @@ def node_masses_along(n_elements, element_mass, mass_lumping="consistent"):
     return masses
 
 
-# ---------------------------------------------------------------------------
-# results
-# ---------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class CableEquilibrium:
-    """One cable in a platform equilibrium.
+    """One cable in a platform equilibrium; d is the space's dimension.
 
     Attributes
     ----------
     catenary : CatenaryState
         The suspended part in its vertical plane, A at the anchor, B at the exit or tangent point.
     unstrained_length : float [m]
-        Total: suspended part plus, over a pulley, the wrapped arc up to the hang point.
+        Total: suspended part plus, over a pulley, the wrap up to the hang point.
     anchor_point, exit_point : ndarray, shape (d,) [m]
-        World positions of the anchor and of the exit point (over a pulley: the tangent point).
+        World positions of the anchor and of the exit (over a pulley: tangent) point.
     force_on_platform, force_on_exit : ndarray, shape (d,) [N]
-        Forces the cable exerts on the platform at its anchor and on its exit (tangent) point.
+        Forces the cable exerts on the platform and on its exit (tangent) point.
     cable : CatenaryCable
-        The catenary parameters of the suspended part.
+        The suspended part's catenary parameters.
     guess : tuple
         Warm start of the next solve of this cable.
     horizontal_direction : ndarray, shape (d,)
-        The x axis of the catenary's plane: planar (1, 0); spatial ``u``, the horizontal unit
-        vector from the anchor towards the exit (any one for a vertical cable), over a swivel
-        ``e_rho`` from the axis towards the anchor.
-    pulley_radius : float [m]
-        0 for a fixed exit point.
-    wrap_angle : float [rad]
-        Angle wrapped on the pulley (0 for a fixed exit point).
+        The x axis of the catenary's plane: planar (1, 0); spatial the horizontal unit vector from the
+        anchor towards the exit, over a swivel ``e_rho`` from the axis towards the anchor.
+    pulley_radius, wrap_angle : float [m], [rad]
+        Of the disc the cable wraps (0 for a fixed exit point).
     inlet : ndarray, shape (3,) [m] or None
         A swivel pulley's inlet.
     """
@@ -385,10 +327,9 @@ class CableEquilibrium:
         return self.catenary.tension_b
 
     def points(self, s):
-        """Points of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor, shape (n, d) [m].
-
-        Over a swivel pulley, arc lengths beyond the suspended part lie on the wrap (stretched by the
-        tension at the tangent point), up to ``unstrained_length`` at the inlet."""
+        """Points (n, d) [m] of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor; over a
+        swivel pulley, beyond the suspended part on the wrap (stretched by the tension at the tangent point),
+        up to ``unstrained_length`` at the inlet."""
         s = np.atleast_1d(np.asarray(s, dtype=float))
         suspended = self.suspended_length
         hanging = s <= suspended if self.inlet is not None else np.ones(s.shape, bool)
@@ -414,23 +355,18 @@ class PlatformEquilibrium:
 
     Attributes
     ----------
-    space : Space
     position : ndarray, shape (d,) [m]
         Centre of mass.
     rotation : float or ndarray, shape (3,) [rad]
-        The space's rotation: planar the angle ``phi`` (counter-clockwise), spatial the rotation
-        vector; 0 for a point mass.
+        Planar the angle ``phi``, spatial the rotation vector; 0 for a point mass.
     rotation_matrix : ndarray, shape (d, d)
-        ``R``: platform frame to world frame.
-    cables : tuple of CableEquilibrium
+        Platform frame to world frame.
     stiffness : ndarray, shape (k, k), or None
-        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths, ``k`` the degrees of
-        freedom (N/m, N/rad, N m/m, N m/rad); positive definite where the equilibrium is
-        stable. None where not computed (the spatial inverse).
-    external_wrench : ndarray, shape (wrench_size,) [N, N m]
-    net_wrench : ndarray, shape (wrench_size,) [N, N m]
-        Remaining force and moment (about the centre of mass) on the platform: cables,
-        weight and external load; zero to solver tolerance.
+        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths over the k degrees of freedom;
+        positive definite where the equilibrium is stable. None from the spatial inverse.
+    external_wrench, net_wrench : ndarray, shape (wrench_size,) [N, N m]
+        The external load, and the remaining force and moment (about the centre of mass) of cables,
+        weight and load: zero to solver tolerance.
     """
 
     space: Space
@@ -463,11 +399,6 @@ class PlatformEquilibrium:
         return np.array([c.tension_at_anchor for c in self.cables])
 
     @property
-    def tensions_at_exit(self):
-        """Tension of each cable at its exit (tangent) point, shape (n_cables,) [N]."""
-        return np.array([c.tension_at_exit for c in self.cables])
-
-    @property
     def forces_on_platform(self):
         """Force of each cable on the platform, shape (n_cables, d) [N]."""
         return np.array([c.force_on_platform for c in self.cables])
@@ -477,28 +408,17 @@ class PlatformEquilibrium:
         """World positions of the anchors, shape (n_cables, d) [m]."""
         return np.array([c.anchor_point for c in self.cables])
 
-    @property
-    def is_stable(self):
-        """True when the symmetric part of `stiffness` is positive definite."""
-        return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
 
-
-# ---------------------------------------------------------------------------
-# a small damped Newton solver
-# ---------------------------------------------------------------------------
 def _damped_newton(
     function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
     line_search_steps=50,
 ):
-    """Newton's method with backtracking on the residual norm.
+    """Newton's method on ``function(x) -> (residual, jacobian)`` with backtracking on the residual norm;
+    returns ``(x, residual, jacobian)``.
 
-    ``function(x) -> (residual, jacobian)``; it may raise UnreachableError at a trial
-    point, which then counts as a rejected step. Components listed in ``positive``
-    are kept above 10 % of their current value. Converged when the residual norm is
-    below ``tolerance``, or when no step decreases it any more and it is below
-    ``noise`` (default ``1e3 tolerance``), the precision the residual can have.
-    Returns ``(x, residual, jacobian)``.
-    """
+    A trial point that raises UnreachableError is a rejected step; components in ``positive`` keep above
+    10 % of their value. Converged below ``tolerance``, or where no step decreases the norm and it is
+    below ``noise`` (default ``1e3 tolerance``), the precision the residual can have."""
     noise = 1e3 * tolerance if noise is None else max(noise, tolerance)
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
@@ -543,15 +463,12 @@ def _damped_newton(
 def minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="equilibrium"):
     """Newton's method for a conservative equilibrium, with a line search on the energy.
 
-    ``function(x) -> (residual, jacobian)`` where the residual is the net generalised
-    force, ``-grad(energy)``, and the jacobian ``-hessian``. The energy itself is not
-    needed: along a descent direction ``d`` its slope is ``-residual . d``, and the
-    step length is chosen where that slope stops being (strongly) negative, ie near
-    the energy minimum along the line. Unlike a search on the residual norm, this
-    cannot stall away from an equilibrium, which matters on the curved, stiff valleys
-    of near-vertical cables (a pendulum: stiff along the cable, soft across it).
-    Where the stiffness is not positive definite along the Newton direction, the
-    direction falls back to the (scaled) steepest descent.
+    ``function(x) -> (residual, jacobian)``: the net generalised force ``-grad(energy)`` and ``-hessian``.
+    Along a descent direction ``d`` the energy's slope is ``-residual . d``; the step ends where that
+    slope stops being (strongly) negative, near the energy's minimum on the line. Unlike a search on
+    the residual norm this cannot stall away from an equilibrium, in the curved, stiff valleys of
+    near-vertical cables (stiff along the cable, soft across it). Where the stiffness is not positive
+    definite along the Newton direction, the (scaled) steepest descent is taken.
     """
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
@@ -625,9 +542,7 @@ def _warm_then_cold(solve_from, guess):
     return solve_from(None)
 
 
-# ---------------------------------------------------------------------------
-# one cable: straight geometry
-# ---------------------------------------------------------------------------
+# --- one cable: straight geometry
 def _straight_tangent_angle(pulley, point):
     """Rim angle where a straight cable from ``point`` leaves ``pulley``."""
     centre = np.array(pulley.center)
@@ -647,9 +562,7 @@ def _straight_tangent_angle(pulley, point):
     raise AssertionError("no tangent with the pulley's orientation")  # pragma: no cover
 
 
-# ---------------------------------------------------------------------------
-# one cable: forward (given unstrained length) and inverse (given H)
-# ---------------------------------------------------------------------------
+# --- one cable: forward (given unstrained length) and inverse (given H)
 def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_length, tension_scale):
     """Residual of the pulley cable (span mismatch, tangency) and its partial derivatives.
 
@@ -754,7 +667,7 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
     length, derivative, wrap = suspended_length(x)
     catenary_cable = cable.catenary(length)
     state = state_from_end_forces(catenary_cable, H, V_B, sign_x)
-    if state.max_tension > _tension_limit(cable, max_strain, max_tension):
+    if state.max_tension > tension_limit(cable.axial_stiffness, max_strain, max_tension):
         raise UnreachableError(
             f"cable of unstrained_length {unstrained_length:g} m would need tension "
             f"{state.max_tension:g} N, above its limit"
@@ -766,11 +679,6 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
     equilibrium = _planar_equilibrium(state, catenary_cable, unstrained_length, point, pulley.rim_point(angle),
                                       (H, V_B, angle), wrap, r)
     return equilibrium, stiffness
-
-
-def _tension_limit(cable, max_strain, max_tension):
-    limit = max_strain * cable.axial_stiffness
-    return limit if max_tension is None else min(limit, max_tension)
 
 
 def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
@@ -830,7 +738,7 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
         total = length + r * wrap / (1.0 + state.tension_b / EA)
         equilibrium = _planar_equilibrium(state, catenary, total, point, pulley.rim_point(angle), (length, V_B, angle),
                                           wrap, r)
-    if state.max_tension > _tension_limit(cable, max_strain, max_tension):
+    if state.max_tension > tension_limit(cable.axial_stiffness, max_strain, max_tension):
         raise UnreachableError(f"horizontal_tension {H:g} N needs tension {state.max_tension:g} N, above the limit")
     # unknowns u = (L_c, V_B[, angle]); force on A = (sign_x H, V_B - w L_c)
     d_u_dH = -np.linalg.solve(jacobian, d_residual_dH)
@@ -840,9 +748,7 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
     return equilibrium, force_dH, force_dp
 
 
-# ---------------------------------------------------------------------------
-# one spatial cable: the planar cable in its vertical plane
-# ---------------------------------------------------------------------------
+# --- one spatial cable: the planar cable in its vertical plane
 def _vertical_plane_forward_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
     """A spatial cable from a point exit: the planar catenary in the vertical plane through its ends."""
     catenary_cable = cable.catenary(unstrained_length)
@@ -867,17 +773,9 @@ def _vertical_plane_forward_cable(cable, unstrained_length, anchor_point, guess,
 
 
 def _swivel_plane(cable, anchor_point):
-    """The vertical plane through a swivel pulley's axis and ``anchor_point`` (3,) [m], where its cable hangs.
-
-    Returns the inlet (3,) [m], the plane's horizontal unit vector e_rho (3,), the anchor's span from
-    the inlet in the plane (rho, dz) (2,) [m], and the planar pulley cable whose disc touches the axis
-    at the plane's origin (:func:`_swivel_plane_cable`).
-
-    Raises
-    ------
-    UnreachableError
-        If the anchor lies on the axis (its azimuth, and so the plane, is undefined).
-    """
+    """The vertical plane through a swivel pulley's axis and ``anchor_point`` (3,) [m]: the inlet (3,) [m],
+    its horizontal unit vector e_rho (3,), the anchor's span (rho, dz) [m] from the inlet, and its planar
+    pulley cable. Refuses (UnreachableError) an anchor on the axis."""
     inlet = np.array(cable.point)
     offset = np.asarray(anchor_point, dtype=float) - inlet
     rho = float(math.hypot(offset[0], offset[1]))
@@ -885,7 +783,11 @@ def _swivel_plane(cable, anchor_point):
         raise UnreachableError(f"anchor {np.asarray(anchor_point).tolist()} lies on the axis of the swivel pulley at "
                                f"{inlet.tolist()}: its azimuth is undefined")
     e_rho = np.array([offset[0], offset[1], 0.0]) / rho
-    planar_cable = _swivel_plane_cable(cable.weight_per_length, cable.axial_stiffness, cable.pulley_radius)
+    # over a disc of centre (r_p, 0) hung on its left: its hang point is the inlet at the plane's origin, its
+    # winch line the swivel axis (cdpr_exu.core.geometry, "Swivel pulley"); the anchor at the reference point
+    radius = cable.pulley_radius
+    planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
+                                  pulley=Pulley((radius, 0.0), radius, -1))
     return inlet, e_rho, np.array([rho, offset[2]]), planar_cable
 
 
@@ -946,22 +848,11 @@ def _cable_kernel(cable):
 
 def forward_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
                   max_tension=None):
-    """Solve one cable of given unstrained length [m] from a given anchor point (d,) [m] to its exit.
+    """Solve one cable of given unstrained length [m] from an anchor point (d,) [m] to its exit.
 
-    The solver is the exit's: planar fixed point or pulley, spatial vertical plane (point exit) or
-    swivel plane (module notes). ``guess``: a previous :attr:`CableEquilibrium.guess` of this cable.
-
-    Returns
-    -------
-    equilibrium : CableEquilibrium
-    stiffness : ndarray, shape (d, d) [N/m]
-        ``d(force on platform)/d(anchor point)``.
-
-    Raises
-    ------
-    UnreachableError
-        If the span is beyond the cable's reach at its tension limit.
-    """
+    The solver is the exit's (module notes); ``guess``: a previous :attr:`CableEquilibrium.guess`.
+    Returns the :class:`CableEquilibrium` and ``d(force on platform)/d(anchor point)`` (d, d) [N/m];
+    UnreachableError if the span is beyond reach at the tension limit."""
     return _cable_kernel(cable)[0](cable, unstrained_length, np.asarray(anchor_point, dtype=float), guess,
                                    max_strain, max_tension)
 
@@ -983,17 +874,10 @@ _CABLE_KERNELS = {PLANE: {False: (_planar_forward_cable, _planar_inverse_cable),
                           True: (_swivel_forward_cable, _swivel_inverse_cable)}}
 
 
-# ---------------------------------------------------------------------------
-# the platform: the one driver and its checks
-# ---------------------------------------------------------------------------
+# --- the platform: the one driver and its checks
 def checked_unstrained_lengths(platform, unstrained_lengths):
-    """The cables' unstrained lengths [m] as a float array, one per cable of ``platform``, each positive.
-
-    Raises
-    ------
-    SceneError
-        Naming ``unstrained_lengths``, if they are not numbers, not one per cable or not positive.
-    """
+    """The cables' unstrained lengths [m] as a float array, one positive length per cable of ``platform``;
+    else SceneError naming ``unstrained_lengths``."""
     lengths = real_array("unstrained_lengths", unstrained_lengths)
     if lengths.shape != (len(platform.cables),):
         raise SceneError(f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
@@ -1021,13 +905,9 @@ def _wrench(platform, value):
 def _check_reach(platform, lengths, max_strain, max_tension):
     """Refuse cables that cannot all meet the platform: hang points farther apart than two cables and the
     anchors reach."""
-    reaches = []
-    for cable, length in zip(platform.cables, lengths):
-        limit = max_strain * cable.axial_stiffness
-        if max_tension is not None:
-            limit = min(limit, max_tension)
-        reaches.append(length * (1.0 + limit / cable.axial_stiffness))
-    exits, anchors = platform.hang_points, platform.anchors
+    reaches = [length * (1.0 + tension_limit(c.axial_stiffness, max_strain, max_tension) / c.axial_stiffness)
+               for c, length in zip(platform.cables, lengths)]
+    exits, anchors = np.array([c.hang_point for c in platform.cables]), platform.anchors
     for i in range(len(lengths)):
         for j in range(i):
             gap = float(np.linalg.norm(exits[i] - exits[j]))
@@ -1040,18 +920,11 @@ def _check_reach(platform, lengths, max_strain, max_tension):
 
 
 def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
-    """Equilibrium pose on straight, massless, elastic cables that may go slack (the forward statics' start).
+    """Equilibrium pose (pose_size,) [m, rad] on straight, massless, elastic cables that may go slack.
 
-    Minimises the potential energy ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2`` with ``l_i``
-    the straight length from the anchor to the hang point (over a pulley: the wrapped arc plus the
-    tangent) and ``k_i = EA_i / L_i``. Unlike intersecting the circles of inextensible cables, this
-    always has a solution, also when some cables are too long to be taut.
-
-    Returns
-    -------
-    ndarray, shape (pose_size,)
-        Position [m] and rotation [rad] (0 for a point mass).
-    """
+    Minimises ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2``, ``l_i`` the straight length
+    from the anchor to the hang point (wrap included) and ``k_i = EA_i / L_i``: unlike intersecting the
+    circles of inextensible cables it always has a solution. It starts :func:`solve_statics`."""
     kernel = _checked_platform(platform)
     lengths = checked_unstrained_lengths(platform, unstrained_lengths)
     return kernel.straight_cable_pose(platform, lengths, _wrench(platform, external_wrench))
@@ -1061,23 +934,22 @@ def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wren
                   max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
     """Equilibrium pose of the platform and every cable's forces, for given unstrained lengths.
 
-    Newton's method on the net generalised force (force, and the moment for a rigid platform:
-    planar about the centre of mass, spatial ``J_l^T M``), with the analytic stiffness assembled
-    from the cables' end stiffnesses and a line search on the energy (:func:`minimise_energy`);
-    every evaluation solves each cable's catenary, warm-started from the previous iterate.
+    Newton's method on the net generalised force (force and, rigid, the moment: planar about the centre
+    of mass, spatial ``J_l^T M``) with the analytic stiffness from the cables' end stiffnesses and a
+    line search on the energy (:func:`minimise_energy`), from :func:`straight_cable_pose`; every
+    evaluation solves each cable warm-started from the previous iterate.
 
     Parameters
     ----------
     platform : SuspendedPlatform
     unstrained_lengths : array_like, shape (n_cables,) [m]
-        Total unstrained length of each cable (over a pulley: from its hang point).
+        Over a pulley from its hang point.
     initial_pose : array_like, optional
-        Start: a position, or a pose (the rotation of a point mass is ignored) [m, rad]; default
-        :func:`straight_cable_pose`.
+        A position, or a pose [m, rad] (a point mass's rotation is ignored).
     external_wrench : array_like, shape (wrench_size,) [N, N m], optional
-        Extra force and moment (about the centre of mass) on the platform, eg :func:`inertial_wrench`.
+        Extra force and moment about the centre of mass, eg :func:`inertial_wrench`.
     max_strain, max_tension : float, optional
-        Cable tension limits, as in :func:`cdpr_exu.physics.catenary.solve_forward`.
+        Cable tension limits (:func:`cdpr_exu.physics.catenary.tension_limit`).
 
     Returns
     -------
@@ -1086,10 +958,10 @@ def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wren
     Raises
     ------
     SceneError
-        Naming the argument, if an input is invalid (checked before any solve).
+        Naming the argument, if an input is invalid (before any solve).
     UnreachableError
-        If two cables cannot both reach the platform (checked before any solve), or if no
-        equilibrium is found within the tension limits.
+        If two cables cannot both reach the platform (before any solve), or no equilibrium is found
+        within the tension limits.
     """
     kernel = _checked_platform(platform)
     space = platform.space
@@ -1135,42 +1007,39 @@ def solve_inverse_statics(platform, pose, external_wrench=None, initial_guess=No
                           max_tension=None):
     """Unstrained lengths and cable forces that hold the platform at a pose, on elastic catenaries.
 
-    The unknowns are the cables' horizontal tensions (each cable's unstrained length and forces follow
-    from its inverse catenary, :func:`inverse_cable`); the equations the platform's balance.
+    The unknowns are the cables' horizontal tensions (each cable's length and forces follow from its
+    inverse catenary, :func:`inverse_cable`); the equations the platform's balance.
 
-    * Planar: a square problem, solved by Newton's method from straight massless cables: a point
-      mass on 2 cables; a rigid platform on 2 cables at a position (the rotation is the one
-      equilibrium imposes: give ``pose`` as ``(x, z)``); on 3 cables at a pose ``(x, z, phi)``.
-    * Spatial: the tensions nearest ``initial_guess`` (least squares) that balance the force,
-      and the moment too for a rigid platform on at least six cables (with fewer, the rotation is
-      left free), by Gauss-Newton, each cable's force derivative by a forward difference.
-      Continuing from the previous sample's tensions along a trajectory keeps an
-      over-constrained robot's internal tension.
+    * Planar: a square Newton iteration from straight massless cables (weight continuation as the
+      last resort): a point mass on 2 cables; a rigid platform on 2 cables at a position ``(x, z)``
+      (the rotation is equilibrium's) or on 3 at a pose ``(x, z, phi)``.
+    * Spatial: the tensions nearest ``initial_guess`` (least squares) that balance the force, and the
+      moment too on at least six cables (with fewer the rotation is left free), by Gauss-Newton with
+      forward differences. Continued along a trajectory, a redundant robot keeps its internal tension.
 
     Parameters
     ----------
     platform : SuspendedPlatform
     pose : array_like [m, rad]
-        A position or a pose (see above; spatial: (3,) for a point mass, or (6,)).
+        A position or a pose (above; spatial (3,) for a point mass, or (6,)).
     external_wrench : array_like, shape (wrench_size,) [N, N m], optional
-        Extra load, eg :func:`inertial_wrench` for dynamic feed-forward.
+        Extra load, eg :func:`inertial_wrench`.
     initial_guess : PlatformEquilibrium or array_like (n_cables,) [N], optional
-        A nearby solution (eg the previous sample's), or positive horizontal tensions: they start
-        the iteration (planar, with the solution's rotation) and, spatial, are the tensions to stay
-        near (required there).
+        A nearby solution or positive horizontal tensions: the start (planar, with its rotation) and,
+        spatial, the tensions to stay near (required there).
     max_strain, max_tension : float, optional
-        Cable tension limits, as in :func:`cdpr_exu.physics.catenary.solve_forward` (planar).
+        Cable tension limits (planar), as in :func:`solve_statics`.
 
     Returns
     -------
     PlatformEquilibrium
-        With the unstrained lengths and forces, the rotation, and (planar) the stiffness at fixed lengths.
+        With (planar) the stiffness at fixed lengths.
 
     Raises
     ------
     UnreachableError
-        If a cable would have to push (no equilibrium with positive tensions), a cable would be
-        vertical, a tension exceeds its limit, or the iteration fails.
+        If a cable would have to push or hang vertically, a tension exceeds its limit, or the
+        iteration fails.
     SceneError
         If an argument is invalid, or (planar) the problem is not square.
     """
@@ -1186,9 +1055,7 @@ def solve_inverse_statics(platform, pose, external_wrench=None, initial_guess=No
     return kernel.inverse(platform, pose, wrench, initial_guess, max_strain, max_tension)
 
 
-# ---------------------------------------------------------------------------
-# the pose kernels: what differs per dimension
-# ---------------------------------------------------------------------------
+# --- the pose kernels: what differs per dimension
 class _PlanarStatics:
     """The plane's pose kernel: ``(x, z, phi)``, planar cross products (the paper's statics, bit for bit)."""
 
@@ -1455,14 +1322,10 @@ _KERNELS = {PLANE: _PlanarStatics(), SPACE: _SpatialStatics()}
 
 
 def _straight_path(cable, exit_point, point):
-    """Length [m] of a straight, massless spatial cable from its exit to ``point`` (3,), and the unit
-    vector (3,) along its last straight part towards ``point`` (the length's gradient in ``point``).
-
-    Over a swivel pulley the path wraps the disc in the plane through the axis and ``point``
-    (:func:`cdpr_exu.core.geometry.swivel_pulley_exit`: arc plus free length); where that is
-    undefined (``point`` on the axis or inside the disc, only ever an iterate of the starting
-    guess) the straight distance from the inlet stands in.
-    """
+    """Length [m] of a straight, massless spatial cable from its exit to ``point`` (3,), and the unit vector
+    (3,) of its last straight part towards ``point`` (the length's gradient). Over a swivel pulley it wraps
+    the disc (:func:`cdpr_exu.core.geometry.swivel_pulley_exit`); where that is undefined (only ever an
+    iterate of the start) the straight distance from the inlet stands in."""
     span = point - exit_point
     distance = float(np.linalg.norm(span))
     if cable.pulley_radius > 0.0:
@@ -1476,13 +1339,9 @@ def _straight_path(cable, exit_point, point):
 
 
 def _straight_length_and_gradient(cable, point):
-    """Straight length of a planar cable from ``point`` to the hang point [m] and its gradient in ``point``.
-
-    With a pulley, the length is tangent plus wrapped arc; its gradient is the unit vector from the
-    tangent point to ``point`` (the wrap change cancels the tangent point's motion to first order).
-    Inside a pulley disc (no tangent) the distance to the centre plus half a turn stands in, to keep
-    the energy continuous-ish.
-    """
+    """Straight length [m] of a planar cable from ``point`` to the hang point and its gradient in ``point``:
+    over a pulley tangent plus wrap, the gradient the unit vector from the tangent point (the wrap's change
+    cancels the tangent point's motion); inside the disc the distance to the centre plus half a turn."""
     if cable.pulley is None:
         offset = point - np.array(cable.exit_point)
         length = float(np.hypot(*offset))
@@ -1506,9 +1365,7 @@ def _wrap_angle(angle):
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-# ---------------------------------------------------------------------------
-# the planar inverse: a square Newton iteration in the horizontal tensions
-# ---------------------------------------------------------------------------
+# --- the planar inverse: a square Newton iteration in the horizontal tensions
 def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
     """Horizontal tensions of straight massless cables balancing the load (start guess)."""
     points = _PlanarStatics.anchor_points(platform, position, rotation)
@@ -1535,13 +1392,9 @@ def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
 
 
 def _straight_cable_rotations(platform, position, wrench):
-    """Rotations at which straight massless cables hold the platform with positive tensions.
-
-    Roots of the moment balance (after the force balance fixes the tensions) found by scanning
-    ``[-pi, pi)`` and refining with Brent's method; sorted by size. These start the inverse statics
-    of a rigid platform on two cables, whose equilibrium rotation can be large (near the workspace
-    edge the platform tilts by a radian).
-    """
+    """Rotations in ``[-pi, pi)`` at which straight massless cables hold the platform with positive tensions,
+    smallest first: roots of the moment balance, scanned and refined by Brent's method. They start the
+    inverse of a rigid platform on two cables, which tilts by up to a radian near the workspace edge."""
     def moment(phi):
         try:
             _, tensions, residual = _ideal_tensions(platform, position, phi, wrench, True)
@@ -1698,12 +1551,8 @@ _CONTINUATION_STEPS = (0.0, 0.1, 0.25, 0.45, 0.7, 1.0)
 
 
 def _inverse_by_weight_continuation(platform, position, rotation, wrench, max_strain, max_tension):
-    """Inverse statics by growing the cables' weight from zero, warm-starting each step.
-
-    The last resort when every direct start fails: massless cables are solved reliably from the
-    straight-cable guess, and each step's solution starts the next. Slow (a handful of solves), so
-    only used on failure.
-    """
+    """Inverse statics by growing the cables' weight from zero, each step warm-started from the last: the
+    last resort when every direct start fails (massless cables solve reliably from straight cables)."""
     previous = None
     for fraction in _CONTINUATION_STEPS:
         cables = tuple(SuspendedCable(c.weight_per_length * fraction, c.axial_stiffness, c.anchor, c.exit_point,
