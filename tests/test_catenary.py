@@ -293,7 +293,8 @@ def test_random_cables_round_trip_and_balance_their_weight(length, weight, stiff
         return  # beyond the 10 % strain limit: legitimately unreachable
     # weight balance: round-off of the forces (scale T + wL)
     scale = state.max_tension + total_weight(cable)
-    np.testing.assert_allclose(state.force_on_a + state.force_on_b, [0.0, -total_weight(cable)], atol=1e-12 * scale)
+    np.testing.assert_allclose(state.force_on_a + state.force_on_b, [0.0, -total_weight(cable)],
+                               atol=1e-12 * scale)
     np.testing.assert_allclose(state.span, span, atol=1e-11 * length)
     if state.horizontal_tension > 1e-6 * max(total_weight(cable), state.max_tension) and span[0] != 0.0:
         L, _ = solve_inverse(span, weight, stiffness, state.horizontal_tension)

@@ -601,7 +601,8 @@ def test_robot_in_one_vertical_plane_reproduces_the_planar_statics(rigid, azimut
     # the planar rotation phi turns ``along`` towards +z: about the axis along x e_z
     np.testing.assert_allclose(found.rotation, expected.rotation * np.cross(along, [0.0, 0.0, 1.0]), atol=1e-9)
     np.testing.assert_allclose(found.tensions_at_anchor, expected.tensions_at_anchor, atol=1e-7)
-    np.testing.assert_allclose([c.tension_at_exit for c in found.cables], [c.tension_at_exit for c in expected.cables], atol=1e-7)
+    np.testing.assert_allclose([c.tension_at_exit for c in found.cables],
+                               [c.tension_at_exit for c in expected.cables], atol=1e-7)
 
 
 # ---------------------------------------------------------------------------

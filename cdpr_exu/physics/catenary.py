@@ -61,7 +61,7 @@ def _span_vector(span):
 
 
 def tension_limit(axial_stiffness, max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
-    """Largest admissible tension [N] of a cable of ``EA`` [N]: ``max_strain EA``, or ``max_tension`` if lower."""
+    """Largest admissible tension [N] of a cable of ``EA`` [N]: ``max_strain EA``, or ``max_tension`` [N]."""
     max_strain = positive("max_strain", max_strain)
     limit = max_strain * axial_stiffness
     if max_tension is not None:
@@ -228,11 +228,7 @@ def _span_and_jacobian(H, V_B, L, w, EA, with_jacobian=True):
         cross = -H * L * sum_V / (T_A * T_B * sum_T)
     else:
         cross = 0.0
-    jacobian = [
-        [dx_over_H - ddz_inext_dV + L / EA, cross],
-        [cross, ddz_inext_dV + L / EA],
-    ]
-    return dx, dz, jacobian
+    return dx, dz, [[dx_over_H - ddz_inext_dV + L / EA, cross], [cross, ddz_inext_dV + L / EA]]
 
 
 def _tension_integral(H, V_B, L, w):
@@ -271,18 +267,10 @@ def _make_state(cable, H, V_B, sign_x, slack_span=None):
         dx, dz = abs(float(slack_span[0])), float(slack_span[1])
         stretched = L
     V_A = V_B - w * L
-    return CatenaryState(
-        horizontal_tension=H,
-        vertical_tension_a=V_A,
-        vertical_tension_b=V_B,
-        force_on_a=np.array([sign_x * H, V_A]),
-        force_on_b=np.array([-sign_x * H, -V_B]),
-        tension_a=math.hypot(H, V_A),
-        tension_b=math.hypot(H, V_B),
-        unstrained_length=L,
-        stretched_length=stretched,
-        span=np.array([sign_x * dx, dz]),
-    )
+    return CatenaryState(horizontal_tension=H, vertical_tension_a=V_A, vertical_tension_b=V_B,
+                         force_on_a=np.array([sign_x * H, V_A]), force_on_b=np.array([-sign_x * H, -V_B]),
+                         tension_a=math.hypot(H, V_A), tension_b=math.hypot(H, V_B), unstrained_length=L,
+                         stretched_length=stretched, span=np.array([sign_x * dx, dz]))
 
 
 def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizontal_sign=1.0):
@@ -459,19 +447,11 @@ def _solve_span(L, w, EA, dx, dz, guess):
     residual = math.hypot(rx - dx, rz - dz)
     if residual <= 1e3 * _RELATIVE_TOLERANCE * max(L, math.hypot(dx, dz)):
         return H, V_B
-    raise UnreachableError(
-        f"elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
-        f"unstrained_length {L:g} m (residual {residual:.3g} m)"
-    )
+    raise UnreachableError(f"elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
+                           f"unstrained_length {L:g} m (residual {residual:.3g} m)")
 
 
-def solve_forward(
-    cable,
-    span,
-    initial_guess=None,
-    max_strain=DEFAULT_MAX_STRAIN,
-    max_tension=None,
-):
+def solve_forward(cable, span, initial_guess=None, max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
     """The :class:`CatenaryState` of a cable of given unstrained length hung across ``span`` (2,) [m]
     (``p_B - p_A``, any signs).
 
@@ -501,10 +481,8 @@ def solve_forward(
     chord = math.hypot(dx, dz)
     reach = L * (1.0 + limit / EA)  # stretched length <= reach, chord <= it
     if chord > reach:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m is {chord:g} m long, beyond the reach "
-            f"{reach:g} m of unstrained_length {L:g} m at tension limit {limit:g} N"
-        )
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m is {chord:g} m long, beyond the reach "
+                               f"{reach:g} m of unstrained_length {L:g} m at tension limit {limit:g} N")
 
     slack_span = None
     if w == 0.0:  # massless: straight linear spring, or slack (no force)
@@ -527,10 +505,8 @@ def solve_forward(
 
     state = _make_state(cable, H, V_B, sign_x, slack_span)
     if state.max_tension > limit:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m with unstrained_length {L:g} m needs "
-            f"tension {state.max_tension:g} N, above the limit {limit:g} N"
-        )
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m with unstrained_length {L:g} m needs "
+                               f"tension {state.max_tension:g} N, above the limit {limit:g} N")
     return state
 
 
@@ -550,14 +526,8 @@ def _inextensible_length(w, H, dx, dz):
     return L, V_B
 
 
-def solve_inverse(
-    span,
-    weight_per_length,
-    axial_stiffness,
-    horizontal_tension,
-    max_strain=DEFAULT_MAX_STRAIN,
-    max_tension=None,
-):
+def solve_inverse(span, weight_per_length, axial_stiffness, horizontal_tension, max_strain=DEFAULT_MAX_STRAIN,
+                  max_tension=None):
     """Unstrained length [m] and :class:`CatenaryState` of the cable (``w >= 0`` [N/m], ``EA > 0`` [N]) that
     hangs across ``span`` (2,) [m] (``dx != 0``: a vertical cable has ``H = 0``) with horizontal tension
     ``H > 0`` [N]; the tension limit as in :func:`solve_forward`.
@@ -580,10 +550,8 @@ def solve_inverse(
     sign_x = -1.0 if span[0] < 0.0 else 1.0
     dx, dz = abs(float(span[0])), float(span[1])
     if dx == 0.0:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m is vertical: no cable hangs across it "
-            f"with horizontal_tension {H:g} N > 0"
-        )
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m is vertical: no cable hangs across it "
+                               f"with horizontal_tension {H:g} N > 0")
     chord = math.hypot(dx, dz)
 
     if w == 0.0:
@@ -594,10 +562,9 @@ def solve_inverse(
         try:
             L_inext, V_B = _inextensible_length(w, H, dx, dz)
         except OverflowError:
-            raise UnreachableError(
-                f"span ({span[0]:g}, {span[1]:g}) m: horizontal_tension {H:g} N is too "
-                f"small for weight_per_length {w:g} N/m (the cable would be astronomically long)"
-            ) from None
+            raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m: horizontal_tension {H:g} N is too "
+                                   f"small for weight_per_length {w:g} N/m (the cable would be "
+                                   "astronomically long)") from None
         mean_tension = 0.5 * (math.hypot(H, V_B) + math.hypot(H, V_B - w * L_inext))
         L = L_inext / (1.0 + mean_tension / EA)
         V_B = V_B - 0.5 * w * (L_inext - L)  # keep the low point roughly in place
@@ -606,10 +573,8 @@ def solve_inverse(
     cable = CatenaryCable(L, w, EA)
     state = _make_state(cable, H, V_B, sign_x)
     if state.max_tension > limit:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m with horizontal_tension {H:g} N needs "
-            f"tension {state.max_tension:g} N, above the limit {limit:g} N"
-        )
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m with horizontal_tension {H:g} N needs "
+                               f"tension {state.max_tension:g} N, above the limit {limit:g} N")
     return L, state
 
 
@@ -629,10 +594,8 @@ def _newton_inverse(w, EA, H, dx, dz, L, V_B):
     L, V_B, norm = _damped_newton_2d(evaluate, L, V_B, tolerance)
     if norm <= 1e3 * tolerance:
         return L, V_B
-    raise UnreachableError(
-        f"inverse elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
-        f"horizontal_tension {H:g} N (residual {norm:.3g} m)"
-    )
+    raise UnreachableError(f"inverse elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
+                           f"horizontal_tension {H:g} N (residual {norm:.3g} m)")
 
 
 def profile(cable, state, s):
@@ -682,12 +645,8 @@ def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_
     else:
         length_column = (0.0, 0.0)
     span = np.array([sign * dx, dz])
-    jacobian = np.array(
-        [
-            [sign * jac[0][0], sign * jac[0][1], sign * length_column[0]],
-            [jac[1][0], jac[1][1], length_column[1]],
-        ]
-    )
+    jacobian = np.array([[sign * jac[0][0], sign * jac[0][1], sign * length_column[0]],
+                         [jac[1][0], jac[1][1], length_column[1]]])
     return span, jacobian
 
 

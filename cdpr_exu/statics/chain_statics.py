@@ -31,7 +31,8 @@ import scipy.sparse as sparse
 import scipy.sparse.linalg as sparse_linalg
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import all_at_centre, rotation_from_vector, rotation_matrix, rotation_vector
+from cdpr_exu.core.geometry import (all_at_centre, planar_cross, rotation_from_vector, rotation_matrix,
+                                    rotation_vector)
 from cdpr_exu.core.validation import finite, real_array, shown, vector
 from cdpr_exu.exits import Exit
 from cdpr_exu.physics import swivel_pulley as sp
@@ -166,7 +167,8 @@ _CABLE_CHECKS = {2: _check_planar_cable, 3: _check_spatial_cable}
 
 @dataclass(frozen=True)
 class ChainRobot:
-    """The platform of ``mass`` [kg] and its lumped cables (all of one dimension), ``gravity`` [m/s^2] downwards.
+    """The platform of ``mass`` [kg] and its lumped cables (all of one dimension), ``gravity`` [m/s^2]
+    downwards.
 
     ``anchor_spring_factor``, in space: None, each cable's last node sits on its anchor (an exact spherical
     joint); f > 0, it is tied to it by a spring of stiffness f k (the builder's penalty joint,
@@ -354,18 +356,18 @@ def winch_line_elements(winch_line: float, element_length: float) -> int:
 
 
 def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, contact_stiffness):
-    """Straight unstrained reference (winch end first) and the catenary statics' nodes of a cable over a swivel
-    pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``, n from the inlet to the anchor of
+    """Straight unstrained reference (winch end first) and the catenary statics' nodes of a cable over a
+    swivel pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``, n from the inlet to the anchor of
     unstrained ``length`` [m].
 
-    From the anchor: the catenary (``equilibrium_cable``, a :class:`~cdpr_exu.statics.statics.CableEquilibrium`)
-    up to the tangent point; then the wrap as the chain lies on it, a polygon of chords of the stretched
-    element length (on the arc each chord is short by r_p theta^3 / 24 and pushes with up to 3 kN at
-    l_e = r_p: Newton diverged), each node inside the groove by the depth that carries its share of the
-    pressure, ``T l_e / (r_p k_p)`` (``contact_stiffness`` k_p [N/m]; on the rim psi has no stiffness and
-    Exudyn's static solver met a singular matrix); then down the axis to the winch end, where the builder
-    and the chain statics hold the cable. The tension is the catenary's at the tangent point (frictionless
-    wrap, its weight left out).
+    From the anchor: the catenary (``equilibrium_cable``, a
+    :class:`~cdpr_exu.statics.statics.CableEquilibrium`) up to the tangent point; then the wrap as the chain
+    lies on it, a polygon of chords of the stretched element length (on the arc each chord is short by r_p
+    theta^3 / 24 and pushes with up to 3 kN at l_e = r_p: Newton diverged), each node inside the groove by the
+    depth that carries its share of the pressure, ``T l_e / (r_p k_p)`` (``contact_stiffness`` k_p [N/m]; on
+    the rim psi has no stiffness and Exudyn's static solver met a singular matrix); then down the axis to the
+    winch end, where the builder and the chain statics hold the cable. The tension is the catenary's at the
+    tangent point (frictionless wrap, its weight left out).
     """
     element = length / n_elements
     inlet = equilibrium_cable.inlet
@@ -395,16 +397,11 @@ def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, co
     return reference, current
 
 
-def _anchor_azimuth(equilibrium_cable) -> float:
-    """Azimuth [rad] of the cable's anchor seen from its swivel axis: where the builder starts psi."""
-    return sp.exit_azimuth(equilibrium_cable.anchor_point, equilibrium_cable.inlet)
-
-
 # --- shared: the descent step, the line search, the rounding floor
 def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
-    """Newton's step -H^-1 g (H dense or scipy sparse (N, N), g (N,)), H shifted by ``relative_shift`` times its
-    largest diagonal entry, then ten times more each time, until the step descends (a node on a rim, a slack
-    element, a swivel angle with no stiffness make H indefinite or singular)."""
+    """Newton's step -H^-1 g (H dense or scipy sparse (N, N), g (N,)), H shifted by ``relative_shift`` times
+    its largest diagonal entry, then ten times more each time, until the step descends (a node on a rim, a
+    slack element, a swivel angle with no stiffness make H indefinite or singular)."""
     is_sparse = sparse.issparse(hessian)
     if is_sparse:
         identity = sparse.identity(hessian.shape[0], format="csc")
@@ -447,7 +444,8 @@ def _line_search(move, energy_of, improves, energy: float, slope: float):
 
 def rounding_floor(stiffness, points) -> float:
     """The force [N] below which a chain's node forces are rounding: an element's k (l - l0), its length from
-    coordinates of size |p|, carries k |p| eps; 16 times that for the sums (``stiffness`` k [N/m], ``points`` [m])."""
+    coordinates of size |p|, carries k |p| eps; 16 times that for the sums (``stiffness`` k [N/m], ``points``
+    [m])."""
     return 16.0 * np.finfo(float).eps * float(np.max(stiffness)) * float(np.abs(points).max())
 
 
@@ -463,10 +461,6 @@ def _positions(robot, layout, position, rotation, v, paid_out):
         p[layout.winch[i]] = cable.winch_node(paid_out[i])
         p[layout.anchor[i]] = position + R @ np.asarray(cable.anchor)
     return p, rotation
-
-
-def _cross(a, f):
-    return a[..., 0] * f[..., 1] - a[..., 1] * f[..., 0]
 
 
 def _selection(robot, layout, p, position):
@@ -583,15 +577,15 @@ def chain_forces(robot: ChainRobot, nodes, position, rotation=0.0, external_wren
     F, _, _, _ = planar_forces(robot, layout, p, with_stiffness=False)
     arms = p[layout.anchor] - position
     force = _platform_force(robot, layout, F, wrench)
-    moment = _cross(arms, F[layout.anchor]).sum() + wrench[2]
+    moment = planar_cross(arms, F[layout.anchor]).sum() + wrench[2]
     return F[layout.interior], np.array([*force, moment])
 
 
 def _straight_guess(robot, position, rotation, tensions):
-    """Start of the iteration: straight chains stretched by ``tensions`` (m,) [N], laid from the anchor back over
-    the pulley with elements of l0 (1 + T / k l0) (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`);
-    the paid-out length follows from where node 0 lands. Returns the interior coordinates (flat) and the
-    paid-out lengths."""
+    """Start of the iteration: straight chains stretched by ``tensions`` (m,) [N], laid from the anchor back
+    over the pulley with elements of l0 (1 + T / k l0)
+    (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`); the paid-out length follows from where node 0
+    lands. Returns the interior coordinates (flat) and the paid-out lengths."""
     R = rotation_matrix(rotation)
     interior, paid_out = [], []
     for cable, tension in zip(robot.cables, tensions):
@@ -642,9 +636,10 @@ def _predict(robot, layout, guess, interior, rotation, paid_out, position, wrenc
 def _planar_inverse(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None, external_wrench=None,
                     guess: ChainEquilibrium | None = None, tension_guess=None, tolerance: float = 1e-7,
                     max_iterations: int = 50) -> ChainEquilibrium:
-    """:func:`solve_inverse_chain_statics` in the plane. Tension-only elements have no stiffness in compression,
-    so Newton from compressed elements can stall: the equilibrium is first sought with springs that also
-    push; where none of its elements is compressed it is the tension-only one as well, else it starts it."""
+    """:func:`solve_inverse_chain_statics` in the plane. Tension-only elements have no stiffness in
+    compression, so Newton from compressed elements can stall: the equilibrium is first sought with springs
+    that also push; where none of its elements is compressed it is the tension-only one as well, else it
+    starts it."""
     kwargs = dict(free_rotation=free_rotation, external_wrench=external_wrench, tolerance=tolerance,
                   max_iterations=max_iterations)
     if not any(c.slack for c in robot.cables):
@@ -746,7 +741,7 @@ def catenary_start(robot: ChainRobot, equilibrium):
             n = cable.n_elements - cable.winch_elements
             points = swivel_chain_start(state, n * cable.element_length, n, cable.winch_elements,
                                         cable.pulley.contact_stiffness)[1]
-            angles[i] = _anchor_azimuth(state)
+            angles[i] = sp.exit_azimuth(state.anchor_point, state.inlet)  # where the builder starts psi
         else:
             points = state.points(length - np.linspace(0.0, length, cable.n_elements + 1))
             points[0] = cable.exit_point
@@ -838,10 +833,6 @@ def _spatial_rest(scene, anchor_spring_factor: float | None = None, tension_only
     catenary = solve_statics(catenary_platform(scene), scene.unstrained_lengths)
     robot = chain_robot(scene, anchor_spring_factor, tension_only, catenary)
     return _spatial_forward(robot, *catenary_start(robot, catenary), **kwargs)
-
-
-#: The swivel angles of a chain without swivel pulleys.
-_NO_SWIVEL = np.zeros(0)
 
 
 # --- the inverse: lengths whose chains hold a pose
@@ -990,7 +981,7 @@ def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, t
     else:
         nodes = _swivel_start(nodes, cable.pulley, held_point, anchor_point)
     if cable.pulley is None:
-        psi = _NO_SWIVEL
+        psi = np.zeros(0)
     elif swivel_angle is None or not np.isfinite(swivel_angle):
         psi = np.array([sp.exit_azimuth(anchor_point, cable.pulley.inlet_array)])
     else:
@@ -1328,8 +1319,8 @@ def solve_inverse_chain_statics(robot: ChainRobot, pose, tension_guess=None, **k
 
 def _planar_inverse_solver(robot: ChainRobot):
     """The plane's :meth:`InverseChainStatics.solve` for ``robot``."""
-    def solve(pose, tension_guess, *, guess=None, lengths=None, nodes=None, swivel_angles=None, free_rotation=None,
-              external_wrench=None, tolerance=1e-7, max_iterations=50):
+    def solve(pose, tension_guess, *, guess=None, lengths=None, nodes=None, swivel_angles=None,
+              free_rotation=None, external_wrench=None, tolerance=1e-7, max_iterations=50):
         if lengths is not None or nodes is not None or swivel_angles is not None:
             raise SceneError("lengths, nodes and swivel_angles start the spatial inverse chain statics; the planar "
                              "one starts from guess or tension_guess")
@@ -1346,8 +1337,8 @@ def _spatial_inverse_solver(robot: ChainRobot):
     """Space's :meth:`InverseChainStatics.solve` for ``robot``: each cable's held model built once."""
     models = [_held_model(c, robot.gravity) for c in robot.cables]
 
-    def solve(pose, tension_guess, *, guess=None, lengths=None, nodes=None, swivel_angles=None, free_rotation=None,
-              external_wrench=None, tolerance=1e-9, max_iterations=30):
+    def solve(pose, tension_guess, *, guess=None, lengths=None, nodes=None, swivel_angles=None,
+              free_rotation=None, external_wrench=None, tolerance=1e-9, max_iterations=30):
         if free_rotation is not None:
             raise SceneError("free_rotation is the planar inverse's: in space a rigid platform on fewer than six "
                              f"cables keeps its rotation free, got {shown(free_rotation)}")

@@ -77,8 +77,8 @@ def _point(name, value, size=None):
 
 @dataclass(frozen=True)
 class SuspendedCable:
-    """One cable of the platform: its weight per unstrained length ``w >= 0`` [N/m], ``EA > 0`` [N], its anchor
-    (platform frame, centre of mass at 0; default the centre) and its exit.
+    """One cable of the platform: its weight per unstrained length ``w >= 0`` [N/m], ``EA > 0`` [N], its
+    anchor (platform frame, centre of mass at 0; default the centre) and its exit.
 
     Give exactly one of ``exit_point`` (world frame, (x, z) or (x, y, z) [m]: its size is the cable's
     dimension) and ``pulley``, the :class:`~cdpr_exu.exits.Exit` the cable leaves from: a planar
@@ -327,9 +327,9 @@ class CableEquilibrium:
         return self.catenary.tension_b
 
     def points(self, s):
-        """Points (n, d) [m] of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor; over a
-        swivel pulley, beyond the suspended part on the wrap (stretched by the tension at the tangent point),
-        up to ``unstrained_length`` at the inlet."""
+        """Points (n, d) [m] of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor;
+        over a swivel pulley, beyond the suspended part on the wrap (stretched by the tension at the tangent
+        point), up to ``unstrained_length`` at the inlet."""
         s = np.atleast_1d(np.asarray(s, dtype=float))
         suspended = self.suspended_length
         hanging = s <= suspended if self.inlet is not None else np.ones(s.shape, bool)
@@ -409,10 +409,8 @@ class PlatformEquilibrium:
         return np.array([c.anchor_point for c in self.cables])
 
 
-def _damped_newton(
-    function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
-    line_search_steps=50,
-):
+def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
+                   line_search_steps=50):
     """Newton's method on ``function(x) -> (residual, jacobian)`` with backtracking on the residual norm;
     returns ``(x, residual, jacobian)``.
 
@@ -549,10 +547,8 @@ def _straight_tangent_angle(pulley, point):
     offset = centre - point
     distance = float(np.hypot(*offset))
     if distance <= pulley.radius:
-        raise UnreachableError(
-            f"anchor point ({point[0]:g}, {point[1]:g}) m lies inside the pulley of centre "
-            f"{pulley.center} m and radius {pulley.radius:g} m"
-        )
+        raise UnreachableError(f"anchor point ({point[0]:g}, {point[1]:g}) m lies inside the pulley of "
+                               f"centre {pulley.center} m and radius {pulley.radius:g} m")
     gamma = math.atan2(offset[1], offset[0])
     spread = math.acos(-pulley.radius / distance)
     for angle in (gamma + spread, gamma - spread):
@@ -564,10 +560,8 @@ def _straight_tangent_angle(pulley, point):
 
 # --- one cable: forward (given unstrained length) and inverse (given H)
 def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_length, tension_scale):
-    """Residual of the pulley cable (span mismatch, tangency) and its partial derivatives.
-
-    Returns ``(residual (3,), d/d(H, V_B, L_c, angle) (3, 4), catenary)``.
-    """
+    """Residual of the pulley cable (span mismatch, tangency) (3,), its derivatives in (H, V_B, L_c, angle)
+    (3, 4), and the suspended part's catenary."""
     catenary = cable.catenary(suspended_length)
     span, jac = span_and_jacobian(catenary, H, V_B, sign_x)
     tangent = pulley.rim_point(angle)
@@ -577,9 +571,7 @@ def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_leng
     residual[:2] = span - (tangent - point)
     residual[2] = scale * (sign_x * H * c + V_B * s)
     partial = np.zeros((3, 4))
-    partial[:2, 0] = jac[:, 0]
-    partial[:2, 1] = jac[:, 1]
-    partial[:2, 2] = jac[:, 2]
+    partial[:2, :3] = jac
     partial[:2, 3] = -pulley.radius * np.array([-s, c])
     partial[2, 0] = scale * sign_x * c
     partial[2, 1] = scale * s
@@ -596,19 +588,14 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
     """A planar cable of given length from an anchor point: its equilibrium (the next guess in it) and
     ``d(force on A)/d(anchor point)`` (2, 2)."""
     if cable.pulley is None:
-        catenary_guess = None if guess is None else guess[:2]
         catenary_cable = cable.catenary(unstrained_length)
-        state = solve_forward(
-            catenary_cable,
-            np.array(cable.exit_point) - point,
-            initial_guess=catenary_guess,
-            max_strain=max_strain,
-            max_tension=max_tension,
-        )
-        stiffness = end_stiffness(cable.catenary(unstrained_length), state)
+        state = solve_forward(catenary_cable, np.array(cable.exit_point) - point,
+                              initial_guess=None if guess is None else guess[:2], max_strain=max_strain,
+                              max_tension=max_tension)
         guess = (state.horizontal_tension, state.vertical_tension_b)
-        return _planar_equilibrium(state, catenary_cable, unstrained_length, point, np.array(cable.exit_point),
-                                   guess), stiffness
+        equilibrium = _planar_equilibrium(state, catenary_cable, unstrained_length, point,
+                                          np.array(cable.exit_point), guess)
+        return equilibrium, end_stiffness(catenary_cable, state)
 
     pulley, EA, w, r = cable.pulley, cable.axial_stiffness, cable.weight_per_length, cable.pulley.radius
 
@@ -628,13 +615,10 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
             angle = _straight_tangent_angle(pulley, point)
             suspended = unstrained_length - r * pulley.wrap_to(angle)
             if suspended <= 0.0:
-                raise UnreachableError(
-                    f"unstrained_length {unstrained_length:g} m is shorter than the wrap on the pulley"
-                )
-            state = solve_forward(
-                cable.catenary(suspended), pulley.rim_point(angle) - point,
-                max_strain=max_strain, max_tension=max_tension,
-            )
+                raise UnreachableError(f"unstrained_length {unstrained_length:g} m is shorter than the wrap "
+                                       "on the pulley")
+            state = solve_forward(cable.catenary(suspended), pulley.rim_point(angle) - point,
+                                  max_strain=max_strain, max_tension=max_tension)
             H, V_B = state.horizontal_tension, state.vertical_tension_b
             if H <= 0.0:  # a just-taut massless (or vertical) start: pull a little
                 H = 1e-9 * EA
@@ -649,17 +633,12 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
             length, derivative, _ = suspended_length(x)
             if length <= 0.0:
                 raise UnreachableError("the whole cable would lie on the pulley")
-            residual, partial, _ = _pulley_residual(
-                cable, pulley, sign_x, point, x[0], x[1], x[2], length, tension_scale
-            )
-            jacobian = partial[:, [0, 1, 3]] + np.outer(partial[:, 2], derivative)
-            return residual, jacobian
+            residual, partial, _ = _pulley_residual(cable, pulley, sign_x, point, x[0], x[1], x[2], length,
+                                                    tension_scale)
+            return residual, partial[:, [0, 1, 3]] + np.outer(partial[:, 2], derivative)
 
-        tolerance = _RELATIVE_TOLERANCE * unstrained_length
-        x, _, jacobian = _damped_newton(
-            function, (H, V_B, angle), tolerance, positive=(0,), what="pulley cable",
-            **_INNER_NEWTON,
-        )
+        x, _, jacobian = _damped_newton(function, (H, V_B, angle), _RELATIVE_TOLERANCE * unstrained_length,
+                                        positive=(0,), what="pulley cable", **_INNER_NEWTON)
         return x, jacobian, sign_x, tension_scale
 
     x, jacobian, sign_x, _ = _warm_then_cold(solve_from, guess)
@@ -668,10 +647,8 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
     catenary_cable = cable.catenary(length)
     state = state_from_end_forces(catenary_cable, H, V_B, sign_x)
     if state.max_tension > tension_limit(cable.axial_stiffness, max_strain, max_tension):
-        raise UnreachableError(
-            f"cable of unstrained_length {unstrained_length:g} m would need tension "
-            f"{state.max_tension:g} N, above its limit"
-        )
+        raise UnreachableError(f"cable of unstrained_length {unstrained_length:g} m would need tension "
+                               f"{state.max_tension:g} N, above its limit")
     # d(H, V_B, angle)/d(point) = -jacobian^-1 d(residual)/d(point), d(residual)/d(point) = [I; 0]
     sensitivity = -np.linalg.solve(jacobian, np.vstack([np.eye(2), np.zeros((1, 2))]))
     force_derivative = np.array([[sign_x, 0.0, 0.0], [-w * derivative[0], 1.0 - w * derivative[1], -w * derivative[2]]])
@@ -682,10 +659,8 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
 
 
 def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
-    """A planar cable with given horizontal tension from an anchor point.
-
-    Returns ``(CableEquilibrium, dF_A/dH (2,), dF_A/dp_A at fixed H (2, 2))``, the next guess in the first.
-    """
+    """A planar cable with given horizontal tension from an anchor point: ``(CableEquilibrium, dF_A/dH (2,),
+    dF_A/dp_A at fixed H (2, 2))``, the next guess in the first."""
     H, w, EA = horizontal_tension, cable.weight_per_length, cable.axial_stiffness
     if cable.pulley is None:
         span = np.array(cable.exit_point) - point
@@ -704,10 +679,8 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
         def solve_from(start_guess):
             if start_guess is None:
                 angle = _straight_tangent_angle(pulley, point)
-                length, state = solve_inverse(
-                    pulley.rim_point(angle) - point, w, EA, H,
-                    max_strain=max_strain, max_tension=max_tension,
-                )
+                length, state = solve_inverse(pulley.rim_point(angle) - point, w, EA, H,
+                                              max_strain=max_strain, max_tension=max_tension)
                 V_B = state.vertical_tension_b
             else:
                 length, V_B, angle = start_guess
@@ -717,15 +690,12 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
             def function(x):
                 if x[0] <= 0.0:
                     raise UnreachableError("suspended length must stay positive")
-                residual, partial, _ = _pulley_residual(
-                    cable, pulley, sign_x, point, H, x[1], x[2], x[0], tension_scale
-                )
+                residual, partial, _ = _pulley_residual(cable, pulley, sign_x, point, H, x[1], x[2], x[0],
+                                                        tension_scale)
                 return residual, partial[:, [2, 1, 3]]
 
-            x, _, jacobian = _damped_newton(
-                function, (length, V_B, angle), _RELATIVE_TOLERANCE * length, positive=(0,),
-                what="pulley cable", **_INNER_NEWTON,
-            )
+            x, _, jacobian = _damped_newton(function, (length, V_B, angle), _RELATIVE_TOLERANCE * length,
+                                            positive=(0,), what="pulley cable", **_INNER_NEWTON)
             return x, jacobian, sign_x, tension_scale
 
         x, jacobian, sign_x, tension_scale = _warm_then_cold(solve_from, guess)
@@ -764,12 +734,16 @@ def _vertical_plane_forward_cable(cable, unstrained_length, anchor_point, guess,
     vertical = horizontal <= 1e-9 * max(unstrained_length, float(np.linalg.norm(span)))
     sideways = -planar[0, 0] if vertical else state.horizontal_tension / horizontal
     stiffness -= sideways * (_HORIZONTAL - np.outer(direction, direction))
-    equilibrium = CableEquilibrium(
-        state, float(unstrained_length), np.array(anchor_point, dtype=float), exit_point,
-        state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
-        state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
-        catenary_cable, (state.horizontal_tension, state.vertical_tension_b), direction)
-    return equilibrium, stiffness
+    return _in_vertical_plane(state, float(unstrained_length), anchor_point, exit_point, catenary_cable,
+                              (state.horizontal_tension, state.vertical_tension_b), direction), stiffness
+
+
+def _in_vertical_plane(state, length, anchor_point, exit_point, catenary_cable, guess, direction):
+    """A point exit's cable, the catenary ``state`` in the vertical plane along ``direction`` (3,), in 3-D."""
+    return CableEquilibrium(state, length, np.array(anchor_point, dtype=float), exit_point,
+                            state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
+                            state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z, catenary_cable,
+                            guess, direction)
 
 
 def _swivel_plane(cable, anchor_point):
@@ -825,11 +799,9 @@ def _vertical_plane_inverse_cable(cable, horizontal_tension, anchor_point, guess
     direction = np.array([span[0], span[1], 0.0]) / horizontal
     length, state = solve_inverse((horizontal, span[2]), cable.weight_per_length, cable.axial_stiffness,
                                   horizontal_tension)
-    return CableEquilibrium(
-        state, length, np.array(anchor_point, dtype=float), exit_point,
-        state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
-        state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
-        cable.catenary(length), None, direction), None, None
+    equilibrium = _in_vertical_plane(state, length, anchor_point, exit_point, cable.catenary(length), None,
+                                     direction)
+    return equilibrium, None, None
 
 
 def _swivel_inverse_cable(cable, horizontal_tension, anchor_point, guess, max_strain, max_tension):
@@ -1433,11 +1405,9 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
         free_rotation = rotation is None
         rotation = 0.0 if rotation is None else finite("rotation", rotation)
     if n + int(free_rotation) != dof:
-        raise SceneError(
-            f"inverse statics needs as many unknowns as equations: {n} cables"
-            f"{' + rotation' if free_rotation else ''} for {dof} equations; "
-            f"give a position (x, z) for a rigid platform on 2 cables, a pose (x, z, rotation) on 3"
-        )
+        raise SceneError(f"inverse statics needs as many unknowns as equations: {n} cables"
+                         f"{' + rotation' if free_rotation else ''} for {dof} equations; give a position "
+                         f"(x, z) for a rigid platform on 2 cables, a pose (x, z, rotation) on 3")
     horizontal, tensions, _ = _ideal_tensions(platform, position, rotation, wrench, free_rotation)
     if np.any(tensions <= 0.0):
         # straight massless cables would push; start from a moderate pull and let
@@ -1470,9 +1440,8 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
             jacobian[2, i] = planar_cross(arm, force_dH)
             d_force_dphi = force_dp @ perpendicular(arm)
             jacobian[:2, n] += d_force_dphi
-            jacobian[2, n] += planar_cross(arm, d_force_dphi) + planar_cross(
-                perpendicular(arm), equilibrium.force_on_platform
-            )
+            jacobian[2, n] += (planar_cross(arm, d_force_dphi)
+                               + planar_cross(perpendicular(arm), equilibrium.force_on_platform))
         guesses[:] = [e.guess for e in equilibria]
         residual = kernel.wrench_residual(platform, phi, equilibria, wrench)[:dof]
         columns = list(range(n)) + ([n] if free_rotation else [])
@@ -1523,9 +1492,8 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
                                                        wrench, max_strain, max_tension)
             except UnreachableError:
                 pass
-        raise UnreachableError(
-            f"no equilibrium with pulling cables at position ({position[0]:g}, {position[1]:g}) m ({error})"
-        ) from None
+        raise UnreachableError(f"no equilibrium with pulling cables at position ({position[0]:g}, "
+                               f"{position[1]:g}) m ({error})") from None
     evaluate(scaled / unknown_scale)
     equilibria, phi = cache["last"]
     # stiffness at fixed lengths: the forward cable derivatives at the solution
@@ -1533,11 +1501,8 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
     for cable, equilibrium in zip(platform.cables, equilibria):
         guess = None
         if cable.pulley is not None:
-            guess = (
-                equilibrium.catenary.horizontal_tension,
-                equilibrium.catenary.vertical_tension_b,
-                _rim_angle(cable.pulley, equilibrium.exit_point),
-            )
+            guess = (equilibrium.catenary.horizontal_tension, equilibrium.catenary.vertical_tension_b,
+                     _rim_angle(cable.pulley, equilibrium.exit_point))
         _, stiffness = forward_cable(cable, equilibrium.unstrained_length, equilibrium.anchor_point, guess,
                                      max_strain, max_tension)
         stiffnesses.append(stiffness)
