@@ -92,24 +92,21 @@ class CatenaryCable:
 
 @dataclass(frozen=True, eq=False)
 class CatenaryState:
-    """A solved elastic catenary: end forces, tensions and geometry.
+    """A solved elastic catenary.
 
     Attributes
     ----------
     horizontal_tension : float [N]
-        ``H >= 0``, the horizontal tension component, constant along the cable.
+        ``H >= 0``, constant along the cable.
     vertical_tension_a, vertical_tension_b : float [N]
-        ``V_A`` and ``V_B = V_A + w L``: vertical component of the tension vector
-        (pointing from A to B) at A and at B. ``V_B`` is the upward force the support
-        at B exerts on the cable; ``-V_A`` the one the support at A exerts.
+        ``V_A`` and ``V_B = V_A + w L``, the tension vector's (A towards B) vertical component at A and B:
+        ``V_B`` is the upward force of the support at B on the cable, ``-V_A`` the one at A.
     force_on_a, force_on_b : ndarray, shape (2,) [N]
-        Forces (x, z) the cable exerts on its supports at A and at B. Their sum is
-        the cable weight ``(0, -w L)``.
+        Forces (x, z) of the cable on its supports at A and B; their sum is its weight ``(0, -w L)``.
     tension_a, tension_b : float [N]
-        Tension magnitudes at the ends; the largest tension is at one of them.
-    unstrained_length : float [m]
-    stretched_length : float [m]
-        Arc length of the loaded cable.
+        Tensions at the ends, the largest along the cable at one of them.
+    unstrained_length, stretched_length : float [m]
+        The latter the arc length of the loaded cable.
     span : ndarray, shape (2,) [m]
         ``p_B - p_A``.
     """
@@ -284,12 +281,9 @@ def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizon
 
 
 def _vertical_solution(L, w, EA, dz):
-    """``V_B`` of a vertical cable (H = 0) with span ``(0, dz)``: closed form.
-
-    Three regimes, each linear in ``V_B``: taut with B above A (``V_A >= 0``), taut
-    with B below A (``V_B <= 0``), or slack and folded into a zero-width U with the
-    low point inside (``V_A < 0 < V_B``, only for ``w > 0``).
-    """
+    """``V_B`` of a vertical cable (H = 0) with span ``(0, dz)``, in closed form: taut with B above A
+    (``V_A >= 0``), taut with B below A (``V_B <= 0``), or slack and folded into a zero-width U
+    (``V_A < 0 < V_B``, only for ``w > 0``), each linear in ``V_B``."""
     V_A = (dz - L) * EA / L - 0.5 * w * L
     if V_A >= 0.0:
         return V_A + w * L
@@ -302,14 +296,10 @@ def _vertical_solution(L, w, EA, dz):
 
 
 def _initial_guess(L, w, EA, dx, dz):
-    """Starting ``(H, V_B)`` for the Newton solve (dx > 0, w > 0).
-
-    Taut spans (chord >= L) start from the straight elastic spring plus half the
-    cable weight at each end, or from MoorPy's taut guess ``lambda = 0.2`` if that
-    is larger. Slack spans use the parabolic estimate of Peyrot and Goulois (as in
-    FAST and MoorPy's ``catenary``): ``lambda = sqrt(3 ((L^2 - dz^2)/dx^2 - 1))``,
-    ``H = w dx / (2 lambda)``, ``V_B = w/2 (dz / tanh(lambda) + L)``.
-    """
+    """Starting ``(H, V_B)`` for Newton (dx > 0, w > 0). Taut spans (chord >= L): the straight elastic spring
+    plus half the weight at each end, or MoorPy's taut guess ``lambda = 0.2`` if larger. Slack spans: the
+    parabolic estimate of Peyrot and Goulois (FAST, MoorPy): ``lambda = sqrt(3 ((L^2 - dz^2)/dx^2 - 1))``,
+    ``H = w dx / (2 lambda)``, ``V_B = w/2 (dz / tanh(lambda) + L)``."""
     chord = math.hypot(dx, dz)
     if chord >= L:
         spring_tension = EA * (chord - L) / L
@@ -323,13 +313,9 @@ def _initial_guess(L, w, EA, dx, dz):
 
 
 def _damped_newton_2d(residual, x, y, tolerance, max_drop=None):
-    """Damped Newton on two unknowns ``(x, y)``, ``x`` kept positive.
-
-    ``residual(x, y)`` returns ``(rx, rz, jacobian)``. The step is scaled as a whole
-    (keeping its direction) so that ``x`` drops by at most the fraction ``max_drop``
-    (if given), then halved until the residual norm decreases (Armijo). Returns
-    ``(x, y, norm)`` at convergence (norm <= tolerance) or where the iteration stalls.
-    """
+    """Damped Newton on two unknowns, ``residual(x, y) -> (rx, rz, jacobian)``, ``x`` kept positive: the step,
+    scaled as a whole so that ``x`` drops by at most the fraction ``max_drop``, halved until the residual norm
+    decreases (Armijo). Returns ``(x, y, norm)`` at convergence or where the iteration stalls."""
     rx, rz, jac = residual(x, y)
     norm = math.hypot(rx, rz)
     for _ in range(_MAX_NEWTON_ITERATIONS):
@@ -362,13 +348,9 @@ def _damped_newton_2d(residual, x, y, tolerance, max_drop=None):
 
 
 def _newton_forward(L, w, EA, dx, dz, H, V_B):
-    """Damped Newton in ``(H, V_B)``; returns ``(H, V_B, converged)``.
-
-    The step is scaled as a whole (keeping its direction: near-taut cables have a
-    narrow valley along the cable direction, which a change of variables such as
-    ``log H`` would leave) so that ``H`` drops by at most 90 %, then halved until
-    the residual norm decreases (Armijo).
-    """
+    """:func:`_damped_newton_2d` in ``(H, V_B)``, ``H`` dropping by at most 90 % (the step keeps its
+    direction: near-taut cables have a narrow valley along the cable that a change of variables such as ``log
+    H`` would leave); returns ``(H, V_B, converged)``."""
     scale = max(L, math.hypot(dx, dz))
     tolerance = _RELATIVE_TOLERANCE * scale
 
@@ -392,14 +374,10 @@ def _bracket_root(function, low, high, grow):
 
 
 def _nested_forward(L, w, EA, dx, dz, H_start):
-    """Globally convergent fallback: nested bracketing in ``log H`` and ``V_B``.
-
-    ``dz`` increases strictly with ``V_B`` at fixed ``H`` (``J22 > 0``), and along the
-    curve of fixed ``dz``, ``dx`` increases strictly with ``H`` (``det J / J22 > 0``, the
-    flexibility matrix being positive definite), so two nested Brent solves always
-    find the solution. Used when Newton fails near the singular corners of the
-    catenary (a vertical, just-taut cable whose lower end is at zero tension).
-    """
+    """Globally convergent fallback, for the singular corner of a vertical just-taut cable whose lower end is
+    at zero tension: nested Brent solves in ``log H`` and ``V_B``. ``dz`` grows strictly with ``V_B`` at fixed
+    ``H`` (``J22 > 0``), and along a curve of fixed ``dz``, ``dx`` with ``H`` (``det J / J22 > 0``, the
+    flexibility being positive definite), so they always find the solution."""
     from scipy.optimize import brentq
 
     weight = max(w * L, 1e-300)
@@ -452,24 +430,16 @@ def _solve_span(L, w, EA, dx, dz, guess):
 
 
 def solve_forward(cable, span, initial_guess=None, max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
-    """The :class:`CatenaryState` of a cable of given unstrained length hung across ``span`` (2,) [m]
-    (``p_B - p_A``, any signs).
+    """The :class:`CatenaryState` of a cable hung across ``span`` (2,) [m] (``p_B - p_A``, any signs).
 
-    Newton's method on Irvine's two equations in ``(H, V_B)``, steps limited to keep ``H`` positive,
-    a backtracking line search, from ``initial_guess`` (``(H, V_B)`` [N] in the frame where
-    ``dx >= 0``, eg the previous solution along a path) or the Peyrot-Goulois / MoorPy guess.
-    Should Newton stall (a just-taut, nearly vertical cable whose lower end is at zero tension),
-    a nested bracketing solve, which always converges, takes over. Vertical spans
-    (``|dx| <= 1e-12 L``) and massless cables are solved in closed form. ``max_strain`` (of
-    ``T / EA``) and ``max_tension`` [N] bound the tension (:func:`tension_limit`).
+    Newton's method on Irvine's equations in ``(H, V_B)`` (steps keep ``H`` positive, backtracking), from
+    ``initial_guess`` (``(H, V_B)`` [N] where ``dx >= 0``, eg the previous solution along a path) or the
+    Peyrot-Goulois / MoorPy guess; should it stall (a just-taut, nearly vertical cable whose lower end is at
+    zero tension), a nested bracketing solve, which always converges. Vertical spans (``|dx| <= 1e-12 L``)
+    and massless cables in closed form. ``max_strain`` and ``max_tension`` [N]: :func:`tension_limit`.
 
-    Raises
-    ------
-    UnreachableError
-        If the straight distance between the ends exceeds what the cable reaches at
-        the tension limit, or if the solution exceeds it.
-    SceneError
-        If ``span`` is not a finite 2-vector or a limit is not positive.
+    Raises UnreachableError if the chord exceeds the cable's reach at the tension limit or the solution
+    the limit; SceneError if ``span`` is not a finite 2-vector or a limit is not positive.
     """
     span = _span_vector(span)
     if not isinstance(cable, CatenaryCable):
@@ -530,17 +500,11 @@ def solve_inverse(span, weight_per_length, axial_stiffness, horizontal_tension, 
                   max_tension=None):
     """Unstrained length [m] and :class:`CatenaryState` of the cable (``w >= 0`` [N/m], ``EA > 0`` [N]) that
     hangs across ``span`` (2,) [m] (``dx != 0``: a vertical cable has ``H = 0``) with horizontal tension
-    ``H > 0`` [N]; the tension limit as in :func:`solve_forward`.
+    ``H > 0`` [N]: the closed-form inextensible catenary, corrected for the stretch by Newton's method in
+    ``(L, V_B)``. The tension limit as in :func:`solve_forward`.
 
-    The closed-form inextensible catenary, corrected for the stretch by Newton's method in
-    ``(L, V_B)`` with the analytic Jacobian.
-
-    Raises
-    ------
-    UnreachableError
-        If the span is vertical, or the tension exceeds the limit, or Newton fails.
-    SceneError
-        If an argument is invalid.
+    Raises UnreachableError for a vertical span, a tension above the limit or a failed Newton;
+    SceneError for an invalid argument.
     """
     span = _span_vector(span)
     w = non_negative("weight_per_length", weight_per_length)
@@ -600,14 +564,8 @@ def _newton_inverse(w, EA, H, dx, dz, L, V_B):
 
 def profile(cable, state, s):
     """Points ``(x, z)`` (n, 2) [m] relative to A of the loaded cable (``state`` a solution of ``cable``) at
-    unstrained arc lengths ``s`` (n,) [m] from A, in ``[0, L]``: the span formula with ``L`` replaced by
-    ``s`` and ``V_B`` by ``V(s) = V_A + w s``.
-
-    Raises
-    ------
-    SceneError
-        If an ``s`` lies outside ``[0, L]`` (beyond round-off).
-    """
+    unstrained arc lengths ``s`` (n,) [m] from A: the span formula with ``L`` replaced by ``s`` and ``V_B``
+    by ``V(s) = V_A + w s``. SceneError for an ``s`` outside ``[0, L]`` (beyond round-off)."""
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
     s = np.atleast_1d(real_array("s", s))
     if s.ndim != 1 or not np.all(np.isfinite(s)):

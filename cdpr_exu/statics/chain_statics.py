@@ -64,17 +64,13 @@ class ChainCable:
     anchor : (x, z) or (x, y, z) [m]
         In the platform frame (centre of mass at 0); its size is the Space's.
     pulley : Exit, SwivelPulley or None
-        In the plane the exit (required): node 0 hangs on its winch line by the paid-out length, and a
-        pulley's rim pushes the nodes. In space the swivel pulley every node may touch, None at a point exit.
-    contact_stiffness : float [N/m]
-        In the plane, the rim's penalty k_p (0: no contact); a swivel pulley carries its own.
-    exit_point : (x, y, z) [m], in space (required there)
-        Where node 0 is held: the exit point, or over a swivel pulley the winch end on its axis.
-    winch_elements : int
-        Over a swivel pulley: the elements of the winch line, below the inlet (else 0).
-    winch_travel : float [m]
-        Over a swivel pulley: how far the winch has moved the held winch end up the axis from
-        ``exit_point`` (:class:`cdpr_exu.run.run_3d._SpatialWinches` keeps the elements).
+        In the plane the exit (required): node 0 hangs on its winch line by the paid-out length, a
+        pulley's rim (penalty ``contact_stiffness`` k_p [N/m], 0: none) pushes the nodes. In space the
+        swivel pulley every node may touch (its own k_p), None at a point exit.
+    exit_point, winch_elements, winch_travel : (x, y, z) [m], int, float [m]; in space
+        Where node 0 is held (required): the exit point, or over a swivel pulley the winch end on its
+        axis, ``winch_elements`` below the inlet, moved up the axis by ``winch_travel`` by the winch
+        (:class:`cdpr_exu.run.run_3d._SpatialWinches` keeps the elements).
     """
 
     node_masses: tuple
@@ -283,24 +279,19 @@ class ChainEquilibrium:
 
     Attributes
     ----------
-    position : ndarray, shape (d,) [m]
-        Platform centre of mass.
-    rotation : float [rad] in the plane, ndarray (3, 3) in space
-        Platform frame to world frame (0 / identity for a point mass).
+    position, rotation : ndarray (d,) [m]; float [rad] (plane) or ndarray (3, 3) (space)
+        The platform's centre of mass and rotation (0 / identity for a point mass).
     nodes, tensions : tuple of ndarray, shape (n + 1, d) [m], (n,) [N] each
         Each cable's nodes and elements' axial forces, winch (exit) first.
     forces_on_platform : ndarray, shape (m, d) [N]
-        Each cable's force on the platform at its anchor (the last element's pull, the bending shear and
-        the anchor node's weight; a penalty joint's force if any).
+        Each cable's force at its anchor (the last element's pull, the bending shear, the anchor node's
+        weight; a penalty joint's force if any).
     paid_out : ndarray, shape (m,) [m]
-        Each winch's paid-out length (in the plane beyond the hang point; in space
-        :attr:`ChainCable.paid_out_length`).
+        In the plane beyond the hang point; in space :attr:`ChainCable.paid_out_length`.
     residual : float [N]
         Largest force (moment) imbalance left.
-    swivel_angles : ndarray, shape (m,) [rad] or None
-        In space, each swivel pulley's angle psi (NaN at a point exit).
-    rotation_vector : ndarray, shape (1,) or (3,) [rad]
-        The rotation's coordinates in the pose.
+    swivel_angles, rotation_vector : ndarray (m,) [rad] or None; ndarray (1,) or (3,) [rad]
+        In space each swivel pulley's psi (NaN at a point exit); the rotation's coordinates in the pose.
     """
 
     position: np.ndarray
@@ -863,21 +854,11 @@ def robot_paid_out(robot: ChainRobot, lengths) -> ChainRobot:
 
 @dataclass(frozen=True, eq=False)
 class HeldChain:
-    """One lumped cable at rest between its exit point and a fixed anchor point.
-
-    Attributes
-    ----------
-    nodes : ndarray, shape (n + 1, 3) [m]
-        Exit (over a swivel pulley the held winch end) first, the anchor point last.
-    tensions : ndarray, shape (n,) [N]
-    force : ndarray, shape (3,) [N]
-        The cable's force on the anchor (on the platform).
-    force_rate : ndarray, shape (3,) [N/m]
-        d(force)/d(paid-out length), the anchor held and the chain re-settled (implicit function theorem),
-        paid out as the run's winch pays out (:func:`cable_paid_out`).
-    swivel_angle : float [rad]
-        The swivel pulley's psi (NaN at a point exit).
-    """
+    """One lumped cable at rest between its exit point (over a swivel pulley its held winch end) and a fixed
+    anchor point: ``nodes`` (n + 1, 3) [m] and ``tensions`` (n,) [N] exit first, its ``force`` on the anchor
+    (3,) [N], ``force_rate`` (3,) [N/m] its derivative in the paid-out length with the anchor held and the
+    chain re-settled (implicit function theorem; paid out as :func:`cable_paid_out`), and ``swivel_angle``
+    psi [rad] (NaN at a point exit)."""
 
     nodes: np.ndarray
     tensions: np.ndarray
@@ -1208,24 +1189,15 @@ def solve_chain_statics(robot: ChainRobot, nodes, position, rotation=None, swive
     ----------
     robot : ChainRobot
     nodes : sequence of array_like, each shape (n + 1, 3) [m]
-        Start of each cable's nodes, exit first (eg :func:`catenary_start`); the ends are put on the
-        exit point and (exact joints) the anchor.
-    position : (x, y, z) [m]
-    rotation : ndarray, shape (3, 3), optional
-        Start pose (rotation default identity, ignored for a point mass).
-    swivel_angles : array_like, shape (m,) [rad], optional
-        Start of each swivel pulley's psi (point exits' entries ignored); default each turned towards
-        its cable's last start node.
+        Start of each cable's nodes, exit first (eg :func:`catenary_start`).
+    position, rotation, swivel_angles : (3,) [m], (3, 3) optional, (m,) [rad] optional
+        Start of the platform's pose (rotation default identity, ignored for a point mass) and of each
+        swivel pulley's psi (default turned towards its cable's last start node).
     tolerance : float [N]
-        Largest gradient entry accepted (forces; moments and swivel torques [N m]); at least the rounding
-        floor (:func:`rounding_floor`: 1.6e-7 N on CoGiRo's steel ropes, where 1e-9 N is out of reach).
-    max_iterations : int
+        Largest gradient entry accepted (moments [N m]); at least the rounding floor
+        (:func:`rounding_floor`: 1.6e-7 N on CoGiRo's steel ropes, where 1e-9 N is out of reach).
     external_force : (fx, fy, fz) [N], optional
         Constant extra force on the centre of mass (eg the d'Alembert force -M a).
-
-    Returns
-    -------
-    ChainEquilibrium
 
     Raises
     ------
@@ -1268,14 +1240,13 @@ class InverseChainStatics:
 def solve_inverse_chain_statics(robot: ChainRobot, pose, tension_guess=None, **kwargs) -> ChainEquilibrium:
     """Paid-out lengths, nodes and tensions of the chains that hold ``robot``'s platform at ``pose``.
 
-    Plane (:func:`_planar_inverse`): the nodes minimise the potential at fixed paid-out lengths, the
-    lengths cancel the force the held platform needs; a rigid platform on two cables chooses its rotation
-    (``free_rotation``), on three it is imposed. Space (:func:`_solve_inverse`): Gauss-Newton on the lengths
-    over chains held at their anchors (the cables decouple; only the platform's balance ties them: six
-    equations, three for a point mass or fewer than six cables, whose rotation is left free); among the
-    changes that cancel the imbalance to first order, the one whose tensions (norms of the forces on the
-    platform) come nearest ``tension_guess``: continued along a trajectory, a redundant robot keeps its
-    internal tension.
+    Plane (:func:`_planar_inverse`): the nodes minimise the potential at fixed paid-out lengths, the lengths
+    cancel the force the held platform needs; a rigid platform on two cables chooses its rotation, on three
+    it is imposed. Space (:func:`_solve_inverse`): Gauss-Newton on the lengths over chains held at their
+    anchors, tied only by the platform's balance (six equations; three for a point mass or fewer than six
+    cables, whose rotation is left free); of the changes that cancel the imbalance to first order, the one
+    whose tensions come nearest ``tension_guess``: continued along a trajectory, a redundant robot keeps
+    its internal tension.
 
     Parameters
     ----------
@@ -1285,27 +1256,21 @@ def solve_inverse_chain_statics(robot: ChainRobot, pose, tension_guess=None, **k
         Plane: (x, z) or (x, z, rotation) (imposed, or the start if free). Space: (x, y, z) for a point
         mass or (x, y, z, rotation vector).
     tension_guess : array_like, shape (m,) [N], optional
-        Plane: tensions (>= 0) of the straight start chains, without ``guess``. Space: positive tensions to
-        stay near (default the ``guess``'s).
+        Plane: tensions (>= 0) of the straight start chains, without ``guess``. Space: positive tensions
+        to stay near (default the ``guess``'s).
     guess : ChainEquilibrium, optional
-        A nearby solution (eg the previous pose's), the start (in space its lengths, nodes and angles
-        unless given).
+        A nearby solution, the start (in space its lengths, nodes and angles, unless given).
     lengths, nodes, swivel_angles : optional, in space
-        Start of the paid-out lengths (m,) [m], of each cable's nodes (n + 1, 3) [m] (moved onto the
-        anchors as :func:`solve_held_chain` does), and of each psi (m,) [rad] (NaN: the anchor's azimuth).
+        Start of the paid-out lengths (m,) [m], each cable's nodes (n + 1, 3) [m] and each psi (m,) [rad]
+        (NaN: the anchor's azimuth).
     free_rotation : bool, optional, in the plane
         Let equilibrium choose the rotation (default: a rigid platform on two cables).
     external_wrench : array_like, optional [N, N m]
         Extra load about the centre of mass: (fx, fz, moment) in the plane, (f, moment) in space.
-    tolerance : float, optional
-        Plane: the force imbalance accepted [N] (1e-7). Space: the platform's imbalance relative to the
-        larger of the weight and the largest cable force (1e-9).
-    max_iterations : int, optional
-        Of each Newton iteration (plane, 50) or of the Gauss-Newton (space, 30).
-
-    Returns
-    -------
-    ChainEquilibrium
+    tolerance, max_iterations : float, int, optional
+        Plane: the force imbalance accepted [N] (1e-7), each Newton's iterations (50). Space: the
+        imbalance relative to the larger of the weight and the largest cable force (1e-9), Gauss-Newton
+        iterations (30).
 
     Raises
     ------

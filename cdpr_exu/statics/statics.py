@@ -137,18 +137,13 @@ class SuspendedCable:
 @dataclass(frozen=True)
 class SuspendedPlatform:
     """A platform hung on catenary cables (all planar or all spatial), of mass ``M >= 0`` [kg] whose weight
-    ``M g`` (``gravity`` [m/s^2], default 9.81) acts at its centre of mass along -z.
+    ``M g`` (``gravity`` [m/s^2], default 9.81) acts at its centre of mass along -z; ``inertia`` [kg m^2]
+    about it: planar about the plane's normal, spatial the principal moments (default 0).
 
-    ``inertia`` [kg m^2] about the centre of mass: planar the moment about the plane's normal, spatial
-    the principal moments along the platform axes; default 0 (only :func:`inertial_wrench` uses it).
-
-    Raises
-    ------
-    SceneError
-        Naming the field: no cables, cables of two dimensions, a negative mass, two cables sharing an
-        exit point, two cables of a rigid platform sharing an anchor, too few cables to hang it (a point
-        mass needs one, a rigid body two), or, in space, anchors all on one line through the centre of
-        mass (it would turn freely about it).
+    Raises SceneError naming the field: no cables, cables of two dimensions, a negative mass, two cables
+    sharing an exit point, two cables of a rigid platform sharing an anchor, too few cables to hang it (a
+    point mass needs one, a rigid body two), or, in space, anchors all on one line through the centre of
+    mass (it would turn freely about it).
     """
 
     cables: tuple
@@ -233,14 +228,11 @@ def catenary_platform(scene) -> SuspendedPlatform:
 
 
 def inertial_wrench(platform, acceleration, angular_acceleration=None):
-    """D'Alembert load ``(-M a, -I alpha)`` for dynamic feed-forward, shape (wrench_size,) [N, N m].
+    """D'Alembert load ``(-M a, -I alpha)`` (wrench_size,) [N, N m] for dynamic feed-forward, as
+    ``external_wrench`` of the statics (the cables' inertia neglected: they stay quasi-static).
 
-    ``acceleration`` (d,) [m/s^2] of the centre of mass; ``angular_acceleration`` [rad/s^2]: planar a
-    float, spatial (3,) about the platform axes (its principal axes; the moment neglects the
-    gyroscopic term and holds at the reference orientation); default none. To pass as
-    ``external_wrench`` to the statics solvers; the cables' inertia is neglected (they stay in
-    quasi-static equilibrium).
-    """
+    ``acceleration`` (d,) [m/s^2] of the centre of mass; ``angular_acceleration`` [rad/s^2], planar a float,
+    spatial (3,) about the platform's principal axes (no gyroscopic term; at the reference orientation)."""
     space = platform.space
     a = vector("acceleration", acceleration, space.position_size, f" ({', '.join(space.position_labels)}) [m/s^2]")
     if angular_acceleration is None:
@@ -282,20 +274,16 @@ class CableEquilibrium:
     unstrained_length : float [m]
         Total: suspended part plus, over a pulley, the wrap up to the hang point.
     anchor_point, exit_point : ndarray, shape (d,) [m]
-        World positions of the anchor and of the exit (over a pulley: tangent) point.
+        The anchor and the exit (over a pulley: tangent) point.
     force_on_platform, force_on_exit : ndarray, shape (d,) [N]
-        Forces the cable exerts on the platform and on its exit (tangent) point.
+        The cable's forces on the platform and on its exit (tangent) point.
     cable : CatenaryCable
-        The suspended part's catenary parameters.
-    guess : tuple
-        Warm start of the next solve of this cable.
+        The suspended part's; ``guess`` warm-starts the cable's next solve.
     horizontal_direction : ndarray, shape (d,)
-        The x axis of the catenary's plane: planar (1, 0); spatial the horizontal unit vector from the
-        anchor towards the exit, over a swivel ``e_rho`` from the axis towards the anchor.
-    pulley_radius, wrap_angle : float [m], [rad]
-        Of the disc the cable wraps (0 for a fixed exit point).
-    inlet : ndarray, shape (3,) [m] or None
-        A swivel pulley's inlet.
+        The catenary plane's x axis: planar (1, 0); spatial the horizontal unit vector from the anchor
+        towards the exit, over a swivel ``e_rho`` from the axis towards the anchor.
+    pulley_radius, wrap_angle, inlet : float [m], float [rad], ndarray (3,) [m] or None
+        The disc the cable wraps (0 for a fixed exit point); a swivel pulley's inlet.
     """
 
     catenary: CatenaryState
@@ -357,16 +345,13 @@ class PlatformEquilibrium:
     ----------
     position : ndarray, shape (d,) [m]
         Centre of mass.
-    rotation : float or ndarray, shape (3,) [rad]
-        Planar the angle ``phi``, spatial the rotation vector; 0 for a point mass.
-    rotation_matrix : ndarray, shape (d, d)
-        Platform frame to world frame.
+    rotation, rotation_matrix : float or ndarray (3,) [rad], ndarray (d, d)
+        Planar the angle ``phi``, spatial the rotation vector (0 for a point mass); platform to world.
     stiffness : ndarray, shape (k, k), or None
-        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths over the k degrees of freedom;
-        positive definite where the equilibrium is stable. None from the spatial inverse.
+        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths over the k degrees of freedom
+        (positive definite where stable); None from the spatial inverse.
     external_wrench, net_wrench : ndarray, shape (wrench_size,) [N, N m]
-        The external load, and the remaining force and moment (about the centre of mass) of cables,
-        weight and load: zero to solver tolerance.
+        The external load, and the force and moment left about the centre of mass (zero to tolerance).
     """
 
     space: Space
@@ -906,18 +891,16 @@ def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wren
                   max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
     """Equilibrium pose of the platform and every cable's forces, for given unstrained lengths.
 
-    Newton's method on the net generalised force (force and, rigid, the moment: planar about the centre
-    of mass, spatial ``J_l^T M``) with the analytic stiffness from the cables' end stiffnesses and a
-    line search on the energy (:func:`minimise_energy`), from :func:`straight_cable_pose`; every
-    evaluation solves each cable warm-started from the previous iterate.
+    Newton's method on the net generalised force (rigid: with the moment, planar about the centre of mass,
+    spatial ``J_l^T M``), the analytic stiffness from the cables' end stiffnesses and a line search on the
+    energy (:func:`minimise_energy`), from :func:`straight_cable_pose` or ``initial_pose`` (a position or a
+    pose [m, rad]); every evaluation solves each cable warm-started from the previous iterate.
 
     Parameters
     ----------
     platform : SuspendedPlatform
     unstrained_lengths : array_like, shape (n_cables,) [m]
         Over a pulley from its hang point.
-    initial_pose : array_like, optional
-        A position, or a pose [m, rad] (a point mass's rotation is ignored).
     external_wrench : array_like, shape (wrench_size,) [N, N m], optional
         Extra force and moment about the centre of mass, eg :func:`inertial_wrench`.
     max_strain, max_tension : float, optional
@@ -977,35 +960,22 @@ def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wren
 
 def solve_inverse_statics(platform, pose, external_wrench=None, initial_guess=None, max_strain=DEFAULT_MAX_STRAIN,
                           max_tension=None):
-    """Unstrained lengths and cable forces that hold the platform at a pose, on elastic catenaries.
+    """Unstrained lengths and cable forces that hold the platform at ``pose`` [m, rad], on elastic catenaries.
 
     The unknowns are the cables' horizontal tensions (each cable's length and forces follow from its
-    inverse catenary, :func:`inverse_cable`); the equations the platform's balance.
+    inverse catenary, :func:`inverse_cable`); the equations the platform's balance under its weight and
+    ``external_wrench`` (wrench_size,) [N, N m] (eg :func:`inertial_wrench`).
 
-    * Planar: a square Newton iteration from straight massless cables (weight continuation as the
-      last resort): a point mass on 2 cables; a rigid platform on 2 cables at a position ``(x, z)``
-      (the rotation is equilibrium's) or on 3 at a pose ``(x, z, phi)``.
-    * Spatial: the tensions nearest ``initial_guess`` (least squares) that balance the force, and the
-      moment too on at least six cables (with fewer the rotation is left free), by Gauss-Newton with
-      forward differences. Continued along a trajectory, a redundant robot keeps its internal tension.
+    * Planar: a square Newton iteration from straight massless cables (weight continuation as the last
+      resort): a point mass on 2 cables; a rigid platform on 2 cables at a position ``(x, z)`` (the
+      rotation is equilibrium's) or on 3 at a pose ``(x, z, phi)``. Returns the stiffness too.
+    * Spatial ((3,) for a point mass, else (6,)): the tensions nearest ``initial_guess`` (required; least
+      squares) that balance the force, and the moment on at least six cables (with fewer the rotation is
+      left free), by Gauss-Newton with forward differences; continued along a trajectory, a redundant
+      robot keeps its internal tension.
 
-    Parameters
-    ----------
-    platform : SuspendedPlatform
-    pose : array_like [m, rad]
-        A position or a pose (above; spatial (3,) for a point mass, or (6,)).
-    external_wrench : array_like, shape (wrench_size,) [N, N m], optional
-        Extra load, eg :func:`inertial_wrench`.
-    initial_guess : PlatformEquilibrium or array_like (n_cables,) [N], optional
-        A nearby solution or positive horizontal tensions: the start (planar, with its rotation) and,
-        spatial, the tensions to stay near (required there).
-    max_strain, max_tension : float, optional
-        Cable tension limits (planar), as in :func:`solve_statics`.
-
-    Returns
-    -------
-    PlatformEquilibrium
-        With (planar) the stiffness at fixed lengths.
+    ``initial_guess``: a nearby :class:`PlatformEquilibrium` or positive horizontal tensions (n_cables,)
+    [N], the start (planar, with its rotation). ``max_strain``, ``max_tension``: as in :func:`solve_statics`.
 
     Raises
     ------
