@@ -1,10 +1,9 @@
 """The elastic catenary: a suspended cable with weight and axial elasticity, no bending.
 
-The model is Irvine's (1981), as used for cable robots by Kozak, Zhou and Wang (2006):
-a cable of unstrained length ``L`` [m], weight per unstrained length ``w`` [N/m] and
-axial stiffness ``EA`` [N], linear elastic (Hooke's law on the unstrained arc length),
-hanging between its two ends A (start) and B (end) in the vertical x-z plane, gravity
-along -z. No ground contact, no bending stiffness.
+Irvine's model (1981), as used for cable robots by Kozak, Zhou and Wang (2006): a cable of
+unstrained length ``L`` [m], weight per unstrained length ``w`` [N/m] and axial stiffness ``EA`` [N],
+linear elastic (Hooke's law on the unstrained arc length), hanging between its ends A and B in the
+vertical x-z plane, gravity along -z; no ground contact.
 
 Conventions
 -----------
@@ -24,14 +23,10 @@ zero-width U when it is slack), solved in closed form.
 
 Numerics
 --------
-The textbook form divides by ``w`` and by ``H``. Here the inextensible terms are
-rewritten without either division (see `_span_and_jacobian`):
-``dz_inextensible = L (V_A + V_B) / (T_A + T_B)`` exactly, and
-``dx_inextensible = (H/w) log1p(y)`` with ``y`` proportional to ``w L``, evaluated as
-``L q c H log1p(y)/y``. So the massless limit ``w -> 0`` (a straight linear spring)
-is reached continuously, with no cancellation, and ``w = 0`` itself is solved in
-closed form. The Jacobian ``d(dx, dz)/d(H, V_B)`` is analytic and written in the same
-cancellation-free way.
+The textbook form divides by ``w`` and by ``H``; the inextensible terms and the analytic Jacobian
+``d(dx, dz)/d(H, V_B)`` are rewritten without either division (`_span_and_jacobian`), so the
+massless limit ``w -> 0`` (a straight linear spring) is reached without cancellation and ``w = 0``
+is solved in closed form.
 """
 
 from __future__ import annotations
@@ -54,10 +49,6 @@ stretching; steel yields near 0.5 %). ``max_strain`` or ``max_tension`` give a t
 _RELATIVE_TOLERANCE = 1e-12
 _VERTICAL_TOLERANCE = 1e-12
 _MAX_NEWTON_ITERATIONS = 200
-
-
-def _span_vector(span):
-    return vector("span", span, 2, " (dx, dz) [m]")
 
 
 def tension_limit(axial_stiffness, max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
@@ -441,7 +432,7 @@ def solve_forward(cable, span, initial_guess=None, max_strain=DEFAULT_MAX_STRAIN
     Raises UnreachableError if the chord exceeds the cable's reach at the tension limit or the solution
     the limit; SceneError if ``span`` is not a finite 2-vector or a limit is not positive.
     """
-    span = _span_vector(span)
+    span = vector("span", span, 2, " (dx, dz) [m]")
     if not isinstance(cable, CatenaryCable):
         raise SceneError(f"cable must be a CatenaryCable, got {shown(cable)}")
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
@@ -506,7 +497,7 @@ def solve_inverse(span, weight_per_length, axial_stiffness, horizontal_tension, 
     Raises UnreachableError for a vertical span, a tension above the limit or a failed Newton;
     SceneError for an invalid argument.
     """
-    span = _span_vector(span)
+    span = vector("span", span, 2, " (dx, dz) [m]")
     w = non_negative("weight_per_length", weight_per_length)
     EA = positive("axial_stiffness", axial_stiffness)
     H = positive("horizontal_tension", horizontal_tension)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections import namedtuple
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -33,7 +34,7 @@ import scipy.sparse.linalg as sparse_linalg
 from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.core.geometry import (all_at_centre, planar_cross, rotation_from_vector, rotation_matrix,
                                     rotation_vector)
-from cdpr_exu.core.validation import finite, real_array, shown, vector
+from cdpr_exu.core.validation import finite, non_negative, positive, real_array, shown, vector
 from cdpr_exu.exits import Exit
 from cdpr_exu.physics import swivel_pulley as sp
 from cdpr_exu.statics.statics import catenary_platform, chain_element_mass, node_masses_along, solve_statics
@@ -92,13 +93,9 @@ class ChainCable:
         object.__setattr__(self, "anchor", tuple(float(a) for a in anchor))
         if len(self.node_masses) < 2:
             raise SceneError(f"node_masses needs at least 2 nodes, got {len(self.node_masses)}")
-        for name in ("element_length", "axial_stiffness"):
-            value = finite(name, getattr(self, name))
-            if value <= 0:
-                raise SceneError(f"{name} must be positive and finite, got {shown(value)}")
-        for name in ("bending_stiffness", "contact_stiffness"):
-            if finite(name, getattr(self, name)) < 0:
-                raise SceneError(f"{name} must be zero or positive, got {shown(getattr(self, name))}")
+        for name, check in (("element_length", positive), ("axial_stiffness", positive),
+                            ("bending_stiffness", non_negative), ("contact_stiffness", non_negative)):
+            check(name, getattr(self, name))
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
             raise SceneError(f"node_masses must be finite and non-negative, got {shown(self.node_masses)}")
         finite("winch_travel", self.winch_travel)
@@ -181,9 +178,8 @@ class ChainRobot:
         object.__setattr__(self, "cables", tuple(self.cables))
         if len({len(c.anchor) for c in self.cables}) != 1:
             raise SceneError("cables must all be planar or all spatial (their anchors' sizes differ)")
-        if finite("mass", self.mass) < 0 or finite("gravity", self.gravity) < 0:
-            raise SceneError(f"mass and gravity must be zero or positive, got {shown(self.mass)}, "
-                             f"{shown(self.gravity)}")
+        non_negative("mass", self.mass)
+        non_negative("gravity", self.gravity)
         if self.anchor_spring_factor is not None and not finite("anchor_spring_factor", self.anchor_spring_factor) > 0:
             raise SceneError(f"anchor_spring_factor must be positive or None, got {shown(self.anchor_spring_factor)}")
 
@@ -833,9 +829,7 @@ def cable_paid_out(cable: ChainCable, length: float) -> ChainCable:
     L / n, their stiffness E A n / L, the node masses rho L / n and the bending stiffness E J n / L; over a
     swivel pulley the same elements, the held winch end moved up the axis by the change of the paid-out
     length (``winch_travel``, :attr:`ChainCable.paid_out_length`), the cable running over the disc."""
-    length = finite("length", length)
-    if length <= 0:
-        raise SceneError(f"length must be positive [m], got {shown(length)}")
+    length = positive("length", length, "m")
     if cable.pulley is not None:
         return replace(cable, winch_travel=cable.winch_travel + length - cable.paid_out_length)
     scale = length / cable.unstrained_length
@@ -873,37 +867,32 @@ def _held_model(cable: ChainCable, gravity: float) -> SpatialChains:
     return SpatialChains(ChainRobot((replace(cable, anchor=(0.0, 0.0, 0.0)),), 0.0, gravity))
 
 
+#: Halvings of a held chain's jump the continuation may make (:func:`solve_held_chain`): at most 32 sub-steps.
+CONTINUATION_HALVINGS = 5
+
+
 def solve_held_chain(cable: ChainCable, gravity: float, anchor_point, nodes, *, tolerance: float = 1e-9,
-                     max_iterations: int = 50, swivel_angle: float | None = None) -> HeldChain:
+                     max_iterations: int = 50, swivel_angle: float | None = None, model=None) -> HeldChain:
     """The rest shape of one lumped cable (at the paid-out length wanted, :func:`cable_paid_out`; its
     ``anchor`` unused) held at its exit point (or winch end) and at ``anchor_point`` (x, y, z) [m].
 
     Newton's method on its free nodes and, over a swivel pulley, psi (start ``swivel_angle``, default the
     anchor's azimuth), then the force on the anchor and its rate. ``nodes`` (n + 1, 3) [m] start it, its
-    ends put on the held and anchor points. If Newton fails, the anchor (and a swivel cable's winch end) is
-    moved there in sub-steps (:func:`_solve_held`): on spatial-four-cable-swivel's swivel pulleys, started
-    from the rest's chains, Newton alone stopped at 50 iterations from 2 cm up or 5 cm across; the sub-steps
-    converge 30 cm across and 20 cm up (to 1e-10 relative of Newton given 2000 iterations), not 30 cm up.
-    ``tolerance`` [N]: the largest force left on a free node; below the rounding of the element forces
-    (:func:`rounding_floor`) Newton also stops once a step no longer halves it.
+    ends put on the held and anchor points. ``tolerance`` [N]: the largest force left on a free node; below
+    the rounding of the element forces (:func:`rounding_floor`) Newton also stops once a step no longer
+    halves it. ``model``: the cable's held model, built once by a caller that changes the length
+    (:func:`_paid_out_model`); default built here.
+
+    Only if Newton fails, continuation: the anchor moved from the start's last node to ``anchor_point`` (a
+    swivel cable's winch end from the start's height on the axis to the model's) in sub-steps, each from
+    the last one's chain, a failing sub-step halved again, at most :data:`CONTINUATION_HALVINGS` times (a
+    start that converges keeps its answer bit for bit). On spatial-four-cable-swivel's swivel pulleys,
+    started from the rest's chains, Newton alone stopped at 50 iterations from 2 cm up or 5 cm across; the
+    sub-steps converge 30 cm across and 20 cm up (to 1e-10 relative of Newton given 2000 iterations).
 
     Raises :class:`UnreachableError` if neither Newton nor the sub-steps find a rest shape.
     """
-    return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations,
-                       swivel_angle)
-
-
-#: Halvings of a held chain's jump the continuation may make (:func:`_solve_held`): at most 2^5 = 32 sub-steps.
-CONTINUATION_HALVINGS = 5
-
-
-def _solve_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, tolerance: float,
-                max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
-    """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other
-    lengths). Newton from ``nodes``; only if it fails, continuation: the anchor moved from the start's last
-    node to ``anchor_point`` (a swivel cable's winch end from the start's height on the axis to the model's)
-    in sub-steps, each from the last one's chain, a failing sub-step halved again, at most
-    :data:`CONTINUATION_HALVINGS` times. A start that converges keeps its answer bit for bit."""
+    model = _held_model(cable, gravity) if model is None else model
     anchor_point = vector("anchor_point", anchor_point, 3)
     nodes = np.array(nodes, dtype=float)
     n = cable.n_elements
@@ -951,8 +940,8 @@ def _solve_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, to
 
 def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, tolerance: float,
                  max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
-    """Newton for :func:`_solve_held` from ``nodes`` (n + 1, 3) [m] (checked), its ends first moved onto the held
-    and anchor points (over a swivel pulley by :func:`_swivel_start`)."""
+    """Newton for :func:`solve_held_chain` from ``nodes`` (n + 1, 3) [m] (checked), its ends first moved onto
+    the held and anchor points (over a swivel pulley by :func:`_swivel_start`)."""
     nodes = np.array(nodes, dtype=float)
     n = cable.n_elements
     share = np.linspace(0.0, 1.0, n + 1)[:, None]
@@ -1126,7 +1115,8 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
     scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
 
     def held(trial_lengths, trial_nodes, trial_angles):
-        chains = [_solve_held(_paid_out_model(model, c, L), cable_paid_out(c, L), a, start, 1e-9, 50, psi)
+        chains = [solve_held_chain(cable_paid_out(c, L), robot.gravity, a, start, swivel_angle=psi,
+                                   model=_paid_out_model(model, c, L))
                   for model, c, L, a, start, psi in zip(models, robot.cables, trial_lengths, anchor_points,
                                                         trial_nodes, trial_angles)]
         forces = np.array([chain.force for chain in chains])
@@ -1320,15 +1310,8 @@ def _spatial_inverse_solver(robot: ChainRobot):
     return solve
 
 
-@dataclass(frozen=True)
-class _Methods:
-    """One dimension's chain statics: its cables from a scene, forward solve, rest and inverse solver."""
-
-    cables: object
-    forward: object
-    rest: object
-    inverse: object
-
+#: One dimension's chain statics: its cables from a scene, forward solve, rest and inverse solver.
+_Methods = namedtuple("_Methods", "cables forward rest inverse")
 
 #: Each dimension's chain statics, by the robot's (the scene's) Space: the one place they are chosen.
 _METHODS = {PLANE: _Methods(_planar_robot, _no_planar_forward, _no_planar_forward, _planar_inverse_solver),

@@ -26,8 +26,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.validation import shown
-from cdpr_exu.core.geometry import anchor_points, check_radius, check_side, exit_arrays, finite_array
+from cdpr_exu.core.validation import positive, shown, vector
+from cdpr_exu.core.geometry import anchor_points, check_radius, check_side, exit_arrays
 
 __all__ = ["cable_exits", "ideal_paid_out", "pull_directions", "structure_matrix", "length_jacobian",
            "initial_cable_nodes", "straight_cable_nodes", "anchor_points"]  # anchor_points: for the builder
@@ -86,10 +86,7 @@ def length_jacobian(scene, poses: np.ndarray) -> np.ndarray:
 # --- initial cable configurations
 def straight_cable_nodes(start, end, n_elements):
     """``n_elements + 1`` evenly spaced nodes (n_elements + 1, 2) [m] from ``start`` to ``end`` (2,) [m]."""
-    start = finite_array("start", start, (2,))
-    end = finite_array("end", end, (2,))
-    if start.ndim != 1 or end.ndim != 1:
-        raise SceneError(f"start and end must have shape (2,), got {start.shape} and {end.shape}")
+    start, end = vector("start", start, 2, " [m]"), vector("end", end, 2, " [m]")
     n_elements = _check_n_elements(n_elements)
     fraction = np.linspace(0.0, 1.0, n_elements + 1)[:, None]
     return start + fraction * (end - start)
@@ -115,17 +112,9 @@ def initial_cable_nodes(center, radius, side, anchor, element_length, n_elements
 
     Raises SceneError for a malformed argument, UnreachableError for an anchor inside the pulley disc.
     """
-    center = finite_array("center", center, (2,))
-    if center.ndim != 1:
-        raise SceneError(f"center must have shape (2,), got shape {center.shape}")
+    center, anchor = vector("center", center, 2, " [m]"), vector("anchor", anchor, 2, " [m]")
     radius, side = check_radius("radius", radius), check_side("side", side)
-    anchor = finite_array("anchor", anchor, (2,))
-    if anchor.ndim != 1:
-        raise SceneError(f"anchor must have shape (2,), got shape {anchor.shape}")
-    element_length = finite_array("element_length", element_length)
-    if element_length.ndim != 0 or element_length <= 0.0:
-        raise SceneError(f"element_length must be a scalar > 0 [m], got {shown(element_length)}")
-    element_length = float(element_length)
+    element_length = positive("element_length", element_length, "m")
     n_elements = _check_n_elements(n_elements)
 
     tangent_point, wrap, free_length, unit_vector = exit_arrays(center, radius, side, anchor)

@@ -8,13 +8,11 @@ driver :func:`solve_inverse_statics` (the lengths that hold a pose), both return
 
 **Poses.** Planar (the paper's vertical x-z plane): ``(x, z, phi)``, ``phi`` counter-clockwise
 (paper eq. 17), an anchor ``b_i`` at ``r + R(phi) b_i``, moments ``m = a_x f_z - a_z f_x``.
-Spatial (z up): ``(r, theta)``, ``theta`` the rotation vector, ``R = exp([theta]x)``; its
-derivative enters via the left Jacobian of SO(3) (a change ``d theta`` turns the body by the
-world-frame angle ``J_l(theta) d theta``, so the generalised force on ``theta`` is
-``J_l^T M``). A platform whose anchors all sit at its centre of mass is a point mass: only its
-position is solved. The two dimensions keep their own floating-point kernels (the pose
-kernels :class:`_PlanarStatics` and :class:`_SpatialStatics`, chosen by the platform's space):
-the residual, the pose Jacobian, the straight-cable start and the inverse differ per dimension.
+Spatial (z up): ``(r, theta)``, ``theta`` the rotation vector, ``R = exp([theta]x)``; a change
+``d theta`` turns the body by ``J_l(theta) d theta`` (left Jacobian of SO(3)), so the generalised
+force on ``theta`` is ``J_l^T M``. A point mass (every anchor at the centre of mass) has only its
+position solved. Each dimension keeps its floating-point pose kernel (:class:`_PlanarStatics`,
+:class:`_SpatialStatics`): residual, pose Jacobian, straight-cable start and inverse.
 
 **Cables.** Each cable is an elastic catenary (:mod:`cdpr_exu.physics.catenary`) from its anchor
 (end A) to its exit (end B), solved as the exit asks (:func:`forward_cable`, :func:`inverse_cable`):
@@ -876,24 +874,15 @@ def _check_reach(platform, lengths, max_strain, max_tension):
                     f"{lengths[i]:g} m, at the tension limit) and anchors span")
 
 
-def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
-    """Equilibrium pose (pose_size,) [m, rad] on straight, massless, elastic cables that may go slack.
-
-    Minimises ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2``, ``l_i`` the straight length
-    from the anchor to the hang point (wrap included) and ``k_i = EA_i / L_i``: unlike intersecting the
-    circles of inextensible cables it always has a solution. It starts :func:`solve_statics`."""
-    kernel = _checked_platform(platform)
-    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
-    return kernel.straight_cable_pose(platform, lengths, _wrench(platform, external_wrench))
-
-
 def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wrench=None,
                   max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
     """Equilibrium pose of the platform and every cable's forces, for given unstrained lengths.
 
     Newton's method on the net generalised force (rigid: with the moment, planar about the centre of mass,
     spatial ``J_l^T M``), the analytic stiffness from the cables' end stiffnesses and a line search on the
-    energy (:func:`minimise_energy`), from :func:`straight_cable_pose` or ``initial_pose`` (a position or a
+    energy (:func:`minimise_energy`), from the pose on straight, massless, elastic cables that may go slack
+    (the minimum of ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2``, ``l_i`` the straight length
+    to the hang point and ``k_i = EA_i / L_i``, which always exists), or ``initial_pose`` (a position or a
     pose [m, rad]); every evaluation solves each cable warm-started from the previous iterate.
 
     Parameters

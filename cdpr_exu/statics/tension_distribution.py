@@ -25,10 +25,8 @@ _BOUND_ROUNDING = 1e-9
 
 
 def _tension_limits(min_tension, max_tension, n_cables):
-    limits = []
-    for name, value in (("min_tension", min_tension), ("max_tension", max_tension)):
-        limits.append(per_item(name, value, n_cables))  # >= 0: cables cannot push
-    lower, upper = limits
+    lower = per_item("min_tension", min_tension, n_cables)
+    upper = per_item("max_tension", max_tension, n_cables)
     if np.any(lower > upper):
         raise SceneError(f"min_tension must not exceed max_tension, got min_tension {shown(min_tension)} "
                          f"and max_tension {shown(max_tension)} [N]")
