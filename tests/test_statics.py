@@ -95,7 +95,7 @@ def test_point_mass_in_the_symmetric_middle_hangs_on_equal_tensions():
     tensions = equilibrium.tensions_at_anchor
     # mirror-symmetric problem solved by the same Newton steps: round-off only
     assert tensions[0] == pytest.approx(tensions[1], rel=1e-12)
-    forces = equilibrium.forces_on_platform
+    forces = np.array([c.force_on_platform for c in equilibrium.cables])
     # the vertical components carry the weight, the horizontal ones cancel;
     # the Newton tolerance is 1e-12 of the load
     assert forces[:, 1].sum() == pytest.approx(platform.mass * platform.gravity, rel=1e-11)
@@ -436,7 +436,7 @@ def test_forward_statics_of_the_inverse_lengths_returns_the_pose(dimension, plat
         scene = load_scene(platform_kind)
         platform = catenary_platform(scene)
         rest = solve_statics(platform, scene.unstrained_lengths)
-        target = rest.pose + np.array([0.1, -0.05, 0.02, 0.0, 0.0, 0.02])
+        target = np.append(rest.position, rest.rotation) + np.array([0.1, -0.05, 0.02, 0.0, 0.0, 0.02])
         guess = start = rest.horizontal_tensions
     inverse = solve_inverse_statics(platform, target, initial_guess=guess)
     forward = solve_statics(platform, inverse.unstrained_lengths, initial_pose=None if start is None else target)
@@ -455,10 +455,11 @@ def test_the_spatial_inverse_at_the_rest_gives_back_the_lengths_and_stays_near_t
         rest = solve_statics(platform, scene.unstrained_lengths)
         tensions = rest.horizontal_tensions
         # at the rest pose, with the rest's tensions: the scene's own lengths come back
-        back = solve_inverse_statics(platform, rest.pose, initial_guess=tensions)
+        rest_pose = np.append(rest.position, rest.rotation)
+        back = solve_inverse_statics(platform, rest_pose, initial_guess=tensions)
         np.testing.assert_allclose(back.unstrained_lengths, scene.unstrained_lengths, atol=1e-9)
         # elsewhere the tensions stay nearest the start: an over-constrained robot keeps its internal tension
-        target = rest.pose + np.array([0.1, -0.05, 0.02, 0.0, 0.0, 0.02])
+        target = np.append(rest.position, rest.rotation) + np.array([0.1, -0.05, 0.02, 0.0, 0.0, 0.02])
         inverse = solve_inverse_statics(platform, target, initial_guess=back)
         assert np.abs(inverse.horizontal_tensions - tensions).max() < 0.5 * tensions.max()
 
@@ -619,7 +620,8 @@ def test_symmetric_four_cable_robot_hangs_on_the_axis_with_equal_tensions_and_no
     tensions = equilibrium.tensions_at_anchor
     np.testing.assert_allclose(tensions, tensions.mean(), rtol=1e-12)
     # each cable carries a quarter of the weight at its anchor
-    np.testing.assert_allclose(equilibrium.forces_on_platform[:, 2], platform.mass * platform.gravity / 4, rtol=1e-10)
+    vertical = [c.force_on_platform[2] for c in equilibrium.cables]
+    np.testing.assert_allclose(vertical, platform.mass * platform.gravity / 4, rtol=1e-10)
     assert is_stable(equilibrium)
 
 

@@ -7,19 +7,16 @@ vertical x-z plane, gravity along -z; no ground contact.
 
 Conventions
 -----------
-Arc length ``s`` is unstrained and runs from A (s = 0) to B (s = L). The tension
-vector along the cable, pointing towards B, is ``(H, V(s))`` with ``V(s) = V_A + w s``:
-``H >= 0`` is the horizontal tension (constant along the cable) and
-``V_B = V_A + w L`` is the vertical tension component at B, ie the upward force the
-support at B exerts on the cable. For a span ``(dx, dz) = p_B - p_A`` with ``dx > 0``
+Arc length ``s`` is unstrained, from A (s = 0) to B (s = L). The tension vector, pointing towards
+B, is ``(H, V(s))``, ``V(s) = V_A + w s``: ``H >= 0`` the horizontal tension (constant) and ``V_B``
+the upward force of the support at B on the cable. For a span ``(dx, dz) = p_B - p_A``, ``dx > 0``
 (Irvine's eqs.; `paper-params.md`)::
 
     dx = H/w [asinh(V_B/H) - asinh(V_A/H)] + H L / EA
     dz = H/w [sqrt(1 + (V_B/H)^2) - sqrt(1 + (V_A/H)^2)] + (V_B L - w L^2 / 2) / EA
 
-Spans with ``dx < 0`` are solved in the mirrored frame (x -> -x); ``dx == 0`` is the
-vertical limit ``H = 0`` (a straight hanging cable, or a cable folded into a
-zero-width U when it is slack), solved in closed form.
+Spans with ``dx < 0`` are solved mirrored (x -> -x); ``dx == 0`` is the vertical limit ``H = 0`` (a
+straight hanging cable, or, slack, folded into a zero-width U), solved in closed form.
 
 Numerics
 --------

@@ -26,12 +26,9 @@ __all__ = ["ChainIndex", "PlanarChains", "planar_energy", "planar_forces", "Spat
 
 
 class ChainIndex:
-    """The nodes of all cables numbered one after another, cable after cable.
-
-    Per cable its node count, first and last node; per element its two nodes, cable, stiffness
-    ``k`` [N/m], rest length ``l0`` [m] and law (``slack``: tension-only); per node its mass [kg];
-    per interior joint its bending stiffness ``joint_k`` [N m/rad].
-    """
+    """The nodes of all cables numbered cable after cable: per cable its node count, first and last node; per
+    element its nodes, cable, ``k`` [N/m], ``l0`` [m] and law (``slack``: tension-only); per node its mass
+    [kg]; per interior joint its nodes and bending stiffness ``joint_k`` [N m/rad]."""
 
     def __init__(self, robot):
         self.counts = [c.n_elements + 1 for c in robot.cables]
@@ -47,6 +44,7 @@ class ChainIndex:
         self.slack = np.array([robot.cables[c].slack for c in self.element_cable])
         self.masses = np.concatenate([np.asarray(c.node_masses) for c in robot.cables])
         self.joint_k = np.concatenate([np.full(n - 2, c.bending_stiffness) for c, n in zip(robot.cables, self.counts)])
+        self.joints = bending.cable_joints(self.counts)
 
 
 class PlanarChains(ChainIndex):
@@ -63,7 +61,6 @@ class PlanarChains(ChainIndex):
         self.n_interior = 2 * self.interior.size
         self.n_inner = self.n_interior + int(free_rotation)
         self.interior_rows = (2 * self.interior[:, None] + np.arange(2)).ravel()
-        self.joints = bending.cable_joints(self.counts)
         self.bending = (bending.BendingSpringDamper(self.n_nodes, self.joints, self.joint_k, np.zeros_like(self.joint_k))
                         if np.any(self.joint_k > 0) else None)
         self.zero_velocities = np.zeros(2 * self.n_nodes)
@@ -209,7 +206,7 @@ class SpatialChains(ChainIndex):
         fixed = set(int(f) for f in self.first)
         self.free = np.array([j for j in range(self.n_points) if j not in fixed and j not in body_points], dtype=int)
         self.n_free = 3 * self.free.size
-        self.swivel_cables = robot.swivel_cables
+        self.swivel_cables = [i for i, c in enumerate(robot.cables) if isinstance(c.pulley, sp.SwivelPulley)]
         self.n_psi = len(self.swivel_cables)
         self.psi0 = self.n_free + 3 + (3 if self.rigid else 0)  # first psi unknown
         self.n_unknowns = self.psi0 + self.n_psi
@@ -219,7 +216,6 @@ class SpatialChains(ChainIndex):
         self.weights = np.zeros(self.n_points)
         self.weights[:n_chain] = self.masses * robot.gravity
         self.axial_pattern = block_pattern(self.elements, 3)
-        self.joints = bending.cable_joints(self.counts)
         if not np.any(self.joint_k > 0):
             self.joints, self.joint_k = self.joints[:0], self.joint_k[:0]
         self.pattern = block_pattern(self.joints, 3)

@@ -1,21 +1,16 @@
 """Static equilibrium of the simulator's own lumped cables: chains of nodes, in the plane and in space.
 
-:mod:`cdpr_exu.statics.statics` treats each cable as a continuous elastic catenary. The simulator's
-cable is a chain of n straight elements whose nodes carry the mass, with exact-angle bending springs
-at the interior nodes and an exit that holds or pushes the nodes (a planar pulley's rim, a swivel
-pulley's groove). On the paper's robot (0.25 m elements on 0.25 m pulleys) the chain wraps the pulley
-as a coarse polygon and its bending lifts it off the rim, which moves the paid-out length that puts
-the platform on a pose by millimetres to centimetres. This module solves that discrete model at rest,
-without Exudyn and without damping.
+Not the continuous catenary (:mod:`cdpr_exu.statics.statics`): n straight elements whose nodes carry the
+mass, exact-angle bending springs at the interior nodes, an exit that holds or pushes the nodes (a
+pulley's rim, a swivel pulley's groove). On the paper's robot (0.25 m elements on 0.25 m pulleys) the
+coarse polygon on the pulley and its bending move the paid-out length of a pose by millimetres to
+centimetres. This module solves that discrete model at rest, without Exudyn and without damping.
 
-A :class:`ChainRobot` of :class:`ChainCable` (from a scene: :func:`chain_robot`), one
-:class:`ChainEquilibrium`, and two drivers: :func:`solve_inverse_chain_statics` (the pose given; many
-poses: :class:`InverseChainStatics`) and :func:`solve_chain_statics` (the lengths given, in space;
-from a scene :func:`chain_rest`; the plane's rest on given lengths is Exudyn's,
-:mod:`cdpr_exu.run.rest`). The kernels (:mod:`cdpr_exu.statics.chain_kernels`) stay per dimension,
-operation for operation; all minimise the potential with :func:`descent_step` and one Armijo line
-search (:func:`_line_search`). Over swivel pulleys, where Exudyn's static solver does not converge from
-the catenary start, the forward statics' answer starts the runs (:func:`cdpr_exu.run.settle.start_at_rest`).
+A :class:`ChainRobot` of :class:`ChainCable` (:func:`chain_robot`), one :class:`ChainEquilibrium`, and two
+drivers: :func:`solve_inverse_chain_statics` (the pose given) and :func:`solve_chain_statics` (the lengths
+given, in space; the plane's rest is Exudyn's). The kernels (:mod:`cdpr_exu.statics.chain_kernels`) stay
+per dimension; all minimise the potential with :func:`descent_step` and one Armijo line search. Over
+swivel pulleys the forward statics start the runs (:func:`cdpr_exu.run.settle.start_at_rest`).
 
 Units SI (m, N, kg, rad); the vertical axis up, gravity along it downwards.
 """
@@ -193,11 +188,6 @@ class ChainRobot:
         """True when every anchor sits at the centre of mass (no rotation to balance)."""
         return all_at_centre([c.anchor for c in self.cables])
 
-    @property
-    def swivel_cables(self) -> list:
-        """Indices of the cables that run over a swivel pulley."""
-        return [i for i, c in enumerate(self.cables) if isinstance(c.pulley, sp.SwivelPulley)]
-
 
 def chain_robot(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
                 catenary=None) -> ChainRobot:
@@ -344,17 +334,16 @@ def winch_line_elements(winch_line: float, element_length: float) -> int:
 
 def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, contact_stiffness):
     """Straight unstrained reference (winch end first) and the catenary statics' nodes of a cable over a
-    swivel pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``, n from the inlet to the anchor of
-    unstrained ``length`` [m].
+    swivel pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``, n of unstrained ``length`` [m] from
+    the inlet to the anchor.
 
     From the anchor: the catenary (``equilibrium_cable``, a
-    :class:`~cdpr_exu.statics.statics.CableEquilibrium`) up to the tangent point; then the wrap as the chain
-    lies on it, a polygon of chords of the stretched element length (on the arc each chord is short by r_p
-    theta^3 / 24 and pushes with up to 3 kN at l_e = r_p: Newton diverged), each node inside the groove by the
-    depth that carries its share of the pressure, ``T l_e / (r_p k_p)`` (``contact_stiffness`` k_p [N/m]; on
-    the rim psi has no stiffness and Exudyn's static solver met a singular matrix); then down the axis to the
-    winch end, where the builder and the chain statics hold the cable. The tension is the catenary's at the
-    tangent point (frictionless wrap, its weight left out).
+    :class:`~cdpr_exu.statics.statics.CableEquilibrium`) to the tangent point; the wrap as the chain lies on
+    it, a polygon of stretched chords (chords on the arc are short by r_p theta^3 / 24 and pushed with up to 3
+    kN: Newton diverged), each node inside the groove by the depth that carries its pressure, ``T l_e / (r_p
+    k_p)`` (on the rim psi has no stiffness: Exudyn's static solver met a singular matrix); then down the axis
+    to the held winch end. The tension is the catenary's at the tangent point (frictionless wrap, its weight
+    left out).
     """
     element = length / n_elements
     inlet = equilibrium_cable.inlet
@@ -384,7 +373,6 @@ def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, co
     return reference, current
 
 
-# --- shared: the descent step, the line search, the rounding floor
 def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
     """Newton's step -H^-1 g (H dense or scipy sparse (N, N), g (N,)), H shifted by ``relative_shift`` times
     its largest diagonal entry, then ten times more each time, until the step descends (a node on a rim, a
@@ -873,24 +861,20 @@ CONTINUATION_HALVINGS = 5
 
 def solve_held_chain(cable: ChainCable, gravity: float, anchor_point, nodes, *, tolerance: float = 1e-9,
                      max_iterations: int = 50, swivel_angle: float | None = None, model=None) -> HeldChain:
-    """The rest shape of one lumped cable (at the paid-out length wanted, :func:`cable_paid_out`; its
-    ``anchor`` unused) held at its exit point (or winch end) and at ``anchor_point`` (x, y, z) [m].
+    """The rest shape of one lumped cable (paid out as wanted, :func:`cable_paid_out`; its ``anchor`` unused)
+    held at its exit point (or winch end) and at ``anchor_point`` (x, y, z) [m].
 
     Newton's method on its free nodes and, over a swivel pulley, psi (start ``swivel_angle``, default the
-    anchor's azimuth), then the force on the anchor and its rate. ``nodes`` (n + 1, 3) [m] start it, its
-    ends put on the held and anchor points. ``tolerance`` [N]: the largest force left on a free node; below
-    the rounding of the element forces (:func:`rounding_floor`) Newton also stops once a step no longer
-    halves it. ``model``: the cable's held model, built once by a caller that changes the length
-    (:func:`_paid_out_model`); default built here.
+    anchor's azimuth), from ``nodes`` (n + 1, 3) [m] with its ends put on the held points; then the force
+    on the anchor and its rate. ``tolerance`` [N]: the largest force left on a free node; below the rounding
+    floor (:func:`rounding_floor`) Newton also stops once a step no longer halves it. ``model``: the held
+    model, built once by a caller that changes the length (:func:`_paid_out_model`); default built here.
 
-    Only if Newton fails, continuation: the anchor moved from the start's last node to ``anchor_point`` (a
-    swivel cable's winch end from the start's height on the axis to the model's) in sub-steps, each from
-    the last one's chain, a failing sub-step halved again, at most :data:`CONTINUATION_HALVINGS` times (a
-    start that converges keeps its answer bit for bit). On spatial-four-cable-swivel's swivel pulleys,
-    started from the rest's chains, Newton alone stopped at 50 iterations from 2 cm up or 5 cm across; the
-    sub-steps converge 30 cm across and 20 cm up (to 1e-10 relative of Newton given 2000 iterations).
-
-    Raises :class:`UnreachableError` if neither Newton nor the sub-steps find a rest shape.
+    Only if Newton fails, continuation: the anchor (and a swivel cable's winch end) moved from the start's
+    in sub-steps, each from the last one's chain, a failing one halved, at most
+    :data:`CONTINUATION_HALVINGS` times. On spatial-four-cable-swivel, from the rest's chains, Newton alone
+    stopped at 2 cm up or 5 cm across; the sub-steps converge 30 cm across and 20 cm up (to 1e-10 relative
+    of Newton given 2000 iterations). Raises :class:`UnreachableError` if neither finds a rest shape.
     """
     model = _held_model(cable, gravity) if model is None else model
     anchor_point = vector("anchor_point", anchor_point, 3)
@@ -963,10 +947,8 @@ def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, t
     n_free = 3 * (n - 1)
     free = nodes[1:-1].ravel().copy()
     energy = model.energy(free, anchor_point, R, psi)
-    # Below the rounding floor Newton keeps gaining while it can: the anchor force of a chain stopped
-    # at the floor is off by about the floor, and m of them stall the platform's balance (CoGiRo's
-    # Gauss-Newton crawled for 30 iterations at 1e-5 N). So stop at the tolerance, or below the floor
-    # once a step no longer halves the imbalance.
+    # Below the rounding floor Newton keeps gaining while it can (chains stopped at the floor stalled
+    # CoGiRo's Gauss-Newton for 30 iterations at 1e-5 N): stop there once a step no longer halves it.
     floor = rounding_floor(model.k, nodes)
     last = np.inf
     # a point exit's chain is solved dense (57 unknowns at 20 elements); over a swivel pulley sparse (SuperLU:
@@ -1001,8 +983,7 @@ def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, t
         raise UnreachableError(f"held chain statics did not converge in {max_iterations} iterations "
                                f"(force imbalance {np.max(np.abs(g)):.3g} N)")
     if cable.pulley is None:
-        # d(gradient)/dL at fixed nodes by central differences of the chain paid out by +-dL (the run's
-        # scaling, :func:`cable_paid_out`)
+        # d(gradient)/dL at fixed nodes: central differences of the chain paid out by +-dL (cable_paid_out)
         step = 1e-6
         rate = (_scaled_model(model, 1.0 + step).point_derivatives(nodes, psi)[0]
                 - _scaled_model(model, 1.0 - step).point_derivatives(nodes, psi)[0]) / (2.0 * step * cable.unstrained_length)
@@ -1189,12 +1170,7 @@ def solve_chain_statics(robot: ChainRobot, nodes, position, rotation=None, swive
     external_force : (fx, fy, fz) [N], optional
         Constant extra force on the centre of mass (eg the d'Alembert force -M a).
 
-    Raises
-    ------
-    UnreachableError
-        If Newton finds no equilibrium.
-    SceneError
-        On malformed input, or a planar robot.
+    Raises UnreachableError if Newton finds no equilibrium, SceneError on malformed input or a planar robot.
     """
     return _METHODS[robot.space].forward(robot, nodes, position, rotation, swivel_angles, **kwargs)
 
@@ -1262,12 +1238,8 @@ def solve_inverse_chain_statics(robot: ChainRobot, pose, tension_guess=None, **k
         imbalance relative to the larger of the weight and the largest cable force (1e-9), Gauss-Newton
         iterations (30).
 
-    Raises
-    ------
-    UnreachableError
-        If no lengths with the cables in tension hold the platform there, or the iteration fails.
-    SceneError
-        On malformed input or (plane) a problem that is not square.
+    Raises UnreachableError if no lengths with the cables in tension hold the platform there or the
+    iteration fails; SceneError on malformed input or (plane) a problem that is not square.
     """
     return InverseChainStatics(robot).solve(pose, tension_guess, **kwargs)
 

@@ -1,10 +1,8 @@
 """Ideal kinematics of a cable robot, planar or spatial: cable lengths, rates, pull directions, structure matrix.
 
-Pure NumPy/SciPy. The ideal cables (straight, massless, inextensible) of a scene are its exits'
-(:mod:`cdpr_exu.exits`, with the kernels of :mod:`cdpr_exu.core.geometry`) at the anchors its
-:class:`~cdpr_exu.space.Space` places; written once for both dimensions. The initial node layouts of
-planar cables are here too; the tensions that hold the platform in
-:mod:`cdpr_exu.statics.tension_distribution`.
+Pure NumPy/SciPy, once for both dimensions: the ideal cables (straight, massless, inextensible) are the
+exits' (:mod:`cdpr_exu.exits`) at the anchors the scene's :class:`~cdpr_exu.space.Space` places. The
+initial node layouts of planar cables are here too.
 
 Sign conventions
 ----------------
@@ -13,8 +11,7 @@ cable pulls the platform along ``w_i = -u_i``. The length rate is ``dL_i/dt = u_
 anchor's velocity: a change of wrap cancels the tangent point's motion along the rim). The structure
 matrix ``A`` has columns ``[w_i; (R b_i) x w_i]``: tensions ``f`` exert the wrench ``A f`` about the
 centre of mass, with the Space's cross product (planar ``a_x b_z - a_z b_x``, counter-clockwise
-positive); a point mass has the force rows only. With the angular velocity
-``omega = J_l(theta) dtheta/dt`` in space::
+positive); a point mass has the force rows only. With ``omega = J_l(theta) dtheta/dt`` in space::
 
     dL/dt = -A^T (dr/dt, dphi/dt)            (plane)
     dL/d(r, theta) = -A^T blockdiag(I, J_l(theta))   (space)
@@ -83,7 +80,6 @@ def length_jacobian(scene, poses: np.ndarray) -> np.ndarray:
     return -np.swapaxes(structure_matrix(scene, poses), -1, -2)
 
 
-# --- initial cable configurations
 def straight_cable_nodes(start, end, n_elements):
     """``n_elements + 1`` evenly spaced nodes (n_elements + 1, 2) [m] from ``start`` to ``end`` (2,) [m]."""
     start, end = vector("start", start, 2, " [m]"), vector("end", end, 2, " [m]")

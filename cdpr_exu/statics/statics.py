@@ -17,20 +17,17 @@ position solved. Each dimension keeps its floating-point pose kernel (:class:`_P
 **Cables.** Each cable is an elastic catenary (:mod:`cdpr_exu.physics.catenary`) from its anchor
 (end A) to its exit (end B), solved as the exit asks (:func:`forward_cable`, :func:`inverse_cable`):
 
-* planar, a fixed exit point; or a planar pulley: the cable comes up its winch line
-  ``x = c_x + side r_p``, wraps over the top and leaves the rim tangentially; its unstrained
-  length counts from the hang point ``(c_x + side r_p, c_z)``. Frictionless (uniform tension
-  along the wrap, of unstrained length ``r_p wrap / (1 + T / EA)``); the wrap's weight is
-  carried by the pulley (at most ``w r_p`` of tension: 7e-6 m of stretch for the paper's cable,
-  2.5e-6 relative asymmetry of the stiffness); rigid rim, no pulley inertia;
-* spatial, a point exit: the cable hangs in the vertical plane through its ends, the planar
-  catenary rotated back to 3-D (MoorPy's trick). With ``u`` the horizontal direction from
-  the anchor to the exit and ``h`` the horizontal span, its end stiffness is
-  ``Q K2 Q^T - (H / h) (P_h - u u^T)``, ``Q = [u, e_z]`` (a sideways step turns the pull;
-  for a vertical cable ``H / h`` tends to ``-K2[0, 0]``);
-* spatial, a swivel pulley: the disc turns to the vertical plane through its axis and the
-  anchor, where the cable is the planar pulley cable (centre ``(r_p, 0)``, side -1, hang
-  point at the inlet); its stiffness ``Q K2 Q^T + (f_rho / rho) (P_h - e_rho e_rho^T)``.
+* planar, a fixed exit point, or a pulley: up the winch line ``x = c_x + side r_p``, over the top and
+  off the rim tangentially, the length counted from the hang point ``(c_x + side r_p, c_z)``.
+  Frictionless (the wrap's unstrained length ``r_p wrap / (1 + T / EA)``), its weight carried by the
+  pulley (at most ``w r_p`` of tension: 7e-6 m of stretch, 2.5e-6 relative stiffness asymmetry for the
+  paper's cable); rigid rim, no pulley inertia;
+* spatial, a point exit: the planar catenary in the vertical plane through the ends (MoorPy's trick),
+  its end stiffness ``Q K2 Q^T - (H / h) (P_h - u u^T)``, ``Q = [u, e_z]``, ``u`` the horizontal
+  direction from the anchor to the exit and ``h`` the horizontal span (a sideways step turns the pull;
+  vertical: ``H / h`` tends to ``-K2[0, 0]``);
+* spatial, a swivel pulley: the planar pulley cable in the vertical plane through the axis and the
+  anchor, its stiffness ``Q K2 Q^T + (f_rho / rho) (P_h - e_rho e_rho^T)``.
 
 **Solvers.** The forward problem is an energy minimum (:func:`solve_statics`); statically
 indeterminate robots need no tension distribution (the cables' elasticity picks the equilibrium).
@@ -76,13 +73,9 @@ def _point(name, value, size=None):
 @dataclass(frozen=True)
 class SuspendedCable:
     """One cable of the platform: its weight per unstrained length ``w >= 0`` [N/m], ``EA > 0`` [N], its
-    anchor (platform frame, centre of mass at 0; default the centre) and its exit.
-
-    Give exactly one of ``exit_point`` (world frame, (x, z) or (x, y, z) [m]: its size is the cable's
-    dimension) and ``pulley``, the :class:`~cdpr_exu.exits.Exit` the cable leaves from: a planar
-    :class:`~cdpr_exu.exits.pulley.Pulley`, a :class:`~cdpr_exu.exits.swivel.Swivel`, or an exit the
-    cable does not wrap, taken as the ``exit_point`` at its point.
-    """
+    anchor (platform frame, centre of mass at 0; default the centre) and exactly one of ``exit_point``
+    (world frame, (x, z) or (x, y, z) [m]: its size is the cable's dimension) and ``pulley``, the
+    :class:`~cdpr_exu.exits.Exit` it leaves from (an exit it does not wrap is taken as its point)."""
 
     weight_per_length: float
     axial_stiffness: float
@@ -275,8 +268,8 @@ class CableEquilibrium:
         The anchor and the exit (over a pulley: tangent) point.
     force_on_platform, force_on_exit : ndarray, shape (d,) [N]
         The cable's forces on the platform and on its exit (tangent) point.
-    cable : CatenaryCable
-        The suspended part's; ``guess`` warm-starts the cable's next solve.
+    cable, guess : CatenaryCable, tuple
+        The suspended part's; the warm start of the cable's next solve.
     horizontal_direction : ndarray, shape (d,)
         The catenary plane's x axis: planar (1, 0); spatial the horizontal unit vector from the anchor
         towards the exit, over a swivel ``e_rho`` from the axis towards the anchor.
@@ -362,11 +355,6 @@ class PlatformEquilibrium:
     net_wrench: np.ndarray | None = field(default=None, repr=False)
 
     @property
-    def pose(self):
-        """Position and rotation, shape (pose_size,) [m, rad]."""
-        return np.append(self.position, self.rotation)
-
-    @property
     def unstrained_lengths(self):
         """Unstrained length of each cable, shape (n_cables,) [m]."""
         return np.array([c.unstrained_length for c in self.cables])
@@ -380,16 +368,6 @@ class PlatformEquilibrium:
     def tensions_at_anchor(self):
         """Tension of each cable at its anchor, shape (n_cables,) [N]."""
         return np.array([c.tension_at_anchor for c in self.cables])
-
-    @property
-    def forces_on_platform(self):
-        """Force of each cable on the platform, shape (n_cables, d) [N]."""
-        return np.array([c.force_on_platform for c in self.cables])
-
-    @property
-    def anchor_points(self):
-        """World positions of the anchors, shape (n_cables, d) [m]."""
-        return np.array([c.anchor_point for c in self.cables])
 
 
 def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
@@ -442,15 +420,12 @@ def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, wha
 
 
 def minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="equilibrium"):
-    """Newton's method for a conservative equilibrium, with a line search on the energy.
-
-    ``function(x) -> (residual, jacobian)``: the net generalised force ``-grad(energy)`` and ``-hessian``.
-    Along a descent direction ``d`` the energy's slope is ``-residual . d``; the step ends where that
-    slope stops being (strongly) negative, near the energy's minimum on the line. Unlike a search on
-    the residual norm this cannot stall away from an equilibrium, in the curved, stiff valleys of
-    near-vertical cables (stiff along the cable, soft across it). Where the stiffness is not positive
-    definite along the Newton direction, the (scaled) steepest descent is taken.
-    """
+    """Newton's method for a conservative equilibrium, ``function(x) -> (residual, jacobian)`` the net
+    generalised force ``-grad(energy)`` and ``-hessian``, with a line search on the energy: along a descent
+    direction ``d`` its slope is ``-residual . d``, and the step ends near the minimum on the line (where
+    that slope stops being strongly negative). Unlike a search on the residual norm this cannot stall away
+    from an equilibrium in the curved, stiff valleys of near-vertical cables. Where the stiffness is not
+    positive definite along the Newton direction, the (scaled) steepest descent is taken."""
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
     norm = float(np.linalg.norm(residual))
@@ -523,7 +498,6 @@ def _warm_then_cold(solve_from, guess):
     return solve_from(None)
 
 
-# --- one cable: straight geometry
 def _straight_tangent_angle(pulley, point):
     """Rim angle where a straight cable from ``point`` leaves ``pulley``."""
     centre = np.array(pulley.center)
@@ -740,8 +714,7 @@ def _swivel_plane(cable, anchor_point):
         raise UnreachableError(f"anchor {np.asarray(anchor_point).tolist()} lies on the axis of the swivel pulley at "
                                f"{inlet.tolist()}: its azimuth is undefined")
     e_rho = np.array([offset[0], offset[1], 0.0]) / rho
-    # over a disc of centre (r_p, 0) hung on its left: its hang point is the inlet at the plane's origin, its
-    # winch line the swivel axis (cdpr_exu.core.geometry, "Swivel pulley"); the anchor at the reference point
+    # a disc of centre (r_p, 0) hung on its left: hang point the inlet, winch line the axis (core.geometry)
     radius = cable.pulley_radius
     planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
                                   pulley=Pulley((radius, 0.0), radius, -1))
@@ -796,11 +769,6 @@ def _swivel_inverse_cable(cable, horizontal_tension, anchor_point, guess, max_st
     return _lifted(planar, cable, anchor_point, inlet, e_rho, planar.force_on_platform), None, None
 
 
-def _cable_kernel(cable):
-    """The per-cable solvers (forward, inverse) of ``cable``, by its space and whether it wraps over its exit."""
-    return _CABLE_KERNELS[cable.space][cable.pulley is not None]
-
-
 def forward_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
                   max_tension=None):
     """Solve one cable of given unstrained length [m] from an anchor point (d,) [m] to its exit.
@@ -808,8 +776,9 @@ def forward_cable(cable, unstrained_length, anchor_point, guess=None, max_strain
     The solver is the exit's (module notes); ``guess``: a previous :attr:`CableEquilibrium.guess`.
     Returns the :class:`CableEquilibrium` and ``d(force on platform)/d(anchor point)`` (d, d) [N/m];
     UnreachableError if the span is beyond reach at the tension limit."""
-    return _cable_kernel(cable)[0](cable, unstrained_length, np.asarray(anchor_point, dtype=float), guess,
-                                   max_strain, max_tension)
+    solve = _CABLE_KERNELS[cable.space][cable.pulley is not None][0]
+    return solve(cable, unstrained_length, np.asarray(anchor_point, dtype=float), guess, max_strain,
+                 max_tension)
 
 
 def inverse_cable(cable, horizontal_tension, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
@@ -819,10 +788,12 @@ def inverse_cable(cable, horizontal_tension, anchor_point, guess=None, max_strai
     Returns ``(CableEquilibrium, dF_A/dH, dF_A/dp_A at fixed H)``: the derivatives (d,) and (d, d) of
     a planar cable; None for a spatial one (its inverse statics differentiates numerically).
     """
-    return _cable_kernel(cable)[1](cable, horizontal_tension, np.asarray(anchor_point, dtype=float), guess,
-                                   max_strain, max_tension)
+    solve = _CABLE_KERNELS[cable.space][cable.pulley is not None][1]
+    return solve(cable, horizontal_tension, np.asarray(anchor_point, dtype=float), guess, max_strain,
+                 max_tension)
 
 
+#: Each cable's solvers (forward, inverse), by its space and whether it wraps over its exit.
 _CABLE_KERNELS = {PLANE: {False: (_planar_forward_cable, _planar_inverse_cable),
                           True: (_planar_forward_cable, _planar_inverse_cable)},
                   SPACE: {False: (_vertical_plane_forward_cable, _vertical_plane_inverse_cable),
@@ -895,17 +866,9 @@ def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wren
     max_strain, max_tension : float, optional
         Cable tension limits (:func:`cdpr_exu.physics.catenary.tension_limit`).
 
-    Returns
-    -------
-    PlatformEquilibrium
-
-    Raises
-    ------
-    SceneError
-        Naming the argument, if an input is invalid (before any solve).
-    UnreachableError
-        If two cables cannot both reach the platform (before any solve), or no equilibrium is found
-        within the tension limits.
+    Returns a :class:`PlatformEquilibrium`. Raises SceneError naming an invalid argument, UnreachableError if
+    two cables cannot both reach the platform (both before any solve) or no equilibrium is found within the
+    tension limits.
     """
     kernel = _checked_platform(platform)
     space = platform.space
@@ -966,13 +929,8 @@ def solve_inverse_statics(platform, pose, external_wrench=None, initial_guess=No
     ``initial_guess``: a nearby :class:`PlatformEquilibrium` or positive horizontal tensions (n_cables,)
     [N], the start (planar, with its rotation). ``max_strain``, ``max_tension``: as in :func:`solve_statics`.
 
-    Raises
-    ------
-    UnreachableError
-        If a cable would have to push or hang vertically, a tension exceeds its limit, or the
-        iteration fails.
-    SceneError
-        If an argument is invalid, or (planar) the problem is not square.
+    Raises UnreachableError if a cable would have to push or hang vertically, a tension exceeds its limit,
+    or the iteration fails; SceneError for an invalid argument or (planar) a problem that is not square.
     """
     kernel = _checked_platform(platform)
     wrench = _wrench(platform, external_wrench)
@@ -1177,9 +1135,8 @@ class _SpatialStatics:
             gradient = force if dof == 3 else np.concatenate([force, left_jacobian(theta).T @ moment])
             return value / scale, gradient / scale
 
-        # Unknowns in metres (the rotation vector times the largest arm), so that a step turns the
-        # anchors as far as it moves them: with stiff cables (EA / L of 3e5 N/m, CoGiRo) unscaled
-        # steps spun the platform through several turns.
+        # Unknowns in metres (rotation vector times the largest arm): a step turns the anchors as far as it
+        # moves them (unscaled, CoGiRo's stiff cables, EA / L of 3e5 N/m, spun the platform several turns).
         arm = float(np.linalg.norm(platform.anchors, axis=1).max()) if dof == 6 else 1.0
         unit = np.array([1.0] * 3 + [max(arm, 1e-3)] * 3)[:dof]
 
@@ -1187,9 +1144,8 @@ class _SpatialStatics:
             value, gradient = energy(x / unit)
             return value, gradient / unit
 
-        # Start at the exits' centroid, unrotated: inside the frame, the cables slack or short of their
-        # lengths, so the weight and the taut cables pull the platform onto its equilibrium. (Starting a
-        # cable length below the exits stretched CoGiRo's stiff cables by metres.)
+        # Start at the exits' centroid, unrotated: the weight and the taut cables pull the platform onto its
+        # equilibrium (a cable length below the exits stretched CoGiRo's stiff cables by metres).
         start = np.zeros(dof)
         start[:3] = exits.mean(axis=0)
         solution = minimize(scaled_energy, start * unit, jac=True, method="BFGS",
@@ -1369,8 +1325,7 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
                          f"(x, z) for a rigid platform on 2 cables, a pose (x, z, rotation) on 3")
     horizontal, tensions, _ = _ideal_tensions(platform, position, rotation, wrench, free_rotation)
     if np.any(tensions <= 0.0):
-        # straight massless cables would push; start from a moderate pull and let
-        # Newton decide (it fails, with UnreachableError, if they really must push)
+        # straight massless cables would push: start from a moderate pull and let Newton decide
         weight = max(platform.mass * platform.gravity, 1e-9)
         horizontal = np.maximum(horizontal, 0.1 * weight)
     lengths_guess = [_straight_length_and_gradient(c, p)[0]
@@ -1411,8 +1366,7 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
         residual, jacobian = evaluate(scaled / unknown_scale)
         return residual / residual_scale, jacobian / residual_scale[:, None] / unknown_scale[None, :]
 
-    # With a free rotation, a start where a cable hangs exactly vertical (H = 0
-    # cannot parametrise it) or far from the answer is retried at other rotations.
+    # With a free rotation, a start where a cable hangs vertically (H = 0) or far off is retried turned.
     guessed_rotation = None
     if initial_guess is not None:
         guessed = initial_guess

@@ -59,17 +59,9 @@ def tension_distribution(structure_matrix, wrench, min_tension, max_tension, pos
     pose : array_like, optional
         Only named in the error message.
 
-    Returns
-    -------
-    ndarray, shape (m,) [N]
-
-    Raises
-    ------
-    SceneError
-        Naming the argument: wrong shapes, non-finite values, negative bounds, ``min_tension > max_tension``.
-    UnreachableError
-        "outside the wrench-feasible workspace", naming the pose, if no tensions within the bounds balance
-        the wrench.
+    Returns the tensions (m,) [N]. Raises SceneError naming the argument (wrong shapes, non-finite values,
+    negative bounds, ``min_tension > max_tension``), UnreachableError "outside the wrench-feasible
+    workspace", naming the pose, if no tensions within the bounds balance the wrench.
 
     Notes
     -----
