@@ -59,14 +59,9 @@ def tension_limit(axial_stiffness, max_strain=DEFAULT_MAX_STRAIN, max_tension=No
 
 @dataclass(frozen=True)
 class CatenaryCable:
-    """A suspended elastic cable: unstrained length ``L > 0`` [m], weight per unstrained length
-    ``w >= 0`` [N/m] (0: the massless, straight linear spring) and axial stiffness ``EA > 0`` [N].
-
-    Raises
-    ------
-    SceneError
-        If a value is not finite, or not positive (``weight_per_length``: negative).
-    """
+    """A suspended elastic cable: unstrained length ``L > 0`` [m], weight per unstrained length ``w >= 0``
+    [N/m] (0: the massless, straight linear spring) and axial stiffness ``EA > 0`` [N]; SceneError for a
+    value that is not finite or out of range."""
 
     unstrained_length: float
     weight_per_length: float

@@ -156,10 +156,8 @@ _CABLE_CHECKS = {2: _check_planar_cable, 3: _check_spatial_cable}
 @dataclass(frozen=True)
 class ChainRobot:
     """The platform of ``mass`` [kg] and its lumped cables (all of one dimension), ``gravity`` [m/s^2]
-    downwards.
-
-    ``anchor_spring_factor``, in space: None, each cable's last node sits on its anchor (an exact spherical
-    joint); f > 0, it is tied to it by a spring of stiffness f k (the builder's penalty joint,
+    downwards. ``anchor_spring_factor``, in space: None, each cable's last node on its anchor (an exact
+    spherical joint); f > 0, tied to it by a spring of stiffness f k (the builder's penalty joint,
     :class:`cdpr_exu.builder.robot_3d.ChainSpec3D`)."""
 
     cables: tuple
@@ -195,10 +193,9 @@ def chain_robot(scene, anchor_spring_factor: float | None = None, tension_only: 
 
     ``anchor_spring_factor``: in space, see :class:`ChainRobot`. ``tension_only``: default the scene's
     ``effects.slack``. ``catenary``: in space, the scene's catenary statics, which hold a swivel cable at
-    the winch end its start shape puts it (:func:`swivel_chain_start`); solved here when needed.
-
-    Raises :class:`SceneError` for a bending model other than the exact angle; in the plane also for
-    massless or inextensible cables and contact models other than the node contact.
+    the winch end its start shape puts it (:func:`swivel_chain_start`); solved here when needed. Raises
+    SceneError for a bending model other than the exact angle; in the plane also for massless or
+    inextensible cables and contact models other than the node contact.
     """
     effects = scene.effects
     if effects.bending and effects.bending_model != "exact":

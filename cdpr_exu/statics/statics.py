@@ -202,9 +202,8 @@ class SuspendedPlatform:
 
 def catenary_platform(scene) -> SuspendedPlatform:
     """The catenary-statics model of a scene's robot: each cable's ``w = rho0 g`` [N/m] (0 without cable
-    mass or gravity), ``EA``, anchor and exit, the platform's mass, gravity (0 when off) and inertia.
-
-    Raises :class:`SceneError` if a weight per length overflows or the platform cannot hang."""
+    mass or gravity), ``EA``, anchor and exit, the platform's mass, gravity (0 when off) and inertia;
+    SceneError if a weight per length overflows or the platform cannot hang."""
     gravity = scene.gravity if scene.effects.gravity else 0.0
     weighs = scene.effects.cable_mass and scene.effects.gravity
     weights = [c.linear_density * gravity if weighs else 0.0 for c in scene.cables]
@@ -372,12 +371,10 @@ class PlatformEquilibrium:
 
 def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
                    line_search_steps=50):
-    """Newton's method on ``function(x) -> (residual, jacobian)`` with backtracking on the residual norm;
-    returns ``(x, residual, jacobian)``.
-
-    A trial point that raises UnreachableError is a rejected step; components in ``positive`` keep above
-    10 % of their value. Converged below ``tolerance``, or where no step decreases the norm and it is
-    below ``noise`` (default ``1e3 tolerance``), the precision the residual can have."""
+    """Newton's method on ``function(x) -> (residual, jacobian)``, backtracking on the residual norm; returns
+    ``(x, residual, jacobian)``. A trial that raises UnreachableError is rejected; components in ``positive``
+    stay above 10 % of their value. Converged below ``tolerance``, or where no step decreases the norm and
+    it is below ``noise`` (default ``1e3 tolerance``), the precision the residual can have."""
     noise = 1e3 * tolerance if noise is None else max(noise, tolerance)
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
