@@ -109,7 +109,7 @@ def v_shaped_scene(effects: Effects | None = None, n_elements: int = 6, platform
 # --------------------------------------------------------------------------- spatial
 
 #: The paper's cable (radius 5 mm, E = 1e9 Pa, 0.35 kg/m) as a catenary: w = 3.43 N/m, EA = 7.85e4 N.
-PAPER_CATENARY_CABLE = CatenaryCable.from_material(1.0, 0.005, 1e9, 0.35)
+PAPER_CATENARY_CABLE = CatenaryCable(1.0, 0.35 * 9.81, 1e9 * math.pi * 0.005**2)
 #: Corner signs of the square frame, cable 1 to 4.
 CORNERS = ((1, 1), (-1, 1), (-1, -1), (1, -1))
 #: Unequal lengths [m] that make the four-cable robot hang off-centre and tilt.

@@ -422,8 +422,6 @@ PUBLIC_CALLS = {
     "CatenaryCable weight NaN": (lambda: catenary.CatenaryCable(1, NAN, 1), SceneError, "weight_per_length must be finite"),
     "CatenaryCable length text": (lambda: catenary.CatenaryCable("a", 1, 1), SceneError, "unstrained_length must be a real number"),
     "CatenaryCable EA 0": (lambda: catenary.CatenaryCable(1, 1, 0), SceneError, "axial_stiffness must be positive"),
-    "from_material radius 0": (lambda: catenary.CatenaryCable.from_material(1, 0, 1e9, 0.35), SceneError, "radius"),
-    "from_material gravity negative": (lambda: catenary.CatenaryCable.from_material(1, 0.005, 1e9, 0.35, -9.8), SceneError, "gravity"),
     "solve_forward span NaN": (lambda: catenary.solve_forward(CABLE, [NAN, 0]), SceneError, "span"),
     "solve_forward span shape": (lambda: catenary.solve_forward(CABLE, [1, 0, 0]), SceneError, "span"),
     "solve_forward beyond reach": (lambda: catenary.solve_forward(CABLE, [10, 0]), UnreachableError, "beyond the reach"),

@@ -1,37 +1,29 @@
 """The elastic catenary: a suspended cable with weight and axial elasticity, no bending.
 
-The model is Irvine's (1981), as used for cable robots by Kozak, Zhou and Wang (2006):
-a cable of unstrained length ``L`` [m], weight per unstrained length ``w`` [N/m] and
-axial stiffness ``EA`` [N], linear elastic (Hooke's law on the unstrained arc length),
-hanging between its two ends A (start) and B (end) in the vertical x-z plane, gravity
-along -z. No ground contact, no bending stiffness.
+Irvine's model (1981), as used for cable robots by Kozak, Zhou and Wang (2006): a cable of
+unstrained length ``L`` [m], weight per unstrained length ``w`` [N/m] and axial stiffness ``EA`` [N],
+linear elastic (Hooke's law on the unstrained arc length), hanging between its ends A and B in the
+vertical x-z plane, gravity along -z; no ground contact.
 
 Conventions
 -----------
-Arc length ``s`` is unstrained and runs from A (s = 0) to B (s = L). The tension
-vector along the cable, pointing towards B, is ``(H, V(s))`` with ``V(s) = V_A + w s``:
-``H >= 0`` is the horizontal tension (constant along the cable) and
-``V_B = V_A + w L`` is the vertical tension component at B, ie the upward force the
-support at B exerts on the cable. For a span ``(dx, dz) = p_B - p_A`` with ``dx > 0``
+Arc length ``s`` is unstrained, from A (s = 0) to B (s = L). The tension vector, pointing towards
+B, is ``(H, V(s))``, ``V(s) = V_A + w s``: ``H >= 0`` the horizontal tension (constant) and ``V_B``
+the upward force of the support at B on the cable. For a span ``(dx, dz) = p_B - p_A``, ``dx > 0``
 (Irvine's eqs.; `paper-params.md`)::
 
     dx = H/w [asinh(V_B/H) - asinh(V_A/H)] + H L / EA
     dz = H/w [sqrt(1 + (V_B/H)^2) - sqrt(1 + (V_A/H)^2)] + (V_B L - w L^2 / 2) / EA
 
-Spans with ``dx < 0`` are solved in the mirrored frame (x -> -x); ``dx == 0`` is the
-vertical limit ``H = 0`` (a straight hanging cable, or a cable folded into a
-zero-width U when it is slack), solved in closed form.
+Spans with ``dx < 0`` are solved mirrored (x -> -x); ``dx == 0`` is the vertical limit ``H = 0`` (a
+straight hanging cable, or, slack, folded into a zero-width U), solved in closed form.
 
 Numerics
 --------
-The textbook form divides by ``w`` and by ``H``. Here the inextensible terms are
-rewritten without either division (see `_span_and_jacobian`):
-``dz_inextensible = L (V_A + V_B) / (T_A + T_B)`` exactly, and
-``dx_inextensible = (H/w) log1p(y)`` with ``y`` proportional to ``w L``, evaluated as
-``L q c H log1p(y)/y``. So the massless limit ``w -> 0`` (a straight linear spring)
-is reached continuously, with no cancellation, and ``w = 0`` itself is solved in
-closed form. The Jacobian ``d(dx, dz)/d(H, V_B)`` is analytic and written in the same
-cancellation-free way.
+The textbook form divides by ``w`` and by ``H``; the inextensible terms and the analytic Jacobian
+``d(dx, dz)/d(H, V_B)`` are rewritten without either division (`_span_and_jacobian`), so the
+massless limit ``w -> 0`` (a straight linear spring) is reached without cancellation and ``w = 0``
+is solved in closed form.
 """
 
 from __future__ import annotations
@@ -48,28 +40,16 @@ STANDARD_GRAVITY = 9.81
 """Default gravitational acceleration [m/s^2]."""
 
 DEFAULT_MAX_STRAIN = 0.1
-"""Largest cable strain ``T / EA`` a solution may have before it counts as unreachable.
-
-Linear elasticity is meaningless well before 10 % strain for any real cable (steel
-yields near 0.5 %), and an elastic cable can otherwise reach any span by stretching,
-so some limit must define "unreachable". Pass ``max_strain`` or ``max_tension`` to
-the solvers to use a tighter, physical limit (eg the cable's breaking load).
-"""
+"""Largest strain ``T / EA`` before a span counts as unreachable (an elastic cable reaches any span by
+stretching; steel yields near 0.5 %). ``max_strain`` or ``max_tension`` give a tighter, physical limit."""
 
 _RELATIVE_TOLERANCE = 1e-12
 _VERTICAL_TOLERANCE = 1e-12
 _MAX_NEWTON_ITERATIONS = 200
 
 
-# ---------------------------------------------------------------------------
-# validation helpers
-# ---------------------------------------------------------------------------
-def _span_vector(span):
-    return vector("span", span, 2, " (dx, dz) [m]")
-
-
-def _strain_limits(axial_stiffness, max_strain, max_tension):
-    """Largest admissible end tension [N] from a strain and an optional tension limit."""
+def tension_limit(axial_stiffness, max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
+    """Largest admissible tension [N] of a cable of ``EA`` [N]: ``max_strain EA``, or ``max_tension`` [N]."""
     max_strain = positive("max_strain", max_strain)
     limit = max_strain * axial_stiffness
     if max_tension is not None:
@@ -77,107 +57,39 @@ def _strain_limits(axial_stiffness, max_strain, max_tension):
     return limit
 
 
-# ---------------------------------------------------------------------------
-# parameters and results
-# ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class CatenaryCable:
-    """A suspended elastic cable: unstrained length, weight and axial stiffness.
-
-    Parameters
-    ----------
-    unstrained_length : float [m]
-        Length of the cable at zero tension, ``L > 0``.
-    weight_per_length : float [N/m]
-        Weight per unstrained length, ``w = linear_density * g >= 0``; 0 is the
-        massless (straight linear spring) limit.
-    axial_stiffness : float [N]
-        ``EA``, Young's modulus times cross-section area, ``> 0``.
-
-    Raises
-    ------
-    SceneError
-        If a value is not finite, or not positive (``weight_per_length``: negative).
-    """
+    """A suspended elastic cable: unstrained length ``L > 0`` [m], weight per unstrained length ``w >= 0``
+    [N/m] (0: the massless, straight linear spring) and axial stiffness ``EA > 0`` [N]; SceneError for a
+    value that is not finite or out of range."""
 
     unstrained_length: float
     weight_per_length: float
     axial_stiffness: float
 
     def __post_init__(self):
-        object.__setattr__(
-            self, "unstrained_length", positive("unstrained_length", self.unstrained_length)
-        )
-        object.__setattr__(
-            self,
-            "weight_per_length",
-            non_negative("weight_per_length", self.weight_per_length),
-        )
-        object.__setattr__(
-            self, "axial_stiffness", positive("axial_stiffness", self.axial_stiffness)
-        )
-
-    @classmethod
-    def from_material(
-        cls, unstrained_length, radius, youngs_modulus, linear_density, gravity=STANDARD_GRAVITY
-    ):
-        """Make a cable of circular solid section from its material data.
-
-        Parameters
-        ----------
-        unstrained_length : float [m]
-        radius : float [m]
-            Cable radius; the section area is ``pi radius^2``.
-        youngs_modulus : float [Pa]
-        linear_density : float [kg/m]
-            Mass per unstrained length.
-        gravity : float [m/s^2], optional
-            Gravitational acceleration, default 9.81.
-
-        Returns
-        -------
-        CatenaryCable
-        """
-        radius = positive("radius", radius)
-        youngs_modulus = positive("youngs_modulus", youngs_modulus)
-        linear_density = non_negative("linear_density", linear_density)
-        gravity = non_negative("gravity", gravity)
-        return cls(
-            unstrained_length=unstrained_length,
-            weight_per_length=linear_density * gravity,
-            axial_stiffness=youngs_modulus * math.pi * radius**2,
-        )
-
-    def with_length(self, unstrained_length):
-        """The same cable with another unstrained length [m]."""
-        return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
-
-    @property
-    def weight(self):
-        """Total weight of the cable ``w L`` [N]."""
-        return self.weight_per_length * self.unstrained_length
+        for name, check in (("unstrained_length", positive), ("weight_per_length", non_negative),
+                            ("axial_stiffness", positive)):
+            object.__setattr__(self, name, check(name, getattr(self, name)))
 
 
 @dataclass(frozen=True, eq=False)
 class CatenaryState:
-    """A solved elastic catenary: end forces, tensions and geometry.
+    """A solved elastic catenary.
 
     Attributes
     ----------
     horizontal_tension : float [N]
-        ``H >= 0``, the horizontal tension component, constant along the cable.
+        ``H >= 0``, constant along the cable.
     vertical_tension_a, vertical_tension_b : float [N]
-        ``V_A`` and ``V_B = V_A + w L``: vertical component of the tension vector
-        (pointing from A to B) at A and at B. ``V_B`` is the upward force the support
-        at B exerts on the cable; ``-V_A`` the one the support at A exerts.
+        ``V_A`` and ``V_B = V_A + w L``, the tension vector's (A towards B) vertical component at A and B:
+        ``V_B`` is the upward force of the support at B on the cable, ``-V_A`` the one at A.
     force_on_a, force_on_b : ndarray, shape (2,) [N]
-        Forces (x, z) the cable exerts on its supports at A and at B. Their sum is
-        the cable weight ``(0, -w L)``.
+        Forces (x, z) of the cable on its supports at A and B; their sum is its weight ``(0, -w L)``.
     tension_a, tension_b : float [N]
-        Tension magnitudes at the ends; the largest tension is at one of them.
-    unstrained_length : float [m]
-    stretched_length : float [m]
-        Arc length of the loaded cable.
+        Tensions at the ends, the largest along the cable at one of them.
+    unstrained_length, stretched_length : float [m]
+        The latter the arc length of the loaded cable.
     span : ndarray, shape (2,) [m]
         ``p_B - p_A``.
     """
@@ -204,9 +116,6 @@ class CatenaryState:
         return -1.0 if self.span[0] < 0.0 else 1.0
 
 
-# ---------------------------------------------------------------------------
-# the core: span and its Jacobian from (H, V_B), cancellation-free
-# ---------------------------------------------------------------------------
 def _log1p_ratio(y):
     """``log(1 + y) / y``, 1 at ``y = 0``, 0 at ``y = inf``."""
     if y == 0.0:
@@ -299,11 +208,7 @@ def _span_and_jacobian(H, V_B, L, w, EA, with_jacobian=True):
         cross = -H * L * sum_V / (T_A * T_B * sum_T)
     else:
         cross = 0.0
-    jacobian = [
-        [dx_over_H - ddz_inext_dV + L / EA, cross],
-        [cross, ddz_inext_dV + L / EA],
-    ]
-    return dx, dz, jacobian
+    return dx, dz, [[dx_over_H - ddz_inext_dV + L / EA, cross], [cross, ddz_inext_dV + L / EA]]
 
 
 def _tension_integral(H, V_B, L, w):
@@ -342,40 +247,15 @@ def _make_state(cable, H, V_B, sign_x, slack_span=None):
         dx, dz = abs(float(slack_span[0])), float(slack_span[1])
         stretched = L
     V_A = V_B - w * L
-    return CatenaryState(
-        horizontal_tension=H,
-        vertical_tension_a=V_A,
-        vertical_tension_b=V_B,
-        force_on_a=np.array([sign_x * H, V_A]),
-        force_on_b=np.array([-sign_x * H, -V_B]),
-        tension_a=math.hypot(H, V_A),
-        tension_b=math.hypot(H, V_B),
-        unstrained_length=L,
-        stretched_length=stretched,
-        span=np.array([sign_x * dx, dz]),
-    )
+    return CatenaryState(horizontal_tension=H, vertical_tension_a=V_A, vertical_tension_b=V_B,
+                         force_on_a=np.array([sign_x * H, V_A]), force_on_b=np.array([-sign_x * H, -V_B]),
+                         tension_a=math.hypot(H, V_A), tension_b=math.hypot(H, V_B), unstrained_length=L,
+                         stretched_length=stretched, span=np.array([sign_x * dx, dz]))
 
 
 def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizontal_sign=1.0):
-    """The catenary that a given end force produces: span, forces and lengths.
-
-    This is the explicit direction of the catenary equations: from ``(H, V_B)`` and
-    the cable, the span follows in closed form.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    horizontal_tension : float [N]
-        ``H >= 0``.
-    vertical_tension_b : float [N]
-        ``V_B``, the upward force the support at B exerts on the cable.
-    horizontal_sign : {+1, -1}, optional
-        +1 for B to the right of A (``dx >= 0``), -1 for B to the left.
-
-    Returns
-    -------
-    CatenaryState
-    """
+    """The :class:`CatenaryState` a given end force produces (the span in closed form): ``H >= 0`` [N],
+    ``V_B`` [N], ``horizontal_sign`` +1 for B right of A (``dx >= 0``), -1 for B left of it."""
     H = non_negative("horizontal_tension", horizontal_tension)
     V_B = finite("vertical_tension_b", vertical_tension_b)
     if horizontal_sign not in (1, -1, 1.0, -1.0):
@@ -383,16 +263,10 @@ def state_from_end_forces(cable, horizontal_tension, vertical_tension_b, horizon
     return _make_state(cable, H, V_B, float(horizontal_sign))
 
 
-# ---------------------------------------------------------------------------
-# forward problem: forces from span and unstrained length
-# ---------------------------------------------------------------------------
 def _vertical_solution(L, w, EA, dz):
-    """``V_B`` of a vertical cable (H = 0) with span ``(0, dz)``: closed form.
-
-    Three regimes, each linear in ``V_B``: taut with B above A (``V_A >= 0``), taut
-    with B below A (``V_B <= 0``), or slack and folded into a zero-width U with the
-    low point inside (``V_A < 0 < V_B``, only for ``w > 0``).
-    """
+    """``V_B`` of a vertical cable (H = 0) with span ``(0, dz)``, in closed form: taut with B above A
+    (``V_A >= 0``), taut with B below A (``V_B <= 0``), or slack and folded into a zero-width U
+    (``V_A < 0 < V_B``, only for ``w > 0``), each linear in ``V_B``."""
     V_A = (dz - L) * EA / L - 0.5 * w * L
     if V_A >= 0.0:
         return V_A + w * L
@@ -405,14 +279,10 @@ def _vertical_solution(L, w, EA, dz):
 
 
 def _initial_guess(L, w, EA, dx, dz):
-    """Starting ``(H, V_B)`` for the Newton solve (dx > 0, w > 0).
-
-    Taut spans (chord >= L) start from the straight elastic spring plus half the
-    cable weight at each end, or from MoorPy's taut guess ``lambda = 0.2`` if that
-    is larger. Slack spans use the parabolic estimate of Peyrot and Goulois (as in
-    FAST and MoorPy's ``catenary``): ``lambda = sqrt(3 ((L^2 - dz^2)/dx^2 - 1))``,
-    ``H = w dx / (2 lambda)``, ``V_B = w/2 (dz / tanh(lambda) + L)``.
-    """
+    """Starting ``(H, V_B)`` for Newton (dx > 0, w > 0). Taut spans (chord >= L): the straight elastic spring
+    plus half the weight at each end, or MoorPy's taut guess ``lambda = 0.2`` if larger. Slack spans: the
+    parabolic estimate of Peyrot and Goulois (FAST, MoorPy): ``lambda = sqrt(3 ((L^2 - dz^2)/dx^2 - 1))``,
+    ``H = w dx / (2 lambda)``, ``V_B = w/2 (dz / tanh(lambda) + L)``."""
     chord = math.hypot(dx, dz)
     if chord >= L:
         spring_tension = EA * (chord - L) / L
@@ -426,13 +296,9 @@ def _initial_guess(L, w, EA, dx, dz):
 
 
 def _damped_newton_2d(residual, x, y, tolerance, max_drop=None):
-    """Damped Newton on two unknowns ``(x, y)``, ``x`` kept positive.
-
-    ``residual(x, y)`` returns ``(rx, rz, jacobian)``. The step is scaled as a whole
-    (keeping its direction) so that ``x`` drops by at most the fraction ``max_drop``
-    (if given), then halved until the residual norm decreases (Armijo). Returns
-    ``(x, y, norm)`` at convergence (norm <= tolerance) or where the iteration stalls.
-    """
+    """Damped Newton on two unknowns, ``residual(x, y) -> (rx, rz, jacobian)``, ``x`` kept positive: the step,
+    scaled as a whole so that ``x`` drops by at most the fraction ``max_drop``, halved until the residual norm
+    decreases (Armijo). Returns ``(x, y, norm)`` at convergence or where the iteration stalls."""
     rx, rz, jac = residual(x, y)
     norm = math.hypot(rx, rz)
     for _ in range(_MAX_NEWTON_ITERATIONS):
@@ -465,13 +331,9 @@ def _damped_newton_2d(residual, x, y, tolerance, max_drop=None):
 
 
 def _newton_forward(L, w, EA, dx, dz, H, V_B):
-    """Damped Newton in ``(H, V_B)``; returns ``(H, V_B, converged)``.
-
-    The step is scaled as a whole (keeping its direction: near-taut cables have a
-    narrow valley along the cable direction, which a change of variables such as
-    ``log H`` would leave) so that ``H`` drops by at most 90 %, then halved until
-    the residual norm decreases (Armijo).
-    """
+    """:func:`_damped_newton_2d` in ``(H, V_B)``, ``H`` dropping by at most 90 % (the step keeps its
+    direction: near-taut cables have a narrow valley along the cable that a change of variables such as ``log
+    H`` would leave); returns ``(H, V_B, converged)``."""
     scale = max(L, math.hypot(dx, dz))
     tolerance = _RELATIVE_TOLERANCE * scale
 
@@ -495,14 +357,10 @@ def _bracket_root(function, low, high, grow):
 
 
 def _nested_forward(L, w, EA, dx, dz, H_start):
-    """Globally convergent fallback: nested bracketing in ``log H`` and ``V_B``.
-
-    ``dz`` increases strictly with ``V_B`` at fixed ``H`` (``J22 > 0``), and along the
-    curve of fixed ``dz``, ``dx`` increases strictly with ``H`` (``det J / J22 > 0``, the
-    flexibility matrix being positive definite), so two nested Brent solves always
-    find the solution. Used when Newton fails near the singular corners of the
-    catenary (a vertical, just-taut cable whose lower end is at zero tension).
-    """
+    """Globally convergent fallback, for the singular corner of a vertical just-taut cable whose lower end is
+    at zero tension: nested Brent solves in ``log H`` and ``V_B``. ``dz`` grows strictly with ``V_B`` at fixed
+    ``H`` (``J22 > 0``), and along a curve of fixed ``dz``, ``dx`` with ``H`` (``det J / J22 > 0``, the
+    flexibility being positive definite), so they always find the solution."""
     from scipy.optimize import brentq
 
     weight = max(w * L, 1e-300)
@@ -550,68 +408,34 @@ def _solve_span(L, w, EA, dx, dz, guess):
     residual = math.hypot(rx - dx, rz - dz)
     if residual <= 1e3 * _RELATIVE_TOLERANCE * max(L, math.hypot(dx, dz)):
         return H, V_B
-    raise UnreachableError(
-        f"elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
-        f"unstrained_length {L:g} m (residual {residual:.3g} m)"
-    )
+    raise UnreachableError(f"elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
+                           f"unstrained_length {L:g} m (residual {residual:.3g} m)")
 
 
-def solve_forward(
-    cable,
-    span,
-    initial_guess=None,
-    max_strain=DEFAULT_MAX_STRAIN,
-    max_tension=None,
-):
-    """End forces of a cable of given unstrained length hung across a given span.
+def solve_forward(cable, span, initial_guess=None, max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
+    """The :class:`CatenaryState` of a cable hung across ``span`` (2,) [m] (``p_B - p_A``, any signs).
 
-    Solves Irvine's two equations for ``(H, V_B)`` by Newton's method with the
-    analytic Jacobian, with steps limited to keep ``H`` positive and a backtracking
-    line search, from the Peyrot-Goulois / MoorPy initial guess. Should Newton
-    stall (near the singular corner of a just-taut, nearly vertical cable whose
-    lower end is at zero tension), a nested bracketing solve, which always converges,
-    takes over. Vertical spans (``|dx| <= 1e-12 L``) and massless cables (``w == 0``)
-    are solved in closed form.
+    Newton's method on Irvine's equations in ``(H, V_B)`` (steps keep ``H`` positive, backtracking), from
+    ``initial_guess`` (``(H, V_B)`` [N] where ``dx >= 0``, eg the previous solution along a path) or the
+    Peyrot-Goulois / MoorPy guess; should it stall (a just-taut, nearly vertical cable whose lower end is at
+    zero tension), a nested bracketing solve, which always converges. Vertical spans (``|dx| <= 1e-12 L``)
+    and massless cables in closed form. ``max_strain`` and ``max_tension`` [N]: :func:`tension_limit`.
 
-    Parameters
-    ----------
-    cable : CatenaryCable
-    span : array_like, shape (2,) [m]
-        ``p_B - p_A``, any signs.
-    initial_guess : tuple (H, V_B) [N], optional
-        Start the Newton iteration here (eg the previous solution along a path),
-        in the frame where ``dx >= 0``.
-    max_strain : float, optional
-        Largest admissible ``T / EA`` anywhere on the cable (default 0.1).
-    max_tension : float [N], optional
-        Largest admissible tension, in addition to ``max_strain``.
-
-    Returns
-    -------
-    CatenaryState
-
-    Raises
-    ------
-    UnreachableError
-        If the straight distance between the ends exceeds what the cable reaches at
-        the tension limit, or if the solution exceeds it.
-    SceneError
-        If ``span`` is not a finite 2-vector or a limit is not positive.
+    Raises UnreachableError if the chord exceeds the cable's reach at the tension limit or the solution
+    the limit; SceneError if ``span`` is not a finite 2-vector or a limit is not positive.
     """
-    span = _span_vector(span)
+    span = vector("span", span, 2, " (dx, dz) [m]")
     if not isinstance(cable, CatenaryCable):
         raise SceneError(f"cable must be a CatenaryCable, got {shown(cable)}")
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
-    tension_limit = _strain_limits(EA, max_strain, max_tension)
+    limit = tension_limit(EA, max_strain, max_tension)
     sign_x = -1.0 if span[0] < 0.0 else 1.0
     dx, dz = abs(float(span[0])), float(span[1])
     chord = math.hypot(dx, dz)
-    reach = L * (1.0 + tension_limit / EA)  # stretched length <= reach, chord <= it
+    reach = L * (1.0 + limit / EA)  # stretched length <= reach, chord <= it
     if chord > reach:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m is {chord:g} m long, beyond the reach "
-            f"{reach:g} m of unstrained_length {L:g} m at tension limit {tension_limit:g} N"
-        )
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m is {chord:g} m long, beyond the reach "
+                               f"{reach:g} m of unstrained_length {L:g} m at tension limit {limit:g} N")
 
     slack_span = None
     if w == 0.0:  # massless: straight linear spring, or slack (no force)
@@ -633,17 +457,12 @@ def solve_forward(
         H, V_B = _solve_span(L, w, EA, dx, dz, guess)
 
     state = _make_state(cable, H, V_B, sign_x, slack_span)
-    if state.max_tension > tension_limit:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m with unstrained_length {L:g} m needs "
-            f"tension {state.max_tension:g} N, above the limit {tension_limit:g} N"
-        )
+    if state.max_tension > limit:
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m with unstrained_length {L:g} m needs "
+                               f"tension {state.max_tension:g} N, above the limit {limit:g} N")
     return state
 
 
-# ---------------------------------------------------------------------------
-# inverse problem: unstrained length from span and horizontal tension
-# ---------------------------------------------------------------------------
 def _inextensible_length(w, H, dx, dz):
     """Inextensible catenary through the span with horizontal tension H: (L, V_B).
 
@@ -660,56 +479,26 @@ def _inextensible_length(w, H, dx, dz):
     return L, V_B
 
 
-def solve_inverse(
-    span,
-    weight_per_length,
-    axial_stiffness,
-    horizontal_tension,
-    max_strain=DEFAULT_MAX_STRAIN,
-    max_tension=None,
-):
-    """Unstrained length that hangs across a span with a given horizontal tension.
+def solve_inverse(span, weight_per_length, axial_stiffness, horizontal_tension, max_strain=DEFAULT_MAX_STRAIN,
+                  max_tension=None):
+    """Unstrained length [m] and :class:`CatenaryState` of the cable (``w >= 0`` [N/m], ``EA > 0`` [N]) that
+    hangs across ``span`` (2,) [m] (``dx != 0``: a vertical cable has ``H = 0``) with horizontal tension
+    ``H > 0`` [N]: the closed-form inextensible catenary, corrected for the stretch by Newton's method in
+    ``(L, V_B)``. The tension limit as in :func:`solve_forward`.
 
-    Starts from the closed-form inextensible catenary and corrects it for the
-    stretch by Newton's method in ``(L, V_B)`` with the analytic Jacobian.
-
-    Parameters
-    ----------
-    span : array_like, shape (2,) [m]
-        ``p_B - p_A``; ``dx`` must be nonzero (a vertical cable has ``H = 0``).
-    weight_per_length : float [N/m]
-        ``w >= 0``.
-    axial_stiffness : float [N]
-        ``EA > 0``.
-    horizontal_tension : float [N]
-        ``H > 0``.
-    max_strain, max_tension : float, optional
-        Tension limit, as in `solve_forward`.
-
-    Returns
-    -------
-    unstrained_length : float [m]
-    state : CatenaryState
-
-    Raises
-    ------
-    UnreachableError
-        If the span is vertical, or the tension exceeds the limit, or Newton fails.
-    SceneError
-        If an argument is invalid.
+    Raises UnreachableError for a vertical span, a tension above the limit or a failed Newton;
+    SceneError for an invalid argument.
     """
-    span = _span_vector(span)
+    span = vector("span", span, 2, " (dx, dz) [m]")
     w = non_negative("weight_per_length", weight_per_length)
     EA = positive("axial_stiffness", axial_stiffness)
     H = positive("horizontal_tension", horizontal_tension)
-    tension_limit = _strain_limits(EA, max_strain, max_tension)
+    limit = tension_limit(EA, max_strain, max_tension)
     sign_x = -1.0 if span[0] < 0.0 else 1.0
     dx, dz = abs(float(span[0])), float(span[1])
     if dx == 0.0:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m is vertical: no cable hangs across it "
-            f"with horizontal_tension {H:g} N > 0"
-        )
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m is vertical: no cable hangs across it "
+                               f"with horizontal_tension {H:g} N > 0")
     chord = math.hypot(dx, dz)
 
     if w == 0.0:
@@ -720,10 +509,9 @@ def solve_inverse(
         try:
             L_inext, V_B = _inextensible_length(w, H, dx, dz)
         except OverflowError:
-            raise UnreachableError(
-                f"span ({span[0]:g}, {span[1]:g}) m: horizontal_tension {H:g} N is too "
-                f"small for weight_per_length {w:g} N/m (the cable would be astronomically long)"
-            ) from None
+            raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m: horizontal_tension {H:g} N is too "
+                                   f"small for weight_per_length {w:g} N/m (the cable would be "
+                                   "astronomically long)") from None
         mean_tension = 0.5 * (math.hypot(H, V_B) + math.hypot(H, V_B - w * L_inext))
         L = L_inext / (1.0 + mean_tension / EA)
         V_B = V_B - 0.5 * w * (L_inext - L)  # keep the low point roughly in place
@@ -731,11 +519,9 @@ def solve_inverse(
 
     cable = CatenaryCable(L, w, EA)
     state = _make_state(cable, H, V_B, sign_x)
-    if state.max_tension > tension_limit:
-        raise UnreachableError(
-            f"span ({span[0]:g}, {span[1]:g}) m with horizontal_tension {H:g} N needs "
-            f"tension {state.max_tension:g} N, above the limit {tension_limit:g} N"
-        )
+    if state.max_tension > limit:
+        raise UnreachableError(f"span ({span[0]:g}, {span[1]:g}) m with horizontal_tension {H:g} N needs "
+                               f"tension {state.max_tension:g} N, above the limit {limit:g} N")
     return L, state
 
 
@@ -755,39 +541,14 @@ def _newton_inverse(w, EA, H, dx, dz, L, V_B):
     L, V_B, norm = _damped_newton_2d(evaluate, L, V_B, tolerance)
     if norm <= 1e3 * tolerance:
         return L, V_B
-    raise UnreachableError(
-        f"inverse elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
-        f"horizontal_tension {H:g} N (residual {norm:.3g} m)"
-    )
+    raise UnreachableError(f"inverse elastic catenary did not converge for span ({dx:g}, {dz:g}) m and "
+                           f"horizontal_tension {H:g} N (residual {norm:.3g} m)")
 
 
-# ---------------------------------------------------------------------------
-# geometry and stiffness of a solved state
-# ---------------------------------------------------------------------------
 def profile(cable, state, s):
-    """Points of the loaded cable at given unstrained arc lengths, relative to A.
-
-    Closed form of the elastic catenary profile: the span formula with ``L``
-    replaced by ``s`` and ``V_B`` by ``V(s) = V_A + w s``.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    state : CatenaryState
-        A solution for this cable.
-    s : array_like, shape (n,) [m]
-        Unstrained arc lengths from A, in ``[0, L]``.
-
-    Returns
-    -------
-    points : ndarray, shape (n, 2) [m]
-        ``(x, z)`` of the cable at ``s``, relative to A.
-
-    Raises
-    ------
-    SceneError
-        If an ``s`` lies outside ``[0, L]`` (beyond round-off).
-    """
+    """Points ``(x, z)`` (n, 2) [m] relative to A of the loaded cable (``state`` a solution of ``cable``) at
+    unstrained arc lengths ``s`` (n,) [m] from A: the span formula with ``L`` replaced by ``s`` and ``V_B``
+    by ``V(s) = V_A + w s``. SceneError for an ``s`` outside ``[0, L]`` (beyond round-off)."""
     L, w, EA = cable.unstrained_length, cable.weight_per_length, cable.axial_stiffness
     s = np.atleast_1d(real_array("s", s))
     if s.ndim != 1 or not np.all(np.isfinite(s)):
@@ -805,27 +566,12 @@ def profile(cable, state, s):
 
 
 def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_sign=1.0):
-    """Span of the catenary from its end force, and its derivatives.
+    """Span ``p_B - p_A`` (2,) [m] of the catenary from its end force (as :func:`state_from_end_forces`), and
+    ``d(span)/d(H, V_B, L)`` (2, 3) [m/N, m/N, -].
 
-    Parameters
-    ----------
-    cable : CatenaryCable
-    horizontal_tension : float [N]
-        ``H >= 0``.
-    vertical_tension_b : float [N]
-        ``V_B``.
-    horizontal_sign : {+1, -1}, optional
-        Side of B relative to A, as in `state_from_end_forces`.
-
-    Returns
-    -------
-    span : ndarray, shape (2,) [m]
-        ``p_B - p_A``.
-    jacobian : ndarray, shape (2, 3)
-        ``d(span)/d(H, V_B, L)`` [m/N, m/N, -]. The last column adds unstrained
-        length at end A with ``(H, V_B)`` fixed: the new piece continues the cable
-        along its direction at A. Entry ``[0, 0]`` is ``inf`` for a slack vertical
-        cable (a U of zero width: no horizontal stiffness).
+    The last column adds unstrained length at end A with ``(H, V_B)`` fixed: the new piece continues
+    the cable along its direction at A. Entry ``[0, 0]`` is ``inf`` for a slack vertical cable (a U
+    of zero width: no horizontal stiffness).
     """
     if not isinstance(cable, CatenaryCable):
         raise SceneError(f"cable must be a CatenaryCable, got {shown(cable)}")
@@ -840,33 +586,9 @@ def span_and_jacobian(cable, horizontal_tension, vertical_tension_b, horizontal_
     else:
         length_column = (0.0, 0.0)
     span = np.array([sign * dx, dz])
-    jacobian = np.array(
-        [
-            [sign * jac[0][0], sign * jac[0][1], sign * length_column[0]],
-            [jac[1][0], jac[1][1], length_column[1]],
-        ]
-    )
+    jacobian = np.array([[sign * jac[0][0], sign * jac[0][1], sign * length_column[0]],
+                         [jac[1][0], jac[1][1], length_column[1]]])
     return span, jacobian
-
-
-def span_jacobian(cable, state):
-    """``d(span)/d(H, V_B)``: flexibility of the catenary in its end-force parameters.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    state : CatenaryState
-
-    Returns
-    -------
-    ndarray, shape (2, 2) [m/N]
-        Rows ``(dx, dz)`` of the signed span, columns ``(H, V_B)``. Entry ``[0, 0]``
-        is ``inf`` for a slack vertical cable (zero horizontal stiffness).
-    """
-    _, jacobian = span_and_jacobian(
-        cable, state.horizontal_tension, state.vertical_tension_b, state.horizontal_sign
-    )
-    return jacobian[:, :2]
 
 
 def end_stiffness(cable, state):
@@ -876,16 +598,7 @@ def end_stiffness(cable, state):
     ``S = diag(-sign_x, -1)`` at B; the span moves with ``p_B``, so
     ``d(force on B)/d(p_B) = -S' J^-1 S'`` with ``S' = diag(sign_x, 1)`` and
     ``J = d(dx_mirrored, dz)/d(H, V_B)``. The matrix is symmetric and negative
-    (semi-)definite: ``K = -end_stiffness`` is the usual positive tangent stiffness.
-
-    Parameters
-    ----------
-    cable : CatenaryCable
-    state : CatenaryState
-
-    Returns
-    -------
-    ndarray, shape (2, 2) [N/m]
+    (semi-)definite: ``K = -end_stiffness`` is the usual positive tangent stiffness. Shape (2, 2) [N/m].
     """
     w = cable.weight_per_length
     H, V_B = state.horizontal_tension, state.vertical_tension_b
@@ -908,7 +621,3 @@ def end_stiffness(cable, state):
     mirror = np.diag([sign, 1.0])
     return -mirror @ inverse @ mirror
 
-
-def stretched_length(cable, state):
-    """Arc length of the loaded cable [m]: ``L + (1/EA) integral of T ds``."""
-    return state.stretched_length

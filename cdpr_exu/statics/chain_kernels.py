@@ -1,17 +1,13 @@
-"""The per-dimension kernels of the chain statics (:mod:`cdpr_exu.statics.chain_statics`).
+"""The per-dimension kernels of the chain statics (:mod:`cdpr_exu.statics.chain_statics`): the potential of
+the lumped cables, its gradient (the nodal forces) and Hessian (the tangent stiffness), operation for
+operation the simulator's own floating-point numbers, the nodes of all cables numbered cable after cable.
 
-The potential of the lumped cables, its gradient (the nodal forces) and its Hessian (the
-tangent stiffness), operation for operation the simulator's own floating-point numbers:
-
-* the plane (x, z), :class:`PlanarChains`: numba kernels of the axial springs (tension-only
-  when slack), the rim contact k_p (r_p - d) along the radius and the node weights, and the
-  exact-angle bending of :mod:`cdpr_exu.physics.bending`;
-* space (x, y, z), :class:`SpatialChains`: the potential of the chains, the platform's pose and
-  the swivel pulleys' angles, with the 3-D exact-angle bending (:mod:`cdpr_exu.physics.bending_3d`),
-  the tension-only law (:mod:`cdpr_exu.physics.axial_3d`) and the swivel groove
-  (:mod:`cdpr_exu.physics.swivel_pulley`), the dynamic model's own kernels at zero velocity.
-
-Both number the nodes of all cables one after another, cable after cable. Units SI.
+* the plane (x, z), :class:`PlanarChains`: numba kernels of the axial springs (tension-only when slack),
+  the rim contact k_p (r_p - d) along the radius and the node weights, and the exact-angle bending of
+  :mod:`cdpr_exu.physics.bending`;
+* space (x, y, z), :class:`SpatialChains`: the chains, the platform's pose and the swivel angles, with the
+  dynamic model's kernels at zero velocity (:mod:`cdpr_exu.physics.bending_3d`,
+  :mod:`cdpr_exu.physics.axial_3d`, :mod:`cdpr_exu.physics.swivel_pulley`).
 """
 
 from __future__ import annotations
@@ -30,12 +26,9 @@ __all__ = ["ChainIndex", "PlanarChains", "planar_energy", "planar_forces", "Spat
 
 
 class ChainIndex:
-    """The nodes of all cables numbered one after another, cable after cable.
-
-    Per cable its node count, first and last node; per element its two nodes, cable, stiffness
-    ``k`` [N/m], rest length ``l0`` [m] and law (``slack``: tension-only); per node its mass [kg];
-    per interior joint its bending stiffness ``joint_k`` [N m/rad].
-    """
+    """The nodes of all cables numbered cable after cable: per cable its node count, first and last node; per
+    element its nodes, cable, ``k`` [N/m], ``l0`` [m] and law (``slack``: tension-only); per node its mass
+    [kg]; per interior joint its nodes and bending stiffness ``joint_k`` [N m/rad]."""
 
     def __init__(self, robot):
         self.counts = [c.n_elements + 1 for c in robot.cables]
@@ -51,31 +44,27 @@ class ChainIndex:
         self.slack = np.array([robot.cables[c].slack for c in self.element_cable])
         self.masses = np.concatenate([np.asarray(c.node_masses) for c in robot.cables])
         self.joint_k = np.concatenate([np.full(n - 2, c.bending_stiffness) for c, n in zip(robot.cables, self.counts)])
+        self.joints = bending.cable_joints(self.counts)
 
 
 class PlanarChains(ChainIndex):
-    """The planar chains' index bookkeeping, contact and bending: global nodes of all cables and the inner unknowns.
-
-    The inner unknowns ``v`` are the interior node coordinates of every cable, cable
-    after cable, then the rotation when it is free.
-    """
+    """The planar chains' index, contact and bending; the inner unknowns ``v`` are the interior node
+    coordinates of every cable, cable after cable, then the rotation when it is free."""
 
     def __init__(self, robot, free_rotation: bool):
         super().__init__(robot)
-        self.interior = np.concatenate([
-            np.arange(f + 1, f + n - 1) for f, n in zip(self.first, self.counts)]).astype(int)
+        self.interior = np.concatenate([np.arange(f + 1, f + n - 1)
+                                        for f, n in zip(self.first, self.counts)]).astype(int)
         self.winch = self.first.copy()
         self.anchor = self.last
         self.free_rotation = free_rotation
         self.n_interior = 2 * self.interior.size
         self.n_inner = self.n_interior + int(free_rotation)
         self.interior_rows = (2 * self.interior[:, None] + np.arange(2)).ravel()
-        self.joints = bending.cable_joints(self.counts)
         self.bending = (bending.BendingSpringDamper(self.n_nodes, self.joints, self.joint_k, np.zeros_like(self.joint_k))
                         if np.any(self.joint_k > 0) else None)
         self.zero_velocities = np.zeros(2 * self.n_nodes)
-        # (2, 2N): sums the anchor nodes' coordinates; its transpose moves every anchor
-        # with the platform position
+        # (2, 2N): sums the anchor nodes' coordinates; its transpose moves every anchor with the platform
         self.anchor_sum = np.zeros((2, 2 * self.n_nodes))
         for j in self.anchor:
             self.anchor_sum[:, 2 * j:2 * j + 2] = np.eye(2)
@@ -83,9 +72,8 @@ class PlanarChains(ChainIndex):
         self.node_center = np.concatenate([np.tile(np.asarray(c.pulley.point, float), (n, 1))
                                            for c, n in zip(robot.cables, self.counts)])
         self.node_radius = np.concatenate([np.full(n, c.pulley.radius) for c, n in zip(robot.cables, self.counts)])
-        self.node_contact = np.concatenate([
-            np.full(n, c.contact_stiffness if c.pulley.wraps else 0.0)
-            for c, n in zip(robot.cables, self.counts)])
+        self.node_contact = np.concatenate([np.full(n, c.contact_stiffness if c.pulley.wraps else 0.0)
+                                            for c, n in zip(robot.cables, self.counts)])
 
 
 @njit(cache=True)
@@ -171,18 +159,9 @@ def planar_energy(robot, layout, p):
 
 
 def planar_forces(robot, layout, p, with_stiffness=True):
-    """Nodal forces, tangent stiffness, element tensions and potential energy.
-
-    Returns
-    -------
-    F : ndarray, shape (n_nodes, 2) [N]
-        Net force on every node (springs, bending, contact, weight).
-    K : ndarray, shape (2 n_nodes, 2 n_nodes) [N/m] or None
-        ``-dF/dX``.
-    tension : ndarray, shape (n_elements_total,) [N]
-    energy : float [J]
-        Elastic, contact and gravitational potential of the cables.
-    """
+    """Nodal forces (n_nodes, 2) [N] (springs, bending, contact, weight), the tangent stiffness ``-dF/dX``
+    (2 n_nodes, 2 n_nodes) [N/m] (None without ``with_stiffness``), the element tensions [N] and the
+    cables' potential energy [J] at node positions ``p`` (n_nodes, 2) [m]."""
     N = layout.n_nodes
     p = np.ascontiguousarray(p, dtype=float)
     if np.any(np.hypot(*(p[layout.elements[:, 1]] - p[layout.elements[:, 0]]).T) <= 0):
@@ -206,13 +185,11 @@ def planar_forces(robot, layout, p, with_stiffness=True):
 class SpatialChains(ChainIndex):
     """Points, unknowns and the potential with its gradient and Hessian.
 
-    Points (rows of ``P``, shape (n_points, 3)): the chain nodes of every cable, cable after
-    cable, then (with penalty joints) one anchor point per cable. Each point is fixed
-    (the held first nodes), free (its own three unknowns) or on the platform (``x + R b``).
-    The "point coordinates" are the points' 3 n_points coordinates followed by the swivel
-    angles psi (one per swivel cable). Unknowns ``v``: the free points' coordinates, then the
-    platform position, then (rigid) the rotation increment ``d`` (``R <- exp([d]x) R``), then
-    the swivel angles. A state is the tuple ``(free, x, R, psi)``.
+    Points (rows of ``P``, (n_points, 3)): every cable's nodes, then (penalty joints) one anchor point per
+    cable; each fixed (the held first nodes), free, or on the platform (``x + R b``). The point coordinates
+    are their 3 n_points coordinates, then the swivel angles psi. Unknowns ``v``: the free points'
+    coordinates, the platform position, (rigid) the rotation increment ``d`` (``R <- exp([d]x) R``), the
+    swivel angles. A state is ``(free, x, R, psi)``.
     """
 
     def __init__(self, robot):
@@ -229,7 +206,7 @@ class SpatialChains(ChainIndex):
         fixed = set(int(f) for f in self.first)
         self.free = np.array([j for j in range(self.n_points) if j not in fixed and j not in body_points], dtype=int)
         self.n_free = 3 * self.free.size
-        self.swivel_cables = robot.swivel_cables
+        self.swivel_cables = [i for i, c in enumerate(robot.cables) if isinstance(c.pulley, sp.SwivelPulley)]
         self.n_psi = len(self.swivel_cables)
         self.psi0 = self.n_free + 3 + (3 if self.rigid else 0)  # first psi unknown
         self.n_unknowns = self.psi0 + self.n_psi
@@ -239,7 +216,6 @@ class SpatialChains(ChainIndex):
         self.weights = np.zeros(self.n_points)
         self.weights[:n_chain] = self.masses * robot.gravity
         self.axial_pattern = block_pattern(self.elements, 3)
-        self.joints = bending.cable_joints(self.counts)
         if not np.any(self.joint_k > 0):
             self.joints, self.joint_k = self.joints[:0], self.joint_k[:0]
         self.pattern = block_pattern(self.joints, 3)

@@ -1,32 +1,16 @@
 """Static equilibrium of the simulator's own lumped cables: chains of nodes, in the plane and in space.
 
-:mod:`cdpr_exu.statics.statics` treats each cable as a continuous elastic catenary. The
-simulator does not: its cable is a chain of n straight elements whose nodes carry the mass
-(the scene's lumping), with exact-angle bending springs at the interior nodes, and an exit
-that holds or pushes the nodes (a planar pulley's rim, a swivel pulley's groove). On the
-paper's robot (0.25 m elements on 0.25 m pulleys) the chain wraps the pulley as a coarse
-polygon and its bending springs lift it off the rim; both change the paid-out length that
-puts the platform on a pose by millimetres to centimetres. This module solves the same
-discrete model the simulator integrates, at rest, without Exudyn and without damping.
+Not the continuous catenary (:mod:`cdpr_exu.statics.statics`): n straight elements whose nodes carry the
+mass, exact-angle bending springs at the interior nodes, an exit that holds or pushes the nodes (a
+pulley's rim, a swivel pulley's groove). On the paper's robot (0.25 m elements on 0.25 m pulleys) the
+coarse polygon on the pulley and its bending move the paid-out length of a pose by millimetres to
+centimetres. This module solves that discrete model at rest, without Exudyn and without damping.
 
-One description for both dimensions: a :class:`ChainRobot` of :class:`ChainCable` built from
-a scene by :func:`chain_robot`, one :class:`ChainEquilibrium`, and two drivers:
-
-* :func:`solve_inverse_chain_statics` (and :class:`InverseChainStatics` for many poses): the
-  pose given, the paid-out lengths, nodes and tensions found;
-* :func:`solve_chain_statics` (:func:`chain_rest` from a scene): the lengths given, the rest
-  pose found (in space; the plane's rest for given lengths is Exudyn's, :mod:`cdpr_exu.run.rest`).
-
-Behind them, each dimension's kernels (:mod:`cdpr_exu.statics.chain_kernels`), kept operation for
-operation: in the plane (x, z) two nested Newton iterations, the nodes minimising the potential at
-fixed paid-out lengths (the winch end on the winch line ``x = c_x + side r_p``,
-:mod:`cdpr_exu.builder.winch`), the lengths cancelling the force the held platform needs; in space
-(x, y, z) Newton's method on the potential of the chains, the platform's pose and the swivel
-angles, and the inverse by Gauss-Newton on the lengths over chains held at their anchors
-(:func:`solve_held_chain`). All minimise with :func:`descent_step` and one Armijo line search
-(:func:`_line_search`). Over swivel pulleys, where Exudyn's static solver does not converge from
-the catenary start (:func:`cdpr_exu.run.settle.settle`), the forward statics' answer
-starts the runs (:func:`cdpr_exu.run.settle.start_at_rest`).
+A :class:`ChainRobot` of :class:`ChainCable` (:func:`chain_robot`), one :class:`ChainEquilibrium`, and two
+drivers: :func:`solve_inverse_chain_statics` (the pose given) and :func:`solve_chain_statics` (the lengths
+given, in space; the plane's rest is Exudyn's). The kernels (:mod:`cdpr_exu.statics.chain_kernels`) stay
+per dimension; all minimise the potential with :func:`descent_step` and one Armijo line search. Over
+swivel pulleys the forward statics start the runs (:func:`cdpr_exu.run.settle.start_at_rest`).
 
 Units SI (m, N, kg, rad); the vertical axis up, gravity along it downwards.
 """
@@ -35,6 +19,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections import namedtuple
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -42,8 +27,9 @@ import scipy.sparse as sparse
 import scipy.sparse.linalg as sparse_linalg
 
 from cdpr_exu.core.errors import SceneError, UnreachableError
-from cdpr_exu.core.geometry import all_at_centre, rotation_from_vector, rotation_matrix, rotation_vector
-from cdpr_exu.core.validation import finite, real_array, shown, vector
+from cdpr_exu.core.geometry import (all_at_centre, planar_cross, rotation_from_vector, rotation_matrix,
+                                    rotation_vector)
+from cdpr_exu.core.validation import finite, non_negative, positive, real_array, shown, vector
 from cdpr_exu.exits import Exit
 from cdpr_exu.physics import swivel_pulley as sp
 from cdpr_exu.statics.statics import catenary_platform, chain_element_mass, node_masses_along, solve_statics
@@ -67,32 +53,20 @@ class ChainCable:
     ----------
     node_masses : tuple of float, length n + 1 [kg]
         Winch (or exit) node first; its weight is carried by the winch or the frame.
-    element_length : float [m]
-        Unstrained element length l0 = L / n.
-    axial_stiffness : float [N/m]
-        k = EA / l0 (inextensible chains have no statics here).
-    bending_stiffness : float [N m/rad]
-        k_theta = EJ / l0 of each interior joint (0: no bending).
+    element_length, axial_stiffness, bending_stiffness : float [m], [N/m], [N m/rad]
+        l0 = L / n, k = EA / l0 (> 0), and k_theta = EJ / l0 of each interior joint (0: no bending).
     slack : bool
         Tension-only elements.
     anchor : (x, z) or (x, y, z) [m]
-        Anchor in the platform frame (centre of mass at 0); its size is the Space's.
+        In the platform frame (centre of mass at 0); its size is the Space's.
     pulley : Exit, SwivelPulley or None
-        What the cable runs over. In the plane the exit (:mod:`cdpr_exu.exits`, required): node 0
-        hangs on its winch line by the paid-out length, and a pulley's rim pushes the nodes. In
-        space the swivel pulley every node may touch
-        (:class:`cdpr_exu.physics.swivel_pulley.SwivelPulley`), None at a point exit.
-    contact_stiffness : float [N/m]
-        In the plane, the rim's penalty k_p (0: no contact); a swivel pulley carries its own.
-    exit_point : (x, y, z) [m], in space (required there)
-        Where node 0 is held: the exit point, or over a swivel pulley the winch end on the
-        pulley's vertical axis below its inlet, where the builder holds it.
-    winch_elements : int
-        Over a swivel pulley: the elements of the winch line, below the inlet (else 0).
-    winch_travel : float [m]
-        Over a swivel pulley: how far the winch has moved the held winch end up the axis from
-        ``exit_point`` (paying out; else 0). The run's swivel winch keeps the chain's elements
-        and moves only this end (:class:`cdpr_exu.run.run_3d._SpatialWinches`).
+        In the plane the exit (required): node 0 hangs on its winch line by the paid-out length, a
+        pulley's rim (penalty ``contact_stiffness`` k_p [N/m], 0: none) pushes the nodes. In space the
+        swivel pulley every node may touch (its own k_p), None at a point exit.
+    exit_point, winch_elements, winch_travel : (x, y, z) [m], int, float [m]; in space
+        Where node 0 is held (required): the exit point, or over a swivel pulley the winch end on its
+        axis, ``winch_elements`` below the inlet, moved up the axis by ``winch_travel`` by the winch
+        (:class:`cdpr_exu.run.run_3d._SpatialWinches` keeps the elements).
     """
 
     node_masses: tuple
@@ -114,13 +88,9 @@ class ChainCable:
         object.__setattr__(self, "anchor", tuple(float(a) for a in anchor))
         if len(self.node_masses) < 2:
             raise SceneError(f"node_masses needs at least 2 nodes, got {len(self.node_masses)}")
-        for name in ("element_length", "axial_stiffness"):
-            value = finite(name, getattr(self, name))
-            if value <= 0:
-                raise SceneError(f"{name} must be positive and finite, got {shown(value)}")
-        for name in ("bending_stiffness", "contact_stiffness"):
-            if finite(name, getattr(self, name)) < 0:
-                raise SceneError(f"{name} must be zero or positive, got {shown(getattr(self, name))}")
+        for name, check in (("element_length", positive), ("axial_stiffness", positive),
+                            ("bending_stiffness", non_negative), ("contact_stiffness", non_negative)):
+            check(name, getattr(self, name))
         if np.any(~np.isfinite(self.node_masses)) or min(self.node_masses) < 0:
             raise SceneError(f"node_masses must be finite and non-negative, got {shown(self.node_masses)}")
         finite("winch_travel", self.winch_travel)
@@ -151,9 +121,8 @@ class ChainCable:
 
     @property
     def paid_out_length(self) -> float:
-        """In space: the winch's paid-out length [m], L = n l0 at a point exit; over a swivel pulley the
-        length from the inlet the cable was built with, (n - k) l0 (k = ``winch_elements``), plus
-        ``winch_travel``. (In the plane the paid-out length is the statics' unknown.)"""
+        """In space: the winch's paid-out length [m], n l0 at a point exit, over a swivel pulley
+        (n - ``winch_elements``) l0 + ``winch_travel``. (In the plane it is the statics' unknown.)"""
         return (self.n_elements - self.winch_elements) * self.element_length + self.winch_travel
 
 
@@ -186,20 +155,10 @@ _CABLE_CHECKS = {2: _check_planar_cable, 3: _check_spatial_cable}
 
 @dataclass(frozen=True)
 class ChainRobot:
-    """The platform and its lumped cables.
-
-    Parameters
-    ----------
-    cables : tuple of ChainCable
-        All of one dimension.
-    mass : float [kg]
-    gravity : float [m/s^2]
-        Along the vertical, downwards (0: no gravity, also on the cables).
-    anchor_spring_factor : float or None
-        In space: None, each cable's last node sits on its anchor (an exact spherical joint); a
-        number f > 0, it is tied to the anchor by an isotropic spring of stiffness f k (the
-        builder's penalty joint, :class:`cdpr_exu.builder.robot_3d.ChainSpec3D`).
-    """
+    """The platform of ``mass`` [kg] and its lumped cables (all of one dimension), ``gravity`` [m/s^2]
+    downwards. ``anchor_spring_factor``, in space: None, each cable's last node on its anchor (an exact
+    spherical joint); f > 0, tied to it by a spring of stiffness f k (the builder's penalty joint,
+    :class:`cdpr_exu.builder.robot_3d.ChainSpec3D`)."""
 
     cables: tuple
     mass: float
@@ -212,9 +171,8 @@ class ChainRobot:
         object.__setattr__(self, "cables", tuple(self.cables))
         if len({len(c.anchor) for c in self.cables}) != 1:
             raise SceneError("cables must all be planar or all spatial (their anchors' sizes differ)")
-        if finite("mass", self.mass) < 0 or finite("gravity", self.gravity) < 0:
-            raise SceneError(f"mass and gravity must be zero or positive, got {shown(self.mass)}, "
-                             f"{shown(self.gravity)}")
+        non_negative("mass", self.mass)
+        non_negative("gravity", self.gravity)
         if self.anchor_spring_factor is not None and not finite("anchor_spring_factor", self.anchor_spring_factor) > 0:
             raise SceneError(f"anchor_spring_factor must be positive or None, got {shown(self.anchor_spring_factor)}")
 
@@ -228,33 +186,16 @@ class ChainRobot:
         """True when every anchor sits at the centre of mass (no rotation to balance)."""
         return all_at_centre([c.anchor for c in self.cables])
 
-    @property
-    def swivel_cables(self) -> list:
-        """Indices of the cables that run over a swivel pulley."""
-        return [i for i, c in enumerate(self.cables) if isinstance(c.pulley, sp.SwivelPulley)]
-
 
 def chain_robot(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
                 catenary=None) -> ChainRobot:
-    """The chain-statics model of a scene, with the effects the scene's builder adds.
+    """The chain-statics model of a scene, with the effects its builder adds.
 
-    Parameters
-    ----------
-    scene : Scene
-    anchor_spring_factor : float or None
-        In space, see :class:`ChainRobot` (the plane's chains end on their anchors).
-    tension_only : bool, optional
-        Default the scene's ``effects.slack`` (the spatial static mode builds spring elements: False).
-    catenary : PlatformEquilibrium, optional
-        In space, the scene's catenary statics: a cable over a swivel pulley is held at the winch end
-        its start shape puts it (:func:`swivel_chain_start`), as the builder holds it; solved here
-        when not given and needed.
-
-    Raises
-    ------
-    SceneError
-        For a bending model other than the exact angle; in the plane also for massless or
-        inextensible cables and contact models other than the node contact.
+    ``anchor_spring_factor``: in space, see :class:`ChainRobot`. ``tension_only``: default the scene's
+    ``effects.slack``. ``catenary``: in space, the scene's catenary statics, which hold a swivel cable at
+    the winch end its start shape puts it (:func:`swivel_chain_start`); solved here when needed. Raises
+    SceneError for a bending model other than the exact angle; in the plane also for massless or
+    inextensible cables and contact models other than the node contact.
     """
     effects = scene.effects
     if effects.bending and effects.bending_model != "exact":
@@ -317,31 +258,23 @@ def _spatial_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
 
 @dataclass(frozen=True, eq=False)
 class ChainEquilibrium:
-    """A static equilibrium of the chains and platform.
+    """A static equilibrium of the chains and platform; d the Space's dimension, m cables.
 
     Attributes
     ----------
-    position : ndarray, shape (2,) or (3,) [m]
-        Platform centre of mass.
-    rotation : float [rad] in the plane, ndarray (3, 3) in space
-        Platform frame to world frame (0 / identity for a point mass).
-    nodes : tuple of ndarray, each shape (n + 1, 2 or 3) [m]
-        Node positions of each cable, winch (exit) node first, anchor last.
-    tensions : tuple of ndarray, each shape (n,) [N]
-        Axial force of each element, winch first (positive in tension).
-    forces_on_platform : ndarray, shape (m, 2 or 3) [N]
-        Force each cable exerts on the platform at its anchor (the last element's pull, the
-        bending shear and the anchor node's weight; a penalty joint's force if any).
+    position, rotation : ndarray (d,) [m]; float [rad] (plane) or ndarray (3, 3) (space)
+        The platform's centre of mass and rotation (0 / identity for a point mass).
+    nodes, tensions : tuple of ndarray, shape (n + 1, d) [m], (n,) [N] each
+        Each cable's nodes and elements' axial forces, winch (exit) first.
+    forces_on_platform : ndarray, shape (m, d) [N]
+        Each cable's force at its anchor (the last element's pull, the bending shear, the anchor node's
+        weight; a penalty joint's force if any).
     paid_out : ndarray, shape (m,) [m]
-        Each winch's paid-out length (in the plane beyond the pulley's hang point; in space
-        :attr:`ChainCable.paid_out_length`).
+        In the plane beyond the hang point; in space :attr:`ChainCable.paid_out_length`.
     residual : float [N]
         Largest force (moment) imbalance left.
-    iterations : int
-    swivel_angles : ndarray, shape (m,) [rad] or None
-        In space, each swivel pulley's angle psi (NaN at a point exit).
-    rotation_vector : ndarray, shape (1,) or (3,) [rad]
-        The rotation's coordinates in the pose: (rotation,) in the plane, the rotation vector in space.
+    swivel_angles, rotation_vector : ndarray (m,) [rad] or None; ndarray (1,) or (3,) [rad]
+        In space each swivel pulley's psi (NaN at a point exit); the rotation's coordinates in the pose.
     """
 
     position: np.ndarray
@@ -373,11 +306,9 @@ class ChainEquilibrium:
 
 def chain_over(exit_: Exit, equilibrium_cable, length: float, n_elements: int):
     """How a spatial chain of ``n_elements`` from ``exit_`` to its anchor starts, as the builder builds it and
-    the chain statics hold it: the elements below the exit (its winch line), the straight unstrained reference
-    and the catenary's node positions (the held winch end first, shape (k + n + 1, 3) each [m]), and the
-    physics of the disc the cable wraps over (:class:`~cdpr_exu.physics.swivel_pulley.SwivelPulley`; None
-    where it leaves from the exit's point, held there). An exit that wraps gives its ``winch_line`` [m],
-    ``contact_stiffness`` [N/m] and ``pulley()`` (:class:`~cdpr_exu.exits.swivel.Swivel`)."""
+    the chain statics hold it: the elements below the exit, the straight unstrained reference and the
+    catenary's nodes (held winch end first, (k + n + 1, 3) [m] each), and the disc it wraps
+    (:class:`~cdpr_exu.physics.swivel_pulley.SwivelPulley`; None at a point exit, held at its point)."""
     if exit_.wraps:
         below = winch_line_elements(exit_.winch_line, length / n_elements)
         return (below, *swivel_chain_start(equilibrium_cable, length, n_elements, below, exit_.contact_stiffness),
@@ -393,35 +324,23 @@ def chain_over(exit_: Exit, equilibrium_cable, length: float, n_elements: int):
 
 
 def winch_line_elements(winch_line: float, element_length: float) -> int:
-    """Elements of a cable below a swivel pulley's inlet (its winch line along the axis): the
-    winch line ``winch_line`` [m] in elements of ``element_length`` [m], at least 2 (the builder's)."""
+    """Elements below a swivel pulley's inlet: its ``winch_line`` [m] in elements of ``element_length`` [m],
+    at least 2 (the builder's)."""
     return max(2, int(round(winch_line / element_length)))
 
 
 def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, contact_stiffness):
-    """Straight unstrained reference (winch end first) and the catenary statics' node positions of a
-    cable over a swivel pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``.
+    """Straight unstrained reference (winch end first) and the catenary statics' nodes of a cable over a
+    swivel pulley, shape (k + n + 1, 3) each [m], k = ``winch_elements``, n of unstrained ``length`` [m] from
+    the inlet to the anchor.
 
-    From the anchor: the catenary up to the tangent point; then the wrap as the lumped
-    cable lies on it, a polygon of chords of the stretched element length (on the arc
-    instead, each chord is short by r_p theta^3 / 24 and pushes with up to 3 kN at
-    l_e = r_p: Newton then diverged), each node inside the groove by the depth that carries
-    its share of the pressure, ``T l_e / (r_p k_p)`` (on the rim itself psi has no stiffness:
-    Exudyn's static solver met a singular matrix); then down the axis to the winch end.
-    The tension is the catenary's at the tangent point (frictionless wrap, its weight
-    left out, as in the statics). The winch end (the first row of both) is where the
-    cable is held: the builder holds it there, and so do the chain statics.
-
-    Parameters
-    ----------
-    equilibrium_cable : SpatialCableState
-        The cable in the catenary statics (:func:`cdpr_exu.statics.statics.solve_statics`).
-    length : float [m]
-        Unstrained length from the inlet to the anchor (the catenary's).
-    n_elements, winch_elements : int
-        Elements from the inlet to the anchor, and below the inlet.
-    contact_stiffness : float [N/m]
-        The pulley's penalty stiffness k_p.
+    From the anchor: the catenary (``equilibrium_cable``, a
+    :class:`~cdpr_exu.statics.statics.CableEquilibrium`) to the tangent point; the wrap as the chain lies on
+    it, a polygon of stretched chords (chords on the arc are short by r_p theta^3 / 24 and pushed with up to 3
+    kN: Newton diverged), each node inside the groove by the depth that carries its pressure, ``T l_e / (r_p
+    k_p)`` (on the rim psi has no stiffness: Exudyn's static solver met a singular matrix); then down the axis
+    to the held winch end. The tension is the catenary's at the tangent point (frictionless wrap, its weight
+    left out).
     """
     element = length / n_elements
     inlet = equilibrium_cable.inlet
@@ -451,22 +370,10 @@ def swivel_chain_start(equilibrium_cable, length, n_elements, winch_elements, co
     return reference, current
 
 
-def _anchor_azimuth(equilibrium_cable) -> float:
-    """Azimuth [rad] of the cable's anchor seen from its swivel axis: where the builder starts psi."""
-    return sp.exit_azimuth(equilibrium_cable.anchor_point, equilibrium_cable.inlet)
-
-
-# ---------------------------------------------------------------------------
-# shared: the descent step, the line search, the rounding floor
-# ---------------------------------------------------------------------------
 def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
-    """Newton's step -H^-1 g, with H shifted by a multiple of the identity until it is a descent direction.
-
-    An indefinite or singular Hessian (a node on a rim, a slack element, a swivel angle
-    with no stiffness) is shifted by ``relative_shift`` times its largest diagonal entry,
-    then ten times more each time. ``hessian``: dense (N, N) or a scipy sparse matrix;
-    ``gradient``: (N,). Returns the step, shape (N,).
-    """
+    """Newton's step -H^-1 g (H dense or scipy sparse (N, N), g (N,)), H shifted by ``relative_shift`` times
+    its largest diagonal entry, then ten times more each time, until the step descends (a node on a rim, a
+    slack element, a swivel angle with no stiffness make H indefinite or singular)."""
     is_sparse = sparse.issparse(hessian)
     if is_sparse:
         identity = sparse.identity(hessian.shape[0], format="csc")
@@ -486,15 +393,13 @@ def descent_step(hessian, gradient, relative_shift: float = 1e-8) -> np.ndarray:
 
 
 def _line_search(move, energy_of, improves, energy: float, slope: float):
-    """Armijo's backtracking along a descent step: ``(trial, its energy)`` or None when no step is accepted.
+    """Armijo's backtracking along a descent step: ``(trial, its energy)``, or None when no step is accepted.
 
-    Tries ``move(alpha)`` for alpha = 1, 1/2, 1/4... (40 halvings) and takes the first whose energy
-    (``energy_of(trial)``) falls by 1e-4 of what the ``slope`` (g . step) promises. The penalty contact
-    makes the Hessian jump where a node lands on or leaves a rim or groove; the energy stays
-    continuously differentiable, so every step is a descent step (a force residual would not be).
-    Near the solution the energy's decrease, ~ |g|^2 / k, falls below its rounding (~1e-13 |E|):
-    there the step is taken if ``improves(trial)`` (the gradient shrinks), and refused if not (the
-    gradient is then as small as it gets).
+    Tries ``move(alpha)``, alpha = 1, 1/2, ... (40 halvings), takes the first whose ``energy_of(trial)``
+    falls by 1e-4 of what ``slope`` (g . step) promises. The penalty contact makes the Hessian jump but the
+    energy stays C1, so every step descends (a force residual would not). Near the solution the decrease,
+    ~ |g|^2 / k, falls below the energy's rounding (1e-13 |E|): there a step is taken if
+    ``improves(trial)`` (the gradient shrinks), else refused (the gradient is as small as it gets).
     """
     roundoff = 1e-13 * (1.0 + abs(energy))
     alpha = 1.0
@@ -510,17 +415,13 @@ def _line_search(move, energy_of, improves, energy: float, slope: float):
 
 
 def rounding_floor(stiffness, points) -> float:
-    """The force [N] below which a chain's node forces are rounding: an element's k (l - l0), its length
-    computed from coordinates of size |p|, carries k |p| eps; 16 times that for the sums. ``stiffness``:
-    the elements' k [N/m]; ``points``: the coordinates [m]."""
+    """The force [N] below which a chain's node forces are rounding: an element's k (l - l0), its length from
+    coordinates of size |p|, carries k |p| eps; 16 times that for the sums (``stiffness`` k [N/m], ``points``
+    [m])."""
     return 16.0 * np.finfo(float).eps * float(np.max(stiffness)) * float(np.abs(points).max())
 
 
-# ---------------------------------------------------------------------------
-# the plane: numba kernels (exact-angle bending, rim contact), nodes and paid-out lengths at a pose
-# ---------------------------------------------------------------------------
-
-
+# --- the plane: nodes and paid-out lengths at a pose
 def _positions(robot, layout, position, rotation, v, paid_out):
     """All node positions, shape (n_nodes, 2) [m], and the rotation [rad]."""
     if layout.free_rotation:
@@ -532,10 +433,6 @@ def _positions(robot, layout, position, rotation, v, paid_out):
         p[layout.winch[i]] = cable.winch_node(paid_out[i])
         p[layout.anchor[i]] = position + R @ np.asarray(cable.anchor)
     return p, rotation
-
-
-def _cross(a, f):
-    return a[..., 0] * f[..., 1] - a[..., 1] * f[..., 0]
 
 
 def _selection(robot, layout, p, position):
@@ -637,25 +534,12 @@ def _platform_force_gradient(layout, state):
 
 
 def chain_forces(robot: ChainRobot, nodes, position, rotation=0.0, external_wrench=None):
-    """Force imbalance of a configuration: interior nodes and platform.
+    """Force imbalance of a planar configuration: ``robot``'s ``nodes`` (each (n + 1, 2) [m], winch first,
+    the anchors where the pose puts them), the platform at ``position`` (x, z) [m] and ``rotation`` [rad]
+    under ``external_wrench`` (fx, fz, moment) [N, N m].
 
-    Parameters
-    ----------
-    robot : ChainRobot
-    nodes : sequence of ndarray, each shape (n + 1, 2) [m]
-        Node positions per cable, winch node first; the anchors must sit where the pose
-        puts them.
-    position : (x, z) [m]
-    rotation : float [rad]
-    external_wrench : (fx, fz, moment), optional [N, N, N m]
-
-    Returns
-    -------
-    node_forces : ndarray, shape (n_interior, 2) [N]
-        Net force on each interior node (all cables, in order).
-    platform_wrench : ndarray, shape (3,) [N, N, N m]
-        Net force and moment on the platform about its centre of mass.
-    """
+    Returns the net force on each interior node, (n_interior, 2) [N] (all cables, in order), and the net
+    force and moment on the platform about its centre of mass, (3,) [N, N m]."""
     layout = PlanarChains(robot, free_rotation=False)
     p = np.concatenate([np.asarray(n, dtype=float) for n in nodes])
     if p.shape != (layout.n_nodes, 2):
@@ -665,18 +549,15 @@ def chain_forces(robot: ChainRobot, nodes, position, rotation=0.0, external_wren
     F, _, _, _ = planar_forces(robot, layout, p, with_stiffness=False)
     arms = p[layout.anchor] - position
     force = _platform_force(robot, layout, F, wrench)
-    moment = _cross(arms, F[layout.anchor]).sum() + wrench[2]
+    moment = planar_cross(arms, F[layout.anchor]).sum() + wrench[2]
     return F[layout.interior], np.array([*force, moment])
 
 
 def _straight_guess(robot, position, rotation, tensions):
-    """Start of the iteration: straight chains stretched by ``tensions`` [N], shape (m,).
-
-    Each chain is laid from its anchor back over its pulley with elements of length
-    l0i (1 + T / k_i l0i) (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`), so that
-    every element carries the tension T; the paid-out length follows from where node
-    0 lands. Returns the interior node coordinates (flat) and the paid-out lengths.
-    """
+    """Start of the iteration: straight chains stretched by ``tensions`` (m,) [N], laid from the anchor back
+    over the pulley with elements of l0 (1 + T / k l0)
+    (:func:`~cdpr_exu.statics.kinematics.initial_cable_nodes`); the paid-out length follows from where node 0
+    lands. Returns the interior coordinates (flat) and the paid-out lengths."""
     R = rotation_matrix(rotation)
     interior, paid_out = [], []
     for cable, tension in zip(robot.cables, tensions):
@@ -695,13 +576,9 @@ def _straight_guess(robot, position, rotation, tensions):
 
 
 def _predict(robot, layout, guess, interior, rotation, paid_out, position, wrench):
-    """Tangent predictor from a solution at ``guess.position`` to ``position``.
-
-    Linearises the equilibrium (nodes and platform force) at the guess and moves the
-    nodes, rotation and paid-out lengths along it; an anchor that moved by a centimetre
-    would otherwise stretch its element by that much (kN of force) and the iteration
-    would have to walk it back. Falls back to the guess if the linear system is singular.
-    """
+    """Tangent predictor from the solution ``guess`` to ``position``: the linearised equilibrium (nodes and
+    platform force) moves the nodes, rotation and paid-out lengths (else a centimetre's anchor move stretches
+    its element by kN, for the iteration to walk back). The guess itself if the system is singular."""
     v = np.concatenate([interior, [rotation] if layout.free_rotation else []])
     dp = position - np.asarray(guess.position)
     if not np.any(dp):
@@ -731,14 +608,10 @@ def _predict(robot, layout, guess, interior, rotation, paid_out, position, wrenc
 def _planar_inverse(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None, external_wrench=None,
                     guess: ChainEquilibrium | None = None, tension_guess=None, tolerance: float = 1e-7,
                     max_iterations: int = 50) -> ChainEquilibrium:
-    """:func:`solve_inverse_chain_statics` in the plane: two nested Newton iterations (:func:`_planar_solve`).
-
-    Tension-only (slack) elements have no stiffness in compression, so Newton started
-    from a guess with compressed elements can stall on them. Their equilibrium is first
-    sought with springs that also push: where no element of that equilibrium is
-    compressed it is the tension-only one as well (the two potentials agree wherever
-    every element is stretched); otherwise it is the start of the tension-only solve.
-    """
+    """:func:`solve_inverse_chain_statics` in the plane. Tension-only elements have no stiffness in
+    compression, so Newton from compressed elements can stall: the equilibrium is first sought with springs
+    that also push; where none of its elements is compressed it is the tension-only one as well, else it
+    starts it."""
     kwargs = dict(free_rotation=free_rotation, external_wrench=external_wrench, tolerance=tolerance,
                   max_iterations=max_iterations)
     if not any(c.slack for c in robot.cables):
@@ -756,13 +629,10 @@ def _planar_inverse(robot: ChainRobot, position, rotation=0.0, *, free_rotation=
 def _planar_solve(robot: ChainRobot, position, rotation=0.0, *, free_rotation=None, external_wrench=None,
                   guess: ChainEquilibrium | None = None, tension_guess=None, tolerance: float = 1e-7,
                   max_iterations: int = 50) -> ChainEquilibrium:
-    """:func:`_planar_inverse` for one element law (the robot's own).
-
-    Inner: with the platform held at ``position`` and the paid-out lengths given, the nodes (and the
-    free rotation) minimise the potential (:func:`_minimise`). Outer: the paid-out lengths are
-    corrected until the cables carry the platform, i.e. the force the held platform needs vanishes;
-    its derivative follows from the inner tangent stiffness (the nodes stay in equilibrium).
-    """
+    """:func:`_planar_inverse` for the robot's own element law. Inner: the platform held at ``position`` and
+    the paid-out lengths given, the nodes (and a free rotation) minimise the potential (:func:`_minimise`).
+    Outer: Newton on the paid-out lengths until the held platform needs no force, its derivative from the
+    inner tangent stiffness."""
     position = vector("position", position, 2)
     rotation = finite("rotation", rotation)
     m = len(robot.cables)
@@ -827,27 +697,13 @@ def _planar_solve(robot: ChainRobot, position, rotation=0.0, *, free_rotation=No
                             rotation_vector=np.array([rotation]))
 
 
-# ---------------------------------------------------------------------------
-# space: the potential of the 3-D chains (bending, tension-only law, swivel groove), pose and swivels free
-# ---------------------------------------------------------------------------
+# --- space: the potential of the 3-D chains (bending, tension-only law, swivel groove), pose and swivels free
 def catenary_start(robot: ChainRobot, equilibrium):
-    """Start of the iteration: the nodes on the catenary statics' cables, as the builder starts its chains.
-
-    Parameters
-    ----------
-    robot : ChainRobot
-    equilibrium : PlatformEquilibrium
-        Of the same cables (:func:`cdpr_exu.statics.statics.solve_statics`).
-
-    Returns
-    -------
-    nodes : list of ndarray, each shape (n + 1, 3) [m]
-        Over a swivel pulley the builder's start (:func:`swivel_chain_start`).
-    position : ndarray, shape (3,) [m]
-    rotation : ndarray, shape (3, 3)
-    swivel_angles : ndarray, shape (m,) [rad]
-        Each swivel pulley at its anchor's azimuth, as the builder starts it (NaN for a point exit).
-    """
+    """The nodes on the catenary statics' cables (``equilibrium``, a
+    :class:`~cdpr_exu.statics.statics.PlatformEquilibrium` of the same cables), as the builder starts its
+    chains: each cable's nodes (n + 1, 3) [m] (over a swivel pulley :func:`swivel_chain_start`), the
+    position (3,) [m], the rotation (3, 3), and each swivel pulley's angle at its anchor's azimuth (m,) [rad]
+    (NaN at a point exit)."""
     if len(equilibrium.cables) != len(robot.cables):
         raise SceneError(f"equilibrium has {len(equilibrium.cables)} cables, the robot {len(robot.cables)}")
     nodes, angles = [], np.full(len(robot.cables), np.nan)
@@ -857,7 +713,7 @@ def catenary_start(robot: ChainRobot, equilibrium):
             n = cable.n_elements - cable.winch_elements
             points = swivel_chain_start(state, n * cable.element_length, n, cable.winch_elements,
                                         cable.pulley.contact_stiffness)[1]
-            angles[i] = _anchor_azimuth(state)
+            angles[i] = sp.exit_azimuth(state.anchor_point, state.inlet)  # where the builder starts psi
         else:
             points = state.points(length - np.linspace(0.0, length, cable.n_elements + 1))
             points[0] = cable.exit_point
@@ -951,22 +807,14 @@ def _spatial_rest(scene, anchor_spring_factor: float | None = None, tension_only
     return _spatial_forward(robot, *catenary_start(robot, catenary), **kwargs)
 
 
-#: The swivel angles of a chain without swivel pulleys.
-_NO_SWIVEL = np.zeros(0)
-
-
-# ---------------------------------------------------------------------------
-# the inverse: lengths whose chains hold a pose
-# ---------------------------------------------------------------------------
+# --- the inverse: lengths whose chains hold a pose
 def cable_paid_out(cable: ChainCable, length: float) -> ChainCable:
     """``cable`` paid out to the unstrained ``length`` [m], as the run's variable-length winch changes it
     (:class:`cdpr_exu.run.run_3d._SpatialWinches`): at a point exit the same n elements of length
     L / n, their stiffness E A n / L, the node masses rho L / n and the bending stiffness E J n / L; over a
     swivel pulley the same elements, the held winch end moved up the axis by the change of the paid-out
     length (``winch_travel``, :attr:`ChainCable.paid_out_length`), the cable running over the disc."""
-    length = finite("length", length)
-    if length <= 0:
-        raise SceneError(f"length must be positive [m], got {shown(length)}")
+    length = positive("length", length, "m")
     if cable.pulley is not None:
         return replace(cable, winch_travel=cable.winch_travel + length - cable.paid_out_length)
     scale = length / cable.unstrained_length
@@ -985,25 +833,11 @@ def robot_paid_out(robot: ChainRobot, lengths) -> ChainRobot:
 
 @dataclass(frozen=True, eq=False)
 class HeldChain:
-    """One lumped cable at rest between its exit point and a fixed anchor point.
-
-    Attributes
-    ----------
-    nodes : ndarray, shape (n + 1, 3) [m]
-        Exit (over a swivel pulley the held winch end) first, the anchor point last.
-    tensions : ndarray, shape (n,) [N]
-        Axial force of each element, exit first.
-    force : ndarray, shape (3,) [N]
-        Force the cable exerts on the anchor (the last element's pull, the bending shear and
-        the anchor node's weight: what it exerts on the platform).
-    force_rate : ndarray, shape (3,) [N/m]
-        d(force)/d(paid-out length) with the anchor held: the chain re-settles (implicit
-        function theorem on the nodes' and the swivel's balance). Paid out as the run's winch
-        pays out (:func:`cable_paid_out`): longer elements at a point exit, the winch end moved
-        up the axis over a swivel pulley.
-    swivel_angle : float [rad]
-        The swivel pulley's angle psi (NaN at a point exit).
-    """
+    """One lumped cable at rest between its exit point (over a swivel pulley its held winch end) and a fixed
+    anchor point: ``nodes`` (n + 1, 3) [m] and ``tensions`` (n,) [N] exit first, its ``force`` on the anchor
+    (3,) [N], ``force_rate`` (3,) [N/m] its derivative in the paid-out length with the anchor held and the
+    chain re-settled (implicit function theorem; paid out as :func:`cable_paid_out`), and ``swivel_angle``
+    psi [rad] (NaN at a point exit)."""
 
     nodes: np.ndarray
     tensions: np.ndarray
@@ -1018,60 +852,28 @@ def _held_model(cable: ChainCable, gravity: float) -> SpatialChains:
     return SpatialChains(ChainRobot((replace(cable, anchor=(0.0, 0.0, 0.0)),), 0.0, gravity))
 
 
-def solve_held_chain(cable: ChainCable, gravity: float, anchor_point, nodes, *, tolerance: float = 1e-9,
-                     max_iterations: int = 50, swivel_angle: float | None = None) -> HeldChain:
-    """The rest shape of one lumped cable held at its exit point (or winch end) and at ``anchor_point``.
-
-    Newton's method on its free nodes and, over a swivel pulley, the pulley's angle psi (the
-    potential of :func:`solve_chain_statics`, with the same line search), then the force
-    on the anchor and its rate with the paid-out length. If Newton fails from ``nodes``, the
-    anchor (and a swivel cable's winch end) is moved there from the start's in sub-steps, each
-    solved from the last (:func:`_solve_held`). Over the swivel pulleys of
-    spatial-four-cable-swivel, started from the rest's chains with the length changed as the
-    straight distance from the inlet: Newton alone crawled (line search) and stopped at 50
-    iterations from 2 cm up or 5 cm across; with the sub-steps, 30 cm across and 20 cm up
-    converge (0.5 to 4 s, to within 1e-10 relative of Newton alone given 2000 iterations),
-    30 cm up does not.
-
-    Parameters
-    ----------
-    cable : ChainCable
-        At the paid-out length wanted (:func:`cable_paid_out`); its ``anchor`` is not used.
-    gravity : float [m/s^2]
-    anchor_point : (x, y, z) [m]
-        World position of the anchor.
-    nodes : array_like, shape (n + 1, 3) [m]
-        Start of the nodes, exit first; the ends are put on the held and anchor points, the nodes
-        between moved along by the same share of the ends' displacement as of the cable.
-    tolerance : float [N]
-        Largest force left on a free node; below the rounding of the element forces
-        (:func:`rounding_floor`: 4e-8 N on IPAnema's stiff cables, 2e-14 m of stretch), the
-        iteration also stops once a Newton step no longer halves it.
-    swivel_angle : float [rad], optional
-        Start of psi over a swivel pulley (default the anchor's azimuth about the axis).
-
-    Raises
-    ------
-    UnreachableError
-        If Newton finds no rest shape, neither from ``nodes`` nor in sub-steps.
-    """
-    return _solve_held(_held_model(cable, gravity), cable, anchor_point, nodes, tolerance, max_iterations,
-                       swivel_angle)
-
-
-#: Halvings of a held chain's jump the continuation may make (:func:`_solve_held`): at most 2^5 = 32 sub-steps.
+#: Halvings of a held chain's jump the continuation may make (:func:`solve_held_chain`): at most 32 sub-steps.
 CONTINUATION_HALVINGS = 5
 
 
-def _solve_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, tolerance: float,
-                max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
-    """:func:`solve_held_chain` with the cable's model given (built once, :func:`_paid_out_model` for other lengths).
+def solve_held_chain(cable: ChainCable, gravity: float, anchor_point, nodes, *, tolerance: float = 1e-9,
+                     max_iterations: int = 50, swivel_angle: float | None = None, model=None) -> HeldChain:
+    """The rest shape of one lumped cable (paid out as wanted, :func:`cable_paid_out`; its ``anchor`` unused)
+    held at its exit point (or winch end) and at ``anchor_point`` (x, y, z) [m].
 
-    Newton from ``nodes`` first; only if it fails, by continuation: the anchor moved from the start's last
-    node to ``anchor_point`` (and over a swivel pulley the held winch end from the start's height on the axis
-    to the model's) in sub-steps, each solved from the previous one's chain, a sub-step that fails halved
-    again, at most :data:`CONTINUATION_HALVINGS` times. A start that converges keeps its answer bit for bit.
+    Newton's method on its free nodes and, over a swivel pulley, psi (start ``swivel_angle``, default the
+    anchor's azimuth), from ``nodes`` (n + 1, 3) [m] with its ends put on the held points; then the force
+    on the anchor and its rate. ``tolerance`` [N]: the largest force left on a free node; below the rounding
+    floor (:func:`rounding_floor`) Newton also stops once a step no longer halves it. ``model``: the held
+    model, built once by a caller that changes the length (:func:`_paid_out_model`); default built here.
+
+    Only if Newton fails, continuation: the anchor (and a swivel cable's winch end) moved from the start's
+    in sub-steps, each from the last one's chain, a failing one halved, at most
+    :data:`CONTINUATION_HALVINGS` times. On spatial-four-cable-swivel, from the rest's chains, Newton alone
+    stopped at 2 cm up or 5 cm across; the sub-steps converge 30 cm across and 20 cm up (to 1e-10 relative
+    of Newton given 2000 iterations). Raises :class:`UnreachableError` if neither finds a rest shape.
     """
+    model = _held_model(cable, gravity) if model is None else model
     anchor_point = vector("anchor_point", anchor_point, 3)
     nodes = np.array(nodes, dtype=float)
     n = cable.n_elements
@@ -1119,8 +921,8 @@ def _solve_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, to
 
 def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, tolerance: float,
                  max_iterations: int, swivel_angle: float | None = None) -> HeldChain:
-    """Newton for :func:`_solve_held` from ``nodes`` (n + 1, 3) [m] (checked), its ends first moved onto the held
-    and anchor points (over a swivel pulley by :func:`_swivel_start`)."""
+    """Newton for :func:`solve_held_chain` from ``nodes`` (n + 1, 3) [m] (checked), its ends first moved onto
+    the held and anchor points (over a swivel pulley by :func:`_swivel_start`)."""
     nodes = np.array(nodes, dtype=float)
     n = cable.n_elements
     share = np.linspace(0.0, 1.0, n + 1)[:, None]
@@ -1130,7 +932,7 @@ def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, t
     else:
         nodes = _swivel_start(nodes, cable.pulley, held_point, anchor_point)
     if cable.pulley is None:
-        psi = _NO_SWIVEL
+        psi = np.zeros(0)
     elif swivel_angle is None or not np.isfinite(swivel_angle):
         psi = np.array([sp.exit_azimuth(anchor_point, cable.pulley.inlet_array)])
     else:
@@ -1142,10 +944,8 @@ def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, t
     n_free = 3 * (n - 1)
     free = nodes[1:-1].ravel().copy()
     energy = model.energy(free, anchor_point, R, psi)
-    # Below the rounding floor Newton keeps gaining while it can: the anchor force of a chain stopped
-    # at the floor is off by about the floor, and m of them stall the platform's balance (CoGiRo's
-    # Gauss-Newton crawled for 30 iterations at 1e-5 N). So stop at the tolerance, or below the floor
-    # once a step no longer halves the imbalance.
+    # Below the rounding floor Newton keeps gaining while it can (chains stopped at the floor stalled
+    # CoGiRo's Gauss-Newton for 30 iterations at 1e-5 N): stop there once a step no longer halves it.
     floor = rounding_floor(model.k, nodes)
     last = np.inf
     # a point exit's chain is solved dense (57 unknowns at 20 elements); over a swivel pulley sparse (SuperLU:
@@ -1180,8 +980,7 @@ def _newton_held(model: SpatialChains, cable: ChainCable, anchor_point, nodes, t
         raise UnreachableError(f"held chain statics did not converge in {max_iterations} iterations "
                                f"(force imbalance {np.max(np.abs(g)):.3g} N)")
     if cable.pulley is None:
-        # d(gradient)/dL at fixed nodes by central differences of the chain paid out by +-dL (the run's
-        # scaling, :func:`cable_paid_out`)
+        # d(gradient)/dL at fixed nodes: central differences of the chain paid out by +-dL (cable_paid_out)
         step = 1e-6
         rate = (_scaled_model(model, 1.0 + step).point_derivatives(nodes, psi)[0]
                 - _scaled_model(model, 1.0 - step).point_derivatives(nodes, psi)[0]) / (2.0 * step * cable.unstrained_length)
@@ -1294,7 +1093,8 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
     scale = np.array([1.0, 1.0, 1.0, 1.0 / arm_scale, 1.0 / arm_scale, 1.0 / arm_scale])[:rows]
 
     def held(trial_lengths, trial_nodes, trial_angles):
-        chains = [_solve_held(_paid_out_model(model, c, L), cable_paid_out(c, L), a, start, 1e-9, 50, psi)
+        chains = [solve_held_chain(cable_paid_out(c, L), robot.gravity, a, start, swivel_angle=psi,
+                                   model=_paid_out_model(model, c, L))
                   for model, c, L, a, start, psi in zip(models, robot.cables, trial_lengths, anchor_points,
                                                         trial_nodes, trial_angles)]
         forces = np.array([chain.force for chain in chains])
@@ -1345,68 +1145,38 @@ def _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_
                            f"(imbalance {residual:.3g} N after {iteration} iterations)")
 
 
-# ---------------------------------------------------------------------------
-# the drivers: one interface, the kernel chosen by the robot's Space
-# ---------------------------------------------------------------------------
+# --- the drivers: one interface, the kernel chosen by the robot's Space
 def solve_chain_statics(robot: ChainRobot, nodes, position, rotation=None, swivel_angles=None,
                         **kwargs) -> ChainEquilibrium:
-    """The rest of the chains and platform for the cables' unstrained lengths (the forward chain statics).
+    """The rest of the chains and platform on the cables' unstrained lengths (the forward chain statics).
 
-    In space, Newton's method on the total potential from a start (the unknowns: the free nodes, the
-    platform's pose, the swivel pulleys' angles). The plane has none: its rest for given lengths is
-    Exudyn's (:func:`cdpr_exu.run.rest.solve_rest`), its chain statics hold a pose
-    (:func:`solve_inverse_chain_statics`).
+    In space, Newton's method on the total potential (unknowns: the free nodes, the platform's pose, the
+    swivel angles). The plane has none: its rest is Exudyn's (:func:`cdpr_exu.run.rest.solve_rest`).
 
     Parameters
     ----------
     robot : ChainRobot
     nodes : sequence of array_like, each shape (n + 1, 3) [m]
-        Start positions of each cable's nodes, exit first (eg :func:`catenary_start`);
-        the exit node is put on the exit point and (with exact joints) the last on the anchor.
-    position : (x, y, z) [m]
-        Start of the platform's centre of mass.
-    rotation : ndarray, shape (3, 3), optional
-        Start of the platform's rotation (default identity; ignored for a point mass).
-    swivel_angles : array_like, shape (m,) [rad], optional
-        Start of each swivel pulley's psi (entries of point exits ignored); default each
-        pulley turned towards its cable's last start node.
+        Start of each cable's nodes, exit first (eg :func:`catenary_start`).
+    position, rotation, swivel_angles : (3,) [m], (3, 3) optional, (m,) [rad] optional
+        Start of the platform's pose (rotation default identity, ignored for a point mass) and of each
+        swivel pulley's psi (default turned towards its cable's last start node).
     tolerance : float [N]
-        Largest entry of the potential's gradient accepted (node forces, platform force, moment,
-        torques on the swivels [N m]); at least the rounding of the element forces
-        (:func:`rounding_floor`: 4e-9 N on the four-cable robot, 1.6e-7 N on CoGiRo's steel
-        ropes, where 1e-9 N cannot be reached).
-    max_iterations : int
+        Largest gradient entry accepted (moments [N m]); at least the rounding floor
+        (:func:`rounding_floor`: 1.6e-7 N on CoGiRo's steel ropes, where 1e-9 N is out of reach).
     external_force : (fx, fy, fz) [N], optional
-        A constant extra force on the platform's centre of mass (eg the d'Alembert force
-        -M a of an acceleration); its potential is -F . x.
+        Constant extra force on the centre of mass (eg the d'Alembert force -M a).
 
-    Returns
-    -------
-    ChainEquilibrium
-
-    Raises
-    ------
-    UnreachableError
-        If Newton finds no equilibrium.
-    SceneError
-        On malformed input, or a planar robot.
+    Raises UnreachableError if Newton finds no equilibrium, SceneError on malformed input or a planar robot.
     """
     return _METHODS[robot.space].forward(robot, nodes, position, rotation, swivel_angles, **kwargs)
 
 
 def chain_rest(scene, anchor_spring_factor: float | None = None, tension_only: bool | None = None,
                **kwargs) -> ChainEquilibrium:
-    """The lumped robot of a scene at rest on its unstrained lengths (:func:`solve_chain_statics` from
-    :func:`chain_robot`, started on the catenary statics as the builder starts Exudyn's); ``kwargs`` go to
-    :func:`solve_chain_statics`.
-
-    Raises
-    ------
-    UnreachableError
-        If the catenary statics or the chains find no equilibrium.
-    SceneError
-        For a planar scene (:func:`solve_chain_statics`).
-    """
+    """The lumped robot of a scene at rest on its unstrained lengths: :func:`solve_chain_statics` (``kwargs``)
+    from :func:`chain_robot`, started on the catenary statics as the builder starts Exudyn's. UnreachableError
+    if either finds no equilibrium; SceneError for a planar scene."""
     return _METHODS[scene.space].rest(scene, anchor_spring_factor, tension_only, **kwargs)
 
 
@@ -1416,15 +1186,8 @@ def _no_planar_forward(*args, **kwargs):
 
 
 class InverseChainStatics:
-    """The inverse chain statics of one robot, for many poses (:func:`solve_inverse_chain_statics`).
-
-    In space each cable's held model is built once (the lengths change by scaling it, or by moving a
-    swivel cable's winch end: :func:`_paid_out_model`).
-
-    Parameters
-    ----------
-    robot : ChainRobot
-    """
+    """The inverse chain statics of one robot for many poses (:func:`solve_inverse_chain_statics`); in space
+    each cable's held model is built once (:func:`_paid_out_model` changes its length)."""
 
     def __init__(self, robot: ChainRobot):
         if not isinstance(robot, ChainRobot):
@@ -1432,77 +1195,56 @@ class InverseChainStatics:
         self.robot = robot
         self._solve = _METHODS[robot.space].inverse(robot)
 
-    def solve(self, pose, tension_guess=None, *, guess: ChainEquilibrium | None = None, lengths=None, nodes=None,
-              swivel_angles=None, free_rotation=None, external_wrench=None, tolerance: float | None = None,
-              max_iterations: int | None = None) -> ChainEquilibrium:
+    def solve(self, pose, tension_guess=None, **kwargs) -> ChainEquilibrium:
         """As :func:`solve_inverse_chain_statics` (same parameters, robot aside)."""
-        return self._solve(pose, tension_guess, guess=guess, lengths=lengths, nodes=nodes, swivel_angles=swivel_angles,
-                           free_rotation=free_rotation, external_wrench=external_wrench, tolerance=tolerance,
-                           max_iterations=max_iterations)
+        return self._solve(pose, tension_guess, **kwargs)
 
 
 def solve_inverse_chain_statics(robot: ChainRobot, pose, tension_guess=None, **kwargs) -> ChainEquilibrium:
     """Paid-out lengths, nodes and tensions of the chains that hold ``robot``'s platform at ``pose``.
 
-    In the plane (two nested Newton iterations, :func:`_planar_inverse`): the nodes minimise the
-    potential at fixed paid-out lengths, the lengths cancel the force the held platform needs; a
-    rigid platform on two cables chooses its rotation (``free_rotation``), on three it is imposed.
-    In space (Gauss-Newton on the lengths over chains held at their anchors, :func:`_solve_inverse`):
-    the cables decouple and only the platform's balance ties them, six equations (three for a point
-    mass, or a rigid platform on fewer than six cables, whose rotation is left free as in
-    :func:`cdpr_exu.statics.statics.solve_inverse_statics`) in the m lengths; among the
-    length changes that cancel the imbalance to first order, the one whose tensions (the norm of each
-    cable's force on the platform) come nearest ``tension_guess``: continued along a trajectory, a
-    redundant robot keeps its internal tension.
+    Plane (:func:`_planar_inverse`): the nodes minimise the potential at fixed paid-out lengths, the lengths
+    cancel the force the held platform needs; a rigid platform on two cables chooses its rotation, on three
+    it is imposed. Space (:func:`_solve_inverse`): Gauss-Newton on the lengths over chains held at their
+    anchors, tied only by the platform's balance (six equations; three for a point mass or fewer than six
+    cables, whose rotation is left free); of the changes that cancel the imbalance to first order, the one
+    whose tensions come nearest ``tension_guess``: continued along a trajectory, a redundant robot keeps
+    its internal tension.
 
     Parameters
     ----------
     robot : ChainRobot
-        In space any lengths: they are paid out to ``lengths`` as the run's winches pay out
-        (:func:`cable_paid_out`).
+        In space its lengths are paid out to ``lengths`` (:func:`cable_paid_out`).
     pose : array_like [m, rad]
-        Plane: (x, z) or (x, z, rotation), the rotation imposed or (free) the start. Space: (x, y, z)
-        for a point mass or (x, y, z, rotation vector).
+        Plane: (x, z) or (x, z, rotation) (imposed, or the start if free). Space: (x, y, z) for a point
+        mass or (x, y, z, rotation vector).
     tension_guess : array_like, shape (m,) [N], optional
-        Plane: tensions (>= 0) the straight start chains carry, when there is no ``guess`` (eg the
-        catenary statics'). Space: positive tensions to stay near (default the ``guess``'s).
+        Plane: tensions (>= 0) of the straight start chains, without ``guess``. Space: positive tensions
+        to stay near (default the ``guess``'s).
     guess : ChainEquilibrium, optional
-        A nearby solution (the previous pose of a trajectory) to start from (in space its paid-out
-        lengths, nodes and swivel angles, unless given).
+        A nearby solution, the start (in space its lengths, nodes and angles, unless given).
     lengths, nodes, swivel_angles : optional, in space
-        Start of the paid-out lengths (m,) [m], of each cable's nodes (n + 1, 3) [m], exit first (moved
-        onto the anchors as :func:`solve_held_chain` does), and of each swivel pulley's psi (m,) [rad]
-        (NaN or default: the anchor's azimuth about its axis).
+        Start of the paid-out lengths (m,) [m], each cable's nodes (n + 1, 3) [m] and each psi (m,) [rad]
+        (NaN: the anchor's azimuth).
     free_rotation : bool, optional, in the plane
-        Let equilibrium choose the rotation (default: for a rigid platform on two cables).
+        Let equilibrium choose the rotation (default: a rigid platform on two cables).
     external_wrench : array_like, optional [N, N m]
-        Extra load on the platform about its centre of mass (eg the d'Alembert load -M a): (fx, fz,
-        moment) in the plane, (f, moment) in space.
-    tolerance : float, optional
-        Plane: the largest force imbalance accepted on nodes and platform [N] (default 1e-7). Space:
-        the platform's imbalance accepted relative to the larger of the weight and the largest cable
-        force (default 1e-9).
-    max_iterations : int, optional
-        Of each Newton iteration (plane, default 50) or of the Gauss-Newton (space, default 30).
+        Extra load about the centre of mass: (fx, fz, moment) in the plane, (f, moment) in space.
+    tolerance, max_iterations : float, int, optional
+        Plane: the force imbalance accepted [N] (1e-7), each Newton's iterations (50). Space: the
+        imbalance relative to the larger of the weight and the largest cable force (1e-9), Gauss-Newton
+        iterations (30).
 
-    Returns
-    -------
-    ChainEquilibrium
-
-    Raises
-    ------
-    UnreachableError
-        If no lengths with the cables in tension hold the platform there, or the iteration fails.
-    SceneError
-        On malformed input or (in the plane) a problem that is not square.
+    Raises UnreachableError if no lengths with the cables in tension hold the platform there or the
+    iteration fails; SceneError on malformed input or (plane) a problem that is not square.
     """
     return InverseChainStatics(robot).solve(pose, tension_guess, **kwargs)
 
 
 def _planar_inverse_solver(robot: ChainRobot):
     """The plane's :meth:`InverseChainStatics.solve` for ``robot``."""
-    def solve(pose, tension_guess, *, guess, lengths, nodes, swivel_angles, free_rotation, external_wrench,
-              tolerance, max_iterations):
+    def solve(pose, tension_guess, *, guess=None, lengths=None, nodes=None, swivel_angles=None,
+              free_rotation=None, external_wrench=None, tolerance=1e-7, max_iterations=50):
         if lengths is not None or nodes is not None or swivel_angles is not None:
             raise SceneError("lengths, nodes and swivel_angles start the spatial inverse chain statics; the planar "
                              "one starts from guess or tension_guess")
@@ -1511,8 +1253,7 @@ def _planar_inverse_solver(robot: ChainRobot):
             raise SceneError(f"pose must be (x, z) or (x, z, rotation), got {shown(pose.tolist())}")
         return _planar_inverse(robot, pose[:2], pose[2] if pose.size == 3 else 0.0, free_rotation=free_rotation,
                                external_wrench=external_wrench, guess=guess, tension_guess=tension_guess,
-                               tolerance=1e-7 if tolerance is None else tolerance,
-                               max_iterations=50 if max_iterations is None else max_iterations)
+                               tolerance=tolerance, max_iterations=max_iterations)
     return solve
 
 
@@ -1520,8 +1261,8 @@ def _spatial_inverse_solver(robot: ChainRobot):
     """Space's :meth:`InverseChainStatics.solve` for ``robot``: each cable's held model built once."""
     models = [_held_model(c, robot.gravity) for c in robot.cables]
 
-    def solve(pose, tension_guess, *, guess, lengths, nodes, swivel_angles, free_rotation, external_wrench,
-              tolerance, max_iterations):
+    def solve(pose, tension_guess, *, guess=None, lengths=None, nodes=None, swivel_angles=None,
+              free_rotation=None, external_wrench=None, tolerance=1e-9, max_iterations=30):
         if free_rotation is not None:
             raise SceneError("free_rotation is the planar inverse's: in space a rigid platform on fewer than six "
                              f"cables keeps its rotation free, got {shown(free_rotation)}")
@@ -1533,21 +1274,13 @@ def _spatial_inverse_solver(robot: ChainRobot):
         if tension_guess is None or lengths is None or nodes is None:
             raise SceneError("the spatial inverse chain statics need tension_guess, lengths and nodes to start "
                              "from, or a guess")
-        return _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench,
-                              1e-9 if tolerance is None else tolerance,
-                              30 if max_iterations is None else max_iterations, swivel_angles)
+        return _solve_inverse(robot, models, pose, tension_guess, lengths, nodes, external_wrench, tolerance,
+                              max_iterations, swivel_angles)
     return solve
 
 
-@dataclass(frozen=True)
-class _Methods:
-    """One dimension's chain statics: its cables from a scene, forward solve, rest and inverse solver."""
-
-    cables: object
-    forward: object
-    rest: object
-    inverse: object
-
+#: One dimension's chain statics: its cables from a scene, forward solve, rest and inverse solver.
+_Methods = namedtuple("_Methods", "cables forward rest inverse")
 
 #: Each dimension's chain statics, by the robot's (the scene's) Space: the one place they are chosen.
 _METHODS = {PLANE: _Methods(_planar_robot, _no_planar_forward, _no_planar_forward, _planar_inverse_solver),

@@ -8,46 +8,31 @@ driver :func:`solve_inverse_statics` (the lengths that hold a pose), both return
 
 **Poses.** Planar (the paper's vertical x-z plane): ``(x, z, phi)``, ``phi`` counter-clockwise
 (paper eq. 17), an anchor ``b_i`` at ``r + R(phi) b_i``, moments ``m = a_x f_z - a_z f_x``.
-Spatial (z up): ``(r, theta)``, ``theta`` the rotation vector, ``R = exp([theta]x)``; its
-derivative enters via the left Jacobian of SO(3) (a change ``d theta`` turns the body by the
-world-frame angle ``J_l(theta) d theta``, so the generalised force on ``theta`` is
-``J_l^T M``). A platform whose anchors all sit at its centre of mass is a point mass: only its
-position is solved. The two dimensions keep their own floating-point kernels (the pose
-kernels :class:`_PlanarStatics` and :class:`_SpatialStatics`, chosen by the platform's space):
-the residual, the pose Jacobian, the straight-cable start and the inverse differ per dimension.
+Spatial (z up): ``(r, theta)``, ``theta`` the rotation vector, ``R = exp([theta]x)``; a change
+``d theta`` turns the body by ``J_l(theta) d theta`` (left Jacobian of SO(3)), so the generalised
+force on ``theta`` is ``J_l^T M``. A point mass (every anchor at the centre of mass) has only its
+position solved. Each dimension keeps its floating-point pose kernel (:class:`_PlanarStatics`,
+:class:`_SpatialStatics`): residual, pose Jacobian, straight-cable start and inverse.
 
-**Cables.** Each cable is an elastic catenary (:mod:`cdpr_exu.physics.catenary`: weight,
-axial elasticity, no bending) from its anchor (end A) to its exit (end B), chosen by the exit
-(:func:`forward_cable`, :func:`inverse_cable`):
+**Cables.** Each cable is an elastic catenary (:mod:`cdpr_exu.physics.catenary`) from its anchor
+(end A) to its exit (end B), solved as the exit asks (:func:`forward_cable`, :func:`inverse_cable`):
 
-* planar, a fixed exit point; or a planar pulley: the cable comes up from its winch along
-  ``x = c_x + side r_p``, wraps over the top and leaves the rim tangentially; its unstrained
-  length counts from the hang point ``(c_x + side r_p, c_z)`` and includes the wrap.
-  Frictionless (uniform tension along the wrap, whose unstrained length is
-  ``r_p wrap / (1 + T / EA)``); the wrap's weight is carried by the pulley (at most ``w r_p``
-  of tension, 7e-6 m of stretch for the paper's cable; a slight non-conservativeness, 2.5e-6
-  relative asymmetry of the stiffness); rigid rim, no pulley inertia. A platform under the
-  inner rim of a pulley cannot be held (:class:`UnreachableError`);
-* spatial, a point exit: the cable hangs in the vertical plane through its ends, the planar
-  catenary rotated back to 3-D (MoorPy's trick). With ``u`` the horizontal direction from
-  the anchor to the exit and ``h`` the horizontal span, its end stiffness is
-  ``Q K2 Q^T - (H / h) (P_h - u u^T)``, ``Q = [u, e_z]`` (a sideways step turns the pull;
-  for a vertical cable ``H / h`` tends to ``-K2[0, 0]``);
-* spatial, a swivel pulley: the disc turns to the vertical plane through its axis and the
-  anchor, where the cable is the planar pulley cable (centre ``(r_p, 0)``, side -1, hang
-  point at the inlet); its stiffness ``Q K2 Q^T + (f_rho / rho) (P_h - e_rho e_rho^T)``.
+* planar, a fixed exit point, or a pulley: up the winch line ``x = c_x + side r_p``, over the top and
+  off the rim tangentially, the length counted from the hang point ``(c_x + side r_p, c_z)``.
+  Frictionless (the wrap's unstrained length ``r_p wrap / (1 + T / EA)``), its weight carried by the
+  pulley (at most ``w r_p`` of tension: 7e-6 m of stretch, 2.5e-6 relative stiffness asymmetry for the
+  paper's cable); rigid rim, no pulley inertia;
+* spatial, a point exit: the planar catenary in the vertical plane through the ends (MoorPy's trick),
+  its end stiffness ``Q K2 Q^T - (H / h) (P_h - u u^T)``, ``Q = [u, e_z]``, ``u`` the horizontal
+  direction from the anchor to the exit and ``h`` the horizontal span (a sideways step turns the pull;
+  vertical: ``H / h`` tends to ``-K2[0, 0]``);
+* spatial, a swivel pulley: the planar pulley cable in the vertical plane through the axis and the
+  anchor, its stiffness ``Q K2 Q^T + (f_rho / rho) (P_h - e_rho e_rho^T)``.
 
-**Solvers.** The forward problem is an energy minimum (cables conservative, weight ``M g z``):
-Newton's method with the analytic stiffness and a line search on the energy
-(:func:`minimise_energy`), started from :func:`straight_cable_pose` (straight, massless,
-elastic cables that may go slack), every evaluation solving each cable warm-started from the
-previous iterate; statically indeterminate robots need no tension distribution (the cables'
-elasticity picks the equilibrium). The inverse: planar, a square Newton iteration in the
-horizontal tensions (and the rotation a rigid platform on two cables takes), started from
-straight massless cables, with a weight continuation as the last resort; spatial, the
-horizontal tensions nearest a guess (least squares) that balance the platform, by
-Gauss-Newton. Horizontal tension cannot parametrise a vertical cable, so the inverse needs
-every cable off the vertical. Both accept an external wrench (eg :func:`inertial_wrench`).
+**Solvers.** The forward problem is an energy minimum (:func:`solve_statics`); statically
+indeterminate robots need no tension distribution (the cables' elasticity picks the equilibrium).
+The inverse (:func:`solve_inverse_statics`) is parametrised by the horizontal tensions, so it
+needs every cable off the vertical. Both accept an external wrench (eg :func:`inertial_wrench`).
 """
 
 from __future__ import annotations
@@ -66,7 +51,7 @@ from cdpr_exu.core.validation import finite, non_negative, positive, real_array,
 from cdpr_exu.exits import Exit, Pulley
 from cdpr_exu.physics.catenary import (DEFAULT_MAX_STRAIN, STANDARD_GRAVITY, CatenaryCable, CatenaryState,
                                        end_stiffness, profile, solve_forward, solve_inverse, span_and_jacobian,
-                                       state_from_end_forces)
+                                       state_from_end_forces, tension_limit)
 from cdpr_exu.space import PLANE, SPACE, Space, space_of
 
 _RELATIVE_TOLERANCE = 1e-12
@@ -77,9 +62,6 @@ _HORIZONTAL = np.diag([1.0, 1.0, 0.0])
 _PLANE_X = np.array([1.0, 0.0])
 
 
-# ---------------------------------------------------------------------------
-# parameters
-# ---------------------------------------------------------------------------
 def _point(name, value, size=None):
     """A point as a tuple of floats: (x, z) or (x, y, z) [m], its size given or read from ``value``."""
     if size is None:
@@ -90,25 +72,10 @@ def _point(name, value, size=None):
 
 @dataclass(frozen=True)
 class SuspendedCable:
-    """One cable of the platform: its material, its anchor and its exit.
-
-    Parameters
-    ----------
-    weight_per_length : float [N/m]
-        ``w >= 0``, weight per unstrained length.
-    axial_stiffness : float [N]
-        ``EA > 0``.
-    anchor : (x, z) or (x, y, z) [m], optional
-        Anchor on the platform, platform frame (centre of mass at 0); default the centre.
-    exit_point : (x, z) or (x, y, z) [m], optional
-        Fixed exit point, world frame; its size is the cable's dimension. Give exactly one of
-        ``exit_point`` and ``pulley``.
-    pulley : Exit, optional
-        The exit the cable leaves from (:mod:`cdpr_exu.exits`): a planar
-        :class:`~cdpr_exu.exits.pulley.Pulley` or a :class:`~cdpr_exu.exits.swivel.Swivel`, or
-        an exit the cable does not wrap (a point exit), taken as the fixed ``exit_point`` at
-        its point.
-    """
+    """One cable of the platform: its weight per unstrained length ``w >= 0`` [N/m], ``EA > 0`` [N], its
+    anchor (platform frame, centre of mass at 0; default the centre) and exactly one of ``exit_point``
+    (world frame, (x, z) or (x, y, z) [m]: its size is the cable's dimension) and ``pulley``, the
+    :class:`~cdpr_exu.exits.Exit` it leaves from (an exit it does not wrap is taken as its point)."""
 
     weight_per_length: float
     axial_stiffness: float
@@ -158,39 +125,16 @@ class SuspendedCable:
         return CatenaryCable(unstrained_length, self.weight_per_length, self.axial_stiffness)
 
 
-def _swivel_plane_cable(weight_per_length, axial_stiffness, radius) -> SuspendedCable:
-    """The planar cable of a swivel pulley of radius ``radius`` [m], in the vertical plane through its axis
-    and the anchor: over a pulley of centre (r_p, 0), hung on its left (side -1), so that its hang point
-    is the inlet at the plane's origin and its winch line the swivel axis (:mod:`cdpr_exu.core.geometry`,
-    "Swivel pulley"); the anchor at the platform's reference point."""
-    radius = float(radius)
-    return SuspendedCable(weight_per_length, axial_stiffness, anchor=(0.0, 0.0), pulley=Pulley((radius, 0.0), radius, -1))
-
-
 @dataclass(frozen=True)
 class SuspendedPlatform:
-    """A platform hung on catenary cables, in the plane or in space (the cables' space).
+    """A platform hung on catenary cables (all planar or all spatial), of mass ``M >= 0`` [kg] whose weight
+    ``M g`` (``gravity`` [m/s^2], default 9.81) acts at its centre of mass along -z; ``inertia`` [kg m^2]
+    about it: planar about the plane's normal, spatial the principal moments (default 0).
 
-    Parameters
-    ----------
-    cables : sequence of SuspendedCable
-        All planar or all spatial.
-    mass : float [kg]
-        ``M >= 0``; its weight ``M g`` acts at the centre of mass, along -z.
-    gravity : float [m/s^2], optional
-        Default 9.81.
-    inertia : float or (float, float, float) [kg m^2], optional
-        About the centre of mass: planar, the moment about the plane's normal; spatial, the
-        principal moments along the platform axes. Default 0; only :func:`inertial_wrench`
-        and the dynamics use it.
-
-    Raises
-    ------
-    SceneError
-        Naming the field: no cables, cables of two dimensions, a negative mass, two cables
-        sharing an exit point, two cables of a rigid platform sharing an anchor, too few
-        cables to hang it (a point mass needs one, a rigid body two), or, in space, anchors
-        all on one line through the centre of mass (it would turn freely about it).
+    Raises SceneError naming the field: no cables, cables of two dimensions, a negative mass, two cables
+    sharing an exit point, two cables of a rigid platform sharing an anchor, too few cables to hang it (a
+    point mass needs one, a rigid body two), or, in space, anchors all on one line through the centre of
+    mass (it would turn freely about it).
     """
 
     cables: tuple
@@ -255,22 +199,11 @@ class SuspendedPlatform:
         """Anchors in the platform frame, shape (n_cables, d) [m]."""
         return np.array([c.anchor for c in self.cables])
 
-    @property
-    def hang_points(self):
-        """Where each cable's unstrained length counts from, shape (n_cables, d) [m]."""
-        return np.array([c.hang_point for c in self.cables])
-
 
 def catenary_platform(scene) -> SuspendedPlatform:
-    """The catenary-statics model of a scene's robot, planar or spatial: each cable's weight per length
-    ``rho0 g`` [N/m] (0 without cable mass or gravity), its ``EA`` [N], anchor and exit, the platform's
-    mass, gravity (0 when off) and inertia.
-
-    Raises
-    ------
-    SceneError
-        If a weight per length overflows, or the platform cannot hang (:class:`SuspendedPlatform`).
-    """
+    """The catenary-statics model of a scene's robot: each cable's ``w = rho0 g`` [N/m] (0 without cable
+    mass or gravity), ``EA``, anchor and exit, the platform's mass, gravity (0 when off) and inertia;
+    SceneError if a weight per length overflows or the platform cannot hang."""
     gravity = scene.gravity if scene.effects.gravity else 0.0
     weighs = scene.effects.cable_mass and scene.effects.gravity
     weights = [c.linear_density * gravity if weighs else 0.0 for c in scene.cables]
@@ -285,14 +218,11 @@ def catenary_platform(scene) -> SuspendedPlatform:
 
 
 def inertial_wrench(platform, acceleration, angular_acceleration=None):
-    """D'Alembert load ``(-M a, -I alpha)`` for dynamic feed-forward, shape (wrench_size,) [N, N m].
+    """D'Alembert load ``(-M a, -I alpha)`` (wrench_size,) [N, N m] for dynamic feed-forward, as
+    ``external_wrench`` of the statics (the cables' inertia neglected: they stay quasi-static).
 
-    ``acceleration`` (d,) [m/s^2] of the centre of mass; ``angular_acceleration`` [rad/s^2]: planar a
-    float, spatial (3,) about the platform axes (its principal axes; the moment neglects the
-    gyroscopic term and holds at the reference orientation); default none. To pass as
-    ``external_wrench`` to the statics solvers; the cables' inertia is neglected (they stay in
-    quasi-static equilibrium).
-    """
+    ``acceleration`` (d,) [m/s^2] of the centre of mass; ``angular_acceleration`` [rad/s^2], planar a float,
+    spatial (3,) about the platform's principal axes (no gyroscopic term; at the reference orientation)."""
     space = platform.space
     a = vector("acceleration", acceleration, space.position_size, f" ({', '.join(space.position_labels)}) [m/s^2]")
     if angular_acceleration is None:
@@ -323,37 +253,27 @@ def node_masses_along(n_elements, element_mass, mass_lumping="consistent"):
     return masses
 
 
-# ---------------------------------------------------------------------------
-# results
-# ---------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class CableEquilibrium:
-    """One cable in a platform equilibrium.
+    """One cable in a platform equilibrium; d is the space's dimension.
 
     Attributes
     ----------
     catenary : CatenaryState
         The suspended part in its vertical plane, A at the anchor, B at the exit or tangent point.
     unstrained_length : float [m]
-        Total: suspended part plus, over a pulley, the wrapped arc up to the hang point.
+        Total: suspended part plus, over a pulley, the wrap up to the hang point.
     anchor_point, exit_point : ndarray, shape (d,) [m]
-        World positions of the anchor and of the exit point (over a pulley: the tangent point).
+        The anchor and the exit (over a pulley: tangent) point.
     force_on_platform, force_on_exit : ndarray, shape (d,) [N]
-        Forces the cable exerts on the platform at its anchor and on its exit (tangent) point.
-    cable : CatenaryCable
-        The catenary parameters of the suspended part.
-    guess : tuple
-        Warm start of the next solve of this cable.
+        The cable's forces on the platform and on its exit (tangent) point.
+    cable, guess : CatenaryCable, tuple
+        The suspended part's; the warm start of the cable's next solve.
     horizontal_direction : ndarray, shape (d,)
-        The x axis of the catenary's plane: planar (1, 0); spatial ``u``, the horizontal unit
-        vector from the anchor towards the exit (any one for a vertical cable), over a swivel
-        ``e_rho`` from the axis towards the anchor.
-    pulley_radius : float [m]
-        0 for a fixed exit point.
-    wrap_angle : float [rad]
-        Angle wrapped on the pulley (0 for a fixed exit point).
-    inlet : ndarray, shape (3,) [m] or None
-        A swivel pulley's inlet.
+        The catenary plane's x axis: planar (1, 0); spatial the horizontal unit vector from the anchor
+        towards the exit, over a swivel ``e_rho`` from the axis towards the anchor.
+    pulley_radius, wrap_angle, inlet : float [m], float [rad], ndarray (3,) [m] or None
+        The disc the cable wraps (0 for a fixed exit point); a swivel pulley's inlet.
     """
 
     catenary: CatenaryState
@@ -385,10 +305,9 @@ class CableEquilibrium:
         return self.catenary.tension_b
 
     def points(self, s):
-        """Points of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor, shape (n, d) [m].
-
-        Over a swivel pulley, arc lengths beyond the suspended part lie on the wrap (stretched by the
-        tension at the tangent point), up to ``unstrained_length`` at the inlet."""
+        """Points (n, d) [m] of the loaded cable at unstrained arc lengths ``s`` (n,) [m] from the anchor;
+        over a swivel pulley, beyond the suspended part on the wrap (stretched by the tension at the tangent
+        point), up to ``unstrained_length`` at the inlet."""
         s = np.atleast_1d(np.asarray(s, dtype=float))
         suspended = self.suspended_length
         hanging = s <= suspended if self.inlet is not None else np.ones(s.shape, bool)
@@ -414,23 +333,15 @@ class PlatformEquilibrium:
 
     Attributes
     ----------
-    space : Space
     position : ndarray, shape (d,) [m]
         Centre of mass.
-    rotation : float or ndarray, shape (3,) [rad]
-        The space's rotation: planar the angle ``phi`` (counter-clockwise), spatial the rotation
-        vector; 0 for a point mass.
-    rotation_matrix : ndarray, shape (d, d)
-        ``R``: platform frame to world frame.
-    cables : tuple of CableEquilibrium
+    rotation, rotation_matrix : float or ndarray (3,) [rad], ndarray (d, d)
+        Planar the angle ``phi``, spatial the rotation vector (0 for a point mass); platform to world.
     stiffness : ndarray, shape (k, k), or None
-        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths, ``k`` the degrees of
-        freedom (N/m, N/rad, N m/m, N m/rad); positive definite where the equilibrium is
-        stable. None where not computed (the spatial inverse).
-    external_wrench : ndarray, shape (wrench_size,) [N, N m]
-    net_wrench : ndarray, shape (wrench_size,) [N, N m]
-        Remaining force and moment (about the centre of mass) on the platform: cables,
-        weight and external load; zero to solver tolerance.
+        ``-d(generalised force)/d(pose)`` at fixed unstrained lengths over the k degrees of freedom
+        (positive definite where stable); None from the spatial inverse.
+    external_wrench, net_wrench : ndarray, shape (wrench_size,) [N, N m]
+        The external load, and the force and moment left about the centre of mass (zero to tolerance).
     """
 
     space: Space
@@ -441,11 +352,6 @@ class PlatformEquilibrium:
     stiffness: np.ndarray | None = field(default=None, repr=False)
     external_wrench: np.ndarray | None = field(default=None, repr=False)
     net_wrench: np.ndarray | None = field(default=None, repr=False)
-
-    @property
-    def pose(self):
-        """Position and rotation, shape (pose_size,) [m, rad]."""
-        return np.append(self.position, self.rotation)
 
     @property
     def unstrained_lengths(self):
@@ -462,43 +368,13 @@ class PlatformEquilibrium:
         """Tension of each cable at its anchor, shape (n_cables,) [N]."""
         return np.array([c.tension_at_anchor for c in self.cables])
 
-    @property
-    def tensions_at_exit(self):
-        """Tension of each cable at its exit (tangent) point, shape (n_cables,) [N]."""
-        return np.array([c.tension_at_exit for c in self.cables])
 
-    @property
-    def forces_on_platform(self):
-        """Force of each cable on the platform, shape (n_cables, d) [N]."""
-        return np.array([c.force_on_platform for c in self.cables])
-
-    @property
-    def anchor_points(self):
-        """World positions of the anchors, shape (n_cables, d) [m]."""
-        return np.array([c.anchor_point for c in self.cables])
-
-    @property
-    def is_stable(self):
-        """True when the symmetric part of `stiffness` is positive definite."""
-        return bool(np.all(np.linalg.eigvalsh(0.5 * (self.stiffness + self.stiffness.T)) > 0.0))
-
-
-# ---------------------------------------------------------------------------
-# a small damped Newton solver
-# ---------------------------------------------------------------------------
-def _damped_newton(
-    function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
-    line_search_steps=50,
-):
-    """Newton's method with backtracking on the residual norm.
-
-    ``function(x) -> (residual, jacobian)``; it may raise UnreachableError at a trial
-    point, which then counts as a rejected step. Components listed in ``positive``
-    are kept above 10 % of their current value. Converged when the residual norm is
-    below ``tolerance``, or when no step decreases it any more and it is below
-    ``noise`` (default ``1e3 tolerance``), the precision the residual can have.
-    Returns ``(x, residual, jacobian)``.
-    """
+def _damped_newton(function, x0, tolerance, positive=(), max_iterations=100, what="equilibrium", noise=None,
+                   line_search_steps=50):
+    """Newton's method on ``function(x) -> (residual, jacobian)``, backtracking on the residual norm; returns
+    ``(x, residual, jacobian)``. A trial that raises UnreachableError is rejected; components in ``positive``
+    stay above 10 % of their value. Converged below ``tolerance``, or where no step decreases the norm and
+    it is below ``noise`` (default ``1e3 tolerance``), the precision the residual can have."""
     noise = 1e3 * tolerance if noise is None else max(noise, tolerance)
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
@@ -541,18 +417,12 @@ def _damped_newton(
 
 
 def minimise_energy(function, x0, tolerance, noise, max_iterations=200, what="equilibrium"):
-    """Newton's method for a conservative equilibrium, with a line search on the energy.
-
-    ``function(x) -> (residual, jacobian)`` where the residual is the net generalised
-    force, ``-grad(energy)``, and the jacobian ``-hessian``. The energy itself is not
-    needed: along a descent direction ``d`` its slope is ``-residual . d``, and the
-    step length is chosen where that slope stops being (strongly) negative, ie near
-    the energy minimum along the line. Unlike a search on the residual norm, this
-    cannot stall away from an equilibrium, which matters on the curved, stiff valleys
-    of near-vertical cables (a pendulum: stiff along the cable, soft across it).
-    Where the stiffness is not positive definite along the Newton direction, the
-    direction falls back to the (scaled) steepest descent.
-    """
+    """Newton's method for a conservative equilibrium, ``function(x) -> (residual, jacobian)`` the net
+    generalised force ``-grad(energy)`` and ``-hessian``, with a line search on the energy: along a descent
+    direction ``d`` its slope is ``-residual . d``, and the step ends near the minimum on the line (where
+    that slope stops being strongly negative). Unlike a search on the residual norm this cannot stall away
+    from an equilibrium in the curved, stiff valleys of near-vertical cables. Where the stiffness is not
+    positive definite along the Newton direction, the (scaled) steepest descent is taken."""
     x = np.array(x0, dtype=float)
     residual, jacobian = function(x)
     norm = float(np.linalg.norm(residual))
@@ -625,19 +495,14 @@ def _warm_then_cold(solve_from, guess):
     return solve_from(None)
 
 
-# ---------------------------------------------------------------------------
-# one cable: straight geometry
-# ---------------------------------------------------------------------------
 def _straight_tangent_angle(pulley, point):
     """Rim angle where a straight cable from ``point`` leaves ``pulley``."""
     centre = np.array(pulley.center)
     offset = centre - point
     distance = float(np.hypot(*offset))
     if distance <= pulley.radius:
-        raise UnreachableError(
-            f"anchor point ({point[0]:g}, {point[1]:g}) m lies inside the pulley of centre "
-            f"{pulley.center} m and radius {pulley.radius:g} m"
-        )
+        raise UnreachableError(f"anchor point ({point[0]:g}, {point[1]:g}) m lies inside the pulley of "
+                               f"centre {pulley.center} m and radius {pulley.radius:g} m")
     gamma = math.atan2(offset[1], offset[0])
     spread = math.acos(-pulley.radius / distance)
     for angle in (gamma + spread, gamma - spread):
@@ -647,14 +512,10 @@ def _straight_tangent_angle(pulley, point):
     raise AssertionError("no tangent with the pulley's orientation")  # pragma: no cover
 
 
-# ---------------------------------------------------------------------------
-# one cable: forward (given unstrained length) and inverse (given H)
-# ---------------------------------------------------------------------------
+# --- one cable: forward (given unstrained length) and inverse (given H)
 def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_length, tension_scale):
-    """Residual of the pulley cable (span mismatch, tangency) and its partial derivatives.
-
-    Returns ``(residual (3,), d/d(H, V_B, L_c, angle) (3, 4), catenary)``.
-    """
+    """Residual of the pulley cable (span mismatch, tangency) (3,), its derivatives in (H, V_B, L_c, angle)
+    (3, 4), and the suspended part's catenary."""
     catenary = cable.catenary(suspended_length)
     span, jac = span_and_jacobian(catenary, H, V_B, sign_x)
     tangent = pulley.rim_point(angle)
@@ -664,9 +525,7 @@ def _pulley_residual(cable, pulley, sign_x, point, H, V_B, angle, suspended_leng
     residual[:2] = span - (tangent - point)
     residual[2] = scale * (sign_x * H * c + V_B * s)
     partial = np.zeros((3, 4))
-    partial[:2, 0] = jac[:, 0]
-    partial[:2, 1] = jac[:, 1]
-    partial[:2, 2] = jac[:, 2]
+    partial[:2, :3] = jac
     partial[:2, 3] = -pulley.radius * np.array([-s, c])
     partial[2, 0] = scale * sign_x * c
     partial[2, 1] = scale * s
@@ -683,19 +542,14 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
     """A planar cable of given length from an anchor point: its equilibrium (the next guess in it) and
     ``d(force on A)/d(anchor point)`` (2, 2)."""
     if cable.pulley is None:
-        catenary_guess = None if guess is None else guess[:2]
         catenary_cable = cable.catenary(unstrained_length)
-        state = solve_forward(
-            catenary_cable,
-            np.array(cable.exit_point) - point,
-            initial_guess=catenary_guess,
-            max_strain=max_strain,
-            max_tension=max_tension,
-        )
-        stiffness = end_stiffness(cable.catenary(unstrained_length), state)
+        state = solve_forward(catenary_cable, np.array(cable.exit_point) - point,
+                              initial_guess=None if guess is None else guess[:2], max_strain=max_strain,
+                              max_tension=max_tension)
         guess = (state.horizontal_tension, state.vertical_tension_b)
-        return _planar_equilibrium(state, catenary_cable, unstrained_length, point, np.array(cable.exit_point),
-                                   guess), stiffness
+        equilibrium = _planar_equilibrium(state, catenary_cable, unstrained_length, point,
+                                          np.array(cable.exit_point), guess)
+        return equilibrium, end_stiffness(catenary_cable, state)
 
     pulley, EA, w, r = cable.pulley, cable.axial_stiffness, cable.weight_per_length, cable.pulley.radius
 
@@ -715,13 +569,10 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
             angle = _straight_tangent_angle(pulley, point)
             suspended = unstrained_length - r * pulley.wrap_to(angle)
             if suspended <= 0.0:
-                raise UnreachableError(
-                    f"unstrained_length {unstrained_length:g} m is shorter than the wrap on the pulley"
-                )
-            state = solve_forward(
-                cable.catenary(suspended), pulley.rim_point(angle) - point,
-                max_strain=max_strain, max_tension=max_tension,
-            )
+                raise UnreachableError(f"unstrained_length {unstrained_length:g} m is shorter than the wrap "
+                                       "on the pulley")
+            state = solve_forward(cable.catenary(suspended), pulley.rim_point(angle) - point,
+                                  max_strain=max_strain, max_tension=max_tension)
             H, V_B = state.horizontal_tension, state.vertical_tension_b
             if H <= 0.0:  # a just-taut massless (or vertical) start: pull a little
                 H = 1e-9 * EA
@@ -736,17 +587,12 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
             length, derivative, _ = suspended_length(x)
             if length <= 0.0:
                 raise UnreachableError("the whole cable would lie on the pulley")
-            residual, partial, _ = _pulley_residual(
-                cable, pulley, sign_x, point, x[0], x[1], x[2], length, tension_scale
-            )
-            jacobian = partial[:, [0, 1, 3]] + np.outer(partial[:, 2], derivative)
-            return residual, jacobian
+            residual, partial, _ = _pulley_residual(cable, pulley, sign_x, point, x[0], x[1], x[2], length,
+                                                    tension_scale)
+            return residual, partial[:, [0, 1, 3]] + np.outer(partial[:, 2], derivative)
 
-        tolerance = _RELATIVE_TOLERANCE * unstrained_length
-        x, _, jacobian = _damped_newton(
-            function, (H, V_B, angle), tolerance, positive=(0,), what="pulley cable",
-            **_INNER_NEWTON,
-        )
+        x, _, jacobian = _damped_newton(function, (H, V_B, angle), _RELATIVE_TOLERANCE * unstrained_length,
+                                        positive=(0,), what="pulley cable", **_INNER_NEWTON)
         return x, jacobian, sign_x, tension_scale
 
     x, jacobian, sign_x, _ = _warm_then_cold(solve_from, guess)
@@ -754,11 +600,9 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
     length, derivative, wrap = suspended_length(x)
     catenary_cable = cable.catenary(length)
     state = state_from_end_forces(catenary_cable, H, V_B, sign_x)
-    if state.max_tension > _tension_limit(cable, max_strain, max_tension):
-        raise UnreachableError(
-            f"cable of unstrained_length {unstrained_length:g} m would need tension "
-            f"{state.max_tension:g} N, above its limit"
-        )
+    if state.max_tension > tension_limit(cable.axial_stiffness, max_strain, max_tension):
+        raise UnreachableError(f"cable of unstrained_length {unstrained_length:g} m would need tension "
+                               f"{state.max_tension:g} N, above its limit")
     # d(H, V_B, angle)/d(point) = -jacobian^-1 d(residual)/d(point), d(residual)/d(point) = [I; 0]
     sensitivity = -np.linalg.solve(jacobian, np.vstack([np.eye(2), np.zeros((1, 2))]))
     force_derivative = np.array([[sign_x, 0.0, 0.0], [-w * derivative[0], 1.0 - w * derivative[1], -w * derivative[2]]])
@@ -768,16 +612,9 @@ def _planar_forward_cable(cable, unstrained_length, point, guess, max_strain, ma
     return equilibrium, stiffness
 
 
-def _tension_limit(cable, max_strain, max_tension):
-    limit = max_strain * cable.axial_stiffness
-    return limit if max_tension is None else min(limit, max_tension)
-
-
 def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, max_tension):
-    """A planar cable with given horizontal tension from an anchor point.
-
-    Returns ``(CableEquilibrium, dF_A/dH (2,), dF_A/dp_A at fixed H (2, 2))``, the next guess in the first.
-    """
+    """A planar cable with given horizontal tension from an anchor point: ``(CableEquilibrium, dF_A/dH (2,),
+    dF_A/dp_A at fixed H (2, 2))``, the next guess in the first."""
     H, w, EA = horizontal_tension, cable.weight_per_length, cable.axial_stiffness
     if cable.pulley is None:
         span = np.array(cable.exit_point) - point
@@ -796,10 +633,8 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
         def solve_from(start_guess):
             if start_guess is None:
                 angle = _straight_tangent_angle(pulley, point)
-                length, state = solve_inverse(
-                    pulley.rim_point(angle) - point, w, EA, H,
-                    max_strain=max_strain, max_tension=max_tension,
-                )
+                length, state = solve_inverse(pulley.rim_point(angle) - point, w, EA, H,
+                                              max_strain=max_strain, max_tension=max_tension)
                 V_B = state.vertical_tension_b
             else:
                 length, V_B, angle = start_guess
@@ -809,15 +644,12 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
             def function(x):
                 if x[0] <= 0.0:
                     raise UnreachableError("suspended length must stay positive")
-                residual, partial, _ = _pulley_residual(
-                    cable, pulley, sign_x, point, H, x[1], x[2], x[0], tension_scale
-                )
+                residual, partial, _ = _pulley_residual(cable, pulley, sign_x, point, H, x[1], x[2], x[0],
+                                                        tension_scale)
                 return residual, partial[:, [2, 1, 3]]
 
-            x, _, jacobian = _damped_newton(
-                function, (length, V_B, angle), _RELATIVE_TOLERANCE * length, positive=(0,),
-                what="pulley cable", **_INNER_NEWTON,
-            )
+            x, _, jacobian = _damped_newton(function, (length, V_B, angle), _RELATIVE_TOLERANCE * length,
+                                            positive=(0,), what="pulley cable", **_INNER_NEWTON)
             return x, jacobian, sign_x, tension_scale
 
         x, jacobian, sign_x, tension_scale = _warm_then_cold(solve_from, guess)
@@ -830,7 +662,7 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
         total = length + r * wrap / (1.0 + state.tension_b / EA)
         equilibrium = _planar_equilibrium(state, catenary, total, point, pulley.rim_point(angle), (length, V_B, angle),
                                           wrap, r)
-    if state.max_tension > _tension_limit(cable, max_strain, max_tension):
+    if state.max_tension > tension_limit(cable.axial_stiffness, max_strain, max_tension):
         raise UnreachableError(f"horizontal_tension {H:g} N needs tension {state.max_tension:g} N, above the limit")
     # unknowns u = (L_c, V_B[, angle]); force on A = (sign_x H, V_B - w L_c)
     d_u_dH = -np.linalg.solve(jacobian, d_residual_dH)
@@ -840,9 +672,7 @@ def _planar_inverse_cable(cable, horizontal_tension, point, guess, max_strain, m
     return equilibrium, force_dH, force_dp
 
 
-# ---------------------------------------------------------------------------
-# one spatial cable: the planar cable in its vertical plane
-# ---------------------------------------------------------------------------
+# --- one spatial cable: the planar cable in its vertical plane
 def _vertical_plane_forward_cable(cable, unstrained_length, anchor_point, guess, max_strain, max_tension):
     """A spatial cable from a point exit: the planar catenary in the vertical plane through its ends."""
     catenary_cable = cable.catenary(unstrained_length)
@@ -858,26 +688,22 @@ def _vertical_plane_forward_cable(cable, unstrained_length, anchor_point, guess,
     vertical = horizontal <= 1e-9 * max(unstrained_length, float(np.linalg.norm(span)))
     sideways = -planar[0, 0] if vertical else state.horizontal_tension / horizontal
     stiffness -= sideways * (_HORIZONTAL - np.outer(direction, direction))
-    equilibrium = CableEquilibrium(
-        state, float(unstrained_length), np.array(anchor_point, dtype=float), exit_point,
-        state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
-        state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
-        catenary_cable, (state.horizontal_tension, state.vertical_tension_b), direction)
-    return equilibrium, stiffness
+    return _in_vertical_plane(state, float(unstrained_length), anchor_point, exit_point, catenary_cable,
+                              (state.horizontal_tension, state.vertical_tension_b), direction), stiffness
+
+
+def _in_vertical_plane(state, length, anchor_point, exit_point, catenary_cable, guess, direction):
+    """A point exit's cable, the catenary ``state`` in the vertical plane along ``direction`` (3,), in 3-D."""
+    return CableEquilibrium(state, length, np.array(anchor_point, dtype=float), exit_point,
+                            state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
+                            state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z, catenary_cable,
+                            guess, direction)
 
 
 def _swivel_plane(cable, anchor_point):
-    """The vertical plane through a swivel pulley's axis and ``anchor_point`` (3,) [m], where its cable hangs.
-
-    Returns the inlet (3,) [m], the plane's horizontal unit vector e_rho (3,), the anchor's span from
-    the inlet in the plane (rho, dz) (2,) [m], and the planar pulley cable whose disc touches the axis
-    at the plane's origin (:func:`_swivel_plane_cable`).
-
-    Raises
-    ------
-    UnreachableError
-        If the anchor lies on the axis (its azimuth, and so the plane, is undefined).
-    """
+    """The vertical plane through a swivel pulley's axis and ``anchor_point`` (3,) [m]: the inlet (3,) [m],
+    its horizontal unit vector e_rho (3,), the anchor's span (rho, dz) [m] from the inlet, and its planar
+    pulley cable. Refuses (UnreachableError) an anchor on the axis."""
     inlet = np.array(cable.point)
     offset = np.asarray(anchor_point, dtype=float) - inlet
     rho = float(math.hypot(offset[0], offset[1]))
@@ -885,7 +711,10 @@ def _swivel_plane(cable, anchor_point):
         raise UnreachableError(f"anchor {np.asarray(anchor_point).tolist()} lies on the axis of the swivel pulley at "
                                f"{inlet.tolist()}: its azimuth is undefined")
     e_rho = np.array([offset[0], offset[1], 0.0]) / rho
-    planar_cable = _swivel_plane_cable(cable.weight_per_length, cable.axial_stiffness, cable.pulley_radius)
+    # a disc of centre (r_p, 0) hung on its left: hang point the inlet, winch line the axis (core.geometry)
+    radius = cable.pulley_radius
+    planar_cable = SuspendedCable(cable.weight_per_length, cable.axial_stiffness, anchor=(0.0, 0.0),
+                                  pulley=Pulley((radius, 0.0), radius, -1))
     return inlet, e_rho, np.array([rho, offset[2]]), planar_cable
 
 
@@ -923,11 +752,9 @@ def _vertical_plane_inverse_cable(cable, horizontal_tension, anchor_point, guess
     direction = np.array([span[0], span[1], 0.0]) / horizontal
     length, state = solve_inverse((horizontal, span[2]), cable.weight_per_length, cable.axial_stiffness,
                                   horizontal_tension)
-    return CableEquilibrium(
-        state, length, np.array(anchor_point, dtype=float), exit_point,
-        state.force_on_a[0] * direction + state.force_on_a[1] * _E_Z,
-        state.force_on_b[0] * direction + state.force_on_b[1] * _E_Z,
-        cable.catenary(length), None, direction), None, None
+    equilibrium = _in_vertical_plane(state, length, anchor_point, exit_point, cable.catenary(length), None,
+                                     direction)
+    return equilibrium, None, None
 
 
 def _swivel_inverse_cable(cable, horizontal_tension, anchor_point, guess, max_strain, max_tension):
@@ -939,31 +766,16 @@ def _swivel_inverse_cable(cable, horizontal_tension, anchor_point, guess, max_st
     return _lifted(planar, cable, anchor_point, inlet, e_rho, planar.force_on_platform), None, None
 
 
-def _cable_kernel(cable):
-    """The per-cable solvers (forward, inverse) of ``cable``, by its space and whether it wraps over its exit."""
-    return _CABLE_KERNELS[cable.space][cable.pulley is not None]
-
-
 def forward_cable(cable, unstrained_length, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
                   max_tension=None):
-    """Solve one cable of given unstrained length [m] from a given anchor point (d,) [m] to its exit.
+    """Solve one cable of given unstrained length [m] from an anchor point (d,) [m] to its exit.
 
-    The solver is the exit's: planar fixed point or pulley, spatial vertical plane (point exit) or
-    swivel plane (module notes). ``guess``: a previous :attr:`CableEquilibrium.guess` of this cable.
-
-    Returns
-    -------
-    equilibrium : CableEquilibrium
-    stiffness : ndarray, shape (d, d) [N/m]
-        ``d(force on platform)/d(anchor point)``.
-
-    Raises
-    ------
-    UnreachableError
-        If the span is beyond the cable's reach at its tension limit.
-    """
-    return _cable_kernel(cable)[0](cable, unstrained_length, np.asarray(anchor_point, dtype=float), guess,
-                                   max_strain, max_tension)
+    The solver is the exit's (module notes); ``guess``: a previous :attr:`CableEquilibrium.guess`.
+    Returns the :class:`CableEquilibrium` and ``d(force on platform)/d(anchor point)`` (d, d) [N/m];
+    UnreachableError if the span is beyond reach at the tension limit."""
+    solve = _CABLE_KERNELS[cable.space][cable.pulley is not None][0]
+    return solve(cable, unstrained_length, np.asarray(anchor_point, dtype=float), guess, max_strain,
+                 max_tension)
 
 
 def inverse_cable(cable, horizontal_tension, anchor_point, guess=None, max_strain=DEFAULT_MAX_STRAIN,
@@ -973,27 +785,22 @@ def inverse_cable(cable, horizontal_tension, anchor_point, guess=None, max_strai
     Returns ``(CableEquilibrium, dF_A/dH, dF_A/dp_A at fixed H)``: the derivatives (d,) and (d, d) of
     a planar cable; None for a spatial one (its inverse statics differentiates numerically).
     """
-    return _cable_kernel(cable)[1](cable, horizontal_tension, np.asarray(anchor_point, dtype=float), guess,
-                                   max_strain, max_tension)
+    solve = _CABLE_KERNELS[cable.space][cable.pulley is not None][1]
+    return solve(cable, horizontal_tension, np.asarray(anchor_point, dtype=float), guess, max_strain,
+                 max_tension)
 
 
+#: Each cable's solvers (forward, inverse), by its space and whether it wraps over its exit.
 _CABLE_KERNELS = {PLANE: {False: (_planar_forward_cable, _planar_inverse_cable),
                           True: (_planar_forward_cable, _planar_inverse_cable)},
                   SPACE: {False: (_vertical_plane_forward_cable, _vertical_plane_inverse_cable),
                           True: (_swivel_forward_cable, _swivel_inverse_cable)}}
 
 
-# ---------------------------------------------------------------------------
-# the platform: the one driver and its checks
-# ---------------------------------------------------------------------------
+# --- the platform: the one driver and its checks
 def checked_unstrained_lengths(platform, unstrained_lengths):
-    """The cables' unstrained lengths [m] as a float array, one per cable of ``platform``, each positive.
-
-    Raises
-    ------
-    SceneError
-        Naming ``unstrained_lengths``, if they are not numbers, not one per cable or not positive.
-    """
+    """The cables' unstrained lengths [m] as a float array, one positive length per cable of ``platform``;
+    else SceneError naming ``unstrained_lengths``."""
     lengths = real_array("unstrained_lengths", unstrained_lengths)
     if lengths.shape != (len(platform.cables),):
         raise SceneError(f"unstrained_lengths must have one entry per cable ({len(platform.cables)}), "
@@ -1021,13 +828,9 @@ def _wrench(platform, value):
 def _check_reach(platform, lengths, max_strain, max_tension):
     """Refuse cables that cannot all meet the platform: hang points farther apart than two cables and the
     anchors reach."""
-    reaches = []
-    for cable, length in zip(platform.cables, lengths):
-        limit = max_strain * cable.axial_stiffness
-        if max_tension is not None:
-            limit = min(limit, max_tension)
-        reaches.append(length * (1.0 + limit / cable.axial_stiffness))
-    exits, anchors = platform.hang_points, platform.anchors
+    reaches = [length * (1.0 + tension_limit(c.axial_stiffness, max_strain, max_tension) / c.axial_stiffness)
+               for c, length in zip(platform.cables, lengths)]
+    exits, anchors = np.array([c.hang_point for c in platform.cables]), platform.anchors
     for i in range(len(lengths)):
         for j in range(i):
             gap = float(np.linalg.norm(exits[i] - exits[j]))
@@ -1039,57 +842,30 @@ def _check_reach(platform, lengths, max_strain, max_tension):
                     f"{lengths[i]:g} m, at the tension limit) and anchors span")
 
 
-def straight_cable_pose(platform, unstrained_lengths, external_wrench=None):
-    """Equilibrium pose on straight, massless, elastic cables that may go slack (the forward statics' start).
-
-    Minimises the potential energy ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2`` with ``l_i``
-    the straight length from the anchor to the hang point (over a pulley: the wrapped arc plus the
-    tangent) and ``k_i = EA_i / L_i``. Unlike intersecting the circles of inextensible cables, this
-    always has a solution, also when some cables are too long to be taut.
-
-    Returns
-    -------
-    ndarray, shape (pose_size,)
-        Position [m] and rotation [rad] (0 for a point mass).
-    """
-    kernel = _checked_platform(platform)
-    lengths = checked_unstrained_lengths(platform, unstrained_lengths)
-    return kernel.straight_cable_pose(platform, lengths, _wrench(platform, external_wrench))
-
-
 def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wrench=None,
                   max_strain=DEFAULT_MAX_STRAIN, max_tension=None):
     """Equilibrium pose of the platform and every cable's forces, for given unstrained lengths.
 
-    Newton's method on the net generalised force (force, and the moment for a rigid platform:
-    planar about the centre of mass, spatial ``J_l^T M``), with the analytic stiffness assembled
-    from the cables' end stiffnesses and a line search on the energy (:func:`minimise_energy`);
-    every evaluation solves each cable's catenary, warm-started from the previous iterate.
+    Newton's method on the net generalised force (rigid: with the moment, planar about the centre of mass,
+    spatial ``J_l^T M``), the analytic stiffness from the cables' end stiffnesses and a line search on the
+    energy (:func:`minimise_energy`), from the pose on straight, massless, elastic cables that may go slack
+    (the minimum of ``M g z - wrench . pose + sum k_i max(l_i - L_i, 0)^2 / 2``, ``l_i`` the straight length
+    to the hang point and ``k_i = EA_i / L_i``, which always exists), or ``initial_pose`` (a position or a
+    pose [m, rad]); every evaluation solves each cable warm-started from the previous iterate.
 
     Parameters
     ----------
     platform : SuspendedPlatform
     unstrained_lengths : array_like, shape (n_cables,) [m]
-        Total unstrained length of each cable (over a pulley: from its hang point).
-    initial_pose : array_like, optional
-        Start: a position, or a pose (the rotation of a point mass is ignored) [m, rad]; default
-        :func:`straight_cable_pose`.
+        Over a pulley from its hang point.
     external_wrench : array_like, shape (wrench_size,) [N, N m], optional
-        Extra force and moment (about the centre of mass) on the platform, eg :func:`inertial_wrench`.
+        Extra force and moment about the centre of mass, eg :func:`inertial_wrench`.
     max_strain, max_tension : float, optional
-        Cable tension limits, as in :func:`cdpr_exu.physics.catenary.solve_forward`.
+        Cable tension limits (:func:`cdpr_exu.physics.catenary.tension_limit`).
 
-    Returns
-    -------
-    PlatformEquilibrium
-
-    Raises
-    ------
-    SceneError
-        Naming the argument, if an input is invalid (checked before any solve).
-    UnreachableError
-        If two cables cannot both reach the platform (checked before any solve), or if no
-        equilibrium is found within the tension limits.
+    Returns a :class:`PlatformEquilibrium`. Raises SceneError naming an invalid argument, UnreachableError if
+    two cables cannot both reach the platform (both before any solve) or no equilibrium is found within the
+    tension limits.
     """
     kernel = _checked_platform(platform)
     space = platform.space
@@ -1133,46 +909,25 @@ def solve_statics(platform, unstrained_lengths, initial_pose=None, external_wren
 
 def solve_inverse_statics(platform, pose, external_wrench=None, initial_guess=None, max_strain=DEFAULT_MAX_STRAIN,
                           max_tension=None):
-    """Unstrained lengths and cable forces that hold the platform at a pose, on elastic catenaries.
+    """Unstrained lengths and cable forces that hold the platform at ``pose`` [m, rad], on elastic catenaries.
 
-    The unknowns are the cables' horizontal tensions (each cable's unstrained length and forces follow
-    from its inverse catenary, :func:`inverse_cable`); the equations the platform's balance.
+    The unknowns are the cables' horizontal tensions (each cable's length and forces follow from its
+    inverse catenary, :func:`inverse_cable`); the equations the platform's balance under its weight and
+    ``external_wrench`` (wrench_size,) [N, N m] (eg :func:`inertial_wrench`).
 
-    * Planar: a square problem, solved by Newton's method from straight massless cables: a point
-      mass on 2 cables; a rigid platform on 2 cables at a position (the rotation is the one
-      equilibrium imposes: give ``pose`` as ``(x, z)``); on 3 cables at a pose ``(x, z, phi)``.
-    * Spatial: the tensions nearest ``initial_guess`` (least squares) that balance the force,
-      and the moment too for a rigid platform on at least six cables (with fewer, the rotation is
-      left free), by Gauss-Newton, each cable's force derivative by a forward difference.
-      Continuing from the previous sample's tensions along a trajectory keeps an
-      over-constrained robot's internal tension.
+    * Planar: a square Newton iteration from straight massless cables (weight continuation as the last
+      resort): a point mass on 2 cables; a rigid platform on 2 cables at a position ``(x, z)`` (the
+      rotation is equilibrium's) or on 3 at a pose ``(x, z, phi)``. Returns the stiffness too.
+    * Spatial ((3,) for a point mass, else (6,)): the tensions nearest ``initial_guess`` (required; least
+      squares) that balance the force, and the moment on at least six cables (with fewer the rotation is
+      left free), by Gauss-Newton with forward differences; continued along a trajectory, a redundant
+      robot keeps its internal tension.
 
-    Parameters
-    ----------
-    platform : SuspendedPlatform
-    pose : array_like [m, rad]
-        A position or a pose (see above; spatial: (3,) for a point mass, or (6,)).
-    external_wrench : array_like, shape (wrench_size,) [N, N m], optional
-        Extra load, eg :func:`inertial_wrench` for dynamic feed-forward.
-    initial_guess : PlatformEquilibrium or array_like (n_cables,) [N], optional
-        A nearby solution (eg the previous sample's), or positive horizontal tensions: they start
-        the iteration (planar, with the solution's rotation) and, spatial, are the tensions to stay
-        near (required there).
-    max_strain, max_tension : float, optional
-        Cable tension limits, as in :func:`cdpr_exu.physics.catenary.solve_forward` (planar).
+    ``initial_guess``: a nearby :class:`PlatformEquilibrium` or positive horizontal tensions (n_cables,)
+    [N], the start (planar, with its rotation). ``max_strain``, ``max_tension``: as in :func:`solve_statics`.
 
-    Returns
-    -------
-    PlatformEquilibrium
-        With the unstrained lengths and forces, the rotation, and (planar) the stiffness at fixed lengths.
-
-    Raises
-    ------
-    UnreachableError
-        If a cable would have to push (no equilibrium with positive tensions), a cable would be
-        vertical, a tension exceeds its limit, or the iteration fails.
-    SceneError
-        If an argument is invalid, or (planar) the problem is not square.
+    Raises UnreachableError if a cable would have to push or hang vertically, a tension exceeds its limit,
+    or the iteration fails; SceneError for an invalid argument or (planar) a problem that is not square.
     """
     kernel = _checked_platform(platform)
     wrench = _wrench(platform, external_wrench)
@@ -1186,9 +941,7 @@ def solve_inverse_statics(platform, pose, external_wrench=None, initial_guess=No
     return kernel.inverse(platform, pose, wrench, initial_guess, max_strain, max_tension)
 
 
-# ---------------------------------------------------------------------------
-# the pose kernels: what differs per dimension
-# ---------------------------------------------------------------------------
+# --- the pose kernels: what differs per dimension
 class _PlanarStatics:
     """The plane's pose kernel: ``(x, z, phi)``, planar cross products (the paper's statics, bit for bit)."""
 
@@ -1379,9 +1132,8 @@ class _SpatialStatics:
             gradient = force if dof == 3 else np.concatenate([force, left_jacobian(theta).T @ moment])
             return value / scale, gradient / scale
 
-        # Unknowns in metres (the rotation vector times the largest arm), so that a step turns the
-        # anchors as far as it moves them: with stiff cables (EA / L of 3e5 N/m, CoGiRo) unscaled
-        # steps spun the platform through several turns.
+        # Unknowns in metres (rotation vector times the largest arm): a step turns the anchors as far as it
+        # moves them (unscaled, CoGiRo's stiff cables, EA / L of 3e5 N/m, spun the platform several turns).
         arm = float(np.linalg.norm(platform.anchors, axis=1).max()) if dof == 6 else 1.0
         unit = np.array([1.0] * 3 + [max(arm, 1e-3)] * 3)[:dof]
 
@@ -1389,9 +1141,8 @@ class _SpatialStatics:
             value, gradient = energy(x / unit)
             return value, gradient / unit
 
-        # Start at the exits' centroid, unrotated: inside the frame, the cables slack or short of their
-        # lengths, so the weight and the taut cables pull the platform onto its equilibrium. (Starting a
-        # cable length below the exits stretched CoGiRo's stiff cables by metres.)
+        # Start at the exits' centroid, unrotated: the weight and the taut cables pull the platform onto its
+        # equilibrium (a cable length below the exits stretched CoGiRo's stiff cables by metres).
         start = np.zeros(dof)
         start[:3] = exits.mean(axis=0)
         solution = minimize(scaled_energy, start * unit, jac=True, method="BFGS",
@@ -1455,14 +1206,10 @@ _KERNELS = {PLANE: _PlanarStatics(), SPACE: _SpatialStatics()}
 
 
 def _straight_path(cable, exit_point, point):
-    """Length [m] of a straight, massless spatial cable from its exit to ``point`` (3,), and the unit
-    vector (3,) along its last straight part towards ``point`` (the length's gradient in ``point``).
-
-    Over a swivel pulley the path wraps the disc in the plane through the axis and ``point``
-    (:func:`cdpr_exu.core.geometry.swivel_pulley_exit`: arc plus free length); where that is
-    undefined (``point`` on the axis or inside the disc, only ever an iterate of the starting
-    guess) the straight distance from the inlet stands in.
-    """
+    """Length [m] of a straight, massless spatial cable from its exit to ``point`` (3,), and the unit vector
+    (3,) of its last straight part towards ``point`` (the length's gradient). Over a swivel pulley it wraps
+    the disc (:func:`cdpr_exu.core.geometry.swivel_pulley_exit`); where that is undefined (only ever an
+    iterate of the start) the straight distance from the inlet stands in."""
     span = point - exit_point
     distance = float(np.linalg.norm(span))
     if cable.pulley_radius > 0.0:
@@ -1476,13 +1223,9 @@ def _straight_path(cable, exit_point, point):
 
 
 def _straight_length_and_gradient(cable, point):
-    """Straight length of a planar cable from ``point`` to the hang point [m] and its gradient in ``point``.
-
-    With a pulley, the length is tangent plus wrapped arc; its gradient is the unit vector from the
-    tangent point to ``point`` (the wrap change cancels the tangent point's motion to first order).
-    Inside a pulley disc (no tangent) the distance to the centre plus half a turn stands in, to keep
-    the energy continuous-ish.
-    """
+    """Straight length [m] of a planar cable from ``point`` to the hang point and its gradient in ``point``:
+    over a pulley tangent plus wrap, the gradient the unit vector from the tangent point (the wrap's change
+    cancels the tangent point's motion); inside the disc the distance to the centre plus half a turn."""
     if cable.pulley is None:
         offset = point - np.array(cable.exit_point)
         length = float(np.hypot(*offset))
@@ -1506,9 +1249,7 @@ def _wrap_angle(angle):
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-# ---------------------------------------------------------------------------
-# the planar inverse: a square Newton iteration in the horizontal tensions
-# ---------------------------------------------------------------------------
+# --- the planar inverse: a square Newton iteration in the horizontal tensions
 def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
     """Horizontal tensions of straight massless cables balancing the load (start guess)."""
     points = _PlanarStatics.anchor_points(platform, position, rotation)
@@ -1535,13 +1276,9 @@ def _ideal_tensions(platform, position, rotation, wrench, free_rotation):
 
 
 def _straight_cable_rotations(platform, position, wrench):
-    """Rotations at which straight massless cables hold the platform with positive tensions.
-
-    Roots of the moment balance (after the force balance fixes the tensions) found by scanning
-    ``[-pi, pi)`` and refining with Brent's method; sorted by size. These start the inverse statics
-    of a rigid platform on two cables, whose equilibrium rotation can be large (near the workspace
-    edge the platform tilts by a radian).
-    """
+    """Rotations in ``[-pi, pi)`` at which straight massless cables hold the platform with positive tensions,
+    smallest first: roots of the moment balance, scanned and refined by Brent's method. They start the
+    inverse of a rigid platform on two cables, which tilts by up to a radian near the workspace edge."""
     def moment(phi):
         try:
             _, tensions, residual = _ideal_tensions(platform, position, phi, wrench, True)
@@ -1580,15 +1317,12 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
         free_rotation = rotation is None
         rotation = 0.0 if rotation is None else finite("rotation", rotation)
     if n + int(free_rotation) != dof:
-        raise SceneError(
-            f"inverse statics needs as many unknowns as equations: {n} cables"
-            f"{' + rotation' if free_rotation else ''} for {dof} equations; "
-            f"give a position (x, z) for a rigid platform on 2 cables, a pose (x, z, rotation) on 3"
-        )
+        raise SceneError(f"inverse statics needs as many unknowns as equations: {n} cables"
+                         f"{' + rotation' if free_rotation else ''} for {dof} equations; give a position "
+                         f"(x, z) for a rigid platform on 2 cables, a pose (x, z, rotation) on 3")
     horizontal, tensions, _ = _ideal_tensions(platform, position, rotation, wrench, free_rotation)
     if np.any(tensions <= 0.0):
-        # straight massless cables would push; start from a moderate pull and let
-        # Newton decide (it fails, with UnreachableError, if they really must push)
+        # straight massless cables would push: start from a moderate pull and let Newton decide
         weight = max(platform.mass * platform.gravity, 1e-9)
         horizontal = np.maximum(horizontal, 0.1 * weight)
     lengths_guess = [_straight_length_and_gradient(c, p)[0]
@@ -1617,9 +1351,8 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
             jacobian[2, i] = planar_cross(arm, force_dH)
             d_force_dphi = force_dp @ perpendicular(arm)
             jacobian[:2, n] += d_force_dphi
-            jacobian[2, n] += planar_cross(arm, d_force_dphi) + planar_cross(
-                perpendicular(arm), equilibrium.force_on_platform
-            )
+            jacobian[2, n] += (planar_cross(arm, d_force_dphi)
+                               + planar_cross(perpendicular(arm), equilibrium.force_on_platform))
         guesses[:] = [e.guess for e in equilibria]
         residual = kernel.wrench_residual(platform, phi, equilibria, wrench)[:dof]
         columns = list(range(n)) + ([n] if free_rotation else [])
@@ -1630,8 +1363,7 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
         residual, jacobian = evaluate(scaled / unknown_scale)
         return residual / residual_scale, jacobian / residual_scale[:, None] / unknown_scale[None, :]
 
-    # With a free rotation, a start where a cable hangs exactly vertical (H = 0
-    # cannot parametrise it) or far from the answer is retried at other rotations.
+    # With a free rotation, a start where a cable hangs vertically (H = 0) or far off is retried turned.
     guessed_rotation = None
     if initial_guess is not None:
         guessed = initial_guess
@@ -1670,9 +1402,8 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
                                                        wrench, max_strain, max_tension)
             except UnreachableError:
                 pass
-        raise UnreachableError(
-            f"no equilibrium with pulling cables at position ({position[0]:g}, {position[1]:g}) m ({error})"
-        ) from None
+        raise UnreachableError(f"no equilibrium with pulling cables at position ({position[0]:g}, "
+                               f"{position[1]:g}) m ({error})") from None
     evaluate(scaled / unknown_scale)
     equilibria, phi = cache["last"]
     # stiffness at fixed lengths: the forward cable derivatives at the solution
@@ -1680,11 +1411,8 @@ def _planar_inverse(platform, position, rotation, wrench, max_strain, max_tensio
     for cable, equilibrium in zip(platform.cables, equilibria):
         guess = None
         if cable.pulley is not None:
-            guess = (
-                equilibrium.catenary.horizontal_tension,
-                equilibrium.catenary.vertical_tension_b,
-                _rim_angle(cable.pulley, equilibrium.exit_point),
-            )
+            guess = (equilibrium.catenary.horizontal_tension, equilibrium.catenary.vertical_tension_b,
+                     _rim_angle(cable.pulley, equilibrium.exit_point))
         _, stiffness = forward_cable(cable, equilibrium.unstrained_length, equilibrium.anchor_point, guess,
                                      max_strain, max_tension)
         stiffnesses.append(stiffness)
@@ -1698,12 +1426,8 @@ _CONTINUATION_STEPS = (0.0, 0.1, 0.25, 0.45, 0.7, 1.0)
 
 
 def _inverse_by_weight_continuation(platform, position, rotation, wrench, max_strain, max_tension):
-    """Inverse statics by growing the cables' weight from zero, warm-starting each step.
-
-    The last resort when every direct start fails: massless cables are solved reliably from the
-    straight-cable guess, and each step's solution starts the next. Slow (a handful of solves), so
-    only used on failure.
-    """
+    """Inverse statics by growing the cables' weight from zero, each step warm-started from the last: the
+    last resort when every direct start fails (massless cables solve reliably from straight cables)."""
     previous = None
     for fraction in _CONTINUATION_STEPS:
         cables = tuple(SuspendedCable(c.weight_per_length * fraction, c.axial_stiffness, c.anchor, c.exit_point,

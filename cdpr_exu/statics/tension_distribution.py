@@ -1,11 +1,9 @@
 """Cable tensions within their bounds that hold a platform: one tension distribution, planar or spatial.
 
-Pure NumPy/SciPy; no Exudyn. :func:`tension_distribution` solves ``A f + w = 0`` with
-``t_min <= f <= t_max`` for any structure matrix ``A`` (planar 3 x m, spatial 6 x m, the
-force rows of a point mass) and wrench ``w``; :func:`tensions` does it for a scene along
-poses, against the platform's weight (:func:`weight_wrench`) and an external wrench, within
-the cables' ``min_tension`` / ``max_tension``. Units SI; the moment about the centre of mass.
-"""
+Pure NumPy/SciPy. :func:`tension_distribution` solves ``A f + w = 0``, ``t_min <= f <= t_max`` for any
+structure matrix (planar 3 x m, spatial 6 x m, a point mass's force rows) and wrench; :func:`tensions`
+does it for a scene along poses, against the platform's weight (:func:`weight_wrench`) and an external
+wrench, within the cables' ``min_tension`` / ``max_tension``. Units SI; moments about the centre of mass."""
 
 from __future__ import annotations
 
@@ -27,10 +25,8 @@ _BOUND_ROUNDING = 1e-9
 
 
 def _tension_limits(min_tension, max_tension, n_cables):
-    limits = []
-    for name, value in (("min_tension", min_tension), ("max_tension", max_tension)):
-        limits.append(per_item(name, value, n_cables))  # >= 0: cables cannot push
-    lower, upper = limits
+    lower = per_item("min_tension", min_tension, n_cables)
+    upper = per_item("max_tension", max_tension, n_cables)
     if np.any(lower > upper):
         raise SceneError(f"min_tension must not exceed max_tension, got min_tension {shown(min_tension)} "
                          f"and max_tension {shown(max_tension)} [N]")
@@ -48,71 +44,43 @@ def _outside(pose, wrench, lower, upper, reason):
 def tension_distribution(structure_matrix, wrench, min_tension, max_tension, pose=None):
     """Cable tensions within their bounds that balance a wrench: ``A f + w = 0``, closest to the mid tensions.
 
-    Solves the quadratic programme::
-
-        minimise ||f - f_mid||^2   subject to   A f = -w,   t_min <= f <= t_max,
-
-    ``f_mid = (t_min + t_max) / 2``, for any number of cables: redundant (m > n),
-    square, or too few (then only wrenches in the range of ``A`` are balanced).
+    Solves ``min ||f - f_mid||^2`` subject to ``A f = -w``, ``t_min <= f <= t_max``,
+    ``f_mid = (t_min + t_max) / 2``, for any number of cables (too few: only wrenches in the range of
+    ``A`` are balanced).
 
     Parameters
     ----------
     structure_matrix : array_like, shape (n, m)
-        ``A`` (:func:`cdpr_exu.statics.kinematics.structure_matrix`): n = 3 or 6 (planar or spatial), the
-        position size for a point mass.
+        ``A`` (:func:`cdpr_exu.statics.kinematics.structure_matrix`).
     wrench : array_like, shape (n,) [N, N m]
-        Everything but the cables acting on the platform (weight, external load,
-        inertia), about the platform's reference point.
+        Everything but the cables acting on the platform (weight, external load, inertia).
     min_tension, max_tension : float or array_like, shape (m,) [N]
-        Tension bounds, ``0 <= t_min <= t_max``.
+        ``0 <= t_min <= t_max``.
     pose : array_like, optional
         Only named in the error message.
 
-    Returns
-    -------
-    ndarray, shape (m,) [N]
-
-    Raises
-    ------
-    SceneError
-        Naming the argument: wrong shapes, non-finite values, negative bounds,
-        ``min_tension > max_tension``.
-    UnreachableError
-        "outside the wrench-feasible workspace", naming the pose, if no tensions
-        within the bounds balance the wrench.
+    Returns the tensions (m,) [N]. Raises SceneError naming the argument (wrong shapes, non-finite values,
+    negative bounds, ``min_tension > max_tension``), UnreachableError "outside the wrench-feasible
+    workspace", naming the pose, if no tensions within the bounds balance the wrench.
 
     Notes
     -----
-    **Why this QP and not the improved closed-form method** (Pott, Springer 2018).
-    The closed-form method takes ``f = f_mid - A^+ (w + A f_mid)``; that is exactly
-    this QP's minimiser whenever no bound is active, so the two agree inside the
-    workspace. When a bound is active, the improved closed-form method fixes the
-    violating cable at its limit and repeats with the others: a greedy reduction,
-    not guaranteed to find a distribution whenever one exists. The QP is: it has a
-    unique solution (strictly convex objective) and reports infeasibility only for an
-    empty feasible set, so "outside the wrench-feasible workspace" means what it
-    says; its solution is the same for symmetric poses of a symmetric robot. The cost
-    (a few NNLS iterations on a (m - n + 1) x 2m matrix) is no concern here.
+    **Why this QP, not the improved closed-form method** (Pott, Springer 2018). Both give
+    ``f = f_mid - A^+ (w + A f_mid)`` while no bound is active; when one is, the closed-form method fixes
+    the violating cable at its limit and repeats, a greedy reduction not guaranteed to find a distribution
+    that exists. The strictly convex QP has a unique solution and is infeasible only for an empty feasible
+    set, so "outside the wrench-feasible workspace" means what it says.
 
-    **How it is solved, exactly and without tolerances to tune.** With the SVD of
-    ``A``, ``f = f_p + N lambda``: ``f_p = f_mid + A^+ (-w - A f_mid)`` the point of
-    the equality set closest to ``f_mid`` and ``N`` an orthonormal basis of the null
-    space of ``A``. Since ``f_p - f_mid`` is orthogonal to ``N``, the QP becomes the
-    least-distance programme ``min ||lambda|| s.t. G lambda >= h`` (the bounds), and
-    ``A f = -w`` holds to round-off whatever ``lambda``. Lawson and Hanson's LDP
-    algorithm (Solving Least Squares Problems, 1974, ch. 23) solves it with one
-    non-negative least-squares problem (``scipy.optimize.nnls``, an active-set method
-    with finite termination): ``min ||E u - e_last||, u >= 0``, ``E = [G^T; h^T]``.
-    A zero residual ``r`` certifies infeasibility; otherwise
-    ``lambda = -r[:-1] / r[-1]`` and ``-r[-1] = ||r||^2 = 1 / (1 + ||lambda||^2)``.
-    With tensions scaled by the largest tension range, a feasible ``lambda`` has
-    ``||lambda|| <= sqrt(m) / 2`` (``||f - f_mid||^2 = ||f_p - f_mid||^2 + ||lambda||^2``
-    and every feasible ``f`` is within ``sqrt(m) / 2`` ranges of ``f_mid``), so a
-    feasible problem has ``-r[-1] >= 1 / (1 + m / 4)`` (1/3 for 8 cables). The pose is
-    refused when ``-r[-1]`` is below half of that (or NNLS reports a residual below
-    1e-6); an accepted solution is then checked against the bounds (to 1e-9 of the
-    tension range, then clipped onto them), so a rounding error can only refuse, never
-    return tensions outside the bounds.
+    **How, exactly and without tolerances to tune.** With the SVD of ``A``, ``f = f_p + N lambda``: ``f_p =
+    f_mid + A^+ (-w - A f_mid)`` is the point of the equality set closest to ``f_mid``, ``N`` an orthonormal
+    null-space basis, so the QP becomes the least-distance programme ``min ||lambda|| s.t. G lambda >= h``
+    (the bounds), ``A f = -w`` holding to round-off. Lawson and Hanson's LDP algorithm (Solving Least Squares
+    Problems, 1974, ch. 23) solves it with one NNLS (``min ||E u - e_last||, u >= 0``, ``E = [G^T; h^T]``): a
+    zero residual ``r`` certifies infeasibility, else ``lambda = -r[:-1] / r[-1]`` and ``-r[-1] = 1 / (1 +
+    ||lambda||^2)``. With tensions in units of the largest range a feasible ``lambda`` has ``||lambda|| <=
+    sqrt(m) / 2``, so ``-r[-1] >= 1 / (1 + m / 4)``; the pose is refused below half of that (or an NNLS
+    residual below 1e-6), and a solution is checked against the bounds (to 1e-9 of the range, then clipped):
+    rounding can only refuse, never return tensions outside the bounds.
     """
     matrix = finite_array("structure_matrix", structure_matrix)
     if matrix.ndim != 2 or matrix.shape[1] < 1:
@@ -161,9 +129,8 @@ def tension_distribution(structure_matrix, wrench, min_tension, max_tension, pos
 
 
 def weight_wrench(scene) -> np.ndarray:
-    """The wrench of the platform's weight about its centre of mass: the force ``-M g`` along the vertical,
-    no moment, shape (n,) [N, N m] as the scene's :func:`~cdpr_exu.statics.kinematics.structure_matrix`
-    (gravity 0 where the scene switches it off)."""
+    """The platform's weight as a wrench about its centre of mass, shape (n,) [N, N m] as the scene's
+    structure matrix (gravity 0 where the scene switches it off)."""
     space = scene.space
     wrench = np.zeros(space.position_size if scene.platform.is_point_mass else space.wrench_size)
     wrench[space.vertical] = -scene.platform.mass * (scene.gravity if scene.effects.gravity else 0.0)
@@ -171,26 +138,12 @@ def weight_wrench(scene) -> np.ndarray:
 
 
 def tensions(scene, poses, external_wrench=None) -> np.ndarray:
-    """Cable tensions within the cables' limits that hold the platform at pose(s) against its weight.
+    """Cable tensions (m,) or (N, m) [N] within the cables' limits (0 and inf where not given) that hold the
+    platform at ``poses`` (pose_size,) or (N, pose_size) [m, rad] against its weight and ``external_wrench``
+    (n,) [N, N m] (world frame, about the centre of mass).
 
-    Parameters
-    ----------
-    scene : cdpr_exu.scenes.scene.Scene
-        Its cables' ``min_tension`` / ``max_tension`` bound the tensions (0 and inf where not given).
-    poses : array_like, shape (pose_size,) or (N, pose_size) [m, rad]
-    external_wrench : array_like, shape (n,) [N, N m], optional
-        Extra force and moment about the centre of mass, world frame (n as :func:`weight_wrench`).
-
-    Returns
-    -------
-    ndarray, shape (m,) or (N, m) [N]
-
-    Raises
-    ------
-    UnreachableError
-        "outside the wrench-feasible workspace", naming the pose (and ``poses[k]``, the first such one
-        of several), or an anchor the cables cannot reach.
-    """
+    Raises UnreachableError "outside the wrench-feasible workspace", naming the pose (and ``poses[k]``, the
+    first such one), or for an anchor the cables cannot reach."""
     poses = finite_array("poses", poses, (scene.space.pose_size,))
     wrench = weight_wrench(scene)
     if external_wrench is not None:
