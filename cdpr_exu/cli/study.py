@@ -1,16 +1,6 @@
 """``cdpr study``: parameter sweeps (:mod:`cdpr_exu.studies.study`) and the accuracy study
-(:mod:`cdpr_exu.studies.accuracy`).
-
-Examples::
-
-    cdpr study sweep paper-circle --param cables.n_elements=10,15 --param platform.mass=1,2.5 --out results/study
-    cdpr study accuracy paper-circle --out /tmp/quick --quick
-
-Adding a ``cdpr study`` sub-command::
-
-    def add_commands(subparsers):
-        accuracy = study_subparsers(subparsers).add_parser("accuracy", ...)
-        accuracy.set_defaults(func=...)
+(:mod:`cdpr_exu.studies.accuracy`); another module adds a ``cdpr study`` sub-command with
+``study_subparsers(subparsers).add_parser(name, ...)``.
 """
 
 from __future__ import annotations
@@ -50,11 +40,7 @@ for a 2-parameter grid) into --out. Failed and refused runs are recorded as rows
 
 
 def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubParsersAction:
-    """The sub-parsers of ``cdpr study`` (made on first call; the same object after).
-
-    Other modules add ``cdpr study <name>`` commands with
-    ``study_subparsers(subparsers).add_parser(name, ...)`` in their ``add_commands``.
-    """
+    """The sub-parsers of ``cdpr study`` (made on first call; the same object after)."""
     existing = getattr(subparsers, "_cdpr_study_subparsers", None)
     if existing is not None:
         return existing

@@ -1,11 +1,4 @@
-"""``cdpr view`` and ``cdpr animate``: replay a run folder (:mod:`cdpr_exu.post.viewer`).
-
-Examples::
-
-    cdpr view results/paper_circle
-    cdpr animate results/paper_circle --out results/paper_circle/animation.gif
-    cdpr animate results/paper_circle --out circle.mp4 --fps 30 --size 960x720
-"""
+"""``cdpr view`` and ``cdpr animate``: replay a run folder (:mod:`cdpr_exu.post.viewer`)."""
 
 from __future__ import annotations
 

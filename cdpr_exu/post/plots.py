@@ -51,9 +51,6 @@ _PLATFORM_COLOR = "0.25"
 _PULLEY_COLOR = "0.55"
 
 
-# --------------------------------------------------------------------------- helpers
-
-
 def new_figure(width: float, height: float, left: float = 0.85, right: float = 0.2, bottom: float = 0.6,
                top: float = 0.4, wspace: float = 0.0, hspace: float = 0.0, columns: int = 1,
                lines: int = 1) -> Figure:
@@ -276,9 +273,6 @@ def _time_axis(ax, scene: Scene | None, result: Result) -> None:
     ax.grid(True, linewidth=0.4, alpha=0.6)
 
 
-# --------------------------------------------------------------------------- axes
-
-
 def _snapshot_axes(ax, scene: Scene, result: Result, rows: np.ndarray, t: float, limits) -> None:
     """One panel of Fig. 6: the robot at time ``t`` with the reference and the path so far."""
     _draw_pulleys(ax, scene)
@@ -378,9 +372,6 @@ def _errors_axes(ax, scene: Scene | None, result: Result) -> None:
     ax.set_title("Position error of the platform centre", fontsize=10)
     _legend(ax, fontsize=8, loc="best")
     _mark_end(ax, result)
-
-
-# --------------------------------------------------------------------------- figures
 
 
 def plot_snapshots(scene: Scene, result: Result, path: str | Path,
@@ -569,9 +560,6 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     _legend(ax, fontsize=8, loc="best")
     paths.append(save_figure(figure, folder / "comparison_errors.png"))
     return paths
-
-
-# --------------------------------------------------------------------------- rest states and spatial runs
 
 
 def plot_rest(rest: Rest, path: str | Path) -> Path:

@@ -78,9 +78,6 @@ class NoDisplayError(CdprError, RuntimeError):
     """No window can be opened here (no display, or Exudyn's windows are switched off)."""
 
 
-# --------------------------------------------------------------------------- loading
-
-
 @dataclass
 class Replay:
     """A run folder loaded for replay: its scene, the model rebuilt from it (a planar one decorated) and
@@ -181,9 +178,6 @@ def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
         VIEWS[scene.space].decorate(replay)
     check_solution_fits(replay.model, solution, f"solution file {str(solution_file)!r}")
     return replay
-
-
-# --------------------------------------------------------------------------- drawing
 
 
 def reference_path(scene: Scene, times: np.ndarray) -> np.ndarray:
@@ -334,9 +328,6 @@ class View:
     style: object
 
 
-# --------------------------------------------------------------------------- camera
-
-
 @dataclass(frozen=True)
 class Camera:
     """An orthographic view of the x-z plane (Exudyn x-y) as the raytracer draws it: the world point
@@ -401,9 +392,6 @@ def _view_points(replay: Replay) -> np.ndarray:
     parts += [platform + [dx * half_diagonal, dz * half_diagonal] for dx, dz in ((-1, -1), (1, 1))]
     parts.append(reference_path(scene, replay.times))
     return np.concatenate(parts)
-
-
-# --------------------------------------------------------------------------- viewer
 
 
 #: How each space's replay is drawn: planar runs decorated and fitted to the x-z plane, spatial runs in
@@ -471,9 +459,6 @@ def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
     SolutionViewer(mbs, replay.solution, rowIncrement=min(int(every), replay.n_rows),
                    timeout=1.0 / DEFAULT_FPS, runOnStart=True, runMode=0,
                    title=f"cdpr view: {replay.scene.name} ({replay.run_dir})")
-
-
-# --------------------------------------------------------------------------- animation
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -689,41 +674,16 @@ FRAME_SOURCES = {PLANE: _RaytracedFrames, SPACE: _AxesFrames}
 def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
                      every: int | None = None, size: tuple[int, int] = DEFAULT_SIZE,
                      frames_dir: str | Path | None = None, progress: bool = False) -> tuple[Path, int, float]:
-    """Render a run folder to a GIF or MP4 without a display; every option is checked before any work.
+    """Render a run folder to ``out_file`` (``.gif``, or ``.mp4`` with imageio-ffmpeg; default
+    ``run_dir/animation.gif``) without a display; returns the file, its number of frames and the seconds
+    per frame. A planar run's rows are drawn in the rebuilt model by Exudyn's raytracer, with a caption
+    and the platform's travelled path; a spatial run's samples with matplotlib's 3-D axes.
 
-    A planar run: each chosen row of the solution file is drawn in the rebuilt model by Exudyn's
-    raytracer, with a caption (scene, time) and the platform's travelled path beside the reference.
-    A spatial run: each chosen sample of ``result.npz`` is drawn with matplotlib's 3-D axes
-    (:data:`FRAME_SOURCES`).
-
-    Parameters
-    ----------
-    run_dir : path
-        Folder written by ``cdpr run SCENE --out DIR``.
-    out_file : path, optional
-        ``.gif`` or ``.mp4`` (needs imageio-ffmpeg); default ``run_dir/animation.gif``.
-    fps : float [1/s]
-        Frame rate (a GIF stores frame times in steps of 10 ms: at most 100).
-    every : int, optional
-        Row step; default: real-time playback at ``fps``.
-    size : (width, height) [pixels]
-    frames_dir : path, optional
-        Also write each frame there as ``frame_00000.png``, ... (its older frames removed).
-    progress : bool
-        A progress bar (on a terminal).
-
-    Returns
-    -------
-    (Path, int, float)
-        The animation file, its number of frames and the seconds per frame.
-
-    Raises
-    ------
-    RunFolderError, SolutionMismatchError
-        Missing or unfitting files.
-    CdprError
-        A bad option (named as the command line spells it), an unknown file type, MP4 without
-        imageio-ffmpeg.
+    ``fps`` [1/s] (a GIF stores frame times in steps of 10 ms: at most 100), ``every`` the row step
+    (default: real-time playback), ``size`` (width, height) [pixels], ``frames_dir`` also gets each frame
+    as ``frame_00000.png``, ... (its older frames removed). Every option is checked before any work:
+    CdprError names a bad one as the command line spells it; RunFolderError, SolutionMismatchError for
+    missing or unfitting files.
     """
     from tqdm import tqdm
 

@@ -125,9 +125,6 @@ DEFINITIONS = {
 }
 
 
-# --------------------------------------------------------------------------- result
-
-
 @dataclass(frozen=True, eq=False)
 class Rest:
     """A scene at rest, in its space (d = 2: (x, z) in the paper's plane; d = 3), m cables. Units SI.
@@ -273,9 +270,6 @@ def rest_above_exits(scene: Scene, position, rotation, lowest_tension: float, ca
             + bending_text(scene, catenary, "what holds it up")
             + f", and its lowest element force is {lowest_tension:.3g} N. Give the cables a smaller "
             "youngs_modulus or radius (a wire rope bends far more easily than a solid rod of its modulus)")
-
-
-# --------------------------------------------------------------------------- in the plane: dynamic relaxation
 
 
 def _relax(scene: Scene, *, tolerance: float = DEFAULT_TOLERANCE, max_time: float = DEFAULT_MAX_TIME,
@@ -474,9 +468,6 @@ def _check_run(model: Model, scene: Scene) -> float:
     return speed
 
 
-# --------------------------------------------------------------------------- the state
-
-
 def _coordinates(model: Model, key: str) -> np.ndarray:
     """The current absolute coordinates (reference + displacement) of ``key``'s ODE2 indices."""
     data = model.mbs.systemData
@@ -618,9 +609,6 @@ def _planar_lines(rest: Rest) -> list[str]:
     return lines + [f"  note: {note}" for note in rest.notes]
 
 
-# --------------------------------------------------------------------------- in space: Exudyn's static solve
-
-
 def _solve_from_catenaries(scene: Scene, **relaxation) -> Rest:
     """Bring a spatial ``scene`` to rest: catenary statics, then Exudyn's static solve of the lumped robot
     (see the module notes); the planar relaxation's options (``relaxation``) do not apply."""
@@ -718,9 +706,6 @@ def _spatial_lines(rest: Rest) -> list[str]:
             lines.append(f"  swivel pulley {i + 1}: psi = {np.degrees(psi):.4f} deg (anchor azimuth {azimuth:.4f} "
                          f"deg), wrap {np.degrees(cable.wrap_angle):.2f} deg")
     return lines
-
-
-# --------------------------------------------------------------------------- the one choice of the method
 
 
 @dataclass(frozen=True)
