@@ -26,7 +26,7 @@ def print_controller_row(name: str, summary: dict) -> None:
 
 
 def print_progress(line: str) -> None:
-    """Print a line of the learning controllers' progress at once (the trials take a while)."""
+    """Print a line of the learning controllers' progress at once."""
     print(line, flush=True)
 
 

@@ -99,8 +99,7 @@ def _print_summary(summary: dict, settled: dict, space: Space, out: Path | None)
         print(f"  written to {out}/")
 
 
-#: Rows of the printed summary a space leaves out (a planar summary has no rotation error; a spatial run
-#: no pulley rim to penetrate).
+#: Rows of the printed summary a space leaves out.
 NOT_PRINTED = {PLANE: ("max / RMS position error", "max rotation error"), SPACE: ("max pulley penetration",)}
 
 def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: bool = True,

@@ -54,8 +54,7 @@ _PULLEY_COLOR = "0.55"
 def new_figure(width: float, height: float, left: float = 0.85, right: float = 0.2, bottom: float = 0.6,
                top: float = 0.4, wspace: float = 0.0, hspace: float = 0.0, columns: int = 1,
                lines: int = 1) -> Figure:
-    """A figure with an Agg canvas and fixed margins around a grid of ``lines`` x ``columns`` axes, all
-    sizes in inches (fixed margins instead of a layout engine halve the drawing time)."""
+    """A figure with an Agg canvas and fixed margins [inches] (half the drawing time of a layout engine)."""
     figure = Figure(figsize=(width, height))
     FigureCanvasAgg(figure)
     axes_width = (width - left - right - wspace * (columns - 1)) / columns
@@ -92,8 +91,7 @@ def _last_time(result: Result) -> float | None:
 
 
 def _reference_path(scene: Scene | None, result: Result | None) -> np.ndarray:
-    """The reference path (x, z) of the platform centre, shape (K, 2) [m]: the scene's over its whole end
-    time (a partial run still shows where it was meant to go), else the result's."""
+    """The reference path (x, z) (K, 2) [m]: the scene's over its whole end time, else the result's."""
     if scene is not None and scene.trajectory is not None:
         end = float(scene.solver.end_time)
         if result is not None and len(result.time) and np.isfinite(result.time).any():
@@ -150,9 +148,8 @@ def _draw_pulleys(ax, scene: Scene) -> None:
 
 
 def _free_span_sag(scene: Scene, i: int, nodes: np.ndarray):
-    """``(start, end, sag)`` [m] of cable ``i``'s free span: its chord from the exit's tangent point to
-    the anchor (the last node) and the largest distance below it of a free node (off the pulley, between
-    the chord's ends); None where no chord forms (anchor inside the pulley, non-finite nodes)."""
+    """``(start, end, sag)`` [m]: cable ``i``'s chord from the exit's tangent point to the anchor and the
+    largest distance below it of a free node; None where no chord forms."""
     if not np.all(np.isfinite(nodes)):
         return None
     anchor = nodes[-1]
@@ -377,8 +374,7 @@ def _errors_axes(ax, scene: Scene | None, result: Result) -> None:
 def plot_snapshots(scene: Scene, result: Result, path: str | Path,
                    times: Iterable[float] = (0, 2, 4, 6, 8, 10)) -> Path:
     """The robot at the instants ``times`` [s] (the nearest samples) in the x-z plane (paper Fig. 6), one
-    panel each with shared limits: pulleys, cables' nodes (square: winch end), platform, the reference
-    (dashed) and the path so far (solid); an instant after a failed run's end says so."""
+    panel each, with the reference (dashed) and the path so far (solid)."""
     times = [float(t) for t in times]
     rows = _valid_rows(result)
     limits = _robot_limits(scene, result, rows)
@@ -430,20 +426,17 @@ def plot_path(scene: Scene, result: Result, path: str | Path) -> Path:
 
 
 def plot_rotation(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
-    """Platform rotation [deg] over time, counter-clockwise positive (Fig. 7b); over the ``scene``'s end
-    time if given."""
+    """Platform rotation [deg] over time (Fig. 7b); over the ``scene``'s end time if given."""
     return _one_panel(_rotation_axes, path, scene, result, 6.0, 3.8)
 
 
 def plot_errors(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
-    """x and z error of the platform centre [cm] over time (Fig. 7c); over the ``scene``'s end time if
-    given."""
+    """x and z error of the platform centre [cm] over time (Fig. 7c)."""
     return _one_panel(_errors_axes, path, scene, result, 6.0, 3.8)
 
 
 def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
-    """Cable tensions over time [N], one panel per cable: the elements at the platform end and at the
-    winch end, and the range over all elements (shaded; negative: compression)."""
+    """Cable tensions [N] over time, one panel per cable: platform end, winch end, all elements' range."""
     m = len(result.tensions)
     lines = max(1, m)
     figure = new_figure(6.5, 0.95 + 2.3 * lines + 0.4 * (lines - 1), top=0.35, hspace=0.4, lines=lines)
@@ -476,16 +469,13 @@ def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
 
 def plot_overview(scene: Scene, result: Result, folder: str | Path, times: Iterable[float] | None = None,
                   after: float = 1.0) -> list[Path]:
-    """The figures of one run, planar or spatial, into ``folder``: the figure functions of the result's
-    space (:data:`OVERVIEWS`): :func:`plot_planar_overview` or :func:`plot_spatial_run` (``overview.png``,
-    its errors marked from ``after`` [s] on). Returns the files written."""
+    """The figures of one run into ``folder``, its space's (:data:`OVERVIEWS`); returns the files written."""
     return OVERVIEWS[result.space](scene, result, Path(folder), times, after)
 
 
 def plot_planar_overview(scene: Scene, result: Result, folder: str | Path,
                          times: Iterable[float] | None = None, after: float = 1.0) -> list[Path]:  # noqa: ARG001
-    """All figures of one planar run into ``folder`` (:data:`OVERVIEW_FILES`, in that order, the last a
-    2x2 overview); snapshots at ``times`` [s], by default six spread over the scene's end time."""
+    """All figures of one planar run into ``folder`` (:data:`OVERVIEW_FILES`); snapshots at ``times`` [s]."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     if times is None:
@@ -515,9 +505,8 @@ def plot_planar_overview(scene: Scene, result: Result, folder: str | Path,
 
 
 def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | Path) -> list[Path]:
-    """Compare runs of one scene by label (legend order), one colour each: ``comparison_paths.png``
-    (the platform centre's paths against the scene's reference) and ``comparison_errors.png`` (position
-    error norm [cm] over time)."""
+    """Compare runs of one scene by label, one colour each: ``comparison_paths.png`` (the paths against the
+    reference) and ``comparison_errors.png`` (position error norm [cm] over time)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     colors = [f"C{j % 10}" for j in range(len(results))]
@@ -650,8 +639,7 @@ def _spatial_rest(rest: Rest, path: str | Path) -> Path:
 
 
 def plot_spatial_run(result: Result, path: str | Path, after: float = 1.0) -> Path:
-    """Overview figure: the path from above and from the side, against the reference; the position
-    error over time; the lowest element tension of each cable over time."""
+    """A spatial run's overview: its path from above and from the side, position error and lowest tensions."""
     figure = Figure(figsize=(11.0, 8.0))
     FigureCanvasAgg(figure)
     axes = figure.subplots(2, 2)
@@ -669,17 +657,15 @@ def plot_spatial_run(result: Result, path: str | Path, after: float = 1.0) -> Pa
     for k, name in enumerate("xyz"):
         error.plot(result.time, 1000.0 * result.position_error[:, k], label=f"error {name}")
     error.axvline(after, color="0.6", linewidth=0.8, linestyle=":")
-    error.set_xlabel("t [s]")
-    error.set_ylabel("actual - reference [mm]")
-    error.grid(True, linewidth=0.3)
-    error.legend(fontsize=8)
     for i, series in enumerate(result.tensions):
         tension.plot(result.time, series.min(axis=1), label=f"cable {i + 1}")
     tension.axhline(0.0, color="k", linewidth=0.8)
-    tension.set_xlabel("t [s]")
-    tension.set_ylabel("lowest element tension [N]")
-    tension.grid(True, linewidth=0.3)
-    tension.legend(fontsize=7, ncol=2)
+    for ax, label, legend in ((error, "actual - reference [mm]", {"fontsize": 8}),
+                              (tension, "lowest element tension [N]", {"fontsize": 7, "ncol": 2})):
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel(label)
+        ax.grid(True, linewidth=0.3)
+        ax.legend(**legend)
     summary = result.summary(after)
     worst = summary["max_position_error_m"]
     figure.suptitle(f"{result.scene_name} under {result.controller}: max position error after {after:g} s "

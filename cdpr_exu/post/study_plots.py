@@ -128,9 +128,8 @@ def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], 
 
 
 def plot_robustness(rows: Sequence[Mapping[str, Any]], out: str | Path) -> dict[str, Path]:
-    """``robustness_<controller>.png`` by name: a heat map per controller of a robustness study over its
-    platform mass and cable density errors (at the nominal stiffness and exits), the max position error
-    and its ratio to ideal IK's."""
+    """``robustness_<controller>.png`` by name: a robustness study's max position error (and its ratio to
+    ideal IK's) over the platform mass and cable density errors, at the nominal stiffness and exits."""
     axes = [SimpleNamespace(path=name, values=tuple(sorted({row[name] for row in rows})))  # as a study's Variation
             for name in ("platform_mass", "cable_density")]
     quantities = (("max_position_error_m", 1000.0, "max position error [mm]"),
@@ -152,9 +151,8 @@ _STEP_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 
 
 def plot_pareto(study, path: str | Path) -> Path:
-    """Error against CPU time of an AccuracyStudy, log-log, the platform position error (with the
-    tolerances) and the platform-end tensions' RMS error: one marker per run (colour: model, shape: step
-    size), the Pareto front drawn."""
+    """An AccuracyStudy's position and tension errors against CPU time, log-log: a marker per run (colour:
+    model, shape: step size), the Pareto front drawn."""
     rows = study.rows
     models = list(dict.fromkeys(r["model"] for r in rows))
     spare = [m for m in models if m not in _MODEL_COLORS]

@@ -44,7 +44,7 @@ SOLUTION_FILE = "solution.sol"
 DEFAULT_SIZE = (640, 480)
 #: Default frame rate of ``cdpr animate`` [frames per second].
 DEFAULT_FPS = 25.0
-#: Highest frame rate a GIF can store: its frame times are whole hundredths of a second [frames per second].
+#: Highest frame rate a GIF can store (frame times in hundredths of a second) [frames per second].
 MAX_GIF_FPS = 100.0
 #: Share of the scene's extent left free around it in an animation frame.
 FRAME_MARGIN = 0.06
@@ -80,9 +80,8 @@ class NoDisplayError(CdprError, RuntimeError):
 
 @dataclass
 class Replay:
-    """A run folder loaded for replay: its scene, the model rebuilt from it (a planar one decorated) and
-    the solution (:func:`exudyn.utilities.LoadSolutionFile`'s dict; ``solution["data"]``: one row per
-    output time, time first)."""
+    """A run folder loaded for replay: its scene, the model rebuilt from it and the solution
+    (:func:`exudyn.utilities.LoadSolutionFile`'s dict; ``solution["data"]``: a row per output, time first)."""
 
     run_dir: Path
     scene: Scene
@@ -149,8 +148,7 @@ def load_solution(path: str | Path) -> dict:
 
 
 def check_solution_fits(model, solution: dict, source: str) -> None:
-    """SolutionMismatchError if the solution's exported sizes (ODE2 coordinates, velocities and
-    accelerations, ODE1, algebraic and data coordinates) differ from ``model``'s system."""
+    """SolutionMismatchError if the solution's exported coordinate sizes differ from ``model``'s system."""
     data = model.mbs.systemData
     n_ode2, n_vel2, n_acc2, n_ode1, n_vel1, n_algebraic, n_data = (int(n) for n in solution["columnsExported"])
     expected = {"ODE2 coordinates": (n_ode2, data.ODE2Size()), "ODE1 coordinates": (n_ode1, data.ODE1Size()),
@@ -214,10 +212,9 @@ def scene_extent(scene: Scene) -> float:
 
 
 def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
-    """Add drawing-only items to an assembled planar model, assemble it again and return the new ground
-    object's index: the pulleys, the reference path ``reference_xz`` (N, 2) [m] (a polyline, or a circle
-    for a fixed reference), the platform's rectangle and anchors, cables as plain lines, no constraint
-    or contact symbols. No node and no coordinate is added."""
+    """Add drawing-only items (no node, no coordinate) to an assembled planar model and assemble it again;
+    returns the new ground object's index: pulleys, the reference path ``reference_xz`` (N, 2) [m], the
+    platform's rectangle and anchors, cables as lines, no constraint or contact symbols."""
     scene, mbs = model.scene, model.mbs
     extent = scene_extent(scene)
     items = []
@@ -261,8 +258,7 @@ def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
 
 
 def _style_settings(settings, extent: float) -> None:
-    """Visualization settings of every replay: no loads or markers, cable elements as lines, nodes as
-    small spheres for a scene ``extent`` [m] across, the view kept where set."""
+    """Visualization settings of every replay, for a scene ``extent`` [m] across."""
     settings.loads.show = False
     settings.markers.show = False
     settings.connectors.springNumberOfWindings = 1
@@ -292,8 +288,7 @@ def _spatial_poses(replay: Replay) -> np.ndarray:
 
 
 def _style_spatial(replay: Replay, size: tuple[int, int] = (1024, 768)) -> None:
-    """A spatial replay's settings and a view from the side (z up, turned 27 degrees about it) onto the
-    middle of the exits and the platform's path."""
+    """A spatial replay's settings and a side view onto the exits and the platform's path."""
     settings = replay.model.system_container.visualizationSettings
     points = np.vstack([replay.scene.exit_points, _spatial_poses(replay)[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
@@ -330,9 +325,8 @@ class View:
 
 @dataclass(frozen=True)
 class Camera:
-    """An orthographic view of the x-z plane (Exudyn x-y) as the raytracer draws it: the world point
-    ``center`` (x, z) [m] at the image centre, ``zoom`` [m] half the visible height (Exudyn's), ``size``
-    (width, height) [pixels]."""
+    """An orthographic view of the x-z plane (Exudyn x-y): ``center`` (x, z) [m] at the image centre,
+    ``zoom`` [m] half the visible height (Exudyn's), ``size`` (width, height) [pixels]."""
 
     center: tuple[float, float]
     zoom: float
@@ -401,8 +395,7 @@ VIEWS = {PLANE: View(lambda replay: replay.positions()["platform"], _decorate_pl
 
 
 def display_problem() -> str | None:
-    """Why no window can be opened here, or None if one can: Exudyn's own switch, a display on X11 or
-    Wayland systems, tkinter (the viewer's dialog), and on X11 a display that accepts a connection."""
+    """Why no window can be opened here (Exudyn's switch, no display, no tkinter), or None if one can."""
     if getattr(exu.special.userInterface, "suppressSolutionViewer", False):
         return ("Exudyn's windows are switched off in this process (the environment variable "
                 "EXUDYN_SUPPRESS_UI_WINDOW_OPEN is set, or exudyn.special.userInterface.suppressSolutionViewer)")
@@ -614,9 +607,7 @@ class _RaytracedFrames:
 
 
 class _AxesFrames:
-    """The frames of a spatial run: the samples of its ``result.npz`` (cables' nodes, pose, reference)
-    drawn with matplotlib's 3-D axes, each a PIL RGB image of ``size`` pixels; ``name`` is the scene's
-    (from summary.json) or the folder's."""
+    """The frames of a spatial run: the samples of its ``result.npz`` drawn with matplotlib's 3-D axes."""
 
     @staticmethod
     def check(run_dir: Path) -> None:

@@ -52,8 +52,6 @@ class Result:
     velocity, node_velocities, pulley_penetration : ndarray or None
         Where the run records them (planar runs): the pose's time derivative (N, pose_size), the nodes'
         velocities [m/s], the deepest node penetration into each cable's pulley (N, m) [m].
-    wall_time, cpu_time : float [s]
-        Wall-clock and process CPU time of the solve.
     status : str
         "completed", "failed: <cause>" or "interrupted at ...".
     winch_reservoir : ndarray, shape (N, m), or None [m]
@@ -281,21 +279,12 @@ def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = Non
                    highest_exit: float | None = None, limits=None) -> dict[str, Any]:
     """What a run did that a real robot could not, over all its samples (never an error window).
 
-    The element tensions, each cable's slack time, elements that pushed (a negative tension), the
-    tension limits crossed (:func:`tension_limit_report`) and a platform above its highest exit (every
-    cable pulls it down there), with a warning sentence for each. The lowest tensions and slack times
-    leave out t = 0, the initial condition (a planar run starts from unstretched cables at 0 N); the
-    rest cover t = 0 too, and the warning says when the compression is in the initial state.
-
-    Parameters
-    ----------
-    times : ndarray, shape (N,) [s]
-    tensions : sequence of ndarray, each shape (N, n_i) [N]
-    heights : ndarray, shape (N,) [m], optional
-        Height of the platform's centre of mass.
-    highest_exit : float [m], optional
-        Height of the highest exit; without it (or ``heights``), ``platform_above_exits`` is None.
-    limits : list of [t_min or None, t_max or None] [N], one per cable, or None
+    The element tensions, each cable's slack time, elements that pushed, the tension limits crossed and
+    a platform above its highest exit, with a warning for each. The lowest tensions and slack times
+    leave out t = 0, the initial condition (a planar run starts from unstretched cables at 0 N).
+    ``tensions`` (N, n_i) [N] per cable at ``times`` (N,) [s]; ``heights`` (N,) [m] of the platform's centre
+    and ``highest_exit`` [m] (without them ``platform_above_exits`` is None); ``limits``: [t_min, t_max]
+    [N] (or None) per cable, or None.
     """
     times = np.asarray(times, dtype=float)
     tensions = [np.asarray(t, dtype=float) for t in tensions]
@@ -340,8 +329,7 @@ def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = Non
 
 
 def after_start_up(settled: dict[str, Any], error_figures) -> dict[str, Any]:
-    """The ``after_start_up`` entry of a run's summary.json: the ``error_figures`` of the summary measured
-    after the start-up (``settled``), with its window and notes."""
+    """The ``after_start_up`` entry of a summary.json: ``settled``'s ``error_figures``, window and notes."""
     return {key: settled[key] for key in ("errors_measured_after_s", *error_figures, "notes")}
 
 

@@ -25,9 +25,8 @@ from cdpr_exu.physics import swivel_pulley as sp
 
 @dataclass(frozen=True, eq=False)
 class SpatialRunResult:
-    """A dynamic run at the start of each step and the end time: ``time`` (k,) [s], the platform's
-    ``position`` (k, 3) [m] and ``rotation_vector`` (k, 3) [rad], ``energy`` (k,) [J] if asked, the
-    ``wall_time`` [s] of ``SolveDynamic`` and its ``newton_iterations``."""
+    """A dynamic run at each step's start and the end: ``time`` (k,) [s], the platform's ``position`` (k, 3)
+    [m] and ``rotation_vector`` (k, 3) [rad], ``energy`` (k,) [J] if asked, ``wall_time`` [s]."""
 
     time: np.ndarray
     position: np.ndarray
@@ -38,9 +37,8 @@ class SpatialRunResult:
 
 
 def run_dynamic(mbs, items, end_time, step_size, spectral_radius=0.9, record_energy=False, settings=None):
-    """Integrate the assembled robot from its initial configuration (at rest) over ``end_time`` [s] at
-    ``step_size`` [s] (generalised-alpha at ``spectral_radius``, or ``settings``), recording
-    :func:`robot_energy` at every step if ``record_energy``; SolverFailure if the integration fails."""
+    """Integrate the assembled robot from its initial configuration over ``end_time`` at ``step_size`` [s],
+    with :func:`robot_energy` at every step if ``record_energy``; SolverFailure if it fails."""
     end_time, step_size = positive("end_time", end_time), positive("step_size", step_size)
     settings = dynamic_settings(end_time, step_size, spectral_radius) if settings is None else settings
     times, positions, rotations, energies = [], [], [], []
@@ -75,9 +73,7 @@ class SwivelRun:
 
     Attributes
     ----------
-    time, psi : ndarray (S,) [s], [rad]
-    energy : ndarray (S,) [J]
-        Mechanical energy: kinetic (nodes and swivel), gravity, axial, bending, contact.
+    time, psi, energy : ndarray (S,) [s], [rad], [J]
     dissipated : ndarray (S,) [J]
         Energy taken out by the bearing so far, integral d_s psi_dot^2 dt (trapezoidal).
     mass_azimuth : ndarray (S,) [rad]
@@ -87,8 +83,6 @@ class SwivelRun:
     final_positions : ndarray (N, 3) [m]
     failed : str
         Empty, or why the run stopped early (the solver's error, or an energy rise above ``abort_rise``).
-    guard_rejections : int
-        Steps repeated smaller by the energy guard.
     """
 
     time: np.ndarray
@@ -234,8 +228,7 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
         minimum = step * 1e-3
 
         def guard(mbs_, t):
-            """Repeat a step at a quarter of its size if its converged state gained more than
-            ``energy_guard`` [J]: nothing in this scene can supply energy (no moving winch)."""
+            """Repeat a step that gained more than ``energy_guard`` (no moving winch supplies energy)."""
             size = mbs_.sys["dynamicSolver"].it.currentStepSize
             if state(mbs_, exu.ConfigurationType.Current)[3] - accepted[0] > energy_guard and size > minimum:
                 rejected[0] += 1

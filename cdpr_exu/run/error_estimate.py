@@ -1,9 +1,7 @@
 """How accurate is a run? A Richardson estimate of its discretisation error in the cable.
 
-The accuracy study (``results/accuracy``) shows the lumped cable's error falling as n^-p with p
-close to 2 (observed 1.9 to 2.5 on the paper circle; the step contributes far less at 2e-3 s), in
-space too (docs/accuracy.md). So a *companion* run with r times as many elements (r = 2, or 1/2 for
-fine cables that still fit their pulleys, which is cheaper) tells the first run's error:
+The lumped cable's error falls as n^-p with p close to 2 (``results/accuracy``, docs/accuracy.md), so a
+*companion* run with r times as many elements (r = 2, or 1/2 for fine cables) tells a run's error:
 
     e(n) ~ |x_n - x_rn| / |1 - r^-p|,
 
@@ -40,9 +38,8 @@ MAX_ELEMENTS = 400
 
 @dataclass(frozen=True)
 class ErrorEstimate:
-    """The estimated discretisation error of a run's platform path: the largest position error of the
-    centre after ``after_s`` [s] (None when there is none: ``note`` says why, as it says how it was made),
-    the companion run's elements per cable and its wall and CPU time [s], the assumed ``order``."""
+    """The estimated largest position error of a run's platform centre after ``after_s`` [s] (None: ``note``
+    says why), with the companion run's elements per cable and wall and CPU time [s]."""
 
     max_position_error_m: float | None
     companion_n_elements: int | None
@@ -65,8 +62,7 @@ def richardson_factor(ratio: float, order: float = ORDER) -> float:
 
 
 def companion_elements(scene) -> int:
-    """Elements per cable of the companion run: half as many for fine cables if they still fit the
-    pulleys (the builder checks), else twice as many."""
+    """Elements per cable of the companion run: half as many for fine cables that fit, else twice."""
     n = max(c.n_elements for c in scene.cables)
     if n >= 30:
         try:
@@ -83,8 +79,8 @@ def _with_elements(scene, n: int):
 
 
 def path_distance(result, other, after: float = 0.0) -> float:
-    """Largest distance [m] of ``result``'s platform centre from ``other``'s (interpolated onto ``result``'s
-    sample times, which may lie up to a step after the output times) from ``after`` [s] on."""
+    """Largest distance [m] of ``result``'s platform centre from ``other``'s (interpolated) after ``after``
+    [s]."""
     mask = result.time >= after - 1e-9
     positions, other_positions = result.position, other.position
     path = np.column_stack([np.interp(result.time[mask], other.time, other_positions[:, k])
@@ -136,8 +132,7 @@ def estimate_line(estimate: ErrorEstimate) -> str:
 
 
 def summary_entry(estimate: ErrorEstimate) -> dict:
-    """The entries of ``summary.json`` for an estimate: ``error_estimate`` and, with a companion run, its
-    wall and CPU times (:func:`~cdpr_exu.core.output.write_summary` puts them into ``timing.json``)."""
+    """The entries of ``summary.json`` for an estimate (the companion's times go to ``timing.json``)."""
     timing = ("companion_wall_time_s", "companion_cpu_time_s")
     data = {"error_estimate": {k: v for k, v in estimate.to_dict().items() if k not in timing}}
     if estimate.companion_n_elements is not None:
@@ -147,8 +142,7 @@ def summary_entry(estimate: ErrorEstimate) -> dict:
 
 def elements_for_tolerance(n: int, estimated_error: float, tolerance: float, order: float = ORDER) -> int:
     """Fewest elements per cable whose error by e(n) = C n^-p through (n, estimated_error) is below
-    ``tolerance``, never fewer than ``n``: below n the model would be extrapolated out of the measured
-    range, where coarser cables meet limits it knows nothing of (pulleys, swivels; docs/accuracy.md)."""
+    ``tolerance``, never fewer than ``n`` (the model is not extrapolated out of its measured range)."""
     if estimated_error <= tolerance:
         return n
     needed = math.ceil(n * (estimated_error / tolerance) ** (1.0 / order))

@@ -13,11 +13,9 @@ length and end forces of its *free span*, the part the elastic catenary
 * with a point exit, or over a pulley no node touches, the whole cable, from node 0 (held by the
   winch constraints) to the platform anchor (node n);
 * over a pulley, from the *leave point* to the anchor: with node c the last node in contact with the
-  rim, the point of the rim where the tangent from node c + 1 touches it (the tangent nearer node c),
-  then the elements from node c + 1 on (the catenary's suspended part). The wrapped part is left out
-  on purpose: the lumped model wraps the pulley with straight chords, about a centimetre per element
-  shorter than the arc for 0.25 m elements on a 0.25 m pulley, and where such a coarse polygon leaves
-  the rim is uncertain by a good part of an element (``examples/catenary_validation.py``).
+  rim, the point of the rim where the tangent from node c + 1 touches it (nearer node c), then the
+  elements from node c + 1 on (the catenary's suspended part). The wrapped part is left out: the
+  lumped model wraps the pulley with chords, shorter than the arc (``examples/catenary_validation.py``).
 
 End forces are those the cable *exerts on* its supports, as the catenary's ``force_on_a`` (platform)
 and ``force_on_b`` (upper end): ``platform_force + upper_force = (0, -W)`` at rest, W the span's
@@ -27,25 +25,19 @@ coordinate constraints; over a pulley: the cable's internal force at the cut thr
 (c, c + 1), its axial force plus the shear of the two bending joints that straddle the cut (3.8 N
 beside 14 N on the paper's scene).
 
-The static polish (measured on the paper's scenes) converges in one Newton iteration from the settled
-state, moves the nodes by 2e-7 m and brings a free span's force balance from 2e-7 N to 1e-11 N: cheap,
-and an exact equilibrium. A point-mass platform's rotation is locked for it: nothing resists that
-rotation, so the static Jacobian would be singular. Without bending damping the cable's swinging modes
-are all but undamped (0.5 to 0.9 m/s after 60 s): such a scene is settled with the paper's bending on,
-and the static solver then finds its own model's rest from there (a continuation in the bending
-stiffness). ``Rest.method`` says which path was taken.
+The static polish converges in one Newton iteration from the settled state and makes it an exact
+equilibrium (a free span's force balance from 2e-7 N to 1e-11 N on the paper's scenes). Without bending
+damping the swinging modes are all but undamped: such a scene is settled with the paper's bending on,
+and the static solver finds its own model's rest from there. ``Rest.method`` says which path was taken.
 
-**In space** the scene is solved by two independent methods: the **catenary statics**
-(:func:`cdpr_exu.statics.statics.solve_statics`: elastic catenaries in vertical planes, no bending),
-and the lumped robot of :mod:`cdpr_exu.builder.robot_3d` with the scene's effects, started on the
-catenary solution (over swivel pulleys, where Exudyn's static solver does not converge from there, on
-the chain statics' equilibrium, :func:`cdpr_exu.run.settle.start_at_rest`) and brought to equilibrium
-by Exudyn's static solver. The rest says how far the two lie apart (the discretisation error, about
-n^-2, plus bending). A rigid platform's cable ends are held by stiff penalty joints (Exudyn's static
-solver diverges on ``ObjectJointSpherical`` when the body must turn), adding 1 / (:data:`PENALTY` n)
-of a cable's compliance. The static solve uses spring elements also for tension-only cables (Exudyn's
-static solver fails from a start with slack elements); while every element is taut the two give the
-same equilibrium, and a compressed element is reported.
+**In space** two independent methods solve the scene: the **catenary statics**
+(:func:`cdpr_exu.statics.statics.solve_statics`: elastic catenaries, no bending), and Exudyn's static
+solver on the lumped robot with the scene's effects, started on the catenary solution (over swivel
+pulleys on the chain statics', :func:`cdpr_exu.run.settle.start_at_rest`). The rest says how far the
+two lie apart (the discretisation error, about n^-2, plus bending). A rigid platform's cable ends are
+held by stiff penalty joints (Exudyn's static solver diverges on ``ObjectJointSpherical`` when the body
+must turn), adding 1 / (:data:`PENALTY` n) of a cable's compliance. Tension-only cables are solved
+with spring elements (a slack start fails); a compressed element is reported.
 """
 
 from __future__ import annotations
@@ -81,16 +73,12 @@ DEFAULT_TOLERANCE = 1.0e-6
 DEFAULT_MAX_TIME = 60.0
 #: Default length of each extension of the run after the scene's end time [s].
 DEFAULT_CHUNK_TIME = 2.0
-#: The node speed of a chunk is its largest over this final part of the chunk [s]
-#: (not only at its last step, which a swinging mode may pass at a turning point).
+#: The node speed of a chunk is its largest over this final part of it [s] (not at a turning point).
 SPEED_WINDOW = 0.5
-#: The static polish is kept only if it moves no node farther than this [m]. A state at
-#: rest to 1e-6 m/s is within about v * tau (tau ~ 1 s: the Kelvin-Voigt time constant
-#: c_i / k_i, and the swinging periods) of its equilibrium, so 1 mm is three orders of
-#: magnitude of margin; a larger jump means another equilibrium branch was found.
+#: The static polish is kept only if it moves no node farther than this [m]: a state at rest to
+#: 1e-6 m/s lies about v * 1 s from its equilibrium; a larger jump found another equilibrium branch.
 POLISH_MAX_SHIFT = 1.0e-3
-#: Simulated time of the check run from a static solution of a scene without bending
-#: damping [s]: its largest node speed is reported as ``max_node_speed_m_s``.
+#: Simulated time [s] of the check run of ``max_node_speed_m_s`` after a bending continuation.
 CHECK_TIME = 0.2
 #: Name of the path taken by the planar relaxation, by case.
 METHODS = {
@@ -99,9 +87,8 @@ METHODS = {
     "bending-continuation+static": "settled with the paper's bending on, then Exudyn's static solver "
                                    "on the scene's own model from there",
 }
-#: Stiffness of the penalty spherical joints of a rigid platform in space, in element axial
-#: stiffnesses: they add 1 / (100 n) of a cable's compliance (3e-7 m at n = 40 on the
-#: four-cable robot, measured in tests/test_spatial_robot.py).
+#: Stiffness of the penalty spherical joints of a rigid platform in space, in element axial stiffnesses
+#: (3e-7 m at n = 40 on the four-cable robot, tests/test_spatial_robot.py).
 PENALTY = 100.0
 #: A spatial answer farther than this fraction of the shortest cable from its elastic catenaries'
 #: is flagged (``warnings``): the shipped swivel robot rests 0.9 % away (22 mm, its bending around
@@ -143,9 +130,9 @@ class Rest:
     anchor_tensions : ndarray, shape (m,) [N]; platform_forces : ndarray, shape (m, d) [N]
         Each cable's axial force at its anchor and the force it exerts on the platform there.
     method : str
-        How the rest was found: a key of :data:`METHODS` in the plane, a description in space.
+        A key of :data:`METHODS` in the plane, a description in space.
     warnings, notes : tuple of str
-        What makes this answer suspect, with its figures; what the solver tried and refused.
+        What makes this answer suspect; what the solver tried and refused.
 
     Planar only (None in space; :data:`DEFINITIONS`): ``cable_stretched_length_m``,
     ``cable_unstrained_length_m``, ``first_free_node`` (0, or c + 1 over a pulley), ``upper_points_m``,
@@ -208,8 +195,7 @@ class Rest:
         return REST_METHODS[self.space].lines(self)
 
     def save(self, folder: str | Path) -> dict[str, Path]:
-        """Write ``summary.json`` (with provenance) and, in the plane, ``rest.npz`` into ``folder``; returns
-        their paths by kind ("summary", "npz")."""
+        """Write ``summary.json`` and, in the plane, ``rest.npz`` into ``folder``; returns the paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         paths = {"summary": write_summary(folder, {**self.summary(), **provenance()})}
@@ -229,19 +215,16 @@ def solve_rest(scene: Scene, **options) -> Rest:
     SceneError
         A scene the method cannot bring to rest (massless planar cables, an explicit integrator, a
         bad option), naming the field.
-    UnreachableError
-        The catenary statics of a spatial scene find no equilibrium.
-    SolverFailure
-        The solver fails, the planar scene is not at rest after ``max_time``, or the spatial
-        equilibrium holds the platform above its exits (:func:`rest_above_exits`).
+    UnreachableError, SolverFailure
+        No equilibrium of the catenary statics; the solver fails, the planar scene is not at rest after
+        ``max_time``, or the spatial equilibrium holds the platform above its exits.
     """
     return REST_METHODS[scene.space].solve(scene, **options)
 
 
 def bending_text(scene: Scene, catenary, what: str) -> str:
-    """A sentence for messages: ``what`` is the cables' bending E J [N m^2], its bending length
-    sqrt(E J / T) at the catenaries' largest tension T against the smallest swivel radius (or the
-    shortest cable)."""
+    """A sentence: ``what`` is the cables' bending E J [N m^2], its bending length sqrt(E J / T) at the
+    catenaries' largest tension T against the smallest swivel radius (or the shortest cable)."""
     cable = scene.cables[0]
     if not scene.effects.bending:
         return "the cables have no bending (effects.bending = false)"
@@ -330,8 +313,7 @@ def _relax(scene: Scene, *, tolerance: float = DEFAULT_TOLERANCE, max_time: floa
 
 
 def _build(scene: Scene) -> Model:
-    """The scene's model; a point-mass platform's rotation is locked (it feels no moment, and the lock
-    makes the static Jacobian regular)."""
+    """The scene's model; a point-mass platform's rotation (which feels no moment) is locked."""
     model = build_model(scene)
     if scene.platform.is_point_mass:
         mbs = model.mbs
@@ -519,9 +501,8 @@ def _bending_cut_force(scene: Scene, cable_index: int, positions: np.ndarray, ve
 
 def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method: str,
                 shift: float | None, notes: tuple, reaction_sign: float = 1.0) -> Rest:
-    """Read the rest state off the model (the module notes define it). ``reaction_sign`` is -1 for a state
-    of Exudyn's static solver, whose constraint reactions (Lagrange multipliers) have the opposite sign of
-    the dynamic solver's (measured); the conventions are the dynamic solver's (``tests/test_model.py``)."""
+    """Read the rest state off the model. ``reaction_sign`` is -1 for a state of Exudyn's static solver,
+    whose constraint reactions have the opposite sign of the dynamic solver's (``tests/test_model.py``)."""
     mbs = model.mbs
     pose = _coordinates(model, "platform")
     force = exu.OutputVariableType.Force
@@ -610,8 +591,7 @@ def _planar_lines(rest: Rest) -> list[str]:
 
 
 def _solve_from_catenaries(scene: Scene, **relaxation) -> Rest:
-    """Bring a spatial ``scene`` to rest: catenary statics, then Exudyn's static solve of the lumped robot
-    (see the module notes); the planar relaxation's options (``relaxation``) do not apply."""
+    """Bring a spatial ``scene`` to rest (the module notes); the planar ``relaxation`` does not apply."""
     start = _time.perf_counter()
     platform = catenary_platform(scene)
     lengths = scene.unstrained_lengths
@@ -710,9 +690,8 @@ def _spatial_lines(rest: Rest) -> list[str]:
 
 @dataclass(frozen=True)
 class _RestMethod:
-    """How a scene of one space is brought to rest, and how its rest is told: the solver
-    (``solve(scene, **options) -> Rest``), the summary, the arrays of ``rest.npz`` (None: no
-    such file) and the console lines."""
+    """How a scene of one space is brought to rest and its rest told: solver, summary, ``rest.npz``'s
+    arrays (None: no such file) and console lines."""
 
     solve: Callable[..., Rest]
     summary: Callable[[Rest], dict]

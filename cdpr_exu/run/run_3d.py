@@ -5,11 +5,9 @@ swivel pulleys on the lumped robot's own: :func:`cdpr_exu.run.settle.start_at_re
 
 **The winch at a point exit** pays the cable out at a fixed point (over a swivel pulley the winch end
 moves along the pulley's axis instead). The lumped cable keeps its n elements and follows its paid-out
-(unstrained) length L(t): element length L / n, axial stiffness E A n / L and damping d_n A n / L, node
-masses rho L / n (half at the ends) with their weights, bending stiffness E J n / L and damping
-d_n J n / L, set before every step. Its statics are the elastic catenary's of length L and its mass the
-cable's paid out; it leaves out the flow of material through the exit (the nodes slide along the cable
-by up to (L(t) - L(0)) s / L), an axial motion whose inertia is small beside the platform's.
+length L(t): every element's length, stiffness and damping, the node masses and the bending scale with
+L / n before every step. Its statics are the elastic catenary's of length L; it leaves out the flow of
+material through the exit, an axial motion whose inertia is small beside the platform's.
 
 Units SI; z up, gravity along -z; poses ``(x, y, z, theta)`` with ``theta`` the platform's rotation vector.
 """
@@ -99,8 +97,7 @@ MAX_ROTATION_ERROR_DEG = 90.0
 
 class _SpatialMonitor:
     """Checks the platform at the start and after each step for states the run cannot come back from:
-    coordinates no longer finite, a platform above its highest exit (every cable pulls it down there),
-    or one turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference's orientation."""
+    not finite, above its highest exit, turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference."""
 
     def __init__(self, scene: Scene):
         self.trajectory = scene.trajectory
@@ -108,8 +105,7 @@ class _SpatialMonitor:
         self.turns = not scene.platform.is_point_mass
 
     def problem(self, t: float, position: np.ndarray, rotation: np.ndarray) -> str | None:
-        """What is wrong at ``t`` [s] with the platform at ``position`` (3,) [m], ``rotation`` (3, 3), or
-        None."""
+        """What is wrong at ``t`` [s] with the platform at ``position`` (3,) [m], ``rotation`` (3, 3)."""
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(rotation))):
             return f"the coordinates are no longer finite at t = {t:.4f} s"
         if position[2] > self.ceiling:
@@ -131,8 +127,7 @@ class _SpatialMonitor:
 
 
 def _warn_outside_measured_region(scene: Scene) -> None:
-    """A SwivelStabilityWarning when the solver settings lie outside the region where runs over a swivel
-    pulley were measured to keep their energy."""
+    """Warn where runs over a swivel pulley were not measured to keep their energy at these settings."""
     solver = scene.solver
     for exit_, cable in zip(scene.exits, scene.cables):
         if not exit_.wraps:
@@ -152,11 +147,9 @@ def _rest_above_exits(scene: Scene, mbs, items) -> str | None:
 
 
 class Run3D:
-    """The spatial robot's side of a run (:data:`~cdpr_exu.run.simulate.RUNS`; built before the controller's
-    reset, which starts from its rest): the winches follow the command before every step; every step that
-    reaches an output time (and the one that ends the run) is recorded with its own time, and every step
-    is checked. A measurement holds the pose, its time derivative and each cable's last element's axial
-    force [N] at the start of the step. SolverFailure at t = 0 if settling over swivel pulleys failed.
+    """The spatial robot's side of a run (:data:`~cdpr_exu.run.simulate.RUNS`): the winches follow the
+    command before every step; the steps that reach an output time (and the last) are recorded with their
+    own time; every step is checked. SolverFailure at t = 0 if settling over swivel pulleys failed.
     """
 
     def __init__(self, scene: Scene, model: Model3D):
@@ -188,8 +181,7 @@ class Run3D:
         self.start = _time.perf_counter()
 
     def measured_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """The platform's pose (x, y, z, rotation vector) [m, rad] and its time derivative (the rotation
-        vector's rate by :meth:`Space.rotation_rate`) [m/s, rad/s] now, each shape (6,)."""
+        """The platform's pose [m, rad] and its time derivative [m/s, rad/s] now, each shape (6,)."""
         mbs, items = self.model.mbs, self.model.items
         position, rotation = platform_pose(mbs, items)
         velocity = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.Velocity))
@@ -216,8 +208,7 @@ class Run3D:
                            state_time=self.step_start)
 
     def record(self, t: float) -> None:
-        """Store the state now: pose, paid-out lengths, each cable's nodes and element forces (the state
-        vectors read once, not node by node)."""
+        """Store the state now (the state vectors read once, not node by node)."""
         mbs, items = self.model.mbs, self.model.items
         position, rotation = platform_pose(mbs, items)
         self.times.append(t)
@@ -290,8 +281,7 @@ class Run3D:
                       [np.asarray(s) for s in self.tensions], np.asarray(self.paid))
 
     def reached(self, result: Result) -> tuple[float, bool]:  # noqa: ARG002
-        """The solver's own time [s] (the samples may end an output period before it) and whether it is the
-        end time."""
+        """The solver's own time [s] (past the last sample) and whether it is the end time."""
         return self.reached_time, self.reached_time >= self.scene.solver.end_time - 1e-9
 
     def notes(self, failure: str, time: float) -> tuple[str, str]:  # noqa: ARG002

@@ -21,10 +21,9 @@ from cdpr_exu.statics.chain_statics import ChainCable, ChainRobot, solve_chain_s
 
 @dataclass(frozen=True, eq=False)
 class SpatialStaticResult:
-    """Exudyn's static solution of the lumped robot: the platform's ``position`` (3,) [m], ``rotation``
-    (3, 3) and ``rotation_vector`` (3,) [rad]; the joint reactions on it ``forces_on_platform`` (m, 3) [N]
-    at ``anchor_points`` (m, 3) [m], their norms ``tensions_at_anchor`` (m,) [N] (what a load cell reads:
-    the catenary's ``tension_at_anchor`` to O(n^-2)); ``wall_time`` [s] of ``SolveStatic``."""
+    """Exudyn's static solution of the lumped robot: the platform's pose, the joint reactions on it
+    ``forces_on_platform`` (m, 3) [N] at ``anchor_points`` (m, 3) [m] and their norms ``tensions_at_anchor``
+    (m,) [N] (what a load cell reads: the catenary's ``tension_at_anchor`` to O(n^-2))."""
 
     position: np.ndarray
     rotation: np.ndarray
@@ -57,13 +56,10 @@ def settle(mbs, items, duration=SETTLE_TIME, step_size=SETTLE_STEP):
     """Let the assembled robot come to rest from its initial configuration and make that its start.
 
     The fallback of :func:`start_at_rest`, whose chain statics find the same equilibrium 200 times
-    faster (benchmarks/results/swivel_start.md). Exudyn's static solver does not converge from the
-    catenary start over a swivel pulley (its first Newton step raised the residual 300-fold); after this
-    settle (generalised-alpha at spectral radius 0, modified Newton, adaptive steps, zero initial
-    accelerations: the consistent ones put tens of joules into the first step) it converges in 3 to 6
-    iterations, and its equilibrium is the start: the Kelvin-Voigt creep (time constant d_n / E) leaves
-    the settled state millimetres and joules off it. Where the static solver fails, the settled state
-    stays the start, with a ``RuntimeWarning``.
+    faster (benchmarks/results/swivel_start.md). After this settle (zero initial accelerations: the
+    consistent ones put tens of joules into the first step) Exudyn's static solver, which does not
+    converge from the catenary start over a swivel pulley, takes the state to its equilibrium (the
+    Kelvin-Voigt creep leaves it millimetres off); where it fails, with a ``RuntimeWarning``.
     """
     settings = dynamic_settings(duration, step_size, spectral_radius=0.0, tolerance=1e-6)
     ti = settings.timeIntegration
@@ -99,9 +95,8 @@ def _start_at_rest(mbs):
 
 
 def chain_statics_robot(mbs, items) -> ChainRobot:
-    """The chain statics' model of a built, assembled robot, read from its items: the same node masses,
-    stiffnesses, bending, tension-only law, first nodes held where the initial configuration has them,
-    swivel pulleys and anchor joints."""
+    """The chain statics' model of a built, assembled robot, read from its items (first nodes held where
+    the initial configuration has them)."""
     platform, chain = items.platform, items.chain
     cables = []
     for i, cable in enumerate(platform.cables):
@@ -116,8 +111,7 @@ def chain_statics_robot(mbs, items) -> ChainRobot:
 
 
 def set_configuration(mbs, items, equilibrium):
-    """Put the assembled robot at rest in ``equilibrium`` (a ChainEquilibrium of :func:`chain_statics_robot`),
-    as its initial and current configuration."""
+    """Put the assembled robot at rest in a chain-statics ``equilibrium``, initial and current."""
     q = np.array(mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Initial))
     for spec, nodes in zip(items.chains, equilibrium.nodes):
         displacement = np.asarray(nodes, float).ravel() - spec.reference
@@ -141,10 +135,9 @@ def set_configuration(mbs, items, equilibrium):
 
 @dataclass(frozen=True, eq=False)
 class RestStart:
-    """How :func:`start_at_rest` brought the robot to rest: ``method`` "chain statics" or "dynamic settle"
-    (the fallback), ``statics`` the chain statics' ChainEquilibrium (None after the fallback),
-    ``polish_shift`` [m, rad] the largest change of a coordinate by Exudyn's static solver (None: not
-    polished)."""
+    """How :func:`start_at_rest` brought the robot to rest: ``method`` "chain statics" or "dynamic settle",
+    the chain ``statics``' equilibrium (None after the fallback), the largest change of a coordinate by
+    Exudyn's static solver ``polish_shift`` [m, rad] (None: not polished)."""
 
     method: str
     statics: object
@@ -155,13 +148,12 @@ def start_at_rest(mbs, items, max_iterations: int = 100) -> RestStart:
     """Bring the assembled robot from its initial (catenary) configuration to its static equilibrium by the
     chain statics and make that its start.
 
-    The chain statics (:func:`~cdpr_exu.statics.chain_statics.solve_chain_statics` on
-    :func:`chain_statics_robot`, the same discrete model, in at most ``max_iterations`` Newton steps)
-    solve the robot over swivel pulleys, where Exudyn's static solver does not converge from the catenary
-    start; Exudyn's static solver then polishes that state (it moves no coordinate by more than 1e-15 on
-    spatial-four-cable-swivel), except on a rigid platform held by exact spherical joints, where it
-    diverges. If the chain statics fail, :func:`settle` is the fallback; if the polish fails, the chain
-    statics' state stays the start; either with a ``RuntimeWarning``.
+    The chain statics (on :func:`chain_statics_robot`, the same discrete model, at most
+    ``max_iterations`` Newton steps) solve the robot over swivel pulleys, where Exudyn's static solver
+    does not converge from the catenary start; Exudyn's static solver then polishes that state (1e-15),
+    except on a rigid platform on exact spherical joints, where it diverges. If the chain statics fail,
+    :func:`settle` is the fallback; if the polish fails, their state is the start; either with a
+    ``RuntimeWarning``.
     """
     robot = chain_statics_robot(mbs, items)
     start = ([chain_positions(mbs, items, i, current=False) for i in range(len(items.chains))],
@@ -189,9 +181,8 @@ def start_at_rest(mbs, items, max_iterations: int = 100) -> RestStart:
 
 
 def solve_static(mbs, items, settings=None):
-    """Exudyn's static equilibrium of the assembled robot from its initial configuration, as a
-    :class:`SpatialStaticResult`; SolverFailure if it does not converge (as on a rigid platform on exact
-    spherical joints: use ``ChainSpec3D.anchor_spring_factor``)."""
+    """Exudyn's static equilibrium of the assembled robot from its initial configuration; SolverFailure if
+    it does not converge (as on a rigid platform on exact spherical joints)."""
     settings = static_settings() if settings is None else settings
     hint = ("" if items.is_point_mass or items.chain.anchor_spring_factor is not None else
             " (a rigid platform on exact spherical joints: set ChainSpec3D.anchor_spring_factor)")

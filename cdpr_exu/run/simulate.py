@@ -43,8 +43,8 @@ MAX_PENETRATION_FRACTION = 0.5
 
 
 class _Monitor:
-    """Checks each recorded sample for states the model cannot describe: all cables' elements at once
-    (one strain and one depth per element, over flat arrays); the cable reported is the first that fails."""
+    """Checks each recorded sample for states the model cannot describe, all elements at once (the cable
+    reported is the first that fails)."""
 
     def __init__(self, scene: Scene, indices: dict[str, np.ndarray], reference: np.ndarray):
         self.scene = scene
@@ -133,10 +133,9 @@ class _Monitor:
 class _Recorder:
     """Stores Exudyn's coordinates at the output times (called once per step).
 
-    Each sample is the state at the end of the first step that reaches its output time, with that
-    step's time: a real state, never an interpolation (where the adaptive step shrank one, later
-    samples lie up to a step after their output time). Interpolating across a step where an element
-    snaps taut or a node strikes the rim made elements look slack and nodes cut into the pulley.
+    Each sample is the state at the end of the first step that reaches its output time, with that step's
+    time: never an interpolation, which across a step where an element snaps taut or a node strikes the
+    rim made elements look slack and nodes cut into the pulley.
     """
 
     def __init__(self, model: Model, output_period: float, end_time: float):
@@ -207,8 +206,7 @@ class _Recorder:
 
 def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndarray, forces: np.ndarray,
                  times: np.ndarray):
-    """Polylines (winch end, hang point, tangent point, anchor), their time derivatives and the tensions
-    of massless ropes, whose points follow from the platform pose and the paid-out length."""
+    """Massless ropes' polylines (winch end, hang point, tangent point, anchor), rates and tensions."""
     from cdpr_exu.statics.kinematics import anchor_points
 
     k = len(times)
@@ -383,10 +381,9 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
              sparse_jacobian: bool | None = None) -> Result:
     """Simulate ``scene``, planar or spatial, under ``controller`` (default: ideal inverse kinematics).
 
-    One run loop for both dimensions: it builds the scene's model, wraps the controller in
-    :class:`SmoothStart` (its commands start at the paid-out lengths), integrates with Exudyn's implicit
-    solver and returns the one Result. What differs by dimension (winch drive, measurement, records,
-    checks) lives in the model's run side (:data:`RUNS`).
+    One run loop for both dimensions: the controller wrapped in :class:`SmoothStart` (its commands start at
+    the paid-out lengths), Exudyn's implicit solver, one Result; the model's run side (:data:`RUNS`) holds
+    what differs by dimension.
 
     ``solution_file``: also write Exudyn's solution file there; ``progress``: True shows a progress bar,
     a callable is called as ``progress(t, wall_time)`` about 100 times; ``sparse_jacobian``: planar runs'

@@ -19,8 +19,7 @@ from cdpr_exu.scenes.scene import Scene
 
 @contextlib.contextmanager
 def quiet_exudyn():
-    """Keep Exudyn's console messages (failure banners, allocation warnings) to itself while active: the
-    project reports failures in its own words (``exu.config.printToConsole``, restored afterwards)."""
+    """Keep Exudyn's console messages to itself while active: the project reports failures in its words."""
     before = exu.config.printToConsole
     exu.config.printToConsole = False
     try:
@@ -31,9 +30,8 @@ def quiet_exudyn():
 
 @contextlib.contextmanager
 def interrupt_flag():
-    """While active, Ctrl-C (SIGINT) sets ``flag["interrupted"]`` instead of raising (a second one raises):
-    the post-step function ends the integration cleanly, keeping the samples so far. Outside the main
-    thread (no signal handlers there) Ctrl-C behaves as usual."""
+    """While active (in the main thread), a first Ctrl-C sets ``flag["interrupted"]`` instead of raising:
+    the post-step function ends the integration cleanly, keeping the samples so far."""
     flag = {"interrupted": False}
     if threading.current_thread() is not threading.main_thread():
         yield flag
@@ -53,9 +51,8 @@ def interrupt_flag():
 
 
 def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
-    """Exudyn settings of the run of ``scene``: generalized-alpha, the sparse LU solver, (modified) Newton
-    with the Jacobian updated every step, no step-size recommendation of the contact (it shrinks steps
-    to about 1e-6 s); ``solution_file``, if given, is written."""
+    """Exudyn settings of the run of ``scene`` (the contact's step-size recommendation, which shrinks steps
+    to about 1e-6 s, off); ``solution_file``, if given, is written."""
     solver = scene.solver
     settings = exu.SimulationSettings()
     ti = settings.timeIntegration
@@ -101,8 +98,8 @@ def output_times(end_time: float, output_period: float) -> np.ndarray:
     return np.arange(count) * output_period
 
 def solver_report(mbs: exu.MainSystem, message: str) -> str:
-    """What Exudyn's solver said when it stopped: its error string, time, step and residual (the exception's
-    text is only "SolveDynamic terminated"; ``mbs.sys["dynamicSolver"]`` knows why)."""
+    """What Exudyn's solver said when it stopped (its error string, time, step, residual): the exception's
+    text is only "SolveDynamic terminated"."""
     solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
     if solver is None:
         return f"Exudyn's solver stopped: {message}"
@@ -158,9 +155,8 @@ RK44_STABILITY_LIMIT = 2.785
 
 
 def explicit_step_limit(scene: Scene) -> float:
-    """Estimated largest stable step [s] of explicit RK44 on ``scene``'s cables: the fastest mode of a chain
-    of over-damped Kelvin-Voigt elements is the zig-zag, eigenvalue about -4 c_i / m_i (undamped:
-    frequency 2 sqrt(k_i / m_i), a pulley contact adds sqrt(k_p / m_i)), and RK44 needs h |lambda| < 2.8."""
+    """Estimated largest stable step [s] of explicit RK44 on ``scene``'s cables: the zig-zag mode's
+    eigenvalue is about -4 c_i / m_i (undamped: 2 sqrt(k_i / m_i), with contact sqrt(k_p / m_i) more)."""
     limits = []
     for cable, pulley in zip(scene.cables, scene.exits):
         mass = float(cable.node_masses()[1:-1].min()) if cable.n_elements > 1 else cable.element_mass
@@ -231,9 +227,8 @@ def first_step_hints(scene: Scene) -> list[str]:
 
 
 def likely_cause(scene: Scene, failure: str = "", failure_time: float | None = None) -> str:
-    """A hint at what most likely made the integration fail: after the cause named in ``failure`` (the
-    monitor's or the solver's words), and for a stop within the first step (``failure_time`` [s]) what in
-    the scene makes the first step fail."""
+    """A hint at what most likely made the integration fail, after the cause named in ``failure`` and the
+    time of the stop ``failure_time`` [s] (within the first step: what in the scene makes it fail)."""
     hints = []
     if scene.solver.integrator == "rk44":
         limit = explicit_step_limit(scene)
