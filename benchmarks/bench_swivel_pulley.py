@@ -50,7 +50,7 @@ def _measure(inertia, damping, step, tolerance, end_time, rate_factor=0.7, spect
              element_length=0.05, guard=None, hang=False, modified=False):
     pulley = SwivelPulley(swivel_inertia=inertia, bearing_damping=damping)
     run = run_swivel_pendulum(pulley, step, end_time, rate_factor=rate_factor, spectral_radius=spectral_radius,
-                              newton_tolerance=tolerance, abort_rise=ABORT_RISE, record_every=10**9,
+                              newton_tolerance=tolerance, abort_rise=ABORT_RISE,
                               element_length=element_length, energy_guard=guard,
                               swing=not hang, cone_angle=0.0 if hang else math.radians(30.0),
                               modified_newton=modified)

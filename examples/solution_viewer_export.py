@@ -38,7 +38,7 @@ def main() -> None:
 
     print(f"\nReplay it interactively (needs a display):  cdpr view {out}")
     start = time.perf_counter()
-    gif = render_animation(out, out / "animation.gif", fps=25, size=(640, 480), progress=True)
+    gif, _, _ = render_animation(out, out / "animation.gif", fps=25, size=(640, 480), progress=True)
     print(f"Animation without a display: {gif} ({time.perf_counter() - start:.1f} s)")
 
     if args.view:

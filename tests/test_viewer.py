@@ -249,7 +249,7 @@ def test_animation_frames_show_the_pulleys_where_the_camera_puts_them(run_dir, t
 
 def test_mp4_has_one_frame_per_chosen_row(run_dir, tmp_path):
     imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg")
-    out = viewer.render_animation(run_dir, tmp_path / "anim.mp4", every=10, size=(160, 120), fps=10)
+    out, _, _ = viewer.render_animation(run_dir, tmp_path / "anim.mp4", every=10, size=(160, 120), fps=10)
     reader = imageio_ffmpeg.read_frames(str(out))
     meta = next(reader)
     assert tuple(meta["size"]) == (160, 120)

@@ -1,10 +1,4 @@
-"""``cdpr compare``: a scene under every controller, tabulated (:mod:`cdpr_exu.studies.comparison`).
-
-Examples::
-
-    cdpr compare paper-circle --out results/controllers
-    cdpr compare paper-circle-slow --controllers ideal_ik,tension_aware_chordal
-"""
+"""``cdpr compare``: a scene under every controller, tabulated (:mod:`cdpr_exu.studies.comparison`)."""
 
 from __future__ import annotations
 
@@ -24,8 +18,7 @@ from cdpr_exu.studies.learning import DEFAULT_RULE, StoppingRule
 
 
 def print_controller_row(name: str, summary: dict) -> None:
-    """The line ``cdpr compare`` prints as a controller's run ends: its max and RMS position error [mm] and
-    its status (with the warnings a real robot cannot have)."""
+    """The line ``cdpr compare`` prints as a controller's run ends: max and RMS position error, status."""
     def mm(value):  # sub-millimetre errors (spatial robots) with their micrometres
         return "     n/a" if value is None else f"{1000 * value:8.2f}" if value >= 1e-3 else f"{1000 * value:8.4f}"
     print(f"  {name:32s} max {mm(summary['max_position_error_m'])} mm   "
@@ -33,13 +26,13 @@ def print_controller_row(name: str, summary: dict) -> None:
 
 
 def print_progress(line: str) -> None:
-    """Print a line of the learning controllers' progress at once (the trials take a while)."""
+    """Print a line of the learning controllers' progress at once."""
     print(line, flush=True)
 
 
 def _show(scene, summaries: dict, table, args: argparse.Namespace) -> list[str]:
-    """Issue each controller's warnings and (unless ``--quiet``) print ``table(summaries)`` and the output
-    folder; returns the controllers whose run did not complete."""
+    """Issue each controller's warnings, print ``table(summaries)`` unless ``--quiet``; returns the
+    controllers whose run did not complete."""
     for name, summary in summaries.items():
         raise_warnings(summary, f"{scene.name} under {name}: ")
     if not args.quiet:
@@ -50,14 +43,9 @@ def _show(scene, summaries: dict, table, args: argparse.Namespace) -> list[str]:
     return [name for name, summary in summaries.items() if summary.get("status") != "completed"]
 
 
-def _check_time_options(args: argparse.Namespace) -> None:
-    """Refuse a negative or non-finite ``--after`` or ``--ramp-time`` [s], naming the option (before any run)."""
+def _cmd_compare(args: argparse.Namespace) -> int:
     non_negative("--after", args.after)
     non_negative("--ramp-time", args.ramp_time)
-
-
-def _cmd_compare(args: argparse.Namespace) -> int:
-    _check_time_options(args)
     check_output_folder(args.out, command="compare")
     scene = load_scene(args.scene)
     started = smooth_start(scene, args.ramp_time)

@@ -1,10 +1,4 @@
-"""``cdpr run``: run a planar or spatial scene, write its files and print its summary.
-
-Examples::
-
-    cdpr run paper-circle --out results/paper_circle
-    cdpr run my_robot.toml --out out/my_robot --end-time 5 --step-size 1e-3
-"""
+"""``cdpr run``: run a planar or spatial scene, write its files and print its summary."""
 
 from __future__ import annotations
 
@@ -31,17 +25,10 @@ EPILOG_RUN = """examples:
 """ + EXIT_CODES
 
 
-def _scene_with_overrides(args: argparse.Namespace, scene: Scene | None = None) -> Scene:
-    """``scene`` (default: the one ``args.scene`` names, loaded) with ``--end-time`` and ``--step-size`` applied."""
-    scene = load_scene(args.scene) if scene is None else scene
-    changes = {}
-    if getattr(args, "end_time", None) is not None:
-        changes["end_time"] = args.end_time
-    if getattr(args, "step_size", None) is not None:
-        changes["step_size"] = args.step_size
-    if changes:
-        scene = scene.with_changes(solver=replace(scene.solver, **changes))
-    return scene
+def _scene_with_overrides(args: argparse.Namespace, scene: Scene) -> Scene:
+    """``scene`` with ``--end-time`` and ``--step-size`` applied."""
+    changes = {key: getattr(args, key) for key in ("end_time", "step_size") if getattr(args, key) is not None}
+    return scene.with_changes(solver=replace(scene.solver, **changes)) if changes else scene
 
 
 def _figure(value, scale: float = 1.0, unit: str = "", digits: int = 2, sign: bool = False) -> str:
@@ -55,10 +42,8 @@ def _figure(value, scale: float = 1.0, unit: str = "", digits: int = 2, sign: bo
 
 
 def _print_summary(summary: dict, settled: dict, space: Space, out: Path | None) -> None:
-    """Print a run's summary, planar or spatial: one table whose error rows come from the Space's labels
-    (each position axis, the vertical error's range, the rotation), over the whole run and after
-    :data:`SETTLED_AFTER`; then the tensions, slack and cost (whole run), each tension-limit violation, the
-    notes and the output folder."""
+    """Print a run's summary: one table of errors (rows from the Space's labels) over the whole run and
+    after :data:`SETTLED_AFTER`, tensions, slack and cost; then tension-limit violations, notes, folder."""
     def pair(key, scale, unit, digits=2):  # a figure a space leaves out is n/a (and its row not printed)
         return _figure(summary.get(key), scale, unit, digits), _figure(settled.get(key), scale, unit, digits)
 
@@ -114,29 +99,21 @@ def _print_summary(summary: dict, settled: dict, space: Space, out: Path | None)
         print(f"  written to {out}/")
 
 
-#: Rows of the printed summary a space leaves out: a planar run prints what it printed before spatial runs
-#: shared the table (its summary has no rotation error; its position error is in summary.json); a spatial
-#: run has no pulley rim to penetrate.
+#: Rows of the printed summary a space leaves out.
 NOT_PRINTED = {PLANE: ("max / RMS position error", "max rotation error"), SPACE: ("max pulley penetration",)}
 
 def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: bool = True,
               controller=None, error_estimate: bool = False) -> dict:
-    """Run ``scene`` (planar or spatial) and write its files into ``out``; returns the summary.
+    """Run ``scene`` and write its files into ``out``; returns the summary.
 
-    Writes ``scene.toml`` (the scene as run: a rerun from it gives the same result),
-    ``result.npz``, ``pose.csv``, ``summary.json`` (wall-clock figures in ``timing.json``),
-    ``solution.sol`` (Exudyn's solution file, its date blanked, for ``cdpr view``) and the
-    figures (:func:`cdpr_exu.post.plots.plot_overview`), after removing the files of an
-    earlier run there (:func:`cdpr_exu.core.output.clear_outputs`; a folder of another
-    command's output is refused). A failed or interrupted (Ctrl-C) run still writes what
-    was computed up to then, then re-raises. ``out`` and the reference are checked before
-    anything is written. With ``error_estimate`` a companion run estimates the
-    discretisation error (:mod:`cdpr_exu.run.error_estimate`): ``error_estimate`` in
-    summary.json and a printed line.
+    Writes ``scene.toml`` (a rerun from it gives the same result), ``result.npz``, ``pose.csv``,
+    ``summary.json`` (wall-clock figures in ``timing.json``), ``solution.sol`` (its date blanked) and the
+    figures, after removing an earlier run's files there (:func:`~cdpr_exu.core.output.clear_outputs`).
+    ``out`` and the reference are checked before anything is written; a failed or interrupted run writes
+    what was computed, then re-raises. With ``error_estimate`` a companion run estimates the
+    discretisation error (:mod:`cdpr_exu.run.error_estimate`).
     """
-    # A reference the cables cannot reach or hold is refused before anything is written
-    # (simulate checks it too, but only after scene.toml would be in the folder).
-    check_runnable(scene)
+    check_runnable(scene)  # before scene.toml is written
     solution_file = None
     if out is not None:
         out = check_output_folder(out, command="run")
@@ -181,8 +158,8 @@ def run_scene(scene: Scene, out: Path | None, *, quiet: bool = False, figures: b
 
 
 def _elements_for(scene, tolerance: float, quiet: bool):
-    """The scene (planar or spatial) with the fewest elements per cable, never fewer than it has, that the error
-    model says meet ``tolerance`` [m] (:func:`cdpr_exu.run.error_estimate.elements_for_tolerance` says why not fewer)."""
+    """The scene with the fewest elements per cable that the error model says meet ``tolerance`` [m]
+    (:func:`~cdpr_exu.run.error_estimate.elements_for_tolerance`)."""
     n = max(c.n_elements for c in scene.cables)
     pilot = estimate_error(scene, simulate(scene), after=SETTLED_AFTER)
     if pilot.max_position_error_m is None:

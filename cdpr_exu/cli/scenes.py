@@ -1,9 +1,4 @@
-"""``cdpr scenes``: list the shipped scenes.
-
-Example::
-
-    cdpr scenes
-"""
+"""``cdpr scenes``: list the shipped scenes."""
 
 from __future__ import annotations
 

@@ -1,10 +1,4 @@
-"""``cdpr static``: a scene brought to rest (:mod:`cdpr_exu.run.rest`).
-
-Examples::
-
-    cdpr static paper-catenary-fixed --out results/static_fixed
-    cdpr static spatial-four-cable --out results/static_spatial
-"""
+"""``cdpr static``: a scene brought to rest (:mod:`cdpr_exu.run.rest`)."""
 
 from __future__ import annotations
 

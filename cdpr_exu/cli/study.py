@@ -1,17 +1,5 @@
 """``cdpr study``: parameter sweeps (:mod:`cdpr_exu.studies.study`) and the accuracy study
-(:mod:`cdpr_exu.studies.accuracy`).
-
-Examples::
-
-    cdpr study sweep paper-circle --param cables.n_elements=10,15 --param platform.mass=1,2.5 --out results/study
-    cdpr study accuracy paper-circle --out /tmp/quick --quick
-
-Adding a ``cdpr study`` sub-command::
-
-    def add_commands(subparsers):
-        accuracy = study_subparsers(subparsers).add_parser("accuracy", ...)
-        accuracy.set_defaults(func=...)
-"""
+(:mod:`cdpr_exu.studies.accuracy`)."""
 
 from __future__ import annotations
 
@@ -49,24 +37,6 @@ for a 2-parameter grid) into --out. Failed and refused runs are recorded as rows
 """
 
 
-def study_subparsers(subparsers: argparse._SubParsersAction) -> argparse._SubParsersAction:
-    """The sub-parsers of ``cdpr study`` (made on first call; the same object after).
-
-    Other modules add ``cdpr study <name>`` commands with
-    ``study_subparsers(subparsers).add_parser(name, ...)`` in their ``add_commands``.
-    """
-    existing = getattr(subparsers, "_cdpr_study_subparsers", None)
-    if existing is not None:
-        return existing
-    study = subparsers.add_parser("study", help="parameter studies over a scene, in parallel",
-                                  description="Parameter studies: run a scene over many parameter values "
-                                  "on all cores or on a Dask cluster, and tabulate and plot the results.",
-                                  epilog=EPILOG_STUDY + "\n" + EXIT_CODES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    study_sub = study.add_subparsers(dest="study_command", required=True, metavar="COMMAND")
-    subparsers._cdpr_study_subparsers = study_sub
-    return study_sub
-
-
 def _cmd_sweep(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)  # planar or spatial
     if args.end_time is not None:
@@ -90,9 +60,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _add_sweep(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cdpr study sweep`` (and the ``study`` group) to the ``cdpr`` command."""
-    sweep = study_subparsers(subparsers).add_parser(
+def _add_sweep(study: argparse._SubParsersAction) -> None:
+    sweep = study.add_parser(
         "sweep", help="run a scene over a grid of parameter values",
         description="Run a scene once per combination of parameter values (a grid, or --zip), in "
         "parallel, and write a CSV/JSON table and summary plots. Failed and refused runs are recorded, "
@@ -151,9 +120,8 @@ def _cmd_accuracy(args: argparse.Namespace) -> int:
     return 0
 
 
-def _add_accuracy(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cdpr study accuracy`` to the ``cdpr`` command."""
-    accuracy = study_subparsers(subparsers).add_parser(
+def _add_accuracy(study: argparse._SubParsersAction) -> None:
+    accuracy = study.add_parser(
         "accuracy", help="error against run time over the model ladder, elements and step sizes",
         description="Run a scene on every model of the ladder over elements per cable and step sizes, "
         "compare each run with a reference (the full model, finest discretisation), and write the "
@@ -172,5 +140,11 @@ def _add_accuracy(subparsers: argparse._SubParsersAction) -> None:
 
 def add_commands(subparsers: argparse._SubParsersAction) -> None:
     """Add ``cdpr study`` with its sub-commands ``sweep`` and ``accuracy`` to the ``cdpr`` command."""
-    _add_sweep(subparsers)
-    _add_accuracy(subparsers)
+    study = subparsers.add_parser("study", help="parameter studies over a scene, in parallel",
+                                  description="Parameter studies: run a scene over many parameter values "
+                                  "on all cores or on a Dask cluster, and tabulate and plot the results.",
+                                  epilog=EPILOG_STUDY + "\n" + EXIT_CODES,
+                                  formatter_class=argparse.RawDescriptionHelpFormatter)
+    study_sub = study.add_subparsers(dest="study_command", required=True, metavar="COMMAND")
+    _add_sweep(study_sub)
+    _add_accuracy(study_sub)

@@ -1,11 +1,4 @@
-"""``cdpr view`` and ``cdpr animate``: replay a run folder (:mod:`cdpr_exu.post.viewer`).
-
-Examples::
-
-    cdpr view results/paper_circle
-    cdpr animate results/paper_circle --out results/paper_circle/animation.gif
-    cdpr animate results/paper_circle --out circle.mp4 --fps 30 --size 960x720
-"""
+"""``cdpr view`` and ``cdpr animate``: replay a run folder (:mod:`cdpr_exu.post.viewer`)."""
 
 from __future__ import annotations
 
@@ -13,7 +6,7 @@ import argparse
 import sys
 
 from cdpr_exu.core.errors import EXIT_CODES
-from cdpr_exu.post.viewer import (DEFAULT_FPS, DEFAULT_SIZE, NoDisplayError, parse_size, render_animation_timed,
+from cdpr_exu.post.viewer import (DEFAULT_FPS, DEFAULT_SIZE, NoDisplayError, parse_size, render_animation,
                                    view_solution)
 
 EPILOG_VIEW = """examples:
@@ -54,9 +47,9 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
 
 def _cmd_animate(args: argparse.Namespace) -> int:
-    out, frames, seconds = render_animation_timed(args.run_dir, args.out, fps=args.fps, every=args.every,
-                                                  size=args.size, frames_dir=args.frames_dir,
-                                                  progress=not args.quiet, multi_sampling=2)
+    out, frames, seconds = render_animation(args.run_dir, args.out, fps=args.fps, every=args.every,
+                                            size=args.size, frames_dir=args.frames_dir,
+                                            progress=not args.quiet)
     if not args.quiet:
         print(f"wrote {out}: {frames} frames of {args.size[0]}x{args.size[1]} at {args.fps:g} frames/s "
               f"({seconds:.3f} s per frame)")

@@ -1,17 +1,12 @@
-"""Figures of a run: the robot at several instants, the platform's path, rotation,
-errors and cable tensions (the paper's Figs. 6 and 7), and controller comparisons; the
-rest of the static mode (:func:`plot_rest`: a profile in the plane, 3-D and from above in
-space); a spatial run's overview (:func:`plot_spatial_run`).
+"""Figures of a run: the robot at several instants, the platform's path, rotation, errors and cable
+tensions (the paper's Figs. 6 and 7), controller comparisons, a spatial run's overview
+(:func:`plot_spatial_run`) and the rest of the static mode (:func:`plot_rest`).
 
-Every function takes a :class:`~cdpr_exu.scenes.scene.Scene` and/or a
-:class:`~cdpr_exu.results.result.Result`, writes one PNG and returns its path. Figures are
-made with :class:`matplotlib.figure.Figure` and the Agg canvas, without pyplot's global
-state, so they are safe in worker processes and need no display.
-
-A failed or partial run is plotted as far as it goes: rows whose platform pose is not
-finite are left out, and an instant the run never reached is marked as such.
-Positions are in the paper's vertical x-z plane; the rotation is positive
-counter-clockwise; errors are actual - reference.
+Each writes PNGs and returns their paths, drawn on :class:`matplotlib.figure.Figure` with the Agg
+canvas (no pyplot state: safe in worker processes, no display). A failed or partial run is plotted as
+far as it goes: rows whose pose is not finite are left out, an instant never reached is marked.
+Planar positions are in the paper's x-z plane, the rotation positive counter-clockwise; errors are
+actual - reference.
 """
 
 from __future__ import annotations
@@ -56,18 +51,10 @@ _PLATFORM_COLOR = "0.25"
 _PULLEY_COLOR = "0.55"
 
 
-# --------------------------------------------------------------------------- helpers
-
-
 def new_figure(width: float, height: float, left: float = 0.85, right: float = 0.2, bottom: float = 0.6,
                top: float = 0.4, wspace: float = 0.0, hspace: float = 0.0, columns: int = 1,
                lines: int = 1) -> Figure:
-    """A new figure with an Agg canvas attached (no pyplot), its subplot margins fixed.
-
-    All sizes in inches: the figure's ``width`` and ``height``, the margins around the
-    grid of ``lines`` x ``columns`` axes, and the gaps ``wspace``/``hspace`` between
-    them. Fixed margins instead of a layout engine halve the drawing time.
-    """
+    """A figure with an Agg canvas and fixed margins [inches] (half the drawing time of a layout engine)."""
     figure = Figure(figsize=(width, height))
     FigureCanvasAgg(figure)
     axes_width = (width - left - right - wspace * (columns - 1)) / columns
@@ -78,11 +65,9 @@ def new_figure(width: float, height: float, left: float = 0.85, right: float = 0
 
 
 def save_figure(figure: Figure, path: str | Path) -> Path:
-    """Write ``figure`` as PNG to ``path`` (parent folders made) and return the path."""
+    """Write ``figure`` as PNG to ``path`` (parent folders made; "tight": grown to hold every artist)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    # "tight" grows the image to hold every artist (a legend below the axes, a long
-    # title), so that nothing is cut at the edges; the margin is plain background.
     figure.savefig(path, dpi=DPI, format="png", bbox_inches="tight", pad_inches=0.1)
     return path
 
@@ -106,11 +91,7 @@ def _last_time(result: Result) -> float | None:
 
 
 def _reference_path(scene: Scene | None, result: Result | None) -> np.ndarray:
-    """The whole reference path (x, z) of the platform centre, shape (K, 2) [m].
-
-    Sampled from the scene's trajectory over the scene's full end time, so that a
-    partial run still shows where it was meant to go; else the result's reference.
-    """
+    """The reference path (x, z) (K, 2) [m]: the scene's over its whole end time, else the result's."""
     if scene is not None and scene.trajectory is not None:
         end = float(scene.solver.end_time)
         if result is not None and len(result.time) and np.isfinite(result.time).any():
@@ -167,17 +148,8 @@ def _draw_pulleys(ax, scene: Scene) -> None:
 
 
 def _free_span_sag(scene: Scene, i: int, nodes: np.ndarray):
-    """Straight chord of cable ``i``'s free span and its largest sag below it.
-
-    The chord runs from the ideal tangent point on the pulley (the pulley centre for a
-    point exit) to the anchor, the last node. The sag is the largest distance of a free
-    node (off the pulley disc, between the chord's ends) below the chord.
-
-    Returns
-    -------
-    (start, end, sag) : ndarray (2,), ndarray (2,), float [m]; or None if the chord
-    cannot be formed (anchor inside the pulley, non-finite nodes).
-    """
+    """``(start, end, sag)`` [m]: cable ``i``'s chord from the exit's tangent point to the anchor and the
+    largest distance below it of a free node; None where no chord forms."""
     if not np.all(np.isfinite(nodes)):
         return None
     anchor = nodes[-1]
@@ -198,7 +170,6 @@ def _free_span_sag(scene: Scene, i: int, nodes: np.ndarray):
     relative = nodes - start
     along = relative @ direction
     below = relative @ normal
-    # Free nodes: those after the last one touching the pulley (winch-side nodes excluded).
     on_pulley = np.flatnonzero(np.linalg.norm(nodes - center, axis=1) <= radius * 1.02 + 1e-9)
     first_free = on_pulley[-1] + 1 if len(on_pulley) else 1
     free = np.zeros(len(nodes), dtype=bool)
@@ -297,9 +268,6 @@ def _time_axis(ax, scene: Scene | None, result: Result) -> None:
     if end:
         ax.set_xlim(0.0, end)
     ax.grid(True, linewidth=0.4, alpha=0.6)
-
-
-# --------------------------------------------------------------------------- axes
 
 
 def _snapshot_axes(ax, scene: Scene, result: Result, rows: np.ndarray, t: float, limits) -> None:
@@ -403,32 +371,10 @@ def _errors_axes(ax, scene: Scene | None, result: Result) -> None:
     _mark_end(ax, result)
 
 
-# --------------------------------------------------------------------------- figures
-
-
 def plot_snapshots(scene: Scene, result: Result, path: str | Path,
                    times: Iterable[float] = (0, 2, 4, 6, 8, 10)) -> Path:
-    """The robot at several instants in the x-z plane (paper Fig. 6), one panel each.
-
-    Each panel shows the pulleys, each cable as the polyline of its nodes (square:
-    winch end), the platform rectangle, the reference path (dashed) and the path of
-    the platform centre so far (solid). All panels share limits and an equal aspect.
-
-    Parameters
-    ----------
-    scene : Scene
-    result : Result
-    path : str or Path
-        PNG file to write.
-    times : iterable of float [s]
-        Instants to show; the nearest stored sample is drawn. An instant after the
-        end of a failed run gives a panel saying so.
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
+    """The robot at the instants ``times`` [s] (the nearest samples) in the x-z plane (paper Fig. 6), one
+    panel each, with the reference (dashed) and the path so far (solid)."""
     times = [float(t) for t in times]
     rows = _valid_rows(result)
     limits = _robot_limits(scene, result, rows)
@@ -468,61 +414,29 @@ def plot_snapshots(scene: Scene, result: Result, path: str | Path,
     return save_figure(figure, path)
 
 
-def plot_path(scene: Scene, result: Result, path: str | Path) -> Path:
-    """Reference and actual path of the platform centre in the x-z plane (Fig. 7a).
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
-    figure = new_figure(5.5, 5.6, left=0.8, bottom=1.0)
-    _path_axes(figure.add_subplot(), scene, result)
+def _one_panel(draw, path: str | Path, scene: Scene | None, result: Result, *size, **margins) -> Path:
+    figure = new_figure(*size, **margins)
+    draw(figure.add_subplot(), scene, result)
     return save_figure(figure, path)
+
+
+def plot_path(scene: Scene, result: Result, path: str | Path) -> Path:
+    """Reference and actual path of the platform centre in the x-z plane (Fig. 7a)."""
+    return _one_panel(_path_axes, path, scene, result, 5.5, 5.6, left=0.8, bottom=1.0)
 
 
 def plot_rotation(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
-    """Platform rotation [deg] over time, positive counter-clockwise (Fig. 7b).
-
-    ``scene`` (optional) sets the time axis to the scene's full end time.
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
-    figure = new_figure(6.0, 3.8)
-    _rotation_axes(figure.add_subplot(), scene, result)
-    return save_figure(figure, path)
+    """Platform rotation [deg] over time (Fig. 7b); over the ``scene``'s end time if given."""
+    return _one_panel(_rotation_axes, path, scene, result, 6.0, 3.8)
 
 
 def plot_errors(result: Result, path: str | Path, scene: Scene | None = None) -> Path:
-    """x and z error of the platform centre, actual - reference [cm], over time (Fig. 7c).
-
-    ``scene`` (optional) sets the time axis to the scene's full end time.
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
-    figure = new_figure(6.0, 3.8)
-    _errors_axes(figure.add_subplot(), scene, result)
-    return save_figure(figure, path)
+    """x and z error of the platform centre [cm] over time (Fig. 7c)."""
+    return _one_panel(_errors_axes, path, scene, result, 6.0, 3.8)
 
 
 def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
-    """Cable tensions over time [N]: the element at the platform end and at the winch
-    end of each cable, and the range over all its elements (shaded); one panel per cable.
-
-    Negative values are compression (the lumped elements can push unless the scene
-    makes them tension-only).
-
-    Returns
-    -------
-    Path
-        The file written.
-    """
+    """Cable tensions [N] over time, one panel per cable: platform end, winch end, all elements' range."""
     m = len(result.tensions)
     lines = max(1, m)
     figure = new_figure(6.5, 0.95 + 2.3 * lines + 0.4 * (lines - 1), top=0.35, hspace=0.4, lines=lines)
@@ -555,30 +469,13 @@ def plot_tensions(scene: Scene, result: Result, path: str | Path) -> Path:
 
 def plot_overview(scene: Scene, result: Result, folder: str | Path, times: Iterable[float] | None = None,
                   after: float = 1.0) -> list[Path]:
-    """The figures of one run, planar or spatial, into ``folder``: the figure functions of the result's
-    space (:data:`OVERVIEWS`): :func:`plot_planar_overview` or :func:`plot_spatial_run` (``overview.png``,
-    its errors marked from ``after`` [s] on). Returns the files written."""
+    """The figures of one run into ``folder``, its space's (:data:`OVERVIEWS`); returns the files written."""
     return OVERVIEWS[result.space](scene, result, Path(folder), times, after)
 
 
 def plot_planar_overview(scene: Scene, result: Result, folder: str | Path,
                          times: Iterable[float] | None = None, after: float = 1.0) -> list[Path]:  # noqa: ARG001
-    """All figures of one planar run into ``folder`` with fixed names, plus a 2x2 overview.
-
-    Writes ``snapshots.png``, ``path.png``, ``rotation.png``, ``errors.png``,
-    ``tensions.png`` and ``overview.png`` (path, rotation, errors and the robot at
-    several instants in one panel).
-
-    Parameters
-    ----------
-    times : iterable of float [s], optional
-        Snapshot instants; by default six, evenly spread over the scene's end time.
-
-    Returns
-    -------
-    list of Path
-        The files written, in the order above.
-    """
+    """All figures of one planar run into ``folder`` (:data:`OVERVIEW_FILES`); snapshots at ``times`` [s]."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     if times is None:
@@ -608,25 +505,8 @@ def plot_planar_overview(scene: Scene, result: Result, folder: str | Path,
 
 
 def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | Path) -> list[Path]:
-    """Compare several runs of one scene, e.g. controllers: one colour per run.
-
-    Writes ``comparison_paths.png`` (platform-centre paths against the reference, equal
-    aspect) and ``comparison_errors.png`` (position error norm |actual - reference| over
-    time [cm]).
-
-    Parameters
-    ----------
-    scene : Scene
-        Gives the reference path and the time span.
-    results : mapping of str to Result
-        Runs by label, in legend order.
-    folder : str or Path
-
-    Returns
-    -------
-    list of Path
-        The two files written.
-    """
+    """Compare runs of one scene by label, one colour each: ``comparison_paths.png`` (the paths against the
+    reference) and ``comparison_errors.png`` (position error norm [cm] over time)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     colors = [f"C{j % 10}" for j in range(len(results))]
@@ -671,9 +551,6 @@ def plot_comparison(scene: Scene, results: Mapping[str, Result], folder: str | P
     return paths
 
 
-# --------------------------------------------------------------------------- rest states and spatial runs
-
-
 def plot_rest(rest: Rest, path: str | Path) -> Path:
     """Figure of a scene at rest, its space's (:data:`REST_FIGURES`); writes a PNG and returns its path."""
     return REST_FIGURES[rest.space](rest, path)
@@ -705,10 +582,7 @@ def _planar_rest(rest: Rest, path: str | Path) -> Path:
     ax.grid(True, linewidth=0.4, alpha=0.5)
     ax.legend(loc="upper center", fontsize=7, framealpha=0.9)
     ax.set_title(f"{scene.name} at rest ({rest.method}; x: leave points)", fontsize=9)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=DPI, format="png", bbox_inches="tight")
-    return path
+    return save_figure(figure, path)
 
 
 #: Points per catenary curve in a spatial rest's figure.
@@ -765,8 +639,7 @@ def _spatial_rest(rest: Rest, path: str | Path) -> Path:
 
 
 def plot_spatial_run(result: Result, path: str | Path, after: float = 1.0) -> Path:
-    """Overview figure: the path from above and from the side, against the reference; the position
-    error over time; the lowest element tension of each cable over time."""
+    """A spatial run's overview: its path from above and from the side, position error and lowest tensions."""
     figure = Figure(figsize=(11.0, 8.0))
     FigureCanvasAgg(figure)
     axes = figure.subplots(2, 2)
@@ -784,17 +657,15 @@ def plot_spatial_run(result: Result, path: str | Path, after: float = 1.0) -> Pa
     for k, name in enumerate("xyz"):
         error.plot(result.time, 1000.0 * result.position_error[:, k], label=f"error {name}")
     error.axvline(after, color="0.6", linewidth=0.8, linestyle=":")
-    error.set_xlabel("t [s]")
-    error.set_ylabel("actual - reference [mm]")
-    error.grid(True, linewidth=0.3)
-    error.legend(fontsize=8)
     for i, series in enumerate(result.tensions):
         tension.plot(result.time, series.min(axis=1), label=f"cable {i + 1}")
     tension.axhline(0.0, color="k", linewidth=0.8)
-    tension.set_xlabel("t [s]")
-    tension.set_ylabel("lowest element tension [N]")
-    tension.grid(True, linewidth=0.3)
-    tension.legend(fontsize=7, ncol=2)
+    for ax, label, legend in ((error, "actual - reference [mm]", {"fontsize": 8}),
+                              (tension, "lowest element tension [N]", {"fontsize": 7, "ncol": 2})):
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel(label)
+        ax.grid(True, linewidth=0.3)
+        ax.legend(**legend)
     summary = result.summary(after)
     worst = summary["max_position_error_m"]
     figure.suptitle(f"{result.scene_name} under {result.controller}: max position error after {after:g} s "

@@ -1,9 +1,7 @@
-"""Figures of the studies: a parameter sweep's figures (:func:`plot_study`) and the accuracy study's
-Pareto plot (:func:`plot_pareto`).
-
-Each takes the study's rows (plain data) or its :class:`~cdpr_exu.studies.accuracy.AccuracyStudy`,
-writes PNGs and returns their paths; the studies (:mod:`cdpr_exu.studies.study`,
-:mod:`cdpr_exu.studies.accuracy`) call them when they write their folders.
+"""Figures of the studies: a parameter sweep's (:func:`plot_study`), a robustness study's heat maps
+(:func:`plot_robustness`) and the accuracy study's Pareto plot (:func:`plot_pareto`), from their rows
+(plain data) or the :class:`~cdpr_exu.studies.accuracy.AccuracyStudy`; each writes PNGs and returns
+their paths.
 """
 
 from __future__ import annotations
@@ -22,9 +20,6 @@ from cdpr_exu.core.output import finite_number, value_text
 from cdpr_exu.post.plots import DPI, new_figure, save_figure
 
 
-# --------------------------------------------------------------------------- parameter studies
-
-
 def _file_stem(path: str) -> str:
     return re.sub(r"[^A-Za-z0-9_]+", "_", path).strip("_")
 
@@ -35,14 +30,10 @@ def _is_numeric(values: Sequence[Any]) -> bool:
 
 def plot_study(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], out: str | Path,
                mode: str = "grid") -> dict[str, Path]:
-    """Summary figures of a study; returns their paths by name. ``rows`` are :func:`~cdpr_exu.studies.study.run_study`'s,
-    ``variations`` its :class:`~cdpr_exu.studies.study.Variation` objects (``path`` and ``values``).
-
-    For each varied parameter, ``vs_<path>.png``: the maximum position error and the
-    Newton iterations (the run's cost, the same from run to run, unlike its wall time) against that parameter (one line per value of the other parameter in a
-    2-parameter grid, per combination of the others beyond). A 2-parameter grid also
-    gets ``heatmap.png``. Failed and refused runs are marked with red crosses at the
-    bottom of the axes.
+    """Summary figures of a study (``rows`` and ``variations`` of :func:`~cdpr_exu.studies.study.run_study`),
+    by name: for each varied parameter ``vs_<path>.png``, the max position error and the Newton
+    iterations (a cost the same from run to run) against it, one line per combination of the others;
+    ``heatmap.png`` for a 2-parameter grid. Failed and refused runs: red crosses at the foot of the axes.
     """
     out = Path(out)
     written: dict[str, Path] = {}
@@ -137,10 +128,8 @@ def _plot_heatmap(rows: Sequence[Mapping[str, Any]], variations: Sequence[Any], 
 
 
 def plot_robustness(rows: Sequence[Mapping[str, Any]], out: str | Path) -> dict[str, Path]:
-    """A heat map per controller of a robustness study (:mod:`cdpr_exu.studies.robustness`) over its
-    platform mass and cable density errors (at the nominal stiffness and exits): the max position error and its ratio to
-    ideal IK's;
-    ``robustness_<controller>.png``, returned by name."""
+    """``robustness_<controller>.png`` by name: a robustness study's max position error (and its ratio to
+    ideal IK's) over the platform mass and cable density errors, at the nominal stiffness and exits."""
     axes = [SimpleNamespace(path=name, values=tuple(sorted({row[name] for row in rows})))  # as a study's Variation
             for name in ("platform_mass", "cable_density")]
     quantities = (("max_position_error_m", 1000.0, "max position error [mm]"),
@@ -154,8 +143,6 @@ def plot_robustness(rows: Sequence[Mapping[str, Any]], out: str | Path) -> dict[
     return written
 
 
-# --------------------------------------------------------------------------- accuracy study
-
 #: Colours of the ladder's models; other models take the spare colours in turn.
 _MODEL_COLORS = {"ideal": "tab:gray", "elastic": "tab:green", "catenary": "tab:orange", "full": "tab:blue",
                  "full, linear bending": "tab:purple"}  # model_name("full", LINEAR_BENDING) of the accuracy study
@@ -164,12 +151,8 @@ _STEP_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 
 
 def plot_pareto(study, path: str | Path) -> Path:
-    """Error against cost (CPU time), log-log: one marker per run, coloured by model, Pareto front drawn.
-
-    Left: the platform position error; right: the RMS error of the platform-end
-    tensions. Marker shapes give the step size; tolerance lines at 1 mm, 1 cm, 5 cm. ``study`` is a
-    :class:`~cdpr_exu.studies.accuracy.AccuracyStudy`.
-    """
+    """An AccuracyStudy's position and tension errors against CPU time, log-log: a marker per run (colour:
+    model, shape: step size), the Pareto front drawn."""
     rows = study.rows
     models = list(dict.fromkeys(r["model"] for r in rows))
     spare = [m for m in models if m not in _MODEL_COLORS]

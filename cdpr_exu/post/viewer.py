@@ -1,32 +1,15 @@
 """Replay a finished run: Exudyn's SolutionViewer, or a headless GIF/MP4 animation.
 
-A run folder written by ``cdpr run SCENE --out DIR`` holds ``scene.toml`` and
-``solution.sol`` (Exudyn's binary solution file), for planar and spatial scenes alike. The
-scene rebuilds the identical Exudyn system (:func:`cdpr_exu.builder.model.build_model`, or
-for a spatial scene the same entry); each row of the
-solution file is then loaded into it (:func:`exudyn.utilities.SetSolutionState`) and drawn.
+A run folder of ``cdpr run SCENE --out DIR`` holds ``scene.toml`` and ``solution.sol`` (Exudyn's
+binary solution file). The scene rebuilds the identical Exudyn system
+(:func:`cdpr_exu.builder.model.build_model`), each row of the solution file is loaded into it
+(:func:`exudyn.utilities.SetSolutionState`) and drawn: interactively (:func:`view_solution`, ``cdpr view``,
+which needs a display) or by Exudyn's software raytracer into a GIF or MP4 (:func:`render_animation`,
+``cdpr animate``; a spatial run is drawn from its ``result.npz`` with matplotlib's 3-D axes).
 
-- :func:`view_solution` (``cdpr view DIR``) replays the run in Exudyn's interactive
-  ``SolutionViewer``: it needs a display. Without one it raises
-  :class:`NoDisplayError` before touching Exudyn's windows (Exudyn would end the
-  whole process there).
-- :func:`render_animation` (``cdpr animate DIR``) draws each chosen row with Exudyn's
-  software raytracer (no window, no OpenGL) and writes a GIF (Pillow) or an MP4
-  (the optional package ``imageio-ffmpeg``), and optionally the PNG frames; a spatial
-  run is drawn from its ``result.npz`` with matplotlib's 3-D axes. The frames source is
-  the one the run's :class:`~cdpr_exu.space.Space` names in :data:`FRAME_SOURCES`.
-
-Both add drawing-only items before replaying (:func:`decorate_model`): the pulleys
-as discs, the platform as its rectangle (``platform.size``) and the reference path
-of the platform as a polyline. They are ground graphics and body graphics only, so
-the coordinates of the system, and thus the columns of the solution file, are
-unchanged (checked on every load). Exudyn's x-y plane is the paper's x-z plane.
-
-Examples::
-
-    cdpr view results/paper_circle
-    cdpr animate results/paper_circle --out results/paper_circle/animation.gif
-    cdpr animate results/paper_circle --out circle.mp4 --fps 30 --size 960x720
+Planar replays get drawing-only items (:func:`decorate_model`: pulleys, platform rectangle, reference
+path): ground and body graphics only, so the columns of the solution file are unchanged (checked on
+every load). Exudyn's x-y plane is the paper's x-z plane.
 """
 
 from __future__ import annotations
@@ -61,7 +44,7 @@ SOLUTION_FILE = "solution.sol"
 DEFAULT_SIZE = (640, 480)
 #: Default frame rate of ``cdpr animate`` [frames per second].
 DEFAULT_FPS = 25.0
-#: Highest frame rate a GIF can store: its frame times are whole hundredths of a second [frames per second].
+#: Highest frame rate a GIF can store (frame times in hundredths of a second) [frames per second].
 MAX_GIF_FPS = 100.0
 #: Share of the scene's extent left free around it in an animation frame.
 FRAME_MARGIN = 0.06
@@ -95,24 +78,10 @@ class NoDisplayError(CdprError, RuntimeError):
     """No window can be opened here (no display, or Exudyn's windows are switched off)."""
 
 
-# --------------------------------------------------------------------------- loading
-
-
 @dataclass
 class Replay:
-    """A run folder loaded for replay: its scene, the rebuilt model and the solution.
-
-    Attributes
-    ----------
-    run_dir : Path
-    scene : Scene
-    model : Model or Model3D
-        Rebuilt from ``scene.toml`` (:func:`cdpr_exu.builder.model.build_model`); a planar one decorated
-        (:func:`decorate_model`).
-    solution : dict
-        As returned by :func:`exudyn.utilities.LoadSolutionFile`; ``solution["data"]``
-        has shape (n_rows, n_columns + 1), time first.
-    """
+    """A run folder loaded for replay: its scene, the model rebuilt from it and the solution
+    (:func:`exudyn.utilities.LoadSolutionFile`'s dict; ``solution["data"]``: a row per output, time first)."""
 
     run_dir: Path
     scene: Scene
@@ -121,7 +90,6 @@ class Replay:
 
     @property
     def n_rows(self) -> int:
-        """Number of stored time instants."""
         return int(self.solution["nRows"])
 
     @property
@@ -130,14 +98,8 @@ class Replay:
         return np.asarray(self.solution["data"][:, 0], dtype=float)
 
     def positions(self) -> dict[str, np.ndarray]:
-        """Positions of the platform and of every cable node in each row.
-
-        Returns
-        -------
-        dict
-            ``"platform"``: shape (n_rows, 3) (x, z, rotation) [m, m, rad];
-            ``"cable_i"``: shape (n_rows, n_i + 1, 2) [m], winch end first.
-        """
+        """Planar positions in each row: ``"platform"`` (n_rows, 3) (x, z, rotation) [m, rad] and
+        ``"cable_i"`` (n_rows, n_i + 1, 2) [m], winch end first."""
         mbs = self.model.mbs
         reference = mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
         n_ode2 = int(self.solution["columnsExported"][0])
@@ -145,8 +107,7 @@ class Replay:
         return {name: q[:, index] for name, index in self.model.coordinate_indices().items()}
 
     def platform_pose(self) -> np.ndarray:
-        """The platform's pose in each row, shape (n_rows, pose size): planar (x, z, rotation) [m, m, rad],
-        spatial centre of mass [m] and rotation vector [rad] (by the scene's space, :data:`VIEWS`)."""
+        """The platform's pose in each row, shape (n_rows, pose size) [m, rad] (:data:`VIEWS`)."""
         return VIEWS[self.scene.space].poses(self)
 
 
@@ -157,30 +118,24 @@ def _require_file(path: Path, what: str) -> Path:
     return path
 
 
-def run_files(run_dir: str | Path) -> tuple[Path, Path]:
-    """Paths of the scene and solution files of a run folder, checked to exist.
-
-    Raises
-    ------
-    RunFolderError
-        If the folder or one of the two files is missing.
-    """
+def _run_folder(run_dir: str | Path) -> Path:
+    """``run_dir`` as a Path; RunFolderError if it is no folder."""
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise RunFolderError(f"run folder {str(run_dir)!r} does not exist; write one with "
                              f"`cdpr run SCENE --out {run_dir}`")
+    return run_dir
+
+
+def run_files(run_dir: str | Path) -> tuple[Path, Path]:
+    """Paths of the scene and solution files of a run folder; RunFolderError names what is missing."""
+    run_dir = _run_folder(run_dir)
     return (_require_file(run_dir / SCENE_FILE, "scene file"),
             _require_file(run_dir / SOLUTION_FILE, "solution file"))
 
 
 def load_solution(path: str | Path) -> dict:
-    """Read an Exudyn solution file (text or binary) into Exudyn's solution dictionary.
-
-    Raises
-    ------
-    RunFolderError
-        If the file is missing, unreadable or holds no row.
-    """
+    """Read an Exudyn solution file (text or binary); RunFolderError if it is missing, unreadable or empty."""
     path = Path(path)
     _require_file(path, "solution file")
     try:
@@ -192,18 +147,9 @@ def load_solution(path: str | Path) -> dict:
     return solution
 
 
-def check_solution_fits(model, solution: dict, source: str = "the solution") -> None:
-    """Refuse a solution whose coordinate layout differs from the model's.
-
-    Compares the exported sizes (positions, velocities, accelerations, ODE1,
-    algebraic and data coordinates) with the system sizes of ``model`` (a :class:`Model`
-    or an Exudyn ``MainSystem``).
-
-    Raises
-    ------
-    SolutionMismatchError
-    """
-    data = getattr(model, "mbs", model).systemData
+def check_solution_fits(model, solution: dict, source: str) -> None:
+    """SolutionMismatchError if the solution's exported coordinate sizes differ from ``model``'s system."""
+    data = model.mbs.systemData
     n_ode2, n_vel2, n_acc2, n_ode1, n_vel1, n_algebraic, n_data = (int(n) for n in solution["columnsExported"])
     expected = {"ODE2 coordinates": (n_ode2, data.ODE2Size()), "ODE1 coordinates": (n_ode1, data.ODE1Size()),
                 "algebraic coordinates": (n_algebraic, data.AEsize()), "data coordinates": (n_data, data.DataSize())}
@@ -220,59 +166,28 @@ def check_solution_fits(model, solution: dict, source: str = "the solution") -> 
 
 
 def load_replay(run_dir: str | Path, *, decorate: bool = True) -> Replay:
-    """Load a run folder, planar or spatial: scene, rebuilt (and decorated) model, solution file.
-
-    Parameters
-    ----------
-    run_dir : path
-        Folder written by ``cdpr run SCENE --out DIR``.
-    decorate : bool
-        Add the drawing-only items of the scene's view (:data:`VIEWS`: on planar runs the pulleys,
-        platform rectangle and reference path, :func:`decorate_model`).
-
-    Raises
-    ------
-    RunFolderError, SolutionMismatchError, SceneError
-    """
+    """Load a run folder of ``cdpr run SCENE --out DIR``, planar or spatial, with the drawing-only items
+    of its view if ``decorate`` (:data:`VIEWS`). Raises RunFolderError, SolutionMismatchError, SceneError."""
     scene_file, solution_file = run_files(run_dir)
     scene = load_scene(scene_file)
     solution = load_solution(solution_file)
-    model = build_model(scene)
-    check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
-    replay = Replay(Path(run_dir), scene, model, solution)
-    if decorate and VIEWS[scene.space].decorate(replay):
-        check_solution_fits(model, solution, f"solution file {str(solution_file)!r}")
+    replay = Replay(Path(run_dir), scene, build_model(scene), solution)
+    if decorate:
+        VIEWS[scene.space].decorate(replay)
+    check_solution_fits(replay.model, solution, f"solution file {str(solution_file)!r}")
     return replay
 
 
-# --------------------------------------------------------------------------- drawing
-
-
 def reference_path(scene: Scene, times: np.ndarray) -> np.ndarray:
-    """Reference position of the platform at the given times, shape (N, 2) [m].
-
-    Empty, shape (0, 2), when the scene has no trajectory.
-    """
+    """Reference position of the platform at ``times``, shape (N, 2) [m]; (0, 2) without a trajectory."""
     if scene.trajectory is None or len(times) == 0:
         return np.zeros((0, 2))
     return np.atleast_2d(scene.trajectory.pose(np.asarray(times, dtype=float)))[:, :2]
 
 
 def thin_polyline(points: np.ndarray, min_segment: float) -> np.ndarray:
-    """Drop points of a polyline closer than ``min_segment`` to the last kept one.
-
-    Exudyn's raytracer leaves out segments shorter than about a pixel, so a finely
-    sampled path must be thinned to be drawn at all. The last point is always kept.
-
-    Parameters
-    ----------
-    points : ndarray, shape (N, 2) [m]
-    min_segment : float [m]
-
-    Returns
-    -------
-    ndarray, shape (K, 2) [m], K <= N
-    """
+    """The points (N, 2) [m] of a polyline less those closer than ``min_segment`` [m] to the last kept one
+    (the last point always kept): Exudyn's raytracer leaves out segments shorter than about a pixel."""
     points = np.asarray(points, dtype=float)
     points = points[np.all(np.isfinite(points), axis=1)]
     if len(points) < 2:
@@ -297,24 +212,9 @@ def scene_extent(scene: Scene) -> float:
 
 
 def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
-    """Add drawing-only items to an assembled model and assemble it again.
-
-    Adds a ground object with the pulleys (discs with rim and axle) and the
-    reference path (a polyline, or a small circle for a fixed reference), gives the
-    platform body its rectangle and anchor points, draws cables as plain lines and
-    hides the constraint and contact symbols. No node and no coordinate is added.
-
-    Parameters
-    ----------
-    model : Model
-    reference_xz : ndarray, shape (N, 2) [m], optional
-        Reference path of the platform.
-
-    Returns
-    -------
-    int
-        Index of the added ground object.
-    """
+    """Add drawing-only items (no node, no coordinate) to an assembled planar model and assemble it again;
+    returns the new ground object's index: pulleys, the reference path ``reference_xz`` (N, 2) [m], the
+    platform's rectangle and anchors, cables as lines, no constraint or contact symbols."""
     scene, mbs = model.scene, model.mbs
     extent = scene_extent(scene)
     items = []
@@ -358,8 +258,7 @@ def decorate_model(model: Model, reference_xz: np.ndarray | None = None) -> int:
 
 
 def _style_settings(settings, extent: float) -> None:
-    """Visualization settings of every replay (viewer and animation): no load arrows or markers, cable
-    elements as lines, nodes as small spheres for a scene ``extent`` [m] across, the view kept where set."""
+    """Visualization settings of every replay, for a scene ``extent`` [m] across."""
     settings.loads.show = False
     settings.markers.show = False
     settings.connectors.springNumberOfWindings = 1
@@ -371,15 +270,14 @@ def _style_settings(settings, extent: float) -> None:
 
 
 def _style(model: Model) -> None:
-    """Visualization settings of a planar replay (:func:`_style_settings`), without the coordinate system."""
+    """A planar replay's settings, without the coordinate system."""
     settings = model.system_container.visualizationSettings
     _style_settings(settings, scene_extent(model.scene))
     settings.view0.scene.drawCoordinateSystem = 0
 
 
 def _spatial_poses(replay: Replay) -> np.ndarray:
-    """A spatial replay's platform pose in each row: centre of mass [m] and rotation vector [rad],
-    shape (n_rows, 6)."""
+    """A spatial replay's platform pose (centre [m], rotation vector [rad]) in each row, shape (n_rows, 6)."""
     mbs, items = replay.model.mbs, replay.model.items
     poses = []
     for row in range(replay.n_rows):
@@ -390,8 +288,7 @@ def _spatial_poses(replay: Replay) -> np.ndarray:
 
 
 def _style_spatial(replay: Replay, size: tuple[int, int] = (1024, 768)) -> None:
-    """Visualization settings of a spatial replay (:func:`_style_settings`) and a view
-    from the side (z up, turned 27 degrees about it) onto the middle of the exits and the platform's path."""
+    """A spatial replay's settings and a side view onto the exits and the platform's path."""
     settings = replay.model.system_container.visualizationSettings
     points = np.vstack([replay.scene.exit_points, _spatial_poses(replay)[:, :3]])
     low, high = points.min(axis=0), points.max(axis=0)
@@ -406,14 +303,12 @@ def _style_spatial(replay: Replay, size: tuple[int, int] = (1024, 768)) -> None:
     advanced.initialModelRotation = (RotationMatrixX(-0.5 * np.pi) @ RotationMatrixZ(-0.15 * np.pi)).T.tolist()
 
 
-def _decorate_planar(replay: Replay) -> bool:
-    """Add the planar drawing items (:func:`decorate_model`); True: the model changed."""
+def _decorate_planar(replay: Replay) -> None:
     decorate_model(replay.model, reference_path(replay.scene, replay.times))
-    return True
 
 
 def _view_planar(replay: Replay) -> None:
-    """The planar replay's look in SolutionViewer: its style and a camera fitted to the x-z plane."""
+    """A planar replay's look in SolutionViewer: its style and a camera fitted to the x-z plane."""
     _style(replay.model)
     fit_camera(_view_points(replay), (1024, 768), caption_band=0.12).apply(replay.model)
 
@@ -421,29 +316,17 @@ def _view_planar(replay: Replay) -> None:
 @dataclass(frozen=True)
 class View:
     """How a replay of one space is read and drawn: ``poses(replay)`` the platform's pose in each row,
-    ``decorate(replay) -> bool`` adds drawing-only items (True if any), ``style(replay)`` sets
-    SolutionViewer's look and camera."""
+    ``decorate(replay)`` adds drawing-only items, ``style(replay)`` sets SolutionViewer's look and camera."""
 
     poses: object
     decorate: object
     style: object
 
 
-# --------------------------------------------------------------------------- camera
-
-
 @dataclass(frozen=True)
 class Camera:
-    """An orthographic view of the x-z plane (Exudyn x-y), as the raytracer draws it.
-
-    Attributes
-    ----------
-    center : (x, z) [m]
-        World point at the image centre.
-    zoom : float [m]
-        Half the visible height (Exudyn's render-state ``zoom``).
-    size : (width, height) [pixels]
-    """
+    """An orthographic view of the x-z plane (Exudyn x-y): ``center`` (x, z) [m] at the image centre,
+    ``zoom`` [m] half the visible height (Exudyn's), ``size`` (width, height) [pixels]."""
 
     center: tuple[float, float]
     zoom: float
@@ -472,27 +355,16 @@ class Camera:
         advanced.initialModelRotation = np.eye(3).tolist()
 
 
-def fit_camera(points: np.ndarray, size: tuple[int, int], margin: float = FRAME_MARGIN,
-               caption_band: float = CAPTION_BAND) -> Camera:
-    """The view that shows all ``points`` below a caption band, with a margin.
-
-    Parameters
-    ----------
-    points : ndarray, shape (N, 2) [m]
-        Non-finite points are ignored.
-    size : (width, height) [pixels]
-    margin : float
-        Free share of the points' extent on each side.
-    caption_band : float
-        Share of the image height kept free at the top for the caption.
-    """
+def fit_camera(points: np.ndarray, size: tuple[int, int], caption_band: float = CAPTION_BAND) -> Camera:
+    """The view of ``size`` (width, height) [pixels] that shows all finite ``points`` (N, 2) [m] with a
+    margin (:data:`FRAME_MARGIN`) below a caption band (``caption_band``: a share of the image height)."""
     points = np.asarray(points, dtype=float).reshape(-1, 2)
     points = points[np.all(np.isfinite(points), axis=1)]
     if len(points) == 0:
         points = np.zeros((1, 2))
     low, high = points.min(axis=0), points.max(axis=0)
     span = np.maximum(high - low, 1e-3)
-    pad = margin * max(span)
+    pad = FRAME_MARGIN * max(span)
     low, high = low - pad, high + pad
     width, height = size
     band = caption_band * height
@@ -516,23 +388,14 @@ def _view_points(replay: Replay) -> np.ndarray:
     return np.concatenate(parts)
 
 
-# --------------------------------------------------------------------------- viewer
-
-
 #: How each space's replay is drawn: planar runs decorated and fitted to the x-z plane, spatial runs in
 #: Exudyn's own 3-D view fitted to the exits and the platform's path.
 VIEWS = {PLANE: View(lambda replay: replay.positions()["platform"], _decorate_planar, _view_planar),
-         SPACE: View(_spatial_poses, lambda replay: False, _style_spatial)}
+         SPACE: View(_spatial_poses, lambda replay: None, _style_spatial)}
 
 
 def display_problem() -> str | None:
-    """Why no window can be opened here, or None if one can.
-
-    Checks, in this order: Exudyn's own switch (``EXUDYN_SUPPRESS_UI_WINDOW_OPEN``);
-    on Linux and other X11/Wayland systems, that ``DISPLAY`` or ``WAYLAND_DISPLAY``
-    is set; that tkinter (the viewer's dialog) is installed; and on X11 that the
-    display accepts a connection.
-    """
+    """Why no window can be opened here (Exudyn's switch, no display, no tkinter), or None if one can."""
     if getattr(exu.special.userInterface, "suppressSolutionViewer", False):
         return ("Exudyn's windows are switched off in this process (the environment variable "
                 "EXUDYN_SUPPRESS_UI_WINDOW_OPEN is set, or exudyn.special.userInterface.suppressSolutionViewer)")
@@ -561,23 +424,15 @@ def _rows_per_frame(times: np.ndarray, fps: float) -> int:
 
 
 def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
-    """Replay a run folder in Exudyn's interactive SolutionViewer (needs a display).
-
-    Parameters
-    ----------
-    run_dir : path
-        Folder written by ``cdpr run SCENE --out DIR`` (planar or spatial scene).
-    every : int, optional
-        Show every ``every``-th stored row; default: about real time at 25 frames/s.
+    """Replay a run folder in Exudyn's interactive SolutionViewer, every ``every``-th row (default: about
+    real time at 25 frames/s).
 
     Raises
     ------
     RunFolderError, SolutionMismatchError
-        Missing or unfitting files.
     NoDisplayError
-        When no window can be opened here (checked before any window is tried, since
-        Exudyn ends the whole process when it fails to open one). Exudyn's windows
-        are then switched off for the rest of the process as a second guard.
+        When no window can be opened here, checked before any window is tried (Exudyn ends the whole
+        process when it fails to open one); Exudyn's windows are then switched off for the process.
     """
     run_files(run_dir)
     problem = display_problem()
@@ -599,17 +454,8 @@ def view_solution(run_dir: str | Path, *, every: int | None = None) -> None:
                    title=f"cdpr view: {replay.scene.name} ({replay.run_dir})")
 
 
-# --------------------------------------------------------------------------- animation
-
-
 def parse_size(text: str) -> tuple[int, int]:
-    """Parse an image size ``"WIDTHxHEIGHT"`` [pixels], each 32 to 8192.
-
-    Raises
-    ------
-    ValueError
-        With the bad text in the message.
-    """
+    """An image size ``"WIDTHxHEIGHT"`` [pixels], each 32 to 8192; ValueError naming the bad text."""
     try:
         width, height = (int(part) for part in text.lower().split("x"))
     except ValueError:
@@ -665,7 +511,7 @@ class _Writer:
     """Collects frames into a GIF (Pillow) or streams them into an MP4 (imageio-ffmpeg)."""
 
     @staticmethod
-    def check(path: Path, size: tuple[int, int], fps: float = DEFAULT_FPS) -> None:
+    def check(path: Path, size: tuple[int, int], fps: float) -> None:
         """Refuse an animation file this writer cannot make, before any rendering."""
         suffix = path.suffix.lower()
         if suffix not in (".gif", ".mp4"):
@@ -688,7 +534,6 @@ class _Writer:
             raise CdprError(f"the folder of the animation file {str(path)!r} does not exist")
 
     def __init__(self, path: Path, fps: float, size: tuple[int, int]):
-        self.check(path, size)
         self.path, self.fps, self.frames, self.mp4 = path, fps, [], None
         if path.suffix.lower() == ".mp4":
             import imageio_ffmpeg
@@ -721,80 +566,8 @@ class _Writer:
         self.frames = []
 
 
-@dataclass(frozen=True)
-class AnimationRequest:
-    """The checked options of an animation (:func:`check_animation_request`).
-
-    Attributes
-    ----------
-    run_dir : Path
-    out_file : Path
-        ``.gif`` or ``.mp4``.
-    fps : float [1/s]
-    every : int or None
-        Row step; None: real-time playback at ``fps``.
-    size : (width, height) [pixels]
-    frames_dir : Path or None
-        Created; its old ``frame_*.png`` are removed when the rendering starts.
-    space : Space
-        The run's space: it names the frames source (:data:`FRAME_SOURCES`).
-    """
-
-    run_dir: Path
-    out_file: Path
-    fps: float
-    every: int | None
-    size: tuple[int, int]
-    frames_dir: Path | None
-    space: Space
-
-
-def check_animation_request(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
-                            every: int | None = None, size: tuple[int, int] = DEFAULT_SIZE,
-                            frames_dir: str | Path | None = None) -> AnimationRequest:
-    """Check every option of an animation, for planar and spatial runs alike, before any work.
-
-    The one check behind ``cdpr animate`` and :func:`render_animation` (issue 23.12: a
-    spatial ``--fps 0`` or ``nan`` crashed, ``-5`` crashed after the whole rendering, ``inf``
-    wrote a GIF of zero frame times). Messages name the option as the command line spells it.
-
-    Raises
-    ------
-    CdprError
-        A frame rate that is not a finite number > 0 (or more than a GIF can store), a
-        row step that is not a whole number >= 1, a bad size, an animation file of another
-        kind or in a missing folder, a ``--frames-dir`` that is a file.
-    RunFolderError
-        A folder that holds no run.
-    """
-    if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
-            or not (np.isfinite(fps) and fps > 0):
-        raise CdprError(f"--fps must be a finite number of frames per second > 0, got {fps!r}")
-    if every is not None and (isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1):
-        raise CdprError(f"--every must be a whole number >= 1, got {every!r}")
-    try:
-        width, height = (int(n) for n in size)
-    except (TypeError, ValueError):
-        raise CdprError(f"--size must be (width, height) in pixels, got {size!r}") from None
-    if not (32 <= width <= 8192 and 32 <= height <= 8192):
-        raise CdprError(f"--size must be between 32x32 and 8192x8192 pixels, got {width}x{height}")
-    run_dir = Path(run_dir)
-    if not run_dir.is_dir():
-        raise RunFolderError(f"run folder {str(run_dir)!r} does not exist; write one with "
-                             f"`cdpr run SCENE --out {run_dir}`")
-    space = run_space(run_dir)
-    FRAME_SOURCES[space].check(run_dir)
-    out_file = Path(out_file) if out_file is not None else run_dir / "animation.gif"
-    _Writer.check(out_file, (width, height), float(fps))
-    if frames_dir is not None:
-        frames_dir = check_output_folder(frames_dir, "--frames-dir")
-    return AnimationRequest(run_dir, out_file, float(fps), None if every is None else int(every), (width, height),
-                            frames_dir, space)
-
-
 def run_space(run_dir: str | Path) -> Space:
-    """The :class:`~cdpr_exu.space.Space` of the run a ``cdpr run`` folder holds (its result.npz's
-    :class:`~cdpr_exu.results.result.Result`); planar for a folder without one (older planar runs)."""
+    """The Space of the run in a ``cdpr run`` folder (its result.npz's); planar without one (older runs)."""
     path = Path(run_dir) / "result.npz"
     return Result.load(path).space if path.is_file() else PLANE
 
@@ -807,12 +580,12 @@ class _RaytracedFrames:
         """Refuse a folder without the scene and solution files (:func:`run_files`)."""
         run_files(run_dir)
 
-    def __init__(self, run_dir: Path, size: tuple[int, int], multi_sampling: int):
+    def __init__(self, run_dir: Path, size: tuple[int, int]):
         self.replay = replay = load_replay(run_dir)
         model = replay.model
         _style(model)
         settings = model.system_container.visualizationSettings
-        settings.raytracer.multiSampling = int(multi_sampling)
+        settings.raytracer.multiSampling = 2  # samples per pixel: 1 leaves thin lines broken
         settings.raytracer.numberOfThreads = max(1, os.cpu_count() or 1)
         settings.raytracer.advanced.showText = False  # the caption replaces Exudyn's text
         camera = fit_camera(_view_points(replay), size)
@@ -833,24 +606,14 @@ class _RaytracedFrames:
         return self.caption.draw(image, row, float(self.times[row]))
 
 
-
 class _AxesFrames:
-    """The frames of a spatial run: the samples of its ``result.npz`` (cables' nodes, pose, reference)
-    drawn with matplotlib's 3-D axes, each a PIL RGB image of ``size`` pixels.
-
-    Attributes
-    ----------
-    name : str
-        The scene's name (from summary.json), else the folder's.
-    times : ndarray, shape (N,) [s]
-        Time of each stored sample; :meth:`frame` takes its index.
-    """
+    """The frames of a spatial run: the samples of its ``result.npz`` drawn with matplotlib's 3-D axes."""
 
     @staticmethod
     def check(run_dir: Path) -> None:
         """Nothing more to check: :func:`run_space` read the folder's result.npz."""
 
-    def __init__(self, run_dir: Path, size: tuple[int, int], multi_sampling: int):
+    def __init__(self, run_dir: Path, size: tuple[int, int]):
         from matplotlib.backends.backend_agg import FigureCanvasAgg  # matplotlib: only where a run is drawn
         from matplotlib.figure import Figure
 
@@ -893,84 +656,64 @@ class _AxesFrames:
         return image if image.size == self.size else image.resize(self.size)
 
 
-#: The frames source of a run, by its space: each is built as ``source(run_dir, size, multi_sampling)``,
-#: has ``name``, ``times`` [s] and ``frame(row)`` (a PIL RGB image), and ``check(run_dir)`` refuses a
-#: folder it cannot draw before any work.
+#: The frames source of a run, by its space: each is built as ``source(run_dir, size)``, has ``name``,
+#: ``times`` [s] and ``frame(row)`` (a PIL RGB image), and ``check(run_dir)`` refuses a folder it cannot
+#: draw before any work.
 FRAME_SOURCES = {PLANE: _RaytracedFrames, SPACE: _AxesFrames}
+
 
 def render_animation(run_dir: str | Path, out_file: str | Path | None = None, *, fps: float = DEFAULT_FPS,
                      every: int | None = None, size: tuple[int, int] = DEFAULT_SIZE,
-                     frames_dir: str | Path | None = None, progress: bool = False,
-                     multi_sampling: int = 2) -> Path:
-    """Render a run folder to a GIF or MP4 without a display.
+                     frames_dir: str | Path | None = None, progress: bool = False) -> tuple[Path, int, float]:
+    """Render a run folder to ``out_file`` (``.gif``, or ``.mp4`` with imageio-ffmpeg; default
+    ``run_dir/animation.gif``) without a display; returns the file, its number of frames and the seconds
+    per frame. A planar run's rows are drawn in the rebuilt model by Exudyn's raytracer, with a caption
+    and the platform's travelled path; a spatial run's samples with matplotlib's 3-D axes.
 
-    A planar run: each chosen row of the solution file is loaded into the rebuilt model
-    and drawn with Exudyn's raytracer; a caption gives scene name and time, and the
-    platform's travelled path is drawn over the frame next to the reference path. A
-    spatial run: each chosen sample of ``result.npz`` is drawn with matplotlib's 3-D axes.
-    The run's space names the frames source (:data:`FRAME_SOURCES`). Both go through the same
-    checks (:func:`check_animation_request`), frames folder and file writer.
-
-    Parameters
-    ----------
-    run_dir : path
-        Folder written by ``cdpr run SCENE --out DIR``.
-    out_file : path, optional
-        ``.gif`` or ``.mp4`` (MP4 needs the package imageio-ffmpeg); default
-        ``run_dir/animation.gif``.
-    fps : float [1/s]
-        Frame rate of the animation (GIF stores it in steps of 10 ms, so at most 100).
-    every : int, optional
-        Use every ``every``-th stored row; default: the step that plays the run in
-        real time at ``fps``.
-    size : (width, height) [pixels]
-    frames_dir : path, optional
-        Also write each frame there as ``frame_00000.png``, ... (its older frames are removed).
-    progress : bool
-        Show a progress bar (only on a terminal).
-    multi_sampling : int
-        Raytracer samples per pixel (1, 2 or 4); 1 leaves thin lines broken (planar runs).
-
-    Returns
-    -------
-    Path
-        The animation file.
-
-    Raises
-    ------
-    RunFolderError, SolutionMismatchError
-        Missing or unfitting files.
-    CdprError
-        Unknown file type, bad arguments, or MP4 without imageio-ffmpeg.
+    ``fps`` [1/s] (a GIF stores frame times in steps of 10 ms: at most 100), ``every`` the row step
+    (default: real-time playback), ``size`` (width, height) [pixels], ``frames_dir`` also gets each frame
+    as ``frame_00000.png``, ... (its older frames removed). Every option is checked before any work:
+    CdprError names a bad one as the command line spells it; RunFolderError, SolutionMismatchError for
+    missing or unfitting files.
     """
-    path, _, _ = render_animation_timed(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir,
-                                        progress=progress, multi_sampling=multi_sampling)
-    return path
-
-
-def render_animation_timed(run_dir, out_file, *, fps, every, size, frames_dir, progress,
-                           multi_sampling) -> tuple[Path, int, float]:
-    """:func:`render_animation`, also returning the frame count and seconds per frame."""
     from tqdm import tqdm
 
-    request = check_animation_request(run_dir, out_file, fps=fps, every=every, size=size, frames_dir=frames_dir)
-    source = FRAME_SOURCES[request.space](request.run_dir, request.size, multi_sampling)
-    step = request.every if request.every is not None else _rows_per_frame(source.times, request.fps)
+    if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(fps) and fps > 0):
+        raise CdprError(f"--fps must be a finite number of frames per second > 0, got {fps!r}")
+    if every is not None and (isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1):
+        raise CdprError(f"--every must be a whole number >= 1, got {every!r}")
+    try:
+        width, height = (int(n) for n in size)
+    except (TypeError, ValueError):
+        raise CdprError(f"--size must be (width, height) in pixels, got {size!r}") from None
+    if not (32 <= width <= 8192 and 32 <= height <= 8192):
+        raise CdprError(f"--size must be between 32x32 and 8192x8192 pixels, got {width}x{height}")
+    run_dir = _run_folder(run_dir)
+    space = run_space(run_dir)
+    FRAME_SOURCES[space].check(run_dir)
+    out_file = Path(out_file) if out_file is not None else run_dir / "animation.gif"
+    fps, size = float(fps), (width, height)
+    _Writer.check(out_file, size, fps)
+    if frames_dir is not None:
+        frames_dir = check_output_folder(frames_dir, "--frames-dir")
+    source = FRAME_SOURCES[space](run_dir, size)
+    step = int(every) if every is not None else _rows_per_frame(source.times, fps)
     rows = range(0, len(source.times), step)
-    if request.frames_dir is not None:
-        clear_outputs(request.frames_dir, "animate --frames-dir")  # no frame of a longer, older animation stays
+    if frames_dir is not None:
+        clear_outputs(frames_dir, "animate --frames-dir")  # no frame of a longer, older animation stays
 
     start = _time.perf_counter()
-    writer = _Writer(request.out_file, request.fps, request.size)
+    writer = _Writer(out_file, fps, size)
     try:
         for frame, row in enumerate(tqdm(rows, unit="frame", desc=f"{source.name} ",
                                          disable=None if progress else True)):
             image = source.frame(row)
-            if request.frames_dir is not None:
-                image.save(request.frames_dir / f"frame_{frame:05d}.png")
+            if frames_dir is not None:
+                image.save(frames_dir / f"frame_{frame:05d}.png")
             writer.add(image)
     except BaseException:
         writer.abort()
         raise
     writer.close()
-    return request.out_file, len(rows), (_time.perf_counter() - start) / max(1, len(rows))
+    return out_file, len(rows), (_time.perf_counter() - start) / max(1, len(rows))

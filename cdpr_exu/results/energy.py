@@ -19,16 +19,10 @@ from cdpr_exu.scenes.scene import Scene
 
 @dataclass(frozen=True)
 class EnergyParts:
-    """The energies of a run at each output time, each shape (N,) [J].
-
-    Attributes
-    ----------
-    kinetic : node masses, platform translation and rotation
-    gravitational : m g z of nodes and platform (zero when gravity is off)
-    axial : k_i (l - l0i)^2 / 2 per element (only l > l0i for slack elements)
-    bending : k_theta dtheta^2 / 2 per interior node (zero when bending is off)
-    contact : k_p d^2 / 2 per node at penetration depth d (zero without pulley contact)
-    """
+    """The energies of a run at each output time, each shape (N,) [J]: ``kinetic`` (nodes, platform
+    translation and rotation), ``gravitational`` (m g z), ``axial`` (k_i (l - l0i)^2 / 2 per element, only
+    l > l0i for slack elements), ``bending`` (k_theta dtheta^2 / 2 per interior node), ``contact``
+    (k_p d^2 / 2 per node at penetration depth d); zero where the effect is off."""
 
     kinetic: np.ndarray
     gravitational: np.ndarray
@@ -43,13 +37,8 @@ class EnergyParts:
 
 
 def energy_parts(scene: Scene, result: Result) -> EnergyParts:
-    """The energies of ``result`` (a run of ``scene``) at each output time.
-
-    Raises
-    ------
-    SceneError
-        For massless cables, whose rope points carry no mass or stretch of their own.
-    """
+    """The energies of ``result`` (a planar run of ``scene``) at each output time; SceneError for massless
+    cables, whose rope points carry no mass or stretch of their own."""
     if not scene.effects.cable_mass:
         raise SceneError("energy_parts needs lumped-mass cables (effects.cable_mass = true)")
     g = scene.gravity if scene.effects.gravity else 0.0

@@ -1,12 +1,9 @@
 """The result of a run, planar or spatial: time series of the platform, the cables and the winches, and their files.
 
-A :class:`Result` is plain NumPy data (no Exudyn): the platform pose, every cable
-node's position, every element's tension, the winch lengths and the reference, at
-the output times. Its dimension is data (``dimension``, :attr:`Result.space`): the pose
-is the Space's (:mod:`cdpr_exu.space`: ``(x, z, rotation)`` in the paper's plane, ``(x, y,
-z, rotation vector)`` in space), and the figures of its summary are named from the
-Space's labels. It saves to ``result.npz`` + ``pose.csv`` + ``summary.json`` and loads back
-from the ``.npz``.
+A :class:`Result` is plain NumPy data at the output times. Its dimension is data (:attr:`Result.space`):
+the pose is the Space's (``(x, z, rotation)`` in the paper's plane, ``(x, y, z, rotation vector)`` in
+space) and its summary's figures are named from the Space's labels. It saves to ``result.npz`` +
+``pose.csv`` + ``summary.json`` and loads back from the ``.npz``.
 """
 
 from __future__ import annotations
@@ -30,57 +27,36 @@ from cdpr_exu.space import PLANE, SPACE, Space, space_of
 #: The pose columns of ``pose.csv``, by space.
 POSE_COLUMNS = {PLANE: PLANAR_POSE_COLUMNS, SPACE: SPATIAL_POSE_COLUMNS}
 
-#: Figures a space's summaries leave out. The planar summary.json files (committed in results/, read by
-#: the README's tables) keep the layout they had before spatial runs shared the summary: no ``dimension``
-#: (absent means 2, as in a scene file) and no ``max_rotation_error_deg`` (their rotation about the one
-#: axis is ``max_abs_rotation_deg``; its error is in the figures' rotation panel).
+#: Figures a space's summaries leave out: a planar summary.json (committed in results/, read by the
+#: README's tables) has no ``dimension`` (absent means 2, as in a scene file) and no
+#: ``max_rotation_error_deg`` (its rotation about the one axis is ``max_abs_rotation_deg``).
 LEFT_OUT = {PLANE: ("dimension", "max_rotation_error_deg"), SPACE: ()}
 
 
 @dataclass
 class Result:
-    """Time series of one run, planar or spatial. Units SI.
+    """Time series of one run, planar or spatial (``dimension`` 2 or 3). Units SI.
 
     Attributes
     ----------
-    scene_name : str
-    controller : str
-    dimension : int
-        2 (the paper's x-z plane) or 3: :attr:`space` says what a pose is.
     time : ndarray, shape (N,) [s]
-    pose : ndarray, shape (N, pose_size) [m, rad]
-        The platform's pose: (x, z, rotation) planar, rotation positive counter-clockwise;
-        (x, y, z, rotation vector) spatial, the centre of mass and the platform's rotation vector.
-    reference : ndarray, shape (N, pose_size)
-        The reference pose at the same times.
+    pose, reference : ndarray, shape (N, pose_size) [m, rad]
+        The platform's pose and its reference: (x, z, rotation counter-clockwise) planar,
+        (x, y, z, rotation vector) spatial.
     nodes : list of ndarray, each shape (N, n_i + 1, d) [m]
-        Node positions of cable i, winch end first (planar) or exit first (spatial).
+        Node positions of cable i, upper end (winch or exit) first.
     tensions : list of ndarray, each shape (N, n_i) [N]
         Axial force of each element (tension positive).
     paid_out : ndarray, shape (N, m) [m]
         Commanded paid-out length of each winch.
-    velocity : ndarray, shape (N, pose_size), or None [m/s, rad/s]
-        The pose's time derivative, where the run records it (planar runs: (vx, vz, angular
-        rate)); None where it does not (spatial runs).
-    node_velocities : list of ndarray, each shape (N, n_i + 1, d), or None [m/s]
-        Where recorded (planar runs).
-    pulley_penetration : ndarray, shape (N, m), or None [m]
-        Deepest node penetration into each cable's pulley (0 if none); None where the exits
-        have no contact to penetrate (spatial runs).
-    wall_time : float [s]
-    cpu_time : float [s]
-        Process CPU time of the solve (the same span as ``wall_time``).
-    steps : int
-        Time steps completed.
-    newton_iterations : int
+    velocity, node_velocities, pulley_penetration : ndarray or None
+        Where the run records them (planar runs): the pose's time derivative (N, pose_size), the nodes'
+        velocities [m/s], the deepest node penetration into each cable's pulley (N, m) [m].
     status : str
         "completed", "failed: <cause>" or "interrupted at ...".
-    failure_time : float or None [s]
     winch_reservoir : ndarray, shape (N, m), or None [m]
-        Slack rope held at each winch drum (tension-only cables under kinematic winches,
-        see :func:`cdpr_exu.builder.winch.reservoir_split`); it lengthens each cable's winch
-        element (element 0). None where there is no reservoir.
-    metadata : dict
+        Slack rope held at each winch drum (:func:`cdpr_exu.builder.winch.reservoir_split`), which
+        lengthens the winch element (element 0); None without a reservoir.
     """
 
     scene_name: str
@@ -104,21 +80,14 @@ class Result:
     winch_reservoir: np.ndarray | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
 
-    # ----------------------------------------------------------------- derived
     @property
     def space(self) -> Space:
-        """The run's :class:`~cdpr_exu.space.Space` (what a pose, a position and a rotation are)."""
         return space_of(self.dimension)
 
     @property
-    def labels(self) -> tuple[str, ...]:
-        """The names of the pose's entries (the Space's ``pose_labels``)."""
-        return self.space.pose_labels
-
-    @property
     def error(self) -> np.ndarray:
-        """Pose error actual - reference, shape (N, pose_size) [m, rad] (spatial: the rotation vectors' difference;
-        the angle between the orientations is :meth:`Space.rotation_error_deg`)."""
+        """Pose error actual - reference, shape (N, pose_size) [m, rad] (spatial: the rotation vectors'
+        difference; the angle between the orientations is :meth:`Space.rotation_error_deg`)."""
         return self.pose - self.reference
 
     @property
@@ -138,9 +107,10 @@ class Result:
 
     @property
     def error_figures(self) -> tuple[str, ...]:
-        """The figures of :meth:`summary` measured from its ``after`` on (the rest cover the whole run): each
+        """The figures of :meth:`summary` measured from its ``after`` on, named from the Space's labels: each
         position axis's largest absolute error, the vertical error's range, the centre's largest and RMS
-        error, the platform's largest rotation and its largest rotation error (where the space reports it)."""
+        error, the platform's largest rotation (from its home orientation) and rotation error (the angle
+        from the reference's orientation), less what :data:`LEFT_OUT` says."""
         space = self.space
         vertical = space.position_labels[space.vertical]
         names = (*(f"max_abs_error_{label}_m" for label in space.position_labels), f"min_error_{vertical}_m",
@@ -149,24 +119,11 @@ class Result:
         return tuple(name for name in names if name not in LEFT_OUT[space])
 
     def summary(self, after: float = 0.0) -> dict[str, Any]:
-        """Scalar figures of the run [SI, degrees]: errors (:attr:`error_figures`) measured from time
-        ``after`` on, the safety figures (tensions, slack, pushing, tension limits, a platform above
-        its exits) over the whole run (:func:`safety_figures`).
-
-        The figures are named from the Space's labels, the same rule in both dimensions:
-        ``max_abs_error_<axis>_m`` for each position axis, ``min_error_z_m`` / ``max_error_z_m`` for the
-        vertical one, ``max_position_error_m`` / ``rms_position_error_m`` for the centre,
-        ``max_abs_rotation_deg`` (the platform's rotation from its home orientation) and
-        ``max_rotation_error_deg`` (the angle from the reference's orientation to the platform's);
-        planar summaries leave out what :data:`LEFT_OUT` says.
-
-        A figure that does not exist (no sample at or after ``after``: a run shorter than
-        the error window, or one that failed before it) is None, and ``notes`` says why;
-        ``warnings`` says what no real robot can do (elements that push, a platform above
-        its exits).
-        """
+        """Scalar figures of the run [SI, degrees]: the errors (:attr:`error_figures`) from time ``after``
+        on, the safety figures (:func:`safety_figures`) over the whole run. A figure without a sample at or
+        after ``after`` is None, and ``notes`` says why."""
         space = self.space
-        d, vertical = space.position_size, space.vertical
+        vertical = space.vertical
         mask = self.time >= after
         err = self.position_error[mask]
         pose, reference = self.pose[mask], self.reference[mask]
@@ -213,15 +170,12 @@ class Result:
             del summary[key]
         return summary
 
-    # ----------------------------------------------------------------- files
     def save(self, folder: str | Path, after: float = 1.0, extra: dict[str, Any] | None = None) -> dict[str, Path]:
-        """Write ``result.npz``, ``pose.csv`` and ``summary.json`` into ``folder``.
+        """Write ``result.npz``, ``pose.csv`` and ``summary.json`` into ``folder``; returns the paths by kind.
 
-        ``summary.json`` is :meth:`summary` over the whole run with the provenance (:func:`provenance`),
-        ``extra``'s entries, the metadata and the errors after ``after`` [s] (``after_start_up``); the wall-clock
-        figures go to ``timing.json`` (:func:`~cdpr_exu.core.output.write_summary`). ``result.npz``
-        holds the same arrays under the same names in both dimensions (``platform_pose``,
-        ``reference_pose``, ``platform_velocity`` where recorded, ...). Returns the paths written, by kind.
+        ``summary.json`` is :meth:`summary` over the whole run with the provenance, ``extra``'s entries,
+        the metadata and the errors after ``after`` [s] (``after_start_up``); wall-clock figures go to
+        ``timing.json`` (:func:`~cdpr_exu.core.output.write_summary`).
         """
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
@@ -239,8 +193,7 @@ class Result:
             if self.node_velocities is not None:
                 arrays[f"node_velocities_{i}"] = self.node_velocities[i]
             arrays[f"tensions_{i}"] = tensions
-        # The wall time lives in timing.json, so that result.npz is the same from run to run; the
-        # dimension is written where it is not the default (2, as in a scene file).
+        # no wall time (timing.json has it): result.npz is the same from run to run
         info = {"scene_name": self.scene_name, "controller": self.controller,
                 **({} if "dimension" in LEFT_OUT[self.space] else {"dimension": self.dimension}),
                 "steps": self.steps, "newton_iterations": self.newton_iterations, "status": self.status,
@@ -303,12 +256,8 @@ def provenance() -> dict[str, Any]:
 
 
 def slack_time(times: np.ndarray, tensions: np.ndarray) -> float | None:
-    """Time [s] during which some element of a cable carries no tension (slack, or pushing).
-
-    ``times`` shape (N,) [s]; ``tensions`` shape (N, n) [N], the cable's element tensions
-    at those times. Each sample stands for the interval after it. None with fewer than
-    two samples.
-    """
+    """Time [s] during which some element of a cable (``tensions`` (N, n) [N] at ``times`` (N,) [s]) carries
+    no tension, each sample standing for the interval after it; None with fewer than two samples."""
     if len(times) < 2:
         return None
     slack = np.any(np.asarray(tensions).reshape(len(times), -1) <= 0.0, axis=1)
@@ -316,55 +265,26 @@ def slack_time(times: np.ndarray, tensions: np.ndarray) -> float | None:
     return float(np.sum(widths[slack]))
 
 
-def _nan_max(values) -> float | None:
-    """Largest finite entry of ``values``, or None when there is none."""
+def _nan_max(values, extreme=np.nanmax) -> float | None:
+    """Largest (``extreme=np.nanmin``: smallest) finite entry of ``values``, or None when there is none."""
     values = np.asarray(values, dtype=float)
-    return float(np.nanmax(values)) if values.size and np.isfinite(values).any() else None
+    return float(extreme(values)) if values.size and np.isfinite(values).any() else None
 
 
 def _nan_min(values) -> float | None:
-    """Smallest finite entry of ``values``, or None when there is none."""
-    values = np.asarray(values, dtype=float)
-    return float(np.nanmin(values)) if values.size and np.isfinite(values).any() else None
+    return _nan_max(values, np.nanmin)
 
 
 def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = None,
                    highest_exit: float | None = None, limits=None) -> dict[str, Any]:
-    """What a run did that a real robot could not, over its samples.
+    """What a run did that a real robot could not, over all its samples (never an error window).
 
-    One computation for planar and spatial summaries: the element tensions, each cable's
-    slack time, elements that pushed (a negative tension: the lumped cable carried
-    compression), the tension limits crossed (:func:`tension_limit_report`) and a platform
-    above its highest exit (every cable then pulls it down: only pushing cables could
-    hold it there). Never limited to an error window: a run shorter than the window, or
-    a jolt at its start, is reported all the same.
-
-    The lowest tensions and the slack times cover the samples after t = 0: the sample at
-    t = 0 is the initial condition, not something the run did (a planar run starts from
-    straight unstretched cables, which carry nothing there (0 N to round-off): every run would read 0 N and
-    one more output period of slack). Pushing, the largest tension, a platform above its
-    exits and the tension limits cover every sample, t = 0 included: the warning says when
-    the compression is in the initial state.
-
-    Parameters
-    ----------
-    times : ndarray, shape (N,) [s]
-    tensions : sequence of ndarray, each shape (N, n_i) [N]
-        Element tensions of each cable (tension positive).
-    heights : ndarray, shape (N,) [m], optional
-        Height (z) of the platform's centre of mass.
-    highest_exit : float [m], optional
-        Height of the highest exit: the highest pulley centre (planar), exit point or swivel
-        inlet (spatial). Without it (or ``heights``), ``platform_above_exits`` is None.
-    limits : list of [t_min or None, t_max or None] [N], one per cable, or None
-
-    Returns
-    -------
-    dict
-        ``min_element_tension_N``, ``max_element_tension_N``, ``min_tension_per_cable_N``,
-        ``slack_time_per_cable_s``, ``elements_pushed``, ``platform_above_exits``,
-        ``highest_exit_z_m``, ``warnings`` (one sentence per fact above) and, with ``limits``,
-        ``tension_limits_N`` and ``tension_limit_violations``.
+    The element tensions, each cable's slack time, elements that pushed, the tension limits crossed and
+    a platform above its highest exit, with a warning for each. The lowest tensions and slack times
+    leave out t = 0, the initial condition (a planar run starts from unstretched cables at 0 N).
+    ``tensions`` (N, n_i) [N] per cable at ``times`` (N,) [s]; ``heights`` (N,) [m] of the platform's centre
+    and ``highest_exit`` [m] (without them ``platform_above_exits`` is None); ``limits``: [t_min, t_max]
+    [N] (or None) per cable, or None.
     """
     times = np.asarray(times, dtype=float)
     tensions = [np.asarray(t, dtype=float) for t in tensions]
@@ -409,49 +329,33 @@ def safety_figures(times: np.ndarray, tensions, heights: np.ndarray | None = Non
 
 
 def after_start_up(settled: dict[str, Any], error_figures) -> dict[str, Any]:
-    """The ``after_start_up`` entry of a run's summary.json: the error figures ``error_figures`` of a
-    summary measured after the start-up (``settled``), with its window and notes (its safety figures
-    cover the whole run, as the summary's own)."""
+    """The ``after_start_up`` entry of a summary.json: ``settled``'s ``error_figures``, window and notes."""
     return {key: settled[key] for key in ("errors_measured_after_s", *error_figures, "notes")}
 
 
 def warning_flags(summary: dict[str, Any]) -> list[str]:
-    """What a summary's safety figures flag, in words ("cables pushed", "platform above its exits"): the
-    comparison tables and the printed status show them beside the status."""
+    """What a summary's safety figures flag, in words ("cables pushed", "platform above its exits")."""
     return [text for key, text in (("elements_pushed", "cables pushed"), ("platform_above_exits",
                                                                           "platform above its exits"))
             if summary.get(key)]
 
 
 def status_text(summary: dict[str, Any]) -> str:
-    """A summary's status as printed: "completed" is not clean when its safety figures flag something
-    ("completed (cables pushed: see the warnings)")."""
+    """A summary's status as printed, with its flags ("completed (cables pushed: see the warnings)")."""
     flags = warning_flags(summary)
     return summary["status"] + (f" ({', '.join(flags)}: see the warnings)" if flags else "")
 
 
 def raise_warnings(summary: dict[str, Any], label: str = "") -> None:
-    """Issue each of ``summary``'s ``warnings`` as an :class:`~cdpr_exu.core.errors.UnphysicalResultWarning`
-    (prefixed with ``label``): the ``cdpr`` command prints each once, as one line."""
+    """Issue each of ``summary``'s ``warnings``, prefixed with ``label``, as an UnphysicalResultWarning."""
     for text in summary.get("warnings", ()):
         _warnings.warn(f"{label}{text}", UnphysicalResultWarning, stacklevel=2)
 
 
 def tension_limit_report(times: np.ndarray, tensions, limits) -> dict[str, Any]:
-    """``tension_limit_violations``: each cable's element tensions outside its (t_min, t_max), if any are set.
-
-    One entry per cable and limit crossed: the limit, when it was first crossed, the
-    most extreme tension and for how long some element was beyond it. Empty (``{}``:
-    absent from the summary) for a scene without tension limits. Planar and spatial
-    runs report the same way.
-
-    Parameters
-    ----------
-    times : ndarray, shape (N,) [s]
-    tensions : sequence of ndarray, each shape (N, n) [N]
-        Element tensions of each cable at those times.
-    limits : list of [t_min or None, t_max or None] [N], one per cable, or None
-    """
+    """``tension_limit_violations``: one entry per cable and limit (t_min, t_max) its element tensions
+    (N, n) [N] at ``times`` (N,) [s] crossed: the limit, when first crossed, the most extreme tension and
+    for how long; ``{}`` (absent from the summary) without ``limits``."""
     if limits is None:
         return {}
     times = np.asarray(times, dtype=float)

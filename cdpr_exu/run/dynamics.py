@@ -1,10 +1,6 @@
-"""Dynamic runs of an assembled spatial robot or of one cable over a swivel pulley, for tests and benchmarks.
-
-:func:`run_dynamic` integrates a robot of :func:`cdpr_exu.builder.robot_3d.build_spatial_robot`
-from its initial configuration at a fixed step (generalised-alpha, optional energy record);
-:func:`run_swivel_pendulum` builds and runs the measured swivel-pulley scene: a mass on a cable
-over the pulley, swinging around the axis (:mod:`cdpr_exu.builder.swivel_chain`). The
-scene-level runs are :func:`cdpr_exu.run.simulate.simulate`. Units SI; z up.
+"""Dynamic runs of an assembled spatial robot (:func:`run_dynamic`) or of one cable over a swivel
+pulley (:func:`run_swivel_pendulum`), for tests and benchmarks; a scene runs in
+:func:`cdpr_exu.run.simulate.simulate`. Units SI; z up.
 """
 
 from __future__ import annotations
@@ -19,7 +15,7 @@ import numpy as np
 
 from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
 from cdpr_exu.builder.robot_3d import platform_pose, robot_energy
-from cdpr_exu.run.settle import dynamic_settings
+from cdpr_exu.run.settle import dynamic_settings, static_settings
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy
 from cdpr_exu.core.errors import SolverFailure
 from cdpr_exu.core.geometry import rotation_vector
@@ -29,19 +25,8 @@ from cdpr_exu.physics import swivel_pulley as sp
 
 @dataclass(frozen=True, eq=False)
 class SpatialRunResult:
-    """A dynamic run: platform trajectory and, when asked, the energy.
-
-    Attributes
-    ----------
-    time : ndarray, shape (k,) [s]
-        Start of each step, and the end time.
-    position : ndarray, shape (k, 3) [m]
-    rotation_vector : ndarray, shape (k, 3) [rad]
-    energy : ndarray, shape (k,) [J] or None
-    wall_time : float [s]
-        Of ``SolveDynamic`` (with the recording).
-    newton_iterations : int
-    """
+    """A dynamic run at each step's start and the end: ``time`` (k,) [s], the platform's ``position`` (k, 3)
+    [m] and ``rotation_vector`` (k, 3) [rad], ``energy`` (k,) [J] if asked, ``wall_time`` [s]."""
 
     time: np.ndarray
     position: np.ndarray
@@ -52,30 +37,8 @@ class SpatialRunResult:
 
 
 def run_dynamic(mbs, items, end_time, step_size, spectral_radius=0.9, record_energy=False, settings=None):
-    """Integrate the assembled robot from its initial configuration (at rest) over ``end_time`` [s].
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-        Assembled.
-    items : SpatialRobotItems
-    end_time, step_size : float [s]
-    spectral_radius : float, optional
-        Of the generalised-alpha integrator (1: no numerical damping).
-    record_energy : bool, optional
-        Record :func:`robot_energy` at every step (a Python call per step).
-    settings : exudyn.SimulationSettings, optional
-        Default :func:`dynamic_settings`.
-
-    Returns
-    -------
-    SpatialRunResult
-
-    Raises
-    ------
-    SolverFailure
-        If the integration fails.
-    """
+    """Integrate the assembled robot from its initial configuration over ``end_time`` at ``step_size`` [s],
+    with :func:`robot_energy` at every step if ``record_energy``; SolverFailure if it fails."""
     end_time, step_size = positive("end_time", end_time), positive("step_size", step_size)
     settings = dynamic_settings(end_time, step_size, spectral_radius) if settings is None else settings
     times, positions, rotations, energies = [], [], [], []
@@ -106,31 +69,20 @@ def run_dynamic(mbs, items, end_time, step_size, spectral_radius=0.9, record_ene
 
 @dataclass
 class SwivelRun:
-    """Histories of a run of :func:`run_swivel_pendulum` (one row per step, t = 0 first).
+    """Histories of a run of :func:`run_swivel_pendulum`, one row per step (t = 0 first).
 
     Attributes
     ----------
-    time : ndarray (S,) [s]
-    energy : ndarray (S,) [J]
-        Mechanical energy: kinetic (nodes and swivel), gravity, axial, bending, contact.
+    time, psi, energy : ndarray (S,) [s], [rad], [J]
     dissipated : ndarray (S,) [J]
         Energy taken out by the bearing so far, integral d_s psi_dot^2 dt (trapezoidal).
-    psi : ndarray (S,) [rad]
     mass_azimuth : ndarray (S,) [rad]
         Azimuth of the end mass seen from the axis (where ideal kinematics puts psi).
     in_contact : ndarray (S,) of int
         Nodes touching the pulley.
-    positions : ndarray (S', N, 3) [m]
-        Node positions every ``record_every`` rows (the first row included).
     final_positions : ndarray (N, 3) [m]
-        Node positions at the last step.
-    newton_iterations, steps : int
-    wall_time : float [s]
     failed : str
-        Empty, or why the run stopped early (the solver's error, or the energy rose by more
-        than ``abort_rise``).
-    guard_rejections : int
-        Steps repeated smaller by the energy guard (``energy_guard``).
+        Empty, or why the run stopped early (the solver's error, or an energy rise above ``abort_rise``).
     """
 
     time: np.ndarray
@@ -139,7 +91,6 @@ class SwivelRun:
     psi: np.ndarray
     mass_azimuth: np.ndarray
     in_contact: np.ndarray
-    positions: np.ndarray
     final_positions: np.ndarray
     newton_iterations: int
     steps: int
@@ -167,27 +118,23 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
                         cone_angle: float = math.radians(30.0), free_length: float = 1.0,
                         winch_length: float = 0.3, element_length: float = 0.05, cable_radius: float = 0.002,
                         youngs_modulus: float = 1.0e9, linear_density: float = 0.05, axial_damping: float = 0.0,
-                        psi: float = 0.0, psi_offset: float = 0.0, swing: bool = True, rate_factor: float = 1.0,
-                        spectral_radius: float = 0.5, gravity: float = 9.81, record_every: int = 1,
-                        newton_tolerance: float = 1e-10, verbose: int = 0, initial_accelerations: bool = True,
-                        adaptive: bool = True, abort_rise: float = math.inf,
-                        settle_statically: bool = False, max_newton_iterations: int = 25,
-                        energy_guard: float | None = None, modified_newton: bool = False) -> SwivelRun:
+                        psi: float = 0.0, swing: bool = True, rate_factor: float = 1.0,
+                        spectral_radius: float = 0.5, gravity: float = 9.81, newton_tolerance: float = 1e-10,
+                        abort_rise: float = math.inf,
+                        settle_statically: bool = False, energy_guard: float | None = None,
+                        modified_newton: bool = False) -> SwivelRun:
     """Run a mass on a cable over a swivel pulley: a conical pendulum (``swing``) or a hang.
 
-    The cable (held at ``winch_length`` [m] below the inlet on the axis) comes up the axis,
-    wraps the disc at azimuth ``psi`` and leaves at ``cone_angle`` [rad] from the vertical
-    for ``free_length`` [m] to the ``end_mass`` [kg]. With ``swing`` the whole cable and the
-    swivel start turning rigidly about the axis at the conical pendulum's rate
-    omega = rate_factor sqrt(g tan(angle) / R), R the mass's distance from the axis (1: a circle;
-    less: the mass swings in and out, its azimuth rate varies); the swivel starts at
-    ``psi + psi_offset``. Step ``step`` [s], generalized-alpha with ``spectral_radius``,
-    full Newton (or modified, Jacobian each step, with ``modified_newton``); no damping but
-    the bearing's (and ``axial_damping`` [N s/m] per element).
-    With ``settle_statically``, Exudyn's static solver then starts from the final state, and
-    ``final_positions`` and the last ``psi`` are its rest state. With ``energy_guard`` [J],
-    a step whose Newton solution gains more than that over the last accepted step is
-    repeated at a quarter of its size (down to step / 1000).
+    The cable (held at ``winch_length`` [m] below the inlet on the axis) comes up the axis, wraps the
+    disc at azimuth ``psi`` and leaves at ``cone_angle`` [rad] from the vertical for ``free_length`` [m]
+    to the ``end_mass`` [kg]. With ``swing`` the cable and the swivel start turning rigidly about the
+    axis at omega = rate_factor sqrt(g tan(angle) / R), R the mass's distance from the axis (1: the
+    conical pendulum's circle; less: the mass swings in and out). Step ``step`` [s], adaptive,
+    generalized-alpha at ``spectral_radius``, full (or ``modified_newton``) Newton; no damping but the
+    bearing's and ``axial_damping`` [N s/m]. With ``settle_statically``, Exudyn's static solver then
+    starts from the final state (``final_positions`` and the last ``psi`` are its rest). With
+    ``energy_guard`` [J], a step that gains more than that is repeated at a quarter of its size (down to
+    step / 1000).
     """
     if energy_guard is None:
         for concern in sp.stability_concerns(modified_newton, spectral_radius, newton_tolerance, element_length,
@@ -211,7 +158,7 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     reach = math.hypot(path[-1, 0] - inlet[0], path[-1, 1] - inlet[1])
     omega = math.sqrt(gravity * math.tan(cone_angle) / reach) if swing and cone_angle > 0.0 else 0.0
     omega *= rate_factor
-    swivel = add_swivel_pulley(mbs, chain, pulley, psi + psi_offset, omega)
+    swivel = add_swivel_pulley(mbs, chain, pulley, psi, omega)
     mbs.Assemble()
     n3 = 3 * len(path)
     if omega:
@@ -227,23 +174,19 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     ti = settings.timeIntegration
     ti.numberOfSteps = int(round(end_time / step))
     ti.endTime = end_time
-    ti.verboseMode = verbose
     ti.generalizedAlpha.spectralRadius = spectral_radius
-    ti.generalizedAlpha.computeInitialAccelerations = initial_accelerations
     ti.newton.useModifiedNewton = modified_newton
     ti.newton.modifiedNewtonJacUpdatePerStep = True  # as the planar runs (cdpr_exu.simulate)
     ti.newton.relativeTolerance = newton_tolerance
-    ti.newton.maxIterations = max_newton_iterations
-    # Exudyn halves the step where Newton fails (a node entering the stiff contact) and
-    # grows it back; the steps taken are reported (SwivelRun.steps).
-    ti.adaptiveStep = adaptive
+    # Exudyn's adaptive step (its default) halves the step where Newton fails (a node entering the
+    # stiff contact) and grows it back; the steps taken are reported (SwivelRun.steps).
     ti.minimumStepSize = step * 1e-4
     settings.solution.file.write = False
     settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
 
     chain_index = np.array([mbs.GetNodeODE2Index(node) + k for node in chain.nodes for k in range(3)])
     psi_index = mbs.GetNodeODE2Index(swivel.node)
-    rows = {key: [] for key in ("time", "energy", "psi", "azimuth", "contact", "positions", "rate")}
+    rows = {key: [] for key in ("time", "energy", "psi", "azimuth", "contact", "rate")}
     bending = 0.0 if chain.bending is None else bending_stiffness
 
     def state(mbs_, configuration):
@@ -269,8 +212,6 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
         rows["rate"].append(rate)
         rows["azimuth"].append(sp.exit_azimuth(points[-1], inlet))
         rows["contact"].append(int(np.count_nonzero(np.any(force[:n3].reshape(-1, 3) != 0.0, axis=1))))
-        if len(rows["time"]) % record_every == 1 or record_every == 1:
-            rows["positions"].append(points.copy())
         last[:] = points
         if energy - rows["energy"][0] > abort_rise:
             aborted.append(t)
@@ -287,8 +228,7 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
         minimum = step * 1e-3
 
         def guard(mbs_, t):
-            """Repeat a step at a quarter of its size if its converged state gained more than
-            ``energy_guard`` [J]: nothing in this scene can supply energy (no moving winch)."""
+            """Repeat a step that gained more than ``energy_guard`` (no moving winch supplies energy)."""
             size = mbs_.sys["dynamicSolver"].it.currentStepSize
             if state(mbs_, exu.ConfigurationType.Current)[3] - accepted[0] > energy_guard and size > minimum:
                 rejected[0] += 1
@@ -307,12 +247,8 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
         # Exudyn's static solver from where the run ended: the rest state without a swing left
         mbs.SetPostStepUserFunction(0)
         mbs.systemData.SetODE2Coordinates(mbs.systemData.GetODE2Coordinates(), exu.ConfigurationType.Initial)
-        static = exu.SimulationSettings()
-        static.staticSolver.newton.relativeTolerance = 1e-10
+        static = static_settings(1e-10)
         static.staticSolver.newton.absoluteTolerance = 1e-12
-        static.staticSolver.newton.maxIterations = 50
-        static.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-        static.solution.file.write = False
         mbs.SolveStatic(static)
         q_all = np.asarray(mbs.systemData.GetODE2Coordinates())
         last[:] = (chain.reference + q_all[chain_index]).reshape(-1, 3)
@@ -326,6 +262,5 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
     power = pulley.bearing_damping * rate**2
     dissipated = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
     return SwivelRun(t, np.array(rows["energy"]), dissipated, np.unwrap(np.array(rows["psi"])),
-                     np.unwrap(np.array(rows["azimuth"])), np.array(rows["contact"]),
-                     np.array(rows["positions"]), last.copy(),
+                     np.unwrap(np.array(rows["azimuth"])), np.array(rows["contact"]), last.copy(),
                      int(iterations), int(steps), wall, failed, rejected[0])

@@ -1,86 +1,43 @@
 """The static mode: a scene brought to rest, in either space, and what the cables look like there.
 
-:func:`solve_rest` brings a scene to rest with the winches holding their initial lengths
-(the trajectory is not followed) by its space's method (:data:`REST_METHODS`, chosen
-once from the scene's :class:`~cdpr_exu.space.Space`), and returns one :class:`Rest`:
-the platform's position and rotation, every node, every element's axial force, the
-anchor tensions and the forces on the platform, the method, warnings; and what only one
-space's method gives as optional fields (the free spans and the dynamics in the plane,
-the catenary comparison and the swivel angles in space). Units SI; z up, gravity along -z.
+:func:`solve_rest` brings a scene to rest with the winches holding their initial lengths (the
+trajectory is not followed) by its space's method (:data:`REST_METHODS`) and returns one :class:`Rest`.
+Units SI; z up, gravity along -z.
 
-**In the plane** (dynamic relaxation of the lumped :class:`~cdpr_exu.builder.model.Model`):
-the scene is integrated with its own damping and solver settings, in chunks, until the
-largest node speed falls below a tolerance, then the state is polished with Exudyn's
-static solver (``mbs.SolveStatic``). For each cable the rest holds the length and end
-forces of its *free span*, the part that the elastic catenary
+**In the plane** (dynamic relaxation of the lumped :class:`~cdpr_exu.builder.model.Model`): the scene
+is integrated with its own damping and solver settings, in chunks, until the largest node speed falls
+below a tolerance; then Exudyn's static solver polishes the state. For each cable the rest holds the
+length and end forces of its *free span*, the part the elastic catenary
 (:mod:`cdpr_exu.physics.catenary`) describes:
 
+* with a point exit, or over a pulley no node touches, the whole cable, from node 0 (held by the
+  winch constraints) to the platform anchor (node n);
+* over a pulley, from the *leave point* to the anchor: with node c the last node in contact with the
+  rim, the point of the rim where the tangent from node c + 1 touches it (nearer node c), then the
+  elements from node c + 1 on (the catenary's suspended part). The wrapped part is left out: the
+  lumped model wraps the pulley with chords, shorter than the arc (``examples/catenary_validation.py``).
 
-* with a point exit (the cable does not wrap its exit), or over a pulley that no node
-  touches, the whole cable, from its upper end (node 0, held by the winch
-  constraints) to the platform anchor (node n);
-* over a pulley, the cable from the point where it leaves the rim to the anchor. Let
-  node c be the last node (counting from the winch) in contact with the rim. The
-  cable leaves the pulley on element (c, c + 1); its *leave point* is the point of the
-  rim where the tangent from node c + 1 touches it (the tangent nearer node c). The
-  free span is the straight piece from the leave point to node c + 1 plus the
-  elements from node c + 1 to the anchor. This is the lumped counterpart of the
-  catenary's suspended part (anchor to tangent point, ``CableEquilibrium.catenary``).
-  The wrapped part is left out on purpose: the lumped model wraps the pulley with
-  straight chords, shorter than the arc by about a centimetre per element for 0.25 m
-  elements on a 0.25 m pulley (26 mm over the paper's wrap), a property of the
-  discretisation, not of the cable. Where such a coarse polygon leaves the rim is
-  itself uncertain by a good part of an element (about 2 cm along the rim on the
-  paper's scene, see ``examples/catenary_validation.py``); with elements short
-  against the pulley radius both effects vanish.
+End forces are those the cable *exerts on* its supports, as the catenary's ``force_on_a`` (platform)
+and ``force_on_b`` (upper end): ``platform_force + upper_force = (0, -W)`` at rest, W the span's
+weight. At the platform: the reaction of the revolute joint that pins the anchor node (exact: with the
+bending shear and the anchor node's weight); at a point exit: the reactions of the winch node's two
+coordinate constraints; over a pulley: the cable's internal force at the cut through element
+(c, c + 1), its axial force plus the shear of the two bending joints that straddle the cut (3.8 N
+beside 14 N on the paper's scene).
 
-End forces are the forces the cable *exerts on* its supports, as the catenary's
-``force_on_a`` (platform) and ``force_on_b`` (upper end); with the span's weight W,
-``platform_force + upper_force = (0, -W)`` at rest:
+The static polish converges in one Newton iteration from the settled state and makes it an exact
+equilibrium (a free span's force balance from 2e-7 N to 1e-11 N on the paper's scenes). Without bending
+damping the swinging modes are all but undamped: such a scene is settled with the paper's bending on,
+and the static solver finds its own model's rest from there. ``Rest.method`` says which path was taken.
 
-* at the platform: the reaction of the revolute joint that pins the anchor node to the
-  platform (exact: it includes the bending shear and the anchor node's weight; the
-  axial force of the anchor element is given as well, ``anchor_tensions_N``);
-* at a point exit: the reactions (Lagrange multipliers) of the winch node's two
-  coordinate constraints (node 0 and its weight belong to the span);
-* over a pulley: the internal force of the cable at the cut through element
-  (c, c + 1): that element's axial force along it, plus, with bending, the shear of the
-  two bending joints that straddle the cut (3.8 N beside an axial force of 14 N on the
-  paper's scene, so it cannot be left out). Node c + 1 touches nothing.
-
-Static solver notes (measured on the paper's scenes, settled for 8 s to 3e-7 m/s): from
-the settled state the static solver converges in one Newton iteration, in milliseconds;
-it moves the nodes by 2e-7 m and the element forces by 1e-6 N, and brings the force
-balance of a free span from 2e-7 N (the inertia of the residual creep) to 1e-11 N. So
-it changes nothing that matters here, but it is cheap and makes the state an exact
-equilibrium. It needs the rotation of a point-mass platform locked
-(:data:`ROTATION_LOCK`): nothing resists that rotation, so the static Jacobian is
-singular (the cause of the failures "from the straight start"; with the lock and 20
-load steps it converges from there too, with bending). Without bending
-damping (``effects.bending_damping`` off, eg the "catenary" preset) the cable's
-swinging modes are all but undamped (still 0.5 to 0.9 m/s after 60 s on the paper's
-scene): there the scene is settled with the paper's bending stiffness and damping
-switched on, and the static solver then finds the rest of the scene's own model from
-that state (a continuation in the bending stiffness; from the straight start it finds
-equilibria of pushing elements instead). ``Rest.method`` says which path was taken.
-
-**In space** (the lumped robot of :mod:`cdpr_exu.builder.robot_3d` in Exudyn's static
-solve, beside its elastic catenaries): the scene is solved twice, by two independent
-methods: the **catenary statics** (:func:`cdpr_exu.statics.statics.solve_statics`: each
-cable a continuous elastic catenary in its own vertical plane, no bending), and the scene's
-chains with its effects (bending included), started on the catenary solution and brought to
-equilibrium by Exudyn's static solver. Over swivel pulleys, where Exudyn's static solver
-does not converge from the catenary start, the chain statics
-(:mod:`cdpr_exu.statics.chain_statics`, the same discrete model) first take it to
-equilibrium (:func:`cdpr_exu.run.settle.start_at_rest`), and Exudyn's static
-solver confirms it. The rest says how far the catenary answer lies from it (the
-discretisation error, about n^-2, plus the effect of bending). A rigid platform's cable ends
-are held by stiff penalty joints in the static solve (Exudyn's static solver diverges on
-``ObjectJointSpherical`` when the body must turn); they add 1 / (:data:`PENALTY` n) of a
-cable's compliance. The static solve uses spring elements also where the scene's cables are
-tension-only (``effects.slack``): a slack element has no stiffness, and Exudyn's static
-solver fails from such a start; while every element is taut the two give the same
-equilibrium, and a compressed element is reported.
+**In space** two independent methods solve the scene: the **catenary statics**
+(:func:`cdpr_exu.statics.statics.solve_statics`: elastic catenaries, no bending), and Exudyn's static
+solver on the lumped robot with the scene's effects, started on the catenary solution (over swivel
+pulleys on the chain statics', :func:`cdpr_exu.run.settle.start_at_rest`). The rest says how far the
+two lie apart (the discretisation error, about n^-2, plus bending). A rigid platform's cable ends are
+held by stiff penalty joints (Exudyn's static solver diverges on ``ObjectJointSpherical`` when the body
+must turn), adding 1 / (:data:`PENALTY` n) of a cable's compliance. Tension-only cables are solved
+with spring elements (a slack start fails); a compressed element is reported.
 """
 
 from __future__ import annotations
@@ -116,16 +73,12 @@ DEFAULT_TOLERANCE = 1.0e-6
 DEFAULT_MAX_TIME = 60.0
 #: Default length of each extension of the run after the scene's end time [s].
 DEFAULT_CHUNK_TIME = 2.0
-#: The node speed of a chunk is its largest over this final part of the chunk [s]
-#: (not only at its last step, which a swinging mode may pass at a turning point).
+#: The node speed of a chunk is its largest over this final part of it [s] (not at a turning point).
 SPEED_WINDOW = 0.5
-#: The static polish is kept only if it moves no node farther than this [m]. A state at
-#: rest to 1e-6 m/s is within about v * tau (tau ~ 1 s: the Kelvin-Voigt time constant
-#: c_i / k_i, and the swinging periods) of its equilibrium, so 1 mm is three orders of
-#: magnitude of margin; a larger jump means another equilibrium branch was found.
+#: The static polish is kept only if it moves no node farther than this [m]: a state at rest to
+#: 1e-6 m/s lies about v * 1 s from its equilibrium; a larger jump found another equilibrium branch.
 POLISH_MAX_SHIFT = 1.0e-3
-#: Simulated time of the check run from a static solution of a scene without bending
-#: damping [s]: its largest node speed is reported as ``max_node_speed_m_s``.
+#: Simulated time [s] of the check run of ``max_node_speed_m_s`` after a bending continuation.
 CHECK_TIME = 0.2
 #: Name of the path taken by the planar relaxation, by case.
 METHODS = {
@@ -134,21 +87,12 @@ METHODS = {
     "bending-continuation+static": "settled with the paper's bending on, then Exudyn's static solver "
                                    "on the scene's own model from there",
 }
-#: Whether a point-mass platform's rotation is locked by a coordinate constraint. The
-#: rotation of a point mass feels no moment (its anchors are at its centre of mass),
-#: so locking it changes no answer; it makes the static Jacobian regular.
-ROTATION_LOCK = True
-#: Stiffness of the penalty spherical joints of a rigid platform in space, in element axial
-#: stiffnesses: they add 1 / (100 n) of a cable's compliance (3e-7 m at n = 40 on the
-#: four-cable robot, measured in tests/test_spatial_robot.py).
+#: Stiffness of the penalty spherical joints of a rigid platform in space, in element axial stiffnesses
+#: (3e-7 m at n = 40 on the four-cable robot, tests/test_spatial_robot.py).
 PENALTY = 100.0
-#: A spatial answer farther than this fraction of the shortest cable's unstrained length from
-#: its own elastic-catenary answer is flagged (``warnings``). The two differ by the
-#: discretisation (n^-2: at most 0.5 mm on the shipped point-exit robots) and by the bending
-#: the catenary leaves out: the shipped swivel robot, whose cables wrap 0.1 m pulleys, rests
-#: 22 mm from its catenaries, 0.9 % of its 2.4 m cables (measured). 5 % is over five times
-#: that; beyond it the answer is the bending model's more than a hanging cable's (E = 1e10 Pa
-#: on the same robot: 132 mm, 5.5 %; 1e11 Pa: above its pulleys).
+#: A spatial answer farther than this fraction of the shortest cable from its elastic catenaries'
+#: is flagged (``warnings``): the shipped swivel robot rests 0.9 % away (22 mm, its bending around
+#: 0.1 m pulleys; measured), at E = 1e10 Pa 5.5 %, where bending more than hanging sets the answer.
 FAR_FROM_CATENARY = 0.05
 
 #: Definitions written into a planar rest's ``summary.json``.
@@ -168,62 +112,34 @@ DEFINITIONS = {
 }
 
 
-# --------------------------------------------------------------------------- result
-
-
 @dataclass(frozen=True, eq=False)
 class Rest:
     """A scene at rest, in its space (d = 2: (x, z) in the paper's plane; d = 3), m cables. Units SI.
 
     Attributes
     ----------
-    scene : Scene
     position : ndarray, shape (d,) [m]
         Platform centre of mass.
     rotation : float or ndarray, shape (3,) [rad]
-        The platform's rotation as its space has it: the counter-clockwise angle in the plane,
-        the rotation vector in space.
+        The counter-clockwise angle in the plane, the rotation vector in space.
     rotation_matrix : ndarray, shape (d, d)
         Platform frame to world frame.
-    nodes : tuple of ndarray, each shape (n_i + 1, d) [m]
-        Node positions of each cable, upper end (winch or exit) first.
-    tensions : tuple of ndarray, each shape (n_i,) [N]
-        Axial force of each element (tension positive; negative: compressed, which a real
-        cable cannot be).
-    anchor_tensions : ndarray, shape (m,) [N]
-        Axial force of each cable at its anchor.
-    platform_forces : ndarray, shape (m, d) [N]
-        Force each cable exerts on the platform at its anchor.
+    nodes, tensions : tuple of ndarray, shapes (n_i + 1, d) [m] and (n_i,) [N]
+        Node positions of each cable (upper end first) and each element's axial force (negative:
+        compressed, which a real cable cannot be).
+    anchor_tensions : ndarray, shape (m,) [N]; platform_forces : ndarray, shape (m, d) [N]
+        Each cable's axial force at its anchor and the force it exerts on the platform there.
     method : str
-        How the rest was found: a key of :data:`METHODS` in the plane, a description in space.
-    wall_time_s : float [s]
-    warnings : tuple of str
-        What makes this answer suspect, each with its figures (empty: nothing).
-    notes : tuple of str
-        What the solver tried and refused (eg a static polish that did not converge).
+        A key of :data:`METHODS` in the plane, a description in space.
+    warnings, notes : tuple of str
+        What makes this answer suspect; what the solver tried and refused.
 
-    Planar only (dynamic relaxation; None in space), see the module notes:
-    cable_stretched_length_m, cable_unstrained_length_m : ndarray, shape (m,) [m]
-        Length and unstrained length of each cable's free span.
-    first_free_node : ndarray of int, shape (m,)
-        First node of the free span: 0 for a point exit, c + 1 over a pulley.
-    upper_points_m, upper_forces_N : ndarray, shape (m, 2) [m], [N]
-        Upper end of the free span (node 0, or the leave point on the rim), and the force
-        each free span exerts on its upper support there.
-    span_weights_N : ndarray, shape (m,) [N]
-        Weight of the nodes of each free span.
-    max_node_speed_m_s, time_s : float [m/s], [s]
-        Largest node speed over the last :data:`SPEED_WINDOW` of the dynamics; their simulated time.
-    static_shift_m : float or None [m]
-        How far the static solver moved the farthest node (None: not used or refused).
-
-    Spatial only (None in the plane):
-    catenary : PlatformEquilibrium
-        The elastic-catenary statics of the same scene.
-    anchor_joint : str
-        How the cable ends are held in the static solve.
-    swivel_angles : ndarray, shape (m,) [rad], or None
-        Each swivel pulley's angle (None: no swivel pulleys).
+    Planar only (None in space; :data:`DEFINITIONS`): ``cable_stretched_length_m``,
+    ``cable_unstrained_length_m``, ``first_free_node`` (0, or c + 1 over a pulley), ``upper_points_m``,
+    ``upper_forces_N``, ``span_weights_N``, ``max_node_speed_m_s`` (over the last :data:`SPEED_WINDOW`),
+    ``time_s`` (simulated), ``static_shift_m`` (the static solver's largest node shift; None: not used).
+    Spatial only (None in the plane): ``catenary`` (the elastic-catenary statics' PlatformEquilibrium),
+    ``anchor_joint`` (how the cable ends are held), ``swivel_angles`` (m,) [rad] (None: no swivels).
     """
 
     scene: Scene
@@ -253,7 +169,6 @@ class Rest:
 
     @property
     def space(self):
-        """The scene's :class:`~cdpr_exu.space.Space`."""
         return self.scene.space
 
     @property
@@ -272,17 +187,15 @@ class Rest:
         return self.platform_forces + self.upper_forces_N + weight
 
     def summary(self) -> dict[str, Any]:
-        """Plain data (JSON-ready, SI units in the key names) for ``summary.json``."""
+        """Plain data for ``summary.json`` (SI units in the key names)."""
         return REST_METHODS[self.space].summary(self)
 
     def summary_lines(self) -> list[str]:
-        """The rest in a few lines of text, for the console (the CLI prints them)."""
+        """The rest in a few lines of text (the CLI prints them)."""
         return REST_METHODS[self.space].lines(self)
 
     def save(self, folder: str | Path) -> dict[str, Path]:
-        """Write ``summary.json`` (with provenance) and, in the plane, ``rest.npz`` into ``folder``; returns
-        their paths by kind ("summary", "npz"). The figure (``rest_profile.png``) is
-        :func:`cdpr_exu.post.plots.plot_rest`'s."""
+        """Write ``summary.json`` and, in the plane, ``rest.npz`` into ``folder``; returns the paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         paths = {"summary": write_summary(folder, {**self.summary(), **provenance()})}
@@ -294,27 +207,24 @@ class Rest:
 
 def solve_rest(scene: Scene, **options) -> Rest:
     """Bring ``scene`` to rest, the winches holding their initial lengths, by its space's method
-    (:data:`REST_METHODS`). ``options`` are the planar relaxation's (:func:`_relax`: ``tolerance``
-    [m/s], ``max_time`` [s], ``chunk_time`` [s], ``polish``); a spatial static solve ignores them.
+    (:data:`REST_METHODS`). ``options`` are the planar relaxation's (:func:`_relax`); a spatial static
+    solve ignores them.
 
     Raises
     ------
     SceneError
-        If the scene cannot be brought to rest this way (massless planar cables, an explicit
-        integrator, a bad option), naming the field.
-    UnreachableError
-        If the catenary statics of a spatial scene find no equilibrium.
-    SolverFailure
-        If the solver fails, the planar scene is not at rest after ``max_time``, or the spatial
-        equilibrium holds the platform above its exits (:func:`rest_above_exits`).
+        A scene the method cannot bring to rest (massless planar cables, an explicit integrator, a
+        bad option), naming the field.
+    UnreachableError, SolverFailure
+        No equilibrium of the catenary statics; the solver fails, the planar scene is not at rest after
+        ``max_time``, or the spatial equilibrium holds the platform above its exits.
     """
     return REST_METHODS[scene.space].solve(scene, **options)
 
 
 def bending_text(scene: Scene, catenary, what: str) -> str:
-    """The cables' bending against their pulleys, for messages: ``what`` (e.g. "what moves it") is
-    the bending E J [N m^2] whose bending length sqrt(E J / T) at the catenaries' largest tension T
-    is compared with the smallest swivel radius (or the shortest cable: point exits)."""
+    """A sentence: ``what`` is the cables' bending E J [N m^2], its bending length sqrt(E J / T) at the
+    catenaries' largest tension T against the smallest swivel radius (or the shortest cable)."""
     cable = scene.cables[0]
     if not scene.effects.bending:
         return "the cables have no bending (effects.bending = false)"
@@ -331,22 +241,10 @@ def bending_text(scene: Scene, catenary, what: str) -> str:
 
 
 def rest_above_exits(scene: Scene, position, rotation, lowest_tension: float, catenary) -> str | None:
-    """Why a rest of the lumped robot with every anchor above its exit is no cable robot's rest, or None.
-
-    Such a rest is held by elements that push or by the cables' bending, not by hanging cables
-    (:meth:`Scene.above_exits`): cables whose bending length sqrt(E J / T) is many
-    times their pulleys' radius stand up like rods rather than wrap their pulleys (measured on
-    the swivel robot: E = 1e11 Pa, 16.8 kg: 6.9 times, platform 0.14 m above the inlets).
-
-    Parameters
-    ----------
-    position : (3,) [m]; rotation : (3, 3)
-        The platform's pose at that rest.
-    lowest_tension : float [N]
-        The lowest element force there (negative: compressed).
-    catenary : PlatformEquilibrium
-        The scene's elastic-catenary statics.
-    """
+    """Why a rest of the lumped robot at ``position`` (3,) [m], ``rotation`` (3, 3) is no cable robot's
+    rest, or None: every anchor above its exit (:meth:`Scene.above_exits`) is held by elements that push
+    (``lowest_tension`` [N] < 0) or by bending, not by hanging cables (cables whose bending length is
+    many times their pulleys' radius stand up like rods). ``catenary``: the scene's catenary statics."""
     above = scene.above_exits(position, rotation)
     if above is None:
         return None
@@ -357,20 +255,14 @@ def rest_above_exits(scene: Scene, position, rotation, lowest_tension: float, ca
             "youngs_modulus or radius (a wire rope bends far more easily than a solid rod of its modulus)")
 
 
-# --------------------------------------------------------------------------- in the plane: dynamic relaxation
-
-
 def _relax(scene: Scene, *, tolerance: float = DEFAULT_TOLERANCE, max_time: float = DEFAULT_MAX_TIME,
            chunk_time: float = DEFAULT_CHUNK_TIME, polish: bool = True) -> Rest:
-    """Bring a planar ``scene`` to rest by dynamic relaxation (see the module notes).
+    """Bring a planar ``scene`` (massive cables, implicit solver) to rest by dynamic relaxation.
 
-    Integrates with the scene's solver settings up to its end time, then in chunks of
-    ``chunk_time`` until the largest node speed over the last :data:`SPEED_WINDOW` of a
-    chunk is below ``tolerance`` [m/s] (giving up after ``max_time`` [s] of simulated time);
-    then (``polish``) runs Exudyn's static solver from there and keeps its answer if it
-    converged within :data:`POLISH_MAX_SHIFT`. A scene without bending damping is settled
-    with the paper's bending on and then solved statically with its own effects. The scene
-    needs massive cables (``effects.cable_mass``) and the implicit solver.
+    Integrates up to its end time, then in chunks of ``chunk_time`` [s] until the largest node speed
+    over the last :data:`SPEED_WINDOW` of a chunk is below ``tolerance`` [m/s] (giving up after
+    ``max_time`` [s]); then (``polish``) keeps Exudyn's static solution from there if it converged
+    within :data:`POLISH_MAX_SHIFT`. See the module notes for a scene without bending damping.
     """
     for name, value in (("tolerance", tolerance), ("max_time", max_time), ("chunk_time", chunk_time)):
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
@@ -415,17 +307,15 @@ def _relax(scene: Scene, *, tolerance: float = DEFAULT_TOLERANCE, max_time: floa
                 f"{min(t.min() for t in tensions):.3g} N): an equilibrium no hanging cable reaches", time=elapsed)
         speed = _check_run(model, scene)
         method = "bending-continuation+static"
-    # Exudyn's static solver returns the constraint reactions with the opposite sign of
-    # its dynamic solver's (measured: the same state gives negated Lagrange multipliers).
-    reaction_sign = -1.0 if method.endswith("static") else 1.0
+    reaction_sign = -1.0 if method.endswith("static") else 1.0  # see _rest_state
     state = _rest_state(model, scene, speed, elapsed, method, shift, tuple(notes), reaction_sign)
     return replace(state, wall_time_s=_time.perf_counter() - start)
 
 
 def _build(scene: Scene) -> Model:
-    """The scene's model, with a point-mass platform's rotation locked (see :data:`ROTATION_LOCK`)."""
+    """The scene's model; a point-mass platform's rotation (which feels no moment) is locked."""
     model = build_model(scene)
-    if ROTATION_LOCK and scene.platform.is_point_mass:
+    if scene.platform.is_point_mass:
         mbs = model.mbs
         ground = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
         ground_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
@@ -499,23 +389,14 @@ def _integrate_until_rest(model: Model, scene: Scene, tolerance: float, max_time
 
 def _last_state(model: Model) -> dict[str, Any]:
     """The platform pose and node positions where a failed run to rest stopped (finite values only)."""
-    data = model.mbs.systemData
-    indices = model.coordinate_indices()
-    reference = np.asarray(data.GetODE2Coordinates(exu.ConfigurationType.Reference))
-    q = np.asarray(data.GetODE2Coordinates())
-    pose = reference[indices["platform"]] + q[indices["platform"]]
-    state = {"platform_pose": pose.tolist() if np.all(np.isfinite(pose)) else None}
-    nodes = [reference[indices[f"cable_{i}"]] + q[indices[f"cable_{i}"]] for i in range(len(model.cables))]
-    state["nodes_m"] = [n.tolist() if np.all(np.isfinite(n)) else None for n in nodes]
-    return state
+    pose = _coordinates(model, "platform")
+    return {"platform_pose": pose.tolist() if np.all(np.isfinite(pose)) else None,
+            "nodes_m": [n.tolist() if np.all(np.isfinite(n)) else None for n in _cable_positions(model)]}
 
 
 def _static_solve(model: Model, max_shift: float | None) -> float | None:
-    """Exudyn's static solver from the model's current state, velocities zeroed.
-
-    Returns the largest node shift [m] if it converged (and moved no node farther than
-    ``max_shift``); otherwise restores the state and returns None.
-    """
+    """Exudyn's static solver from the model's current state, velocities zeroed: the largest node shift
+    [m] if it converged and moved no node farther than ``max_shift``; else None, the state restored."""
     mbs = model.mbs
     data = mbs.systemData
     saved = data.GetSystemState()
@@ -523,14 +404,11 @@ def _static_solve(model: Model, max_shift: float | None) -> float | None:
     state = list(saved)
     state[1] = np.zeros_like(np.asarray(state[1]))
     data.SetSystemState(state, configuration=exu.ConfigurationType.Initial)
-    printing = exu.config.printToConsole
-    exu.config.printToConsole = False  # a failed static solve prints a page of hints
     try:
-        converged = bool(mbs.SolveStatic(static_settings(1e-10), showHints=False, showCausingItems=False))
+        with quiet_exudyn():  # a failed static solve prints a page of hints
+            converged = bool(mbs.SolveStatic(static_settings(1e-10), showHints=False, showCausingItems=False))
     except (exu.SolverError, RuntimeError, SystemError):
         converged = False
-    finally:
-        exu.config.printToConsole = printing
     after = np.concatenate(_cable_positions(model)) if converged else before
     shift = float(np.linalg.norm(after - before, axis=1).max()) if converged else math.inf
     if not converged or not np.isfinite(shift) or (max_shift is not None and shift > max_shift):
@@ -572,15 +450,16 @@ def _check_run(model: Model, scene: Scene) -> float:
     return speed
 
 
-# --------------------------------------------------------------------------- the state
+def _coordinates(model: Model, key: str) -> np.ndarray:
+    """The current absolute coordinates (reference + displacement) of ``key``'s ODE2 indices."""
+    data = model.mbs.systemData
+    index = model.coordinate_indices()[key]
+    return np.asarray(data.GetODE2Coordinates(exu.ConfigurationType.Reference))[index] \
+        + np.asarray(data.GetODE2Coordinates())[index]
 
 
 def _cable_positions(model: Model) -> list[np.ndarray]:
-    data = model.mbs.systemData
-    reference = np.asarray(data.GetODE2Coordinates(exu.ConfigurationType.Reference))
-    q = np.asarray(data.GetODE2Coordinates())
-    indices = model.coordinate_indices()
-    return [reference[indices[f"cable_{i}"]] + q[indices[f"cable_{i}"]] for i in range(len(model.cables))]
+    return [_coordinates(model, f"cable_{i}") for i in range(len(model.cables))]
 
 
 def _cable_velocities(model: Model) -> list[np.ndarray]:
@@ -590,21 +469,8 @@ def _cable_velocities(model: Model) -> list[np.ndarray]:
 
 
 def leave_point(center: np.ndarray, radius: float, outside: np.ndarray, near: np.ndarray) -> np.ndarray:
-    """Point of a pulley rim where the tangent from ``outside`` touches it, on the side of ``near``.
-
-    Parameters
-    ----------
-    center : ndarray, shape (2,) [m]
-    radius : float [m]
-    outside : ndarray, shape (2,) [m]
-        A point outside the rim (the first free node).
-    near : ndarray, shape (2,) [m]
-        A point on the rim (the last node in contact) that picks one of the two tangents.
-
-    Returns
-    -------
-    ndarray, shape (2,) [m]
-    """
+    """The point (2,) [m] of a pulley rim (``center`` (2,) [m], ``radius`` [m]) where the tangent from
+    ``outside`` (2,) [m] touches it, of the two the one nearer ``near`` (2,) [m] (the last node in contact)."""
     delta = np.asarray(outside, float) - center
     distance = float(np.hypot(*delta))
     beta = math.atan2(delta[1], delta[0])
@@ -635,29 +501,19 @@ def _bending_cut_force(scene: Scene, cable_index: int, positions: np.ndarray, ve
 
 def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method: str,
                 shift: float | None, notes: tuple, reaction_sign: float = 1.0) -> Rest:
-    """Read the rest state off the model (see the module notes for the definitions).
-
-    ``reaction_sign`` is -1 when the state comes from Exudyn's static solver, whose
-    constraint reactions have the opposite sign of the dynamic solver's; the conventions
-    below are the dynamic solver's, pinned by ``tests/test_model.py``.
-    """
+    """Read the rest state off the model. ``reaction_sign`` is -1 for a state of Exudyn's static solver,
+    whose constraint reactions have the opposite sign of the dynamic solver's (``tests/test_model.py``)."""
     mbs = model.mbs
-    data = mbs.systemData
-    reference = np.asarray(data.GetODE2Coordinates(exu.ConfigurationType.Reference))
-    q = np.asarray(data.GetODE2Coordinates())
-    platform = model.coordinate_indices()["platform"]
-    pose = reference[platform] + q[platform]
+    pose = _coordinates(model, "platform")
     force = exu.OutputVariableType.Force
     positions, velocities = _cable_positions(model), _cable_velocities(model)
-    tensions, lengths, unstrained, first, upper_points, upper_forces = [], [], [], [], [], []
-    platform_forces, anchor_tensions, weights = [], [], []
+    tensions, platform_forces, spans = [], [], []  # spans: the free spans' columns of the Rest
     for i, (cable, nodes, v) in enumerate(zip(scene.cables, positions, velocities)):
         tension = element_tensions(cable, nodes, v, scene.effects)
         tensions.append(tension)
         node_weights = scene.gravity * cable.node_masses() if scene.effects.gravity else np.zeros(len(nodes))
         elements = np.linalg.norm(np.diff(nodes, axis=0), axis=1)
         platform_forces.append(reaction_sign * np.asarray(mbs.GetObjectOutput(model.platform.joints[i], force))[:2])
-        anchor_tensions.append(tension[-1])
         pulley = scene.exits[i]
         touching = np.flatnonzero(penetration(pulley, nodes) > 0.0) if pulley.wraps else []
         if len(touching) == 0 or touching[-1] >= len(nodes) - 1:
@@ -670,27 +526,21 @@ def _rest_state(model: Model, scene: Scene, speed: float, elapsed: float, method
                 # force on it (minus the joint's force on the nodes beyond it), its weight
                 pull = tension[0] * (nodes[1] - nodes[0]) / elements[0]
                 upper = pull - _bending_cut_force(scene, i, nodes, v, 0) - np.array([0.0, node_weights[0]])
-            first.append(0)
-            upper_points.append(nodes[0])
-            upper_forces.append(upper)
-            lengths.append(float(elements.sum()))
-            unstrained.append(cable.unstrained_length)
-            weights.append(float(node_weights.sum()))
+            spans.append((0, nodes[0], upper, float(elements.sum()), cable.unstrained_length,
+                          float(node_weights.sum())))
             continue
         c = int(touching[-1])
         point = leave_point(np.asarray(pulley.point), pulley.radius, nodes[c + 1], nodes[c])
         piece = float(np.hypot(*(nodes[c + 1] - point)))
         on_span = tension[c] * (nodes[c] - nodes[c + 1]) / elements[c] + _bending_cut_force(scene, i, nodes, v, c)
-        first.append(c + 1)
-        upper_points.append(point)
-        upper_forces.append(-on_span)
-        lengths.append(piece + float(elements[c + 1:].sum()))
         strain = tension[c] / cable.axial_rigidity
-        unstrained.append(piece / (1.0 + strain) + (len(elements) - c - 1) * cable.element_length)
-        weights.append(float(node_weights[c + 1:].sum()))
+        spans.append((c + 1, point, -on_span, piece + float(elements[c + 1:].sum()),
+                      piece / (1.0 + strain) + (len(elements) - c - 1) * cable.element_length,
+                      float(node_weights[c + 1:].sum())))
+    first, upper_points, upper_forces, lengths, unstrained, weights = (list(column) for column in zip(*spans))
     return Rest(
         scene=scene, position=pose[:2].copy(), rotation=float(pose[2]), rotation_matrix=PLANE.rotation_matrix(pose[2]),
-        nodes=tuple(positions), tensions=tuple(tensions), anchor_tensions=np.array(anchor_tensions),
+        nodes=tuple(positions), tensions=tuple(tensions), anchor_tensions=np.array([t[-1] for t in tensions]),
         platform_forces=np.array(platform_forces), method=method, notes=notes,
         cable_stretched_length_m=np.array(lengths), cable_unstrained_length_m=np.array(unstrained),
         first_free_node=np.array(first, dtype=int), upper_points_m=np.array(upper_points),
@@ -740,12 +590,8 @@ def _planar_lines(rest: Rest) -> list[str]:
     return lines + [f"  note: {note}" for note in rest.notes]
 
 
-# --------------------------------------------------------------------------- in space: Exudyn's static solve
-
-
 def _solve_from_catenaries(scene: Scene, **relaxation) -> Rest:
-    """Bring a spatial ``scene`` to rest: catenary statics, then Exudyn's static solve of the lumped robot
-    (see the module notes); the planar relaxation's options (``relaxation``) do not apply."""
+    """Bring a spatial ``scene`` to rest (the module notes); the planar ``relaxation`` does not apply."""
     start = _time.perf_counter()
     platform = catenary_platform(scene)
     lengths = scene.unstrained_lengths
@@ -842,14 +688,10 @@ def _spatial_lines(rest: Rest) -> list[str]:
     return lines
 
 
-# --------------------------------------------------------------------------- the one choice of the method
-
-
 @dataclass(frozen=True)
 class _RestMethod:
-    """How a scene of one space is brought to rest, and how its rest is told: the solver
-    (``solve(scene, **options) -> Rest``), the summary, the arrays of ``rest.npz`` (None: no
-    such file) and the console lines."""
+    """How a scene of one space is brought to rest and its rest told: solver, summary, ``rest.npz``'s
+    arrays (None: no such file) and console lines."""
 
     solve: Callable[..., Rest]
     summary: Callable[[Rest], dict]

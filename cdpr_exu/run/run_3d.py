@@ -1,20 +1,13 @@
 """The spatial robot's side of the one run loop (:func:`cdpr_exu.run.simulate.simulate`): :class:`Run3D`.
 
-The robot (:mod:`cdpr_exu.builder.robot_3d`) starts at rest on its elastic-catenary equilibrium (over swivel
-pulleys on the lumped robot's own equilibrium: :func:`cdpr_exu.run.settle.start_at_rest`).
+The robot (:mod:`cdpr_exu.builder.robot_3d`) starts at rest on its elastic-catenary equilibrium (over
+swivel pulleys on the lumped robot's own: :func:`cdpr_exu.run.settle.start_at_rest`).
 
-**The winch at a point exit.** A spatial scene's cable leaves the frame at a fixed
-point, where the winch pays it out (over a swivel pulley the winch end moves along
-the pulley's axis instead, :mod:`cdpr_exu.builder.robot_3d`). The lumped cable keeps
-its n elements and changes with its paid-out (unstrained) length L(t): every element's
-unstrained length L / n, its axial stiffness E A n / L and damping d_n A n / L, the node
-masses rho L / n (half at the ends) and their weights, and the bending stiffness
-E J n / L and damping d_n J n / L, set before every step. This is a *variable-length* lumped cable: its
-statics are those of the elastic catenary of length L (which depends on L only, not on
-where along the cable the change happens), and its mass is the mass of the cable paid
-out. What it leaves out is the flow of material through the exit: the nodes slide
-along the cable by up to (L(t) - L(0)) (s / L) instead of the cable running in at the
-exit, an axial motion whose inertia is small beside the platform's.
+**The winch at a point exit** pays the cable out at a fixed point (over a swivel pulley the winch end
+moves along the pulley's axis instead). The lumped cable keeps its n elements and follows its paid-out
+length L(t): every element's length, stiffness and damping, the node masses and the bending scale with
+L / n before every step. Its statics are the elastic catenary's of length L; it leaves out the flow of
+material through the exit, an axial motion whose inertia is small beside the platform's.
 
 Units SI; z up, gravity along -z; poses ``(x, y, z, theta)`` with ``theta`` the platform's rotation vector.
 """
@@ -53,13 +46,10 @@ class _SpatialWinches:
     def set_lengths(self, lengths: np.ndarray, rates: np.ndarray) -> None:
         """Give every cable the paid-out length ``lengths`` (m,) [m], changing at ``rates`` (m,) [m/s].
 
-        Over a swivel pulley the cable keeps its elements: its held winch end moves along
-        the swivel axis by the change of the paid-out length (cable runs over the disc).
-
-        The rate goes to each element's damper as Exudyn's ``velocityOffset``: the
-        Kelvin-Voigt damper acts on the strain rate d(l - l0)/dt, so a cable that is paid
-        out without stretching is not damped (without the offset the paper's damping
-        constant on a CoGiRo cable paid out at 0.25 m/s pulls with 740 N).
+        Over a swivel pulley the held winch end moves along the swivel axis instead. The rate goes to each
+        element's damper as Exudyn's ``velocityOffset``: the Kelvin-Voigt damper acts on d(l - l0)/dt, so
+        a cable paid out without stretching is not damped (without it a CoGiRo cable paid out at 0.25 m/s
+        pulls with 740 N).
         """
         mbs, items = self.mbs, self.items
         set_object = mbs.SetObjectParameter
@@ -106,10 +96,8 @@ MAX_ROTATION_ERROR_DEG = 90.0
 
 
 class _SpatialMonitor:
-    """Checks the platform at the start and after each step for states the run cannot come back from
-    (the spatial counterpart of the planar monitor): coordinates no longer finite, a platform above
-    its highest exit (every cable pulls it down there: only cables that push could hold it), or one
-    turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference's orientation."""
+    """Checks the platform at the start and after each step for states the run cannot come back from:
+    not finite, above its highest exit, turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference."""
 
     def __init__(self, scene: Scene):
         self.trajectory = scene.trajectory
@@ -117,8 +105,7 @@ class _SpatialMonitor:
         self.turns = not scene.platform.is_point_mass
 
     def problem(self, t: float, position: np.ndarray, rotation: np.ndarray) -> str | None:
-        """What is wrong at time ``t`` [s] with the platform at ``position`` (3,) [m], turned by ``rotation`` (3, 3),
-        or None."""
+        """What is wrong at ``t`` [s] with the platform at ``position`` (3,) [m], ``rotation`` (3, 3)."""
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(rotation))):
             return f"the coordinates are no longer finite at t = {t:.4f} s"
         if position[2] > self.ceiling:
@@ -140,8 +127,7 @@ class _SpatialMonitor:
 
 
 def _warn_outside_measured_region(scene: Scene) -> None:
-    """Warn (:class:`cdpr_exu.physics.swivel_pulley.SwivelStabilityWarning`) when the scene's solver settings lie
-    outside the region where runs over a swivel pulley were measured to keep their energy."""
+    """Warn where runs over a swivel pulley were not measured to keep their energy at these settings."""
     solver = scene.solver
     for exit_, cable in zip(scene.exits, scene.cables):
         if not exit_.wraps:
@@ -153,8 +139,7 @@ def _warn_outside_measured_region(scene: Scene) -> None:
 
 
 def _rest_above_exits(scene: Scene, mbs, items) -> str | None:
-    """Why the lumped robot's rest (over swivel pulleys) cannot start a run, or None: it holds the platform
-    above its exits (:func:`cdpr_exu.run.rest.rest_above_exits`: its bending or pushing elements do)."""
+    """Why the robot's rest over swivel pulleys cannot start a run (:func:`rest_above_exits`), or None."""
     position, rotation = platform_pose(mbs, items, current=False)
     lowest = min(float(element_forces(mbs, items, i, current=False).min()) for i in range(scene.n_cables))
     above = rest_above_exits(scene, position, rotation, lowest, items.initial)
@@ -162,17 +147,9 @@ def _rest_above_exits(scene: Scene, mbs, items) -> str | None:
 
 
 class Run3D:
-    """The spatial robot's side of a run (built before the controller's reset, which starts from its rest):
-    the winches follow the command before every step (:class:`_SpatialWinches`); after every step that
-    reaches an output time the state is recorded with the step's own time (and the step that ends the run),
-    and every step is checked (:class:`_SpatialMonitor`). A controller's measurement is the platform's pose
-    (x, y, z, rotation vector), its rate (the pose's time derivative) and each cable's last element's axial
-    force [N] at the start of the step (``Measurement.state_time``).
-
-    Raises
-    ------
-    SolverFailure
-        At t = 0, without a partial result, if settling the robot over its swivel pulleys failed.
+    """The spatial robot's side of a run (:data:`~cdpr_exu.run.simulate.RUNS`): the winches follow the
+    command before every step; the steps that reach an output time (and the last) are recorded with their
+    own time; every step is checked. SolverFailure at t = 0 if settling over swivel pulleys failed.
     """
 
     def __init__(self, scene: Scene, model: Model3D):
@@ -204,9 +181,7 @@ class Run3D:
         self.start = _time.perf_counter()
 
     def measured_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """The platform's pose (x, y, z, rotation vector) [m, rad] and its time derivative [m/s, rad/s] now
-        (the rotation vector's rate from Exudyn's angular velocity, :meth:`Space.rotation_rate`, as planar
-        runs give the pose's rate), each shape (6,)."""
+        """The platform's pose [m, rad] and its time derivative [m/s, rad/s] now, each shape (6,)."""
         mbs, items = self.model.mbs, self.model.items
         position, rotation = platform_pose(mbs, items)
         velocity = np.array(mbs.GetNodeOutput(items.platform_node, exu.OutputVariableType.Velocity))
@@ -217,7 +192,7 @@ class Run3D:
         return np.concatenate([position, theta]), np.concatenate([velocity, rate])
 
     def initial_pose(self) -> np.ndarray:
-        """The pose the controller starts from: where the robot rests (x, y, z, rotation vector), shape (6,)."""
+        """The pose the controller starts from: where the robot rests, shape (6,)."""
         return self.measured_state()[0]
 
     def measurement(self, t: float) -> Measurement:
@@ -233,8 +208,7 @@ class Run3D:
                            state_time=self.step_start)
 
     def record(self, t: float) -> None:
-        """Store the state now: the platform's pose, the paid-out lengths, each cable's nodes and element
-        forces (the state vectors read once, not node by node: 336 Exudyn calls per sample on CoGiRo)."""
+        """Store the state now (the state vectors read once, not node by node)."""
         mbs, items = self.model.mbs, self.model.items
         position, rotation = platform_pose(mbs, items)
         self.times.append(t)
@@ -248,8 +222,7 @@ class Run3D:
                                                    velocities=v[index]))  # spring and damper
 
     def begin(self, controller: Controller, report) -> None:
-        """Record the start; a start no run can come back from (over swivel pulleys, a rest held up by the
-        chains' bending, with its cause) is the run's stop reason before the first step."""
+        """Record the start; a start no run can come back from is the stop reason before the first step."""
         self.controller, self.report = controller, report
         self.record(0.0)
         self.next = 1
@@ -308,10 +281,9 @@ class Run3D:
                       [np.asarray(s) for s in self.tensions], np.asarray(self.paid))
 
     def reached(self, result: Result) -> tuple[float, bool]:  # noqa: ARG002
-        """The solver's own time [s] (the samples may end up to one output period before it), and whether it
-        reached the end time."""
+        """The solver's own time [s] (past the last sample) and whether it is the end time."""
         return self.reached_time, self.reached_time >= self.scene.solver.end_time - 1e-9
 
     def notes(self, failure: str, time: float) -> tuple[str, str]:  # noqa: ARG002
-        """What the failure's message says before and after the cause: nothing more."""
+        """Nothing to add to a failure's message."""
         return "", ""

@@ -1,5 +1,5 @@
-"""Bringing a built spatial robot (:mod:`cdpr_exu.builder.robot_3d`) to rest, and its static and dynamic
-solver settings: the runs of the builder's model before a scene's run starts (the builder builds, runs live here).
+"""Bringing a built spatial robot (:mod:`cdpr_exu.builder.robot_3d`) to rest before a run, and the static
+and dynamic solver settings of those runs.
 """
 
 from __future__ import annotations
@@ -15,27 +15,15 @@ from exudyn.rigidBodyUtilities import RotationMatrix2EulerParameters
 from cdpr_exu.builder.robot_3d import anchor_forces, anchor_points, chain_positions, platform_pose, swivel_angles
 from cdpr_exu.core.errors import SolverFailure, UnreachableError
 from cdpr_exu.core.geometry import rotation_vector
+from cdpr_exu.run.solver import quiet_exudyn
 from cdpr_exu.statics.chain_statics import ChainCable, ChainRobot, solve_chain_statics
 
 
 @dataclass(frozen=True, eq=False)
 class SpatialStaticResult:
-    """Exudyn's static solution of the lumped robot.
-
-    Attributes
-    ----------
-    position : ndarray, shape (3,) [m]
-    rotation : ndarray, shape (3, 3)
-    rotation_vector : ndarray, shape (3,) [rad]
-    forces_on_platform : ndarray, shape (n_cables, 3) [N]
-        The joint reactions on the platform (:func:`anchor_forces`).
-    anchor_points : ndarray, shape (n_cables, 3) [m]
-    tensions_at_anchor : ndarray, shape (n_cables,) [N]
-        Norm of each cable's force on the platform (what a load cell at the anchor reads; the
-        catenary's ``tension_at_anchor``, to O(n^-2)).
-    wall_time : float [s]
-        Of ``SolveStatic``.
-    """
+    """Exudyn's static solution of the lumped robot: the platform's pose, the joint reactions on it
+    ``forces_on_platform`` (m, 3) [N] at ``anchor_points`` (m, 3) [m] and their norms ``tensions_at_anchor``
+    (m,) [N] (what a load cell reads: the catenary's ``tension_at_anchor`` to O(n^-2))."""
 
     position: np.ndarray
     rotation: np.ndarray
@@ -65,32 +53,13 @@ SETTLE_TIME, SETTLE_STEP = 0.5, 5.0e-3
 
 
 def settle(mbs, items, duration=SETTLE_TIME, step_size=SETTLE_STEP):
-    """Let the assembled robot come to rest from its initial configuration, then make that its start (at rest).
+    """Let the assembled robot come to rest from its initial configuration and make that its start.
 
-    The fallback of :func:`start_at_rest`, which finds the same equilibrium by the chain
-    statics in a fraction of the time (spatial-four-cable-swivel with bending and
-    tension-only elements: 0.07 s of CPU time against this settle's 15 s, the two states
-    3e-10 apart; benchmarks/results/swivel_start.md).
-
-    Exudyn's static solver does not converge from the catenary start of a cable over a
-    swivel pulley (measured on spatial-four-cable-swivel at 24 and 48 elements: the
-    first Newton step raised the residual 300-fold, psi held or not); after this settle
-    it converges in 3 to 6 iterations, as the planar static mode polishes a settled
-    state (:mod:`cdpr_exu.run.rest`). Generalised-alpha at spectral radius 0, modified
-    Newton, adaptive steps, zero initial accelerations (the consistent ones, of a start
-    a few newtons out of balance on stiff elements, put tens of joules into the first
-    step), the cables' own damping.
-
-    The settle alone does not reach rest: the Kelvin-Voigt elements creep with the time
-    constant d_n / E (1 s on the paper's cable), so after 0.5 s spatial-four-cable-swivel
-    still hung 8.6 mm above its equilibrium, its nodes up to 54 mm away and 6.7 J above it
-    (measured). Started from there with its velocities zeroed, a run without axial damping
-    lost 5.1 J in its first step at spectral radius 0 (the out-of-balance elements'
-    energy, numerically damped): what looked like a wrong energy record. So Exudyn's
-    static solver then takes the settled state to the lumped robot's equilibrium (3 to 6
-    iterations), and that is the start. Where it fails (a rigid platform on exact
-    spherical joints, see the module notes) the settled state stays the start, with a
-    ``RuntimeWarning`` that says so.
+    The fallback of :func:`start_at_rest`, whose chain statics find the same equilibrium 200 times
+    faster (benchmarks/results/swivel_start.md). After this settle (zero initial accelerations: the
+    consistent ones put tens of joules into the first step) Exudyn's static solver, which does not
+    converge from the catenary start over a swivel pulley, takes the state to its equilibrium (the
+    Kelvin-Voigt creep leaves it millimetres off); where it fails, with a ``RuntimeWarning``.
     """
     settings = dynamic_settings(duration, step_size, spectral_radius=0.0, tolerance=1e-6)
     ti = settings.timeIntegration
@@ -99,14 +68,11 @@ def settle(mbs, items, duration=SETTLE_TIME, step_size=SETTLE_STEP):
     ti.adaptiveStep = True
     ti.minimumStepSize = step_size * 1e-4
     ti.generalizedAlpha.computeInitialAccelerations = False
-    printing = exu.config.printToConsole
-    exu.config.printToConsole = False
     try:
-        mbs.SolveDynamic(settings)
+        with quiet_exudyn():
+            mbs.SolveDynamic(settings)
     except (exu.SolverError, RuntimeError, SystemError) as error:
         raise SolverFailure(f"settling the robot over its swivel pulleys failed: {error}") from None
-    finally:
-        exu.config.printToConsole = printing
     settled = _start_at_rest(mbs)
     try:
         solve_static(mbs, items)
@@ -129,16 +95,8 @@ def _start_at_rest(mbs):
 
 
 def chain_statics_robot(mbs, items) -> ChainRobot:
-    """The chain statics' model (:mod:`cdpr_exu.statics.chain_statics`) of a built robot, read from its items:
-    the same node masses, element stiffnesses, bending, tension-only law, held first nodes (a swivel
-    cable's winch end where the builder holds it), swivel pulleys and anchor joints.
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-        Assembled; the first nodes are held where its initial configuration has them.
-    items : SpatialRobotItems
-    """
+    """The chain statics' model of a built, assembled robot, read from its items (first nodes held where
+    the initial configuration has them)."""
     platform, chain = items.platform, items.chain
     cables = []
     for i, cable in enumerate(platform.cables):
@@ -153,16 +111,7 @@ def chain_statics_robot(mbs, items) -> ChainRobot:
 
 
 def set_configuration(mbs, items, equilibrium):
-    """Put the assembled robot at rest in a chain-statics equilibrium, as its initial and current configuration.
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-        Assembled.
-    items : SpatialRobotItems
-    equilibrium : ChainEquilibrium
-        Of :func:`chain_statics_robot` (the nodes, the platform's pose and the swivel angles).
-    """
+    """Put the assembled robot at rest in a chain-statics ``equilibrium``, initial and current."""
     q = np.array(mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Initial))
     for spec, nodes in zip(items.chains, equilibrium.nodes):
         displacement = np.asarray(nodes, float).ravel() - spec.reference
@@ -186,19 +135,9 @@ def set_configuration(mbs, items, equilibrium):
 
 @dataclass(frozen=True, eq=False)
 class RestStart:
-    """How :func:`start_at_rest` brought the robot to rest.
-
-    Attributes
-    ----------
-    method : str
-        "chain statics" (the chain statics' equilibrium, polished by Exudyn's static solver
-        where it applies) or "dynamic settle" (the fallback, :func:`settle`).
-    statics : ChainEquilibrium or None
-        The chain statics' answer (None after the fallback).
-    polish_shift : float or None [m, rad]
-        Largest change of any coordinate by Exudyn's static solver from the chain statics'
-        equilibrium (None: not polished).
-    """
+    """How :func:`start_at_rest` brought the robot to rest: ``method`` "chain statics" or "dynamic settle",
+    the chain ``statics``' equilibrium (None after the fallback), the largest change of a coordinate by
+    Exudyn's static solver ``polish_shift`` [m, rad] (None: not polished)."""
 
     method: str
     statics: object
@@ -206,30 +145,15 @@ class RestStart:
 
 
 def start_at_rest(mbs, items, max_iterations: int = 100) -> RestStart:
-    """Bring the assembled robot to its static equilibrium by the chain statics and make that its start (at rest).
+    """Bring the assembled robot from its initial (catenary) configuration to its static equilibrium by the
+    chain statics and make that its start.
 
-    The chain statics (:func:`cdpr_exu.statics.chain_statics.solve_chain_statics`
-    on :func:`chain_statics_robot`, the same discrete model, started where the builder
-    started Exudyn's) solve the robot over swivel pulleys, where Exudyn's static solver
-    does not converge from the catenary start; then Exudyn's static solver polishes that
-    state (on spatial-four-cable-swivel it converges at once and moves no coordinate by
-    more than 1e-15, measured), except on a rigid platform held by exact spherical joints,
-    where it is known to diverge (the module notes) and the chain statics' answer is the
-    start. If the chain statics fail, the dynamic :func:`settle` is the fallback, with a
-    ``RuntimeWarning`` that says so; if the polish fails, the chain statics' state stays the
-    start, with a ``RuntimeWarning``.
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-        Assembled, in its initial (catenary) configuration.
-    items : SpatialRobotItems
-    max_iterations : int
-        Of the chain statics' Newton iteration (the shipped swivel scene takes 12 to 15).
-
-    Returns
-    -------
-    RestStart
+    The chain statics (on :func:`chain_statics_robot`, the same discrete model, at most
+    ``max_iterations`` Newton steps) solve the robot over swivel pulleys, where Exudyn's static solver
+    does not converge from the catenary start; Exudyn's static solver then polishes that state (1e-15),
+    except on a rigid platform on exact spherical joints, where it diverges. If the chain statics fail,
+    :func:`settle` is the fallback; if the polish fails, their state is the start; either with a
+    ``RuntimeWarning``.
     """
     robot = chain_statics_robot(mbs, items)
     start = ([chain_positions(mbs, items, i, current=False) for i in range(len(items.chains))],
@@ -257,38 +181,17 @@ def start_at_rest(mbs, items, max_iterations: int = 100) -> RestStart:
 
 
 def solve_static(mbs, items, settings=None):
-    """Exudyn's static equilibrium of the assembled robot, from its initial (catenary) configuration.
-
-    Parameters
-    ----------
-    mbs : exudyn.MainSystem
-        Assembled (``mbs.Assemble()``).
-    items : SpatialRobotItems
-    settings : exudyn.SimulationSettings, optional
-        Default :func:`static_settings`.
-
-    Returns
-    -------
-    SpatialStaticResult
-
-    Raises
-    ------
-    SolverFailure
-        If Exudyn's static solver does not converge (on a rigid platform with exact
-        spherical joints it does not: use ``ChainSpec3D.anchor_spring_factor``).
-    """
+    """Exudyn's static equilibrium of the assembled robot from its initial configuration; SolverFailure if
+    it does not converge (as on a rigid platform on exact spherical joints)."""
     settings = static_settings() if settings is None else settings
     hint = ("" if items.is_point_mass or items.chain.anchor_spring_factor is not None else
             " (a rigid platform on exact spherical joints: set ChainSpec3D.anchor_spring_factor)")
     start = time.perf_counter()
-    printing = exu.config.printToConsole
-    exu.config.printToConsole = False  # a failed static solve prints a page of hints
     try:
-        converged = bool(mbs.SolveStatic(settings, showHints=False, showCausingItems=False))
+        with quiet_exudyn():  # a failed static solve prints a page of hints
+            converged = bool(mbs.SolveStatic(settings, showHints=False, showCausingItems=False))
     except (exu.SolverError, RuntimeError, SystemError) as error:
         raise SolverFailure(f"Exudyn's static solver failed: {error}{hint}") from None
-    finally:
-        exu.config.printToConsole = printing
     wall_time = time.perf_counter() - start
     if not converged:
         raise SolverFailure(f"Exudyn's static solver did not converge{hint}")

@@ -43,11 +43,8 @@ MAX_PENETRATION_FRACTION = 0.5
 
 
 class _Monitor:
-    """Checks each recorded sample for states the model cannot describe.
-
-    All cables' elements are checked at once (one strain and one depth per element,
-    over flat arrays built here); the cable reported is the first that fails.
-    """
+    """Checks each recorded sample for states the model cannot describe, all elements at once (the cable
+    reported is the first that fails)."""
 
     def __init__(self, scene: Scene, indices: dict[str, np.ndarray], reference: np.ndarray):
         self.scene = scene
@@ -55,21 +52,17 @@ class _Monitor:
         self.cable_numbers = np.array(lumped, dtype=int)
         self.check_pulleys = scene.pulley_contact
         self.on_segments = scene.contact_model is not None and scene.contact_model.on_segments
-        # flat arrays over the lumped cables: node coordinates (N, 2), element ends (E,), per element
-        # its cable (position in ``lumped``), rest length [m], pulley centre [m] and radius [m]
-        self.node_index = (np.concatenate([indices[f"cable_{i}"] for i in lumped]) if lumped
-                           else np.zeros((0, 2), dtype=int))
-        self.reference_nodes = reference[self.node_index]
-        counts = [len(indices[f"cable_{i}"]) for i in lumped]
-        first_node = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int) if lumped else np.zeros(0, int)
-        self.start = np.concatenate([f + np.arange(n - 1) for f, n in zip(first_node, counts)]).astype(int) \
-            if lumped else np.zeros(0, int)
-        self.element_cable = np.concatenate([np.full(n - 1, k) for k, n in enumerate(counts)]).astype(int) \
-            if lumped else np.zeros(0, int)
-        self.first_element = np.concatenate([[0], np.cumsum([n - 1 for n in counts])[:-1]]).astype(int) \
-            if lumped else np.zeros(0, int)
-        self.rest = np.concatenate([np.full(scene.cables[i].n_elements, scene.cables[i].element_length)
-                                    for i in lumped]) if lumped else np.zeros(0)
+        self.rest = np.zeros(0)  # rest length of each element [m]; none: massless ropes, no element to check
+        if lumped:  # flat arrays: node coordinates (N, 2), element starts, each element's cable
+            self.node_index = np.concatenate([indices[f"cable_{i}"] for i in lumped])
+            self.reference_nodes = reference[self.node_index]
+            counts = [len(indices[f"cable_{i}"]) for i in lumped]
+            first_node = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int)
+            self.start = np.concatenate([f + np.arange(n - 1) for f, n in zip(first_node, counts)])
+            self.element_cable = np.concatenate([np.full(n - 1, k) for k, n in enumerate(counts)]).astype(int)
+            self.first_element = np.concatenate([[0], np.cumsum([n - 1 for n in counts])[:-1]]).astype(int)
+            self.rest = np.concatenate([np.full(scene.cables[i].n_elements, scene.cables[i].element_length)
+                                        for i in lumped])
         if self.check_pulleys and lumped:
             self.centers = scene.exit_points[lumped][self.element_cable]
             self.radii = np.array([exit_.radius for exit_ in scene.exits])[lumped][self.element_cable]
@@ -88,11 +81,8 @@ class _Monitor:
         self.ceiling = tops.max() if suspended else np.inf
 
     def problem(self, t: float, q: np.ndarray, surplus: np.ndarray | None = None) -> str | None:
-        """A description of what is wrong at time ``t``, or None.
-
-        ``surplus`` [m], shape (m,): slack rope held at each drum, which lengthens the
-        winch element (:func:`cdpr_exu.builder.winch.reservoir_split`).
-        """
+        """What is wrong at time ``t`` [s], or None; ``surplus`` (m,) [m]: slack rope held at each drum,
+        which lengthens the winch element (:func:`cdpr_exu.builder.winch.reservoir_split`)."""
         if not np.all(np.isfinite(q)):
             return f"the coordinates are no longer finite at t = {t:.4f} s"
         if self.rest.size:
@@ -143,14 +133,9 @@ class _Monitor:
 class _Recorder:
     """Stores Exudyn's coordinates at the output times (called once per step).
 
-    Each sample is the state at the end of the first step that reaches its output time,
-    with that step's time: a real state of the model, never an interpolation. Steps end
-    on the output times unless Exudyn's adaptive step has shrunk one (eg where a slack
-    element snaps taut); then later samples lie up to one step after their output time
-    (the result's ``time`` says when). Linear or cubic interpolation onto the grid was
-    tried and dropped: across a step where an element snaps taut or a node strikes the
-    rim it made elements look slack (0 N where both ends carried 11 N and more) and
-    nodes cut into the pulley (0.19 mm).
+    Each sample is the state at the end of the first step that reaches its output time, with that step's
+    time: never an interpolation, which across a step where an element snaps taut or a node strikes the
+    rim made elements look slack and nodes cut into the pulley.
     """
 
     def __init__(self, model: Model, output_period: float, end_time: float):
@@ -168,7 +153,7 @@ class _Recorder:
         self.count = 0
 
     def record_if_due(self, t: float, paid_out: np.ndarray, surplus: np.ndarray | None = None) -> bool:
-        """Store the state if an output time is due; True if it was stored."""
+        """Store the state if an output time is due; True if stored."""
         if self.count < len(self.output_times) and t >= self.output_times[self.count] - 1e-9:
             data = self.model.mbs.systemData
             self.q[self.count] = data.GetODE2Coordinates()
@@ -221,11 +206,7 @@ class _Recorder:
 
 def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndarray, forces: np.ndarray,
                  times: np.ndarray):
-    """Polylines (winch end, hang point, tangent point, anchor) and tensions of massless ropes.
-
-    The ropes have no nodes: their points follow from the platform pose and the
-    paid-out length; their velocities are time derivatives of those points.
-    """
+    """Massless ropes' polylines (winch end, hang point, tangent point, anchor), rates and tensions."""
     from cdpr_exu.statics.kinematics import anchor_points
 
     k = len(times)
@@ -245,23 +226,10 @@ def _rope_series(scene: Scene, model: Model, pose: np.ndarray, paid_out: np.ndar
 
 
 class Run2D:
-    """The planar robot's side of a run: its winch drive, measurement, records and checks.
-
-    Before each step it asks the controller for the winch commands (from a
-    :class:`Measurement`) and drives the winches (kinematic lengths, servo motor forces,
-    the slack-rope reservoir); after each step it records the outputs that are due
-    (:class:`_Recorder`), checks them (:class:`_Monitor`), reports progress and ends the
-    integration on a problem or a Ctrl-C, keeping what was computed.
-
-    Attributes
-    ----------
-    paid_out, rate : ndarray, shape (m,) [m, m/s]
-        The last commanded (or, for servos, measured) paid-out lengths and rates.
-    stop_reason : str or None
-        Why the run was stopped early (a monitor problem or a controller error).
-    interrupted : dict
-        ``{"interrupted": bool}``, set by :func:`interrupt_flag` during the solve.
-    """
+    """The planar robot's side of a run (:data:`RUNS`): before each step the controller's command drives
+    the winches (kinematic lengths, servo motor forces, the slack-rope reservoir); after each step the
+    outputs due are recorded (:class:`_Recorder`) and checked (:class:`_Monitor`). ``paid_out`` and
+    ``rate`` (m,) [m, m/s] are the last commanded (servos: measured) lengths and rates."""
 
     def __init__(self, scene: Scene, model: Model):
         self.scene, self.model = scene, model
@@ -287,11 +255,11 @@ class Run2D:
         self.start = _time.perf_counter()
 
     def initial_pose(self) -> None:
-        """The pose the controller starts from: None, the scene's initial pose (the model is built there)."""
+        """None: the controller starts from the scene's initial pose (the model is built there)."""
         return None
 
     def begin(self, controller: Controller, report) -> None:
-        """Record the start (a planar start is always runnable)."""
+        """Record the start (always runnable)."""
         self.controller, self.report = controller, report
         self.recorder.record_if_due(0.0, self.paid_out)
         self.start = _time.perf_counter()
@@ -385,7 +353,6 @@ class Run2D:
             self.report(t, _time.perf_counter() - self.start)
         return True
 
-
     def result(self, controller_name: str, failure: str | None) -> Result:
         """What was recorded, as a :class:`Result`; after a failure it ends at its last finite sample."""
         recorder = self.recorder
@@ -414,36 +381,20 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
              sparse_jacobian: bool | None = None) -> Result:
     """Simulate ``scene``, planar or spatial, under ``controller`` (default: ideal inverse kinematics).
 
-    One run loop for both dimensions: it builds the scene's model (:func:`cdpr_exu.builder.model.build_model`),
-    wraps the controller in :class:`SmoothStart` (its commands start at the paid-out lengths), integrates
-    with Exudyn's implicit solver and returns the one :class:`~cdpr_exu.results.result.Result`. What
-    differs by dimension (the winch drive, the measurement, the records and the checks) lives in the
-    model's run side (:data:`RUNS`: :class:`Run2D`, :class:`cdpr_exu.run.run_3d.Run3D`).
+    One run loop for both dimensions: the controller wrapped in :class:`SmoothStart` (its commands start at
+    the paid-out lengths), Exudyn's implicit solver, one Result; the model's run side (:data:`RUNS`) holds
+    what differs by dimension.
 
-    Parameters
-    ----------
-    scene : Scene
-    controller : Controller, optional
-        Gives the winch commands once per step; default :class:`IdealIKController`.
-    solution_file : path, optional
-        Also write Exudyn's solution file there, for ``SolutionViewer``.
-    progress : bool or callable
-        True shows a progress bar (simulated time, ratio to real time); a callable
-        is called as ``progress(t, wall_time)`` about 100 times per run.
-    sparse_jacobian : bool, optional
-        Planar runs: hand Exudyn the cables' Jacobian as sparse triplets (True) or a dense
-        matrix (False); default: sparse for fine cables (see :func:`cdpr_exu.builder.model.build_model`).
-
-    Returns
-    -------
-    Result
+    ``solution_file``: also write Exudyn's solution file there; ``progress``: True shows a progress bar,
+    a callable is called as ``progress(t, wall_time)`` about 100 times; ``sparse_jacobian``: planar runs'
+    cable Jacobian sparse or dense (:func:`~cdpr_exu.builder.model.build_model`).
 
     Raises
     ------
     SceneError, UnreachableError
-        Before the run, if the scene has no reference or it leaves the workspace.
-    SolverFailure
-        If the solver fails; ``.time`` and ``.partial_result`` say when and what was
+        Before the run (:func:`check_runnable`).
+    SolverFailure, RunInterrupted
+        When the solver fails or Ctrl-C stops it; ``.time`` and ``.partial_result`` say when and what was
         computed up to then.
     """
     check_runnable(scene)
@@ -501,23 +452,16 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
 
 
 def check_runnable(scene: Scene) -> None:
-    """Refuse a scene :func:`simulate` cannot run, before anything is built or written (``cdpr run`` checks
-    before it writes): no ``[trajectory]``, or a reference the cables cannot follow
-    (:func:`cdpr_exu.statics.workspace.check_reference`).
-
-    Raises
-    ------
-    SceneError, UnreachableError
-    """
+    """Refuse a scene :func:`simulate` cannot run, before anything is built or written: SceneError without
+    a ``[trajectory]``, UnreachableError for a reference the cables cannot follow (``check_reference``)."""
     if scene.trajectory is None:
         raise SceneError(f"scene {scene.name!r} has no [trajectory]: `cdpr run` needs one (`cdpr static` does not)")
     check_reference(scene)
 
 
-#: The run side of each dimension's model, ``RUNS[type(model)](scene, model)``: its winch drive, measurement,
-#: records and checks behind one interface (``initial_pose()``, ``begin(controller, report)``, ``pre_step``,
-#: ``post_step``, ``stop_reason``, ``interrupted``, ``start``, ``result(name, failure)``, ``reached(result)``,
-#: ``notes(failure, time)``).
+#: The run side of each dimension's model, ``RUNS[type(model)](scene, model)``, behind one interface:
+#: ``initial_pose()``, ``begin(controller, report)``, ``pre_step``, ``post_step``, ``stop_reason``,
+#: ``interrupted``, ``start``, ``result(name, failure)``, ``reached(result)``, ``notes(failure, time)``.
 RUNS = {Model: Run2D, Model3D: Run3D}
 
 

@@ -1,9 +1,6 @@
 """What the run loop, each dimension's run side and the static mode share: Exudyn's settings and
-console, Ctrl-C, the output times, the solver's own report of a failure, the likely cause of a
-failure (:func:`likely_cause`), and the progress bar.
-
-Below the run loop (:mod:`cdpr_exu.run.simulate`) and the spatial run side (:mod:`cdpr_exu.run.run_3d`),
-so that the one :func:`~cdpr_exu.run.simulate.simulate` uses both without a circle of imports.
+console, Ctrl-C, the output times, the solver's report of a failure and its likely cause, the progress
+bar. Below :mod:`cdpr_exu.run.simulate` and :mod:`cdpr_exu.run.run_3d`, so that neither imports the other.
 """
 
 from __future__ import annotations
@@ -22,13 +19,7 @@ from cdpr_exu.scenes.scene import Scene
 
 @contextlib.contextmanager
 def quiet_exudyn():
-    """Keep Exudyn's own console messages (failure banners, allocation warnings) to itself.
-
-    The project reports failures in its own words; Exudyn's banner ("DYNAMIC SOLVER
-    FAILED ... use showHints=True") and its memory-allocation warning would only
-    confuse. Both go through ``exudyn.Print``, which ``exu.config.printToConsole``
-    switches off; the setting is restored afterwards.
-    """
+    """Keep Exudyn's console messages to itself while active: the project reports failures in its words."""
     before = exu.config.printToConsole
     exu.config.printToConsole = False
     try:
@@ -39,12 +30,8 @@ def quiet_exudyn():
 
 @contextlib.contextmanager
 def interrupt_flag():
-    """While active, Ctrl-C (SIGINT) sets ``flag["interrupted"]`` instead of raising.
-
-    The solver's post-step function checks the flag and ends the time integration
-    cleanly, so the samples computed so far are kept. Outside the main thread (where
-    signal handlers cannot be installed) Ctrl-C behaves as usual.
-    """
+    """While active (in the main thread), a first Ctrl-C sets ``flag["interrupted"]`` instead of raising:
+    the post-step function ends the integration cleanly, keeping the samples so far."""
     flag = {"interrupted": False}
     if threading.current_thread() is not threading.main_thread():
         yield flag
@@ -52,7 +39,7 @@ def interrupt_flag():
     previous = signal.getsignal(signal.SIGINT)
 
     def handler(signum, frame):  # noqa: ARG001
-        if flag["interrupted"]:  # a second Ctrl-C: the user insists
+        if flag["interrupted"]:
             raise KeyboardInterrupt
         flag["interrupted"] = True
 
@@ -64,12 +51,8 @@ def interrupt_flag():
 
 
 def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> exu.SimulationSettings:
-    """Exudyn settings of the implicit run of ``scene``.
-
-    Generalized-alpha with the scene's spectral radius, the sparse LU solver, and
-    (modified) Newton whose Jacobian is updated every step. The contact's own
-    step-size recommendation is switched off (it shrinks steps to about 1e-6 s).
-    """
+    """Exudyn settings of the run of ``scene`` (the contact's step-size recommendation, which shrinks steps
+    to about 1e-6 s, off); ``solution_file``, if given, is written."""
     solver = scene.solver
     settings = exu.SimulationSettings()
     ti = settings.timeIntegration
@@ -77,39 +60,28 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     ti.endTime = solver.end_time
     ti.verboseMode = 0
     ti.generalizedAlpha.spectralRadius = solver.spectral_radius
-    # By default start from zero accelerations. The consistent initial acceleration of a
-    # straight cable's free nodes is -g, but the Kelvin-Voigt damping (c_i / m_i ~ 4e6
-    # 1/s) cuts it off within microseconds; carried into the first step it injects a
-    # start-up energy jolt (13 J on the paper scene at 1.7e-2 s steps). Without it the
-    # paper circle's path moves by 0.7 mm and its step-size error halves; a drop from
-    # rest, though, then converges at first order (SolverSpec.initial_accelerations).
+    # Zero initial accelerations by default: a straight cable's consistent -g is cut off by the
+    # Kelvin-Voigt damping within microseconds, and carried into the first step it injects a start-up
+    # jolt (13 J on the paper scene at 1.7e-2 s); a drop from rest, though, then converges at first order.
     ti.generalizedAlpha.computeInitialAccelerations = bool(solver.initial_accelerations)
     ti.newton.useModifiedNewton = solver.newton == "modified"
     ti.newton.modifiedNewtonJacUpdatePerStep = True
     ti.newton.maxIterations = solver.max_newton_iterations
-    # 1e-6 by default (SolverSpec.newton_tolerance): Exudyn's 1e-8 buys nothing at the
-    # millimetres asked here, and on stiff massless ropes it sits at the residual's
-    # round-off, so Newton stalls and the adaptive step shrinks up to 350-fold.
+    # 1e-6 by default: Exudyn's 1e-8 buys nothing at millimetres and sits at the round-off of stiff
+    # massless ropes' residual, where Newton stalls and the adaptive step shrinks up to 350-fold.
     ti.newton.relativeTolerance = solver.newton_tolerance
     ti.discontinuous.useRecommendedStepSize = False
     ti.adaptiveStep = True
     ti.minimumStepSize = solver.step_size * 1e-4
     settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-    # Where the Jacobian's sparsity pattern is the same at every factorisation, analyse it once: the
-    # path is the same bit for bit, x1.13 of the CPU time on the paper circle (issue 25). The exact-angle
-    # bending joints' blocks are never zero, so they hold the pattern fixed; without them (no bending,
-    # or the linear curvature spring, which has no x-z terms) a tension-only element that goes slack
-    # drops its entries, and a pattern analysed before orders the LU differently: the path moves by
-    # 1e-14 m to 2e-8 N (golden cases planar_preset_catenary, planar_linear_bending).
+    # Analyse the sparsity pattern once where it never changes (x1.13 of the CPU time, bit for bit): the
+    # exact-angle bending joints' blocks are never zero; without them a slack tension-only element drops
+    # its entries and a pattern analysed before would order the LU differently (1e-14 m on the path).
     effects = scene.effects
     settings.linearSolver.reuseAnalyzedPattern = effects.bending and effects.bending_model == "exact"
     if solver.integrator == "rk44":
-        # Explicit classical Runge-Kutta at the fixed step (comparison runs only).
-        # SolveDynamic takes the solver type from these settings when called without
-        # solverType; ``timeIntegration.explicitIntegration`` is the deprecated name of
-        # ``timeIntegration.explicit``. The winch's ground-coordinate constraints are
-        # eliminated (``explicit.eliminateConstraints``, Exudyn's default); the
-        # platform joints must be spring-dampers (see cdpr_exu.builder.platform).
+        # Explicit classical Runge-Kutta at the fixed step (comparison runs only); the winch's coordinate
+        # constraints eliminated, the platform joints spring-dampers (cdpr_exu.builder.platform).
         ti.solverType = exu.DynamicSolverType.RK44
         ti.adaptiveStep = False
         ti.explicit.eliminateConstraints = True
@@ -121,17 +93,13 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     return settings
 
 def output_times(end_time: float, output_period: float) -> np.ndarray:
-    """The output times of a run [s], shape (N,): the multiples of ``output_period`` from 0 up to
-    ``end_time`` (none after it; the end time is one of them only when it is a multiple)."""
+    """The output times of a run [s], shape (N,): multiples of ``output_period`` from 0 to ``end_time``."""
     count = int(math.floor(end_time / output_period + 1e-9)) + 1
     return np.arange(count) * output_period
 
 def solver_report(mbs: exu.MainSystem, message: str) -> str:
-    """What Exudyn's solver said when it stopped: its error string, time, step and residual.
-
-    Exudyn's exception text is only "SolveDynamic terminated"; the stored solver
-    (``mbs.sys["dynamicSolver"]``) knows why.
-    """
+    """What Exudyn's solver said when it stopped (its error string, time, step, residual): the exception's
+    text is only "SolveDynamic terminated"."""
     solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
     if solver is None:
         return f"Exudyn's solver stopped: {message}"
@@ -150,7 +118,7 @@ def solver_report(mbs: exu.MainSystem, message: str) -> str:
     return f"Exudyn's solver stopped ({message}): {reason} ({', '.join(details)})"
 
 def progress_reporter(progress, scene: Scene):
-    """A per-step callback that updates a tqdm bar or a user callable ~100 times."""
+    """A per-step callback that updates a tqdm bar or calls ``progress(t, wall)`` about 100 times."""
     if not progress:
         return None
     end = scene.solver.end_time
@@ -187,12 +155,8 @@ RK44_STABILITY_LIMIT = 2.785
 
 
 def explicit_step_limit(scene: Scene) -> float:
-    """Estimated largest stable step of explicit RK44 on ``scene``'s cables [s].
-
-    The fastest mode of a chain of over-damped Kelvin-Voigt elements is the zig-zag,
-    eigenvalue about -4 c_i / m_i; undamped, its frequency is 2 sqrt(k_i / m_i), and a
-    pulley contact adds sqrt(k_p / m_i). RK44 needs h |lambda| below about 2.8.
-    """
+    """Estimated largest stable step [s] of explicit RK44 on ``scene``'s cables: the zig-zag mode's
+    eigenvalue is about -4 c_i / m_i (undamped: 2 sqrt(k_i / m_i), with contact sqrt(k_p / m_i) more)."""
     limits = []
     for cable, pulley in zip(scene.cables, scene.exits):
         mass = float(cable.node_masses()[1:-1].min()) if cable.n_elements > 1 else cable.element_mass
@@ -263,18 +227,8 @@ def first_step_hints(scene: Scene) -> list[str]:
 
 
 def likely_cause(scene: Scene, failure: str = "", failure_time: float | None = None) -> str:
-    """A hint at what most likely made the integration fail.
-
-    Parameters
-    ----------
-    scene : Scene
-    failure : str
-        What stopped the run (the monitor's or the solver's words): the hint follows
-        the cause named there.
-    failure_time : float, optional [s]
-        When the run stopped; a stop within the first step gets hints about what in
-        the scene makes the first step fail.
-    """
+    """A hint at what most likely made the integration fail, after the cause named in ``failure`` and the
+    time of the stop ``failure_time`` [s] (within the first step: what in the scene makes it fail)."""
     hints = []
     if scene.solver.integrator == "rk44":
         limit = explicit_step_limit(scene)
