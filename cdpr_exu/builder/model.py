@@ -189,7 +189,8 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
         servo = scene.winch.kind == "servo"
         winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], drive_height=not servo))
         if servo:
-            servos.append(add_servo_drum(mbs, winches[-1], items.nodes[0], scene.winch))
+            servos.append(add_servo_drum(mbs, items.nodes[0], scene.space.vertical, scene.winch))
+            winches[-1].vertical = servos[-1].connector
         candidates = np.zeros(0, dtype=int) if contact is None else contact_candidates(scene, i)
         contact_elements.append(contact_segments(candidates, cable.n_elements) if on_segments
                                 else np.zeros(0, dtype=np.int64))

@@ -46,6 +46,7 @@ from cdpr_exu.exits import PointExit
 
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
+from cdpr_exu.builder.winch import add_servo_drum
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # the disc and its angle psi
 from cdpr_exu.statics.statics import (PlatformEquilibrium, SuspendedPlatform, catenary_platform, chain_element_mass,
                                       checked_unstrained_lengths, node_masses_along, solve_statics)
@@ -385,13 +386,16 @@ def swivel_angles(mbs, items, current=True):
 @dataclass
 class Model3D:
     """A spatial scene's assembled Exudyn system (the planar :class:`cdpr_exu.builder.model.Model`'s role):
-    ``items`` (:class:`SpatialRobotItems`), ``initial_paid_out`` (m,) [m] the unstrained lengths it starts with."""
+    ``items`` (:class:`SpatialRobotItems`), ``initial_paid_out`` (m,) [m] the unstrained lengths it starts with;
+    ``servos`` a servo winch's drums, each moving its chain's held end along the swivel axis (the z hold, which
+    keeps the drum still while the robot settles, is released for the run)."""
 
     scene: object
     system_container: object
     mbs: object
     items: SpatialRobotItems
     initial_paid_out: np.ndarray
+    servos: list = field(default_factory=list)
 
     def item_counts(self) -> dict[str, int]:
         """How many Exudyn items each part added."""
@@ -411,5 +415,7 @@ def build_model_3d(scene, sparse_jacobian: bool | None = None) -> Model3D:  # no
     container = exu.SystemContainer()
     mbs = container.AddSystem()
     items = build_spatial_robot(mbs, platform, lengths, scene_chain_spec(scene), initial=start, exits=scene.exits)
+    servos = [add_servo_drum(mbs, chain.nodes[0], scene.space.vertical, scene.winch)
+              for chain in items.chains] if scene.winch.kind == "servo" else []
     mbs.Assemble()
-    return Model3D(scene, container, mbs, items, lengths)
+    return Model3D(scene, container, mbs, items, lengths, servos)

@@ -79,33 +79,54 @@ def servo_gains(spec: WinchSpec) -> np.ndarray:
 @dataclass
 class ServoItems:
     """The drum of a servo winch: a one-coordinate node s (paid-out change) [m], the ``LoadCoordinate``
-    ``load`` of the motor force on it [N] and the servo ``gains`` (3,)."""
+    ``load`` of the motor force on it [N], the servo ``gains`` (3,) and the ``connector`` joining s to the winch node."""
 
     drum_node: int
     load: int
     gains: np.ndarray
+    connector: int
 
 
-def add_servo_drum(mbs: exu.MainSystem, winch: WinchItems, node: int, spec: WinchSpec) -> ServoItems:
-    """Drive the height of the winch node by a drum under a motor force.
+def add_servo_drum(mbs: exu.MainSystem, node: int, vertical: int, spec: WinchSpec) -> ServoItems:
+    """Drive the winch node's up coordinate (index ``vertical``: the Space's) by a drum under a motor force.
 
-    The drum coordinate s is the paid-out length change (rope taken off the drum); the
-    winch node's height follows it through the (now offset-free) vertical constraint.
+    The drum coordinate s is the paid-out length change (rope taken off the drum); the winch node's
+    height follows it through an offset-free ``ObjectConnectorCoordinate`` (the connector).
     """
     drum = mbs.AddNode(eii.NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.0],
                                            initialCoordinates_t=[0.0], numberOfODE2Coordinates=1))
     mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=[drum], massMatrix=np.eye(1) * spec.drum_mass))
     drum_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=drum, coordinate=0))
-    node_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node, coordinate=1))
-    winch.vertical = mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[drum_marker, node_marker], offset=0.0))
+    node_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node, coordinate=vertical))
+    connector = mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[drum_marker, node_marker], offset=0.0))
     load = mbs.AddLoad(eii.LoadCoordinate(markerNumber=drum_marker, load=0.0))
-    return ServoItems(drum, load, servo_gains(spec))
+    return ServoItems(drum, load, servo_gains(spec), connector)
 
 
-def servo_force(servo: ServoItems, error_integral: float, error: float, error_rate: float,
-                feed_forward: float) -> float:
-    """Motor force on the drum [N]: u = u_ff - K (integral e, e, e')."""
-    return float(feed_forward - servo.gains @ np.array([error_integral, error, error_rate]))
+class ServoDrums:
+    """The servo law of a model's drums, in both dimensions: once per step (Exudyn's pre-step) the motor force
+    u = u_ff - K (integral e, e, e') [N], e = s - s_cmd, with the winch-end tension fed forward (u_ff = -T:
+    the cable pulls rope off the drum)."""
+
+    def __init__(self, mbs: exu.MainSystem, servos: list[ServoItems], initial_paid_out: np.ndarray):
+        self.servos, self.initial = servos, initial_paid_out
+        self.index = [mbs.GetNodeODE2Index(servo.drum_node) for servo in servos]
+        self.integral = np.zeros(len(servos))
+        self.time = 0.0
+
+    def measured(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The paid-out lengths and rates the drums measure, (m,) each [m, m/s], from the state vectors."""
+        return self.initial + q[self.index], v[self.index]
+
+    def drive(self, mbs: exu.MainSystem, t: float, command, q: np.ndarray, v: np.ndarray, tensions) -> None:
+        """Set each drum's motor force for the ``command`` at ``t`` [s]; ``tensions`` (m,) [N] of the winch elements."""
+        dt, self.time = t - self.time, t
+        for i, (servo, index) in enumerate(zip(self.servos, self.index)):
+            error = q[index] - (command.paid_out[i] - self.initial[i])
+            error_rate = v[index] - command.paid_out_rate[i]
+            self.integral[i] += error * dt
+            force = float(-tensions[i] - servo.gains @ np.array([self.integral[i], error, error_rate]))
+            mbs.SetLoadParameter(servo.load, "load", force)
 
 
 # --------------------------------------------------------------------------- slack rope at the winch

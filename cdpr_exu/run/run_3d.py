@@ -22,6 +22,7 @@ import numpy as np
 
 from controllers.base import Controller, Measurement
 from cdpr_exu.builder.robot_3d import Model3D, element_forces, platform_pose
+from cdpr_exu.builder.winch import ServoDrums
 from cdpr_exu.core.errors import SolverFailure
 from cdpr_exu.core.geometry import rotation_from_vector, rotation_vector
 from cdpr_exu.physics.swivel_pulley import SwivelStabilityWarning, stability_concerns
@@ -164,6 +165,9 @@ class Run3D:
                 raise SolverFailure(f"settling the robot over its swivel pulleys before the run failed: "
                                     f"{solver_report(mbs, exudyn_said)}", time=0.0) from None
         self.winches = _SpatialWinches(mbs, scene, items, model.initial_paid_out)
+        self.drums = ServoDrums(mbs, model.servos, model.initial_paid_out)
+        for chain in items.chains[:len(model.servos)]:  # the drums hold the winch ends now (builder.robot_3d)
+            mbs.SetObjectParameter(chain.holds[2], "activeConnector", False)
         self.monitor = _SpatialMonitor(scene)
         self.outputs = output_times(scene.solver.end_time, scene.solver.output_period)
         m = scene.n_cables
@@ -172,7 +176,7 @@ class Run3D:
         # each cable's node coordinates in the system's state vectors: a sample reads those vectors once
         self.coordinates = [np.concatenate([np.arange(3) + mbs.GetNodeODE2Index(node) for node in chain.nodes])
                             for chain in items.chains]
-        self.kinematic = scene.winch.kind == "kinematic"
+        self.driven = scene.winch.kind != "fixed"
         self.next, self.step_start, self.reached_time = 0, 0.0, 0.0
         self.stop_reason: str | None = None
         self.interrupted = {"interrupted": False}
@@ -233,16 +237,23 @@ class Run3D:
 
     def pre_step(self, mbs_, t) -> bool:  # noqa: ARG002 - Exudyn's signature
         """Exudyn's pre-step function: command the winches; False stops the run."""
-        if not self.kinematic:
+        if not self.driven:
             return True
         try:
+            if self.drums.servos:  # the drums measure what they paid out
+                q, v = mbs_.systemData.GetODE2Coordinates(), mbs_.systemData.GetODE2Coordinates_t()
+                self.winches.applied, self.winches.rate = self.drums.measured(q, v)
             command = self.controller.command(self.measurement(t))
             paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
             rates = np.asarray(command.paid_out_rate, dtype=float).reshape(-1)
             lengths = self.model.initial_paid_out
             if paid_out.shape != lengths.shape or not (np.all(np.isfinite(paid_out)) and np.all(paid_out > 0.0)):
                 raise ValueError(f"the command must be {lengths.size} finite positive lengths, got {command.paid_out!r}")
-            self.winches.set_lengths(paid_out, rates)
+            if self.drums.servos:  # fed forward: the tension of each chain's winch element
+                tensions = [element_forces(mbs_, self.model.items, i)[0] for i in range(len(paid_out))]
+                self.drums.drive(mbs_, t, command, q, v, tensions)
+            else:
+                self.winches.set_lengths(paid_out, rates)
         except Exception as err:  # noqa: BLE001 - reported as the cause of the stop, with the partial result
             self.stop_reason = (f"controller {self.controller.name!r} raised at t = {t:.4f} s: "
                                 f"{type(err).__name__}: {err}")
@@ -275,7 +286,7 @@ class Run3D:
     def result(self, controller_name: str, failure: str | None) -> Result:  # noqa: ARG002 - every sample is kept
         """What was recorded, as a :class:`Result`."""
         time = np.asarray(self.times)
-        return Result(self.scene.name, controller_name if self.kinematic else "fixed winches",
+        return Result(self.scene.name, controller_name if self.driven else "fixed winches",
                       self.scene.space.dimension, time, np.asarray(self.poses),
                       np.atleast_2d(self.scene.trajectory.pose(time)), [np.asarray(s) for s in self.nodes],
                       [np.asarray(s) for s in self.tensions], np.asarray(self.paid))

@@ -30,7 +30,7 @@ from cdpr_exu.run.solver import (interrupt_flag, likely_cause, output_times, pro
 from cdpr_exu.run.run_3d import Run3D
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.statics.workspace import check_reference
-from cdpr_exu.builder.winch import RopeReservoir, servo_force, set_paid_out_length
+from cdpr_exu.builder.winch import RopeReservoir, ServoDrums, set_paid_out_length
 
 
 #: A run stops when an element's strain exceeds this: the lumped model has left the
@@ -248,9 +248,7 @@ class Run2D:
         # coordinates of each cable's first two nodes, shape (m, 2, 2): its winch element
         self.first_nodes = (np.array([self.indices[f"cable_{i}"][:2] for i in range(len(scene.cables))])
                             if self.reservoir else np.zeros((0, 2, 2), dtype=int))
-        self.drum_index = [model.mbs.GetNodeODE2Index(servo.drum_node) for servo in model.servos]
-        self.servo_integral = np.zeros(len(model.servos))
-        self.servo_time = 0.0
+        self.drums = ServoDrums(model.mbs, model.servos, model.initial_paid_out)
         self.step_start = 0.0  # end of the last accepted step: the time of the state the solver has [s]
         self.start = _time.perf_counter()
 
@@ -288,19 +286,6 @@ class Run2D:
         return Measurement(t, self.paid_out.copy(), self.rate.copy(), pose, velocity, tensions,
                            state_time=self.step_start)
 
-    def drive_servos(self, mbs_, t: float, command, q: np.ndarray, v: np.ndarray) -> None:
-        """Motor force of each servo drum from the command (once per step)."""
-        dt = t - self.servo_time
-        self.servo_time = t
-        for i, (servo, index) in enumerate(zip(self.model.servos, self.drum_index)):
-            error = q[index] - (command.paid_out[i] - self.model.initial_paid_out[i])
-            error_rate = v[index] - command.paid_out_rate[i]
-            self.servo_integral[i] += error * dt
-            tension = self._cable_tensions(q, v, i, slice(0, 2))[0]
-            # The cable pulls rope off the drum with its winch-end tension: feed it forward.
-            force = servo_force(servo, self.servo_integral[i], error, error_rate, -tension)
-            mbs_.SetLoadParameter(servo.load, "load", force)
-
     def pre_step(self, mbs_, t: float) -> bool:
         """Exudyn's pre-step function: command and drive the winches; False stops the run."""
         model = self.model
@@ -310,14 +295,14 @@ class Run2D:
             if model.servos:
                 q = mbs_.systemData.GetODE2Coordinates()
                 v = mbs_.systemData.GetODE2Coordinates_t()
-                self.paid_out = model.initial_paid_out + q[self.drum_index]
-                self.rate = v[self.drum_index]
+                self.paid_out, self.rate = self.drums.measured(q, v)
             command = self.controller.command(self.measurement(t))
             paid_out = np.asarray(command.paid_out, dtype=float).reshape(-1)
             if paid_out.shape != self.paid_out.shape or not np.all(np.isfinite(paid_out)):
                 raise ValueError(f"the command must be {self.paid_out.size} finite lengths, got {command.paid_out!r}")
             if model.servos:
-                self.drive_servos(mbs_, t, command, q, v)
+                tensions = [self._cable_tensions(q, v, i, slice(0, 2))[0] for i in range(len(model.servos))]
+                self.drums.drive(mbs_, t, command, q, v, tensions)
                 return True
         except Exception as err:  # noqa: BLE001 - reported as the cause of the stop
             self.stop_reason = (f"controller {self.controller.name!r} raised at t = {t:.4f} s: "

@@ -311,7 +311,8 @@ class WinchSpec:
         "kinematic": node 0 follows the command exactly along the vertical line below the
         pulley (the paper's flow source). "servo": a drum (``drum_inertia`` [kg m^2], drum and
         motor, ``drum_radius`` [m]) reels the cable under a motor torque from state feedback
-        with integral action, loaded by the cable tension. "fixed": node 0 held (static scenes).
+        with integral action, loaded by the cable tension (in space over swivel exits only: the drum moves
+        the winch end along the swivel axis). "fixed": node 0 held (static scenes).
     servo_design : {"pole_placement", "lqr"}
         Pole placement puts the three closed-loop poles near -``servo_bandwidth`` [rad/s];
         LQR weights position error against motor force for about that bandwidth.
@@ -930,8 +931,10 @@ def _spatial_rules(scene: Scene) -> None:
                                  f"{shown(getattr(first, name))}: the cables of a spatial scene share one "
                                  "discretisation, damping and bending so far")
     catenary_platform(scene)  # refuses coincident exits, too few cables, anchors on one line
-    if scene.winch.kind == "servo":
-        raise SceneError("winch.kind = 'servo': servo drums are planar only so far; use 'kinematic' or 'fixed'")
+    points = [i for i, exit_ in enumerate(scene.exits) if not exit_.wraps]
+    if scene.winch.kind == "servo" and points:
+        raise SceneError(f"winch.kind = 'servo' needs swivel exits: exits {points} are points, where the winch changes "
+                         "every element's rest length and no winch node moves for a drum; use exits of kind 'swivel'")
     if scene.solver.integrator != "generalized_alpha":
         raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
 
