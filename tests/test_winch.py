@@ -157,6 +157,36 @@ def test_a_spatial_scene_with_point_exits_refuses_servo_winches_naming_winch_kin
         scene.with_changes(winch=WinchSpec(kind="servo"))
 
 
+def _held_tension_swing(scene) -> float:
+    """Largest peak-to-peak winch-end tension [N] of ``scene``'s robot held by its servo drums, after 0.5 s."""
+    model = build_model(scene)
+    run = RUNS[type(model)](scene, model)
+    hold = _Step()
+    hold.reset(scene, model.initial_paid_out)
+    run.begin(hold, None)
+    model.mbs.SetPreStepUserFunction(run.pre_step)
+    model.mbs.SetPostStepUserFunction(run.post_step)
+    model.mbs.SolveDynamic(solver_settings(scene))
+    result = run.result("hold", None)
+    late = result.time > 0.5
+    return max(float(np.ptp(t[late, 0])) for t in result.tensions)
+
+
+def test_a_servo_step_too_coarse_for_the_drum_on_its_cable_is_refused_and_the_largest_allowed_holds_still():
+    """The drum's motor force is set once per step: a step beyond MAX_SERVO_STEP / sqrt(k / m) is refused
+    before any run, naming solver.step_size and its limit (the shipped swivel robot's 10 ms: 1.28). Held
+    for 1 s, its 35 N winch-end tensions swing by 0.6 N at 5 ms (0.64, allowed) and by 67 N at the refused
+    10 ms (the scene forced past its check to show why)."""
+    with pytest.raises(SceneError, match=r"solver\.step_size = 0\.01 s is too coarse .* <= 0\.0055 s"):
+        _servo_scene(3, 1.0, 1e-2)
+    allowed = _servo_scene(3, 1.0, 5e-3)
+    assert _held_tension_swing(allowed) < 2.0  # 0.58 N measured
+    forced = _servo_scene(3, 1.0, 5e-3)
+    object.__setattr__(forced.solver, "step_size", 1e-2)  # past the check: what it refuses
+    object.__setattr__(forced.solver, "output_period", 1e-2)
+    assert _held_tension_swing(forced) > 20.0  # 67 N measured
+
+
 # --------------------------------------------------------------------------- slack rope at the drum
 
 from cdpr_exu.builder.winch import RESERVOIR_THRESHOLD, TAUT_MARGIN, reservoir_split  # noqa: E402

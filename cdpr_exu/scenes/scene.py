@@ -753,6 +753,7 @@ class Scene:
         for i, (cable, exit_) in enumerate(zip(self.cables, self.exits)):
             exit_.check(cable, i, f"{table}[{i}]")
         rules.check(self)
+        _check_servo_step(self)
         if self.trajectory is None and self.platform.initial_pose is not None:
             _set(self, "trajectory", HoldTrajectory(tuple(self.platform.initial_pose), space=space))
         self._check_start()
@@ -898,6 +899,28 @@ def _listify(value: Any) -> Any:
     if isinstance(value, (tuple, list)):
         return [_listify(v) for v in value]
     return value
+
+
+#: Largest step times the drum-on-cable frequency sqrt(k / m) a servo winch takes [-]: its motor force is set
+#: once per step and feeds the winch-end tension forward one step late. Measured on the held
+#: spatial-four-cable-swivel: 0.64 (5 ms) rings by +-1 N, 1.28 (10 ms) between 15 and 72 N; the paper robot
+#: runs at 0.20 (2 ms).
+MAX_SERVO_STEP = 0.7
+
+
+def _check_servo_step(scene: Scene) -> None:
+    """Refuse a servo winch whose step cannot resolve its drum (mass J / r^2) on the stiffest cable (EA / l0)."""
+    if scene.winch.kind != "servo":
+        return
+    stiffness = max(cable.axial_rigidity / cable.unstrained_length for cable in scene.cables)
+    frequency = float(np.sqrt(stiffness / scene.winch.drum_mass))
+    limit = MAX_SERVO_STEP / frequency
+    if scene.solver.step_size > limit:
+        raise SceneError(
+            f"solver.step_size = {scene.solver.step_size:g} s is too coarse for winch.kind = 'servo': the drum "
+            f"({scene.winch.drum_mass:.3g} kg along the cable) on its cable ({stiffness:.3g} N/m) rings at "
+            f"{frequency:.3g} rad/s and its motor force is set once per step; use solver.step_size <= {limit:.2g} s "
+            "or a heavier drum (winch.drum_inertia)")
 
 
 def _planar_rules(scene: Scene) -> None:
