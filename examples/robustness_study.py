@@ -13,9 +13,10 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
    beside what the real run did (docs/robustness.md reads them).
 2. Every controller on every plant (``robustness.md``, ``robustness.csv``, ``robustness.json``, a heat map
    per controller ``robustness_<controller>.png``), into ``results/robustness/planar/``.
-3. The spatial CoGiRo-class robot (``spatial-cogiro``) under the chain correction's three starts
-   (:data:`controllers.base.STARTS`) and the catenary's, nominal and with the 10 % model error of
-   ``spatial-cogiro-mismatch``: ``results/robustness/spatial-cogiro/``.
+3. The spatial CoGiRo-class and IPAnema-class robots (``spatial-cogiro``, ``spatial-ipanema``) under the
+   chain correction's three starts (:data:`controllers.base.STARTS`) and the catenary's, the closed loop and
+   ILC, nominal and with the 10 % model error of ``spatial-cogiro-mismatch``:
+   ``results/robustness/spatial-cogiro/``, ``results/robustness/spatial-ipanema/``.
 
 Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
 this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after
@@ -54,10 +55,14 @@ PLANAR = {
     "ilc": ("ilc", {}),
 }
 
-#: The spatial controllers (item 3): the catenary's and the chain's starts.
-SPATIAL = {f"tension_aware{'_chain' if statics == 'chain' else ''}_{start}": ("tension_aware",
-                                                                             {"statics": statics, "start": start})
-           for statics in ("catenary", "chain") for start in ("absolute", "relative", "calibrated")}
+#: The spatial controllers (item 3): the catenary's and the chain's starts, the closed loop and ILC.
+SPATIAL = {**{f"tension_aware{'_chain' if statics == 'chain' else ''}_{start}": ("tension_aware",
+                                                                               {"statics": statics, "start": start})
+              for statics in ("catenary", "chain") for start in ("absolute", "relative", "calibrated")},
+           "closed_loop_tension_aware": ("closed_loop_tension_aware", {}), "ilc": ("ilc", {})}
+
+#: The spatial robots (item 4): the CoGiRo-class and the IPAnema-class, each nominal and with a 10 % model error.
+SPATIAL_SCENES = ("spatial-cogiro", "spatial-ipanema")
 
 #: Poses the loop is linearised at: 8 over one turn of the circle, after the 1 s ramp.
 POSES = 8
@@ -112,7 +117,7 @@ def main() -> None:
     parser.add_argument("--skip-spatial", action="store_true", help="the planar study only")
     args = parser.parse_args()
     if args.fresh:
-        for folder in ("planar", "spatial-cogiro"):
+        for folder in ("planar", *SPATIAL_SCENES):
             (OUT / folder / ROBUSTNESS_FILES["rows"]).unlink(missing_ok=True)
 
     model = smooth_start(load_scene("paper-circle"))
@@ -134,8 +139,9 @@ def main() -> None:
     print(margins_markdown(table))
     if not args.skip_spatial:
         grid = [{"platform_mass": 0.0, "cable_density": 0.0}, {"platform_mass": 0.1, "cable_density": -0.1}]
-        run_robustness(load_scene("spatial-cogiro"), SPATIAL, grid, OUT / "spatial-cogiro", workers=args.workers)
-        print((OUT / "spatial-cogiro" / ROBUSTNESS_FILES["table"]).read_text())
+        for name in SPATIAL_SCENES:
+            run_robustness(load_scene(name), SPATIAL, grid, OUT / name, workers=args.workers)
+            print((OUT / name / ROBUSTNESS_FILES["table"]).read_text())
     print(f"written to {OUT}/")
 
 
