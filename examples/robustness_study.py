@@ -14,8 +14,8 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
 2. Every controller on every plant (``robustness.md``, ``robustness.csv``, ``robustness.json``, a heat map
    per controller ``robustness_<controller>.png``), into ``results/robustness/planar/``.
 3. The spatial CoGiRo-class and IPAnema-class robots (``spatial-cogiro``, ``spatial-ipanema``) under the
-   chain correction's three starts (:data:`controllers.base.STARTS`) and the catenary's, the closed loop and
-   ILC, nominal and with the 10 % model error of ``spatial-cogiro-mismatch``:
+   chain correction's three starts (:data:`controllers.base.STARTS`) and the catenary's, the closed loop,
+   ILC and the model feed-forward, nominal and with the 10 % model error of ``spatial-cogiro-mismatch``:
    ``results/robustness/spatial-cogiro/``, ``results/robustness/spatial-ipanema/``.
 
 Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
@@ -55,11 +55,14 @@ PLANAR = {
     "ilc": ("ilc", {}),
 }
 
-#: The spatial controllers (item 3): the catenary's and the chain's starts, the closed loop and ILC.
+#: The spatial controllers (item 3): the catenary's and the chain's starts, the closed loop, ILC and the model
+#: feed-forward (learned on the model) with and without the loop.
 SPATIAL = {**{f"tension_aware{'_chain' if statics == 'chain' else ''}_{start}": ("tension_aware",
                                                                                {"statics": statics, "start": start})
               for statics in ("catenary", "chain") for start in ("absolute", "relative", "calibrated")},
-           "closed_loop_tension_aware": ("closed_loop_tension_aware", {}), "ilc": ("ilc", {})}
+           "closed_loop_tension_aware": ("closed_loop_tension_aware", {}), "ilc": ("ilc", {}),
+           "model_feed_forward": ("model_feed_forward", {}),
+           "closed_loop_model_feed_forward": ("closed_loop_model_feed_forward", {})}
 
 #: The spatial robots (item 4): the CoGiRo-class and the IPAnema-class, each nominal and with a 10 % model error.
 SPATIAL_SCENES = ("spatial-cogiro", "spatial-ipanema")
