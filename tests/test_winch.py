@@ -90,12 +90,8 @@ class _Step:
         return WinchCommand(paid_out, np.zeros_like(paid_out))
 
 
-@pytest.mark.parametrize("dimension", [2, 3])
-def test_at_rest_the_servo_drum_s_motor_force_balances_the_winch_end_tension(dimension):
-    """Held for 1 s (the robot settles from its start), the drum is still: its motor force is the pull
-    of the winch node on it, and that is the winch element's tension less the winch node's weight and
-    the bending joint's shear (measured 2.3 % and 2.7 % of the tension in the plane and in space)."""
-    scene = _servo_scene(dimension, 1.0, 2e-3)
+def _held(scene):
+    """(model, result) of ``scene``'s robot with every winch held at its paid-out length over the run."""
     model = build_model(scene)
     run = RUNS[type(model)](scene, model)
     hold = _Step()
@@ -105,6 +101,16 @@ def test_at_rest_the_servo_drum_s_motor_force_balances_the_winch_end_tension(dim
     model.mbs.SetPostStepUserFunction(run.post_step)
     model.mbs.SolveDynamic(solver_settings(scene))
     result = run.result("hold", None)
+    return model, result
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_at_rest_the_servo_drum_s_motor_force_balances_the_winch_end_tension(dimension):
+    """Held for 1 s (the robot settles from its start), the drum is still: its motor force is the pull
+    of the winch node on it, and that is the winch element's tension less the winch node's weight and
+    the bending joint's shear (measured 2.3 % and 2.7 % of the tension in the plane and in space)."""
+    scene = _servo_scene(dimension, 1.0, 2e-3)
+    model, result = _held(scene)
     assert len(model.servos) == scene.n_cables
     motor = np.array([model.mbs.GetLoadParameter(servo.load, "load") for servo in model.servos])
     pull = np.array([model.mbs.GetObjectOutput(servo.connector, exu.OutputVariableType.Force) for servo in model.servos])
@@ -159,15 +165,7 @@ def test_a_spatial_scene_with_point_exits_refuses_servo_winches_naming_winch_kin
 
 def _held_tension_swing(scene) -> float:
     """Largest peak-to-peak winch-end tension [N] of ``scene``'s robot held by its servo drums, after 0.5 s."""
-    model = build_model(scene)
-    run = RUNS[type(model)](scene, model)
-    hold = _Step()
-    hold.reset(scene, model.initial_paid_out)
-    run.begin(hold, None)
-    model.mbs.SetPreStepUserFunction(run.pre_step)
-    model.mbs.SetPostStepUserFunction(run.post_step)
-    model.mbs.SolveDynamic(solver_settings(scene))
-    result = run.result("hold", None)
+    result = _held(scene)[1]
     late = result.time > 0.5
     return max(float(np.ptp(t[late, 0])) for t in result.tensions)
 
