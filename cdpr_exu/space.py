@@ -38,13 +38,15 @@ class Space:
     ``dimension`` 2 or 3, ``name`` "planar" or "spatial" (for messages); ``position_labels``,
     ``rotation_labels``, ``pose_labels`` name the entries in order (tables, CSV headers, figures),
     whose counts are ``position_size`` (2 | 3), ``rotation_size`` (1 | 3), ``pose_size`` and
-    ``wrench_size`` (3 | 6), units ``pose_units``; ``vertical`` is the index of the up axis in a position.
+    ``wrench_size`` (3 | 6), units ``pose_units``; ``vertical`` is the index of the up axis in a position;
+    ``pose_columns`` name the entries with their units in CSV files (a run's ``pose.csv``, a trajectory file).
     """
 
     dimension: int
     name: str
     position_labels: tuple[str, ...]
     rotation_labels: tuple[str, ...]
+    pose_columns: tuple[str, ...]
 
     @property
     def position_size(self) -> int:
@@ -154,6 +156,7 @@ class PlanarSpace(Space):
     name = "planar"
     position_labels = ("x", "z")
     rotation_labels = ("rotation",)
+    pose_columns = ("x_m", "z_m", "rotation_rad")
 
     def rotation_matrix(self, rotation) -> np.ndarray:
         return geometry.rotation_matrix(float(np.asarray(rotation).reshape(-1)[0]))
@@ -202,6 +205,7 @@ class SpatialSpace(Space):
     name = "spatial"
     position_labels = ("x", "y", "z")
     rotation_labels = ("rx", "ry", "rz")
+    pose_columns = ("x_m", "y_m", "z_m", "rotation_x_rad", "rotation_y_rad", "rotation_z_rad")
 
     def rotation_matrix(self, rotation) -> np.ndarray:
         return geometry.rotation_from_vector(rotation)

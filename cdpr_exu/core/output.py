@@ -143,12 +143,6 @@ def write_npz(path: str | Path, **arrays: Any) -> Path:
     return path
 
 
-#: Pose columns of a planar run's ``pose.csv`` (after ``time_s``; the reference's follow, ``x_ref_m``, ...).
-PLANAR_POSE_COLUMNS: tuple[str, ...] = ("x_m", "z_m", "rotation_rad")
-#: Pose columns of a spatial run's ``pose.csv``: the centre of mass and the rotation vector.
-SPATIAL_POSE_COLUMNS: tuple[str, ...] = ("x_m", "y_m", "z_m", "rotation_x_rad", "rotation_y_rad", "rotation_z_rad")
-
-
 def write_pose_csv(path: str | Path, time: Any, pose: Any, reference: Any, columns: Sequence[str]) -> Path:
     """Write a run's platform path as CSV: ``time`` (N,) [s], ``pose`` and ``reference`` (N, len(columns)),
     under ``columns`` (unit last; the reference's with ``_ref`` before the unit)."""

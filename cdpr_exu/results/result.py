@@ -20,12 +20,8 @@ from typing import Any
 import numpy as np
 
 from cdpr_exu.core.errors import UnphysicalResultWarning
-from cdpr_exu.core.output import (PLANAR_POSE_COLUMNS, SPATIAL_POSE_COLUMNS, json_text, write_npz, write_pose_csv,
-                                  write_summary)
+from cdpr_exu.core.output import json_text, write_npz, write_pose_csv, write_summary
 from cdpr_exu.space import PLANE, SPACE, Space, space_of
-
-#: The pose columns of ``pose.csv``, by space.
-POSE_COLUMNS = {PLANE: PLANAR_POSE_COLUMNS, SPACE: SPATIAL_POSE_COLUMNS}
 
 #: Figures a space's summaries leave out: a planar summary.json (committed in results/, read by the
 #: README's tables) has no ``dimension`` (absent means 2, as in a scene file) and no
@@ -199,7 +195,7 @@ class Result:
                 "steps": self.steps, "newton_iterations": self.newton_iterations, "status": self.status,
                 "failure_time": self.failure_time, "metadata": self.metadata}
         write_npz(folder / "result.npz", info=np.array(json_text(info)), **arrays)
-        write_pose_csv(folder / "pose.csv", self.time, self.pose, self.reference, POSE_COLUMNS[self.space])
+        write_pose_csv(folder / "pose.csv", self.time, self.pose, self.reference, self.space.pose_columns)
         summary = {**self.summary(0.0), **provenance(), **(extra or {})}
         summary.update({k: v for k, v in self.metadata.items() if k not in summary})
         summary["after_start_up"] = after_start_up(self.summary(after), self.error_figures)

@@ -43,9 +43,8 @@ import numpy as np
 from scipy.interpolate import BSpline, PPoly, make_interp_spline
 
 from cdpr_exu.core.errors import SceneError
-from cdpr_exu.core.output import PLANAR_POSE_COLUMNS, SPATIAL_POSE_COLUMNS
 from cdpr_exu.core.validation import entries, finite, shown
-from cdpr_exu.space import PLANE, SPACE, Space
+from cdpr_exu.space import PLANE, Space
 
 __all__ = [
     "Trajectory",
@@ -520,20 +519,15 @@ class WaypointsTrajectory(Trajectory):
         return times[np.isfinite(times)]  # a pose entry that stands still has no roots, but NaN
 
 
-#: The columns of a trajectory file by space: ``time_s`` first, then the pose as a run's ``pose.csv`` names it.
-FILE_COLUMNS: dict[Space, tuple[str, ...]] = {PLANE: ("time_s",) + PLANAR_POSE_COLUMNS,
-                                              SPACE: ("time_s",) + SPATIAL_POSE_COLUMNS}
-
-
 class FileTrajectory(WaypointsTrajectory):
     """``kind = "file"``: the waypoints of :class:`WaypointsTrajectory` read from a CSV file.
 
     The table's one key, ``path``, names the file, relative to the scene file's folder. Its
     header names the columns, each with its unit in the name as a run's ``pose.csv`` has them
-    (:data:`FILE_COLUMNS`): ``time_s, x_m, z_m, rotation_rad`` in the plane, ``time_s, x_m, y_m,
-    z_m, rotation_x_rad, rotation_y_rad, rotation_z_rad`` in space (the rotation vector); other
-    columns are ignored (a run's ``pose.csv`` reads back as its platform's path). One row per
-    waypoint. The file is read once, when the scene is loaded, into a
+    (``time_s``, then the Space's ``pose_columns``): ``time_s, x_m, z_m, rotation_rad`` in the
+    plane, ``time_s, x_m, y_m, z_m, rotation_x_rad, rotation_y_rad, rotation_z_rad`` in space (the
+    rotation vector); other columns are ignored (a run's ``pose.csv`` reads back as its platform's
+    path). One row per waypoint. The file is read once, when the scene is loaded, into a
     :class:`WaypointsTrajectory`: a scene saved then (a run folder's ``scene.toml``) holds the
     waypoints themselves and reruns without the file.
     """
@@ -543,7 +537,7 @@ class FileTrajectory(WaypointsTrajectory):
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], space: Space, folder: Path | None = None) -> WaypointsTrajectory:
         """The waypoints of the file ``data["path"]``; SceneError naming the file, the line and the column."""
-        columns = FILE_COLUMNS[space]
+        columns = ("time_s",) + space.pose_columns
         if set(data) != {"path"} or not isinstance(data["path"], str):
             raise SceneError(f"trajectory of kind 'file' takes one key, path (a CSV file of {', '.join(columns)}, "
                              f"relative to the scene file), got {shown(dict(data))}")

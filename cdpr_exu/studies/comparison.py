@@ -22,7 +22,7 @@ from cdpr_exu.space import PLANE, SPACE
 from cdpr_exu.core.errors import CdprError, RunInterrupted, SceneError, SolverFailure
 from cdpr_exu.core.output import (check_output_folder, clear_outputs, fixed, write_pose_csv,
                                   write_summary)
-from cdpr_exu.results.result import POSE_COLUMNS, Result, provenance, warning_flags
+from cdpr_exu.results.result import Result, provenance, warning_flags
 from cdpr_exu.run.simulate import simulate
 from cdpr_exu.scenes.scene import Scene, save_scene
 from cdpr_exu.scenes.trajectories import CircleTrajectory
@@ -196,7 +196,7 @@ class _PlanarComparison:
                                            + markdown_table(summaries))
         for name, result in results.items():
             write_pose_csv(out / f"pose_{name}.csv", result.time, result.pose, result.reference,
-                           POSE_COLUMNS[result.space])
+                           result.space.pose_columns)
         if results:
             plot_comparison(scene, results, out)
 
