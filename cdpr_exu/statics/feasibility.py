@@ -26,7 +26,7 @@ from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.statics.kinematics import cable_exits, structure_matrix
 from cdpr_exu.statics.statics import catenary_platform, inverse_cable
 from cdpr_exu.statics.tension_distribution import tension_distribution, weight_wrench
-from cdpr_exu.statics.workspace import _turns
+from cdpr_exu.statics.workspace import cables_turn_platform
 
 #: What each status means.
 STATUSES = {
@@ -87,7 +87,7 @@ def tension_bounds(scene, min_tension=None, max_tension=None) -> np.ndarray:
 
 
 def _rows(scene, matrix) -> int:
-    return scene.space.wrench_size if _turns(scene, matrix) else scene.space.position_size
+    return scene.space.wrench_size if cables_turn_platform(scene, matrix) else scene.space.position_size
 
 
 def massless_holding(scene, pose, limits) -> Holding:

@@ -164,8 +164,9 @@ def reference_wrenches(scene, times: np.ndarray) -> np.ndarray:
     return np.column_stack([force, moment])
 
 
-def _turns(scene, matrix: np.ndarray) -> bool:
-    """Whether the cables can turn the platform about every axis (the module notes' rule)."""
+def cables_turn_platform(scene, matrix: np.ndarray) -> bool:
+    """Whether the cables can turn the platform about every axis (the module notes' rule): then the moment is
+    asked with the force. ``matrix`` (wrench_size, m): the structure matrix at a pose."""
     size = scene.space.wrench_size
     return (not scene.platform.is_point_mass and scene.n_cables >= size
             and len(matrix) == size and np.linalg.matrix_rank(matrix) == size)
@@ -204,7 +205,7 @@ def _check_held(scene, times, poses) -> None:
                 f"{_pose_text(scene, times, poses, k)} is outside the workspace: the cables can {force}, but not "
                 f"together with {moment.format(np.round(wrenches[k, d:], 4).tolist())} {why}; {residual:.4g} {unit} "
                 "would remain unbalanced")
-        if not _turns(scene, matrices[0]):
+        if not cables_turn_platform(scene, matrices[0]):
             return  # the platform turns to balance the moment (a point mass has none)
 
 

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, Sequence
 
 from cdpr_exu.core.errors import OutputError, SceneError
+from cdpr_exu.core.validation import entries
 from cdpr_exu.studies.study import executor_for, progress_bar
 
 #: Files a workspace grid writes.
@@ -116,14 +117,14 @@ def make_grid(scene, axes: Sequence[str], orientations: Sequence[Sequence[float]
         given[label] = spec
     specs = [given.get(label, (float(start[i]),) * 2 + (1,)) for i, label in enumerate(labels)]
     rotations = orientations or [start[space.position_size:]]
-    rotations = [space.rotation(f"orientation[{k}]", r[0] if len(r) == 1 else r) for k, r in enumerate(rotations)]
+    rotations = [entries(f"orientation[{k}]", r, space.rotation_size, "rad") for k, r in enumerate(rotations)]
     size = math.prod(count for *_, count in specs) * len(rotations)
     needed = size * len(columns(labels, scene.n_cables)) * BYTES_PER_VALUE
     if needed > MAX_GRID_BYTES:
         raise SceneError(f"grid: {size} positions and orientations need about {needed / 2**30:.1f} GiB for their "
                          f"rows, beyond the {MAX_GRID_BYTES / 2**30:g} GiB allowed; use fewer points")
     values = tuple(tuple(a + (b - a) * k / max(n - 1, 1) for k in range(n)) for a, b, n in specs)
-    return WorkspaceGrid(labels, values, tuple(tuple(r) if isinstance(r, tuple) else (r,) for r in rotations))
+    return WorkspaceGrid(labels, values, tuple(rotations))
 
 
 # --------------------------------------------------------------------------- the workers
