@@ -219,11 +219,17 @@ class Run3D:
         self.poses.append(np.concatenate([position, rotation_vector(rotation)]))
         self.paid.append(self.winches.applied.copy())
         q, v = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
-        for i, (chain, index) in enumerate(zip(items.chains, self.coordinates)):
-            positions = (chain.reference + q[index]).reshape(-1, 3)
+        for i in range(len(items.chains)):
+            positions, forces = self._chain(i, q, v)
             self.nodes[i].append(positions)
-            self.tensions[i].append(element_forces(mbs, items, i, positions=positions,
-                                                   velocities=v[index]))  # spring and damper
+            self.tensions[i].append(forces)
+
+    def _chain(self, i: int, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Cable ``i``'s node positions (n + 1, 3) [m] and element forces (n,) [N] (spring and damper),
+        from the system's state vectors ``q``, ``v`` read once."""
+        mbs, items, index = self.model.mbs, self.model.items, self.coordinates[i]
+        positions = (items.chains[i].reference + q[index]).reshape(-1, 3)
+        return positions, element_forces(mbs, items, i, positions=positions, velocities=v[index])
 
     def begin(self, controller: Controller, report) -> None:
         """Record the start; a start no run can come back from is the stop reason before the first step."""
@@ -250,8 +256,8 @@ class Run3D:
             if paid_out.shape != lengths.shape or not (np.all(np.isfinite(paid_out)) and np.all(paid_out > 0.0)):
                 raise ValueError(f"the command must be {lengths.size} finite positive lengths, got {command.paid_out!r}")
             if self.drums.servos:  # fed forward: the tension of each chain's winch element
-                tensions = [element_forces(mbs_, self.model.items, i)[0] for i in range(len(paid_out))]
-                self.drums.drive(mbs_, t, command, q, v, tensions)
+                winch_ends = [self._chain(i, q, v)[1][0] for i in range(len(paid_out))]
+                self.drums.drive(mbs_, t, command, q, v, winch_ends)
             else:
                 self.winches.set_lengths(paid_out, rates)
         except Exception as err:  # noqa: BLE001 - reported as the cause of the stop, with the partial result
