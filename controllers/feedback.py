@@ -50,7 +50,7 @@ class FilteredPositionPI:
     Parameters
     ----------
     proportional_gain, integral_gain : float [-, 1/s]
-        k_p and k_i, >= 0.
+        k_p and k_i, >= 0 (defaults: :data:`controllers.loop_design.DESIGNED`, chosen from the loop's margins).
     cutoff : float [Hz]
         Of the error filter (> 0).
     start_time : float [s]
@@ -58,8 +58,8 @@ class FilteredPositionPI:
     rotation : bool
         Feed the rotation error back too (a rigid platform only).
     margin_check : {"off", "refuse", "feed_forward"}
-        :data:`MARGIN_CHECKS`; "off" keeps today's runs (today's planar gains keep 28 deg on the
-        paper's circle at t = 1 s).
+        :data:`MARGIN_CHECKS`; "off" by default: the default gains keep >= 10 dB and >= 33 deg on the
+        paper robot's 13 plants (docs/robustness.md), and the check costs about 1.5 s of CPU per pose.
 
     Raises
     ------
@@ -68,7 +68,8 @@ class FilteredPositionPI:
         ``margin_check = "refuse"``, for a loop short of the required margins.
     """
 
-    def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, cutoff: float = 5.0,
+    def __init__(self, proportional_gain: float = loop_design.DESIGNED.proportional_gain,
+                 integral_gain: float = loop_design.DESIGNED.integral_gain, cutoff: float = loop_design.DESIGNED.cutoff,
                  start_time: float = 0.5, rotation: bool = False, margin_check: str = "off"):
         for name, value in (("proportional_gain", proportional_gain), ("integral_gain", integral_gain)):
             if not np.isfinite(value) or value < 0:

@@ -31,6 +31,7 @@ from cdpr_exu.statics.kinematics import anchor_points, ideal_paid_out, initial_c
 
 from .base import CommandStart, Measurement, WinchCommand
 from .feedback import FilteredPositionPI
+from .loop_design import DESIGNED
 
 
 def chain_length(scene, anchors: np.ndarray) -> np.ndarray:
@@ -328,8 +329,9 @@ class ClosedLoopTensionAwareController(TensionAwareController):
 
     uses_pose = True
 
-    def __init__(self, proportional_gain: float = 2.0, integral_gain: float = 40.0, start_time: float = 0.5,
-                 cutoff: float = 5.0, rotation: bool = False, margin_check: str = "off", **kwargs):
+    def __init__(self, proportional_gain: float = DESIGNED.proportional_gain,
+                 integral_gain: float = DESIGNED.integral_gain, start_time: float = 0.5,
+                 cutoff: float = DESIGNED.cutoff, rotation: bool = False, margin_check: str = "off", **kwargs):
         super().__init__(**kwargs)
         self.feedback = FilteredPositionPI(proportional_gain, integral_gain, cutoff, start_time, rotation, margin_check)
         self.name = "closed_loop_" + self.name

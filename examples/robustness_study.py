@@ -7,10 +7,12 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
 13 plants. Three steps, one command:
 
 1. The position loop of ``closed_loop_tension_aware`` linearised on every plant at 8 poses of one turn
-   (:mod:`controllers.loop_design`), with today's gains (k_p = 2, k_i = 40 /s, f_c = 5 Hz), and gains chosen
-   from those margins: >= 6 dB and >= 30 deg on every plant and pose, the smallest sensitivity at the
-   circle's own frequency. ``margins.md`` and ``margins.json``: the worst margins over the poses per plant,
-   beside what the real run did (docs/robustness.md reads them).
+   (:mod:`controllers.loop_design`), with the gains chosen by trial before (``previous``: k_p = 2, k_i = 40 /s,
+   f_c = 5 Hz) and the gains chosen from the margins (``designed``): >= 6 dB and >= 30 deg on every plant and
+   pose, the smallest sensitivity at the circle's own frequency; the designed gains are the loop's defaults
+   (:data:`controllers.loop_design.DESIGNED`: the script stops if the design picks others). ``margins.md``
+   and ``margins.json``: the worst margins over the poses per plant, beside what the real run did
+   (docs/robustness.md reads them).
 2. Every controller on every plant (``robustness.md``, ``robustness.csv``, ``robustness.json``, a heat map
    per controller ``robustness_<controller>.png``), into ``results/robustness/planar/``.
 3. The spatial CoGiRo-class and IPAnema-class robots (``spatial-cogiro``, ``spatial-ipanema``) under the
@@ -20,10 +22,8 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
 
 Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
 this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after
-the first second. About 10 min of CPU time (ILC's 10 trials per plant are most of it); the spatial part
-about 8 min more; the 4 stiffness and exit plants add about 40 %. The model-based feed-forward
-(``model_feed_forward``, ``closed_loop_model_feed_forward``) runs as well with its kind (a name of
-:data:`controllers.registry.CONTROLLERS`) added to :data:`PLANAR`.
+the first second. About 15 min of CPU time (the learning controllers' trials are most of it); the spatial
+part about 8 min more.
 
 Run::
 
@@ -52,6 +52,8 @@ PLANAR = {
     "tension_aware_chain": ("tension_aware", {"statics": "chain"}),
     "tension_aware_chain_relative": ("tension_aware", {"statics": "chain", "start": "relative"}),
     "closed_loop_tension_aware": ("closed_loop_tension_aware", {}),
+    "closed_loop_tension_aware_previous": ("closed_loop_tension_aware", asdict(loop_design.PREVIOUS)),
+    "closed_loop_model_feed_forward": ("closed_loop_model_feed_forward", {}),
     "ilc": ("ilc", {}),
 }
 
@@ -87,7 +89,7 @@ def margins_rows(cases, grid, gains: dict, rows, delay: float) -> list[dict]:
     for (name, chosen), (index, point) in ((g, p) for g in gains.items() for p in enumerate(grid)):
         margins = loop_design.worst([loop_design.loop_margins(robot, jacobian, chosen, delay, response=response)
                                      for i, _, robot, jacobian, response in cases if i == index])
-        label = "closed_loop_tension_aware" + ("" if name == "today" else f"_{name}")
+        label = "closed_loop_tension_aware" + ("" if name == "designed" else f"_{name}")
         run = runs.get((*(point[e] for e in ERRORS), label), {})
         table.append({**{e: point[e] for e in ERRORS}, "gains": name, **asdict(chosen), **asdict(margins),
                       "run": ("completed" if run.get("completed") else f"failed at {run.get('failure_time_s') or 0.0:.1f} s"
@@ -129,9 +131,11 @@ def main() -> None:
     cases = loop_design.loop_cases(model, [perturbed(model, **point) for point in grid],
                                    1.0 + turn * np.arange(POSES) / POSES)
     designed, _ = loop_design.design_gains(cases, delay, model.trajectory.angular_rate / (2 * np.pi))
-    gains = {"today": loop_design.TODAY, "designed": designed}
-    controllers = {**PLANAR, "closed_loop_tension_aware_designed": ("closed_loop_tension_aware", asdict(designed))}
-    rows = run_robustness(model, controllers, grid, OUT / "planar", workers=args.workers)
+    if designed != loop_design.DESIGNED:
+        raise SystemExit(f"the margins now pick {designed}, not the defaults {loop_design.DESIGNED}: update "
+                         "controllers.loop_design.DESIGNED (and the closed-loop golden cases) first")
+    gains = {"previous": loop_design.PREVIOUS, "designed": designed}
+    rows = run_robustness(model, PLANAR, grid, OUT / "planar", workers=args.workers)
     table = margins_rows(cases, grid, gains, rows, delay)
     write_summary(OUT / "planar", {"scene": model.name, "poses_per_plant": POSES, "delay_s": delay,
                                    "design": "gain margin >= 6 dB and phase margin >= 30 deg on every plant and pose; "
