@@ -185,8 +185,9 @@ def run_robustness(scene, controllers: Mapping[str, tuple[str, dict]], grid: Seq
         point = {e: float(point.get(e, 0.0)) for e in ERRORS}
         base = done.get(_key({**point, "controller": "ideal_ik"}), {})
         for label in controllers:
-            row = dict(done.get(_key({**point, "controller": label}), {**point, "controller": label,
-                                                                       "status": "missing", "completed": False}))
+            # every error column, also on rows of a rows.jsonl written before a column existed
+            row = {**point, **done.get(_key({**point, "controller": label}), {"controller": label,
+                                                                              "status": "missing", "completed": False})}
             mine, theirs = row.get("max_position_error_m"), base.get("max_position_error_m")
             row["max_error_vs_ideal_ik"] = theirs / mine if row["completed"] and base.get("completed") and mine else None
             rows.append(row)
