@@ -56,10 +56,10 @@ def test_full_preset_is_the_paper_model_with_tension_only_elements(paper_scene):
         assert full[item] == paper[item], item
 
 
-def test_bending_off_removes_the_bending_joints_and_their_object(paper_scene):
+def test_bending_off_removes_the_bending_joints_and_their_python_forces(paper_scene):
     off = counts(paper_scene, "paper", bending=False, bending_damping=False)
     assert off["bending_joints"] == 0
-    assert off["cable_force_objects"] == 0  # nothing left for the generic object to carry
+    assert off["cable_force_objects"] == 1  # it carries the masses and weights, with no Python function
     assert off["axial_spring_dampers"] == ELEMENTS and off["mass_points"] == NODES
     tension_only = counts(paper_scene, bending=False, bending_damping=False)
     assert tension_only["bending_joints"] == 0 and tension_only["cable_force_objects"] == 1  # the slack elements

@@ -122,15 +122,17 @@ def test_pulley_contacts_only_on_nodes_that_can_reach_the_pulley(paper_model):
         np.testing.assert_array_equal(nodes, contact_candidates(paper_model.scene, i))
 
 
-def test_catenary_preset_adds_no_bending_object():
+def test_catenary_preset_adds_no_bending_joints():
     scene = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary"))
     counts = build_model(scene).item_counts()
     assert counts["bending_joints"] == 0
     assert counts["slack_elements"] == 2 * 15  # tension-only, in the one cable-force object
     assert counts["cable_force_objects"] == 1
     pushing = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary", slack=False))
-    counts = build_model(pushing).item_counts()
-    assert counts["cable_force_objects"] == 0  # no bending, no slack: nothing for the object to carry
+    model = build_model(pushing)
+    counts = model.item_counts()
+    assert counts["cable_force_objects"] == 1  # no bending, no slack: the object carries masses and weights
+    assert model.mbs.GetObject(model.cable_forces.object)["forceUserFunction"] == 0  # and calls no Python
     assert counts["axial_spring_dampers"] == 2 * 15
 
 

@@ -5,7 +5,9 @@ platform anchor. Each element is an axial spring-damper (Exudyn's); each interio
 rotational spring-damper on the relative angle of its two elements. The bending of all cables
 is one ``ObjectGenericODE2`` with numba force and Jacobian (:mod:`cdpr_exu.physics.bending`),
 one Python call per Newton iteration for the whole robot; it also carries the tension-only
-elements (:mod:`cdpr_exu.physics.axial`) and the smooth node or segment pulley contacts.
+elements (:mod:`cdpr_exu.physics.axial`), the smooth node or segment pulley contacts, and the nodes'
+masses (its constant diagonal mass matrix) and weights (its force vector): no mass point or load item
+per node (measured x1.2 of the 60-element paper circle's CPU time, paths moved by round-off).
 
 Exudyn items live in its x-y plane: the paper's (x, z) maps to Exudyn's (x, y).
 """
@@ -32,53 +34,46 @@ from cdpr_exu.physics.segment_contact import SegmentPulleyContact
 @dataclass
 class CableItems:
     """Exudyn indices of one cable's items: ``nodes`` (``NodePoint2D``, winch end first, n + 1)
-    and their ``markers``, axial ``springs`` (n, or distance constraints; empty with slack), gravity
-    ``loads``; ``reference`` (n + 1, 2) [m] the initial node positions, ``masses`` (n + 1,) [kg]."""
+    and their ``markers``, axial ``springs`` (n, or distance constraints; empty with slack);
+    ``reference`` (n + 1, 2) [m] the initial node positions, ``masses`` (n + 1,) [kg] and ``weights``
+    (n + 1,) [N] (zero without gravity), which the cables' generic object carries (:func:`add_cable_forces`)."""
 
     nodes: list[int]
     markers: list[int]
     reference: np.ndarray
+    masses: np.ndarray
+    weights: np.ndarray
     springs: list[int] = field(default_factory=list)
-    loads: list[int] = field(default_factory=list)
-    masses: np.ndarray | None = None
 
 
 def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effects: Effects,
               gravity: float) -> CableItems:
-    """Add the mass points, axial spring-dampers and gravity loads of one cable.
+    """Add the nodes and axial spring-dampers of one cable; its masses and weights go into the cables'
+    generic object (:func:`add_cable_forces`).
 
     ``nodes_xz`` (n + 1, 2) [m]: initial node positions (x, z), winch end first, each element at
     its unstrained length; ``gravity`` [m/s^2] along -z.
     """
     nodes_xz = np.asarray(nodes_xz, dtype=float)
     masses = cable.node_masses()
-    items = CableItems(nodes=[], markers=[], reference=nodes_xz.copy(), masses=masses)
-    for (x, z), mass in zip(nodes_xz, masses):
+    weights = masses * gravity if effects.gravity and gravity > 0.0 else np.zeros_like(masses)
+    items = CableItems(nodes=[], markers=[], reference=nodes_xz.copy(), masses=masses, weights=weights)
+    for x, z in nodes_xz:
         node = mbs.AddNode(eii.NodePoint2D(referenceCoordinates=[x, z]))
-        mbs.AddObject(eii.ObjectMassPoint2D(mass=float(mass), nodeNumber=node))
         items.nodes.append(node)
         items.markers.append(mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
     damping = cable.axial_damping if effects.axial_damping else 0.0
     if effects.slack:
-        return _add_gravity(mbs, items, masses, effects, gravity)  # axial forces: see add_cable_forces
+        return items  # axial forces: see add_cable_forces
     if not effects.axial_elasticity:  # inextensible elements: distance constraints
         for a, b in zip(items.markers[:-1], items.markers[1:]):
             items.springs.append(mbs.AddObject(eii.ObjectConnectorDistance(
                 markerNumbers=[a, b], distance=cable.element_length)))
-        return _add_gravity(mbs, items, masses, effects, gravity)
+        return items
     for a, b in zip(items.markers[:-1], items.markers[1:]):
         items.springs.append(mbs.AddObject(eii.ObjectConnectorSpringDamper(
             markerNumbers=[a, b], referenceLength=cable.element_length,
             stiffness=cable.axial_stiffness, damping=damping)))
-    return _add_gravity(mbs, items, masses, effects, gravity)
-
-
-def _add_gravity(mbs: exu.MainSystem, items: CableItems, masses: np.ndarray, effects: Effects,
-                 gravity: float) -> CableItems:
-    if effects.gravity and gravity > 0.0:
-        for marker, mass in zip(items.markers, masses):
-            items.loads.append(mbs.AddLoad(eii.LoadForceVector(
-                markerNumber=marker, loadVector=[0.0, -float(mass) * gravity, 0.0])))
     return items
 
 
@@ -123,8 +118,8 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
                      effects: Effects, pulleys: list[Pulley] | None = None,
                      contact_elements: list[np.ndarray] | None = None,
                      sparse_jacobian: bool = True,
-                     contact_nodes: list[np.ndarray] | None = None) -> CableForceItems | None:
-    """Add the bending, tension-only and smooth contact forces of all cables as one object.
+                     contact_nodes: list[np.ndarray] | None = None) -> CableForceItems:
+    """Add the masses, weights, bending, tension-only and smooth contact forces of all cables as one object.
 
     Parameters
     ----------
@@ -140,14 +135,13 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         Return the Jacobian as sparse triplets (cost linear in the number of nodes) instead of a
         dense (2N, 2N) matrix; with segment contact the dense form is kept.
 
-    Returns None when no effect needs the object. The Jacobian is analytic, ``fODE2 * K +
-    fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
+    The masses form the object's constant diagonal mass matrix, the weights its force vector; without
+    bending, tension-only elements or smooth contact it has no user function (nothing in Python). The
+    Jacobian is analytic, ``fODE2 * K + fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
     """
     counts = [len(it.nodes) for it in items]
     contact = _segment_contact(counts, pulleys, contact_elements)
     node_contact = _node_contact(counts, pulleys, contact_nodes)
-    if not (effects.bending or effects.slack or contact is not None or node_contact is not None):
-        return None
     reference = np.concatenate([it.reference for it in items]).ravel()
     size = reference.size
     if effects.bending:
@@ -207,7 +201,10 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
 
     nodes = [n for it in items for n in it.nodes]
     functions = (force_function, jacobian_function)
-    mass = np.zeros((size, size))
+    mass = np.diag(np.repeat(np.concatenate([it.masses for it in items]), 2))
+    weights = np.zeros(size)
+    weights[1::2] = -np.concatenate([it.weights for it in items])  # Exudyn's y is the paper's z
+    matrices["forceVector"] = matrices.get("forceVector", 0.0) + weights
     if sparse_jacobian and contact is None and not linear:
         blocks = [_bending_blocks(spring)]
         if effects.slack and len(elements):
@@ -215,15 +212,17 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         if node_contact is not None:
             blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
         functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions, where))
-        mass = _sparse(np.zeros((size, size)))
-    if linear and not effects.slack and contact is None and node_contact is None:
+        mass = _sparse(mass)
+    if not (effects.bending or effects.slack or contact is not None or node_contact is not None):
+        functions = (0, 0)  # masses and weights only
+    elif linear and not effects.slack and contact is None and node_contact is None:
         # Nothing left for Python per Newton iteration: no force function, and a Jacobian
         # function that returns an empty matrix, so that Exudyn adds the constant K and D
         # itself (without any Jacobian function it would differentiate them numerically).
         # Sparse triplets: dense (2N, 2N) matrices made a 2 x 61-node cable 8 times slower.
         matrices = {key: _sparse(value) if key != "forceVector" else value for key, value in matrices.items()}
         empty = _sparse(np.zeros((size, size)))
-        mass = _sparse(np.zeros((size, size)))
+        mass = _sparse(mass)
 
         def zero_jacobian(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
             return empty

@@ -56,11 +56,12 @@ class Model:
     contact_elements: list[np.ndarray] = field(default_factory=list)
 
     def item_counts(self) -> dict[str, int]:
-        """How many Exudyn items each effect added."""
+        """How many Exudyn items each effect added; the cable nodes' masses (``mass_points``) and weights
+        (``gravity_loads``, with the platform's load) count the entries of the cables' generic object."""
         return {
             "mass_points": sum(len(c.nodes) for c in self.cables),
             "axial_spring_dampers": sum(len(c.springs) for c in self.cables),
-            "gravity_loads": sum(len(c.loads) for c in self.cables) + (self.platform.load is not None),
+            "gravity_loads": sum(np.count_nonzero(c.weights) for c in self.cables) + (self.platform.load is not None),
             "cable_force_objects": int(self.cable_forces is not None),
             "bending_joints": 0 if self.cable_forces is None else len(self.cable_forces.joints),
             "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
