@@ -115,8 +115,9 @@ def test_paper_scene_bends_at_every_interior_node_in_one_object(paper_model):
 def test_pulley_contacts_only_on_nodes_that_can_reach_the_pulley(paper_model):
     counts = paper_model.item_counts()
     assert 0 < counts["pulley_contacts"] < 2 * 16
-    for i, (contacts, nodes) in enumerate(zip(paper_model.contacts, paper_model.contact_nodes)):
-        assert len(contacts) == len(nodes)
+    contact = paper_model.cable_forces.node_contact  # all of them in the cables' object, Exudyn's law frozen
+    assert contact.nodes.size == counts["pulley_contacts"] and contact.band == 0.0
+    for i, nodes in enumerate(paper_model.contact_nodes):
         assert 0 not in nodes  # the winch node's motion is prescribed
         assert 15 not in nodes  # the anchor node stays over 1 m below the pulley centre
         np.testing.assert_array_equal(nodes, contact_candidates(paper_model.scene, i))
@@ -129,10 +130,8 @@ def test_catenary_preset_adds_no_bending_joints():
     assert counts["slack_elements"] == 2 * 15  # tension-only, in the one cable-force object
     assert counts["cable_force_objects"] == 1
     pushing = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary", slack=False))
-    model = build_model(pushing)
-    counts = model.item_counts()
-    assert counts["cable_force_objects"] == 1  # no bending, no slack: the object carries masses and weights
-    assert model.mbs.GetObject(model.cable_forces.object)["forceUserFunction"] == 0  # and calls no Python
+    counts = build_model(pushing).item_counts()
+    assert counts["cable_force_objects"] == 1  # no bending, no slack: the object carries masses, weights, contact
     assert counts["axial_spring_dampers"] == 2 * 15
 
 

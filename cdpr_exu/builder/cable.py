@@ -27,7 +27,7 @@ from cdpr_exu.physics import cable_forces
 from cdpr_exu.exits import Pulley
 from cdpr_exu.scenes.scene import CableSpec, Effects
 from cdpr_exu.physics import node_contact as node_contact_module
-from cdpr_exu.physics.node_contact import NodePulleyContact
+from cdpr_exu.physics.node_contact import FrozenNodeContact, NodePulleyContact
 from cdpr_exu.physics.segment_contact import SegmentPulleyContact
 
 
@@ -118,7 +118,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
                      effects: Effects, pulleys: list[Pulley] | None = None,
                      contact_elements: list[np.ndarray] | None = None,
                      sparse_jacobian: bool = True,
-                     contact_nodes: list[np.ndarray] | None = None) -> CableForceItems:
+                     contact_nodes: list[np.ndarray] | None = None, frozen_contact: bool = False) -> CableForceItems:
     """Add the masses, weights, bending, tension-only and smooth contact forces of all cables as one object.
 
     Parameters
@@ -129,8 +129,13 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         Pulley of each cable; needed with contacts.
     contact_elements, contact_nodes : list of ndarray of int, optional
         Per cable, the cable-local elements (element j joins nodes j and j + 1) that get a segment
-        rim contact ("segment") and the nodes that get a smooth node contact ("node_smooth",
-        :mod:`cdpr_exu.physics.node_contact`); None or all empty: none, and no cost for it.
+        rim contact ("segment") and the nodes that get a node contact (:mod:`cdpr_exu.physics.node_contact`);
+        None or all empty: none, and no cost for it.
+    frozen_contact : bool
+        The node contact is Exudyn's law frozen within Newton's iteration ("node"), not the smooth one
+        ("node_smooth"): its gaps are data coordinates of one ``NodeGenericData`` (restored with a rejected
+        step), switched by the system's PostNewton function (this object's; measured x1.2 against Exudyn's
+        contact items on the 60-element paper circle, the path within 1e-5 mm).
     sparse_jacobian : bool
         Return the Jacobian as sparse triplets (cost linear in the number of nodes) instead of a
         dense (2N, 2N) matrix; with segment contact the dense form is kept.
@@ -141,7 +146,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     """
     counts = [len(it.nodes) for it in items]
     contact = _segment_contact(counts, pulleys, contact_elements)
-    node_contact = _node_contact(counts, pulleys, contact_nodes)
+    node_contact = _node_contact(counts, pulleys, contact_nodes, frozen_contact)
     reference = np.concatenate([it.reference for it in items]).ravel()
     size = reference.size
     if effects.bending:
@@ -176,10 +181,17 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
 
     where = []  # the object's coordinates in the system's state vectors (_state)
+    frozen = node_contact is not None and frozen_contact
+    if frozen:
+        read_gaps = _frozen_contact(mbs, node_contact, reference, positions, where)
+    else:
+        def read_gaps(mbs):  # noqa: ARG001
+            return None
 
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         # bending and tension-only elements in one compiled call (cable_forces), then any rim contact
         displacements, velocities = _state(mbs, item, where)
+        read_gaps(mbs)
         cut.force_evaluated(t)
         force = cable_forces.cable_force(reference, displacements, velocities, positions, *joint_args, force_buffer)
         if contact is not None:
@@ -190,6 +202,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
         displacements, velocities = _state(mbs, item, where)
+        read_gaps(mbs)
         jacobian = cable_forces.cable_jacobian(reference, displacements, velocities, positions, *joint_args,
                                                float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer,
                                                kink[0], cut.active)
@@ -211,7 +224,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
             blocks.append(_slack_blocks(elements, rest, axial_k, axial_c, kink, cut))
         if node_contact is not None:
             blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
-        functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions, where))
+        functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions, where, read_gaps))
         mass = _sparse(mass)
     if not (effects.bending or effects.slack or contact is not None or node_contact is not None):
         functions = (0, 0)  # masses and weights only
@@ -276,10 +289,11 @@ def _state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
     return data.GetODE2Coordinates()[where[0]], data.GetODE2Coordinates_t()[where[0]]
 
 
-def _sparse_jacobian_function(blocks, reference, positions, where):
+def _sparse_jacobian_function(blocks, reference, positions, where, read_gaps):
     """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets in a fixed pattern:
     ``blocks`` lists ``(rows, columns, fill)`` per force, ``fill(positions, velocities, f_q, f_q_t,
-    out_values)`` writing the values; ``where`` as :func:`_state`."""
+    out_values)`` writing the values; ``where`` as :func:`_state`; ``read_gaps(mbs)`` refreshes a frozen
+    contact's state."""
     size = reference.size
     bounds = np.cumsum([0] + [rows.size for rows, _, _ in blocks])
     triplets = np.zeros((int(bounds[-1]), 3))
@@ -290,6 +304,7 @@ def _sparse_jacobian_function(blocks, reference, positions, where):
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001 - Exudyn's signature
         displacements, velocities = _state(mbs, item, where)
+        read_gaps(mbs)
         np.add(reference, displacements, out=positions)
         for (_, _, fill), out_values, first, last in zip(blocks, values, bounds[:-1], bounds[1:]):
             fill(positions, velocities, float(f_q), float(f_q_t), out_values)
@@ -315,14 +330,47 @@ def _pulley_arrays(counts: list[int], pulleys: list[Pulley] | None, per_cable: l
                        for name in ("center", "radius", "contact_stiffness", "contact_damping")])
 
 
-def _node_contact(counts: list[int], pulleys: list[Pulley] | None,
-                  contact_nodes: list[np.ndarray] | None) -> NodePulleyContact | None:
-    """The node rim contacts of the listed nodes with their cables' pulleys (None if none)."""
+def _node_contact(counts: list[int], pulleys: list[Pulley] | None, contact_nodes: list[np.ndarray] | None,
+                  frozen: bool) -> NodePulleyContact | None:
+    """The node rim contacts of the listed nodes with their cables' pulleys, frozen or smooth (None if none)."""
     arrays = _pulley_arrays(counts, pulleys, contact_nodes,
                             "node contact needs one pulley and one list of contact nodes per cable")
     if arrays is None:
         return None
+    if frozen:
+        return FrozenNodeContact(sum(counts), *arrays)
     return NodePulleyContact(sum(counts), *arrays, band=node_contact_module.CONTACT_ONSET_DEPTH)
+
+
+def _frozen_contact(mbs: exu.MainSystem, contact: FrozenNodeContact, reference: np.ndarray, positions: np.ndarray,
+                    where: list):
+    """Keep the frozen contact's gaps in a ``NodeGenericData`` (initialised at ``reference``, so restored by the
+    solver with a rejected step) and switch them in the system's PostNewton function, as Exudyn's contact
+    items do theirs (their step-size recommendation is off in every run: run.solver). Returns
+    ``read_gaps(mbs)``, which loads the gaps into ``contact`` (the force functions call it first)."""
+    contact.switch(reference, contact.gaps)  # the gaps d - r_p - r_n [m] at the start
+    data_node = mbs.AddNode(eii.NodeGenericData(initialCoordinates=contact.gaps.tolist(),
+                                                numberOfDataCoordinates=contact.gaps.size))
+    place = []
+
+    def read_gaps(mbs):
+        data = mbs.systemData
+        if not place:
+            index = np.asarray(data.GetNodeLTGData(data_node), dtype=np.int64)
+            place.append(slice(int(index[0]), int(index[0]) + index.size))
+        contact.gaps = data.GetDataCoordinates()[place[0]]
+
+    def post_newton(mbs, t):  # noqa: ARG001 - Exudyn's signature
+        data = mbs.systemData
+        read_gaps(mbs)
+        np.add(reference, data.GetODE2Coordinates()[where[0]], out=positions)
+        values = data.GetDataCoordinates()
+        error = contact.switch(positions, values[place[0]])
+        data.SetDataCoordinates(values)
+        return [error, -1.0]
+
+    mbs.SetPostNewtonUserFunction(post_newton)
+    return read_gaps
 
 
 def _segment_contact(counts: list[int], pulleys: list[Pulley] | None,

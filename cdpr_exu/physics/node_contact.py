@@ -17,6 +17,12 @@ the contact is stiff (omega h = 200 on the paper circle at 1e-2 s), and an itera
 starts outside the disc overshoots deep into it. So ``pulley_contact_model = "node_smooth"``
 is an option, not the default. The Jacobian is analytic (2 x 2 per node, sparse triplets).
 
+:class:`FrozenNodeContact` is the default "node" contact: the law of Exudyn's
+``ObjectContactSphereSphere`` (linear, impact model 0, no friction), F = k_p (r_p + r_n - d) +
+c_p delta_t, on wherever the gap d - r_p - r_n of the last switch is negative, even if the
+node has left the disc since (it may then pull); the switch (:meth:`FrozenNodeContact.switch`)
+runs after each Newton solve, as Exudyn's PostNewtonStep, and returns its discontinuous error.
+
 Coordinates are flat arrays ``x0, y0, x1, y1, ...`` [m, m/s] over a global node list; each
 contact node carries its own pulley. This module does not import Exudyn.
 """
@@ -31,7 +37,7 @@ from cdpr_exu.physics.axial import tension_law
 from cdpr_exu.core.errors import SceneError
 from cdpr_exu.core.validation import per_item, points_per_item, shown, whole_array
 
-__all__ = ["CONTACT_ONSET_DEPTH", "NodePulleyContact", "node_contact_force_kernel",
+__all__ = ["CONTACT_ONSET_DEPTH", "FrozenNodeContact", "NodePulleyContact", "node_contact_force_kernel",
            "node_contact_triplet_values"]
 
 #: Penetration [m] over which the contact force switches on (C1 smoothstep): a hundredth
@@ -74,17 +80,23 @@ def node_contact_force_kernel(positions, velocities, nodes, centers, radii, stif
 @njit(cache=True)
 def _node_block(positions, velocities, node, cx, cy, radius, stiffness, damping, band,
                 factor_position, factor_velocity, block):
-    """``factor_position * K + factor_velocity * D`` of one node (2 x 2) into ``block``; False if no force.
-
-    With F_e = dF/d delta and F_r = dF/d delta_t, P = I - n n^T:
-    K = -df/dp = n (F_e n + F_r P v / d)^T - F P / d,   D = -df/dv = F_r n n^T.
-    """
+    """``factor_position * K + factor_velocity * D`` of one node (2 x 2) into ``block``; False if no force."""
     d, nx, ny, vx, vy = _node_state(positions, velocities, node, cx, cy)
     if d >= radius or d <= _MIN_DISTANCE:
         return False
     force, slope, viscous = tension_law(radius - d, -(nx * vx + ny * vy), stiffness, damping, band)
     if force == 0.0 and slope == 0.0 and viscous == 0.0:
         return False
+    return _law_block(d, nx, ny, vx, vy, force, slope, viscous, factor_position, factor_velocity, block)
+
+
+@njit(cache=True)
+def _law_block(d, nx, ny, vx, vy, force, slope, viscous, factor_position, factor_velocity, block):
+    """The 2 x 2 block of a normal force F(delta, delta_t) at distance d, normal n, velocity v; True.
+
+    With F_e = dF/d delta (``slope``) and F_r = dF/d delta_t (``viscous``), P = I - n n^T:
+    K = -df/dp = n (F_e n + F_r P v / d)^T - F P / d,   D = -df/dv = F_r n n^T.
+    """
     n = (nx, ny)
     projected = (vx - (nx * vx + ny * vy) * nx, vy - (nx * vx + ny * vy) * ny)  # P v
     for i in range(2):
@@ -169,3 +181,110 @@ class NodePulleyContact:
         return node_contact_triplet_values(positions, velocities, self.nodes, self.centers, self.radii,
                                            self.stiffness, self.damping, self.band, float(factor_position),
                                            float(factor_velocity), out_values)
+
+
+@njit(cache=True)
+def switch_contacts(positions, nodes, centers, reach, stiffness, gaps):
+    """Exudyn's PostNewtonStep of the frozen contacts: overwrite ``gaps`` (C,) [m] with the gaps at
+    ``positions``; return the discontinuous error [N], the largest k_p |gap| of a node whose side of the rim
+    changed (0 if none)."""
+    error = 0.0
+    for k in range(nodes.shape[0]):
+        rx = positions[2 * nodes[k]] - centers[k, 0]
+        ry = positions[2 * nodes[k] + 1] - centers[k, 1]
+        gap = np.sqrt(rx * rx + ry * ry) - reach[k]
+        if (gap > 0.0) != (gaps[k] > 0.0):
+            error = max(error, abs(gap) * stiffness[k])
+        gaps[k] = gap
+    return error
+
+
+@njit(cache=True)
+def frozen_contact_force_kernel(positions, velocities, nodes, centers, reach, stiffness, damping, gaps, out):
+    """Add the frozen contacts' forces to ``out`` (2N,) [N]: F = k (reach - d) + c delta_t along n where
+    ``gaps`` (C,) [m] (of the last switch) are negative."""
+    for k in range(nodes.shape[0]):
+        if gaps[k] >= 0.0:
+            continue
+        node = nodes[k]
+        d, nx, ny, vx, vy = _node_state(positions, velocities, node, centers[k, 0], centers[k, 1])
+        force = stiffness[k] * (reach[k] - d) - damping[k] * (nx * vx + ny * vy)
+        out[2 * node] += force * nx
+        out[2 * node + 1] += force * ny
+    return out
+
+
+@njit(cache=True)
+def _frozen_block(positions, velocities, k, nodes, centers, reach, stiffness, damping, gaps, factor_position,
+                  factor_velocity, block):
+    """The 2 x 2 block of frozen contact k into ``block``; False where it is off."""
+    if gaps[k] >= 0.0:
+        return False
+    d, nx, ny, vx, vy = _node_state(positions, velocities, nodes[k], centers[k, 0], centers[k, 1])
+    if d <= _MIN_DISTANCE:
+        return False
+    force = stiffness[k] * (reach[k] - d) - damping[k] * (nx * vx + ny * vy)
+    return _law_block(d, nx, ny, vx, vy, force, stiffness[k], damping[k], factor_position, factor_velocity, block)
+
+
+@njit(cache=True)
+def frozen_contact_triplet_values(positions, velocities, nodes, centers, reach, stiffness, damping, gaps,
+                                  factor_position, factor_velocity, out_values):
+    """:func:`node_contact_triplet_values` of the frozen contacts (zeros where the gap is not negative)."""
+    out_values[:] = 0.0
+    block = np.empty((2, 2))
+    for k in range(nodes.shape[0]):
+        if _frozen_block(positions, velocities, k, nodes, centers, reach, stiffness, damping, gaps,
+                         factor_position, factor_velocity, block):
+            for i in range(2):
+                for j in range(2):
+                    out_values[4 * k + 2 * i + j] = block[i, j]
+    return out_values
+
+
+@njit(cache=True)
+def frozen_contact_jacobian_kernel(positions, velocities, nodes, centers, reach, stiffness, damping, gaps,
+                                   factor_position, factor_velocity, out):
+    """Add the frozen contacts' ``factor_position * K + factor_velocity * D`` to the dense ``out`` (2N, 2N)."""
+    block = np.empty((2, 2))
+    for k in range(nodes.shape[0]):
+        if _frozen_block(positions, velocities, k, nodes, centers, reach, stiffness, damping, gaps,
+                         factor_position, factor_velocity, block):
+            for i in range(2):
+                for j in range(2):
+                    out[2 * nodes[k] + i, 2 * nodes[k] + j] += block[i, j]
+    return out
+
+
+#: Radius of the node "sphere" [m] of Exudyn's contact items, kept in the frozen law's reach r_p + r_n.
+NODE_CONTACT_RADIUS = 1.0e-9
+
+
+class FrozenNodeContact(NodePulleyContact):
+    """Exudyn's sphere contact law on nodes with the contact state frozen within Newton's iteration (module
+    docstring). ``gaps`` (C,) [m]: the gaps of the last switch, the state the forces read; the caller keeps
+    them where the solver restores a rejected step's (Exudyn's data coordinates)."""
+
+    def __init__(self, n_nodes, nodes, centers, radii, stiffness, damping):
+        super().__init__(n_nodes, nodes, centers, radii, stiffness, damping, band=0.0)
+        self.reach = self.radii + NODE_CONTACT_RADIUS
+        self.gaps = np.zeros(self.nodes.size)
+
+    def switch(self, positions, gaps) -> float:
+        """Overwrite ``gaps`` (C,) [m], the last switch's, with those at ``positions`` (2 n_nodes,) [m]; return
+        the discontinuous error [N] (:func:`switch_contacts`)."""
+        return switch_contacts(positions, self.nodes, self.centers, self.reach, self.stiffness, gaps)
+
+    def add_force(self, positions, velocities, out):
+        return frozen_contact_force_kernel(positions, velocities, self.nodes, self.centers, self.reach,
+                                           self.stiffness, self.damping, self.gaps, out)
+
+    def add_jacobian(self, positions, velocities, factor_position, factor_velocity, out):
+        return frozen_contact_jacobian_kernel(positions, velocities, self.nodes, self.centers, self.reach,
+                                              self.stiffness, self.damping, self.gaps, float(factor_position),
+                                              float(factor_velocity), out)
+
+    def triplet_values(self, positions, velocities, factor_position, factor_velocity, out_values):
+        return frozen_contact_triplet_values(positions, velocities, self.nodes, self.centers, self.reach,
+                                             self.stiffness, self.damping, self.gaps, float(factor_position),
+                                             float(factor_velocity), out_values)
