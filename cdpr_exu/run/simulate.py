@@ -444,8 +444,11 @@ def simulate(scene: Scene, controller: Controller | None = None, *, solution_fil
     result = run.result(controller.name, failure)
     solved = mbs.sys.get("dynamicSolver")  # none when the start was refused
     result.wall_time, result.cpu_time = wall, cpu
-    result.steps, result.newton_iterations = (0, 0) if solved is None else (
-        int(solved.it.currentStepIndex), int(solved.it.newtonStepsCount))
+    if solved is not None:
+        it = solved.it
+        result.steps, result.newton_iterations = int(it.currentStepIndex), int(it.newtonStepsCount)
+        result.jacobians = int(it.newtonJacobiCount)
+        result.discontinuous_iterations = int(it.discontinuousIterationsCount)
     result.metadata.update({"effects": scene.effects.preset, "step_size_s": solver.step_size,
                             "n_elements": [c.n_elements for c in scene.cables], "item_counts": model.item_counts(),
                             # above the highest exit every cable pulls the platform down (Result.summary)
