@@ -60,43 +60,52 @@ def _node_state(positions, velocities, node, cx, cy):
 
 
 @njit(cache=True)
-def node_contact_force_kernel(positions, velocities, nodes, centers, radii, stiffness, damping, band, out):
+def _contact_law(positions, velocities, k, nodes, centers, radii, stiffness, damping, band, gaps):
+    """(on, d, nx, ny, vx, vy, F, dF/d delta, dF/d delta_t) of contact k: the smooth law inside the disc
+    (``gaps`` None), else the frozen law wherever gaps[k] < 0 (``radii`` then r_p + r_n)."""
+    d, nx, ny, vx, vy = _node_state(positions, velocities, nodes[k], centers[k, 0], centers[k, 1])
+    off = (False, d, nx, ny, vx, vy, 0.0, 0.0, 0.0)
+    if d <= _MIN_DISTANCE:
+        return off
+    if gaps is not None:
+        if gaps[k] >= 0.0:
+            return off
+        force = stiffness[k] * (radii[k] - d) - damping[k] * (nx * vx + ny * vy)
+        return True, d, nx, ny, vx, vy, force, stiffness[k], damping[k]
+    if d >= radii[k]:
+        return off
+    force, slope, viscous = tension_law(radii[k] - d, -(nx * vx + ny * vy), stiffness[k], damping[k], band)
+    return True, d, nx, ny, vx, vy, force, slope, viscous
+
+
+@njit(cache=True)
+def node_contact_force_kernel(positions, velocities, nodes, centers, radii, stiffness, damping, band, out, gaps=None):
     """Add the rim-contact forces of ``nodes`` to ``out`` (2N,) [N] and return it (unchecked).
 
     ``positions``, ``velocities`` (2N,) [m, m/s]; ``nodes`` (C,) global indices, ``centers`` (C, 2) [m],
-    ``radii``, ``stiffness``, ``damping`` (C,) [m, N/m, N s/m] as :class:`NodePulleyContact`'s.
+    ``radii``, ``stiffness``, ``damping`` (C,) [m, N/m, N s/m] and ``gaps`` as :class:`NodePulleyContact`'s.
     """
     for k in range(nodes.shape[0]):
-        node = nodes[k]
-        d, nx, ny, vx, vy = _node_state(positions, velocities, node, centers[k, 0], centers[k, 1])
-        if d >= radii[k] or d <= _MIN_DISTANCE:
-            continue
-        force = tension_law(radii[k] - d, -(nx * vx + ny * vy), stiffness[k], damping[k], band)[0]
-        out[2 * node] += force * nx
-        out[2 * node + 1] += force * ny
+        on, _, nx, ny, _, _, force, _, _ = _contact_law(positions, velocities, k, nodes, centers, radii, stiffness,
+                                                         damping, band, gaps)
+        if on:
+            out[2 * nodes[k]] += force * nx
+            out[2 * nodes[k] + 1] += force * ny
     return out
 
 
 @njit(cache=True)
-def _node_block(positions, velocities, node, cx, cy, radius, stiffness, damping, band,
+def _node_block(positions, velocities, k, nodes, centers, radii, stiffness, damping, band, gaps,
                 factor_position, factor_velocity, block):
-    """``factor_position * K + factor_velocity * D`` of one node (2 x 2) into ``block``; False if no force."""
-    d, nx, ny, vx, vy = _node_state(positions, velocities, node, cx, cy)
-    if d >= radius or d <= _MIN_DISTANCE:
-        return False
-    force, slope, viscous = tension_law(radius - d, -(nx * vx + ny * vy), stiffness, damping, band)
-    if force == 0.0 and slope == 0.0 and viscous == 0.0:
-        return False
-    return _law_block(d, nx, ny, vx, vy, force, slope, viscous, factor_position, factor_velocity, block)
+    """``factor_position * K + factor_velocity * D`` of contact k (2 x 2) into ``block``; False if no force.
 
-
-@njit(cache=True)
-def _law_block(d, nx, ny, vx, vy, force, slope, viscous, factor_position, factor_velocity, block):
-    """The 2 x 2 block of a normal force F(delta, delta_t) at distance d, normal n, velocity v; True.
-
-    With F_e = dF/d delta (``slope``) and F_r = dF/d delta_t (``viscous``), P = I - n n^T:
+    With F_e = dF/d delta and F_r = dF/d delta_t, P = I - n n^T:
     K = -df/dp = n (F_e n + F_r P v / d)^T - F P / d,   D = -df/dv = F_r n n^T.
     """
+    on, d, nx, ny, vx, vy, force, slope, viscous = _contact_law(positions, velocities, k, nodes, centers, radii,
+                                                                stiffness, damping, band, gaps)
+    if not on or (force == 0.0 and slope == 0.0 and viscous == 0.0):
+        return False
     n = (nx, ny)
     projected = (vx - (nx * vx + ny * vy) * nx, vy - (nx * vx + ny * vy) * ny)  # P v
     for i in range(2):
@@ -108,15 +117,15 @@ def _law_block(d, nx, ny, vx, vy, force, slope, viscous, factor_position, factor
 
 
 @njit(cache=True)
-def node_contact_triplet_values(positions, velocities, nodes, centers, radii, stiffness, damping, band,
+def node_contact_triplet_values(positions, velocities, nodes, centers, radii, stiffness, damping, band, gaps,
                                 factor_position, factor_velocity, out_values):
     """Values of ``factor_position * K + factor_velocity * D`` at
     :func:`~cdpr_exu.physics.sparse_blocks.block_pattern`'s places (overwrites ``out_values``, shape (4 C,))."""
     out_values[:] = 0.0
     block = np.empty((2, 2))
     for k in range(nodes.shape[0]):
-        if _node_block(positions, velocities, nodes[k], centers[k, 0], centers[k, 1], radii[k], stiffness[k],
-                       damping[k], band, factor_position, factor_velocity, block):
+        if _node_block(positions, velocities, k, nodes, centers, radii, stiffness, damping, band, gaps,
+                       factor_position, factor_velocity, block):
             for i in range(2):
                 for j in range(2):
                     out_values[4 * k + 2 * i + j] = block[i, j]
@@ -124,14 +133,14 @@ def node_contact_triplet_values(positions, velocities, nodes, centers, radii, st
 
 
 @njit(cache=True)
-def node_contact_jacobian_kernel(positions, velocities, nodes, centers, radii, stiffness, damping, band,
+def node_contact_jacobian_kernel(positions, velocities, nodes, centers, radii, stiffness, damping, band, gaps,
                                  factor_position, factor_velocity, out):
     """Add ``factor_position * K + factor_velocity * D`` (2N, 2N) of the contacts to the dense ``out`` (unchecked)."""
     block = np.empty((2, 2))
     for k in range(nodes.shape[0]):
         node = nodes[k]
-        if _node_block(positions, velocities, node, centers[k, 0], centers[k, 1], radii[k], stiffness[k],
-                       damping[k], band, factor_position, factor_velocity, block):
+        if _node_block(positions, velocities, k, nodes, centers, radii, stiffness, damping, band, gaps,
+                       factor_position, factor_velocity, block):
             for i in range(2):
                 for j in range(2):
                     out[2 * node + i, 2 * node + j] += block[i, j]
@@ -160,16 +169,17 @@ class NodePulleyContact:
         if not np.isfinite(band) or band < 0.0:
             raise SceneError(f"band must be a finite length >= 0 [m]; got {shown(band)}")
         self.band = band
+        self.gaps = None  # the frozen law's state (FrozenNodeContact); None: the smooth law
 
     def add_force(self, positions, velocities, out):
         """Add the contact forces (2 n_nodes,) [N] to ``out`` and return it."""
         return node_contact_force_kernel(positions, velocities, self.nodes, self.centers, self.radii,
-                                         self.stiffness, self.damping, self.band, out)
+                                         self.stiffness, self.damping, self.band, out, self.gaps)
 
     def add_jacobian(self, positions, velocities, factor_position, factor_velocity, out):
         """Add ``factor_position * K + factor_velocity * D`` (2 n_nodes, 2 n_nodes) to ``out``."""
         return node_contact_jacobian_kernel(positions, velocities, self.nodes, self.centers, self.radii,
-                                            self.stiffness, self.damping, self.band, float(factor_position),
+                                            self.stiffness, self.damping, self.band, self.gaps, float(factor_position),
                                             float(factor_velocity), out)
 
     def triplet_pattern(self):
@@ -179,7 +189,7 @@ class NodePulleyContact:
     def triplet_values(self, positions, velocities, factor_position, factor_velocity, out_values):
         """Values at :meth:`triplet_pattern`'s places (overwrites ``out_values``)."""
         return node_contact_triplet_values(positions, velocities, self.nodes, self.centers, self.radii,
-                                           self.stiffness, self.damping, self.band, float(factor_position),
+                                           self.stiffness, self.damping, self.band, self.gaps, float(factor_position),
                                            float(factor_velocity), out_values)
 
 
@@ -199,63 +209,6 @@ def switch_contacts(positions, nodes, centers, reach, stiffness, gaps):
     return error
 
 
-@njit(cache=True)
-def frozen_contact_force_kernel(positions, velocities, nodes, centers, reach, stiffness, damping, gaps, out):
-    """Add the frozen contacts' forces to ``out`` (2N,) [N]: F = k (reach - d) + c delta_t along n where
-    ``gaps`` (C,) [m] (of the last switch) are negative."""
-    for k in range(nodes.shape[0]):
-        if gaps[k] >= 0.0:
-            continue
-        node = nodes[k]
-        d, nx, ny, vx, vy = _node_state(positions, velocities, node, centers[k, 0], centers[k, 1])
-        force = stiffness[k] * (reach[k] - d) - damping[k] * (nx * vx + ny * vy)
-        out[2 * node] += force * nx
-        out[2 * node + 1] += force * ny
-    return out
-
-
-@njit(cache=True)
-def _frozen_block(positions, velocities, k, nodes, centers, reach, stiffness, damping, gaps, factor_position,
-                  factor_velocity, block):
-    """The 2 x 2 block of frozen contact k into ``block``; False where it is off."""
-    if gaps[k] >= 0.0:
-        return False
-    d, nx, ny, vx, vy = _node_state(positions, velocities, nodes[k], centers[k, 0], centers[k, 1])
-    if d <= _MIN_DISTANCE:
-        return False
-    force = stiffness[k] * (reach[k] - d) - damping[k] * (nx * vx + ny * vy)
-    return _law_block(d, nx, ny, vx, vy, force, stiffness[k], damping[k], factor_position, factor_velocity, block)
-
-
-@njit(cache=True)
-def frozen_contact_triplet_values(positions, velocities, nodes, centers, reach, stiffness, damping, gaps,
-                                  factor_position, factor_velocity, out_values):
-    """:func:`node_contact_triplet_values` of the frozen contacts (zeros where the gap is not negative)."""
-    out_values[:] = 0.0
-    block = np.empty((2, 2))
-    for k in range(nodes.shape[0]):
-        if _frozen_block(positions, velocities, k, nodes, centers, reach, stiffness, damping, gaps,
-                         factor_position, factor_velocity, block):
-            for i in range(2):
-                for j in range(2):
-                    out_values[4 * k + 2 * i + j] = block[i, j]
-    return out_values
-
-
-@njit(cache=True)
-def frozen_contact_jacobian_kernel(positions, velocities, nodes, centers, reach, stiffness, damping, gaps,
-                                   factor_position, factor_velocity, out):
-    """Add the frozen contacts' ``factor_position * K + factor_velocity * D`` to the dense ``out`` (2N, 2N)."""
-    block = np.empty((2, 2))
-    for k in range(nodes.shape[0]):
-        if _frozen_block(positions, velocities, k, nodes, centers, reach, stiffness, damping, gaps,
-                         factor_position, factor_velocity, block):
-            for i in range(2):
-                for j in range(2):
-                    out[2 * nodes[k] + i, 2 * nodes[k] + j] += block[i, j]
-    return out
-
-
 #: Radius of the node "sphere" [m] of Exudyn's contact items, kept in the frozen law's reach r_p + r_n.
 NODE_CONTACT_RADIUS = 1.0e-9
 
@@ -263,28 +216,15 @@ NODE_CONTACT_RADIUS = 1.0e-9
 class FrozenNodeContact(NodePulleyContact):
     """Exudyn's sphere contact law on nodes with the contact state frozen within Newton's iteration (module
     docstring). ``gaps`` (C,) [m]: the gaps of the last switch, the state the forces read; the caller keeps
-    them where the solver restores a rejected step's (Exudyn's data coordinates)."""
+    them where the solver restores a rejected step's (Exudyn's data coordinates). ``radii`` hold the reach
+    r_p + r_n (:data:`NODE_CONTACT_RADIUS`)."""
 
     def __init__(self, n_nodes, nodes, centers, radii, stiffness, damping):
         super().__init__(n_nodes, nodes, centers, radii, stiffness, damping, band=0.0)
-        self.reach = self.radii + NODE_CONTACT_RADIUS
+        self.radii = self.radii + NODE_CONTACT_RADIUS
         self.gaps = np.zeros(self.nodes.size)
 
     def switch(self, positions, gaps) -> float:
         """Overwrite ``gaps`` (C,) [m], the last switch's, with those at ``positions`` (2 n_nodes,) [m]; return
         the discontinuous error [N] (:func:`switch_contacts`)."""
-        return switch_contacts(positions, self.nodes, self.centers, self.reach, self.stiffness, gaps)
-
-    def add_force(self, positions, velocities, out):
-        return frozen_contact_force_kernel(positions, velocities, self.nodes, self.centers, self.reach,
-                                           self.stiffness, self.damping, self.gaps, out)
-
-    def add_jacobian(self, positions, velocities, factor_position, factor_velocity, out):
-        return frozen_contact_jacobian_kernel(positions, velocities, self.nodes, self.centers, self.reach,
-                                              self.stiffness, self.damping, self.gaps, float(factor_position),
-                                              float(factor_velocity), out)
-
-    def triplet_values(self, positions, velocities, factor_position, factor_velocity, out_values):
-        return frozen_contact_triplet_values(positions, velocities, self.nodes, self.centers, self.reach,
-                                             self.stiffness, self.damping, self.gaps, float(factor_position),
-                                             float(factor_velocity), out_values)
+        return switch_contacts(positions, self.nodes, self.centers, self.radii, self.stiffness, gaps)
