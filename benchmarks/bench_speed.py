@@ -3,7 +3,10 @@
 Table mode (the default) runs, one after the other in this process, the paper circle at n = 30, 60 and
 120 elements per cable with 1e-2 s steps, the shipped ``paper-circle`` and the spatial scenes, and prints
 for each: CPU time of the solve (``Result.cpu_time``, process CPU time, never wall time), times faster
-than real time, steps, Newton iterations per step, and the cost exponent from 30 to 120 elements. The
+than real time, steps, Newton iterations and Jacobian updates per step, discontinuous iterations, the
+start-up share (CPU time of the first 0.05 s, a run of its own, over the whole run's), the cost exponent
+from 30 to 120 elements, and for the planar rows the platform's largest distance and rotation from the
+converged reference :data:`REFERENCE` (the spatial scenes' references are ``bench_spatial.py``'s). The
 ratios come from one run on one machine; the machines are shared and noisy: compare ratios.
 
 A/B mode measures one change: ``--ab A B`` runs the same scene alternately (A, B, A, B, ...) in fresh
@@ -28,12 +31,19 @@ import sys
 from pathlib import Path
 
 PLANAR = [("paper-circle", n, 1e-2) for n in (30, 60, 120)] + [("paper-circle", None, None)]
+#: The planar rows' converged reference: the paper circle at 120 elements per cable and 2.5e-3 s steps
+#: (0.04 mm from 240 elements at 1.25e-3 s in the accuracy study, docs/accuracy.md).
+REFERENCE = ("paper-circle", 120, 2.5e-3)
+#: The simulated time whose CPU share is the start-up's [s].
+START_UP = 0.05
 SPATIAL = [("spatial-cogiro", None, None), ("spatial-ipanema", None, None), ("spatial-cogiro-mismatch", None, None),
            ("spatial-four-cable-swivel", None, None)]
 
 
-def run_one(name: str, elements: int | None, step: float | None, end_time: float | None) -> dict:
-    """One run of the scene ``name`` (``elements`` per cable and ``step`` [s] where given): its figures."""
+def run_one(name: str, elements: int | None, step: float | None, end_time: float | None,
+            poses: dict | None = None) -> dict:
+    """One run of the scene ``name`` (``elements`` per cable and ``step`` [s] where given): its figures; its
+    times and platform poses into ``poses`` if given."""
     from dataclasses import replace
 
     import numpy as np
@@ -49,13 +59,17 @@ def run_one(name: str, elements: int | None, step: float | None, end_time: float
         solver = replace(solver, end_time=min(end_time, solver.end_time))
     cables = scene.cables if elements is None else tuple(replace(c, n_elements=elements) for c in scene.cables)
     result = simulate(scene.with_changes(cables=cables, solver=solver))
+    if poses is not None:
+        poses.update(time=result.time, pose=result.pose)
     digest = hashlib.sha256()
     for array in (result.time, result.pose, result.paid_out, *result.nodes, *result.tensions):
         digest.update(np.ascontiguousarray(array).tobytes())
     return {"scene": name, "n_elements": cables[0].n_elements, "step_size_s": solver.step_size,
             "cpu_time_s": result.cpu_time, "simulated_time_s": result.simulated_time,
             "real_time_factor": result.simulated_time / result.cpu_time, "steps": result.steps,
-            "newton_per_step": result.newton_iterations / max(result.steps, 1), "digest": digest.hexdigest()[:16]}
+            "newton_per_step": result.newton_iterations / max(result.steps, 1),
+            "jacobians_per_step": result.jacobians / max(result.steps, 1),
+            "discontinuous_iterations": result.discontinuous_iterations, "digest": digest.hexdigest()[:16]}
 
 
 def _worker(args) -> None:
@@ -97,32 +111,52 @@ def ab(args) -> None:
 
 
 def table(args) -> None:
-    """Every scene of the table once, in this process, after a warm-up."""
+    """Every scene of the table once, in this process, after a warm-up; the planar rows against the reference."""
+    import numpy as np
+
     from cdpr_exu.core.output import write_json
 
-    run_one("paper-circle", None, None, 0.05)  # warm-up: numba, imports
+    run_one("paper-circle", None, None, START_UP)  # warm-up: numba, imports
+    reference = {}
+    reference_row = run_one(*REFERENCE, args.end_time, reference)
     rows = []
     for name, n, step in PLANAR + SPATIAL:
-        row = run_one(name, n, step, args.end_time)
+        poses = {}
+        row = run_one(name, n, step, args.end_time, poses)
+        row["start_up_share"] = run_one(name, n, step, START_UP)["cpu_time_s"] / row["cpu_time_s"]
+        row["error_mm"] = row["error_deg"] = None
+        if (name, n, step) in PLANAR:
+            at = [np.interp(poses["time"], reference["time"], reference["pose"][:, k]) for k in range(3)]
+            row["error_mm"] = 1e3 * float(np.hypot(*(poses["pose"][:, :2] - np.column_stack(at[:2])).T).max())
+            row["error_deg"] = float(np.degrees(np.abs(poses["pose"][:, 2] - at[2]).max()))
         rows.append(row)
-        print(f"{name:26s} n = {row['n_elements']:3d}, step {row['step_size_s']:.0e} s: {row['cpu_time_s']:7.2f} s CPU, "
-              f"{row['real_time_factor']:6.2f}x real time, {row['steps']} steps, {row['newton_per_step']:.2f} "
-              "Newton iterations per step", flush=True)
+        print(f"{name:26s} n = {row['n_elements']:3d}, step {row['step_size_s']:.0e} s: "
+              f"{row['cpu_time_s']:7.2f} s CPU, {row['real_time_factor']:6.2f}x real time, {row['steps']} steps, "
+              f"{row['newton_per_step']:.2f} Newton and {row['jacobians_per_step']:.2f} Jacobians per step, "
+              f"{row['discontinuous_iterations']} discontinuous iterations, start-up "
+              f"{100 * row['start_up_share']:.0f} %", flush=True)
     cost = {r["n_elements"]: r["cpu_time_s"] for r in rows[:3]}
     exponent = math.log(cost[120] / cost[30]) / math.log(4)
+    shown = lambda value, digits: "-" if value is None else f"{value:.{digits}f}"  # noqa: E731
     lines = ["# Speed of the one run loop (issue 25), one run each", "",
              "CPU time of the solve (process CPU time, single-threaded); the machine is shared and noisy: "
-             "compare ratios.", "",
-             "| scene | elements per cable | step [s] | CPU time [s] | x real time | steps | Newton iterations / step |",
-             "|---|---|---|---|---|---|---|"]
+             f"compare ratios. Start-up: the CPU share of the first {START_UP} s (a run of its own). Error: the "
+             "platform's largest distance and rotation from the converged reference, the paper circle at "
+             f"{REFERENCE[1]} elements and {REFERENCE[2]} s ({reference_row['cpu_time_s']:.1f} s CPU).", "",
+             "| scene | elements per cable | step [s] | CPU time [s] | x real time | steps | Newton / step | "
+             "Jacobians / step | discontinuous iterations | start-up share | error [mm] | error [deg] |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['scene']} | {r['n_elements']} | {r['step_size_s']:g} | {r['cpu_time_s']:.2f} | "
-              f"{r['real_time_factor']:.2f} | {r['steps']} | {r['newton_per_step']:.2f} |" for r in rows]
+              f"{r['real_time_factor']:.2f} | {r['steps']} | {r['newton_per_step']:.2f} | "
+              f"{r['jacobians_per_step']:.2f} | "
+              f"{r['discontinuous_iterations']} | {100 * r['start_up_share']:.0f} % | {shown(r['error_mm'], 2)} | "
+              f"{shown(r['error_deg'], 3)} |" for r in rows]
     lines += ["", f"Cost of the paper circle from 30 to 120 elements at 1e-2 s grows as n^{exponent:.2f} "
               "(target: no faster than n^1.2)."]
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text("\n".join(lines) + "\n")
-    write_json(Path(args.out).with_suffix(".json"), {"rows": rows, "cost_exponent_30_120": exponent,
-                                                     "cpu_count": os.cpu_count()})
+    write_json(Path(args.out).with_suffix(".json"), {"rows": rows, "reference": reference_row,
+                                                     "cost_exponent_30_120": exponent, "cpu_count": os.cpu_count()})
     print(lines[-1])
 
 

@@ -56,10 +56,10 @@ def test_full_preset_is_the_paper_model_with_tension_only_elements(paper_scene):
         assert full[item] == paper[item], item
 
 
-def test_bending_off_removes_the_bending_joints_and_their_object(paper_scene):
+def test_bending_off_removes_the_bending_joints_and_their_python_forces(paper_scene):
     off = counts(paper_scene, "paper", bending=False, bending_damping=False)
     assert off["bending_joints"] == 0
-    assert off["cable_force_objects"] == 0  # nothing left for the generic object to carry
+    assert off["cable_force_objects"] == 1  # it carries the masses and weights, with no Python function
     assert off["axial_spring_dampers"] == ELEMENTS and off["mass_points"] == NODES
     tension_only = counts(paper_scene, bending=False, bending_damping=False)
     assert tension_only["bending_joints"] == 0 and tension_only["cable_force_objects"] == 1  # the slack elements
@@ -102,7 +102,9 @@ def test_each_preset_adds_only_the_items_of_its_effects(paper_scene, preset):
 
 
 def test_linear_bending_has_the_same_joints_in_constant_matrices_without_a_force_function(paper_scene):
-    model = build_model(paper_scene.with_changes(effects=Effects.from_preset("paper", bending_model="linear")))
+    """Without pulley contact (whose forces live in the same object, computed in Python)."""
+    effects = Effects.from_preset("paper", bending_model="linear", pulley_contact=False)
+    model = build_model(paper_scene.with_changes(effects=effects))
     assert model.item_counts()["bending_joints"] == JOINTS
     item = model.mbs.GetObject(model.cable_forces.object)
     assert item["forceUserFunction"] == 0  # no Python call per Newton iteration

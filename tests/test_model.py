@@ -115,14 +115,15 @@ def test_paper_scene_bends_at_every_interior_node_in_one_object(paper_model):
 def test_pulley_contacts_only_on_nodes_that_can_reach_the_pulley(paper_model):
     counts = paper_model.item_counts()
     assert 0 < counts["pulley_contacts"] < 2 * 16
-    for i, (contacts, nodes) in enumerate(zip(paper_model.contacts, paper_model.contact_nodes)):
-        assert len(contacts) == len(nodes)
+    contact = paper_model.cable_forces.node_contact  # all of them in the cables' object, Exudyn's law frozen
+    assert contact.nodes.size == counts["pulley_contacts"] and contact.band == 0.0
+    for i, nodes in enumerate(paper_model.contact_nodes):
         assert 0 not in nodes  # the winch node's motion is prescribed
         assert 15 not in nodes  # the anchor node stays over 1 m below the pulley centre
         np.testing.assert_array_equal(nodes, contact_candidates(paper_model.scene, i))
 
 
-def test_catenary_preset_adds_no_bending_object():
+def test_catenary_preset_adds_no_bending_joints():
     scene = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary"))
     counts = build_model(scene).item_counts()
     assert counts["bending_joints"] == 0
@@ -130,7 +131,7 @@ def test_catenary_preset_adds_no_bending_object():
     assert counts["cable_force_objects"] == 1
     pushing = load_scene("paper-circle").with_changes(effects=Effects.from_preset("catenary", slack=False))
     counts = build_model(pushing).item_counts()
-    assert counts["cable_force_objects"] == 0  # no bending, no slack: nothing for the object to carry
+    assert counts["cable_force_objects"] == 1  # no bending, no slack: the object carries masses, weights, contact
     assert counts["axial_spring_dampers"] == 2 * 15
 
 

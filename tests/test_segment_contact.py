@@ -217,13 +217,13 @@ def test_segment_contact_adds_no_exudyn_contact_items_and_lists_the_candidate_el
     assert counts["contact_segments"] == len(model.cable_forces.contact_segments) > 0
 
 
-def test_node_contact_is_unchanged():
+def test_node_contact_lives_in_the_generic_object_too():
     scene = PAPER.with_changes(solver=replace(PAPER.solver, end_time=1.0))
     model = build_model(scene)
     types = object_types(model)
     candidates = sum(len(contact_candidates(scene, i)) for i in range(2))
-    assert types["ContactSphereSphere"] == model.item_counts()["pulley_contacts"] == candidates
-    assert types["Ground"] == 2
+    assert model.item_counts()["pulley_contacts"] == model.cable_forces.node_contact.nodes.size == candidates
+    assert types["ContactSphereSphere"] == types["Ground"] == 0  # Exudyn's law, frozen in Newton, in numba
     assert model.item_counts()["contact_segments"] == 0
     assert model.cable_forces.contact is None  # no segment-contact cost at all
 

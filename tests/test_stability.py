@@ -27,6 +27,7 @@ import math
 import re
 from functools import lru_cache
 
+import exudyn as exu
 import numpy as np
 
 from cdpr_exu.results.energy import energy_rise, mechanical_energy
@@ -36,7 +37,7 @@ from cdpr_exu.core.errors import SceneError, SolverFailure, UnreachableError
 from cdpr_exu.builder.model import build_model
 from cdpr_exu.results.result import Result
 from cdpr_exu.scenes.scene import Effects, Scene, WinchSpec, load_scene
-from cdpr_exu.run.simulate import MAX_STRAIN, simulate
+from cdpr_exu.run.simulate import MAX_STRAIN, _Monitor, simulate
 from cdpr_exu.run.solver import explicit_step_limit
 from cdpr_exu.scenes.trajectories import CircleTrajectory, HoldTrajectory, PointToPointTrajectory
 from controllers.base import WinchCommand
@@ -523,6 +524,28 @@ def test_monitor_stop_mid_run_names_the_element_and_keeps_the_result():
     assert_clear_failure(scene, failure, "strained by")
     assert "element 1 of cable 1" in str(failure) or "element 0 of cable 1" in str(failure)
     assert failure.time == pytest.approx(0.3, abs=0.011)
+
+
+def test_the_monitors_compiled_pass_hands_each_fault_to_the_check_that_names_it():
+    """Every sample is checked (the run above stops within one output period, 0.01 s); the compiled pass
+    clears the sound start and lets through a node pulled 0.14 m off its cable (elements strained by at
+    least 7.7 %) and a cable drawn to 0.4 of its distance from the pulley centre (shortened: no fault for
+    tension-only elements, but its wrapped elements 0.6 radii deep, beyond the 0.5 limit)."""
+    scene = load_scene("paper-circle")
+    model = build_model(scene)
+    reference = model.mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Reference)
+    indices = model.coordinate_indices()
+    monitor = _Monitor(scene, indices, reference)
+    q = np.zeros_like(reference)
+    assert monitor.problem(0.0, q) is None
+    pulled = q.copy()
+    pulled[indices["cable_1"][7]] += 0.1
+    assert "element" in monitor.problem(0.0, pulled) and "of cable 2 is strained by" in monitor.problem(0.0, pulled)
+    drawn = q.copy()
+    nodes = indices["cable_0"]
+    center = np.asarray(scene.exits[0].center)
+    drawn[nodes] = center + 0.4 * (reference[nodes] - center) - reference[nodes]
+    assert "cuts" in monitor.problem(0.0, drawn) and "into pulley 1" in monitor.problem(0.0, drawn)
 
 
 # ============================================================================ explicit RK44

@@ -5,7 +5,9 @@ platform anchor. Each element is an axial spring-damper (Exudyn's); each interio
 rotational spring-damper on the relative angle of its two elements. The bending of all cables
 is one ``ObjectGenericODE2`` with numba force and Jacobian (:mod:`cdpr_exu.physics.bending`),
 one Python call per Newton iteration for the whole robot; it also carries the tension-only
-elements (:mod:`cdpr_exu.physics.axial`) and the smooth node or segment pulley contacts.
+elements (:mod:`cdpr_exu.physics.axial`), the smooth node or segment pulley contacts, and the nodes'
+masses (its constant diagonal mass matrix) and weights (its force vector): no mass point or load item
+per node (measured x1.2 of the 60-element paper circle's CPU time, paths moved by round-off).
 
 Exudyn items live in its x-y plane: the paper's (x, z) maps to Exudyn's (x, y).
 """
@@ -25,60 +27,53 @@ from cdpr_exu.physics import cable_forces
 from cdpr_exu.exits import Pulley
 from cdpr_exu.scenes.scene import CableSpec, Effects
 from cdpr_exu.physics import node_contact as node_contact_module
-from cdpr_exu.physics.node_contact import NodePulleyContact
+from cdpr_exu.physics.node_contact import FrozenNodeContact, NodePulleyContact
 from cdpr_exu.physics.segment_contact import SegmentPulleyContact
 
 
 @dataclass
 class CableItems:
     """Exudyn indices of one cable's items: ``nodes`` (``NodePoint2D``, winch end first, n + 1)
-    and their ``markers``, axial ``springs`` (n, or distance constraints; empty with slack), gravity
-    ``loads``; ``reference`` (n + 1, 2) [m] the initial node positions, ``masses`` (n + 1,) [kg]."""
+    and their ``markers``, axial ``springs`` (n, or distance constraints; empty with slack);
+    ``reference`` (n + 1, 2) [m] the initial node positions, ``masses`` (n + 1,) [kg] and ``weights``
+    (n + 1,) [N] (zero without gravity), which the cables' generic object carries (:func:`add_cable_forces`)."""
 
     nodes: list[int]
     markers: list[int]
     reference: np.ndarray
+    masses: np.ndarray
+    weights: np.ndarray
     springs: list[int] = field(default_factory=list)
-    loads: list[int] = field(default_factory=list)
-    masses: np.ndarray | None = None
 
 
 def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effects: Effects,
               gravity: float) -> CableItems:
-    """Add the mass points, axial spring-dampers and gravity loads of one cable.
+    """Add the nodes and axial spring-dampers of one cable; its masses and weights go into the cables'
+    generic object (:func:`add_cable_forces`).
 
     ``nodes_xz`` (n + 1, 2) [m]: initial node positions (x, z), winch end first, each element at
     its unstrained length; ``gravity`` [m/s^2] along -z.
     """
     nodes_xz = np.asarray(nodes_xz, dtype=float)
     masses = cable.node_masses()
-    items = CableItems(nodes=[], markers=[], reference=nodes_xz.copy(), masses=masses)
-    for (x, z), mass in zip(nodes_xz, masses):
+    weights = masses * gravity if effects.gravity and gravity > 0.0 else np.zeros_like(masses)
+    items = CableItems(nodes=[], markers=[], reference=nodes_xz.copy(), masses=masses, weights=weights)
+    for x, z in nodes_xz:
         node = mbs.AddNode(eii.NodePoint2D(referenceCoordinates=[x, z]))
-        mbs.AddObject(eii.ObjectMassPoint2D(mass=float(mass), nodeNumber=node))
         items.nodes.append(node)
         items.markers.append(mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
     damping = cable.axial_damping if effects.axial_damping else 0.0
     if effects.slack:
-        return _add_gravity(mbs, items, masses, effects, gravity)  # axial forces: see add_cable_forces
+        return items  # axial forces: see add_cable_forces
     if not effects.axial_elasticity:  # inextensible elements: distance constraints
         for a, b in zip(items.markers[:-1], items.markers[1:]):
             items.springs.append(mbs.AddObject(eii.ObjectConnectorDistance(
                 markerNumbers=[a, b], distance=cable.element_length)))
-        return _add_gravity(mbs, items, masses, effects, gravity)
+        return items
     for a, b in zip(items.markers[:-1], items.markers[1:]):
         items.springs.append(mbs.AddObject(eii.ObjectConnectorSpringDamper(
             markerNumbers=[a, b], referenceLength=cable.element_length,
             stiffness=cable.axial_stiffness, damping=damping)))
-    return _add_gravity(mbs, items, masses, effects, gravity)
-
-
-def _add_gravity(mbs: exu.MainSystem, items: CableItems, masses: np.ndarray, effects: Effects,
-                 gravity: float) -> CableItems:
-    if effects.gravity and gravity > 0.0:
-        for marker, mass in zip(items.markers, masses):
-            items.loads.append(mbs.AddLoad(eii.LoadForceVector(
-                markerNumber=marker, loadVector=[0.0, -float(mass) * gravity, 0.0])))
     return items
 
 
@@ -123,8 +118,8 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
                      effects: Effects, pulleys: list[Pulley] | None = None,
                      contact_elements: list[np.ndarray] | None = None,
                      sparse_jacobian: bool = True,
-                     contact_nodes: list[np.ndarray] | None = None) -> CableForceItems | None:
-    """Add the bending, tension-only and smooth contact forces of all cables as one object.
+                     contact_nodes: list[np.ndarray] | None = None, frozen_contact: bool = False) -> CableForceItems:
+    """Add the masses, weights, bending, tension-only and smooth contact forces of all cables as one object.
 
     Parameters
     ----------
@@ -134,20 +129,24 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         Pulley of each cable; needed with contacts.
     contact_elements, contact_nodes : list of ndarray of int, optional
         Per cable, the cable-local elements (element j joins nodes j and j + 1) that get a segment
-        rim contact ("segment") and the nodes that get a smooth node contact ("node_smooth",
-        :mod:`cdpr_exu.physics.node_contact`); None or all empty: none, and no cost for it.
+        rim contact ("segment") and the nodes that get a node contact (:mod:`cdpr_exu.physics.node_contact`);
+        None or all empty: none, and no cost for it.
+    frozen_contact : bool
+        The node contact is Exudyn's law frozen within Newton's iteration ("node"), not the smooth one
+        ("node_smooth"): its gaps are data coordinates of one ``NodeGenericData`` (restored with a rejected
+        step), switched by the system's PostNewton function (this object's; measured x1.2 against Exudyn's
+        contact items on the 60-element paper circle, the path within 1e-5 mm).
     sparse_jacobian : bool
         Return the Jacobian as sparse triplets (cost linear in the number of nodes) instead of a
         dense (2N, 2N) matrix; with segment contact the dense form is kept.
 
-    Returns None when no effect needs the object. The Jacobian is analytic, ``fODE2 * K +
-    fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
+    The masses form the object's constant diagonal mass matrix, the weights its force vector; without
+    bending, tension-only elements or smooth contact it has no user function (nothing in Python). The
+    Jacobian is analytic, ``fODE2 * K + fODE2_t * D`` with K = -df/dq, D = -df/dq_t.
     """
     counts = [len(it.nodes) for it in items]
     contact = _segment_contact(counts, pulleys, contact_elements)
-    node_contact = _node_contact(counts, pulleys, contact_nodes)
-    if not (effects.bending or effects.slack or contact is not None or node_contact is not None):
-        return None
+    node_contact = _node_contact(counts, pulleys, contact_nodes, frozen_contact)
     reference = np.concatenate([it.reference for it in items]).ravel()
     size = reference.size
     if effects.bending:
@@ -182,10 +181,17 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
 
     where = []  # the object's coordinates in the system's state vectors (_state)
+    frozen = node_contact is not None and frozen_contact
+    if frozen:
+        read_gaps = _frozen_contact(mbs, node_contact, reference, positions, where)
+    else:
+        def read_gaps(mbs):  # noqa: ARG001
+            return None
 
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         # bending and tension-only elements in one compiled call (cable_forces), then any rim contact
         displacements, velocities = _state(mbs, item, where)
+        read_gaps(mbs)
         cut.force_evaluated(t)
         force = cable_forces.cable_force(reference, displacements, velocities, positions, *joint_args, force_buffer)
         if contact is not None:
@@ -196,6 +202,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
         displacements, velocities = _state(mbs, item, where)
+        read_gaps(mbs)
         jacobian = cable_forces.cable_jacobian(reference, displacements, velocities, positions, *joint_args,
                                                float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer,
                                                kink[0], cut.active)
@@ -207,23 +214,28 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
 
     nodes = [n for it in items for n in it.nodes]
     functions = (force_function, jacobian_function)
-    mass = np.zeros((size, size))
+    mass = np.diag(np.repeat(np.concatenate([it.masses for it in items]), 2))
+    weights = np.zeros(size)
+    weights[1::2] = -np.concatenate([it.weights for it in items])  # Exudyn's y is the paper's z
+    matrices["forceVector"] = matrices.get("forceVector", 0.0) + weights
     if sparse_jacobian and contact is None and not linear:
         blocks = [_bending_blocks(spring)]
         if effects.slack and len(elements):
             blocks.append(_slack_blocks(elements, rest, axial_k, axial_c, kink, cut))
         if node_contact is not None:
             blocks.append((*node_contact.triplet_pattern(), node_contact.triplet_values))
-        functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions, where))
-        mass = _sparse(np.zeros((size, size)))
-    if linear and not effects.slack and contact is None and node_contact is None:
+        functions = (functions[0], _sparse_jacobian_function(blocks, reference, positions, where, read_gaps))
+        mass = _sparse(mass)
+    if not (effects.bending or effects.slack or contact is not None or node_contact is not None):
+        functions = (0, 0)  # masses and weights only
+    elif linear and not effects.slack and contact is None and node_contact is None:
         # Nothing left for Python per Newton iteration: no force function, and a Jacobian
         # function that returns an empty matrix, so that Exudyn adds the constant K and D
         # itself (without any Jacobian function it would differentiate them numerically).
         # Sparse triplets: dense (2N, 2N) matrices made a 2 x 61-node cable 8 times slower.
         matrices = {key: _sparse(value) if key != "forceVector" else value for key, value in matrices.items()}
         empty = _sparse(np.zeros((size, size)))
-        mass = _sparse(np.zeros((size, size)))
+        mass = _sparse(mass)
 
         def zero_jacobian(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
             return empty
@@ -277,10 +289,11 @@ def _state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
     return data.GetODE2Coordinates()[where[0]], data.GetODE2Coordinates_t()[where[0]]
 
 
-def _sparse_jacobian_function(blocks, reference, positions, where):
+def _sparse_jacobian_function(blocks, reference, positions, where, read_gaps):
     """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets in a fixed pattern:
     ``blocks`` lists ``(rows, columns, fill)`` per force, ``fill(positions, velocities, f_q, f_q_t,
-    out_values)`` writing the values; ``where`` as :func:`_state`."""
+    out_values)`` writing the values; ``where`` as :func:`_state`; ``read_gaps(mbs)`` refreshes a frozen
+    contact's state."""
     size = reference.size
     bounds = np.cumsum([0] + [rows.size for rows, _, _ in blocks])
     triplets = np.zeros((int(bounds[-1]), 3))
@@ -291,6 +304,7 @@ def _sparse_jacobian_function(blocks, reference, positions, where):
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001 - Exudyn's signature
         displacements, velocities = _state(mbs, item, where)
+        read_gaps(mbs)
         np.add(reference, displacements, out=positions)
         for (_, _, fill), out_values, first, last in zip(blocks, values, bounds[:-1], bounds[1:]):
             fill(positions, velocities, float(f_q), float(f_q_t), out_values)
@@ -316,14 +330,47 @@ def _pulley_arrays(counts: list[int], pulleys: list[Pulley] | None, per_cable: l
                        for name in ("center", "radius", "contact_stiffness", "contact_damping")])
 
 
-def _node_contact(counts: list[int], pulleys: list[Pulley] | None,
-                  contact_nodes: list[np.ndarray] | None) -> NodePulleyContact | None:
-    """The node rim contacts of the listed nodes with their cables' pulleys (None if none)."""
+def _node_contact(counts: list[int], pulleys: list[Pulley] | None, contact_nodes: list[np.ndarray] | None,
+                  frozen: bool) -> NodePulleyContact | None:
+    """The node rim contacts of the listed nodes with their cables' pulleys, frozen or smooth (None if none)."""
     arrays = _pulley_arrays(counts, pulleys, contact_nodes,
                             "node contact needs one pulley and one list of contact nodes per cable")
     if arrays is None:
         return None
+    if frozen:
+        return FrozenNodeContact(sum(counts), *arrays)
     return NodePulleyContact(sum(counts), *arrays, band=node_contact_module.CONTACT_ONSET_DEPTH)
+
+
+def _frozen_contact(mbs: exu.MainSystem, contact: FrozenNodeContact, reference: np.ndarray, positions: np.ndarray,
+                    where: list):
+    """Keep the frozen contact's gaps in a ``NodeGenericData`` (initialised at ``reference``, so restored by the
+    solver with a rejected step) and switch them in the system's PostNewton function, as Exudyn's contact
+    items do theirs (their step-size recommendation is off in every run: run.solver). Returns
+    ``read_gaps(mbs)``, which loads the gaps into ``contact`` (the force functions call it first)."""
+    contact.switch(reference, contact.gaps)  # the gaps d - r_p - r_n [m] at the start
+    data_node = mbs.AddNode(eii.NodeGenericData(initialCoordinates=contact.gaps.tolist(),
+                                                numberOfDataCoordinates=contact.gaps.size))
+    place = []
+
+    def read_gaps(mbs):
+        data = mbs.systemData
+        if not place:
+            index = np.asarray(data.GetNodeLTGData(data_node), dtype=np.int64)
+            place.append(slice(int(index[0]), int(index[0]) + index.size))
+        contact.gaps = data.GetDataCoordinates()[place[0]]
+
+    def post_newton(mbs, t):  # noqa: ARG001 - Exudyn's signature
+        data = mbs.systemData
+        read_gaps(mbs)
+        np.add(reference, data.GetODE2Coordinates()[where[0]], out=positions)
+        values = data.GetDataCoordinates()
+        error = contact.switch(positions, values[place[0]])
+        data.SetDataCoordinates(values)
+        return [error, -1.0]
+
+    mbs.SetPostNewtonUserFunction(post_newton)
+    return read_gaps
 
 
 def _segment_contact(counts: list[int], pulleys: list[Pulley] | None,

@@ -22,7 +22,6 @@ from cdpr_exu.core.errors import SceneError
 from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes, straight_cable_nodes
 from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.builder.platform import PlatformItems, add_platform, attach_cable
-from cdpr_exu.builder.pulley import add_pulley_contact, add_pulley_ground
 from cdpr_exu.builder.robot_3d import Model3D, build_model_3d
 from cdpr_exu.scenes.scene import Scene
 from cdpr_exu.physics.segment_contact import contact_segments
@@ -34,9 +33,8 @@ from cdpr_exu.space import PLANE, SPACE
 class Model:
     """An assembled Exudyn system of a planar scene, with the indices of its items.
 
-    Per cable: ``contacts`` its Exudyn contact objects (contact model "node"), ``contact_nodes``
-    and ``contact_elements`` the cable-local nodes and elements that carry a rim contact (the
-    smooth and segment ones live in ``cable_forces``). ``initial_paid_out`` (m,) [m]: lambda_i(0),
+    Per cable: ``contact_nodes`` and ``contact_elements`` the cable-local nodes and elements that carry a
+    rim contact (all contacts live in ``cable_forces``). ``initial_paid_out`` (m,) [m]: lambda_i(0),
     the unstrained cable between the pulley's hang point and the anchor. ``ropes``: the massless
     ropes (``effects.cable_mass`` off; ``cables`` is then empty); ``servos``: a servo winch's drums.
     """
@@ -48,7 +46,6 @@ class Model:
     platform: PlatformItems
     winches: list[WinchItems]
     cable_forces: CableForceItems | None
-    contacts: list[list[int]] = field(default_factory=list)
     contact_nodes: list[np.ndarray] = field(default_factory=list)
     initial_paid_out: np.ndarray | None = None
     ropes: list[RopeItems] = field(default_factory=list)
@@ -56,11 +53,12 @@ class Model:
     contact_elements: list[np.ndarray] = field(default_factory=list)
 
     def item_counts(self) -> dict[str, int]:
-        """How many Exudyn items each effect added."""
+        """How many Exudyn items each effect added; the cable nodes' masses (``mass_points``) and weights
+        (``gravity_loads``, with the platform's load) count the entries of the cables' generic object."""
         return {
             "mass_points": sum(len(c.nodes) for c in self.cables),
             "axial_spring_dampers": sum(len(c.springs) for c in self.cables),
-            "gravity_loads": sum(len(c.loads) for c in self.cables) + (self.platform.load is not None),
+            "gravity_loads": sum(np.count_nonzero(c.weights) for c in self.cables) + (self.platform.load is not None),
             "cable_force_objects": int(self.cable_forces is not None),
             "bending_joints": 0 if self.cable_forces is None else len(self.cable_forces.joints),
             "slack_elements": 0 if self.cable_forces is None else len(self.cable_forces.slack_elements),
@@ -178,7 +176,7 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
         return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
     contact = scene.contact_model
     on_segments = contact is not None and contact.on_segments
-    cables, winches, contacts, contact_nodes, paid_out, servos = [], [], [], [], [], []
+    cables, winches, contact_nodes, paid_out, servos = [], [], [], [], []
     contact_elements = []
     for i, (cable, exit_) in enumerate(zip(scene.cables, scene.exits)):
         nodes_xz = initial_nodes(scene, i)
@@ -195,23 +193,18 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
         contact_elements.append(contact_segments(candidates, cable.n_elements) if on_segments
                                 else np.zeros(0, dtype=np.int64))
         contact_nodes.append(np.zeros(0, dtype=int) if on_segments else candidates)
-        if contact is not None and contact.exudyn_items:
-            pulley_marker = add_pulley_ground(mbs, exit_)
-            contacts.append(add_pulley_contact(mbs, exit_, pulley_marker,
-                                               [items.markers[j] for j in candidates], nodes_xz[candidates]))
-        else:  # no contact, or its forces in the cables' generic object (add_cable_forces)
-            contacts.append([])
         paid_out.append(exit_.paid_out_length(cable.unstrained_length, nodes_xz[0]))
         cables.append(items)
     if sparse_jacobian is None:
         sparse_jacobian = sum(c.n_elements + 1 for c in scene.cables) > SPARSE_JACOBIAN_MIN_NODES
-    on_nodes = contact is not None and contact.smooth_nodes
+    on_nodes = contact is not None and not on_segments
     cable_forces = add_cable_forces(mbs, list(scene.cables), cables, effects, list(scene.exits),
                                     contact_elements if on_segments else None, sparse_jacobian=sparse_jacobian,
-                                    contact_nodes=contact_nodes if on_nodes else None)
+                                    contact_nodes=contact_nodes if on_nodes else None,
+                                    frozen_contact=on_nodes and contact.frozen_nodes)
     mbs.Assemble()
-    return Model(scene, system_container, mbs, cables, platform, winches, cable_forces,
-                 contacts, contact_nodes, np.asarray(paid_out), servos=servos, contact_elements=contact_elements)
+    return Model(scene, system_container, mbs, cables, platform, winches, cable_forces, contact_nodes,
+                 np.asarray(paid_out), servos=servos, contact_elements=contact_elements)
 
 
 #: Shortest rope segment kept between the fixed winch point and the pulley [m]; a
@@ -239,8 +232,8 @@ def _build_massless(scene: Scene, system_container, mbs, platform: PlatformItems
         ropes.append(rope)
         paid_out.append(length)
     mbs.Assemble()
-    return Model(scene, system_container, mbs, [], platform, winches, None, [[] for _ in ropes],
-                 [np.zeros(0, dtype=int) for _ in ropes], np.asarray(paid_out), ropes)
+    return Model(scene, system_container, mbs, [], platform, winches, None, [np.zeros(0, dtype=int) for _ in ropes],
+                 np.asarray(paid_out), ropes)
 
 
 #: The builder of each space's item family, by :class:`cdpr_exu.space.Space`.

@@ -4,8 +4,8 @@ The cable comes up from the winch along the vertical line ``x = c_x + s r_p`` (`
 hangs on the pulley's left, ``+1``: on its right), leaves that line at the *hang point*
 ``(c_x + s r_p, c_z)``, wraps over the top of the pulley and leaves the rim towards its anchor
 (:mod:`cdpr_exu.core.geometry`, "Pulley convention"). The rim pushes the cable's nodes out
-with a penalty (``contact_stiffness``, ``contact_damping``; :mod:`cdpr_exu.builder.pulley`,
-:mod:`cdpr_exu.physics.segment_contact`, :mod:`cdpr_exu.physics.node_contact`).
+with a penalty (``contact_stiffness``, ``contact_damping``; :mod:`cdpr_exu.physics.node_contact`,
+:mod:`cdpr_exu.physics.segment_contact`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Pulley rim contact on cable *segments* (the elements between nodes): numba kernels.
 
-Node contact (:mod:`cdpr_exu.builder.pulley`) lets a straight element span the wrap as a
+Node contact (:mod:`cdpr_exu.physics.node_contact`) lets a straight element span the wrap as a
 chord through the disc. Here the contact acts on the element itself: for a segment
 from node a to node b and a pulley of centre c and radius r,
 

@@ -71,6 +71,9 @@ class Result:
     cpu_time: float = 0.0
     steps: int = 0
     newton_iterations: int = 0
+    #: The solver's Jacobian updates and discontinuous iterations of the run (benchmarks; not saved).
+    jacobians: int = 0
+    discontinuous_iterations: int = 0
     status: str = "completed"
     failure_time: float | None = None
     winch_reservoir: np.ndarray | None = None

@@ -1,8 +1,8 @@
 """Where the pulley rim contact acts: one object per model (``Effects.pulley_contact_model``), so that no
 module branches on the name again.
 
-* ``"node"``: Exudyn's sphere contact items push each node in the disc back out
-  (:mod:`cdpr_exu.builder.pulley`), switched in Exudyn's discontinuous iterations;
+* ``"node"``: the law of Exudyn's sphere contact items pushes each node in the disc back out, its state
+  frozen within Newton's iteration and switched after it (:class:`cdpr_exu.physics.node_contact.FrozenNodeContact`);
 * ``"segment"``: each element's point closest to the centre, shared by its two nodes
   (:mod:`cdpr_exu.physics.segment_contact`): straight elements cannot cut the disc as chords;
 * ``"node_smooth"``: the node contact with a smooth onset (:mod:`cdpr_exu.physics.node_contact`).
@@ -16,11 +16,11 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class PulleyContactModel:
-    """What one pulley contact model needs: Exudyn's contact items on the nodes (``exudyn_items``; else the
-    forces live in the cables' numba object), on the segments (``on_segments``) or ``smooth_nodes``."""
+    """What one pulley contact model needs (its forces all live in the cables' numba object): the node contact
+    switched after Newton's iteration (``frozen_nodes``), on the segments (``on_segments``) or ``smooth_nodes``."""
 
     name: str
-    exudyn_items: bool
+    frozen_nodes: bool
     on_segments: bool
     smooth_nodes: bool
 
@@ -36,7 +36,7 @@ class PulleyContactModel:
 
 
 CONTACT_MODELS: dict[str, PulleyContactModel] = {
-    "node": PulleyContactModel("node", exudyn_items=True, on_segments=False, smooth_nodes=False),
-    "segment": PulleyContactModel("segment", exudyn_items=False, on_segments=True, smooth_nodes=False),
-    "node_smooth": PulleyContactModel("node_smooth", exudyn_items=False, on_segments=False, smooth_nodes=True),
+    "node": PulleyContactModel("node", frozen_nodes=True, on_segments=False, smooth_nodes=False),
+    "segment": PulleyContactModel("segment", frozen_nodes=False, on_segments=True, smooth_nodes=False),
+    "node_smooth": PulleyContactModel("node_smooth", frozen_nodes=False, on_segments=False, smooth_nodes=True),
 }

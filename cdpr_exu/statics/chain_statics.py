@@ -211,7 +211,7 @@ def _planar_robot(scene, slack, anchor_spring_factor, catenary) -> ChainRobot:
     if not effects.cable_mass or not effects.axial_elasticity:
         raise SceneError("chain statics needs effects.cable_mass and effects.axial_elasticity "
                          f"(the scene's preset is {shown(effects.preset)}); use the catenary statics instead")
-    if scene.contact_model is not None and not scene.contact_model.exudyn_items:  # the node contact, as Exudyn's items
+    if scene.contact_model is not None and not scene.contact_model.frozen_nodes:  # the node contact, Exudyn's law
         raise SceneError("chain statics models the node contact on pulleys only, got "
                          f"effects.pulley_contact_model = {shown(effects.pulley_contact_model)}")
     if anchor_spring_factor is not None:
