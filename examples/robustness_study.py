@@ -18,7 +18,11 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
 3. The spatial CoGiRo-class and IPAnema-class robots (``spatial-cogiro``, ``spatial-ipanema``) under the
    chain correction's three starts (:data:`controllers.base.STARTS`) and the catenary's, the closed loop,
    ILC and the model feed-forward, nominal and with the 10 % model error of ``spatial-cogiro-mismatch``:
-   ``results/robustness/spatial-cogiro/``, ``results/robustness/spatial-ipanema/``.
+   ``results/robustness/spatial-cogiro/``, ``results/robustness/spatial-ipanema/``; and their loops
+   (:data:`controllers.registry.SPATIAL_LOOP`: the closed loop's with the rotation, 6 x 6, the model
+   feed-forward's without, 3 x 3) linearised at 4 poses of each run, on both plants: ``margins.md`` and
+   ``margins.json`` in each folder, with the gains the margins would choose over both robots (``designed``:
+   reported, not the defaults).
 
 Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
 this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after
@@ -33,7 +37,7 @@ Run::
 from __future__ import annotations
 
 import argparse
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +47,7 @@ from cdpr_exu.scenes.scene import load_scene
 from cdpr_exu.studies.comparison import smooth_start
 from cdpr_exu.studies.robustness import ERRORS, ROBUSTNESS_FILES, error_grid, perturbed, run_robustness
 from controllers import loop_design
+from controllers.registry import SPATIAL_LOOP
 
 OUT = Path(__file__).resolve().parents[1] / "results" / "robustness"
 
@@ -72,6 +77,16 @@ SPATIAL_SCENES = ("spatial-cogiro", "spatial-ipanema")
 #: Poses the loop is linearised at: 8 over one turn of the circle, after the 1 s ramp.
 POSES = 8
 
+#: The spatial loops: controller -> whether it feeds the rotation back (:data:`controllers.registry.SPATIAL_LOOP`).
+SPATIAL_LOOPS = {"closed_loop_tension_aware": SPATIAL_LOOP["rotation"], "closed_loop_model_feed_forward": False}
+
+#: Poses a spatial loop is linearised at: evenly over the run after the trajectory's ramp.
+SPATIAL_POSES = 4
+
+#: The spatial gains the design chooses from (k_p, k_i [1/s], f_c [Hz]), around SPATIAL_LOOP's and below.
+SPATIAL_CANDIDATES = [loop_design.LoopGains(p, i, c) for p in (0.1, 0.2, 0.3, 0.5) for i in (0.0, 1.0, 2.5, 5.0)
+                      for c in (0.5, 1.0, 1.5, 2.0)]
+
 #: The grid: mass x density, then stiffness and exit position one at a time
 #: (:data:`~cdpr_exu.studies.robustness.ERRORS`).
 GRID = [*error_grid(), *error_grid((0.0,), (0.0,), cable_stiffness=(-0.2, 0.2)),
@@ -82,14 +97,16 @@ LABELS = {"platform_mass": ("mass", "{:+.0%}"), "cable_density": ("density", "{:
           "cable_stiffness": ("stiffness", "{:+.0%}"), "exit_offset": ("exits [mm]", "{:+.0f}")}
 
 
-def margins_rows(cases, grid, gains: dict, rows, delay: float) -> list[dict]:
-    """Per gains and plant: the worst margins over the poses, and what the real run did."""
+def margins_rows(cases, grid, loops: dict, rows, delay: float) -> list[dict]:
+    """Per loop (name -> (controller, gains, measured coordinates)) and plant: the worst margins over the poses,
+    and what the real run did."""
     runs = {(*(r[e] for e in ERRORS), r["controller"]): r for r in rows}
     table = []
-    for (name, chosen), (index, point) in ((g, p) for g in gains.items() for p in enumerate(grid)):
-        margins = loop_design.worst([loop_design.loop_margins(robot, jacobian, chosen, delay, response=response)
+    for (name, (label, chosen, size)), (index, point) in ((g, p) for g in loops.items() for p in enumerate(grid)):
+        margins = loop_design.worst([loop_design.loop_margins(replace(robot, outputs=size), jacobian[:, :size],
+                                                              chosen, delay, response=response[:, :size, :size])
                                      for i, _, robot, jacobian, response in cases if i == index])
-        label = "closed_loop_tension_aware" + ("" if name == "designed" else f"_{name}")
+        point = {**dict.fromkeys(ERRORS, 0.0), **point}
         run = runs.get((*(point[e] for e in ERRORS), label), {})
         table.append({**{e: point[e] for e in ERRORS}, "gains": name, **asdict(chosen), **asdict(margins),
                       "run": ("completed" if run.get("completed") else f"failed at {run.get('failure_time_s') or 0.0:.1f} s"
@@ -99,14 +116,14 @@ def margins_rows(cases, grid, gains: dict, rows, delay: float) -> list[dict]:
     return table
 
 
-def margins_markdown(table) -> str:
-    lines = ["| " + " | ".join(label for label, _ in LABELS.values()) + " | gains (k_p, k_i [1/s], f_c [Hz]) | "
+def margins_markdown(table, labels=LABELS) -> str:
+    lines = ["| " + " | ".join(label for label, _ in labels.values()) + " | gains (k_p, k_i [1/s], f_c [Hz]) | "
              "gain margin [dB] | phase margin [deg] | disk margin | sensitivity peak | min pole damping | linear model "
-             "| run | max error [mm] | vs ideal IK |", "|---" * (len(LABELS) + 10) + "|"]
+             "| run | max error [mm] | vs ideal IK |", "|---" * (len(labels) + 10) + "|"]
     for r in table:
         error, ratio = r["max_position_error_m"], r["max_error_vs_ideal_ik"]
         plant = " | ".join(form.format(r[e] * (1000.0 if e == "exit_offset" else 1.0))
-                           for e, (_, form) in LABELS.items())
+                           for e, (_, form) in labels.items())
         lines.append(f"| {plant} | {r['gains']} ({r['proportional_gain']:g}, "
                      f"{r['integral_gain']:g}, {r['cutoff']:g}) | {r['gain_margin_db']:.1f} | {r['phase_margin_deg']:.1f} | "
                      f"{r['disk_margin']:.2f} | {r['sensitivity_peak']:.2f} | {r['min_damping']:.3f} | "
@@ -134,7 +151,8 @@ def main() -> None:
     if designed != loop_design.DESIGNED:
         raise SystemExit(f"the margins now pick {designed}, not the defaults {loop_design.DESIGNED}: update "
                          "controllers.loop_design.DESIGNED (and the closed-loop golden cases) first")
-    gains = {"previous": loop_design.PREVIOUS, "designed": designed}
+    gains = {"previous": ("closed_loop_tension_aware_previous", loop_design.PREVIOUS, 2),
+             "designed": ("closed_loop_tension_aware", designed, 2)}
     rows = run_robustness(model, PLANAR, grid, OUT / "planar", workers=args.workers)
     table = margins_rows(cases, grid, gains, rows, delay)
     write_summary(OUT / "planar", {"scene": model.name, "poses_per_plant": POSES, "delay_s": delay,
@@ -145,11 +163,40 @@ def main() -> None:
     print((OUT / "planar" / ROBUSTNESS_FILES["table"]).read_text())
     print(margins_markdown(table))
     if not args.skip_spatial:
-        grid = [{"platform_mass": 0.0, "cable_density": 0.0}, {"platform_mass": 0.1, "cable_density": -0.1}]
-        for name in SPATIAL_SCENES:
-            run_robustness(load_scene(name), SPATIAL, grid, OUT / name, workers=args.workers)
-            print((OUT / name / ROBUSTNESS_FILES["table"]).read_text())
+        spatial_study(args.workers)
     print(f"written to {OUT}/")
+
+
+def spatial_study(workers) -> None:
+    """The spatial robots' runs (item 3) and their loops' margins, the gains designed over both robots."""
+    grid = [{"platform_mass": 0.0, "cable_density": 0.0}, {"platform_mass": 0.1, "cable_density": -0.1}]
+    studies = {}
+    for name in SPATIAL_SCENES:
+        scene = load_scene(name)
+        rows = run_robustness(scene, SPATIAL, grid, OUT / name, workers=workers)
+        print((OUT / name / ROBUSTNESS_FILES["table"]).read_text())
+        ramp, end = scene.trajectory.ramp_time, scene.solver.end_time
+        times = ramp + (end - ramp) * (np.arange(SPATIAL_POSES) + 0.5) / SPATIAL_POSES
+        studies[name] = (scene, rows, times, loop_design.loop_cases(scene, [perturbed(scene, **p) for p in grid], times,
+                                                                    rotation=True))
+    delays = {scene.solver.step_size for scene, *_ in studies.values()}
+    frequency = max(scene.trajectory.angular_rate / (2 * np.pi) for scene, *_ in studies.values())
+    designed, _ = loop_design.design_gains([case for *_, cases in studies.values() for case in cases], max(delays),
+                                           frequency, candidates=SPATIAL_CANDIDATES)
+    default = loop_design.LoopGains(*(SPATIAL_LOOP[k] for k in ("proportional_gain", "integral_gain", "cutoff")))
+    for name, (scene, rows, times, cases) in studies.items():
+        loops = {**{label: (label, default, 6 if rotation else 3) for label, rotation in SPATIAL_LOOPS.items()},
+                 "designed": ("designed", designed, 6)}
+        table = margins_rows(cases, grid, loops, rows, scene.solver.step_size)
+        write_summary(OUT / name, {"scene": name, "poses_s": times.tolist(), "delay_s": scene.solver.step_size,
+                                   "loops": {label: {**SPATIAL_LOOP, "rotation": rotation}
+                                             for label, rotation in SPATIAL_LOOPS.items()},
+                                   "design": "gain margin >= 6 dB and phase margin >= 30 deg on both robots, both plants "
+                                             "and every pose, rotation fed back; the smallest worst sensitivity at the "
+                                             "circles' frequency; reported, not the defaults",
+                                   "rows": table}, name="margins.json")
+        (OUT / name / "margins.md").write_text(margins_markdown(table, {e: LABELS[e] for e in grid[0]}))
+        print(margins_markdown(table, {e: LABELS[e] for e in grid[0]}))
 
 
 if __name__ == "__main__":  # required: the worker processes are spawned and re-import this file
