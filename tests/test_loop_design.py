@@ -156,7 +156,7 @@ def test_a_spatial_loop_is_checked_before_the_run_with_its_rotation():
     right half plane: refused at reset, naming them (their real run, ClosedLoopController around ideal IK,
     stops at 1.97 s: Exudyn's step reaches its minimum, measured; 4 min of CPU, too long for the suite, and
     registry.SPATIAL_LOOP's comment). The default spatial loop keeps >= 6 dB and >= 30 deg on the 6 x 6
-    loop at the run's 4 poses (13.9 dB and 77.1 deg worst over the study's poses and plants) and stays on."""
+    loop at the run's 4 poses (the study's margins tables give it per plant) and stays on."""
     from controllers.registry import SPATIAL_LOOP
 
     scene = load_scene("spatial-ipanema")
