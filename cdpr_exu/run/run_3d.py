@@ -6,8 +6,11 @@ swivel pulleys on the lumped robot's own: :func:`cdpr_exu.run.settle.start_at_re
 **The winch at a point exit** pays the cable out at a fixed point (over a swivel pulley the winch end
 moves along the pulley's axis instead). The lumped cable keeps its n elements and follows its paid-out
 length L(t): every element's length, stiffness and damping, the node masses and the bending scale with
-L / n before every step. Its statics are the elastic catenary's of length L; it leaves out the flow of
-material through the exit, an axial motion whose inertia is small beside the platform's.
+L / n before every step, the masses in the weight and in the inertia: Exudyn keeps a mass matrix it counts
+as constant (mass points only: a point-mass platform's robot), so the winches have the solver compute it again
+when they changed a mass (a rigid platform's is computed every step anyway). Its statics are the
+elastic catenary's of length L; it leaves out the flow of material through the exit, an axial motion whose
+inertia is small beside the platform's.
 
 Units SI; z up, gravity along -z; poses ``(x, y, z, theta)`` with ``theta`` the platform's rotation vector.
 """
@@ -55,6 +58,7 @@ class _SpatialWinches:
         mbs, items = self.mbs, self.items
         set_object = mbs.SetObjectParameter
         self.rate = np.array(rates, dtype=float)
+        masses_changed = False
         for i, (cable, exit_, chain, length, rate) in enumerate(zip(self.scene.cables, self.scene.exits, items.chains,
                                                                     lengths, rates)):
             if exit_.wraps:  # the winch end moves along the swivel axis: up when paying out
@@ -84,11 +88,14 @@ class _SpatialWinches:
             masses = (items.node_masses[i] * (float(length) / items.unstrained_lengths[i])).tolist()
             for body, mass in zip(chain.masses, masses):
                 set_object(body, "mass", mass)
+            masses_changed = True
             if chain.bending_stiffness is not None:
                 chain.bending_stiffness[:] = items.bending_stiffnesses[i] * items.unstrained_lengths[i] / self.n / element
             if chain.bending_damping is not None:
                 chain.bending_damping[:] = items.bending_dampings[i] * items.unstrained_lengths[i] / self.n / element
             self.applied[i] = length
+        if masses_changed:  # the solver reuses the mass matrix it assembled at the start (reuseConstantMassMatrix)
+            mbs.sys["dynamicSolver"].ComputeMassMatrix(mbs)
 
 
 #: A run stops when the platform has turned farther than this from the reference's orientation [deg]:
