@@ -83,11 +83,8 @@ class _SpatialWinches:
                 set_object(spring, "referenceLength", element)
                 set_object(spring, "stiffness", stiffness)
                 set_object(spring, "damping", damping)
-            # rho l_e per node, as plain floats at once (Exudyn's setters take no arrays: one call per item);
-            # each node's weight follows its mass (a LoadMassProportional, builder.chain_3d)
-            masses = (items.node_masses[i] * (float(length) / items.unstrained_lengths[i])).tolist()
-            for body, mass in zip(chain.masses, masses):
-                set_object(body, "mass", mass)
+            # rho l_e per node: the mass matrix of the chains' generic object, and their weight
+            np.multiply(items.node_masses[i], float(length) / items.unstrained_lengths[i], out=chain.node_mass)
             masses_changed = True
             if chain.bending_stiffness is not None:
                 chain.bending_stiffness[:] = items.bending_stiffnesses[i] * items.unstrained_lengths[i] / self.n / element
@@ -95,6 +92,8 @@ class _SpatialWinches:
                 chain.bending_damping[:] = items.bending_dampings[i] * items.unstrained_lengths[i] / self.n / element
             self.applied[i] = length
         if masses_changed:  # the solver reuses the mass matrix it assembled at the start (reuseConstantMassMatrix)
+            for forces in {chain.forces for chain in items.chains}:
+                forces.masses_changed(mbs)
             mbs.sys["dynamicSolver"].ComputeMassMatrix(mbs)
 
 
