@@ -126,6 +126,18 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     return items
 
 
+def generic_state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
+    """The displacements q and velocities q_t [m, m/s] of the ``ObjectGenericODE2`` ``item``, read from the
+    system's state vectors (``systemData``), not converted from the lists Exudyn hands its user functions;
+    ``where`` caches the object's place in them (a slice where it is one block), found at the first call."""
+    data = mbs.systemData
+    if not where:
+        index = np.asarray(data.GetObjectLTGODE2(item), dtype=np.int64)
+        block = np.array_equal(index, np.arange(index[0], index[0] + index.size))
+        where.append(slice(int(index[0]), int(index[0]) + index.size) if block else index)
+    return data.GetODE2Coordinates()[where[0]], data.GetODE2Coordinates_t()[where[0]]
+
+
 class ChainForces:
     """The one ``ObjectGenericODE2`` (index ``generic``) over the nodes of ``chains``: masses, weight,
     bending and tension-only elements, the chains' arrays views of its own."""
@@ -173,14 +185,10 @@ class ChainForces:
         cut = CutSlopes()  # damper-cut elements keep their taut slopes in a step's first iterations
         where = []
 
-        def state(mbs_, item):  # q, q_t from the system's state vectors, not from the lists Exudyn hands over
-            data = mbs_.systemData
-            if not where:
-                index = np.asarray(data.GetObjectLTGODE2(item), dtype=np.int64)
-                block = np.array_equal(index, np.arange(index[0], index[0] + index.size))
-                where.append(slice(int(index[0]), int(index[0]) + index.size) if block else index)
-            np.add(reference, data.GetODE2Coordinates()[where[0]], out=current)
-            return data.GetODE2Coordinates_t()[where[0]]
+        def state(mbs_, item):
+            displacements, velocities = generic_state(mbs_, item, where)
+            np.add(reference, displacements, out=current)
+            return velocities
 
         def force_function(mbs_, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
             velocities = state(mbs_, item)
