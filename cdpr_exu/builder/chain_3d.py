@@ -3,7 +3,7 @@
 :func:`add_spatial_chain` adds one chain of ``NodePoint`` items, its axial elements either Exudyn's
 ``ObjectConnectorSpringDamper`` (k = E A / l0, c = d_n A / l0) or, with ``tension_only``, the
 tension-only elements of :mod:`cdpr_exu.physics.axial_3d` (Exudyn's push when compressed).
-:func:`add_chain_forces` gives chains, one or all of a robot's, one ``ObjectGenericODE2``: the nodes'
+:class:`ChainForces` gives chains, one or all of a robot's, one ``ObjectGenericODE2``: the nodes'
 masses (its mass matrix), their weight along -z, the forces of :mod:`cdpr_exu.physics.bending_3d`
 (bending springs, and dampers when ``bending_damping > 0``) and the tension-only elements, with one
 sparse triplet Jacobian: one force call per Newton iteration for the whole robot. Units SI; z up.
@@ -32,7 +32,7 @@ class SpatialChainItems:
     elements) and ``holds`` (the three ``ObjectConnectorCoordinate`` holding the first node, whose
     ``offset`` moves it: a winch on a swivel axis) are item indices; ``reference`` (3N,) [m] the
     nodes' reference positions; ``joints`` (J, 3) the bending joints. ``forces`` is the
-    :class:`ChainForces` that carries the chain (None before :func:`add_chain_forces`), ``generic``
+    :class:`ChainForces` that carries the chain (None before it has one), ``generic``
     its ``ObjectGenericODE2``, ``bending`` the same when the chain bends. ``node_mass`` (N,) [kg],
     ``bending_stiffness`` and ``bending_damping`` (J,) [N m/rad, N m s/rad], and with tension-only
     elements ``axial_elements`` (n, 2), ``axial_rest_length``, ``axial_stiffness``,
@@ -92,7 +92,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
     tension_only : bool
         Tension-only axial elements in the generic object instead of Exudyn's spring-dampers.
     forces : bool
-        Give the chain its own :func:`add_chain_forces` (False: the caller gives several chains one).
+        Give the chain its own :class:`ChainForces` (False: the caller gives several chains one).
     """
     positions = np.asarray(positions, dtype=float)
     nodes = [mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point))) for point in positions]
@@ -122,7 +122,7 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         items.axial_damping = np.full(len(rest), float(axial_damping))
         items.axial_rest_rate = np.zeros(len(rest))
     if forces:
-        add_chain_forces(mbs, [items], gravity)
+        ChainForces(mbs, [items], gravity)
     return items
 
 
@@ -139,37 +139,35 @@ def generic_state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
 
 
 class ChainForces:
-    """The one ``ObjectGenericODE2`` (index ``generic``) over the nodes of ``chains``: masses, weight,
-    bending and tension-only elements, the chains' arrays views of its own."""
+    """One ``ObjectGenericODE2`` (index ``generic``) for ``chains`` (:class:`SpatialChainItems`, all tension-only
+    or none, all bending or none): their masses (its mass matrix), weight (``gravity`` [m/s^2] along -z),
+    bending and tension-only elements; the chains' arrays become views of its own."""
 
     def __init__(self, mbs, chains: list, gravity: float):
         offsets = np.cumsum([0] + [len(chain.nodes) for chain in chains])
         nodes = [node for chain in chains for node in chain.nodes]
         size = 3 * len(nodes)
 
-        def joined(name, width=None):  # the chains' arrays end to end (node indices shifted), each a view
-            parts = [(getattr(chain, name), offset) for chain, offset in zip(chains, offsets) if getattr(chain, name) is not None]
-            if not parts:
-                return np.zeros((0, width), dtype=np.int64) if width else None
-            if width:
-                return np.concatenate([part + offset for part, offset in parts]).astype(np.int64)
-            whole = np.concatenate([part for part, _ in parts])
-            start = 0
-            for chain in chains:
-                part = getattr(chain, name)
-                if part is not None:
-                    setattr(chain, name, whole[start:start + len(part)])
-                    start += len(part)
+        def joined(name):  # the chains' arrays end to end, each chain's now a view of the whole (None: none)
+            parts = [getattr(chain, name) for chain in chains]
+            if parts[0] is None:
+                return None
+            whole = np.concatenate(parts)
+            for chain, start, part in zip(chains, np.cumsum([0] + [len(p) for p in parts]), parts):
+                setattr(chain, name, whole[start:start + len(part)])
             return whole
+
+        def shifted(name):  # the chains' node pairs or triples, numbered in the whole
+            return np.concatenate([getattr(chain, name) + offset for chain, offset in zip(chains, offsets)])
 
         self.masses = joined("node_mass")
         stiffness, damping = joined("bending_stiffness"), joined("bending_damping")
-        joints = joined("joints", 3) if stiffness is not None else np.zeros((0, 3), dtype=np.int64)
+        joints = shifted("joints") if stiffness is not None else np.zeros((0, 3), dtype=np.int64)
         stiffness = np.zeros(0) if stiffness is None else stiffness
         rest, axial_k, axial_c, rest_rate = (joined(name) for name in (
             "axial_rest_length", "axial_stiffness", "axial_damping", "axial_rest_rate"))
-        elements = joined("axial_elements", 2)
         tension_only = rest is not None
+        elements = shifted("axial_elements") if tension_only else np.zeros((0, 2), dtype=np.int64)
         reference = np.concatenate([chain.reference for chain in chains])
         bend = float(bending_3d.ISOTROPIC_BEND)
         bending_rows, bending_columns = block_pattern(joints, 3)
@@ -235,13 +233,6 @@ class ChainForces:
         self.mass_matrix.SetWithSparseMatrix(self.mass_triplets, numberOfRows=self.size, numberOfColumns=self.size,
                                              useDenseMatrix=False)
         mbs.SetObjectParameter(self.generic, "massMatrix", self.mass_matrix)
-
-
-def add_chain_forces(mbs: exu.MainSystem, chains: list, gravity: float = 9.81) -> ChainForces:
-    """One ``ObjectGenericODE2`` for ``chains`` (:class:`SpatialChainItems`, all tension-only or none, all
-    with bending dampers or none): their masses, weight (``gravity`` [m/s^2] along -z), bending and
-    tension-only elements."""
-    return ChainForces(mbs, chains, gravity)
 
 
 def chain_energy(items: SpatialChainItems, node_masses: np.ndarray, q: np.ndarray, v: np.ndarray,
