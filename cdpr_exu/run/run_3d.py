@@ -7,8 +7,8 @@ swivel pulleys on the lumped robot's own: :func:`cdpr_exu.run.settle.start_at_re
 moves along the pulley's axis instead). The lumped cable keeps its n elements and follows its paid-out
 length L(t): every element's length, stiffness and damping, the node masses and the bending scale with
 L / n before every step, the masses in the weight and in the inertia: Exudyn keeps a mass matrix it counts
-as constant (mass points only: a point-mass platform's robot), so the winches have the solver compute it again
-when they changed a mass (a rigid platform's is computed every step anyway). Its statics are the
+as constant (a robot without a rigid body: a point-mass platform's), so the winches have the solver compute it
+again when they changed a mass (a rigid platform's is computed every step anyway). Its statics are the
 elastic catenary's of length L; it leaves out the flow of material through the exit, an axial motion whose
 inertia is small beside the platform's.
 
