@@ -208,15 +208,16 @@ def test_a_tension_only_chain_has_no_springs_one_generic_object_and_live_paramet
     np.testing.assert_array_equal(items.axial_stiffness, [1e4, 1e4])
     np.testing.assert_array_equal(items.axial_damping, [2.0, 2.0])
     mbs.Assemble()
-    force_function = items.user_functions[0]
+    force_function = items.forces.user_functions[0]
     q = np.zeros(9)
-    assert np.all(force_function(mbs, 0.0, items.generic, q, q) == 0.0)  # at the rest length
+    weight = np.tile([0.0, 0.0, -0.1 * 9.81], 3)  # the node masses' weight is the generic object's too
+    np.testing.assert_array_equal(force_function(mbs, 0.0, items.generic, q, q), weight)  # at the rest length
     items.axial_rest_length[:] *= 0.9  # reeled in by 5 cm per element, in place
-    force = force_function(mbs, 0.0, items.generic, q, q)
+    force = np.array(force_function(mbs, 0.0, items.generic, q, q))
     np.testing.assert_allclose(force[[0, 3, 6]], [500.0, 0.0, -500.0], rtol=1e-12)  # 1e4 N/m x 0.05 m
-    # without the option: Exudyn's spring-dampers and no generic object
+    # without the option: Exudyn's spring-dampers, the generic object carries the masses and their weight
     plain = add_spatial_chain(exu.SystemContainer().AddSystem(), positions, np.full(3, 0.1), 1e4, 2.0, 0.0)
-    assert len(plain.springs) == 2 and plain.generic is None and not plain.tension_only
+    assert len(plain.springs) == 2 and plain.generic is not None and not plain.tension_only
 
 
 def test_exudyns_system_jacobian_with_tension_only_elements_is_the_one_with_its_own_spring_dampers():
@@ -344,7 +345,12 @@ def _pay_out(tension_only, payout=0.2, duration=0.5, end_time=0.6, step=1e-3, da
             record["strain"] = min(record["strain"], float((lengths / current_rest - 1.0).min()))
             if tension_only:
                 # walk from the platform end: node j's force is T_{j-1} (-u_{j-1}) + T_j u_j
-                nodal = chain_items.user_functions[0](mbs_, t, chain_items.generic, q, v).reshape(-1, 3).copy()
+                # (the robot's one generic object: this chain's rows, its nodes' weight taken off)
+                first = sum(len(other.nodes) for other in items.chains[:cable])
+                generic = np.reshape(chain_items.forces.user_functions[0](mbs_, t, chain_items.generic, None, None),
+                                     (-1, 3))
+                nodal = generic[first:first + len(chain_items.nodes)].copy()
+                nodal[:, 2] += chain_items.node_mass * platform.gravity
                 directions = np.diff(points, axis=0) / lengths[:, None]
                 tension = 0.0
                 for e in range(len(lengths) - 1, -1, -1):

@@ -536,3 +536,19 @@ def test_an_extreme_spatial_run_is_refused_fails_with_a_cause_or_completes_clean
     assert summary["elements_pushed"] == pushed
     assert not pushed or any("elements pushed" in w for w in summary["warnings"])
     assert result.pose[-1, 2] <= summary["highest_exit_z_m"] and not summary["platform_above_exits"]
+
+
+def test_the_monitor_stops_a_turn_past_90_degrees_at_a_sample_and_a_rise_above_the_exits_at_any_step():
+    from cdpr_exu.core.geometry import rotation_from_vector
+    from cdpr_exu.run.run_3d import _SpatialMonitor
+
+    scene = load_scene("spatial-cogiro")
+    monitor = _SpatialMonitor(scene)
+    pose = np.asarray(scene.trajectory.pose(1.0))
+    turned = {angle: rotation_from_vector(pose[3:] + np.radians([0.0, 0.0, angle])) for angle in (89.0, 91.0)}
+    assert monitor.problem(1.0, pose[:3], turned[89.0]) is None
+    assert "turned 91 degrees away" in monitor.problem(1.0, pose[:3], turned[91.0])
+    assert monitor.problem(1.0, pose[:3], None) is None  # between samples the turn is not checked ...
+    above = pose[:3] + [0.0, 0.0, 10.0]
+    assert "rose above its highest exit at t = 1.0000 s" in monitor.problem(1.0, above)  # ... the position is
+    assert "no longer finite" in monitor.problem(1.0, pose[:3] * np.nan)

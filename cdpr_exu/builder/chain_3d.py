@@ -1,11 +1,12 @@
 """A spatial cable in Exudyn: 3-D mass points, axial spring-dampers and exact-angle bending.
 
-:func:`add_spatial_chain` adds one chain of ``NodePoint`` + ``ObjectMassPoint`` items joined by
-Exudyn's ``ObjectConnectorSpringDamper`` (k = E A / l0, c = d_n A / l0), gravity along -z, and
-one ``ObjectGenericODE2`` with a sparse triplet Jacobian for the forces of
-:mod:`cdpr_exu.physics.bending_3d` (bending springs, and dampers when ``bending_damping > 0``)
-and, with ``tension_only``, the tension-only elements of :mod:`cdpr_exu.physics.axial_3d` in
-place of Exudyn's spring-dampers (which push when compressed). Units SI; z up.
+:func:`add_spatial_chain` adds one chain of ``NodePoint`` items, its axial elements either Exudyn's
+``ObjectConnectorSpringDamper`` (k = E A / l0, c = d_n A / l0) or, with ``tension_only``, the
+tension-only elements of :mod:`cdpr_exu.physics.axial_3d` (Exudyn's push when compressed).
+:class:`ChainForces` gives chains, one or all of a robot's, one ``ObjectGenericODE2``: the nodes'
+masses (its mass matrix), their weight along -z, the forces of :mod:`cdpr_exu.physics.bending_3d`
+(bending springs, and dampers when ``bending_damping > 0``) and the tension-only elements, with one
+sparse triplet Jacobian: one force call per Newton iteration for the whole robot. Units SI; z up.
 """
 
 from __future__ import annotations
@@ -27,47 +28,53 @@ from cdpr_exu.physics.axial import CutSlopes, cable_elements
 class SpatialChainItems:
     """Item indices of a spatial chain.
 
-    ``nodes``, ``masses``, ``markers``, ``springs`` (Exudyn's axial spring-dampers), ``loads``
-    (gravity) and ``holds`` (the three ``ObjectConnectorCoordinate`` holding the first node, whose
+    ``nodes``, ``markers``, ``springs`` (Exudyn's axial spring-dampers, none with tension-only
+    elements) and ``holds`` (the three ``ObjectConnectorCoordinate`` holding the first node, whose
     ``offset`` moves it: a winch on a swivel axis) are item indices; ``reference`` (3N,) [m] the
-    nodes' reference positions; ``joints`` (J, 3) the bending joints. ``generic`` is the chain's
-    ``ObjectGenericODE2`` (None when it has none), ``bending`` the same when it bends;
-    ``user_functions`` keeps its Python callables alive. ``bending_stiffness`` and
-    ``bending_damping`` (J,) [N m/rad, N m s/rad], and with tension-only elements
-    ``axial_elements`` (n, 2), ``axial_rest_length``, ``axial_stiffness``, ``axial_damping`` and
-    ``axial_rest_rate`` (n,) [m, N/m, N s/m, m/s], are the very arrays the force functions read
-    (None when absent): a winch paying out cable changes them in place between steps.
+    nodes' reference positions; ``joints`` (J, 3) the bending joints. ``forces`` is the
+    :class:`ChainForces` that carries the chain (None before it has one), ``generic``
+    its ``ObjectGenericODE2``, ``bending`` the same when the chain bends. ``node_mass`` (N,) [kg],
+    ``bending_stiffness`` and ``bending_damping`` (J,) [N m/rad, N m s/rad], and with tension-only
+    elements ``axial_elements`` (n, 2), ``axial_rest_length``, ``axial_stiffness``,
+    ``axial_damping`` and ``axial_rest_rate`` (n,) [m, N/m, N s/m, m/s], are views of the very
+    arrays the force functions read (None when absent): a winch paying out cable changes them in
+    place between steps (the masses then reach Exudyn by :meth:`ChainForces.masses_changed`).
     """
 
     nodes: list
-    masses: list
     markers: list
     springs: list
-    bending: int | None
     reference: np.ndarray
     joints: np.ndarray
-    user_functions: tuple = field(default_factory=tuple)
-    loads: list = field(default_factory=list)
+    node_mass: np.ndarray
+    holds: list = field(default_factory=list)
     bending_stiffness: np.ndarray | None = None
-    generic: int | None = None
+    bending_damping: np.ndarray | None = None
     axial_elements: np.ndarray | None = None
     axial_rest_length: np.ndarray | None = None
     axial_stiffness: np.ndarray | None = None
     axial_damping: np.ndarray | None = None
     axial_rest_rate: np.ndarray | None = None
-    holds: list = field(default_factory=list)
-    bending_damping: np.ndarray | None = None
+    forces: ChainForces | None = None
 
     @property
     def tension_only(self) -> bool:
         """The axial elements are tension-only (in ``generic``), not Exudyn spring-dampers."""
         return self.axial_rest_length is not None
 
+    @property
+    def generic(self) -> int | None:
+        return None if self.forces is None else self.forces.generic
+
+    @property
+    def bending(self) -> int | None:
+        return self.generic if self.bending_stiffness is not None else None
+
 
 def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: np.ndarray, axial_stiffness: float,
                       axial_damping: float, bending_stiffness: float, gravity: float = 9.81,
                       hold_first: bool = True, tension_only: bool = False, bending_damping: float = 0.0,
-                      isotropic_bend: float | None = None) -> SpatialChainItems:
+                      forces: bool = True) -> SpatialChainItems:
     """Add a chain through ``positions`` (N, 3) [m] (unstrained, at rest) to ``mbs``.
 
     Parameters
@@ -84,25 +91,17 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
         Hold the first node in place.
     tension_only : bool
         Tension-only axial elements in the generic object instead of Exudyn's spring-dampers.
-    isotropic_bend : float or None
-        The dampers' eps (None: :data:`cdpr_exu.physics.bending_3d.ISOTROPIC_BEND`).
+    forces : bool
+        Give the chain its own :class:`ChainForces` (False: the caller gives several chains one).
     """
     positions = np.asarray(positions, dtype=float)
-    nodes, masses, markers, springs, loads, holds = [], [], [], [], [], []
-    for point, mass in zip(positions, node_masses):
-        node = mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point)))
-        masses.append(mbs.AddObject(eii.ObjectMassPoint(mass=float(mass), nodeNumber=node)))
-        marker = mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node))
-        if gravity:  # the node's weight follows its mass as a winch pays the cable out (run_3d)
-            loads.append(mbs.AddLoad(eii.LoadMassProportional(
-                markerNumber=mbs.AddMarker(eii.MarkerBodyMass(bodyNumber=masses[-1])),
-                loadVector=[0.0, 0.0, -gravity])))
-        nodes.append(node)
-        markers.append(marker)
-    for i in range(0 if tension_only else len(nodes) - 1):
-        springs.append(mbs.AddObject(eii.ObjectConnectorSpringDamper(
-            markerNumbers=[markers[i], markers[i + 1]], stiffness=axial_stiffness, damping=axial_damping,
-            referenceLength=float(np.linalg.norm(positions[i + 1] - positions[i])))))
+    nodes = [mbs.AddNode(eii.NodePoint(referenceCoordinates=list(point))) for point in positions]
+    markers = [mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)) for node in nodes]
+    rest = np.linalg.norm(np.diff(positions, axis=0), axis=1)
+    springs = [] if tension_only else [mbs.AddObject(eii.ObjectConnectorSpringDamper(
+        markerNumbers=[markers[i], markers[i + 1]], stiffness=axial_stiffness, damping=axial_damping,
+        referenceLength=float(rest[i]))) for i in range(len(nodes) - 1)]
+    holds = []
     if hold_first:
         ground = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
         ground_marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
@@ -110,74 +109,130 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
             held = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=nodes[0], coordinate=coordinate))
             holds.append(mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_marker, held])))
     joints = cable_joints([len(nodes)])
-    reference = positions.ravel().copy()
     bending = bending_stiffness > 0.0 and len(joints) > 0
-    if not bending and not tension_only:
-        return SpatialChainItems(nodes, masses, markers, springs, None, reference, joints, loads=loads, holds=holds)
-    bending_joints = joints if bending else np.zeros((0, 3), dtype=np.int64)
-    stiffness = np.full(len(bending_joints), float(bending_stiffness))
-    damped = bending and bending_damping > 0.0
-    damping = np.full(len(bending_joints), float(bending_damping)) if damped else None
-    bend = float(bending_3d.ISOTROPIC_BEND if isotropic_bend is None else isotropic_bend)
+    items = SpatialChainItems(nodes, markers, springs, positions.ravel().copy(), joints,
+                              np.array(node_masses, dtype=float), holds,
+                              np.full(len(joints), float(bending_stiffness)) if bending else None,
+                              np.full(len(joints), float(bending_damping)) if bending and bending_damping > 0.0
+                              else None)
     if tension_only:
-        elements = cable_elements([len(nodes)])
-        rest = np.linalg.norm(np.diff(positions, axis=0), axis=1)
-        axial_k = np.full(len(elements), float(axial_stiffness))
-        axial_c = np.full(len(elements), float(axial_damping))
-    else:
-        elements = np.zeros((0, 2), dtype=np.int64)
-        rest = axial_k = axial_c = np.zeros(0)
-    rest_rate = np.zeros(len(elements))
-    size = reference.size
-    bending_rows, bending_columns = block_pattern(bending_joints, 3)
-    axial_rows, axial_columns = block_pattern(elements, 3)
-    split = bending_rows.size
-    triplets = np.zeros((split + axial_rows.size, 3))
-    triplets[:, 0] = np.concatenate([bending_rows, axial_rows])
-    triplets[:, 1] = np.concatenate([bending_columns, axial_columns])
-    bending_values = np.zeros(split)
-    axial_values = np.zeros(axial_rows.size)
-    current = np.zeros(size)
-    force = np.zeros(size)
-    container = exu.MatrixContainer()
-    cut = CutSlopes()  # damper-cut elements keep their taut slopes in a step's first iterations
+        items.axial_elements = cable_elements([len(nodes)])
+        items.axial_rest_length = rest
+        items.axial_stiffness = np.full(len(rest), float(axial_stiffness))
+        items.axial_damping = np.full(len(rest), float(axial_damping))
+        items.axial_rest_rate = np.zeros(len(rest))
+    if forces:
+        ChainForces(mbs, [items], gravity)
+    return items
 
-    def force_function(mbs_, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
-        np.add(reference, q, out=current)
-        cut.force_evaluated(t)
-        bending_3d.spatial_bending_force(current, bending_joints, stiffness, force)  # overwrites
-        if damped:
-            bending_3d.add_spatial_bending_damping_force(current, np.asarray(q_t), bending_joints, damping, bend, force)
-        if tension_only:
-            axial_3d.tension_only_force(current, np.asarray(q_t), elements, rest, axial_k, axial_c, rest_rate, force)
-        return force
 
-    def jacobian_function(mbs_, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
-        np.add(reference, q, out=current)
-        bending_3d.spatial_bending_stiffness(current, bending_joints, stiffness, float(f_q), bending_values)
-        if damped:
-            bending_3d.add_spatial_bending_damping_jacobian(current, np.asarray(q_t), bending_joints, damping, bend,
-                                                            float(f_q), float(f_q_t), bending_values)
-        triplets[:split, 2] = bending_values
-        if tension_only:
-            triplets[split:, 2] = axial_3d.tension_only_triplet_values(
-                current, np.asarray(q_t), elements, rest, axial_k, axial_c, rest_rate, float(f_q), float(f_q_t),
-                axial_values, cut.active)
-        container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
-        return container
+def generic_state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
+    """The displacements q and velocities q_t [m, m/s] of the ``ObjectGenericODE2`` ``item``, read from the
+    system's state vectors (``systemData``), not converted from the lists Exudyn hands its user functions;
+    ``where`` caches the object's place in them (a slice where it is one block), found at the first call."""
+    data = mbs.systemData
+    if not where:
+        index = np.asarray(data.GetObjectLTGODE2(item), dtype=np.int64)
+        block = np.array_equal(index, np.arange(index[0], index[0] + index.size))
+        where.append(slice(int(index[0]), int(index[0]) + index.size) if block else index)
+    return data.GetODE2Coordinates()[where[0]], data.GetODE2Coordinates_t()[where[0]]
 
-    empty = exu.MatrixContainer()
-    empty.SetWithSparseMatrix(np.zeros((0, 3)), numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
-    generic = mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=nodes, massMatrix=empty,
-                                                   forceUserFunction=force_function,
-                                                   jacobianUserFunction=jacobian_function))
-    common = dict(user_functions=(force_function, jacobian_function, container), loads=loads, holds=holds,
-                  bending_stiffness=stiffness if bending else None, generic=generic, bending_damping=damping)
-    if not tension_only:
-        return SpatialChainItems(nodes, masses, markers, springs, generic, reference, joints, **common)
-    return SpatialChainItems(nodes, masses, markers, springs, generic if bending else None, reference, joints,
-                             axial_elements=elements, axial_rest_length=rest, axial_stiffness=axial_k,
-                             axial_damping=axial_c, axial_rest_rate=rest_rate, **common)
+
+class ChainForces:
+    """One ``ObjectGenericODE2`` (index ``generic``) for ``chains`` (:class:`SpatialChainItems`, all tension-only
+    or none, all bending or none): their masses (its mass matrix), weight (``gravity`` [m/s^2] along -z),
+    bending and tension-only elements; the chains' arrays become views of its own."""
+
+    def __init__(self, mbs, chains: list, gravity: float):
+        offsets = np.cumsum([0] + [len(chain.nodes) for chain in chains])
+        nodes = [node for chain in chains for node in chain.nodes]
+        size = 3 * len(nodes)
+
+        def joined(name):  # the chains' arrays end to end, each chain's now a view of the whole (None: none)
+            parts = [getattr(chain, name) for chain in chains]
+            if parts[0] is None:
+                return None
+            whole = np.concatenate(parts)
+            for chain, start, part in zip(chains, np.cumsum([0] + [len(p) for p in parts]), parts):
+                setattr(chain, name, whole[start:start + len(part)])
+            return whole
+
+        def shifted(name):  # the chains' node pairs or triples, numbered in the whole
+            return np.concatenate([getattr(chain, name) + offset for chain, offset in zip(chains, offsets)])
+
+        self.masses = joined("node_mass")
+        stiffness, damping = joined("bending_stiffness"), joined("bending_damping")
+        joints = shifted("joints") if stiffness is not None else np.zeros((0, 3), dtype=np.int64)
+        stiffness = np.zeros(0) if stiffness is None else stiffness
+        rest, axial_k, axial_c, rest_rate = (joined(name) for name in (
+            "axial_rest_length", "axial_stiffness", "axial_damping", "axial_rest_rate"))
+        tension_only = rest is not None
+        elements = shifted("axial_elements") if tension_only else np.zeros((0, 2), dtype=np.int64)
+        reference = np.concatenate([chain.reference for chain in chains])
+        bend = float(bending_3d.ISOTROPIC_BEND)
+        bending_rows, bending_columns = block_pattern(joints, 3)
+        axial_rows, axial_columns = block_pattern(elements, 3)
+        split = bending_rows.size
+        triplets = np.zeros((split + axial_rows.size, 3))
+        triplets[:, 0] = np.concatenate([bending_rows, axial_rows])
+        triplets[:, 1] = np.concatenate([bending_columns, axial_columns])
+        bending_values, axial_values = np.zeros(split), np.zeros(axial_rows.size)
+        current, force = np.zeros(size), np.zeros(size)
+        weight = np.zeros(len(nodes))
+        container = exu.MatrixContainer()
+        cut = CutSlopes()  # damper-cut elements keep their taut slopes in a step's first iterations
+        where = []
+
+        def state(mbs_, item):
+            displacements, velocities = generic_state(mbs_, item, where)
+            np.add(reference, displacements, out=current)
+            return velocities
+
+        def force_function(mbs_, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
+            velocities = state(mbs_, item)
+            cut.force_evaluated(t)
+            bending_3d.spatial_bending_force(current, joints, stiffness, force)  # overwrites
+            if damping is not None:
+                bending_3d.add_spatial_bending_damping_force(current, velocities, joints, damping, bend, force)
+            if tension_only:
+                axial_3d.tension_only_force(current, velocities, elements, rest, axial_k, axial_c, rest_rate, force)
+            np.multiply(self.masses, gravity, out=weight)
+            force[2::3] -= weight
+            return force.tolist()  # a list crosses into Exudyn faster than an array
+
+        def jacobian_function(mbs_, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
+            velocities = state(mbs_, item)
+            bending_3d.spatial_bending_stiffness(current, joints, stiffness, float(f_q), bending_values)
+            if damping is not None:
+                bending_3d.add_spatial_bending_damping_jacobian(current, velocities, joints, damping, bend,
+                                                                float(f_q), float(f_q_t), bending_values)
+            triplets[:split, 2] = bending_values
+            if tension_only:
+                triplets[split:, 2] = axial_3d.tension_only_triplet_values(
+                    current, velocities, elements, rest, axial_k, axial_c, rest_rate, float(f_q), float(f_q_t),
+                    axial_values, cut.active)
+            container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
+            return container
+
+        self.size = size
+        diagonal = np.arange(size, dtype=float)
+        self.mass_triplets = np.column_stack([diagonal, diagonal, np.repeat(self.masses, 3)])
+        self.mass_matrix = exu.MatrixContainer()
+        self.mass_matrix.SetWithSparseMatrix(self.mass_triplets, numberOfRows=size, numberOfColumns=size,
+                                             useDenseMatrix=False)
+        self.user_functions = (force_function, jacobian_function, container)  # alive as long as the model
+        self.generic = mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=nodes, massMatrix=self.mass_matrix,
+                                                            forceUserFunction=force_function,
+                                                            jacobianUserFunction=jacobian_function))
+        for chain in chains:
+            chain.forces = self
+
+    def masses_changed(self, mbs) -> None:
+        """Give Exudyn the masses the chains' ``node_mass`` hold now (the weight follows by itself)."""
+        self.mass_triplets[:, 2] = np.repeat(self.masses, 3)
+        self.mass_matrix.SetWithSparseMatrix(self.mass_triplets, numberOfRows=self.size, numberOfColumns=self.size,
+                                             useDenseMatrix=False)
+        mbs.SetObjectParameter(self.generic, "massMatrix", self.mass_matrix)
 
 
 def chain_energy(items: SpatialChainItems, node_masses: np.ndarray, q: np.ndarray, v: np.ndarray,

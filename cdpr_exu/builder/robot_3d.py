@@ -45,7 +45,7 @@ from cdpr_exu.core.validation import non_negative, positive, shown
 from cdpr_exu.exits import PointExit
 
 from cdpr_exu.physics import axial_3d
-from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
+from cdpr_exu.builder.chain_3d import ChainForces, add_spatial_chain, chain_energy
 from cdpr_exu.builder.winch import add_servo_drum
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy  # the disc and its angle psi
 from cdpr_exu.statics.statics import (PlatformEquilibrium, SuspendedPlatform, catenary_platform, chain_element_mass,
@@ -218,7 +218,8 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         below, reference, current, pulley = chain_over(exit_, equilibrium_cable, length, n)
         masses = node_masses_along(n + below, element_mass, chain.mass_lumping)
         items = add_spatial_chain(mbs, reference, masses, float(k), float(c), float(k_theta), gravity=gravity,
-                                  hold_first=True, tension_only=chain.tension_only, bending_damping=float(c_theta))
+                                  hold_first=True, tension_only=chain.tension_only, bending_damping=float(c_theta),
+                                  forces=False)
         for node, displacement in zip(items.nodes, current - reference):
             mbs.SetNodeParameter(node, "initialCoordinates", [float(x) for x in displacement])
         swivel_pulleys.append(pulley)
@@ -228,6 +229,7 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         chains.append(items)
         node_masses.append(masses)
         winch_elements.append(below)
+    ChainForces(mbs, chains, gravity)  # one generic object for every chain: one force call per iteration
 
     position = [float(x) for x in initial.position]
     if platform.is_point_mass:

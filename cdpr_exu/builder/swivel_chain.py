@@ -18,7 +18,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cdpr_exu.physics import swivel_pulley as sp
-from cdpr_exu.builder.chain_3d import SpatialChainItems
+from cdpr_exu.builder.chain_3d import SpatialChainItems, generic_state
 
 
 @dataclass
@@ -71,22 +71,23 @@ def add_swivel_pulley(mbs: exu.MainSystem, chain: SpatialChainItems, pulley: sp.
     bearing = pulley.bearing_damping
     psi_reference = float(psi)
 
-    def _state(q, q_t):
-        q = np.asarray(q)
-        q_t = np.asarray(q_t)
+    where = []
+
+    def _state(mbs_, item):
+        q, q_t = generic_state(mbs_, item, where)
         np.add(reference, q[:last], out=positions)
         velocities[:] = q_t[:last]
         return psi_reference + q[last], q_t[last]
 
     def force_function(mbs_, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
-        angle, rate = _state(q, q_t)
+        angle, rate = _state(mbs_, item)
         force[:] = 0.0
         sp.swivel_contact_force(positions, velocities, angle, rate, *args, force)
         force[last] -= bearing * rate
-        return force
+        return force.tolist()  # a list crosses into Exudyn faster than an array
 
     def jacobian_function(mbs_, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
-        angle, rate = _state(q, q_t)
+        angle, rate = _state(mbs_, item)
         triplets[:-1, 2] = sp.swivel_contact_values(positions, velocities, angle, rate, *args, float(f_q),
                                                     float(f_q_t), values)
         triplets[-1, 2] = float(f_q_t) * bearing

@@ -6,8 +6,11 @@ swivel pulleys on the lumped robot's own: :func:`cdpr_exu.run.settle.start_at_re
 **The winch at a point exit** pays the cable out at a fixed point (over a swivel pulley the winch end
 moves along the pulley's axis instead). The lumped cable keeps its n elements and follows its paid-out
 length L(t): every element's length, stiffness and damping, the node masses and the bending scale with
-L / n before every step. Its statics are the elastic catenary's of length L; it leaves out the flow of
-material through the exit, an axial motion whose inertia is small beside the platform's.
+L / n before every step, the masses in the weight and in the inertia: Exudyn keeps a mass matrix it counts
+as constant (a robot without a rigid body: a point-mass platform's), so the winches have the solver compute it
+again when they changed a mass (a rigid platform's is computed every step anyway). Its statics are the
+elastic catenary's of length L; it leaves out the flow of material through the exit, an axial motion whose
+inertia is small beside the platform's.
 
 Units SI; z up, gravity along -z; poses ``(x, y, z, theta)`` with ``theta`` the platform's rotation vector.
 """
@@ -55,6 +58,7 @@ class _SpatialWinches:
         mbs, items = self.mbs, self.items
         set_object = mbs.SetObjectParameter
         self.rate = np.array(rates, dtype=float)
+        masses_changed = False
         for i, (cable, exit_, chain, length, rate) in enumerate(zip(self.scene.cables, self.scene.exits, items.chains,
                                                                     lengths, rates)):
             if exit_.wraps:  # the winch end moves along the swivel axis: up when paying out
@@ -79,16 +83,18 @@ class _SpatialWinches:
                 set_object(spring, "referenceLength", element)
                 set_object(spring, "stiffness", stiffness)
                 set_object(spring, "damping", damping)
-            # rho l_e per node, as plain floats at once (Exudyn's setters take no arrays: one call per item);
-            # each node's weight follows its mass (a LoadMassProportional, builder.chain_3d)
-            masses = (items.node_masses[i] * (float(length) / items.unstrained_lengths[i])).tolist()
-            for body, mass in zip(chain.masses, masses):
-                set_object(body, "mass", mass)
+            # rho l_e per node: the mass matrix of the chains' generic object, and their weight
+            np.multiply(items.node_masses[i], float(length) / items.unstrained_lengths[i], out=chain.node_mass)
+            masses_changed = True
             if chain.bending_stiffness is not None:
                 chain.bending_stiffness[:] = items.bending_stiffnesses[i] * items.unstrained_lengths[i] / self.n / element
             if chain.bending_damping is not None:
                 chain.bending_damping[:] = items.bending_dampings[i] * items.unstrained_lengths[i] / self.n / element
             self.applied[i] = length
+        if masses_changed:  # the solver reuses the mass matrix it assembled at the start (reuseConstantMassMatrix)
+            for forces in {chain.forces for chain in items.chains}:
+                forces.masses_changed(mbs)
+            mbs.sys["dynamicSolver"].ComputeMassMatrix(mbs)
 
 
 #: A run stops when the platform has turned farther than this from the reference's orientation [deg]:
@@ -97,17 +103,19 @@ MAX_ROTATION_ERROR_DEG = 90.0
 
 
 class _SpatialMonitor:
-    """Checks the platform at the start and after each step for states the run cannot come back from:
-    not finite, above its highest exit, turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference."""
+    """Checks the platform for states the run cannot come back from: not finite or above its highest exit
+    (after every step: the position only), turned more than :data:`MAX_ROTATION_ERROR_DEG` from the reference
+    (at the start and at every recorded sample: a turn is stopped within one output period)."""
 
     def __init__(self, scene: Scene):
         self.trajectory = scene.trajectory
         self.ceiling = float(scene.exit_points[:, 2].max())  # above it every cable pulls the platform down
         self.turns = not scene.platform.is_point_mass
 
-    def problem(self, t: float, position: np.ndarray, rotation: np.ndarray) -> str | None:
-        """What is wrong at ``t`` [s] with the platform at ``position`` (3,) [m], ``rotation`` (3, 3)."""
-        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(rotation))):
+    def problem(self, t: float, position: np.ndarray, rotation: np.ndarray | None = None) -> str | None:
+        """What is wrong at ``t`` [s] with the platform at ``position`` (3,) [m], ``rotation`` (3, 3) (None:
+        not checked)."""
+        if not (np.isfinite(position).all() and (rotation is None or np.isfinite(rotation).all())):
             return f"the coordinates are no longer finite at t = {t:.4f} s"
         if position[2] > self.ceiling:
             if t == 0.0:  # where the robot came to rest (over swivel pulleys: the chain statics)
@@ -117,10 +125,11 @@ class _SpatialMonitor:
             return (f"the platform rose above its highest exit at t = {t:.4f} s (z = {position[2]:.3f} m, the exit at "
                     f"{self.ceiling:.3f} m): only cables that push could hold it there; the run has diverged (a "
                     "winch command that jumps, or a smaller solver.step_size)")
-        if self.turns:
+        if self.turns and rotation is not None:
             reference = rotation_from_vector(np.asarray(self.trajectory.pose(t))[3:])
-            angle = np.degrees(np.linalg.norm(rotation_vector(reference.T @ rotation)))
-            if angle > MAX_ROTATION_ERROR_DEG:
+            # the angle between the two exceeds 90 degrees where trace(reference^T rotation) = 1 + 2 cos < 1
+            if float(np.vdot(reference, rotation)) < 1.0 + 2.0 * np.cos(np.radians(MAX_ROTATION_ERROR_DEG)):
+                angle = np.degrees(np.linalg.norm(rotation_vector(reference.T @ rotation)))
                 return (f"the platform turned {angle:.0f} degrees away from the reference's orientation at "
                         f"t = {t:.4f} s (limit {MAX_ROTATION_ERROR_DEG:g}): it has left the workspace the cables hold "
                         "it in; the run is stopped")
@@ -216,6 +225,7 @@ class Run3D:
         mbs, items = self.model.mbs, self.model.items
         position, rotation = platform_pose(mbs, items)
         self.times.append(t)
+        self.rotation = rotation  # the monitor checks the turn here (post_step)
         self.poses.append(np.concatenate([position, rotation_vector(rotation)]))
         self.paid.append(self.winches.applied.copy())
         q, v = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
@@ -279,7 +289,9 @@ class Run3D:
             self.record(float(t))
             while self.next < len(outputs) and t >= outputs[self.next] - 1e-9:
                 self.next += 1
-        problem = self.monitor.problem(t, *platform_pose(self.model.mbs, self.model.items))
+        # the position after every step, the turn at the samples (record's rotation)
+        position = self.model.mbs.GetNodeOutput(self.model.items.platform_node, exu.OutputVariableType.Position)
+        problem = self.monitor.problem(t, np.asarray(position), self.rotation if self.times[-1] == t else None)
         if problem is not None:
             if t > times[-1]:
                 self.record(float(t))  # the state that stopped the run belongs to its result
