@@ -58,6 +58,7 @@ PLANAR = {
     "tension_aware_chain_relative": ("tension_aware", {"statics": "chain", "start": "relative"}),
     "closed_loop_tension_aware": ("closed_loop_tension_aware", {}),
     "closed_loop_tension_aware_previous": ("closed_loop_tension_aware", asdict(loop_design.PREVIOUS)),
+    "model_feed_forward": ("model_feed_forward", {}),
     "closed_loop_model_feed_forward": ("closed_loop_model_feed_forward", {}),
     "ilc": ("ilc", {}),
 }
