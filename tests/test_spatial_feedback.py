@@ -221,10 +221,12 @@ def test_the_spatial_closed_loop_holds_a_robot_heavier_and_softer_than_its_contr
                     controller_model=ControllerModel(platform={"mass": 20.0}, cable={"youngs_modulus": YOUNG}))
     open_loop = simulate(scene, TensionAwareController()).summary(2.25)
     closed = simulate(scene, CONTROLLERS["closed_loop_tension_aware"](scene)).summary(2.25)
-    # measured 0.75 s after the move: 6.6 um and 1.3e-3 deg open loop, 0.75 um and 4.4e-5 deg closed
+    # measured 0.75 s after the move: 6.6 um and 1.3e-3 deg open loop; closed 2.2 um and 1.5e-4 deg with the
+    # gains designed from the margins (k_p 0.3, f_c 1.5 Hz: a slower loop; 0.75 um and 4.4e-5 deg with the
+    # trial gains k_p 0.5, f_c 2 Hz)
     message = f"open {open_loop['max_position_error_m']:.3e} m, closed {closed['max_position_error_m']:.3e} m"
-    assert closed["max_position_error_m"] < open_loop["max_position_error_m"] / 4.0, message
-    assert closed["max_rotation_error_deg"] < open_loop["max_rotation_error_deg"] / 10.0, message
+    assert closed["max_position_error_m"] < open_loop["max_position_error_m"] / 2.5, message
+    assert closed["max_rotation_error_deg"] < open_loop["max_rotation_error_deg"] / 5.0, message
     assert closed["min_element_tension_N"] > 0.0 and closed["status"] == "completed"
 
 
