@@ -21,8 +21,8 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
    ``results/robustness/spatial-cogiro/``, ``results/robustness/spatial-ipanema/``; and their loops
    (:data:`controllers.registry.SPATIAL_LOOP`: the closed loop's with the rotation, 6 x 6, the model
    feed-forward's without, 3 x 3) linearised at 4 poses of each run, on both plants: ``margins.md`` and
-   ``margins.json`` in each folder, with the gains the margins would choose over both robots (``designed``:
-   reported, not the defaults).
+   ``margins.json`` in each folder; the default gains are those the margins choose over both robots (the
+   script stops if the design picks others), beside the gains first chosen by trial (``previous``).
 
 Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
 this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after

@@ -20,6 +20,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
+from cdpr_exu.builder.chain_3d import generic_state
 from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics import axial
 from cdpr_exu.physics import bending
@@ -180,7 +181,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
     cut = axial.CutSlopes()  # damper-cut elements keep their taut slopes in a step's first iterations
     joint_args = (spring.joints, spring.stiffness, spring.damping, elements, rest, axial_k, axial_c)
 
-    where = []  # the object's coordinates in the system's state vectors (_state)
+    where = []  # the object's coordinates in the system's state vectors (generic_state)
     frozen = node_contact is not None and frozen_contact
     if frozen:
         read_gaps = _frozen_contact(mbs, node_contact, reference, positions, where)
@@ -190,7 +191,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
 
     def force_function(mbs, t, item, q, q_t):  # noqa: ARG001 - Exudyn's signature
         # bending and tension-only elements in one compiled call (cable_forces), then any rim contact
-        displacements, velocities = _state(mbs, item, where)
+        displacements, velocities = generic_state(mbs, item, where)
         read_gaps(mbs)
         cut.force_evaluated(t)
         force = cable_forces.cable_force(reference, displacements, velocities, positions, *joint_args, force_buffer)
@@ -201,7 +202,7 @@ def add_cable_forces(mbs: exu.MainSystem, cables: list[CableSpec], items: list[C
         return force.tolist()  # a list crosses into Exudyn faster than an array
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
-        displacements, velocities = _state(mbs, item, where)
+        displacements, velocities = generic_state(mbs, item, where)
         read_gaps(mbs)
         jacobian = cable_forces.cable_jacobian(reference, displacements, velocities, positions, *joint_args,
                                                float(f_q), float(f_q_t), no_force, no_matrix, jacobian_buffer,
@@ -276,24 +277,11 @@ def _slack_blocks(elements, rest, axial_k, axial_c, kink, cut):
     return rows, columns, fill
 
 
-def _state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
-    """The displacements q and velocities q_t [m, m/s] of the ``ObjectGenericODE2`` ``item``, read from the
-    system's state vectors (``systemData``) rather than converted from the lists Exudyn hands its user
-    functions (measured x1.09 of a paper-circle run's CPU time). ``where`` caches the object's place in
-    those vectors (a slice where it is one block), found at the first call."""
-    data = mbs.systemData
-    if not where:
-        index = np.asarray(data.GetObjectLTGODE2(item), dtype=np.int64)
-        block = index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size))
-        where.append(slice(int(index[0]), int(index[0]) + index.size) if block else index)
-    return data.GetODE2Coordinates()[where[0]], data.GetODE2Coordinates_t()[where[0]]
-
-
 def _sparse_jacobian_function(blocks, reference, positions, where, read_gaps):
     """A ``jacobianUserFunction`` returning ``f_q K + f_q_t D`` as sparse triplets in a fixed pattern:
     ``blocks`` lists ``(rows, columns, fill)`` per force, ``fill(positions, velocities, f_q, f_q_t,
-    out_values)`` writing the values; ``where`` as :func:`_state`; ``read_gaps(mbs)`` refreshes a frozen
-    contact's state."""
+    out_values)`` writing the values; ``where`` as :func:`~cdpr_exu.builder.chain_3d.generic_state`;
+    ``read_gaps(mbs)`` refreshes a frozen contact's state."""
     size = reference.size
     bounds = np.cumsum([0] + [rows.size for rows, _, _ in blocks])
     triplets = np.zeros((int(bounds[-1]), 3))
@@ -303,7 +291,7 @@ def _sparse_jacobian_function(blocks, reference, positions, where, read_gaps):
     container = exu.MatrixContainer()
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001 - Exudyn's signature
-        displacements, velocities = _state(mbs, item, where)
+        displacements, velocities = generic_state(mbs, item, where)
         read_gaps(mbs)
         np.add(reference, displacements, out=positions)
         for (_, _, fill), out_values, first, last in zip(blocks, values, bounds[:-1], bounds[1:]):

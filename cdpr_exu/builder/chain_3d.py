@@ -128,8 +128,10 @@ def add_spatial_chain(mbs: exu.MainSystem, positions: np.ndarray, node_masses: n
 
 def generic_state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
     """The displacements q and velocities q_t [m, m/s] of the ``ObjectGenericODE2`` ``item``, read from the
-    system's state vectors (``systemData``), not converted from the lists Exudyn hands its user functions;
-    ``where`` caches the object's place in them (a slice where it is one block), found at the first call."""
+    system's state vectors (``systemData``), not converted from the lists Exudyn hands its user functions
+    (measured x1.09 of a paper-circle run's CPU time); the planar cables' object and the spatial chains' read
+    theirs here. ``where`` caches the object's place in them (a slice where it is one block), found at the
+    first call."""
     data = mbs.systemData
     if not where:
         index = np.asarray(data.GetObjectLTGODE2(item), dtype=np.int64)

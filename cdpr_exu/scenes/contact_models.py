@@ -17,12 +17,12 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class PulleyContactModel:
     """What one pulley contact model needs (its forces all live in the cables' numba object): the node contact
-    switched after Newton's iteration (``frozen_nodes``), on the segments (``on_segments``) or ``smooth_nodes``."""
+    switched after Newton's iteration (``frozen_nodes``), on the segments (``on_segments``), or else the smooth
+    node contact."""
 
     name: str
     frozen_nodes: bool
     on_segments: bool
-    smooth_nodes: bool
 
     def wrap_radius(self, pulley_radius: float, element_length: float) -> float:
         """Radius [m] the initial nodes wrap the pulley on: with segment contact, the circumscribed circle
@@ -36,7 +36,7 @@ class PulleyContactModel:
 
 
 CONTACT_MODELS: dict[str, PulleyContactModel] = {
-    "node": PulleyContactModel("node", frozen_nodes=True, on_segments=False, smooth_nodes=False),
-    "segment": PulleyContactModel("segment", frozen_nodes=False, on_segments=True, smooth_nodes=False),
-    "node_smooth": PulleyContactModel("node_smooth", frozen_nodes=False, on_segments=False, smooth_nodes=True),
+    "node": PulleyContactModel("node", frozen_nodes=True, on_segments=False),
+    "segment": PulleyContactModel("segment", frozen_nodes=False, on_segments=True),
+    "node_smooth": PulleyContactModel("node_smooth", frozen_nodes=False, on_segments=False),
 }
