@@ -176,8 +176,8 @@ class FilteredPositionPI:
 
         The error is taken at ``measurement.state_time``, when the pose was measured (one step
         earlier: against the later target it would be biased by the velocity times the step,
-        1.2 mm at 0.6 m/s and 2 ms). ``target(t)``: the position [m] the loop holds the platform
-        to (default: the reference); the Jacobian is the reference pose's either way.
+        1.2 mm at 0.6 m/s and 2 ms). ``target(t)``: the pose [m, rad] the loop holds the platform
+        to (its position at least; default: the reference); the Jacobian is the reference pose's either way.
         """
         if self._scene is None:
             raise RuntimeError(f"{type(self).__name__}.reset(scene) must be called first")
@@ -208,7 +208,7 @@ FOLLOW = ("expected", "reference")
 class ClosedLoopController:
     """An open-loop controller (the feed-forward) plus :class:`FilteredPositionPI` feedback (:data:`FOLLOW`).
 
-    Following the path the feed-forward ``expected_position(t)`` gave on the model, the loop
+    Following the path the feed-forward ``expected_pose(t)`` gave on the model, the loop
     acts only on what the model gets wrong and leaves the feed-forward's own residual (the
     cables' fast modes, which the late loop would amplify) alone. On paper-circle-mismatch
     (lengths learned on the model: 2.87 mm there, 10.2 mm open loop on the plant): 2.26 mm,
@@ -249,15 +249,15 @@ class ClosedLoopController:
         """Reset the feed-forward (a learned one learns here) and the feedback."""
         self.feed_forward.reset(scene, initial_paid_out)
         if self.follow == "expected":
-            expected = getattr(self.feed_forward, "expected_position", None)
+            expected = getattr(self.feed_forward, "expected_pose", None)
             if expected is None or expected(0.0) is None:
-                raise SceneError(f"follow = 'expected' needs a feed-forward that expects a path (expected_position), "
+                raise SceneError(f"follow = 'expected' needs a feed-forward that expects a path (expected_pose), "
                                  f"{shown(getattr(self.feed_forward, 'name', self.feed_forward))} does not")
         self.feedback.reset(scene)
 
     def command(self, measurement: Measurement) -> WinchCommand:
         feed_forward = self.feed_forward.command(measurement)
-        target = self.feed_forward.expected_position if self.follow == "expected" else None
+        target = self.feed_forward.expected_pose if self.follow == "expected" else None
         correction = self.feedback.correction(measurement, target)
         return WinchCommand(np.asarray(feed_forward.paid_out, dtype=float) + correction,
                             np.asarray(feed_forward.paid_out_rate, dtype=float))

@@ -52,12 +52,12 @@ def ideal_changes(scene, times: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class CommandTable:
     """Winch commands as changes (N, m) [m] of the paid-out lengths since t = 0 on ``times`` (N,) [s],
-    increasing from 0; ``expected_positions`` (N, d) [m]: the positions they gave where they were learned,
-    if known (what a feedback around them should expect)."""
+    increasing from 0; ``expected_poses`` (N, w) [m, rad]: the platform poses they gave where they were
+    learned (the result's pose: position, then rotation), if known (what a feedback around them should expect)."""
 
     times: np.ndarray
     changes: np.ndarray
-    expected_positions: np.ndarray | None = None
+    expected_poses: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         times = np.asarray(self.times, dtype=float)
@@ -68,18 +68,18 @@ class CommandTable:
             raise SceneError(f"changes must be finite, shape ({len(times)}, m), got shape {changes.shape}")
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "changes", changes)
-        if self.expected_positions is not None:
-            expected = np.asarray(self.expected_positions, dtype=float)
+        if self.expected_poses is not None:
+            expected = np.asarray(self.expected_poses, dtype=float)
             if expected.ndim != 2 or expected.shape[0] != len(times) or not np.all(np.isfinite(expected)):
-                raise SceneError(f"expected_positions must be finite, shape ({len(times)}, d), "
+                raise SceneError(f"expected_poses must be finite, shape ({len(times)}, w), "
                                  f"got shape {expected.shape}")
-            object.__setattr__(self, "expected_positions", expected)
+            object.__setattr__(self, "expected_poses", expected)
 
     def to_dict(self) -> dict:
         """Plain-data form (JSON-ready)."""
         data = {"times_s": self.times.tolist(), "changes_m": self.changes.tolist()}
-        if self.expected_positions is not None:
-            data["expected_positions_m"] = self.expected_positions.tolist()
+        if self.expected_poses is not None:
+            data["expected_poses_m_rad"] = self.expected_poses.tolist()
         return data
 
 
@@ -106,11 +106,11 @@ class ReplayController:
                              f"{scene.solver.end_time:g} s")
         self._spline = CubicSpline(self.table.times, initial + self.table.changes, axis=0)
         self._rate = self._spline.derivative()
-        expected = self.table.expected_positions
+        expected = self.table.expected_poses
         self._expected = None if expected is None else CubicSpline(self.table.times, expected, axis=0)
 
-    def expected_position(self, time: float) -> np.ndarray | None:
-        """The position [m] the commands gave where they were learned, at ``time`` [s]; None if unknown."""
+    def expected_pose(self, time: float) -> np.ndarray | None:
+        """The pose [m, rad] the commands gave where they were learned, at ``time`` [s]; None if unknown."""
         if self._spline is None:
             raise RuntimeError(f"{type(self).__name__}.reset(scene, initial_paid_out) must be called first")
         return None if self._expected is None else np.asarray(self._expected(time))

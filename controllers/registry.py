@@ -18,7 +18,7 @@ from .ideal_ik import IdealIKController
 from .ilc import LearnedController
 from .tension_aware import ClosedLoopTensionAwareController, TensionAwareController
 
-#: Gains of the spatial closed loop, with the rotation fed back: chosen from the loop's margins on the CoGiRo-class
+#: Gains of the spatial closed loops (both feed the rotation back), chosen from the loop's margins on the CoGiRo-class
 #: and IPAnema-class robots, nominal and 10 % off (examples/robustness_study.py, which stops if the design picks
 #: others): >= 10 dB and >= 56 deg. The gains first chosen by trial (:data:`SPATIAL_LOOP_PREVIOUS`) leave the
 #: CoGiRo-class cables' first transverse modes (2.4 Hz) growing in the linear model.
@@ -99,8 +99,7 @@ CONTROLLERS: dict[str, ControllerKind] = _kinds(
                    learns=True),
     ControllerKind("closed_loop_model_feed_forward",
                    {2: _learned("closed_loop_model_feed_forward", on_model=True, loop=True),
-                    3: _learned("closed_loop_model_feed_forward", on_model=True, loop=True,
-                                gains={**SPATIAL_LOOP, "rotation": False})},  # the learned path is positions
+                    3: _learned("closed_loop_model_feed_forward", on_model=True, loop=True, gains=SPATIAL_LOOP)},
                    learns=True),
     ControllerKind("ilc", dict.fromkeys((2, 3), _learned("ilc", on_model=False)), learns=True),
 )

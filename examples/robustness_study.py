@@ -19,8 +19,8 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
    chain correction's three starts (:data:`controllers.base.STARTS`) and the catenary's, the closed loop,
    ILC and the model feed-forward, nominal and with the 10 % model error of ``spatial-cogiro-mismatch``:
    ``results/robustness/spatial-cogiro/``, ``results/robustness/spatial-ipanema/``; and their loops
-   (:data:`controllers.registry.SPATIAL_LOOP`: the closed loop's with the rotation, 6 x 6, the model
-   feed-forward's without, 3 x 3) linearised at 4 poses of each run, on both plants: ``margins.md`` and
+   (:data:`controllers.registry.SPATIAL_LOOP`: the closed loop's and the model feed-forward's, both with the
+   rotation fed back, 6 x 6) linearised at 4 poses of each run, on both plants: ``margins.md`` and
    ``margins.json`` in each folder; the default gains are those the margins choose over both robots (the
    script stops if the design picks others), beside the gains first chosen by trial (``previous``).
 
@@ -81,7 +81,7 @@ SPATIAL_SCENES = ("spatial-cogiro", "spatial-ipanema")
 POSES = 8
 
 #: The spatial loops: controller -> whether it feeds the rotation back (:data:`controllers.registry.SPATIAL_LOOP`).
-SPATIAL_LOOPS = {"closed_loop_tension_aware": SPATIAL_LOOP["rotation"], "closed_loop_model_feed_forward": False}
+SPATIAL_LOOPS = dict.fromkeys(("closed_loop_tension_aware", "closed_loop_model_feed_forward"), SPATIAL_LOOP["rotation"])
 
 #: Poses a spatial loop is linearised at: evenly over the run after the trajectory's ramp.
 SPATIAL_POSES = 4

@@ -81,8 +81,8 @@ def test_bad_feedback_options_are_refused_by_name():
         ClosedLoopController("loop", ReplayController(table), feedback=2.0)
     with pytest.raises(SceneError, match="feed_forward"):
         ClosedLoopController("loop", ClosedLoopTensionAwareController(), FilteredPositionPI())
-    with pytest.raises(SceneError, match="expected_positions"):
-        CommandTable(table.times, table.changes, expected_positions=np.zeros((4, 2)))
+    with pytest.raises(SceneError, match="expected_poses"):
+        CommandTable(table.times, table.changes, expected_poses=np.zeros((4, 2)))
     with pytest.raises(SceneError, match="rule"):
         learners(MISMATCH, rule=10)(True)
     # A feed-forward that expects no path cannot be followed: refused at reset, before any step.

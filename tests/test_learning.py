@@ -105,7 +105,9 @@ def test_ilc_error_falls_over_the_trials_on_a_spatial_plant():
     run = learn_lengths(_spatial_mismatch(), rule=StoppingRule(max_trials=3, min_improvement=0.0))
     errors = [trial.max_position_error_m for trial in run.trials]
     assert len(errors) == 3 and run.best_trial == 3
-    assert run.table.changes.shape[1] == 8 and run.table.expected_positions.shape[1] == 3
+    # The expected path is the best trial's whole pose, its rotation too (a loop around it feeds the rotation back).
+    assert run.table.changes.shape[1] == 8 and run.table.expected_poses.shape[1] == 6
+    assert np.allclose(run.table.expected_poses[-1], run.result.pose[-1], rtol=0.0, atol=1e-12)
     # Measured 0.687, 0.211, 0.066 mm (4 s): ratios 0.31, 0.31, the 1 - gamma = 0.3 of a plant that moves by
     # J^-1 dlambda at once (the error is mostly slow: the mismatch's stretch and sag). 0.5 leaves room for the
     # platform's sway and the cross terms; ideal IK's error is 10 times the last trial's at most.

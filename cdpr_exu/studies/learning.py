@@ -74,7 +74,7 @@ class Trial:
 @dataclass
 class LearningRun:
     """The trials of one learning; ``table`` and ``result``: the best trial's (lowest max error) commands,
-    with the positions they gave (``expected_positions``), and run."""
+    with the poses they gave (``expected_poses``), and run."""
 
     trials: list[Trial]
     table: CommandTable
@@ -164,8 +164,8 @@ def learn_lengths(scene: Scene, law: LearningLaw = DEFAULT_LAW, rule: StoppingRu
             stop_reason = f"trial {trial.number} failed: {failure}"
             break
         if best is None or trial.max_position_error_m < best[0].max_position_error_m:
-            expected = np.column_stack([np.interp(times, result.time, column) for column in result.position.T])
-            best = (trial, replace(table, expected_positions=expected), result)
+            expected = np.column_stack([np.interp(times, result.time, column) for column in result.pose.T])
+            best = (trial, replace(table, expected_poses=expected), result)
         stop_reason = rule.reason_to_stop([t.max_position_error_m for t in trials])
         if stop_reason is not None:
             break
