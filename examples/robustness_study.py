@@ -84,7 +84,7 @@ POSES = 8
 SPATIAL_LOOPS = dict.fromkeys(("closed_loop_tension_aware", "closed_loop_model_feed_forward"), SPATIAL_LOOP["rotation"])
 
 #: Poses a spatial loop is linearised at: evenly over the run after the trajectory's ramp.
-SPATIAL_POSES = 4
+SPATIAL_POSES = 24
 
 #: The spatial gains the design chooses from (k_p, k_i [1/s], f_c [Hz]), around SPATIAL_LOOP's and below.
 SPATIAL_CANDIDATES = [loop_design.LoopGains(p, i, c) for p in (0.1, 0.2, 0.3, 0.5) for i in (0.0, 1.0, 2.5, 5.0)
@@ -178,14 +178,13 @@ def spatial_study(workers) -> None:
         scene = load_scene(name)
         rows = run_robustness(scene, SPATIAL, grid, OUT / name, workers=workers)
         print((OUT / name / ROBUSTNESS_FILES["table"]).read_text())
-        ramp, end = scene.trajectory.ramp_time, scene.solver.end_time
-        times = ramp + (end - ramp) * (np.arange(SPATIAL_POSES) + 0.5) / SPATIAL_POSES
+        times = scene.solver.end_time * (np.arange(SPATIAL_POSES) + 0.5) / SPATIAL_POSES  # the ramp's poses too
         studies[name] = (scene, rows, times, loop_design.loop_cases(scene, [perturbed(scene, **p) for p in grid], times,
                                                                     rotation=True))
     delays = {scene.solver.step_size for scene, *_ in studies.values()}
     frequency = max(scene.trajectory.angular_rate / (2 * np.pi) for scene, *_ in studies.values())
     designed, _ = loop_design.design_gains([case for *_, cases in studies.values() for case in cases], max(delays),
-                                           frequency, candidates=SPATIAL_CANDIDATES)
+                                           frequency, candidates=SPATIAL_CANDIDATES, disk_only=True)
     default, previous = (loop_design.LoopGains(*(gains[k] for k in ("proportional_gain", "integral_gain", "cutoff")))
                          for gains in (SPATIAL_LOOP, SPATIAL_LOOP_PREVIOUS))
     if designed != default:
