@@ -20,14 +20,14 @@ Young's modulus off by -+20 % and its pulleys 3 mm further in or out (:mod:`cdpr
    ILC and the model feed-forward, nominal and with the 10 % model error of ``spatial-cogiro-mismatch``:
    ``results/robustness/spatial-cogiro/``, ``results/robustness/spatial-ipanema/``; and their loops
    (:data:`controllers.registry.SPATIAL_LOOP`: the closed loop's and the model feed-forward's, both with the
-   rotation fed back, 6 x 6) linearised at 4 poses of each run, on both plants: ``margins.md`` and
-   ``margins.json`` in each folder; the default gains are those the margins choose over both robots (the
+   rotation fed back, 6 x 6) linearised at 24 poses over each run, on both plants: ``margins.md`` and
+   ``margins.json`` in each folder; the default gains are those the disk margin chooses over both robots (the
    script stops if the design picks others), beside the gains first chosen by trial (``previous``).
 
 Rows are appended to each folder's ``rows.jsonl`` as runs finish (git-ignored, with wall times); a run of
 this script that is interrupted resumes where it stopped; ``--fresh`` starts over. Errors are measured after
 the first second. About 15 min of CPU time (the learning controllers' trials are most of it); the spatial
-part about 8 min more.
+part about 12 min more.
 
 Run::
 
