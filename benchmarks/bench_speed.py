@@ -41,9 +41,9 @@ SPATIAL = [("spatial-cogiro", None, None), ("spatial-ipanema", None, None), ("sp
 
 
 def run_one(name: str, elements: int | None, step: float | None, end_time: float | None,
-            poses: dict | None = None) -> dict:
-    """One run of the scene ``name`` (``elements`` per cable and ``step`` [s] where given): its figures; its
-    times and platform poses into ``poses`` if given."""
+            poses: dict | None = None, start: str | None = None) -> dict:
+    """One run of the scene ``name`` (``elements`` per cable, ``step`` [s] and ``solver.start`` where given): its
+    figures; its times, platform and reference poses into ``poses`` if given."""
     from dataclasses import replace
 
     import numpy as np
@@ -52,7 +52,7 @@ def run_one(name: str, elements: int | None, step: float | None, end_time: float
     from cdpr_exu.scenes.scene import load_scene
 
     scene = load_scene(name)
-    solver = scene.solver
+    solver = scene.solver if start is None else replace(scene.solver, start=start)
     if step is not None:
         solver = replace(solver, step_size=step)
     if end_time is not None:
@@ -60,11 +60,11 @@ def run_one(name: str, elements: int | None, step: float | None, end_time: float
     cables = scene.cables if elements is None else tuple(replace(c, n_elements=elements) for c in scene.cables)
     result = simulate(scene.with_changes(cables=cables, solver=solver))
     if poses is not None:
-        poses.update(time=result.time, pose=result.pose)
+        poses.update(time=result.time, pose=result.pose, reference=result.reference)
     digest = hashlib.sha256()
     for array in (result.time, result.pose, result.paid_out, *result.nodes, *result.tensions):
         digest.update(np.ascontiguousarray(array).tobytes())
-    return {"scene": name, "n_elements": cables[0].n_elements, "step_size_s": solver.step_size,
+    return {"scene": name, "start": solver.start, "n_elements": cables[0].n_elements, "step_size_s": solver.step_size,
             "cpu_time_s": result.cpu_time, "simulated_time_s": result.simulated_time,
             "real_time_factor": result.simulated_time / result.cpu_time, "steps": result.steps,
             "newton_per_step": result.newton_iterations / max(result.steps, 1),
@@ -85,26 +85,29 @@ def _worker(args) -> None:
 
     warm = load_scene(args.scene)
     simulate(warm.with_changes(solver=replace(warm.solver, end_time=2 * warm.solver.step_size)))
-    print(json.dumps(run_one(args.scene, args.elements, args.step, args.end_time)))
+    print(json.dumps(run_one(args.scene, args.elements, args.step, args.end_time, start=args.start[0])))
 
 
 def ab(args) -> None:
-    """Alternate fresh processes of the two sources; best CPU time of each and whether the paths agree."""
+    """Alternate fresh processes of the two sources (and ``--start`` of each); best CPU time of each and whether
+    the paths agree."""
     best, digests = {}, {}
+    starts = args.start * 2 if len(args.start) == 1 else args.start
     for round_ in range(args.rounds):
-        for side, source in zip("AB", args.ab):
+        for side, source, start in zip("AB", args.ab, starts):
             env = {**os.environ, "PYTHONPATH": str(Path(source).resolve()), "MPLBACKEND": "Agg"}
             command = [sys.executable, __file__, "--worker", "--scene", args.scene,
                        *(["--elements", str(args.elements)] if args.elements else []),
                        *(["--step", str(args.step)] if args.step else []),
-                       *(["--end-time", str(args.end_time)] if args.end_time else []),
+                       *(["--end-time", str(args.end_time)] if args.end_time else []), "--start", start,
                        *(["--fast"] if args.fast in (side, "both") else [])]
             row = json.loads(subprocess.run(command, env=env, check=True, capture_output=True,
                                             text=True).stdout.strip().splitlines()[-1])
             best[side] = min(best.get(side, math.inf), row["cpu_time_s"])
             digests.setdefault(side, set()).add(row["digest"])
-            print(f"round {round_ + 1} {side}: {row['cpu_time_s']:.3f} s CPU, {row['steps']} steps, "
-                  f"{row['newton_per_step']:.2f} Newton/step, digest {row['digest']}", flush=True)
+            print(f"round {round_ + 1} {side} ({start} start): {row['cpu_time_s']:.3f} s CPU, {row['steps']} steps, "
+                  f"{row['newton_per_step']:.2f} Newton and {row['jacobians_per_step']:.2f} Jacobians per step, "
+                  f"digest {row['digest']}", flush=True)
     same = digests["A"] == digests["B"] and len(digests["A"]) == 1
     print(f"best of {args.rounds}: A {best['A']:.3f} s, B {best['B']:.3f} s CPU: B is x{best['A'] / best['B']:.3f} "
           f"faster; paths {'bit for bit the same' if same else 'DIFFER: ' + str(digests)}")
@@ -169,6 +172,8 @@ def main() -> None:
     parser.add_argument("--elements", type=int, default=None)
     parser.add_argument("--step", type=float, default=None)
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--start", nargs="+", default=["paper"], choices=("paper", "steady"),
+                        help="solver.start of the run (A/B mode: one for both sides, or one each)")
     parser.add_argument("--fast", nargs="?", const="both", default=None, help="Exudyn's fast module in A, B or both")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
