@@ -1,19 +1,21 @@
 """Speed of the one run loop (issue 25): CPU time, real-time factor, steps and Newton iterations per step.
 
 Table mode (the default) runs, one after the other in this process, the paper circle at n = 30, 60 and
-120 elements per cable with 1e-2 s steps, the shipped ``paper-circle`` and the spatial scenes, and prints
+120 elements per cable with 1e-2 s steps, the shipped ``paper-circle`` (the paper's start), the 60-element and
+shipped runs again with ``solver.start = "steady"`` (issue 25 item 4) and the spatial scenes, and prints
 for each: CPU time of the solve (``Result.cpu_time``, process CPU time, never wall time), times faster
 than real time, steps, Newton iterations and Jacobian updates per step, discontinuous iterations, the
 start-up share (CPU time of the first 0.05 s, a run of its own, over the whole run's), the cost exponent
 from 30 to 120 elements, and for the planar rows the platform's largest distance and rotation from the
-converged reference :data:`REFERENCE` (the spatial scenes' references are ``bench_spatial.py``'s). The
+converged reference :data:`REFERENCE` of the same start (the spatial scenes' references are ``bench_spatial.py``'s). The
 ratios come from one run on one machine; the machines are shared and noisy: compare ratios.
 
 A/B mode measures one change: ``--ab A B`` runs the same scene alternately (A, B, A, B, ...) in fresh
 processes, each importing ``cdpr_exu`` from the source folder given (a checkout of the commit before and
 after the change), and prints the best of ``--rounds`` CPU times of each, their ratio, and whether the
 two paths are the same bit for bit (a digest of every recorded array). ``--fast A|B|both`` loads
-Exudyn's fast module (``sys.exudynFast``) in that side.
+Exudyn's fast module (``sys.exudynFast``) in that side; ``--start paper steady`` runs one
+source with each start (``--ab . . --start paper steady``).
 
 Run: ``python benchmarks/bench_speed.py [--end-time 10] [--out benchmarks/results/speed.md]``, or
 ``python benchmarks/bench_speed.py --ab /tmp/before . --scene paper-circle --elements 60 --step 1e-2``.
@@ -30,14 +32,16 @@ import subprocess
 import sys
 from pathlib import Path
 
-PLANAR = [("paper-circle", n, 1e-2) for n in (30, 60, 120)] + [("paper-circle", None, None)]
-#: The planar rows' converged reference: the paper circle at 120 elements per cable and 2.5e-3 s steps
-#: (0.04 mm from 240 elements at 1.25e-3 s in the accuracy study, docs/accuracy.md).
+#: Rows: scene, elements per cable and step [s] (None: the scene's), ``solver.start`` (None: the scene's).
+PLANAR = ([("paper-circle", n, 1e-2, "paper") for n in (30, 60, 120)] + [("paper-circle", None, None, "paper")]
+          + [("paper-circle", 60, 1e-2, "steady"), ("paper-circle", None, None, "steady")])
+#: The planar rows' converged reference, one per start (a different start is a different path): the paper circle
+#: at 120 elements per cable and 2.5e-3 s steps (0.04 mm from 240 elements at 1.25e-3 s, docs/accuracy.md).
 REFERENCE = ("paper-circle", 120, 2.5e-3)
 #: The simulated time whose CPU share is the start-up's [s].
 START_UP = 0.05
-SPATIAL = [("spatial-cogiro", None, None), ("spatial-ipanema", None, None), ("spatial-cogiro-mismatch", None, None),
-           ("spatial-four-cable-swivel", None, None)]
+SPATIAL = [(name, None, None, None) for name in
+           ("spatial-cogiro", "spatial-ipanema", "spatial-cogiro-mismatch", "spatial-four-cable-swivel")]
 
 
 def run_one(name: str, elements: int | None, step: float | None, end_time: float | None,
@@ -120,20 +124,21 @@ def table(args) -> None:
     from cdpr_exu.core.output import write_json
 
     run_one("paper-circle", None, None, START_UP)  # warm-up: numba, imports
-    reference = {}
-    reference_row = run_one(*REFERENCE, args.end_time, reference)
+    reference = {start: {} for start in ("paper", "steady")}
+    reference_row = {start: run_one(*REFERENCE, args.end_time, poses, start) for start, poses in reference.items()}
     rows = []
-    for name, n, step in PLANAR + SPATIAL:
+    for name, n, step, start in PLANAR + SPATIAL:
         poses = {}
-        row = run_one(name, n, step, args.end_time, poses)
-        row["start_up_share"] = run_one(name, n, step, START_UP)["cpu_time_s"] / row["cpu_time_s"]
+        row = run_one(name, n, step, args.end_time, poses, start)
+        row["start_up_share"] = run_one(name, n, step, START_UP, start=start)["cpu_time_s"] / row["cpu_time_s"]
         row["error_mm"] = row["error_deg"] = None
-        if (name, n, step) in PLANAR:
-            at = [np.interp(poses["time"], reference["time"], reference["pose"][:, k]) for k in range(3)]
+        if start is not None:
+            ref = reference[start]
+            at = [np.interp(poses["time"], ref["time"], ref["pose"][:, k]) for k in range(3)]
             row["error_mm"] = 1e3 * float(np.hypot(*(poses["pose"][:, :2] - np.column_stack(at[:2])).T).max())
             row["error_deg"] = float(np.degrees(np.abs(poses["pose"][:, 2] - at[2]).max()))
         rows.append(row)
-        print(f"{name:26s} n = {row['n_elements']:3d}, step {row['step_size_s']:.0e} s: "
+        print(f"{name:26s} {row['start']:6s} n = {row['n_elements']:3d}, step {row['step_size_s']:.0e} s: "
               f"{row['cpu_time_s']:7.2f} s CPU, {row['real_time_factor']:6.2f}x real time, {row['steps']} steps, "
               f"{row['newton_per_step']:.2f} Newton and {row['jacobians_per_step']:.2f} Jacobians per step, "
               f"{row['discontinuous_iterations']} discontinuous iterations, start-up "
@@ -144,12 +149,13 @@ def table(args) -> None:
     lines = ["# Speed of the one run loop (issue 25), one run each", "",
              "CPU time of the solve (process CPU time, single-threaded); the machine is shared and noisy: "
              f"compare ratios. Start-up: the CPU share of the first {START_UP} s (a run of its own). Error: the "
-             "platform's largest distance and rotation from the converged reference, the paper circle at "
-             f"{REFERENCE[1]} elements and {REFERENCE[2]} s ({reference_row['cpu_time_s']:.1f} s CPU).", "",
-             "| scene | elements per cable | step [s] | CPU time [s] | x real time | steps | Newton / step | "
+             "platform's largest distance and rotation from the converged reference of the same start "
+             "(`solver.start`; docs/accuracy.md, \"The start\"), the paper circle at "
+             f"{REFERENCE[1]} elements and {REFERENCE[2]} s ({reference_row['paper']['cpu_time_s']:.1f} s CPU).", "",
+             "| scene | start | elements per cable | step [s] | CPU time [s] | x real time | steps | Newton / step | "
              "Jacobians / step | discontinuous iterations | start-up share | error [mm] | error [deg] |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    lines += [f"| {r['scene']} | {r['n_elements']} | {r['step_size_s']:g} | {r['cpu_time_s']:.2f} | "
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {r['scene']} | {r['start']} | {r['n_elements']} | {r['step_size_s']:g} | {r['cpu_time_s']:.2f} | "
               f"{r['real_time_factor']:.2f} | {r['steps']} | {r['newton_per_step']:.2f} | "
               f"{r['jacobians_per_step']:.2f} | "
               f"{r['discontinuous_iterations']} | {100 * r['start_up_share']:.0f} % | {shown(r['error_mm'], 2)} | "
