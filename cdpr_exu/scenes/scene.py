@@ -477,8 +477,9 @@ class SolverSpec:
         each cable's nodes on its elastic catenary at the initial pose, every element strained to its static
         tension (:func:`cdpr_exu.builder.model.presag_nodes`), and the platform and the nodes moving with the
         reference at t = 0 (:func:`~cdpr_exu.builder.model.start_velocities`; at rest under a held
-        reference); same unstrained lengths and paid-out bookkeeping. A different start, so a different path
-        (docs/speed.md). Spatial scenes start at their chain statics' rest already and take "paper" only.
+        reference); same unstrained lengths and paid-out bookkeeping. A different start, so a different
+        path (docs/accuracy.md, "The start"). Spatial scenes start at their chain statics' rest already
+        and take "paper" only.
     """
 
     end_time: float = 10.0
