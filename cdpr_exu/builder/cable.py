@@ -48,19 +48,21 @@ class CableItems:
 
 
 def add_cable(mbs: exu.MainSystem, cable: CableSpec, nodes_xz: np.ndarray, effects: Effects,
-              gravity: float) -> CableItems:
+              gravity: float, velocities: np.ndarray | None = None) -> CableItems:
     """Add the nodes and axial spring-dampers of one cable; its masses and weights go into the cables'
     generic object (:func:`add_cable_forces`).
 
     ``nodes_xz`` (n + 1, 2) [m]: initial node positions (x, z), winch end first, each element at
-    its unstrained length; ``gravity`` [m/s^2] along -z.
+    its unstrained length or strained to its static tension (:func:`cdpr_exu.builder.model.presag_nodes`);
+    ``velocities`` (n + 1, 2) [m/s] their initial velocities (default at rest); ``gravity`` [m/s^2] along -z.
     """
     nodes_xz = np.asarray(nodes_xz, dtype=float)
     masses = cable.node_masses()
     weights = masses * gravity if effects.gravity and gravity > 0.0 else np.zeros_like(masses)
     items = CableItems(nodes=[], markers=[], reference=nodes_xz.copy(), masses=masses, weights=weights)
-    for x, z in nodes_xz:
-        node = mbs.AddNode(eii.NodePoint2D(referenceCoordinates=[x, z]))
+    velocities = np.zeros_like(nodes_xz) if velocities is None else velocities
+    for (x, z), velocity in zip(nodes_xz, velocities):
+        node = mbs.AddNode(eii.NodePoint2D(referenceCoordinates=[x, z], initialVelocities=velocity.tolist()))
         items.nodes.append(node)
         items.markers.append(mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
     damping = cable.axial_damping if effects.axial_damping else 0.0

@@ -21,7 +21,7 @@ from cdpr_exu.physics.sparse_blocks import block_pattern
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.physics import bending_3d
 from cdpr_exu.physics.bending import cable_joints
-from cdpr_exu.physics.axial import CutSlopes, cable_elements
+from cdpr_exu.physics.axial import CUT_SLOPE_ITERATIONS, CutSlopes, cable_elements
 
 
 @dataclass
@@ -143,9 +143,11 @@ def generic_state(mbs, item: int, where: list) -> tuple[np.ndarray, np.ndarray]:
 class ChainForces:
     """One ``ObjectGenericODE2`` (index ``generic``) for ``chains`` (:class:`SpatialChainItems`, all tension-only
     or none, all bending or none): their masses (its mass matrix), weight (``gravity`` [m/s^2] along -z),
-    bending and tension-only elements; the chains' arrays become views of its own."""
+    bending and tension-only elements; the chains' arrays become views of its own. ``cut_slopes``: damper-cut
+    elements keep their taut slopes in a step's first iterations (:class:`~cdpr_exu.physics.axial.CutSlopes`);
+    False over swivel pulleys, whose inlet elements the wrap truly cuts (:func:`~cdpr_exu.builder.robot_3d.build_spatial_robot`)."""
 
-    def __init__(self, mbs, chains: list, gravity: float):
+    def __init__(self, mbs, chains: list, gravity: float, cut_slopes: bool = True):
         offsets = np.cumsum([0] + [len(chain.nodes) for chain in chains])
         nodes = [node for chain in chains for node in chain.nodes]
         size = 3 * len(nodes)
@@ -182,7 +184,7 @@ class ChainForces:
         current, force = np.zeros(size), np.zeros(size)
         weight = np.zeros(len(nodes))
         container = exu.MatrixContainer()
-        cut = CutSlopes()  # damper-cut elements keep their taut slopes in a step's first iterations
+        cut = CutSlopes(CUT_SLOPE_ITERATIONS if cut_slopes else 0)
         where = []
 
         def state(mbs_, item):

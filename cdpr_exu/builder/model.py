@@ -16,9 +16,10 @@ from dataclasses import dataclass, field, replace
 import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
+from scipy.optimize import brentq
 
 from cdpr_exu.builder.cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
-from cdpr_exu.core.errors import SceneError
+from cdpr_exu.core.errors import SceneError, UnreachableError
 from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes, straight_cable_nodes
 from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.builder.platform import PlatformItems, add_platform, attach_cable
@@ -80,8 +81,9 @@ class Model:
         return out
 
 
-def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
-    """Initial node positions (x, z) of a cable, winch end first, shape (n + 1, 2) [m].
+def initial_nodes(scene: Scene, cable_index: int, pose=None) -> np.ndarray:
+    """Initial node positions (x, z) of a cable, winch end first, shape (n + 1, 2) [m], the platform at ``pose``
+    (3,) [m, m, rad] (default its initial pose).
 
     Over a pulley: the paper's ideal configuration, straight from the anchor to the
     pulley, wrapped over it and hanging to the winch, every element at its unstrained
@@ -91,13 +93,98 @@ def initial_nodes(scene: Scene, cable_index: int) -> np.ndarray:
     chord starts inside the disc (the polygon circumscribed about the pulley).
     """
     cable, pulley = scene.cables[cable_index], scene.exits[cable_index]
-    anchor = anchor_points(np.asarray(scene.platform.initial_pose), np.asarray(scene.platform.anchors))[cable_index]
+    pose = scene.platform.initial_pose if pose is None else pose
+    anchor = anchor_points(np.asarray(pose), np.asarray(scene.platform.anchors))[cable_index]
     if not pulley.wraps:
         return straight_cable_nodes(np.asarray(pulley.point), anchor, cable.n_elements)
-    contact = scene.contact_model
-    radius = pulley.radius if contact is None else contact.wrap_radius(pulley.radius, cable.element_length)
-    return initial_cable_nodes(np.asarray(pulley.center), radius, pulley.side, anchor,
+    return initial_cable_nodes(np.asarray(pulley.center), _wrap_radius(scene, cable_index), pulley.side, anchor,
                                cable.element_length, cable.n_elements)
+
+
+def _wrap_radius(scene: Scene, cable_index: int) -> float:
+    """The radius [m] the builder wraps a cable's nodes on: its pulley's, or the segment contact's larger one."""
+    pulley, contact = scene.exits[cable_index], scene.contact_model
+    return pulley.radius if contact is None else contact.wrap_radius(pulley.radius, scene.cables[cable_index].element_length)
+
+
+def presag_nodes(scene: Scene, pose=None) -> tuple[list[np.ndarray], float]:
+    """Each cable's nodes (n + 1, 2) [m], winch end first, near its static rest (``solver.start = "steady"``), and the
+    platform's rotation there [rad].
+
+    The elastic-catenary inverse statics at ``pose`` (3,) [m, m, rad] (default the initial pose; the
+    tension-aware controller's statics, milliseconds) gives each cable's loaded shape: catenary, wrap, winch
+    line. Walking from the anchor, each node lies on that shape at the chord l0 (1 + T / EA) from the last, T the
+    static tension there: every element strained to it. The unstrained lengths and :attr:`Model.initial_paid_out`
+    stay the paper start's; the winch node ends where the chain does. SceneError naming ``solver.start`` if the
+    statics finds no rest at the initial pose (on two cables: at its rotation) or a cable is too short.
+    """
+    from cdpr_exu.statics import statics
+
+    initial = np.asarray(scene.platform.initial_pose if pose is None else pose, dtype=float)
+    try:  # on two cables the rotation is the equilibrium's: at the initial pose it must be the pose's
+        rest = statics.solve_inverse_statics(statics.catenary_platform(scene), initial[:2] if len(scene.cables) < 3
+                                             else initial)
+        if pose is None and abs(rest.rotation - initial[2]) > 1e-9:
+            raise SceneError(f"the cables hold it at rotation {rest.rotation:.6g} rad, not {initial[2]:.6g}")
+    except (SceneError, UnreachableError) as error:
+        raise SceneError(f"solver.start = 'steady' needs a static rest at platform.initial_pose: {error}") from None
+    nodes = []
+    for i, (equilibrium, cable, exit_) in enumerate(zip(rest.cables, scene.cables, scene.exits)):
+        point, tension = _loaded_path(scene, i, equilibrium)
+        placed, s, l0 = np.empty((cable.n_elements + 1, 2)), 0.0, cable.element_length
+        placed[-1] = equilibrium.anchor_point
+        for k in range(cable.n_elements - 1, -1, -1):
+            chord = l0 * (1.0 + tension(s + 0.5 * l0) / equilibrium.cable.axial_stiffness)
+            s = brentq(lambda t, p=placed[k + 1]: np.linalg.norm(point(t) - p) - chord, s, s + 2.0 * l0, xtol=1e-14)
+            placed[k] = point(s)
+        if placed[0, 1] > exit_.hang_point[1]:
+            raise SceneError(f"solver.start = 'steady': cables[{i}].unstrained_length = {cable.unstrained_length} m "
+                             "does not reach past its pulley on its static catenary")
+        nodes.append(placed)
+    return nodes, float(rest.rotation)
+
+
+def _loaded_path(scene: Scene, cable_index: int, equilibrium):
+    """``point(s)`` (2,) [m] and ``tension(s)`` [N] of a cable's static shape at unstrained arc length s [m] from its
+    anchor: the catenary, the wrap stretched by the tension T there (on the builder's wrap radius), the winch line
+    below the hang point stretched by T less the weight above."""
+    exit_, state, cable = scene.exits[cable_index], equilibrium.catenary, equilibrium.cable
+    radius = _wrap_radius(scene, cable_index)
+    span, weight, stiffness, top = (equilibrium.suspended_length, cable.weight_per_length, cable.axial_stiffness,
+                                    equilibrium.tension_at_exit)
+    center, side = np.asarray(exit_.center), exit_.side
+    tangent = np.arctan2(*(equilibrium.exit_point - center)[::-1])
+    wrap_end = span + exit_.radius * equilibrium.wrap_angle / (1.0 + top / stiffness)
+
+    def point(s):
+        if s <= span:
+            return equilibrium.points(s)[0]
+        if s <= wrap_end:
+            angle = tangent - side * (s - span) * (1.0 + top / stiffness) / exit_.radius
+            return center + radius * np.array([np.cos(angle), np.sin(angle)])
+        down = s - wrap_end
+        return center + np.array([side * radius, -down * (1.0 + (top - 0.5 * weight * down) / stiffness)])
+
+    def tension(s):
+        if s <= span:
+            return float(np.hypot(state.horizontal_tension, state.vertical_tension_a + weight * s))
+        return top - weight * max(s - wrap_end, 0.0)
+
+    return point, tension
+
+
+def start_velocities(scene: Scene, nodes: list[np.ndarray], step: float = 1e-6) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The platform's (3,) [m/s, m/s, rad/s] and each cable's node velocities (n + 1, 2) [m/s] of the steady start
+    from its ``nodes`` (:func:`presag_nodes`): the reference's velocity at t = 0 (on two cables the rotation
+    the statics' along it), and the pre-sagged nodes (material points at their unstrained distance from the
+    anchor) as they move with it, a forward difference over ``step`` [s]: the rope over the pulley, the span
+    turning and sagging with its anchor, no element changing its length (to 5e-6 m/s), so no velocity step
+    for the winches' first command to jolt the stiff, damped cables with. The winch node moves as the chain
+    does (ideal IK's rate 5 % less on the paper circle, which its constraint takes up in the first step)."""
+    velocity = np.array(scene.trajectory.velocity(0.0), dtype=float)
+    later, rotation = presag_nodes(scene, np.asarray(scene.platform.initial_pose) + step * velocity)
+    velocity[2] = (rotation - scene.platform.initial_pose[2]) / step
+    return velocity, [(moved - placed) / step for moved, placed in zip(later, nodes)]
 
 
 def contact_candidates(scene: Scene, cable_index: int, margin_elements: float = 2.0) -> np.ndarray:
@@ -165,13 +252,16 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
     :data:`SPARSE_JACOBIAN_MIN_NODES` nodes. UnreachableError if the reference leaves the workspace.
     """
     check_reference(scene)  # a reference the cables cannot reach or hold is refused before anything is built
+    steady = scene.solver.start == "steady"
+    placed = presag_nodes(scene)[0] if steady else None
+    moving, velocities = start_velocities(scene, placed) if steady else (None, None)
     system_container = exu.SystemContainer()
     mbs = system_container.AddSystem()
     ground_node = mbs.AddNode(eii.NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
     ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node, coordinate=0))
 
     effects = scene.effects
-    platform = add_platform(mbs, scene.platform, effects, scene.gravity)
+    platform = add_platform(mbs, scene.platform, effects, scene.gravity, moving)
     if not effects.cable_mass:
         return _build_massless(scene, system_container, mbs, platform, ground_coordinate)
     contact = scene.contact_model
@@ -179,10 +269,11 @@ def build_planar_model(scene: Scene, sparse_jacobian: bool | None = None) -> Mod
     cables, winches, contact_nodes, paid_out, servos = [], [], [], [], []
     contact_elements = []
     for i, (cable, exit_) in enumerate(zip(scene.cables, scene.exits)):
-        nodes_xz = initial_nodes(scene, i)
+        nodes_xz = initial_nodes(scene, i)  # the paper's start: its winch end sets lambda(0) for either start
         if exit_.wraps:
             _check_elements_fit_the_pulley(scene, i, nodes_xz)
-        items = add_cable(mbs, cable, nodes_xz, effects, scene.gravity)
+        items = add_cable(mbs, cable, nodes_xz if placed is None else placed[i], effects, scene.gravity,
+                          None if velocities is None else velocities[i])
         attach_cable(mbs, platform, i, items.markers[-1], cable, explicit=scene.solver.integrator != "generalized_alpha")
         servo = scene.winch.kind == "servo"
         winches.append(add_winch(mbs, ground_coordinate, items.nodes[0], drive_height=not servo))

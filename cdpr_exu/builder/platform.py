@@ -30,11 +30,12 @@ class PlatformItems:
 
 
 def add_platform(mbs: exu.MainSystem, platform: PlatformSpec, effects: Effects,
-                 gravity: float) -> PlatformItems:
-    """Add the platform body at its initial pose, its anchor markers and its weight (``gravity``
-    [m/s^2] along -z)."""
+                 gravity: float, velocity=None) -> PlatformItems:
+    """Add the platform body at its initial pose (moving at ``velocity`` (3,) [m/s, m/s, rad/s], default at rest),
+    its anchor markers and its weight (``gravity`` [m/s^2] along -z)."""
     x, z, rotation = platform.initial_pose
-    node = mbs.AddNode(eii.NodeRigidBody2D(referenceCoordinates=[x, z, rotation]))
+    node = mbs.AddNode(eii.NodeRigidBody2D(referenceCoordinates=[x, z, rotation],
+                                           initialVelocities=[0.0] * 3 if velocity is None else list(velocity)))
     body = mbs.AddObject(eii.ObjectRigidBody2D(mass=platform.mass, inertia=platform.inertia,
                                                nodeNumber=node))
     anchors = [mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=body, localPosition=[bx, bz, 0.0]))

@@ -229,7 +229,10 @@ def build_spatial_robot(mbs, platform, unstrained_lengths, chain=None, initial=N
         chains.append(items)
         node_masses.append(masses)
         winch_elements.append(below)
-    ChainForces(mbs, chains, gravity)  # one generic object for every chain: one force call per iteration
+    # one generic object for every chain: one force call per iteration. Over swivel pulleys the elements at the inlet
+    # are truly cut by their dampers (the wrap bends the cable) and the cut rule held them 15 Newton iterations
+    # at an unchanged residual: without it 5.95 -> 5.35 iterations per step (spatial-four-cable-swivel)
+    ChainForces(mbs, chains, gravity, cut_slopes=all(pulley is None for pulley in swivel_pulleys))
 
     position = [float(x) for x in initial.position]
     if platform.is_point_mass:

@@ -23,6 +23,12 @@ from cdpr_exu.space import PLANE, SPACE
 #: run moved by 0.5 mm without it. Planar runs keep it (not measured without).
 FRESH_JACOBIAN = {PLANE: True, SPACE: False}
 
+#: Where an exit wraps, after how many steps of at most how many Newton iterations a halved step doubles again, by
+#: Space (None: Exudyn's 10 of <= 7). A step that fails over a swivel pulley is one kink (an inlet element's damper
+#: cut) and the halved steps after it took as many iterations as full ones (4.3 and 4.7): spatial-four-cable-swivel
+#: 532 -> 442 steps at (3, 5), the path within 0.04 mm. Planar pulleys keep Exudyn's (not measured).
+STEP_RECOVERY = {PLANE: None, SPACE: (3, 5)}
+
 
 @contextlib.contextmanager
 def quiet_exudyn():
@@ -72,7 +78,8 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     # jolt (13 J on the paper scene at 1.7e-2 s); a drop from rest, though, then converges at first order.
     ti.generalizedAlpha.computeInitialAccelerations = bool(solver.initial_accelerations)
     ti.newton.useModifiedNewton = solver.newton == "modified"
-    ti.newton.modifiedNewtonJacUpdatePerStep = FRESH_JACOBIAN[scene.space] or any(e.wraps for e in scene.exits)
+    wraps = any(e.wraps for e in scene.exits)
+    ti.newton.modifiedNewtonJacUpdatePerStep = FRESH_JACOBIAN[scene.space] or wraps
     ti.newton.maxIterations = solver.max_newton_iterations
     # 1e-6 by default: Exudyn's 1e-8 buys nothing at millimetres and sits at the round-off of stiff
     # massless ropes' residual, where Newton stalls and the adaptive step shrinks up to 350-fold.
@@ -80,6 +87,8 @@ def solver_settings(scene: Scene, solution_file: str | Path | None = None) -> ex
     ti.discontinuous.useRecommendedStepSize = False
     ti.adaptiveStep = True
     ti.minimumStepSize = solver.step_size * 1e-4
+    if wraps and STEP_RECOVERY[scene.space] is not None:
+        ti.adaptiveStepRecoverySteps, ti.adaptiveStepRecoveryIterations = STEP_RECOVERY[scene.space]
     settings.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     # Analyse the sparsity pattern once where it never changes (x1.13 of the CPU time, bit for bit): the
     # exact-angle bending joints' blocks are never zero; without them a slack tension-only element drops

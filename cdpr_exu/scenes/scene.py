@@ -470,6 +470,16 @@ class SolverSpec:
         Relative Newton tolerance per step, in (0, 1e-3]. The default 1e-6 (Exudyn's 1e-8)
         moves the paper circle by 0.14 um at 15 elements and cuts Newton iterations from 3.0
         to 2.2 per step; on stiff massless ropes 1e-8 sits at round-off and stalls Newton.
+    start : {"paper", "steady"}
+        The planar lumped cables' initial state. "paper" (default): straight, unstrained and at rest,
+        the paper's start, which the platform's weight then sags and the winches' first command (the
+        reference's velocity at t = 0) jolts. "steady": as if the robot had been following the reference:
+        each cable's nodes on its elastic catenary at the initial pose, every element strained to its static
+        tension (:func:`cdpr_exu.builder.model.presag_nodes`), and the platform and the nodes moving with the
+        reference at t = 0 (:func:`~cdpr_exu.builder.model.start_velocities`; at rest under a held
+        reference); same unstrained lengths and paid-out bookkeeping. A different start, so a different
+        path (docs/accuracy.md, "The start"). Spatial scenes start at their chain statics' rest already
+        and take "paper" only.
     """
 
     end_time: float = 10.0
@@ -481,8 +491,10 @@ class SolverSpec:
     integrator: str = "generalized_alpha"
     initial_accelerations: bool = False
     newton_tolerance: float = 1e-6
+    start: str = "paper"
 
     def __post_init__(self) -> None:
+        _choice("solver.start", self.start, ("paper", "steady"))
         if not isinstance(self.initial_accelerations, bool):
             raise SceneError(f"solver.initial_accelerations must be true or false, got {shown(self.initial_accelerations)}")
         _set(self, "end_time", positive("solver.end_time", self.end_time, "s"))
@@ -513,6 +525,10 @@ class SolverSpec:
         if tolerance > 1e-3:
             raise SceneError(f"solver.newton_tolerance must be at most 1e-3 (relative), got {shown(self.newton_tolerance)}")
         _set(self, "newton_tolerance", tolerance)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form; the paper's start (the default) left out, so that scene files read as before."""
+        return {k: v for k, v in dataclasses.asdict(self).items() if k != "start" or v != "paper"}
 
     @property
     def n_steps(self) -> int:
@@ -866,7 +882,7 @@ class Scene:
                 "platform": self.platform.to_dict(),
                 "winch": dataclasses.asdict(self.winch),
                 "effects": dataclasses.asdict(self.effects),
-                "solver": dataclasses.asdict(self.solver),
+                "solver": self.solver.to_dict(),
                 "trajectory": self.trajectory.to_dict(),
             }
         else:
@@ -875,7 +891,7 @@ class Scene:
                 "gravity": self.gravity, "cables": cables, "exits": [exit_.to_dict() for exit_ in self.exits],
                 "platform": self.platform.to_dict(),
                 "effects": dataclasses.asdict(self.effects),
-                "solver": dataclasses.asdict(self.solver),
+                "solver": self.solver.to_dict(),
                 "winch": dataclasses.asdict(self.winch),
             }
             if self.trajectory is not None:
@@ -939,6 +955,9 @@ def _planar_rules(scene: Scene) -> None:
             f"solver.integrator = {shown(scene.solver.integrator)} needs winch.kind = 'fixed', got "
             f"{shown(scene.winch.kind)}: Exudyn's explicit solvers eliminate the winch's coordinate constraints "
             "and hold them at their initial value, ignoring every winch command")
+    if scene.solver.start != "paper" and not (scene.effects.cable_mass and all(wraps)):
+        raise SceneError(f"solver.start = {shown(scene.solver.start)} needs lumped cables (effects.cable_mass) over "
+                         "pulleys: it places their nodes on the catenary up to the pulley and the winch line below it")
 
 
 def _spatial_rules(scene: Scene) -> None:
@@ -960,6 +979,9 @@ def _spatial_rules(scene: Scene) -> None:
                          "every element's rest length and no winch node moves for a drum; use exits of kind 'swivel'")
     if scene.solver.integrator != "generalized_alpha":
         raise SceneError("solver.integrator must be 'generalized_alpha' for a spatial scene")
+    if scene.solver.start != "paper":
+        raise SceneError(f"solver.start = {shown(scene.solver.start)}: a spatial scene starts at its chain statics' "
+                         "rest already; leave solver.start out")
 
 
 @dataclass(frozen=True)
