@@ -309,7 +309,6 @@ def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, m
     """Issue 11.6: a Ctrl-C that fell between two runs of `cdpr compare` left an empty
     folder. The interrupt is sent the moment the first controller's row is printed."""
     import io
-    import os
     import signal
 
     from cdpr_exu.cli.compare import print_controller_row
@@ -318,7 +317,10 @@ def test_ctrl_c_between_two_compared_controllers_keeps_the_ones_done(tmp_path, m
     class InterruptAfterFirstRow(io.StringIO):
         def write(self, text):
             if "ideal_ik" in text:
-                os.kill(os.getpid(), signal.SIGINT)  # Python raises KeyboardInterrupt right after this call
+                # raise_signal sends it to this thread, so KeyboardInterrupt comes right after this call; os.kill
+                # to the process could land on another thread (pytest-xdist's) and come late, inside the next run,
+                # which keeps what it had as an interrupted run (the test failed so under load)
+                signal.raise_signal(signal.SIGINT)
             return super().write(text)
 
     scene = load_scene("paper-circle")
