@@ -3,8 +3,9 @@
 On the paper circle (full model) at 60 elements per cable and a 1e-2 s step, the
 fastest setting that met the 1 mm accuracy before this study, it runs:
 
-- ``node``: Exudyn's sphere contact items (the default), which switch contact on and
-  off in discontinuous iterations after Newton has converged;
+- ``node``: the default, the law of Exudyn's sphere contact item computed in the cables' numba
+  object with its contact state frozen while Newton converges and switched in a PostNewton
+  function (discontinuous iterations), as Exudyn's items do (:mod:`cdpr_exu.physics.node_contact`);
 - the same with Exudyn's discontinuous settings loosened
   (``timeIntegration.discontinuous.maxIterations`` 1 and 2);
 - ``node_smooth``: the same penalty law in the cables' numba object, switched on
@@ -82,7 +83,7 @@ def run(scene):
 
 
 CANDIDATES = (
-    ("node (Exudyn items, default)", "node", None, None),
+    ("node (default: frozen in Newton)", "node", None, None),
     ("node, discontinuous.maxIterations = 2", "node", 2, None),
     ("node, discontinuous.maxIterations = 1", "node", 1, None),
     ("node_smooth, b = 0 (sharp)", "node_smooth", None, 0.0),
@@ -121,7 +122,7 @@ def main() -> None:
               "iterations per step, {} steps, path moved {:.3f} mm".format(*row), flush=True)
     lines = [f"# Pulley contact candidates (paper circle, full model, {args.elements} elements per cable, "
              f"step {args.step:g} s, {args.end_time:g} s, one run each)", "",
-             "Path moved: largest platform position difference from the default (Exudyn's contact items). "
+             "Path moved: largest platform position difference from the default (the contact frozen in Newton). "
              "CPU time of one single-threaded run (the wall time of a shared machine varies with its load): compare ratios.", "",
              "| contact | x real time | Newton iterations / step | Jacobians / step | discontinuous iterations / step "
              "| steps taken | path moved [mm] |", "|---|---|---|---|---|---|---|"]
