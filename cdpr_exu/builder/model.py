@@ -20,6 +20,7 @@ from scipy.optimize import brentq
 
 from cdpr_exu.builder.cable import CableForceItems, CableItems, RopeItems, add_cable, add_cable_forces, add_rope
 from cdpr_exu.core.errors import SceneError, UnreachableError
+from cdpr_exu.statics import statics
 from cdpr_exu.statics.kinematics import anchor_points, initial_cable_nodes, straight_cable_nodes
 from cdpr_exu.statics.workspace import check_reference
 from cdpr_exu.builder.platform import PlatformItems, add_platform, attach_cable
@@ -118,8 +119,6 @@ def presag_nodes(scene: Scene, pose=None) -> tuple[list[np.ndarray], float]:
     stay the paper start's; the winch node ends where the chain does. SceneError naming ``solver.start`` if the
     statics finds no rest at the initial pose (on two cables: at its rotation) or a cable is too short.
     """
-    from cdpr_exu.statics import statics
-
     initial = np.asarray(scene.platform.initial_pose if pose is None else pose, dtype=float)
     try:  # on two cables the rotation is the equilibrium's: at the initial pose it must be the pose's
         rest = statics.solve_inverse_statics(statics.catenary_platform(scene), initial[:2] if len(scene.cables) < 3
