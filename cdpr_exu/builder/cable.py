@@ -21,7 +21,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cdpr_exu.builder.chain_3d import generic_state
-from cdpr_exu.physics.sparse_blocks import block_pattern
+from cdpr_exu.physics.sparse_blocks import block_pattern, distinct_places, sum_into_places
 from cdpr_exu.physics import axial
 from cdpr_exu.physics import bending
 from cdpr_exu.physics import cable_forces
@@ -286,19 +286,21 @@ def _sparse_jacobian_function(blocks, reference, positions, where, read_gaps):
     ``read_gaps(mbs)`` refreshes a frozen contact's state."""
     size = reference.size
     bounds = np.cumsum([0] + [rows.size for rows, _, _ in blocks])
-    triplets = np.zeros((int(bounds[-1]), 3))
-    triplets[:, 0] = np.concatenate([rows for rows, _, _ in blocks])
-    triplets[:, 1] = np.concatenate([columns for _, columns, _ in blocks])
-    values = [np.zeros(rows.size) for rows, _, _ in blocks]
+    rows, columns, slot = distinct_places(np.concatenate([rows for rows, _, _ in blocks]),
+                                          np.concatenate([columns for _, columns, _ in blocks]))
+    triplets = np.zeros((rows.size, 3))  # each place off the diagonal once: sum_into_places
+    triplets[:, 0], triplets[:, 1] = rows, columns
+    every_value = np.zeros(slot.size)
+    values = [every_value[first:last] for first, last in zip(bounds[:-1], bounds[1:])]
     container = exu.MatrixContainer()
 
     def jacobian_function(mbs, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001 - Exudyn's signature
         displacements, velocities = generic_state(mbs, item, where)
         read_gaps(mbs)
         np.add(reference, displacements, out=positions)
-        for (_, _, fill), out_values, first, last in zip(blocks, values, bounds[:-1], bounds[1:]):
+        for (_, _, fill), out_values in zip(blocks, values):
             fill(positions, velocities, float(f_q), float(f_q_t), out_values)
-            triplets[first:last, 2] = out_values
+        sum_into_places(every_value, slot, triplets)
         container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
         return container
 

@@ -17,7 +17,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from cdpr_exu.physics.sparse_blocks import block_pattern
+from cdpr_exu.physics.sparse_blocks import block_pattern, distinct_places, sum_into_places
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.physics import bending_3d
 from cdpr_exu.physics.bending import cable_joints
@@ -177,10 +177,12 @@ class ChainForces:
         bending_rows, bending_columns = block_pattern(joints, 3)
         axial_rows, axial_columns = block_pattern(elements, 3)
         split = bending_rows.size
-        triplets = np.zeros((split + axial_rows.size, 3))
-        triplets[:, 0] = np.concatenate([bending_rows, axial_rows])
-        triplets[:, 1] = np.concatenate([bending_columns, axial_columns])
-        bending_values, axial_values = np.zeros(split), np.zeros(axial_rows.size)
+        rows, columns, slot = distinct_places(np.concatenate([bending_rows, axial_rows]),
+                                              np.concatenate([bending_columns, axial_columns]))
+        triplets = np.zeros((rows.size, 3))  # each place off the diagonal once: sum_into_places
+        triplets[:, 0], triplets[:, 1] = rows, columns
+        values = np.zeros(slot.size)
+        bending_values, axial_values = values[:split], values[split:]
         current, force = np.zeros(size), np.zeros(size)
         weight = np.zeros(len(nodes))
         container = exu.MatrixContainer()
@@ -210,11 +212,10 @@ class ChainForces:
             if damping is not None:
                 bending_3d.add_spatial_bending_damping_jacobian(current, velocities, joints, damping, bend,
                                                                 float(f_q), float(f_q_t), bending_values)
-            triplets[:split, 2] = bending_values
             if tension_only:
-                triplets[split:, 2] = axial_3d.tension_only_triplet_values(
-                    current, velocities, elements, rest, axial_k, axial_c, rest_rate, float(f_q), float(f_q_t),
-                    axial_values, cut.active)
+                axial_3d.tension_only_triplet_values(current, velocities, elements, rest, axial_k, axial_c, rest_rate,
+                                                     float(f_q), float(f_q_t), axial_values, cut.active)
+            sum_into_places(values, slot, triplets)
             container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
             return container
 
