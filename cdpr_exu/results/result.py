@@ -1,6 +1,8 @@
 """The result of a run, planar or spatial: time series of the platform, the cables and the winches, and their files.
 
-A :class:`Result` is plain NumPy data at the output times. Its dimension is data (:attr:`Result.space`):
+A :class:`Result` is plain NumPy data at its sample times: the end of the first step at or after each output
+time, so up to a step past it, and other steps sample at other times (compare two runs at the same times,
+interpolating one, not row by row). Its dimension is data (:attr:`Result.space`):
 the pose is the Space's (``(x, z, rotation)`` in the paper's plane, ``(x, y, z, rotation vector)`` in
 space) and its summary's figures are named from the Space's labels. It saves to ``result.npz`` +
 ``pose.csv`` + ``summary.json`` and loads back from the ``.npz``.
@@ -36,6 +38,8 @@ class Result:
     Attributes
     ----------
     time : ndarray, shape (N,) [s]
+        The sample times: each the end of the first step at or after an output time (one sample for a step
+        over several), and the state a run stops at.
     pose, reference : ndarray, shape (N, pose_size) [m, rad]
         The platform's pose and its reference: (x, z, rotation counter-clockwise) planar,
         (x, y, z, rotation vector) spatial.
