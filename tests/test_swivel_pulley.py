@@ -288,3 +288,38 @@ def test_settings_outside_the_measured_region_are_named_and_the_measured_ones_pa
                             ((True, 1.0, 1e-6, 0.05, 0.1), "spectral_radius")):
         concerns = stability_concerns(*arguments)
         assert concerns and name in concerns[0]
+
+
+def test_a_swivel_robot_s_chains_and_swivels_are_one_generic_object_whose_psi_rows_hold_each_swivel_s_torque():
+    """The swivels' contact, bearing damping and inertia J_s are the chains' ChainForces: one ObjectGenericODE2, the
+    swivels' psi its last coordinates; each psi row is that swivel's contact torque (the kernel on its chain alone)
+    less d_s psi_dot, to the last bit (the same operations in the same order)."""
+    from cdpr_exu.builder.model import build_model
+    from cdpr_exu.scenes.scene import load_scene
+
+    model = build_model(load_scene("spatial-four-cable-swivel"))
+    mbs, items = model.mbs, model.items
+    forces = items.chains[0].forces
+    objects = [mbs.GetObject(i) for i in range(mbs.systemData.NumberOfObjects())]
+    assert [o["objectType"] for o in objects].count("GenericODE2") == 1
+    assert all(chain.forces is forces for chain in items.chains)
+    psi = [int(swivel.node) for swivel in items.swivels]
+    assert [int(node) for node in objects[forces.generic]["nodeNumbers"][-4:]] == psi
+    np.testing.assert_array_equal(np.diag(forces.mass_matrix.Convert2DenseMatrix())[-4:],
+                                  [pulley.swivel_inertia for pulley in items.swivel_pulleys])
+    rates = np.array(mbs.systemData.GetODE2Coordinates_t())
+    rates[[mbs.GetNodeODE2Index(node) for node in psi]] = [0.3, -0.2, 0.1, 0.4]  # [rad/s]: the bearings' share
+    mbs.systemData.SetODE2Coordinates_t(rates)
+    force = np.array(forces.user_functions[0](mbs, 0.0, forces.generic, None, None))
+    q = np.asarray(mbs.systemData.GetODE2Coordinates())
+    for k, (swivel, chain, pulley) in enumerate(zip(items.swivels, items.chains, items.swivel_pulleys)):
+        index = [mbs.GetNodeODE2Index(node) + i for node in chain.nodes for i in range(3)]
+        place = mbs.GetNodeODE2Index(swivel.node)
+        rate = rates[place]
+        alone = swivel_contact_force(chain.reference + q[index], rates[index], swivel.psi_reference + q[place], rate,
+                                     swivel.contact_nodes,
+                                     pulley.inlet_array, pulley.radius, pulley.groove_radius, pulley.flange_height,
+                                     pulley.contact_stiffness, pulley.contact_damping, pulley.onset_band,
+                                     np.zeros(len(index) + 1))
+        assert alone[-1] != 0.0  # the cable wraps the pulley
+        assert force[len(force) - 4 + k] == alone[-1] - pulley.bearing_damping * rate

@@ -5,8 +5,10 @@
 tension-only elements of :mod:`cdpr_exu.physics.axial_3d` (Exudyn's push when compressed).
 :class:`ChainForces` gives chains, one or all of a robot's, one ``ObjectGenericODE2``: the nodes'
 masses (its mass matrix), their weight along -z, the forces of :mod:`cdpr_exu.physics.bending_3d`
-(bending springs, and dampers when ``bending_damping > 0``) and the tension-only elements, with one
-sparse triplet Jacobian: one force call per Newton iteration for the whole robot. Units SI; z up.
+(bending springs, and dampers when ``bending_damping > 0``), the tension-only elements and the swivel
+pulleys' contact and bearing damping (:mod:`cdpr_exu.physics.swivel_pulley`, their angles psi its last
+coordinates), with one sparse triplet Jacobian: one force call per Newton iteration for the whole robot.
+Units SI; z up.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 from cdpr_exu.physics.sparse_blocks import block_pattern, distinct_places, sum_into_places
 from cdpr_exu.physics import axial_3d
 from cdpr_exu.physics import bending_3d
+from cdpr_exu.physics import swivel_pulley
 from cdpr_exu.physics.bending import cable_joints
 from cdpr_exu.physics.axial import CUT_SLOPE_ITERATIONS, CutSlopes, cable_elements
 
@@ -145,12 +148,15 @@ class ChainForces:
     or none, all bending or none): their masses (its mass matrix), weight (``gravity`` [m/s^2] along -z),
     bending and tension-only elements; the chains' arrays become views of its own. ``cut_slopes``: damper-cut
     elements keep their taut slopes in a step's first iterations (:class:`~cdpr_exu.physics.axial.CutSlopes`);
-    False over swivel pulleys, whose inlet elements the wrap truly cuts (:func:`~cdpr_exu.builder.robot_3d.build_spatial_robot`)."""
+    False over swivel pulleys, whose inlet elements the wrap truly cuts (:func:`~cdpr_exu.builder.robot_3d.build_spatial_robot`).
+    ``swivels``: :class:`~cdpr_exu.builder.swivel_chain.SwivelItems` of these chains, whose angles psi are the
+    object's last coordinates (after the nodes' 3 N), with their inertia J_s, contact and bearing damping."""
 
-    def __init__(self, mbs, chains: list, gravity: float, cut_slopes: bool = True):
+    def __init__(self, mbs, chains: list, gravity: float, cut_slopes: bool = True, swivels: tuple = ()):
         offsets = np.cumsum([0] + [len(chain.nodes) for chain in chains])
         nodes = [node for chain in chains for node in chain.nodes]
-        size = 3 * len(nodes)
+        points = 3 * len(nodes)  # the nodes' coordinates, then each swivel's psi
+        size = points + len(swivels)
 
         def joined(name):  # the chains' arrays end to end, each chain's now a view of the whole (None: none)
             parts = [getattr(chain, name) for chain in chains]
@@ -172,15 +178,34 @@ class ChainForces:
             "axial_rest_length", "axial_stiffness", "axial_damping", "axial_rest_rate"))
         tension_only = rest is not None
         elements = shifted("axial_elements") if tension_only else np.zeros((0, 2), dtype=np.int64)
-        reference = np.concatenate([chain.reference for chain in chains])
+        reference = np.concatenate([chain.reference for chain in chains] + [[s.psi_reference for s in swivels]])
         bend = float(bending_3d.ISOTROPIC_BEND)
         bending_rows, bending_columns = block_pattern(joints, 3)
         axial_rows, axial_columns = block_pattern(elements, 3)
         split = bending_rows.size
         rows, columns, slot = distinct_places(np.concatenate([bending_rows, axial_rows]),
                                               np.concatenate([bending_columns, axial_columns]))
-        triplets = np.zeros((rows.size, 3))  # each place off the diagonal once: sum_into_places
-        triplets[:, 0], triplets[:, 1] = rows, columns
+        # each swivel's contact: its psi's place (the last of the force the kernel adds into), its contact nodes
+        # numbered in the whole, its pulley's parameters. Its triplets (contact, then bearing) come first, not summed
+        # with the chains': Exudyn sums them as it did each swivel's own object (added before the chains'), and with
+        # the weight taken before the contact forces the path is that of the separate objects to the last bit
+        first = {id(chain): offset for chain, offset in zip(chains, offsets)}
+        contacts = [(points + i, first[id(s.chain)] + s.contact_nodes, s.pulley.inlet_array,
+                     *(getattr(s.pulley, name) for name in ("radius", "groove_radius", "flange_height",
+                                                             "contact_stiffness", "contact_damping", "onset_band")))
+                    for i, s in enumerate(swivels)]
+        bearing = np.array([s.pulley.bearing_damping for s in swivels])
+        patterns = [swivel_pulley.swivel_contact_pattern(contact[1], contact[0] + 1) for contact in contacts]
+        psi = np.arange(points, size)  # the bearings' places
+        ends = np.cumsum([0] + [pattern[0].size for pattern in patterns])
+        own = ends[-1] + psi.size
+        swivel_values = np.zeros(own)
+        contact_values = [swivel_values[a:b] for a, b in zip(ends, ends[1:])]
+        bearing_values = swivel_values[ends[-1]:]
+        triplets = np.zeros((own + rows.size, 3))  # the chains' places off the diagonal once: sum_into_places
+        triplets[:own, 0] = np.concatenate([pattern[0] for pattern in patterns] + [psi])
+        triplets[:own, 1] = np.concatenate([pattern[1] for pattern in patterns] + [psi])
+        triplets[own:, 0], triplets[own:, 1] = rows, columns
         values = np.zeros(slot.size)
         bending_values, axial_values = values[:split], values[split:]
         current, force = np.zeros(size), np.zeros(size)
@@ -203,7 +228,11 @@ class ChainForces:
             if tension_only:
                 axial_3d.tension_only_force(current, velocities, elements, rest, axial_k, axial_c, rest_rate, force)
             np.multiply(self.masses, gravity, out=weight)
-            force[2::3] -= weight
+            force[2:points:3] -= weight
+            for last, *contact in contacts:
+                swivel_pulley.swivel_contact_force(current, velocities, current[last], velocities[last], *contact,
+                                                   force[:last + 1])
+            force[points:] -= bearing * velocities[points:]
             return force.tolist()  # a list crosses into Exudyn faster than an array
 
         def jacobian_function(mbs_, t, item, q, q_t, f_q, f_q_t):  # noqa: ARG001
@@ -215,18 +244,25 @@ class ChainForces:
             if tension_only:
                 axial_3d.tension_only_triplet_values(current, velocities, elements, rest, axial_k, axial_c, rest_rate,
                                                      float(f_q), float(f_q_t), axial_values, cut.active)
-            sum_into_places(values, slot, triplets)
+            for (last, *contact), out in zip(contacts, contact_values):
+                swivel_pulley.swivel_contact_values(current, velocities, current[last], velocities[last], *contact,
+                                                    float(f_q), float(f_q_t), out)
+            np.multiply(bearing, float(f_q_t), out=bearing_values)
+            triplets[:own, 2] = swivel_values
+            sum_into_places(values, slot, triplets[own:])
             container.SetWithSparseMatrix(triplets, numberOfRows=size, numberOfColumns=size, useDenseMatrix=False)
             return container
 
-        self.size = size
+        self.size, self.points = size, points
         diagonal = np.arange(size, dtype=float)
-        self.mass_triplets = np.column_stack([diagonal, diagonal, np.repeat(self.masses, 3)])
+        inertia = [s.pulley.swivel_inertia for s in swivels]
+        self.mass_triplets = np.column_stack([diagonal, diagonal, np.concatenate([np.repeat(self.masses, 3), inertia])])
         self.mass_matrix = exu.MatrixContainer()
         self.mass_matrix.SetWithSparseMatrix(self.mass_triplets, numberOfRows=size, numberOfColumns=size,
                                              useDenseMatrix=False)
         self.user_functions = (force_function, jacobian_function, container)  # alive as long as the model
-        self.generic = mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=nodes, massMatrix=self.mass_matrix,
+        self.generic = mbs.AddObject(eii.ObjectGenericODE2(nodeNumbers=nodes + [s.node for s in swivels],
+                                                            massMatrix=self.mass_matrix,
                                                             forceUserFunction=force_function,
                                                             jacobianUserFunction=jacobian_function))
         for chain in chains:
@@ -234,7 +270,7 @@ class ChainForces:
 
     def masses_changed(self, mbs) -> None:
         """Give Exudyn the masses the chains' ``node_mass`` hold now (the weight follows by itself)."""
-        self.mass_triplets[:, 2] = np.repeat(self.masses, 3)
+        self.mass_triplets[:self.points, 2] = np.repeat(self.masses, 3)
         self.mass_matrix.SetWithSparseMatrix(self.mass_triplets, numberOfRows=self.size, numberOfColumns=self.size,
                                              useDenseMatrix=False)
         mbs.SetObjectParameter(self.generic, "massMatrix", self.mass_matrix)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import exudyn as exu
 import numpy as np
 
-from cdpr_exu.builder.chain_3d import add_spatial_chain, chain_energy
+from cdpr_exu.builder.chain_3d import ChainForces, add_spatial_chain, chain_energy
 from cdpr_exu.builder.robot_3d import platform_pose, robot_energy
 from cdpr_exu.run.settle import dynamic_settings, static_settings
 from cdpr_exu.builder.swivel_chain import add_swivel_pulley, swivel_energy
@@ -153,12 +153,14 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
 
     container = exu.SystemContainer()
     mbs = container.AddSystem()
-    chain = add_spatial_chain(mbs, path, masses, axial_stiffness, axial_damping, bending_stiffness, gravity)
+    chain = add_spatial_chain(mbs, path, masses, axial_stiffness, axial_damping, bending_stiffness, gravity,
+                              forces=False)
     inlet = pulley.inlet_array
     reach = math.hypot(path[-1, 0] - inlet[0], path[-1, 1] - inlet[1])
     omega = math.sqrt(gravity * math.tan(cone_angle) / reach) if swing and cone_angle > 0.0 else 0.0
     omega *= rate_factor
     swivel = add_swivel_pulley(mbs, chain, pulley, psi, omega)
+    ChainForces(mbs, [chain], gravity, swivels=[swivel])
     mbs.Assemble()
     n3 = 3 * len(path)
     if omega:
