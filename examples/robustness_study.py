@@ -83,7 +83,7 @@ POSES = 8
 #: The spatial loops: controller -> whether it feeds the rotation back (:data:`controllers.registry.SPATIAL_LOOP`).
 SPATIAL_LOOPS = dict.fromkeys(("closed_loop_tension_aware", "closed_loop_model_feed_forward"), SPATIAL_LOOP["rotation"])
 
-#: Poses a spatial loop is linearised at: evenly over the run after the trajectory's ramp.
+#: Poses a spatial loop is linearised at: evenly over the whole run, the trajectory's ramp included.
 SPATIAL_POSES = 24
 
 #: The spatial gains the design chooses from (k_p, k_i [1/s], f_c [Hz]), around SPATIAL_LOOP's and below.

@@ -351,9 +351,9 @@ def robot_energy(mbs, items, current=True):
                                          items.bending_stiffnesses):
         q, v = _chain_state(mbs, chain, configuration), _chain_state(mbs, chain, configuration, rate=True)
         energy += chain_energy(chain, masses, q, v, float(k), float(k_theta), gravity)
-    for swivel, pulley in zip(items.swivels, items.swivel_pulleys):
+    for swivel in items.swivels:
         if swivel is not None:
-            energy += _swivel_energy(mbs, items, swivel, pulley, configuration)
+            energy += _swivel_energy(mbs, swivel, configuration)
     if items.chain.anchor_spring_factor is not None:  # the penalty joints' springs
         anchors = np.array([mbs.GetMarkerOutput(marker, exu.OutputVariableType.Position, configuration=configuration)
                             for marker in items.anchor_markers])
@@ -371,14 +371,12 @@ def robot_energy(mbs, items, current=True):
     return energy
 
 
-def _swivel_energy(mbs, items, swivel, pulley, configuration):
+def _swivel_energy(mbs, swivel, configuration):
     """Contact potential and J_s psi_dot^2 / 2 of one swivel pulley [J]."""
-    cable = items.swivels.index(swivel)
-    chain = items.chains[cable]
-    q = _chain_state(mbs, chain, configuration)
+    q = _chain_state(mbs, swivel.chain, configuration)
     psi = mbs.GetNodeOutput(swivel.node, exu.OutputVariableType.Coordinates, configuration=configuration)
     rate = mbs.GetNodeOutput(swivel.node, exu.OutputVariableType.Coordinates_t, configuration=configuration)
-    return swivel_energy(swivel, chain, pulley, q, float(np.ravel(psi)[0]), float(np.ravel(rate)[0]))
+    return swivel_energy(swivel, q, float(np.ravel(psi)[0]), float(np.ravel(rate)[0]))
 
 
 def swivel_angles(mbs, items, current=True):

@@ -47,10 +47,11 @@ def add_swivel_pulley(mbs: exu.MainSystem, chain: SpatialChainItems, pulley: sp.
     return SwivelItems(psi_node, float(psi), nodes.astype(np.int64), chain, pulley)
 
 
-def swivel_energy(items: SwivelItems, chain: SpatialChainItems, pulley: sp.SwivelPulley, q_chain: np.ndarray,
-                  psi_displacement: float, psi_rate: float) -> float:
-    """Energy [J] the swivel adds: contact potential and J_s psi_dot^2 / 2 (q_chain: displacements (3N,))."""
-    positions = chain.reference + q_chain
+def swivel_energy(items: SwivelItems, q_chain: np.ndarray, psi_displacement: float, psi_rate: float) -> float:
+    """Energy [J] the swivel adds: contact potential and J_s psi_dot^2 / 2 (q_chain: its chain's displacements
+    (3N,) [m])."""
+    pulley = items.pulley
+    positions = items.chain.reference + q_chain
     potential = sp.swivel_contact_energy(positions, items.psi_reference + psi_displacement, items.contact_nodes,
                                          pulley.inlet_array, pulley.radius, pulley.groove_radius,
                                          pulley.flange_height, pulley.contact_stiffness, pulley.onset_band)

@@ -197,7 +197,7 @@ def run_swivel_pendulum(pulley: sp.SwivelPulley, step: float, end_time: float, *
         q, v = q_all[chain_index], v_all[chain_index]
         dpsi, rate = float(q_all[psi_index]), float(v_all[psi_index])
         energy = chain_energy(chain, masses, q, v, axial_stiffness, bending, gravity)
-        energy += swivel_energy(swivel, chain, pulley, q, dpsi, rate)
+        energy += swivel_energy(swivel, q, dpsi, rate)
         return q, dpsi, rate, energy
 
     def record(mbs_, t, configuration=exu.ConfigurationType.Current):
